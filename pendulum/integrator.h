@@ -1,0 +1,68 @@
+// Integration of the pendulum model (pendulum/model.h) with SUNDIALS CVODES, at a log's own,
+// possibly non-uniform timestamps, with forward sensitivities of the state with respect to
+// I, K_D, C, psi(t0) and psi'(t0). Conventions: ../shared/PHYSICS.md §2.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pendulum/model.h"
+
+namespace bifilar {
+
+struct IntegratorOptions {
+  double rel_tol = 1e-9;      // CVODES relative tolerance (dimensionless); in (0, 1e-2].
+  double abs_tol = 1e-11;     // CVODES absolute tolerance (rad, rad/s, and for sensitivities); > 0.
+  long max_steps = 1000000;   // Internal steps allowed over the whole trace; > 0.
+
+  bool Check(std::string* why) const;
+};
+
+// Column order of the sensitivity matrices.
+enum SensitivityIndex {
+  kSensInertia = 0,  // d/dI
+  kSensDrag = 1,     // d/dK_D
+  kSensViscous = 2,  // d/dC
+  kSensAngle0 = 3,   // d/dpsi(t0)
+  kSensRate0 = 4,    // d/dpsi'(t0)
+  kNumSensitivities = 5
+};
+
+struct Trajectory {
+  std::vector<double> angle_rad;       // psi(t_k)
+  std::vector<double> rate_rad_per_s;  // psi'(t_k)
+  // d psi'(t_k) / d p_j and d psi(t_k) / d p_j: row k, column j in SensitivityIndex order.
+  // Empty (0 rows) when sensitivities were not requested.
+  Eigen::MatrixXd d_rate;
+  Eigen::MatrixXd d_angle;
+};
+
+// Reusable: keeps the CVODES memory between calls, so a fit's tens of integrations allocate
+// once. Not thread-safe; use one per thread.
+class PendulumIntegrator {
+ public:
+  PendulumIntegrator(PendulumModel model, const RigGeometry& geometry,
+                     const IntegratorOptions& options = IntegratorOptions());
+  ~PendulumIntegrator();
+  PendulumIntegrator(const PendulumIntegrator&) = delete;
+  PendulumIntegrator& operator=(const PendulumIntegrator&) = delete;
+
+  // Integrates from t_s[0], where the state is (angle0, rate0), and fills *out at every t_s
+  // (non-decreasing; repeated times allowed). Returns false with *why set when the solver
+  // fails (never fills NaN).
+  bool Integrate(const PendulumParams& params, double angle0_rad, double rate0_rad_per_s,
+                 const std::vector<double>& t_s, bool with_sensitivities, Trajectory* out,
+                 std::string* why);
+
+  PendulumModel model() const;
+  const RigGeometry& geometry() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace bifilar
