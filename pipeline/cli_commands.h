@@ -3,18 +3,11 @@
 // bifilar::UserError, which the dispatcher prints as one line and turns into exit code 2.
 #pragma once
 
-#include <stdexcept>
-#include <string>
-
 #include <CLI/CLI.hpp>
 
-namespace bifilar {
+#include "pipeline/user_error.h"
 
-// Bad input from a user: the message names the file, line or key and what was expected.
-class UserError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+namespace bifilar {
 
 void RegisterSimulateCommand(CLI::App& app, int* exit_code);
 void RegisterFitCommand(CLI::App& app, int* exit_code);
