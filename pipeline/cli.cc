@@ -16,7 +16,6 @@ int RunCommandLine(int argc, char** argv) {
   RegisterFitCommand(app, &exit_code);
   RegisterEllipseCommands(app, &exit_code);
   RegisterSimulateCommand(app, &exit_code);
-  RegisterBenchCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -13,6 +13,5 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code);
 void RegisterFitCommand(CLI::App& app, int* exit_code);
 void RegisterEllipseCommands(CLI::App& app, int* exit_code);  // `ellipse` and `plan`
 void RegisterProcessCommands(CLI::App& app, int* exit_code);  // `process` and `report`
-void RegisterBenchCommand(CLI::App& app, int* exit_code);
 
 }  // namespace bifilar
