@@ -1,1 +1,249 @@
-// Placeholder: implemented in the pendulum module work.
+// The bifilar pendulum equations of motion: ../shared/PHYSICS.md §2 (see model.h).
+#include "pendulum/model.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace bifilar {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Everything about the rise h(psi) that the models need, computed once:
+//   s = sqrt(L^2 - (D^2/2)(1 - cos psi)),  k = D^2/4
+//   h   = L - s
+//   h'  = k sin psi / s
+//   h'' = k [cos psi / s + k sin^2 psi / s^3]
+//   h''' = -k sin psi / s + 3 k^2 sin psi cos psi / s^3 + 3 k^3 sin^3 psi / s^5
+// (ds/dpsi = -k sin psi / s.) L > D guarantees s^2 >= L^2 - D^2 > 0.
+struct Rise {
+  double h = 0.0, d1 = 0.0, d2 = 0.0, d3 = 0.0;
+};
+
+Rise ComputeRise(const RigGeometry& g, double psi, bool want_d3) {
+  const double L = g.filar_length_m;
+  const double k = 0.25 * g.filar_separation_m * g.filar_separation_m;
+  const double sn = std::sin(psi);
+  const double cs = std::cos(psi);
+  // 1 - cos psi = 2 sin^2(psi/2), accurate for small psi.
+  const double half = std::sin(0.5 * psi);
+  const double one_minus_cos = 2.0 * half * half;
+  const double s2 = L * L - 2.0 * k * one_minus_cos;
+  const double s = std::sqrt(s2);
+  const double inv_s = 1.0 / s;
+  const double inv_s3 = inv_s / s2;
+  Rise r;
+  // h = L - s = (L^2 - s^2) / (L + s), without cancellation for small angles.
+  r.h = 2.0 * k * one_minus_cos / (L + s);
+  r.d1 = k * sn * inv_s;
+  r.d2 = k * (cs * inv_s + k * sn * sn * inv_s3);
+  if (want_d3) {
+    const double inv_s5 = inv_s3 / s2;
+    r.d3 = -k * sn * inv_s + 3.0 * k * k * sn * cs * inv_s3 + 3.0 * k * k * k * sn * sn * sn * inv_s5;
+  }
+  return r;
+}
+
+// Linear (small-angle) stiffness per unit mass g D^2 / (4 L) (m^2/s^2 per rad).
+double LinearStiffnessPerMass(const RigGeometry& g) {
+  return g.gravity_mps2 * g.filar_separation_m * g.filar_separation_m / (4.0 * g.filar_length_m);
+}
+
+bool Fail(std::string* why, const std::string& message) {
+  if (why != nullptr) *why = message;
+  return false;
+}
+
+std::string Num(double v) {
+  std::ostringstream os;
+  os.precision(12);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+const char* ToString(PendulumModel model) {
+  switch (model) {
+    case PendulumModel::kFull:
+      return "full";
+    case PendulumModel::kJardin:
+      return "jardin";
+    case PendulumModel::kLinear:
+      return "linear";
+  }
+  return "unknown";
+}
+
+bool ParsePendulumModel(const std::string& name, PendulumModel* model) {
+  if (name == "full") {
+    *model = PendulumModel::kFull;
+  } else if (name == "jardin") {
+    *model = PendulumModel::kJardin;
+  } else if (name == "linear") {
+    *model = PendulumModel::kLinear;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+bool RigGeometry::Check(std::string* why) const {
+  if (!std::isfinite(filar_length_m) || !(filar_length_m > 0.0)) {
+    return Fail(why, "filar_length_m (L) must be finite and > 0 m, got " + Num(filar_length_m));
+  }
+  if (!std::isfinite(filar_separation_m) || !(filar_separation_m > 0.0)) {
+    return Fail(why, "filar_separation_m (D) must be finite and > 0 m, got " +
+                         Num(filar_separation_m));
+  }
+  if (!(filar_length_m > filar_separation_m)) {
+    return Fail(why, "filar_length_m (L) must be > filar_separation_m (D) so the wires never go "
+                     "slack, got L = " + Num(filar_length_m) + " m, D = " +
+                         Num(filar_separation_m) + " m");
+  }
+  if (!std::isfinite(mass_kg) || !(mass_kg > 0.0)) {
+    return Fail(why, "mass_kg (m) must be finite and > 0 kg, got " + Num(mass_kg));
+  }
+  if (!std::isfinite(gravity_mps2) || !(gravity_mps2 > 0.0)) {
+    return Fail(why, "gravity_mps2 (g) must be finite and > 0 m/s^2, got " + Num(gravity_mps2));
+  }
+  return true;
+}
+
+bool PendulumParams::Check(std::string* why) const {
+  if (!std::isfinite(inertia_kg_m2) || !(inertia_kg_m2 > 0.0)) {
+    return Fail(why, "inertia_kg_m2 (I) must be finite and > 0 kg m^2, got " + Num(inertia_kg_m2));
+  }
+  if (!std::isfinite(drag_coeff_kg_m2) || !(drag_coeff_kg_m2 >= 0.0)) {
+    return Fail(why, "drag_coeff_kg_m2 (K_D) must be finite and >= 0 kg m^2, got " +
+                         Num(drag_coeff_kg_m2));
+  }
+  if (!std::isfinite(viscous_coeff_kg_m2_per_s) || !(viscous_coeff_kg_m2_per_s >= 0.0)) {
+    return Fail(why, "viscous_coeff_kg_m2_per_s (C) must be finite and >= 0 kg m^2/s, got " +
+                         Num(viscous_coeff_kg_m2_per_s));
+  }
+  return true;
+}
+
+double RiseHeight(const RigGeometry& geometry, double angle_rad) {
+  return ComputeRise(geometry, angle_rad, false).h;
+}
+
+double RiseSlope(const RigGeometry& geometry, double angle_rad) {
+  return ComputeRise(geometry, angle_rad, false).d1;
+}
+
+double RiseCurvature(const RigGeometry& geometry, double angle_rad) {
+  return ComputeRise(geometry, angle_rad, false).d2;
+}
+
+double AngularAcceleration(PendulumModel model, const RigGeometry& geometry,
+                           const PendulumParams& params, double angle_rad, double rate_rad_per_s) {
+  const double m = geometry.mass_kg;
+  const double I = params.inertia_kg_m2;
+  const double w = rate_rad_per_s;
+  const double damping =
+      params.drag_coeff_kg_m2 * w * std::abs(w) + params.viscous_coeff_kg_m2_per_s * w;
+  switch (model) {
+    case PendulumModel::kFull: {
+      const Rise r = ComputeRise(geometry, angle_rad, false);
+      return -(m * r.d1 * r.d2 * w * w + damping + m * geometry.gravity_mps2 * r.d1) /
+             (I + m * r.d1 * r.d1);
+    }
+    case PendulumModel::kJardin: {
+      const Rise r = ComputeRise(geometry, angle_rad, false);
+      return -(damping + m * geometry.gravity_mps2 * r.d1) / I;
+    }
+    case PendulumModel::kLinear:
+      return -(damping + m * LinearStiffnessPerMass(geometry) * angle_rad) / I;
+  }
+  return 0.0;
+}
+
+// With psi'' = -N / M (M the effective inertia, N the remaining terms):
+//   d psi''/dx = -(dN/dx + psi'' dM/dx) / M.
+// d(w|w|)/dw = 2|w|.
+AccelerationPartials AngularAccelerationPartials(PendulumModel model, const RigGeometry& geometry,
+                                                 const PendulumParams& params, double angle_rad,
+                                                 double rate_rad_per_s) {
+  const double m = geometry.mass_kg;
+  const double g = geometry.gravity_mps2;
+  const double I = params.inertia_kg_m2;
+  const double K = params.drag_coeff_kg_m2;
+  const double C = params.viscous_coeff_kg_m2_per_s;
+  const double w = rate_rad_per_s;
+  const double abs_w = std::abs(w);
+  const double damping = K * w * abs_w + C * w;
+  const double d_damping_d_w = 2.0 * K * abs_w + C;
+
+  AccelerationPartials p;
+  double M = I;
+  switch (model) {
+    case PendulumModel::kFull: {
+      const Rise r = ComputeRise(geometry, angle_rad, true);
+      M = I + m * r.d1 * r.d1;
+      const double N = m * r.d1 * r.d2 * w * w + damping + m * g * r.d1;
+      const double a = -N / M;
+      const double dN_dpsi = m * (r.d2 * r.d2 + r.d1 * r.d3) * w * w + m * g * r.d2;
+      const double dM_dpsi = 2.0 * m * r.d1 * r.d2;
+      p.accel_rad_per_s2 = a;
+      p.d_angle = -(dN_dpsi + a * dM_dpsi) / M;
+      p.d_rate = -(2.0 * m * r.d1 * r.d2 * w + d_damping_d_w) / M;
+      break;
+    }
+    case PendulumModel::kJardin: {
+      const Rise r = ComputeRise(geometry, angle_rad, false);
+      p.accel_rad_per_s2 = -(damping + m * g * r.d1) / I;
+      p.d_angle = -m * g * r.d2 / I;
+      p.d_rate = -d_damping_d_w / I;
+      break;
+    }
+    case PendulumModel::kLinear: {
+      const double k = m * LinearStiffnessPerMass(geometry);
+      p.accel_rad_per_s2 = -(damping + k * angle_rad) / I;
+      p.d_angle = -k / I;
+      p.d_rate = -d_damping_d_w / I;
+      break;
+    }
+  }
+  // dM/dI = 1 and N does not depend on I: d psi''/dI = -psi''/M.
+  p.d_inertia = -p.accel_rad_per_s2 / M;
+  p.d_drag = -w * abs_w / M;
+  p.d_viscous = -w / M;
+  return p;
+}
+
+double MechanicalEnergy(PendulumModel model, const RigGeometry& geometry,
+                        const PendulumParams& params, double angle_rad, double rate_rad_per_s) {
+  const double m = geometry.mass_kg;
+  const double I = params.inertia_kg_m2;
+  const double w2 = rate_rad_per_s * rate_rad_per_s;
+  switch (model) {
+    case PendulumModel::kFull: {
+      const Rise r = ComputeRise(geometry, angle_rad, false);
+      return 0.5 * (I + m * r.d1 * r.d1) * w2 + m * geometry.gravity_mps2 * r.h;
+    }
+    case PendulumModel::kJardin: {
+      const Rise r = ComputeRise(geometry, angle_rad, false);
+      return 0.5 * I * w2 + m * geometry.gravity_mps2 * r.h;
+    }
+    case PendulumModel::kLinear:
+      return 0.5 * I * w2 + 0.5 * m * LinearStiffnessPerMass(geometry) * angle_rad * angle_rad;
+  }
+  return 0.0;
+}
+
+double SmallAnglePeriod(const RigGeometry& geometry, double inertia_kg_m2) {
+  const double D = geometry.filar_separation_m;
+  return 2.0 * kPi *
+         std::sqrt(4.0 * inertia_kg_m2 * geometry.filar_length_m /
+                   (geometry.mass_kg * geometry.gravity_mps2 * D * D));
+}
+
+double InertiaFromSmallAnglePeriod(const RigGeometry& geometry, double period_s) {
+  const double D = geometry.filar_separation_m;
+  return geometry.mass_kg * geometry.gravity_mps2 * D * D * period_s * period_s /
+         (16.0 * kPi * kPi * geometry.filar_length_m);
+}
+
+}  // namespace bifilar

@@ -1,0 +1,351 @@
+// Integration of the pendulum model with SUNDIALS CVODES (see integrator.h).
+//
+// The 2-state system y = (psi, psi') is not stiff, so CVODES runs Adams-Moulton with the
+// fixed-point nonlinear solver: no Jacobian and no linear solve. The forward sensitivities
+// s_j = dy/dp_j for p = (I, K_D, C, psi(t0), psi'(t0)) obey
+//   s_j' = J s_j + df/dp_j,   J = [[0, 1], [d psi''/d psi, d psi''/d psi']],
+//   df/dp_j = (0, d psi''/dp_j) for I, K_D, C and 0 for the initial conditions,
+// supplied analytically (model.h AngularAccelerationPartials), so CVODES does no finite
+// differences. They start from s_j(t0) = 0 for the parameters and unit vectors for the
+// initial state, and take part in the error test (CVodeSetSensErrCon) so that they are accurate
+// enough for a fit's Jacobian. Outputs are CVODES' interpolants at each requested time
+// (CV_NORMAL), so steps never have to land on samples.
+#include "pendulum/integrator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <cvodes/cvodes.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+namespace bifilar {
+namespace {
+
+// Simultaneous corrector for state and sensitivities (measured faster than staggered for this
+// tiny system: one fixed-point iteration handles all 12 unknowns; see bench/pendulum_bench.cc).
+#ifndef BIFILAR_CVODES_SENS_METHOD
+#define BIFILAR_CVODES_SENS_METHOD CV_SIMULTANEOUS
+#endif
+constexpr int kSensMethod = BIFILAR_CVODES_SENS_METHOD;
+
+bool Fail(std::string* why, const std::string& message) {
+  if (why != nullptr) *why = message;
+  return false;
+}
+
+}  // namespace
+
+bool IntegratorOptions::Check(std::string* why) const {
+  if (!std::isfinite(rel_tol) || !(rel_tol > 0.0) || !(rel_tol <= 1e-2)) {
+    std::ostringstream os;
+    os << "rel_tol must be in (0, 1e-2], got " << rel_tol;
+    return Fail(why, os.str());
+  }
+  if (!std::isfinite(abs_tol) || !(abs_tol > 0.0)) {
+    std::ostringstream os;
+    os << "abs_tol must be finite and > 0, got " << abs_tol;
+    return Fail(why, os.str());
+  }
+  if (max_steps <= 0) {
+    std::ostringstream os;
+    os << "max_steps must be > 0, got " << max_steps;
+    return Fail(why, os.str());
+  }
+  return true;
+}
+
+struct PendulumIntegrator::Impl {
+  PendulumModel model;
+  RigGeometry geometry;
+  IntegratorOptions options;
+  std::string setup_error;  // non-empty when construction failed; Integrate reports it
+
+  SUNContext ctx = nullptr;
+  void* cvode_mem = nullptr;
+  N_Vector y = nullptr;
+  N_Vector* yS = nullptr;
+  SUNNonlinearSolver nls = nullptr;
+  SUNNonlinearSolver nls_sens = nullptr;
+  bool cvode_initialized = false;
+  bool sens_initialized = false;
+
+  PendulumParams params;        // of the current Integrate call, read by the RHS
+  std::string last_cvode_error;  // filled by the CVODES error handler
+
+  ~Impl() {
+    if (cvode_mem != nullptr) CVodeFree(&cvode_mem);
+    if (nls_sens != nullptr) SUNNonlinSolFree(nls_sens);
+    if (nls != nullptr) SUNNonlinSolFree(nls);
+    if (yS != nullptr) N_VDestroyVectorArray(yS, kNumSensitivities);
+    if (y != nullptr) N_VDestroy(y);
+    if (ctx != nullptr) SUNContext_Free(&ctx);
+  }
+
+  static int Rhs(realtype /*t*/, N_Vector y, N_Vector ydot, void* user_data) {
+    const Impl* self = static_cast<const Impl*>(user_data);
+    const double* yv = N_VGetArrayPointer(y);
+    double* dv = N_VGetArrayPointer(ydot);
+    if (!std::isfinite(yv[0]) || !std::isfinite(yv[1])) return 1;  // recoverable: smaller step
+    const double a =
+        AngularAcceleration(self->model, self->geometry, self->params, yv[0], yv[1]);
+    if (!std::isfinite(a)) return 1;
+    dv[0] = yv[1];
+    dv[1] = a;
+    return 0;
+  }
+
+  static int SensRhs(int ns, realtype /*t*/, N_Vector y, N_Vector /*ydot*/, N_Vector* yS,
+                     N_Vector* ySdot, void* user_data, N_Vector /*tmp1*/, N_Vector /*tmp2*/) {
+    const Impl* self = static_cast<const Impl*>(user_data);
+    const double* yv = N_VGetArrayPointer(y);
+    if (!std::isfinite(yv[0]) || !std::isfinite(yv[1])) return 1;
+    const AccelerationPartials p =
+        AngularAccelerationPartials(self->model, self->geometry, self->params, yv[0], yv[1]);
+    const double forcing[kNumSensitivities] = {p.d_inertia, p.d_drag, p.d_viscous, 0.0, 0.0};
+    for (int j = 0; j < ns; ++j) {
+      const double* s = N_VGetArrayPointer(yS[j]);
+      double* sd = N_VGetArrayPointer(ySdot[j]);
+      sd[0] = s[1];
+      sd[1] = p.d_angle * s[0] + p.d_rate * s[1] + forcing[j];
+      if (!std::isfinite(sd[1])) return 1;
+    }
+    return 0;
+  }
+
+  static void ErrHandler(int /*error_code*/, const char* module, const char* function, char* msg,
+                         void* eh_data) {
+    Impl* self = static_cast<Impl*>(eh_data);
+    self->last_cvode_error = std::string(module) + "/" + function + ": " + msg;
+  }
+
+  bool Setup() {
+    std::string why;
+    if (!geometry.Check(&why)) {
+      setup_error = "invalid rig geometry: " + why;
+      return false;
+    }
+    if (!options.Check(&why)) {
+      setup_error = "invalid integrator options: " + why;
+      return false;
+    }
+    if (SUNContext_Create(nullptr, &ctx) != 0) {
+      setup_error = "SUNContext_Create failed";
+      return false;
+    }
+    y = N_VNew_Serial(2, ctx);
+    if (y == nullptr) {
+      setup_error = "N_VNew_Serial failed";
+      return false;
+    }
+    N_VConst(0.0, y);
+    // Fused/array vector kernels: one call per operation on all sensitivity vectors.
+    N_VEnableFusedOps_Serial(y, SUNTRUE);
+    yS = N_VCloneVectorArray(kNumSensitivities, y);
+    cvode_mem = CVodeCreate(CV_ADAMS, ctx);
+    if (yS == nullptr || cvode_mem == nullptr) {
+      setup_error = "CVODES allocation failed";
+      return false;
+    }
+    if (CVodeSetErrHandlerFn(cvode_mem, &Impl::ErrHandler, this) != CV_SUCCESS ||
+        CVodeInit(cvode_mem, &Impl::Rhs, 0.0, y) != CV_SUCCESS ||
+        CVodeSStolerances(cvode_mem, options.rel_tol, options.abs_tol) != CV_SUCCESS ||
+        CVodeSetUserData(cvode_mem, this) != CV_SUCCESS ||
+        CVodeSetMaxNumSteps(cvode_mem, options.max_steps) != CV_SUCCESS) {
+      setup_error = "CVODES set-up failed: " + last_cvode_error;
+      return false;
+    }
+    nls = SUNNonlinSol_FixedPoint(y, 0, ctx);
+    if (nls == nullptr || CVodeSetNonlinearSolver(cvode_mem, nls) != CV_SUCCESS) {
+      setup_error = "CVODES fixed-point solver set-up failed: " + last_cvode_error;
+      return false;
+    }
+    cvode_initialized = true;
+    return true;
+  }
+
+  // Sets s_j(t0): zero for the parameters, unit vectors for psi(t0) and psi'(t0).
+  void ResetSensitivities() {
+    for (int j = 0; j < kNumSensitivities; ++j) N_VConst(0.0, yS[j]);
+    N_VGetArrayPointer(yS[kSensAngle0])[0] = 1.0;
+    N_VGetArrayPointer(yS[kSensRate0])[1] = 1.0;
+  }
+
+  bool EnableSensitivities(std::string* why) {
+    ResetSensitivities();
+    if (!sens_initialized) {
+      if (CVodeSensInit(cvode_mem, kNumSensitivities, kSensMethod, &Impl::SensRhs, yS) !=
+          CV_SUCCESS) {
+        return Fail(why, "CVodeSensInit failed: " + last_cvode_error);
+      }
+      realtype abstol_s[kNumSensitivities];
+      for (double& a : abstol_s) a = options.abs_tol;
+      if (CVodeSensSStolerances(cvode_mem, options.rel_tol, abstol_s) != CV_SUCCESS ||
+          CVodeSetSensErrCon(cvode_mem, SUNTRUE) != CV_SUCCESS) {
+        return Fail(why, "CVODES sensitivity set-up failed: " + last_cvode_error);
+      }
+      if (kSensMethod == CV_SIMULTANEOUS) {
+        nls_sens = SUNNonlinSol_FixedPointSens(kNumSensitivities + 1, y, 0, ctx);
+        if (nls_sens == nullptr ||
+            CVodeSetNonlinearSolverSensSim(cvode_mem, nls_sens) != CV_SUCCESS) {
+          return Fail(why, "CVODES sensitivity solver set-up failed: " + last_cvode_error);
+        }
+      } else {
+        nls_sens = SUNNonlinSol_FixedPointSens(kNumSensitivities, y, 0, ctx);
+        if (nls_sens == nullptr ||
+            CVodeSetNonlinearSolverSensStg(cvode_mem, nls_sens) != CV_SUCCESS) {
+          return Fail(why, "CVODES sensitivity solver set-up failed: " + last_cvode_error);
+        }
+      }
+      sens_initialized = true;
+      return true;
+    }
+    if (CVodeSensReInit(cvode_mem, kSensMethod, yS) != CV_SUCCESS) {
+      return Fail(why, "CVodeSensReInit failed: " + last_cvode_error);
+    }
+    return true;
+  }
+};
+
+PendulumIntegrator::PendulumIntegrator(PendulumModel model, const RigGeometry& geometry,
+                                       const IntegratorOptions& options)
+    : impl_(new Impl) {
+  impl_->model = model;
+  impl_->geometry = geometry;
+  impl_->options = options;
+  impl_->Setup();
+}
+
+PendulumIntegrator::~PendulumIntegrator() = default;
+
+PendulumModel PendulumIntegrator::model() const { return impl_->model; }
+const RigGeometry& PendulumIntegrator::geometry() const { return impl_->geometry; }
+
+bool PendulumIntegrator::Integrate(const PendulumParams& params, double angle0_rad,
+                                   double rate0_rad_per_s, const std::vector<double>& t_s,
+                                   bool with_sensitivities, Trajectory* out, std::string* why) {
+  Impl& im = *impl_;
+  if (!im.setup_error.empty()) return Fail(why, im.setup_error);
+  std::string reason;
+  if (!params.Check(&reason)) return Fail(why, "invalid pendulum parameters: " + reason);
+  if (!std::isfinite(angle0_rad) || !std::isfinite(rate0_rad_per_s)) {
+    return Fail(why, "initial angle and rate must be finite");
+  }
+  const size_t n = t_s.size();
+  for (size_t k = 0; k < n; ++k) {
+    if (!std::isfinite(t_s[k])) {
+      std::ostringstream os;
+      os << "t_s[" << k << "] is not finite";
+      return Fail(why, os.str());
+    }
+    if (k > 0 && t_s[k] < t_s[k - 1]) {
+      std::ostringstream os;
+      os.precision(17);
+      os << "t_s must be non-decreasing, but t_s[" << k << "] = " << t_s[k] << " < t_s["
+         << k - 1 << "] = " << t_s[k - 1];
+      return Fail(why, os.str());
+    }
+  }
+
+  out->angle_rad.resize(n);
+  out->rate_rad_per_s.resize(n);
+  if (with_sensitivities) {
+    out->d_rate.resize(static_cast<Eigen::Index>(n), kNumSensitivities);
+    out->d_angle.resize(static_cast<Eigen::Index>(n), kNumSensitivities);
+  } else {
+    out->d_rate.resize(0, kNumSensitivities);
+    out->d_angle.resize(0, kNumSensitivities);
+  }
+  if (n == 0) return true;
+
+  im.params = params;
+  im.last_cvode_error.clear();
+  const double t0 = t_s[0];
+  double* yv = N_VGetArrayPointer(im.y);
+  yv[0] = angle0_rad;
+  yv[1] = rate0_rad_per_s;
+  if (CVodeReInit(im.cvode_mem, t0, im.y) != CV_SUCCESS) {
+    return Fail(why, "CVodeReInit failed: " + im.last_cvode_error);
+  }
+  if (with_sensitivities) {
+    if (!im.EnableSensitivities(why)) return false;
+  } else if (im.sens_initialized) {
+    CVodeSensToggleOff(im.cvode_mem);
+  }
+
+  // Row 0: the initial state (and its sensitivities).
+  out->angle_rad[0] = angle0_rad;
+  out->rate_rad_per_s[0] = rate0_rad_per_s;
+  if (with_sensitivities) {
+    for (int j = 0; j < kNumSensitivities; ++j) {
+      out->d_angle(0, j) = N_VGetArrayPointer(im.yS[j])[0];
+      out->d_rate(0, j) = N_VGetArrayPointer(im.yS[j])[1];
+    }
+  }
+
+  bool started = false;  // CVode has been called at least once
+  const double eps = 4.0 * std::numeric_limits<double>::epsilon();
+  for (size_t k = 1; k < n; ++k) {
+    const double t = t_s[k];
+    // Repeated times (and, before the first step, times indistinguishable from t0, which
+    // CVODES rejects as "too close") copy the previous row.
+    const bool same = t == t_s[k - 1] ||
+                      (!started && t - t0 <= eps * std::max(std::abs(t0), std::abs(t)));
+    if (same) {
+      out->angle_rad[k] = out->angle_rad[k - 1];
+      out->rate_rad_per_s[k] = out->rate_rad_per_s[k - 1];
+      if (with_sensitivities) {
+        out->d_angle.row(k) = out->d_angle.row(k - 1);
+        out->d_rate.row(k) = out->d_rate.row(k - 1);
+      }
+      continue;
+    }
+    realtype t_ret = t0;
+    const int flag = CVode(im.cvode_mem, t, im.y, &t_ret, CV_NORMAL);
+    started = true;
+    if (flag < 0) {
+      std::ostringstream os;
+      os.precision(10);
+      os << "CVODES failed at t = " << t_ret << " s (" << ToString(im.model)
+         << " model, integrating from " << t0 << " s to " << t << " s): "
+         << (im.last_cvode_error.empty() ? "flag " + std::to_string(flag) : im.last_cvode_error);
+      return Fail(why, os.str());
+    }
+    long num_steps = 0;
+    CVodeGetNumSteps(im.cvode_mem, &num_steps);
+    if (num_steps > im.options.max_steps) {
+      std::ostringstream os;
+      os << "CVODES took more than max_steps = " << im.options.max_steps << " steps by t = " << t
+         << " s";
+      return Fail(why, os.str());
+    }
+    if (!std::isfinite(yv[0]) || !std::isfinite(yv[1])) {
+      std::ostringstream os;
+      os << "non-finite state at t = " << t << " s";
+      return Fail(why, os.str());
+    }
+    out->angle_rad[k] = yv[0];
+    out->rate_rad_per_s[k] = yv[1];
+    if (with_sensitivities) {
+      if (CVodeGetSens(im.cvode_mem, &t_ret, im.yS) != CV_SUCCESS) {
+        return Fail(why, "CVodeGetSens failed: " + im.last_cvode_error);
+      }
+      for (int j = 0; j < kNumSensitivities; ++j) {
+        const double* s = N_VGetArrayPointer(im.yS[j]);
+        if (!std::isfinite(s[0]) || !std::isfinite(s[1])) {
+          std::ostringstream os;
+          os << "non-finite sensitivity at t = " << t << " s";
+          return Fail(why, os.str());
+        }
+        out->d_angle(k, j) = s[0];
+        out->d_rate(k, j) = s[1];
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace bifilar
