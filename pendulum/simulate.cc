@@ -1,0 +1,638 @@
+#include "pendulum/simulate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <sstream>
+
+#include <Eigen/Geometry>
+
+namespace bifilar {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+
+// Portable random numbers: std::mt19937_64 is fully specified by the standard, but the standard
+// distributions are not, so uniforms and normals are made here (same seed -> same bytes anywhere).
+class Rng {
+ public:
+  explicit Rng(uint64_t seed) : engine_(seed) {}
+  double Uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }  // [0, 1)
+  double Uniform(const UniformRange& r) { return r.min + (r.max - r.min) * Uniform(); }
+  double Normal() {  // Box-Muller, one value per call (no cached state)
+    const double u1 = 1.0 - Uniform();  // (0, 1]
+    const double u2 = Uniform();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+  }
+  double Normal(double sigma) { return sigma * Normal(); }
+
+ private:
+  std::mt19937_64 engine_;
+};
+
+std::string Num(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%g", value);
+  return buffer;
+}
+
+bool Fail(std::string* why, const std::string& message) {
+  if (why) *why = message;
+  return false;
+}
+
+bool CheckRange(const UniformRange& r, const char* name, double lower, bool lower_open,
+                std::string* why) {
+  if (!std::isfinite(r.min) || !std::isfinite(r.max)) return Fail(why, std::string(name) + " must be finite");
+  if (r.min > r.max) {
+    return Fail(why, std::string(name) + ": min " + Num(r.min) + " is larger than max " + Num(r.max));
+  }
+  if (lower_open ? !(r.min > lower) : !(r.min >= lower)) {
+    return Fail(why, std::string(name) + " must be " + (lower_open ? "> " : ">= ") + Num(lower) +
+                         " (got " + Num(r.min) + ")");
+  }
+  return true;
+}
+
+bool CheckValue(double value, const char* name, double lower, bool lower_open, double upper,
+                std::string* why) {
+  const bool ok = std::isfinite(value) && (lower_open ? value > lower : value >= lower) &&
+                  value <= upper;
+  if (ok) return true;
+  std::string range = std::string(lower_open ? "(" : "[") + Num(lower) + ", " +
+                      (std::isinf(upper) ? std::string("inf)") : Num(upper) + "]");
+  return Fail(why, std::string(name) + " = " + Num(value) + " is out of range; allowed " + range);
+}
+
+// Quintic smoothstep q(s), s in [0,1]: q(0)=0, q(1)=1, zero slope and curvature at both ends.
+void Smoothstep(double s, double* q, double* dq, double* ddq) {
+  const double s2 = s * s, s3 = s2 * s;
+  *q = s3 * (10.0 - 15.0 * s + 6.0 * s2);
+  *dq = 30.0 * s2 * (1.0 - 2.0 * s + s2);
+  *ddq = 60.0 * s * (1.0 - 3.0 * s + 2.0 * s2);
+}
+
+// psi'' of the truth, including the optional sway-coupling discrepancy term.
+struct TruthDynamics {
+  PendulumModel model;
+  RigGeometry geometry;
+  PendulumParams params;
+  double sway_k = 0.0;  // per rad^4
+
+  double Accel(double angle, double rate) const {
+    double acc = AngularAcceleration(model, geometry, params, angle, rate);
+    if (sway_k != 0.0) {
+      const double slope = model == PendulumModel::kLinear
+                               ? geometry.filar_separation_m * geometry.filar_separation_m /
+                                     (4.0 * geometry.filar_length_m) * angle
+                               : RiseSlope(geometry, angle);
+      const double inertia = model == PendulumModel::kFull
+                                 ? params.inertia_kg_m2 + geometry.mass_kg * slope * slope
+                                 : params.inertia_kg_m2;
+      const double a2 = angle * angle;
+      acc += geometry.mass_kg * geometry.gravity_mps2 * slope * sway_k * a2 * a2 / inertia;
+    }
+    return acc;
+  }
+};
+
+// Fixed-step RK4 (steps <= max_step_s) from (t[0], angle0, rate0) through the times t.
+bool IntegrateRk4(const TruthDynamics& dyn, double angle0, double rate0,
+                  const std::vector<double>& t, std::vector<double>* angle,
+                  std::vector<double>* rate, std::string* why) {
+  constexpr double kMaxStepS = 1e-3;
+  angle->assign(t.size(), 0.0);
+  rate->assign(t.size(), 0.0);
+  double x = angle0, v = rate0, now = t.empty() ? 0.0 : t[0];
+  for (size_t k = 0; k < t.size(); ++k) {
+    const double span = t[k] - now;
+    const int steps = span > 0 ? static_cast<int>(std::ceil(span / kMaxStepS)) : 0;
+    for (int i = 0; i < steps; ++i) {
+      const double h = span / steps;
+      const double k1x = v, k1v = dyn.Accel(x, v);
+      const double k2x = v + 0.5 * h * k1v, k2v = dyn.Accel(x + 0.5 * h * k1x, k2x);
+      const double k3x = v + 0.5 * h * k2v, k3v = dyn.Accel(x + 0.5 * h * k2x, k3x);
+      const double k4x = v + h * k3v, k4v = dyn.Accel(x + h * k3x, k4x);
+      x += h / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x);
+      v += h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
+    }
+    now = t[k];
+    if (!std::isfinite(x) || !std::isfinite(v)) return Fail(why, "sway-coupling integration diverged");
+    (*angle)[k] = x;
+    (*rate)[k] = v;
+  }
+  return true;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+bool TimelineOptions::Check(std::string* why) const {
+  return CheckRange(rest_before_s, "timeline.rest_before_s", 0.0, false, why) &&
+         CheckRange(twist_s, "timeline.twist_s", 0.0, true, why) &&
+         CheckRange(hold_s, "timeline.hold_s", 0.0, false, why) &&
+         CheckValue(tremor_deg, "timeline.tremor_deg", 0.0, false, 5.0, why) &&
+         CheckRange(tremor_hz, "timeline.tremor_hz", 0.0, true, why) &&
+         CheckValue(release_rate_sigma_deg_per_s, "timeline.release_rate_sigma_deg_per_s", 0.0,
+                    false, 90.0, why) &&
+         CheckRange(free_s, "timeline.free_s", 0.0, true, why) &&
+         CheckValue(free_s.max, "timeline.free_s (max)", 0.0, true, 86400.0, why) &&
+         CheckValue(stop_probability, "timeline.stop_probability", 0.0, false, 1.0, why) &&
+         CheckValue(stop_time_constant_s, "timeline.stop_time_constant_s", 0.0, true, 10.0, why) &&
+         CheckRange(rest_after_s, "timeline.rest_after_s", 0.0, false, why);
+}
+
+bool SensorOptions::Check(std::string* why) const {
+  if (!CheckValue(sample_rate_hz, "sensor.sample_rate_hz", 0.0, true, 100000.0, why)) return false;
+  if (!CheckValue(time_jitter_sigma_s, "sensor.time_jitter_sigma_s", 0.0, false,
+                  1.0 / sample_rate_hz, why))
+    return false;
+  return CheckValue(drop_fraction, "sensor.drop_fraction", 0.0, false, 0.5, why) &&
+         CheckValue(drop_burst_probability, "sensor.drop_burst_probability", 0.0, false, 1.0,
+                    why) &&
+         CheckValue(drop_burst_max_samples, "sensor.drop_burst_max_samples", 2.0, false, 100000.0,
+                    why) &&
+         CheckRange(start_time_s, "sensor.start_time_s", -1e9, false, why) &&
+         CheckValue(start_time_s.max, "sensor.start_time_s (max)", -1e9, false, 1e9, why) &&
+         CheckValue(gyro_noise_sigma_deg_per_s, "sensor.gyro_noise_sigma_deg_per_s", 0.0, false,
+                    100.0, why) &&
+         CheckValue(gyro_bias_sigma_deg_per_s, "sensor.gyro_bias_sigma_deg_per_s", 0.0, false,
+                    100.0, why) &&
+         CheckValue(gyro_scale_error_sigma, "sensor.gyro_scale_error_sigma", 0.0, false, 0.2,
+                    why) &&
+         CheckValue(accel_noise_sigma_mps2, "sensor.accel_noise_sigma_mps2", 0.0, false, 10.0,
+                    why) &&
+         CheckValue(accel_bias_sigma_mps2, "sensor.accel_bias_sigma_mps2", 0.0, false, 10.0,
+                    why) &&
+         CheckValue(rocking_max_deg, "sensor.rocking_max_deg", 0.0, false, 10.0, why) &&
+         CheckValue(rocking_frequency_hz, "sensor.rocking_frequency_hz", 0.0, false,
+                    sample_rate_hz / 4.0, why) &&
+         CheckValue(rocking_decay_s, "sensor.rocking_decay_s", 0.0, true, 1e6, why);
+}
+
+bool SimulationOptions::Check(std::string* why) const {
+  std::string integrator_why;
+  if (!integrator.Check(&integrator_why)) return Fail(why, "integrator: " + integrator_why);
+  return timeline.Check(why) && sensor.Check(why) &&
+         CheckValue(negative_amplitude_probability, "negative_amplitude_probability", 0.0, false,
+                    1.0, why) &&
+         CheckValue(sway_coupling_at_60deg, "sway_coupling_at_60deg", 0.0, false, 0.5, why);
+}
+
+bool TraceSetup::Check(std::string* why) const {
+  const RigGeometry& g = geometry;
+  if (!CheckValue(g.filar_length_m, "filar_length_m (L)", 0.0, true, 1000.0, why) ||
+      !CheckValue(g.filar_separation_m, "filar_separation_m (D)", 0.0, true, 1000.0, why) ||
+      !CheckValue(g.mass_kg, "mass_kg (whole suspended mass)", 0.0, true, 1e6, why) ||
+      !CheckValue(g.gravity_mps2, "gravity_mps2", 0.0, true, 100.0, why) ||
+      !CheckValue(params.inertia_kg_m2, "inertia_kg_m2 (whole suspended inertia)", 0.0, true,
+                  1e9, why) ||
+      !CheckValue(params.drag_coeff_kg_m2, "drag_coeff_kg_m2 (K_D)", 0.0, false, 1e9, why) ||
+      !CheckValue(params.viscous_coeff_kg_m2_per_s, "viscous_coeff_kg_m2_per_s (C)", 0.0, false,
+                  1e9, why)) {
+    return false;
+  }
+  if (!(g.filar_length_m > g.filar_separation_m)) {
+    return Fail(why, "filar_length_m (L) = " + Num(g.filar_length_m) +
+                         " must be greater than filar_separation_m (D) = " +
+                         Num(g.filar_separation_m) + " (the wires would go slack); allowed L > D");
+  }
+  if (!std::isfinite(pitch_rad) || std::abs(pitch_rad) > kPi / 2 + 1e-9) {
+    return Fail(why, "pitch = " + Num(pitch_rad / kDeg) + " deg is out of range; allowed [-90, 90]");
+  }
+  if (!std::isfinite(amplitude_rad) || amplitude_rad == 0.0 || std::abs(amplitude_rad) >= 80 * kDeg) {
+    return Fail(why, "amplitude = " + Num(amplitude_rad / kDeg) +
+                         " deg is out of range; allowed 0 < |amplitude| < 80 deg");
+  }
+  if (!body_from_imu.allFinite() ||
+      (body_from_imu.transpose() * body_from_imu - Eigen::Matrix3d::Identity()).norm() > 1e-6 ||
+      body_from_imu.determinant() < 0) {
+    return Fail(why, "IMU mounting (body_from_imu) must be a rotation matrix");
+  }
+  if (!imu_offset_in_body_m.allFinite() || imu_offset_in_body_m.norm() > 100.0) {
+    return Fail(why, "IMU offset must be finite and within 100 m of the CG");
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, uint64_t seed,
+                   SimulatedTrace* out, std::string* why) {
+  if (!options.Check(why) || !setup.Check(why)) return false;
+  const TimelineOptions& tl = options.timeline;
+  const SensorOptions& so = options.sensor;
+  Rng rng(seed);
+  *out = SimulatedTrace();
+  TraceTruth& truth = out->truth;
+
+  // Everything random is drawn here, in a fixed order.
+  const double start_time = rng.Uniform(so.start_time_s);
+  const double rest_before = rng.Uniform(tl.rest_before_s);
+  const double twist = rng.Uniform(tl.twist_s);
+  const double hold = rng.Uniform(tl.hold_s);
+  const double free = rng.Uniform(tl.free_s);
+  const bool stopped = rng.Uniform() < tl.stop_probability;
+  const double rest_after = rng.Uniform(tl.rest_after_s);
+  const double release_rate = rng.Normal(tl.release_rate_sigma_deg_per_s * kDeg);
+  double tremor_amp[3], tremor_omega[3], tremor_phase[3];
+  for (int i = 0; i < 3; ++i) {
+    // Three sinusoids of equal amplitude: RMS of the sum = amp * sqrt(3/2).
+    tremor_amp[i] = tl.tremor_deg * kDeg / std::sqrt(1.5) * (0.5 + rng.Uniform());
+    tremor_omega[i] = 2.0 * kPi * rng.Uniform(tl.tremor_hz);
+    tremor_phase[i] = 2.0 * kPi * rng.Uniform();
+  }
+  Eigen::Vector3d gyro_bias, gyro_scale, accel_bias;
+  for (int i = 0; i < 3; ++i) gyro_bias[i] = rng.Normal(so.gyro_bias_sigma_deg_per_s * kDeg);
+  for (int i = 0; i < 3; ++i) gyro_scale[i] = rng.Normal(so.gyro_scale_error_sigma);
+  for (int i = 0; i < 3; ++i) accel_bias[i] = rng.Normal(so.accel_bias_sigma_mps2);
+  const double rocking_amp = so.rocking_max_deg * kDeg * rng.Uniform();
+  const double rocking_hz =
+      so.rocking_frequency_hz > 0
+          ? so.rocking_frequency_hz
+          : std::sqrt(setup.geometry.gravity_mps2 / setup.geometry.filar_length_m) / (2 * kPi) *
+                (0.9 + 0.2 * rng.Uniform());
+  const double rocking_beta = 2.0 * kPi * rng.Uniform();
+
+  // Timeline.
+  const double t_twist = start_time + rest_before;
+  const double t_hold = t_twist + twist;
+  const double t_release = t_hold + hold;
+  const double t_stop = t_release + free;
+  const double stop_tau = tl.stop_time_constant_s;
+  const double t_end = stopped ? t_stop + 5.0 * stop_tau + rest_after : t_stop;
+  const double dt = 1.0 / so.sample_rate_hz;
+  const double samples_real = std::floor((t_end - start_time) * so.sample_rate_hz) + 1.0;
+  if (samples_real > 5e7) return Fail(why, "log too long: more than 5e7 samples");
+  const int n_nominal = static_cast<int>(samples_real);
+
+  // Timestamps: nominal grid + clipped jitter (strictly increasing), then dropped packets.
+  std::vector<double> times;
+  times.reserve(n_nominal);
+  const double mean_drop_run =
+      (1.0 - so.drop_burst_probability) + so.drop_burst_probability * (2.0 + so.drop_burst_max_samples) / 2.0;
+  const double drop_start_p = so.drop_fraction / (mean_drop_run * (1.0 - so.drop_fraction) + so.drop_fraction);
+  int drop_left = 0, dropped = 0;
+  for (int k = 0; k < n_nominal; ++k) {
+    double jitter = rng.Normal(so.time_jitter_sigma_s);
+    jitter = std::clamp(jitter, -0.4 * dt, 0.4 * dt);
+    const double u = rng.Uniform();
+    const double u_burst = rng.Uniform();
+    const double u_len = rng.Uniform();
+    if (drop_left == 0 && k > 0 && u < drop_start_p) {
+      drop_left = u_burst < so.drop_burst_probability
+                      ? 2 + static_cast<int>(u_len * (so.drop_burst_max_samples - 1))
+                      : 1;
+    }
+    if (drop_left > 0) {
+      --drop_left;
+      ++dropped;
+      continue;
+    }
+    times.push_back(start_time + k * dt + jitter);
+  }
+  const size_t n = times.size();
+  if (n < 2) return Fail(why, "the log would have fewer than 2 samples");
+
+  // The swing angle psi and its derivatives at every kept sample.
+  std::vector<double>& psi = out->angle_rad;
+  std::vector<double>& dpsi = out->rate_rad_per_s;
+  std::vector<double>& ddpsi = out->accel_rad_per_s2;
+  psi.assign(n, 0.0);
+  dpsi.assign(n, 0.0);
+  ddpsi.assign(n, 0.0);
+  const double amplitude = setup.amplitude_rad;
+  std::vector<size_t> free_index;
+  std::vector<double> free_times{t_release};
+  for (size_t k = 0; k < n; ++k) {
+    const double t = times[k];
+    if (t < t_twist) continue;
+    if (t < t_hold) {
+      double q, dq, ddq;
+      Smoothstep((t - t_twist) / twist, &q, &dq, &ddq);
+      psi[k] = amplitude * q;
+      dpsi[k] = amplitude * dq / twist;
+      ddpsi[k] = amplitude * ddq / (twist * twist);
+    } else if (t < t_release) {
+      // Tremor, windowed by sin^2 so the hold starts and ends smoothly.
+      double tr = 0, dtr = 0, ddtr = 0;
+      const double s = t - t_hold;
+      for (int i = 0; i < 3; ++i) {
+        const double ph = tremor_omega[i] * s + tremor_phase[i];
+        tr += tremor_amp[i] * std::sin(ph);
+        dtr += tremor_amp[i] * tremor_omega[i] * std::cos(ph);
+        ddtr -= tremor_amp[i] * tremor_omega[i] * tremor_omega[i] * std::sin(ph);
+      }
+      const double w_arg = kPi * s / hold;
+      const double w = std::sin(w_arg) * std::sin(w_arg);
+      const double dw = kPi / hold * std::sin(2 * w_arg);
+      const double ddw = 2 * kPi * kPi / (hold * hold) * std::cos(2 * w_arg);
+      psi[k] = amplitude + tr * w;
+      dpsi[k] = dtr * w + tr * dw;
+      ddpsi[k] = ddtr * w + 2 * dtr * dw + tr * ddw;
+    } else if (t < t_stop) {
+      free_index.push_back(k);
+      free_times.push_back(t);
+    }
+  }
+  if (free_index.size() < 2) return Fail(why, "the free oscillation has fewer than 2 samples");
+  free_times.push_back(t_stop);  // the state at the stop starts the hand's deceleration
+
+  TruthDynamics dyn{options.model, setup.geometry, setup.params, 0.0};
+  if (options.sway_coupling_at_60deg > 0) {
+    const double a60 = 60.0 * kDeg;
+    dyn.sway_k = 8.0 / 5.0 * options.sway_coupling_at_60deg / (a60 * a60 * a60 * a60);
+  }
+  std::vector<double> free_angle, free_rate;
+  if (dyn.sway_k == 0.0) {
+    PendulumIntegrator integrator(options.model, setup.geometry, options.integrator);
+    Trajectory trajectory;
+    std::string integrator_why;
+    if (!integrator.Integrate(setup.params, amplitude, release_rate, free_times, false, &trajectory,
+                              &integrator_why)) {
+      return Fail(why, "integration of the free oscillation failed: " + integrator_why);
+    }
+    free_angle = trajectory.angle_rad;
+    free_rate = trajectory.rate_rad_per_s;
+  } else if (!IntegrateRk4(dyn, amplitude, release_rate, free_times, &free_angle, &free_rate, why)) {
+    return false;
+  }
+  if (free_angle.size() != free_times.size() || free_rate.size() != free_times.size()) {
+    return Fail(why, "integrator returned the wrong number of samples");
+  }
+  double envelope_at_stop = 0.0;
+  const double small_period = SmallAnglePeriod(setup.geometry, setup.params.inertia_kg_m2);
+  for (size_t i = 0; i < free_index.size(); ++i) {
+    const size_t k = free_index[i];
+    psi[k] = free_angle[i + 1];
+    dpsi[k] = free_rate[i + 1];
+    ddpsi[k] = dyn.Accel(psi[k], dpsi[k]);
+    if (times[k] >= t_stop - small_period) envelope_at_stop = std::max(envelope_at_stop, std::abs(psi[k]));
+  }
+  const double psi_stop = free_angle.back(), rate_stop = free_rate.back();
+  for (size_t k = 0; k < n; ++k) {
+    const double t = times[k];
+    if (t < t_stop) continue;
+    // The hand: rate decays exponentially, the angle settles rate_stop * tau further on.
+    const double e = std::exp(-(t - t_stop) / stop_tau);
+    psi[k] = psi_stop + rate_stop * stop_tau * (1.0 - e);
+    dpsi[k] = rate_stop * e;
+    ddpsi[k] = -rate_stop / stop_tau * e;
+  }
+
+  // IMU synthesis.
+  const double st = std::sin(setup.pitch_rad), ct = std::cos(setup.pitch_rad);
+  const Eigen::Vector3d n_body(-st, 0.0, ct);
+  const Eigen::Vector3d horizontal(ct, 0.0, st);  // in the x-z plane, perpendicular to n
+  const Eigen::Vector3d rock_axis =
+      (std::cos(rocking_beta) * Eigen::Vector3d::UnitY() + std::sin(rocking_beta) * horizontal)
+          .normalized();
+  const Eigen::Matrix3d imu_from_body = setup.body_from_imu.transpose();
+  const Eigen::Vector3d& r = setup.imu_offset_in_body_m;
+  const Eigen::Vector3d r_perp = r - n_body * n_body.dot(r);
+  const Eigen::Vector3d n_cross_r = n_body.cross(r);
+  const double g = setup.geometry.gravity_mps2;
+  const double rock_omega = 2 * kPi * rocking_hz;
+  const double gyro_noise = so.gyro_noise_sigma_deg_per_s * kDeg;
+
+  out->imu.t_s = times;
+  out->imu.gyro_in_imu.resize(n);
+  if (so.accelerometer) out->imu.accel_in_imu.resize(n);
+  for (size_t k = 0; k < n; ++k) {
+    const double t = times[k];
+    double phi = 0, dphi = 0, ddphi = 0;
+    if (t >= t_release && rocking_amp > 0) {
+      const double x = t - t_release;
+      const double e = rocking_amp * std::exp(-x / so.rocking_decay_s);
+      const double c = 1.0 / so.rocking_decay_s;
+      const double s = std::sin(rock_omega * x), co = std::cos(rock_omega * x);
+      phi = e * s;
+      dphi = e * (rock_omega * co - c * s);
+      ddphi = e * ((c * c - rock_omega * rock_omega) * s - 2 * c * rock_omega * co);
+    }
+    const Eigen::Vector3d omega_body = dpsi[k] * n_body + dphi * rock_axis;
+    Eigen::Vector3d gyro = imu_from_body * omega_body;
+    gyro = gyro.cwiseProduct(Eigen::Vector3d::Ones() + gyro_scale) + gyro_bias;
+    for (int i = 0; i < 3; ++i) gyro[i] += rng.Normal(gyro_noise);
+    out->imu.gyro_in_imu[k] = gyro;
+    if (so.accelerometer) {
+      const double hdd = RiseCurvature(setup.geometry, psi[k]) * dpsi[k] * dpsi[k] +
+                         RiseSlope(setup.geometry, psi[k]) * ddpsi[k];
+      const Eigen::Vector3d a_body = ddpsi[k] * n_cross_r - dpsi[k] * dpsi[k] * r_perp -
+                                     hdd * n_body + ddphi * rock_axis.cross(r);
+      // The body rocked by phi about rock_axis sees the down vertical rotated by -phi.
+      const Eigen::Vector3d down_body = Eigen::AngleAxisd(-phi, rock_axis) * n_body;
+      Eigen::Vector3d f = imu_from_body * (a_body - g * down_body) + accel_bias;
+      for (int i = 0; i < 3; ++i) f[i] += rng.Normal(so.accel_noise_sigma_mps2);
+      out->imu.accel_in_imu[k] = f;
+    }
+  }
+  for (size_t k = 0; k < n; ++k) {
+    if (!out->imu.gyro_in_imu[k].allFinite() ||
+        (so.accelerometer && !out->imu.accel_in_imu[k].allFinite()) || !std::isfinite(times[k])) {
+      return Fail(why, "simulation produced a non-finite value (check the parameters)");
+    }
+  }
+
+  truth.start_time_s = start_time;
+  truth.t_twist_s = t_twist;
+  truth.t_release_s = t_release;
+  truth.stopped = stopped;
+  truth.t_stop_s = t_stop;
+  truth.t_end_s = t_end;
+  truth.amplitude_rad = amplitude;
+  truth.release_rate_rad_per_s = release_rate;
+  truth.amplitude_at_stop_rad = envelope_at_stop;
+  truth.gyro_bias_rad_per_s = gyro_bias;
+  truth.gyro_scale_error = gyro_scale;
+  truth.accel_bias_mps2 = so.accelerometer ? accel_bias : Eigen::Vector3d::Zero();
+  truth.swing_axis_in_imu = imu_from_body * n_body;
+  truth.rocking_amplitude_rad = rocking_amp;
+  truth.rocking_frequency_hz = rocking_hz;
+  truth.rocking_axis_in_body = rock_axis;
+  truth.samples_nominal = n_nominal;
+  truth.samples_dropped = dropped;
+  truth.free_samples = static_cast<int>(free_index.size());
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+double AircraftTruth::InertiaAtPitch(double pitch_rad) const {
+  const double c = std::cos(pitch_rad), s = std::sin(pitch_rad);
+  return iz_kg_m2 * c * c + ix_kg_m2 * s * s + ixz_kg_m2 * std::sin(2 * pitch_rad);
+}
+
+double AircraftTruth::PrincipalInclinationRad() const {
+  double tau = 0.5 * std::atan2(2 * ixz_kg_m2, iz_kg_m2 - ix_kg_m2);
+  if (tau <= -kPi / 4) tau += kPi / 2;
+  if (tau > kPi / 4) tau -= kPi / 2;
+  return tau;
+}
+
+bool AircraftTruth::Check(std::string* why) const {
+  if (!CheckValue(mass_kg, "aircraft.mass_kg", 0.0, true, 1e6, why) ||
+      !CheckValue(ix_kg_m2, "aircraft I_x", 0.0, true, 1e9, why) ||
+      !CheckValue(iz_kg_m2, "aircraft I_z", 0.0, true, 1e9, why) ||
+      !CheckValue(ixz_kg_m2, "aircraft I_xz", -1e9, false, 1e9, why)) {
+    return false;
+  }
+  // Smallest value of I(theta) = A - sqrt(B^2 + C^2) must be positive.
+  const double a = 0.5 * (ix_kg_m2 + iz_kg_m2), b = 0.5 * (iz_kg_m2 - ix_kg_m2);
+  if (a - std::hypot(b, ixz_kg_m2) <= 0) {
+    return Fail(why, "aircraft I_xz = " + Num(ixz_kg_m2) +
+                         " is too large: the inertia about some axis would be <= 0; allowed "
+                         "|I_xz| < sqrt(I_x I_z)");
+  }
+  return true;
+}
+
+bool RigTruth::InertiaAtPitch(double nominal_pitch_deg, double* inertia) const {
+  if (inertia_by_pitch_kg_m2.empty()) {
+    *inertia = inertia_kg_m2;
+    return true;
+  }
+  for (const auto& entry : inertia_by_pitch_kg_m2) {
+    if (std::abs(entry.first - nominal_pitch_deg) < 1e-9) {
+      *inertia = entry.second;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool RigTruth::Check(std::string* why) const {
+  if (!CheckValue(mass_kg, "rig.mass_kg", 0.0, true, 1e6, why) ||
+      !CheckValue(imu_mass_kg, "rig.imu_mass_kg", 0.0, false, 1e3, why)) {
+    return false;
+  }
+  if (inertia_by_pitch_kg_m2.empty()) {
+    if (!CheckValue(inertia_kg_m2, "rig.inertia_kg_m2", 0.0, true, 1e9, why)) return false;
+  } else {
+    for (const auto& entry : inertia_by_pitch_kg_m2) {
+      if (!CheckValue(entry.second, ("rig.inertia_by_pitch_kg_m2 at " + Num(entry.first) + " deg").c_str(),
+                      0.0, true, 1e9, why)) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+bool CampaignSpec::Check(std::string* why) const {
+  if (!aircraft.Check(why) || !rig.Check(why)) return false;
+  if (!CheckValue(filar_length_m, "filar_length_m (L)", 0.0, true, 1000.0, why) ||
+      !CheckValue(filar_separation_m, "filar_separation_m (D)", 0.0, true, 1000.0, why) ||
+      !CheckValue(gravity_mps2, "gravity_mps2", 0.0, true, 100.0, why)) {
+    return false;
+  }
+  if (!(filar_length_m > filar_separation_m)) {
+    return Fail(why, "filar_length_m (L) = " + Num(filar_length_m) +
+                         " must be greater than filar_separation_m (D) = " +
+                         Num(filar_separation_m) + " (the wires would go slack); allowed L > D");
+  }
+  if (pitch_deg.empty() && tare_logs == 0) return Fail(why, "pitch_deg: no pitch angles and no tare logs");
+  for (size_t i = 0; i < pitch_deg.size(); ++i) {
+    if (!CheckValue(pitch_deg[i], "pitch_deg", -90.0, false, 90.0, why)) return false;
+    for (size_t j = 0; j < i; ++j) {
+      if (FormatPitchDeg(pitch_deg[j]) == FormatPitchDeg(pitch_deg[i])) {
+        return Fail(why, "pitch_deg: " + Num(pitch_deg[i]) + " appears twice");
+      }
+    }
+    double unused;
+    if (!rig.InertiaAtPitch(pitch_deg[i], &unused)) {
+      return Fail(why, "rig.inertia_by_pitch_kg_m2 has no entry for pitch " + Num(pitch_deg[i]) + " deg");
+    }
+  }
+  double unused;
+  if (tare_logs > 0 && !rig.InertiaAtPitch(tare_pitch_deg, &unused)) {
+    return Fail(why, "rig.inertia_by_pitch_kg_m2 has no entry for the tare pitch " + Num(tare_pitch_deg) + " deg");
+  }
+  return CheckValue(trials_per_pitch, "trials_per_pitch", 1.0, false, 1000.0, why) &&
+         CheckValue(tare_logs, "tare_logs", 0.0, false, 1000.0, why) &&
+         CheckValue(tare_pitch_deg, "tare_pitch_deg", -90.0, false, 90.0, why) &&
+         CheckValue(pitch_error_sigma_deg, "pitch_error_sigma_deg", 0.0, false, 10.0, why) &&
+         CheckRange(amplitude_deg, "amplitude_deg", 0.0, true, why) &&
+         CheckValue(amplitude_deg.max, "amplitude_deg (max)", 0.0, true, 75.0, why) &&
+         CheckRange(drag_coeff_kg_m2, "drag_coeff_kg_m2", 0.0, false, why) &&
+         CheckRange(viscous_coeff_kg_m2_per_s, "viscous_coeff_kg_m2_per_s", 0.0, false, why);
+}
+
+std::string FormatPitchDeg(double pitch_deg) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.6g", pitch_deg);
+  std::string s = buffer;
+  return s == "-0" ? "0" : s;
+}
+
+uint64_t DeriveSeed(uint64_t seed, const std::string& name) {
+  uint64_t h = 1469598103934665603ULL;  // FNV-1a
+  for (unsigned char c : name) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  uint64_t z = seed ^ (h + 0x9E3779B97F4A7C15ULL + (seed << 6) + (seed >> 2));  // SplitMix64
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+Eigen::Matrix3d MountingFromRollPitchYawDeg(double roll_deg, double pitch_deg, double yaw_deg) {
+  return (Eigen::AngleAxisd(yaw_deg * kDeg, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(pitch_deg * kDeg, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll_deg * kDeg, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options, uint64_t seed,
+                      std::vector<CampaignTrace>* out, std::string* why) {
+  if (!spec.Check(why) || !options.Check(why)) return false;
+  out->clear();
+  auto make = [&](const std::string& path, bool tare, int trial, double nominal_deg) -> bool {
+    CampaignTrace ct;
+    ct.relative_path = path;
+    ct.is_tare = tare;
+    ct.trial = trial;
+    ct.nominal_pitch_deg = nominal_deg;
+    Rng rng(DeriveSeed(seed, path + "#setup"));
+    ct.true_pitch_deg = std::clamp(nominal_deg + rng.Normal(spec.pitch_error_sigma_deg), -90.0, 90.0);
+    const double amplitude_deg = rng.Uniform(spec.amplitude_deg);
+    const double sign = rng.Uniform() < options.negative_amplitude_probability ? -1.0 : 1.0;
+    const double drag = rng.Uniform(spec.drag_coeff_kg_m2);
+    const double viscous = rng.Uniform(spec.viscous_coeff_kg_m2_per_s);
+    spec.rig.InertiaAtPitch(nominal_deg, &ct.inertia_rig_kg_m2);
+    ct.inertia_aircraft_kg_m2 = tare ? 0.0 : spec.aircraft.InertiaAtPitch(ct.true_pitch_deg * kDeg);
+    TraceSetup& s = ct.setup;
+    s.geometry.filar_length_m = spec.filar_length_m;
+    s.geometry.filar_separation_m = spec.filar_separation_m;
+    s.geometry.gravity_mps2 = spec.gravity_mps2;
+    s.geometry.mass_kg = spec.rig.mass_kg + spec.rig.imu_mass_kg + (tare ? 0.0 : spec.aircraft.mass_kg);
+    s.params.inertia_kg_m2 = ct.inertia_aircraft_kg_m2 + ct.inertia_rig_kg_m2;
+    s.params.drag_coeff_kg_m2 = drag;
+    s.params.viscous_coeff_kg_m2_per_s = viscous;
+    s.pitch_rad = ct.true_pitch_deg * kDeg;
+    s.amplitude_rad = sign * amplitude_deg * kDeg;
+    s.body_from_imu = spec.rig.body_from_imu;
+    s.imu_offset_in_body_m = spec.rig.imu_offset_in_body_m;
+    std::string trace_why;
+    if (!SimulateTrace(s, options, DeriveSeed(seed, path), &ct.trace, &trace_why)) {
+      return Fail(why, path + ": " + trace_why);
+    }
+    out->push_back(std::move(ct));
+    return true;
+  };
+  for (double pitch : spec.pitch_deg) {
+    for (int k = 1; k <= spec.trials_per_pitch; ++k) {
+      if (!make("pitch_" + FormatPitchDeg(pitch) + "/trial_" + std::to_string(k) + ".csv", false, k,
+                pitch)) {
+        return false;
+      }
+    }
+  }
+  for (int k = 1; k <= spec.tare_logs; ++k) {
+    if (!make("tare/tare_" + std::to_string(k) + ".csv", true, k, spec.tare_pitch_deg)) return false;
+  }
+  return true;
+}
+
+}  // namespace bifilar
