@@ -1,0 +1,165 @@
+// The trace fit: one free-oscillation window of swing rate in, the suspended moment of inertia
+// with an honest uncertainty out. Model, signs and units: ../shared/PHYSICS.md §2.
+//
+// Observation model fitted to every sample k of the window (real, possibly jittered timestamps):
+//
+//   r_k = psi'(t_k; I, K_D, C, psi(t0), psi'(t0)) + b - omega_meas(t_k)
+//
+// psi' from the chosen pendulum model (pendulum/model.h) integrated by CVODES with forward
+// sensitivities (pendulum/integrator.h), which give the analytic Jacobian. Solver: Ceres
+// Levenberg-Marquardt from an initial guess computed from the data alone (fit/trace_guess.h);
+// NLopt refines I in one dimension only when that first fit is poor. The solvers stay inside
+// fit/: nothing here exposes a Ceres or NLopt type.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pendulum/integrator.h"
+#include "pendulum/model.h"
+
+namespace bifilar {
+
+struct TraceFitOptions {
+  PendulumModel model = PendulumModel::kFull;  // Equation of motion fitted (default: full).
+  // CVODES tolerances inside the fit. 1e-10 relative keeps the integration error three orders
+  // below the statistical error of I on a 60 s, 100 Hz trace (see tests/fit_trace_fit_test.cc).
+  IntegratorOptions integrator = DefaultIntegrator();
+  int max_iterations = 50;  // Levenberg-Marquardt iterations (count); > 0.
+
+  // Quality thresholds. A trace failing any of them is `rejected` with the reason.
+  // Residual RMS over the noise estimate (dimensionless), > 1. Noise: TraceFitInput::noise (from
+  // the rest segment) when given, else estimated from the window's own sample-to-sample scatter.
+  double max_rms_over_noise = 1.5;
+  // Largest |autocorrelation| of the residuals at lags 1..whiteness_lags (dimensionless), in
+  // (0, 1). White residuals of N samples give about 1/sqrt(N) (0.013 at N = 6000); a model that
+  // misses the physics (e.g. `linear` on a 30 deg swing) leaves a periodic residual near 1.
+  double max_residual_autocorr = 0.25;
+  int whiteness_lags = 10;  // Lags used by the whiteness statistics (count); >= 1.
+  // Energy on the other gyro axes relative to the swing axis (dimensionless, computed upstream
+  // and passed in TraceFitInput::secondary_motion_ratio); >= 0.
+  double max_secondary_motion_ratio = 0.1;
+  // Amplitude band of the fitted part (deg). The window code trims the trace to the band; here
+  // the fitted amplitude is checked against it: start <= max + 1 deg and end >= min - 0.5 deg.
+  double max_amplitude_deg = 90.0;  // > min_amplitude_deg, <= 90.
+  double min_amplitude_deg = 0.5;   // >= 0.
+  // The window must hold at least this many periods of oscillation (count); >= 2.
+  double min_periods = 2.0;
+
+  // NLopt one-dimensional global refinement of I when the first fit is poor (residual RMS above
+  // refine_rms_over_noise times the noise), then Levenberg-Marquardt again.
+  bool use_nlopt_refine = true;
+  double refine_rms_over_noise = 3.0;  // (dimensionless) > 1.
+
+  // Uncertainty budget: 1-sigma uncertainties of the configured geometry, each propagated to I
+  // to first order (implicit-function derivative of the fitted I). 0 = exact.
+  double filar_length_std_m = 0.0;
+  double filar_separation_std_m = 0.0;
+  double mass_std_kg = 0.0;
+  double gravity_std_mps2 = 0.0;
+
+  // Keep the fitted and residual series in the result (needed by the figure); costs 2N doubles.
+  bool keep_series = true;
+
+  static IntegratorOptions DefaultIntegrator() {
+    IntegratorOptions o;
+    o.rel_tol = 1e-10;
+    o.abs_tol = 1e-12;
+    return o;
+  }
+
+  bool Check(std::string* why) const;
+};
+
+struct TraceFitInput {
+  std::vector<double> t_s;             // sample times of the window (s), strictly increasing
+  std::vector<double> rate_rad_per_s;  // swing rate omega_meas = gyro . n (rad/s), same size
+  double noise_rad_per_s = 0.0;        // gyro noise std from the rest segment; <= 0: unknown
+  double secondary_motion_ratio = -1;  // other-axes energy / swing-axis energy; < 0: unknown
+  RigGeometry geometry;                // L, D, m, g
+  std::string label;                   // file name or other tag used in messages (optional)
+};
+
+// One line of the uncertainty budget: how an input's uncertainty moves I.
+struct UncertaintyContribution {
+  std::string name;           // "filar_length", "filar_separation", "mass", "gravity"
+  double std_input = 0.0;     // configured 1-sigma of the input (m, m, kg, m/s^2)
+  double d_inertia = 0.0;     // dI / d(input) at the solution (kg m^2 per input unit)
+  double contribution_kg_m2 = 0.0;  // |dI/dq| * std_input
+};
+
+// The initial guess, from the data alone (fit/trace_guess.h).
+struct TraceInitialGuess {
+  double period_s = 0.0;             // mean period over the window (zero crossings)
+  double rate_amplitude_rad_per_s = 0.0;  // rate amplitude of the first cycle
+  double decay_rate_per_s = 0.0;     // envelope decay rate lambda (amplitude ~ exp(-lambda t))
+  double cycles = 0.0;               // periods covered by the window
+  PendulumParams params;             // I (amplitude-corrected), K_D, C
+  double angle0_rad = 0.0;           // psi(t0)
+  double rate0_rad_per_s = 0.0;      // psi'(t0)
+  double bias_rad_per_s = 0.0;       // mean over an integer number of cycles
+  double data_noise_rad_per_s = 0.0; // sample-to-sample scatter estimate of the noise
+};
+
+enum class TraceFitStatus { kOk, kRejected, kError };
+const char* ToString(TraceFitStatus status);  // "ok", "rejected", "error"
+
+struct TraceFitResult {
+  TraceFitStatus status = TraceFitStatus::kError;
+  std::string message;             // why rejected / error; "" when ok
+  std::vector<std::string> flags;  // every failed quality check, short machine-readable names
+  PendulumModel model = PendulumModel::kFull;
+
+  PendulumParams params;            // fitted I, K_D, C
+  double angle0_rad = 0.0;          // fitted psi(t0)
+  double rate0_rad_per_s = 0.0;     // fitted psi'(t0)
+  double bias_rad_per_s = 0.0;      // fitted gyro bias b
+  double drag_coeff_std = 0.0;      // statistical std of K_D (kg m^2)
+  double viscous_coeff_std = 0.0;   // statistical std of C (kg m^2/s)
+
+  // Uncertainty of I: statistical (Ceres covariance scaled by the residual variance
+  // 2 cost / (N - 6)), the geometry budget, and both combined in quadrature.
+  double inertia_stat_std_kg_m2 = 0.0;
+  std::vector<UncertaintyContribution> budget;
+  double inertia_budget_std_kg_m2 = 0.0;  // root-sum-square of the budget contributions
+  double inertia_std_kg_m2 = 0.0;         // sqrt(stat^2 + budget^2)
+
+  // Goodness of fit.
+  int num_samples = 0;
+  double residual_rms_rad_per_s = 0.0;
+  double noise_rad_per_s = 0.0;         // noise used for the RMS check (input or data estimate)
+  bool noise_from_input = false;        // true: rest-segment noise; false: from the window
+  double rms_over_noise = 0.0;
+  double residual_autocorr_lag1 = 0.0;  // rho_1 of the residuals
+  double residual_autocorr_max = 0.0;   // max |rho_k|, k = 1..whiteness_lags
+  double ljung_box_q = 0.0;             // Ljung-Box Q over whiteness_lags lags (chi^2, h dof)
+  double amplitude_start_deg = 0.0;     // fitted |psi| peak over the first period
+  double amplitude_end_deg = 0.0;       // fitted |psi| peak over the last period
+  double period_s = 0.0;                // mean period (guess stage)
+
+  // Solver summary.
+  int iterations = 0;
+  double initial_cost = 0.0;  // 1/2 sum r^2 at the initial guess (rad^2/s^2)
+  double final_cost = 0.0;
+  bool nlopt_refined = false;  // NLopt refinement of I was run
+  double fit_seconds = 0.0;    // wall time of FitTrace
+  TraceInitialGuess guess;
+
+  // Series for plotting (empty unless options.keep_series): the window's times, the measured
+  // rate, the fitted rate psi'(t_k) + b and the residual fitted - measured.
+  std::vector<double> t_s;
+  std::vector<double> measured_rate_rad_per_s;
+  std::vector<double> fitted_rate_rad_per_s;
+  std::vector<double> residual_rad_per_s;
+
+  bool IsUsable() const { return status == TraceFitStatus::kOk; }
+  // One line: status, I +- std, K_D, C, rms/noise, iterations, time (and message when not ok).
+  std::string BriefReport() const;
+};
+
+// Fits one window. Never throws on bad data and never returns NaN: invalid input (sizes, NaN,
+// non-increasing times, bad geometry or options) gives kError; data that cannot support a fit
+// (too short, constant, no oscillation) or a failed quality check gives kRejected.
+TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& options);
+
+}  // namespace bifilar
