@@ -1,0 +1,258 @@
+#include "fit/swing_axis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <Eigen/Eigenvalues>
+
+namespace bifilar {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kStandardGravityMps2 = 9.80665;
+constexpr double kRadToDeg = 180.0 / kPi;
+
+// Index range [begin, end) of the samples with t0 <= t <= t1.
+std::pair<size_t, size_t> IndexRange(const std::vector<double>& t, double t0, double t1) {
+  const size_t b = std::lower_bound(t.begin(), t.end(), t0) - t.begin();
+  const size_t e = std::upper_bound(t.begin(), t.end(), t1) - t.begin();
+  return {b, std::max(b, e)};
+}
+
+// Gyro bias guess: the mean gyro over the quietest 0.5 s block of the log (smallest total
+// variance), which is the rest segment on a log that has one.
+Eigen::Vector3d QuietestBlockMean(const ImuData& data) {
+  const size_t n = data.size();
+  Eigen::Vector3d best_mean = Eigen::Vector3d::Zero();
+  double best_var = std::numeric_limits<double>::infinity();
+  size_t begin = 0;
+  while (begin < n) {
+    size_t end = begin;
+    while (end < n && data.t_s[end] - data.t_s[begin] < 0.5) ++end;
+    const size_t count = end - begin;
+    if (count >= 5 || (begin == 0 && end == n)) {
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      for (size_t i = begin; i < end; ++i) mean += data.gyro_in_imu[i];
+      mean /= static_cast<double>(count);
+      double var = 0.0;
+      for (size_t i = begin; i < end; ++i) var += (data.gyro_in_imu[i] - mean).squaredNorm();
+      var /= static_cast<double>(count);
+      if (var < best_var) {
+        best_var = var;
+        best_mean = mean;
+      }
+    }
+    begin = end;
+  }
+  return best_mean;
+}
+
+// Samples at rest: |gyro - bias| below the threshold everywhere within +-half_width of them.
+std::vector<char> RestMask(const ImuData& data, const Eigen::Vector3d& bias, double threshold,
+                           double half_width) {
+  const size_t n = data.size();
+  std::vector<char> loud(n);
+  for (size_t i = 0; i < n; ++i) loud[i] = (data.gyro_in_imu[i] - bias).norm() >= threshold;
+  // Count of loud samples in the time window around each sample (two pointers).
+  std::vector<char> rest(n, 0);
+  size_t lo = 0, hi = 0;
+  int loud_count = 0;
+  for (size_t i = 0; i < n; ++i) {
+    while (hi < n && data.t_s[hi] <= data.t_s[i] + half_width) loud_count += loud[hi++];
+    while (data.t_s[lo] < data.t_s[i] - half_width) loud_count -= loud[lo++];
+    rest[i] = loud_count == 0;
+  }
+  return rest;
+}
+
+Eigen::Vector3d BodySignedAxis(Eigen::Vector3d axis, const Eigen::Matrix3d& imu_to_body) {
+  const Eigen::Vector3d body = imu_to_body * axis;
+  const double key = std::abs(body.z()) > 1e-3 ? body.z() : -body.x();
+  return key < 0.0 ? Eigen::Vector3d(-axis) : axis;
+}
+
+}  // namespace
+
+const char* ToString(SwingAxisMode mode) { return mode == SwingAxisMode::kAuto ? "auto" : "fixed"; }
+
+const char* ToString(SwingAxisSource source) {
+  switch (source) {
+    case SwingAxisSource::kAccelAtRest: return "accel_rest";
+    case SwingAxisSource::kAccelOverWindow: return "accel_window";
+    case SwingAxisSource::kGyroPrincipal: return "gyro_principal";
+    case SwingAxisSource::kFixed: return "fixed";
+  }
+  return "?";
+}
+
+bool SwingAxisOptions::Check(std::string* why) const {
+  if (mode == SwingAxisMode::kFixed && !(fixed_axis_in_imu.allFinite() && fixed_axis_in_imu.norm() > 1e-9)) {
+    *why = "swing axis: the fixed axis must be a finite non-zero vector";
+    return false;
+  }
+  if (!imu_to_body.allFinite() ||
+      (imu_to_body.transpose() * imu_to_body - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
+      imu_to_body.determinant() < 0.0) {
+    *why = "swing axis: imu_to_body must be a rotation matrix (orthonormal, determinant +1)";
+    return false;
+  }
+  if (!(rest_rate_threshold_rad_per_s > 0.0) || !(rest_half_width_s > 0.0)) {
+    *why = "swing axis: rest_rate_threshold_rad_per_s and rest_half_width_s must be > 0";
+    return false;
+  }
+  if (min_rest_samples < 1) {
+    *why = "swing axis: min_rest_samples must be >= 1";
+    return false;
+  }
+  if (!(gravity_tolerance > 0.0 && gravity_tolerance < 1.0)) {
+    *why = "swing axis: gravity_tolerance must be in (0, 1)";
+    return false;
+  }
+  return true;
+}
+
+double PitchFromDownDeg(const Eigen::Vector3d& down_in_body) {
+  return std::atan2(-down_in_body.x(), std::hypot(down_in_body.y(), down_in_body.z())) * kRadToDeg;
+}
+
+double RollFromDownDeg(const Eigen::Vector3d& down_in_body) {
+  return std::atan2(down_in_body.y(), down_in_body.z()) * kRadToDeg;
+}
+
+bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
+                       std::optional<std::pair<double, double>> window_s, SwingAxis* axis,
+                       std::string* why) {
+  if (!options.Check(why)) return false;
+  const size_t n = data.size();
+  if (n < 2 || data.gyro_in_imu.size() != n || (data.has_accel() && data.accel_in_imu.size() != n)) {
+    *why = "swing axis: the log needs at least 2 samples with matching gyro/accelerometer sizes";
+    return false;
+  }
+  if (window_s && !(window_s->second > window_s->first)) {
+    *why = "swing axis: window end must be after its start";
+    return false;
+  }
+  *axis = SwingAxis();
+  const auto range = window_s ? IndexRange(data.t_s, window_s->first, window_s->second)
+                              : std::make_pair<size_t, size_t>(0, static_cast<size_t>(n));
+
+  // Down vertical from the accelerometer: at rest if the log shows enough rest, else averaged over
+  // the window (or the whole log).
+  std::optional<Eigen::Vector3d> down_in_imu;
+  bool down_at_rest = false;
+  if (data.has_accel()) {
+    Eigen::Vector3d bias = QuietestBlockMean(data);
+    std::vector<char> rest;
+    for (int pass = 0; pass < 2; ++pass) {  // second pass: bias from the first pass's rest samples
+      rest = RestMask(data, bias, options.rest_rate_threshold_rad_per_s, options.rest_half_width_s);
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int count = 0;
+      for (size_t i = 0; i < n; ++i) {
+        if (rest[i]) {
+          sum += data.gyro_in_imu[i];
+          ++count;
+        }
+      }
+      if (count == 0) break;
+      bias = sum / count;
+    }
+    Eigen::Vector3d f_sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (size_t i = 0; i < n; ++i) {
+      if (rest[i]) {
+        f_sum += data.accel_in_imu[i];
+        ++count;
+      }
+    }
+    if (count >= options.min_rest_samples) {
+      down_at_rest = true;
+      axis->rest_samples = count;
+    } else {
+      axis->notes.push_back("accelerometer: only " + std::to_string(count) +
+                            " samples at rest; down vector averaged over " +
+                            (window_s ? "the window" : "the whole log") +
+                            " (lever-arm accelerations may tilt it)");
+      f_sum.setZero();
+      count = 0;
+      for (size_t i = range.first; i < range.second; ++i) {
+        f_sum += data.accel_in_imu[i];
+        ++count;
+      }
+    }
+    if (count > 0) {
+      const Eigen::Vector3d f_mean = f_sum / count;
+      axis->rest_accel_mps2 = f_mean.norm();
+      if (!f_mean.allFinite() ||
+          std::abs(f_mean.norm() - kStandardGravityMps2) > options.gravity_tolerance * kStandardGravityMps2) {
+        char buf[512];
+        std::snprintf(buf, sizeof(buf),
+                      "swing axis: the mean accelerometer reading %s is %.4g m/s^2, not gravity "
+                      "(9.81 +- %.0f %%): check the accelerometer unit (m/s^2 or g) and columns",
+                      down_at_rest ? "at rest" : "over the window", f_mean.norm(),
+                      100.0 * options.gravity_tolerance);
+        *why = buf;
+        return false;
+      }
+      down_in_imu = Eigen::Vector3d(-f_mean / f_mean.norm());
+    }
+  }
+  if (down_in_imu) {
+    const Eigen::Vector3d down_in_body = options.imu_to_body * *down_in_imu;
+    axis->pitch_measured_deg = PitchFromDownDeg(down_in_body);
+    axis->roll_measured_deg = RollFromDownDeg(down_in_body);
+  }
+
+  if (options.mode == SwingAxisMode::kFixed) {
+    axis->axis_in_imu = options.fixed_axis_in_imu.normalized();
+    axis->source = SwingAxisSource::kFixed;
+  } else if (down_in_imu) {
+    axis->axis_in_imu = *down_in_imu;
+    axis->source = down_at_rest ? SwingAxisSource::kAccelAtRest : SwingAxisSource::kAccelOverWindow;
+  } else {
+    // Principal direction of the gyro signal over the window (or the whole log).
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (size_t i = range.first; i < range.second; ++i) mean += data.gyro_in_imu[i];
+    const double count = static_cast<double>(std::max<size_t>(1, range.second - range.first));
+    mean /= count;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (size_t i = range.first; i < range.second; ++i) {
+      const Eigen::Vector3d d = data.gyro_in_imu[i] - mean;
+      cov += d * d.transpose();
+    }
+    if (!(cov.trace() > 0.0) || !cov.allFinite()) {
+      *why = "swing axis: the gyro signal is constant over " +
+             std::string(window_s ? "the window" : "the log") + ", so it shows no swing axis";
+      return false;
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+    axis->axis_in_imu = BodySignedAxis(solver.eigenvectors().col(2).normalized(), options.imu_to_body);
+    axis->source = SwingAxisSource::kGyroPrincipal;
+  }
+  axis->axis_in_body = options.imu_to_body * axis->axis_in_imu;
+  axis->rate_rad_per_s.resize(n);
+  for (size_t i = 0; i < n; ++i) axis->rate_rad_per_s[i] = data.gyro_in_imu[i].dot(axis->axis_in_imu);
+  return true;
+}
+
+double SecondaryMotionRatio(const ImuData& data, const Eigen::Vector3d& axis_in_imu, double t0_s,
+                            double t1_s) {
+  const auto range = IndexRange(data.t_s, t0_s, t1_s);
+  if (range.second - range.first < 2 || !(axis_in_imu.norm() > 0.0)) return 0.0;
+  const Eigen::Vector3d n = axis_in_imu.normalized();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (size_t i = range.first; i < range.second; ++i) mean += data.gyro_in_imu[i];
+  mean /= static_cast<double>(range.second - range.first);
+  double along_ss = 0.0, orth_ss = 0.0;
+  for (size_t i = range.first; i < range.second; ++i) {
+    const Eigen::Vector3d d = data.gyro_in_imu[i] - mean;
+    const double along = d.dot(n);
+    along_ss += along * along;
+    orth_ss += (d - along * n).squaredNorm();
+  }
+  if (!(along_ss > 0.0)) return orth_ss > 0.0 ? 1e6 : 0.0;  // no swing at all: capped, never inf
+  return std::min(1e6, std::sqrt(orth_ss / along_ss));
+}
+
+}  // namespace bifilar
