@@ -1,0 +1,39 @@
+// Writing one IMU log (pendulum/imu_data.h, SI) as CSV in a given ImuFormat
+// (pipeline/imu_format.h): the inverse of pipeline/imu_log.h. One header row with the format's
+// column names, then one row per sample, values converted from SI to the format's units and
+// printed with a fixed number of significant digits ("%.{digits}g", locale-independent), so the
+// same data always gives the same bytes and reading it back gives the values to that precision.
+// The file is written to a temporary name beside it and renamed (never half-written).
+#pragma once
+
+#include <string>
+
+#include "pendulum/imu_data.h"
+#include "pipeline/imu_format.h"
+
+namespace bifilar {
+
+struct ImuLogWriteOptions {
+  // Significant digits of every value; 9 keeps microseconds at 1000 s and is far below any IMU
+  // noise; 17 round-trips doubles exactly. In [6, 17], default 9.
+  int significant_digits = 9;
+  // Line end: "\n" (default) or "\r\n".
+  std::string line_end = "\n";
+
+  bool Check(std::string* why) const;
+};
+
+// The CSV text of `data` (throws UserError when the format or data is inconsistent: accel
+// columns named but no accel data, mismatched lengths, non-finite values).
+std::string FormatImuLog(const ImuData& data, const ImuFormat& format,
+                         const ImuLogWriteOptions& options = ImuLogWriteOptions());
+
+// Writes `text` to `path` atomically (temporary file in the same folder, then rename); creates
+// missing parent folders. Throws UserError naming the path on failure.
+void WriteFileAtomically(const std::string& path, const std::string& text);
+
+// FormatImuLog + WriteFileAtomically.
+void WriteImuLog(const std::string& path, const ImuData& data, const ImuFormat& format,
+                 const ImuLogWriteOptions& options = ImuLogWriteOptions());
+
+}  // namespace bifilar
