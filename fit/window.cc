@@ -1,0 +1,588 @@
+#include "fit/window.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace bifilar {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kRadToDeg = 180.0 / kPi;
+
+std::string Prefix(const std::string& name) { return name.empty() ? "" : name + ": "; }
+
+std::string Fmt(const char* format, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
+  char buf[256];
+  std::snprintf(buf, sizeof(buf), format, a, b, c, d);
+  return buf;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + mid, v.end());
+  double m = v[mid];
+  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + mid));
+  return m;
+}
+
+// One half-cycle of x = rate - bias between zero crossings (with hysteresis).
+struct HalfCycle {
+  int sign = 0;
+  double start_s = 0.0;  // interpolated zero crossing where it begins
+  double end_s = 0.0;    // where the next begins (or the last sample time when open)
+  size_t peak_index = 0;
+  double peak = 0.0;     // max sign * x
+  bool open = false;     // the log ended before it did
+  double duration() const { return end_s - start_s; }
+};
+
+// Noise, bias and half-cycles of a series.
+struct Analysis {
+  double sigma = 0.0;
+  bool from_rest = false;
+  double bias = 0.0;
+  double rest_end_s = 0.0;
+  int rest_samples = 0;
+  double range = 0.0;
+  std::vector<double> x;
+  std::vector<HalfCycle> cycles;
+};
+
+double FourthDifferenceSigma(const std::vector<double>& r, size_t begin, size_t end) {
+  std::vector<double> d;
+  if (end < begin + 5) return 0.0;
+  d.reserve(end - begin - 4);
+  for (size_t k = begin; k + 4 < end; ++k) {
+    d.push_back(std::abs(r[k] - 4 * r[k + 1] + 6 * r[k + 2] - 4 * r[k + 3] + r[k + 4]));
+  }
+  return 1.482602218505602 * Median(d) / std::sqrt(70.0);
+}
+
+// Initial rest: blocks whose scatter and mean agree with the first block.
+void FindRest(const std::vector<double>& t, const std::vector<double>& r, double sigma_hf,
+              const WindowOptions& o, Analysis* a) {
+  const size_t n = t.size();
+  std::vector<size_t> block_end;
+  size_t i = 0;
+  while (i < n) {
+    size_t e = i;
+    while (e < n && t[e] - t[i] < o.rest_block_s) ++e;
+    block_end.push_back(e);
+    i = e;
+  }
+  auto stats = [&](size_t b, size_t e, double* mean, double* sd) {
+    double s = 0, s2 = 0;
+    for (size_t k = b; k < e; ++k) s += r[k];
+    *mean = s / static_cast<double>(e - b);
+    for (size_t k = b; k < e; ++k) s2 += (r[k] - *mean) * (r[k] - *mean);
+    *sd = std::sqrt(s2 / std::max<double>(1.0, static_cast<double>(e - b) - 1.0));
+  };
+  if (block_end.size() < 2 || block_end[0] < 5) return;
+  double mean0, sd0;
+  stats(0, block_end[0], &mean0, &sd0);
+  // Rest shows no more scatter than the high-frequency noise (x2.5: jitter inflates sigma_hf on a
+  // swinging log, never the other way round).
+  if (!(sd0 <= 2.5 * sigma_hf) && !(sd0 == 0.0 && sigma_hf == 0.0)) return;
+  double sum = 0.0;
+  size_t count = 0, accepted = 0, begin = 0;
+  const double sd_ref = std::max(sd0, 1e-12);
+  for (size_t b = 0; b < block_end.size(); ++b) {
+    const size_t e = block_end[b];
+    double mean, sd;
+    stats(begin, e, &mean, &sd);
+    const double rest_mean = count ? sum / count : mean0;
+    const double m = static_cast<double>(e - begin);
+    if (e - begin < 3 || sd > 1.6 * sd_ref || std::abs(mean - rest_mean) > 4.0 * sd_ref / std::sqrt(m)) break;
+    for (size_t k = begin; k < e; ++k) sum += r[k];
+    count += e - begin;
+    ++accepted;
+    begin = e;
+  }
+  // Drop the last accepted block: the twist may have begun inside it.
+  if (accepted < 2) return;
+  const size_t rest_end = block_end[accepted - 2];
+  if (t[rest_end - 1] - t[0] < o.min_rest_s) return;
+  double s = 0.0;
+  for (size_t k = 0; k < rest_end; ++k) s += r[k];
+  const double mean = s / static_cast<double>(rest_end);
+  double s2 = 0.0;
+  for (size_t k = 0; k < rest_end; ++k) s2 += (r[k] - mean) * (r[k] - mean);
+  a->from_rest = true;
+  a->bias = mean;
+  a->sigma = std::sqrt(s2 / static_cast<double>(rest_end - 1));
+  a->rest_end_s = t[rest_end - 1];
+  a->rest_samples = static_cast<int>(rest_end);
+}
+
+// Half-cycles with hysteresis h on x.
+std::vector<HalfCycle> HalfCycles(const std::vector<double>& t, const std::vector<double>& x,
+                                  size_t begin, size_t end, double h) {
+  std::vector<HalfCycle> out;
+  int state = 0;
+  size_t last_peak = begin;
+  for (size_t i = begin; i < end; ++i) {
+    const int s = x[i] > h ? 1 : (x[i] < -h ? -1 : 0);
+    if (s != 0 && s != state) {
+      // Zero crossing: the last sign change before i, after the previous peak.
+      double start = t[i];
+      for (size_t j = i; j > last_peak && j > begin; --j) {
+        if ((s > 0 && x[j - 1] <= 0.0) || (s < 0 && x[j - 1] >= 0.0)) {
+          const double x0 = x[j - 1], x1 = x[j];
+          const double f = (x1 != x0) ? -x0 / (x1 - x0) : 0.0;
+          start = t[j - 1] + std::clamp(f, 0.0, 1.0) * (t[j] - t[j - 1]);
+          break;
+        }
+      }
+      if (state == 0 && out.empty()) start = std::min(start, t[i]);
+      if (!out.empty()) out.back().end_s = start;
+      HalfCycle c;
+      c.sign = s;
+      c.start_s = start;
+      c.peak_index = i;
+      c.peak = s * x[i];
+      out.push_back(c);
+      state = s;
+    }
+    if (!out.empty() && state * x[i] > out.back().peak) {
+      out.back().peak = state * x[i];
+      out.back().peak_index = i;
+      last_peak = i;
+    }
+  }
+  if (!out.empty()) {
+    out.back().end_s = t[end - 1];
+    out.back().open = true;
+  }
+  return out;
+}
+
+// Noise, bias, x and half-cycles of the whole series.
+bool Analyse(const std::vector<double>& t, const std::vector<double>& r, const WindowOptions& o,
+             const std::string& name, Analysis* a, FreeOscillationWindow* w) {
+  std::string why;
+  if (!o.Check(&why)) {
+    w->status = WindowStatus::kError;
+    w->message = Prefix(name) + "invalid window options: " + why;
+    return false;
+  }
+  const size_t n = t.size();
+  if (r.size() != n || n < 8) {
+    w->status = WindowStatus::kError;
+    w->message = Prefix(name) + "the swing-rate series needs at least 8 samples (has " +
+                 std::to_string(std::min(n, r.size())) + ")";
+    return false;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(t[i]) || !std::isfinite(r[i]) || (i > 0 && !(t[i] > t[i - 1]))) {
+      w->status = WindowStatus::kError;
+      w->message = Prefix(name) + "the swing-rate series must be finite with increasing times (sample " +
+                   std::to_string(i) + ")";
+      return false;
+    }
+  }
+  const auto [mn, mx] = std::minmax_element(r.begin(), r.end());
+  a->range = *mx - *mn;
+  if (!(a->range > 1e-12 * (1.0 + std::abs(*mx)))) {
+    w->status = WindowStatus::kRejected;
+    w->message = Prefix(name) + "constant data: the swing rate does not change";
+    return false;
+  }
+  const double sigma_hf = FourthDifferenceSigma(r, 0, n);
+  FindRest(t, r, sigma_hf, o, a);
+  if (!a->from_rest) {
+    a->sigma = sigma_hf;
+    a->bias = Median(r);
+  }
+  a->x.resize(n);
+  for (size_t i = 0; i < n; ++i) a->x[i] = r[i] - a->bias;
+  const double sigma_eff = std::max({a->sigma, 1e-6 * a->range, 1e-12});
+  a->cycles = HalfCycles(t, a->x, 0, n, o.hysteresis_sigmas * sigma_eff);
+  w->noise_sigma_rad_per_s = a->sigma;
+  w->noise_from_rest = a->from_rest;
+  w->rest_bias_rad_per_s = a->bias;
+  w->rest_end_s = a->rest_end_s;
+  w->rest_samples = a->rest_samples;
+  return true;
+}
+
+// The half-cycle duration that covers most time among cycles above `min_peak`.
+double HalfPeriod(const std::vector<HalfCycle>& cycles, double min_peak, const WindowOptions& o) {
+  std::vector<double> d;
+  for (const auto& c : cycles) {
+    if (!c.open && c.peak >= min_peak && c.duration() >= 0.5 * o.min_period_s &&
+        c.duration() <= 0.5 * o.max_period_s) {
+      d.push_back(c.duration());
+    }
+  }
+  double best = 0.0, best_score = 0.0;
+  for (double di : d) {
+    double score = 0.0;
+    for (double dj : d) if (dj >= di / 1.2 && dj <= di * 1.2) score += dj;
+    if (score > best_score) {
+      best_score = score;
+      best = di;
+    }
+  }
+  if (best == 0.0) return 0.0;
+  std::vector<double> near;
+  for (double dj : d) if (dj >= best / 1.2 && dj <= best * 1.2) near.push_back(dj);
+  return Median(near);
+}
+
+size_t FirstAtOrAfter(const std::vector<double>& t, double t0) {
+  return std::lower_bound(t.begin(), t.end(), t0) - t.begin();
+}
+size_t LastAtOrBefore(const std::vector<double>& t, double t1) {
+  const size_t e = std::upper_bound(t.begin(), t.end(), t1) - t.begin();
+  return e == 0 ? 0 : e - 1;
+}
+
+void FillPeaks(const Analysis& a, FreeOscillationWindow* w) {
+  bool first = true;
+  for (const auto& c : a.cycles) {
+    if (c.peak_index >= w->first_index && c.peak_index <= w->last_index) {
+      if (first) w->peak_rate_start_rad_per_s = c.peak;
+      first = false;
+      w->peak_rate_end_rad_per_s = c.peak;
+    }
+  }
+}
+
+}  // namespace
+
+const char* ToString(WindowStatus status) {
+  switch (status) {
+    case WindowStatus::kOk: return "ok";
+    case WindowStatus::kRejected: return "rejected";
+    case WindowStatus::kError: return "error";
+  }
+  return "?";
+}
+
+const char* ToString(WindowEnd end) {
+  switch (end) {
+    case WindowEnd::kLogEnd: return "log_end";
+    case WindowEnd::kNoiseFloor: return "noise_floor";
+    case WindowEnd::kStopped: return "stopped";
+    case WindowEnd::kOverride: return "override";
+  }
+  return "?";
+}
+
+bool WindowOptions::Check(std::string* why) const {
+  auto fail = [&](const char* m) { *why = std::string("window: ") + m; return false; };
+  if (!(min_period_s > 0.0 && max_period_s > min_period_s)) return fail("need 0 < min_period_s < max_period_s");
+  if (!(rest_block_s > 0.0 && min_rest_s > 0.0)) return fail("rest_block_s and min_rest_s must be > 0");
+  if (!(hysteresis_sigmas > 0.0)) return fail("hysteresis_sigmas must be > 0");
+  if (!(half_period_tolerance > 0.0 && half_period_tolerance < 1.0)) return fail("half_period_tolerance must be in (0, 1)");
+  if (!(growth_tolerance >= 0.0)) return fail("growth_tolerance must be >= 0");
+  if (!(stop_drop_factor > 0.0 && stop_drop_factor < 1.0)) return fail("stop_drop_factor must be in (0, 1)");
+  if (!(noise_floor_sigmas > 0.0)) return fail("noise_floor_sigmas must be > 0");
+  if (!(start_delay_periods >= 0.0 && end_margin_periods >= 0.0)) return fail("start_delay_periods and end_margin_periods must be >= 0");
+  if (!(min_periods > 0.0)) return fail("min_periods must be > 0");
+  return true;
+}
+
+std::string FreeOscillationWindow::BriefReport() const {
+  if (status != WindowStatus::kOk) return std::string(ToString(status)) + ": " + message;
+  return Fmt("window [%.3f, %.3f] s", t0_s, t1_s) + " (" + ToString(end_reason) + ")" +
+         Fmt(", period %.3f s, noise %.3g rad/s", period_s, noise_sigma_rad_per_s) +
+         (noise_from_rest ? " (rest)" : " (no rest: high-frequency estimate)");
+}
+
+FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
+                                                const std::vector<double>& r,
+                                                const WindowOptions& o, const std::string& name) {
+  FreeOscillationWindow w;
+  Analysis a;
+  if (!Analyse(t, r, o, name, &a, &w)) return w;
+  const double sigma_eff = std::max({a.sigma, 1e-6 * a.range, 1e-12});
+  const double floor = o.noise_floor_sigmas * sigma_eff;
+  const auto& cycles = a.cycles;
+  double max_peak = 0.0;
+  for (const auto& c : cycles) max_peak = std::max(max_peak, c.peak);
+  const double half = HalfPeriod(cycles, std::max(floor, 0.1 * max_peak), o);
+  if (half <= 0.0) {
+    w.message = Prefix(name) + Fmt("no oscillation found (no swing with a period in [%g, %g] s above "
+                                   "the noise floor of %.3g rad/s)",
+                                   o.min_period_s, o.max_period_s, floor);
+    return w;
+  }
+  auto duration_ok = [&](const HalfCycle& c) {
+    if (c.open) return c.duration() <= (1.0 + o.half_period_tolerance) * half;
+    return std::abs(c.duration() - half) <= o.half_period_tolerance * half;
+  };
+
+  // Runs of free oscillation.
+  struct Run {
+    size_t first = 0, last = 0;  // cycle indices, inclusive
+    WindowEnd end = WindowEnd::kLogEnd;
+  };
+  std::vector<Run> runs;
+  bool in_run = false;
+  Run run;
+  std::vector<double> ratios;
+  for (size_t j = 0; j < cycles.size(); ++j) {
+    const HalfCycle& c = cycles[j];
+    if (in_run) {
+      const double prev = cycles[j - 1].peak;
+      double rho = 1.0;
+      if (!ratios.empty()) {
+        std::vector<double> recent(ratios.end() - std::min<size_t>(ratios.size(), 8), ratios.end());
+        rho = std::min(1.0, Median(recent));
+      }
+      const bool short_open = c.open && c.duration() < 0.8 * half;  // peak maybe not reached yet
+      WindowEnd reason = WindowEnd::kLogEnd;
+      bool broken = false;
+      bool restart = false;
+      if (c.peak < floor) {
+        broken = true;
+        reason = WindowEnd::kNoiseFloor;
+      } else if (!duration_ok(c)) {
+        broken = true;
+        reason = WindowEnd::kStopped;
+      } else if (c.peak > prev * (1.0 + o.growth_tolerance) + 3.0 * sigma_eff) {
+        broken = true;
+        reason = WindowEnd::kStopped;  // pushed: the free decay is broken
+        restart = true;
+      } else if (!short_open && c.peak < o.stop_drop_factor * rho * prev) {
+        broken = true;
+        reason = WindowEnd::kStopped;
+      }
+      if (!broken) {
+        if (!short_open) ratios.push_back(c.peak / prev);
+        run.last = j;
+        continue;
+      }
+      run.end = reason;
+      runs.push_back(run);
+      in_run = false;
+      if (!restart) continue;
+    }
+    if (!c.open && duration_ok(c) && c.peak >= floor) {
+      in_run = true;
+      run = Run();
+      run.first = run.last = j;
+      ratios.clear();
+    }
+  }
+  if (in_run) {
+    run.end = WindowEnd::kLogEnd;
+    runs.push_back(run);
+  }
+  // The longest run in time.
+  const Run* best = nullptr;
+  double best_span = 0.0;
+  for (const auto& rn : runs) {
+    const double span = cycles[rn.last].end_s - cycles[rn.first].start_s;
+    if (rn.last > rn.first && span > best_span) {
+      best_span = span;
+      best = &rn;
+    }
+  }
+  if (!best) {
+    w.message = Prefix(name) + "no oscillation found (no sequence of half-cycles that decays like a "
+                               "free swing)";
+    return w;
+  }
+  // Mean period over the closed half-cycles of the run.
+  size_t closed_last = best->last;
+  if (cycles[closed_last].open && closed_last > best->first) --closed_last;
+  const double period =
+      2.0 * (cycles[closed_last].end_s - cycles[best->first].start_s) / (closed_last - best->first + 1);
+  w.period_s = period;
+  w.release_s = cycles[best->first].start_s;
+  w.end_reason = best->end;
+  w.t0_s = cycles[best->first].end_s + o.start_delay_periods * period;
+  switch (best->end) {
+    case WindowEnd::kLogEnd: w.t1_s = t.back(); break;
+    case WindowEnd::kNoiseFloor: w.t1_s = cycles[best->last].end_s; break;
+    default: w.t1_s = t[cycles[best->last].peak_index] - o.end_margin_periods * period; break;
+  }
+  if (!a.from_rest) {
+    // No rest: bias = mean rate over whole periods of the free oscillation.
+    double s = 0.0;
+    size_t count = 0;
+    const size_t b = FirstAtOrAfter(t, cycles[best->first].start_s);
+    const size_t e = LastAtOrBefore(t, cycles[closed_last].end_s);
+    for (size_t k = b; k <= e && k < t.size(); ++k, ++count) s += r[k];
+    if (count > 0) w.rest_bias_rad_per_s = s / count;
+  }
+  if (w.t1_s - w.t0_s < o.min_periods * period) {
+    w.status = WindowStatus::kRejected;
+    w.message = Prefix(name) +
+                Fmt("free oscillation shorter than %g periods: [%.3f, %.3f] s with a period of %.3f s",
+                    o.min_periods, w.t0_s, w.t1_s, period) +
+                " (ends: " + ToString(best->end) + ")";
+    return w;
+  }
+  w.first_index = FirstAtOrAfter(t, w.t0_s);
+  w.last_index = LastAtOrBefore(t, w.t1_s);
+  FillPeaks(a, &w);
+  w.status = WindowStatus::kOk;
+  return w;
+}
+
+FreeOscillationWindow ApplyWindowOverride(const std::vector<double>& t,
+                                          const std::vector<double>& r, double t0_s, double t1_s,
+                                          const WindowOptions& o, const std::string& name) {
+  FreeOscillationWindow w;
+  w.overridden = true;
+  w.end_reason = WindowEnd::kOverride;
+  Analysis a;
+  if (!Analyse(t, r, o, name, &a, &w)) return w;
+  const double half_dt = 0.5 * (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+  if (!std::isfinite(t0_s) || !std::isfinite(t1_s) || !(t1_s > t0_s)) {
+    w.status = WindowStatus::kError;
+    w.message = Prefix(name) + Fmt("window [%g, %g] s: the end must be after the start", t0_s, t1_s);
+    return w;
+  }
+  if (t0_s < t.front() - half_dt || t1_s > t.back() + half_dt) {
+    w.status = WindowStatus::kError;
+    w.message = Prefix(name) + Fmt("window [%g, %g] s is outside the log, which spans [%g, %g] s",
+                                   t0_s, t1_s, t.front(), t.back());
+    return w;
+  }
+  w.t0_s = std::max(t0_s, t.front());
+  w.t1_s = std::min(t1_s, t.back());
+  w.first_index = FirstAtOrAfter(t, w.t0_s);
+  w.last_index = LastAtOrBefore(t, w.t1_s);
+  // Period from the half-cycles inside the window.
+  const double sigma_eff = std::max({a.sigma, 1e-6 * a.range, 1e-12});
+  std::vector<HalfCycle> inside;
+  for (const auto& c : a.cycles) {
+    if (!c.open && c.start_s >= w.t0_s && c.end_s <= w.t1_s) inside.push_back(c);
+  }
+  const double half = HalfPeriod(inside, o.noise_floor_sigmas * sigma_eff, o);
+  if (half <= 0.0) {
+    w.status = WindowStatus::kRejected;
+    w.message = Prefix(name) + Fmt("no oscillation found inside the window [%g, %g] s", w.t0_s, w.t1_s);
+    return w;
+  }
+  w.period_s = 2.0 * half;
+  if (!a.from_rest) {
+    double s = 0.0;
+    for (size_t k = w.first_index; k <= w.last_index; ++k) s += r[k];
+    w.rest_bias_rad_per_s = s / static_cast<double>(w.last_index - w.first_index + 1);
+  }
+  if (w.t1_s - w.t0_s < o.min_periods * w.period_s) {
+    w.status = WindowStatus::kRejected;
+    w.message = Prefix(name) + Fmt("window [%.3f, %.3f] s is shorter than %g periods (period %.3f s)",
+                                   w.t0_s, w.t1_s, o.min_periods, w.period_s);
+    return w;
+  }
+  FillPeaks(a, &w);
+  w.status = WindowStatus::kOk;
+  return w;
+}
+
+// ---- Amplitude ----
+
+std::vector<AngleExtreme> AngleExtremes(const std::vector<double>& t, const std::vector<double>& r,
+                                        const FreeOscillationWindow& w) {
+  std::vector<AngleExtreme> out;
+  if (t.size() != r.size() || t.empty() || w.last_index >= t.size() || w.last_index <= w.first_index) return out;
+  const size_t b = w.first_index, e = w.last_index + 1;
+  std::vector<double> x(t.size(), 0.0);
+  for (size_t k = b; k < e; ++k) x[k] = r[k] - w.rest_bias_rad_per_s;
+  // Cumulative trapezoid angle.
+  std::vector<double> psi(t.size(), 0.0);
+  for (size_t k = b + 1; k < e; ++k) psi[k] = psi[k - 1] + 0.5 * (x[k] + x[k - 1]) * (t[k] - t[k - 1]);
+  double range = 0.0;
+  for (size_t k = b; k < e; ++k) range = std::max(range, std::abs(x[k]));
+  const double h = std::max(4.0 * w.noise_sigma_rad_per_s, 1e-6 * range);
+  const std::vector<HalfCycle> cycles = HalfCycles(t, x, b, e, h);
+  // Angle at each interior zero crossing (start of every half-cycle but the first).
+  std::vector<std::pair<double, double>> ext;  // (t, psi)
+  for (size_t j = 1; j < cycles.size(); ++j) {
+    const double tc = cycles[j].start_s;
+    size_t k = std::upper_bound(t.begin() + b, t.begin() + e, tc) - t.begin();
+    if (k <= b || k >= e) continue;
+    const double f = (tc - t[k - 1]) / (t[k] - t[k - 1]);
+    ext.emplace_back(tc, psi[k - 1] + f * (psi[k] - psi[k - 1]));
+  }
+  if (ext.size() < 2) return out;
+  for (size_t j = 0; j < ext.size(); ++j) {
+    double ref;
+    if (j == 0) ref = ext[1].second;
+    else if (j + 1 == ext.size()) ref = ext[j - 1].second;
+    else ref = 0.5 * (ext[j - 1].second + ext[j + 1].second);
+    out.push_back({ext[j].first, 0.5 * std::abs(ext[j].second - ref) * kRadToDeg});
+  }
+  return out;
+}
+
+bool AmplitudeBandOptions::Check(std::string* why) const {
+  if (!(min_amplitude_deg >= 0.0 && max_amplitude_deg > min_amplitude_deg)) {
+    *why = "amplitude band: need 0 <= min_amplitude_deg < max_amplitude_deg";
+    return false;
+  }
+  if (!(min_periods > 0.0)) {
+    *why = "amplitude band: min_periods must be > 0";
+    return false;
+  }
+  return true;
+}
+
+AmplitudeBand TrimToAmplitudeBand(const std::vector<double>& t, const std::vector<double>& r,
+                                  const FreeOscillationWindow& w, const AmplitudeBandOptions& o,
+                                  const std::string& name) {
+  AmplitudeBand band;
+  std::string why;
+  if (!o.Check(&why)) {
+    band.status = WindowStatus::kError;
+    band.message = Prefix(name) + why;
+    return band;
+  }
+  if (!w.IsUsable()) {
+    band.status = w.status;
+    band.message = w.message;
+    return band;
+  }
+  band.extremes = AngleExtremes(t, r, w);
+  const auto& ex = band.extremes;
+  if (ex.empty()) {
+    band.message = Prefix(name) + "amplitude: fewer than two swing extremes inside the window";
+    return band;
+  }
+  size_t first = 0, end = ex.size();
+  while (first < ex.size() && ex[first].amplitude_deg > o.max_amplitude_deg) ++first;
+  while (end > 0 && ex[end - 1].amplitude_deg < o.min_amplitude_deg) --end;
+  if (first >= end) {
+    band.message = Prefix(name) +
+                   Fmt("amplitude from %.2f to %.2f deg never inside the band [%g, %g] deg",
+                       ex.front().amplitude_deg, ex.back().amplitude_deg, o.min_amplitude_deg,
+                       o.max_amplitude_deg);
+    return band;
+  }
+  const size_t last = end - 1;
+  band.t0_s = w.t0_s;
+  band.t1_s = w.t1_s;
+  if (first > 0) {
+    band.t0_s = ex[first].t_s;
+    band.trimmed_start = true;
+  }
+  if (last + 1 < ex.size()) {
+    band.t1_s = ex[last].t_s;
+    band.trimmed_end = true;
+  }
+  band.amplitude_start_deg = ex[first].amplitude_deg;
+  band.amplitude_end_deg = ex[last].amplitude_deg;
+  band.first_index = FirstAtOrAfter(t, band.t0_s);
+  band.last_index = LastAtOrBefore(t, band.t1_s);
+  if (band.t1_s - band.t0_s < o.min_periods * w.period_s) {
+    band.message = Prefix(name) +
+                   Fmt("only %.2f periods inside the amplitude band [%g, %g] deg", (band.t1_s - band.t0_s) / w.period_s,
+                       o.min_amplitude_deg, o.max_amplitude_deg) +
+                   Fmt(" (amplitude %.2f to %.2f deg over the window)", ex.front().amplitude_deg,
+                       ex.back().amplitude_deg);
+    return band;
+  }
+  band.status = WindowStatus::kOk;
+  return band;
+}
+
+}  // namespace bifilar
