@@ -1,15 +1,57 @@
+// `bifilar process CONFIG [--out DIR] [--jobs N] [--force]` and `bifilar report DIR`.
+#include <unistd.h>
+
+#include <filesystem>
 #include <iostream>
 
+#include "pipeline/campaign.h"
 #include "pipeline/cli_commands.h"
+#include "pipeline/config.h"
+#include "pipeline/report.h"
 
 namespace bifilar {
 
-// Placeholder until the command lands.
 void RegisterProcessCommands(CLI::App& app, int* exit_code) {
-  auto* sub = app.add_subcommand("process", "(not implemented yet)");
-  sub->callback([exit_code] {
-    std::cerr << "bifilar: error: 'process' is not implemented yet\n";
-    *exit_code = 2;
+  struct Args {
+    std::string config;
+    std::string out;
+    int jobs = 0;
+    bool force = false;
+    std::string report_dir;
+  };
+  auto args = std::make_shared<Args>();
+
+  auto* process = app.add_subcommand(
+      "process", "Process a campaign: fit every log, subtract the rig, fit the ellipse, write "
+                 "results.json, traces.csv, angles.csv and report.html");
+  process->add_option("config", args->config, "campaign config (YAML, see configs/README.md)")
+      ->required();
+  process->add_option("--out", args->out, "output folder (default: out/ beside the config)");
+  process->add_option("--jobs", args->jobs, "worker threads (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  process->add_flag("--force", args->force, "ignore the cache and refit every log");
+  process->callback([args, exit_code] {
+    const CampaignConfig config = LoadCampaignConfig(args->config);
+    CampaignOptions options;
+    options.out_dir = args->out.empty()
+                          ? (std::filesystem::path(config.folder) / "out").string()
+                          : args->out;
+    options.jobs = args->jobs;
+    options.force = args->force;
+    options.progress = &std::cerr;
+    options.progress_bar = isatty(2) != 0;
+    const CampaignResult result = RunCampaign(config, options);
+    PrintCampaignSummary(config, result, std::cout);
+    std::cout << "Wrote " << options.out_dir << "/{results.json, traces.csv, angles.csv, report.html}\n";
+    *exit_code = result.summary.exit_code;
+  });
+
+  auto* report = app.add_subcommand("report", "Rebuild DIR/report.html from DIR/results.json");
+  report->add_option("dir", args->report_dir, "output folder of `bifilar process`")->required();
+  report->callback([args, exit_code] {
+    RunReport(args->report_dir);
+    std::cout << "Wrote " << args->report_dir << "/report.html\n";
+    *exit_code = 0;
   });
 }
 

@@ -1,0 +1,102 @@
+// A test campaign: a folder of IMU logs (a few trials per pitch angle) plus the rig's tare logs
+// -> every trace fitted (in parallel, cached), the rig subtracted, per-angle statistics, the
+// ellipse of inertia, and results.json / traces.csv / angles.csv / report.html in OUT.
+// Conventions: ../shared/PHYSICS.md §2 (tare: I_aircraft = I_total - I_rig), §3 (pitch, ellipse).
+#pragma once
+
+#include <functional>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "fit/ellipse.h"
+#include "pipeline/config.h"
+#include "pipeline/trace_process.h"
+
+namespace bifilar {
+
+// One log found by discovery. A file that was found but cannot be used (pitch not readable from
+// its path, listed in the table but missing, same content as an earlier log) carries `error`.
+struct RunFile {
+  std::string path;                         // absolute
+  std::string display;                      // relative to the config folder
+  TraceRole role = TraceRole::kAircraft;
+  std::optional<double> pitch_nominal_deg;  // from the path pattern or the table
+  std::string error;                        // non-empty: becomes an error row
+};
+
+// Aircraft runs (runs.pattern or runs.table) then tare logs, sorted by path within each.
+// Throws UserError when runs.root (or the table) does not exist or nothing at all is found.
+std::vector<RunFile> DiscoverRuns(const CampaignConfig& config);
+
+// Per-angle statistics of the usable (ok) traces of one pitch group.
+struct AngleStats {
+  double pitch_deg = NAN;          // group pitch: the nominal pitch, or mean measured pitch
+  int n = 0;                       // ok traces
+  double inertia_mean_kg_m2 = NAN; // mean aircraft inertia
+  double inertia_std_kg_m2 = NAN;  // sample standard deviation between trials (n >= 2), else NaN
+  double inertia_sem_kg_m2 = NAN;  // standard error of the mean: the between-trial std / sqrt(n)
+                                   // when n >= 2, else the fit's own std
+  double cv_percent = NAN;         // 100 std / mean
+  double fit_std_mean_kg_m2 = NAN; // mean of the traces' own fit std
+};
+
+struct CampaignSummary {
+  int n_traces = 0, n_ok = 0, n_rejected = 0, n_error = 0;  // aircraft + tare
+  int n_fitted = 0, n_reused = 0;  // fits run now / taken from the cache
+  double wall_s = 0.0;             // whole run
+  bool ellipse_fitted = false;
+  std::string ellipse_message;     // why not fitted, if so
+  int exit_code = 0;               // 0 all well, 1 some traces failed or rejected (or no ellipse)
+};
+
+struct CampaignResult {
+  std::vector<TraceRecord> traces;  // aircraft runs then tare logs, discovery order
+  double rig_inertia_kg_m2 = NAN;   // value / tare mean (table: NaN, see per-trace field)
+  double rig_inertia_std_kg_m2 = NAN;
+  int rig_tare_n = 0;               // ok tare logs used
+  std::vector<AngleStats> angles;   // sorted by pitch
+  std::optional<EllipseResult> ellipse_fit;  // fit/ellipse.h, when >= min_angles angles remain
+  nlohmann::json ellipse;           // pipeline/ellipse_json.h document, null when not fitted
+  std::string moments_figure;       // Fig. 3 file name in OUT/figures/, "" when none
+  std::string polar_figure;         // Fig. 4 file name in OUT/figures/, "" when none
+  // Table 1 of the paper (kg m^2): mean of per-angle std, mean CV (%), regression RMSE.
+  double raw_sigma_kg_m2 = NAN, cv_percent = NAN, regression_rmse_kg_m2 = NAN;
+  CampaignSummary summary;
+};
+
+// Fits one trace; ProcessTrace in production, a fake in tests.
+using TraceFitFunction = std::function<TraceRecord(const CampaignConfig&, const std::string& path,
+                                                   const TraceProcessOptions&)>;
+
+struct CampaignOptions {
+  std::string out_dir;        // output folder (created); an existing non-folder is an error
+  int jobs = 0;               // worker threads; 0 = hardware concurrency
+  bool force = false;         // ignore the cache (refit everything)
+  bool write_report = true;   // report.html (needs the figures)
+  bool figures = true;        // draw per-trace fit figures and Fig. 3/4
+  std::ostream* progress = nullptr;  // progress lines / bar; nullptr = quiet
+  bool progress_bar = false;  // redraw one line ('\r') instead of one line per trace
+  TraceFitFunction fit_function;  // empty = ProcessTrace
+
+  bool Check(std::string* why) const;
+};
+
+// Runs the campaign and writes OUT/{results.json, traces.csv, angles.csv, report.html} (each
+// atomically), OUT/cache/ and OUT/figures/. Throws UserError for config/usage problems (the CLI
+// turns it into exit code 2); problems with single logs are error rows.
+CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& options);
+
+// Rig inertia subtracted at `pitch_deg` from the spec and the fitted tare mean/std. False with
+// *why when it cannot be found (table: pitch outside it; tare: no usable tare log).
+bool RigInertiaAt(const CampaignConfig& config, double tare_mean_kg_m2, double tare_std_kg_m2,
+                  double pitch_deg, double* inertia_kg_m2, double* std_kg_m2, std::string* why);
+
+// The console summary: Table 2 with uncertainties in the config's units, counts, reuse, time.
+void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& result,
+                          std::ostream& out);
+
+}  // namespace bifilar

@@ -1,0 +1,433 @@
+#include "pipeline/config.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <Eigen/Geometry>
+
+#include "pipeline/user_error.h"
+#include "pipeline/yaml_reader.h"
+
+namespace bifilar {
+namespace {
+
+namespace fs = std::filesystem;
+
+// map.Child(key), safe when the key is absent (YamlMap::Child on an absent key keeps an invalid
+// yaml-cpp node whose type queries throw; an empty mapping is what we mean).
+YamlMap Sub(YamlMap& map, const std::string& key) {
+  if (map.Has(key)) return map.Child(key);
+  map.Optional(key);
+  return YamlMap(YAML::Node(YAML::NodeType::Null), map.file(), map.KeyPath(key));
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw UserError(path + ": cannot open config file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Positive finite number, or throw naming the key.
+double Positive(YamlMap& map, const std::string& key) {
+  YAML::Node node = map.Required(key);
+  const double value = map.AsDouble(node, key);
+  if (!(value > 0.0)) throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be > 0");
+  return value;
+}
+
+double NonNegative(YamlMap& map, const std::string& key, double fallback) {
+  YAML::Node node = map.Optional(key);
+  if (!node.IsDefined() || node.IsNull()) return fallback;
+  const double value = map.AsDouble(node, key);
+  if (value < 0.0) throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be >= 0");
+  return value;
+}
+
+std::array<std::string, 3> ThreeColumns(YamlMap& map, const std::string& key) {
+  YAML::Node node = map.Required(key);
+  if (!node.IsSequence() || node.size() != 3) {
+    throw UserError(map.Where(node) + ": '" + map.KeyPath(key) +
+                    "' must be a list of 3 column names (x, y, z)");
+  }
+  std::array<std::string, 3> columns;
+  for (int i = 0; i < 3; ++i) columns[i] = map.AsString(node[i], key);
+  return columns;
+}
+
+Eigen::Vector3d ThreeVector(const YamlMap& map, const YAML::Node& node, const std::string& key) {
+  if (!node.IsSequence() || node.size() != 3) {
+    throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be a list of 3 numbers");
+  }
+  return Eigen::Vector3d(map.AsDouble(node[0], key), map.AsDouble(node[1], key),
+                         map.AsDouble(node[2], key));
+}
+
+void ReadImu(YamlMap imu, ImuConfig* out) {
+  ImuFormat& format = out->format;
+  {
+    YamlMap time = Sub(imu, "time");
+    format.time_column = time.OptionalString("column", format.time_column);
+    const std::string unit = time.OptionalString("unit", ToString(format.time_unit));
+    if (!ParseTimeUnit(unit, &format.time_unit)) {
+      throw UserError(time.Where(time.Optional("unit")) + ": '" + time.KeyPath("unit") +
+                      "' must be s, ms or us, not '" + unit + "'");
+    }
+    time.Finish();
+  }
+  {
+    YamlMap gyro = Sub(imu, "gyro");
+    if (gyro.Has("columns")) format.gyro_columns = ThreeColumns(gyro, "columns");
+    const std::string unit = gyro.OptionalString("unit", ToString(format.gyro_unit));
+    if (!ParseRateUnit(unit, &format.gyro_unit)) {
+      throw UserError(gyro.Where(gyro.Optional("unit")) + ": '" + gyro.KeyPath("unit") +
+                      "' must be rad/s or deg/s, not '" + unit + "'");
+    }
+    gyro.Finish();
+  }
+  if (imu.Has("accel") && imu.Optional("accel").IsNull()) {
+    format.accel_columns = {"", "", ""};  // `accel: null`: the log has no accelerometer
+  } else {
+    YamlMap accel = Sub(imu, "accel");
+    if (accel.Has("columns")) format.accel_columns = ThreeColumns(accel, "columns");
+    const std::string unit = accel.OptionalString("unit", ToString(format.accel_unit));
+    if (!ParseAccelUnit(unit, &format.accel_unit)) {
+      throw UserError(accel.Where(accel.Optional("unit")) + ": '" + accel.KeyPath("unit") +
+                      "' must be m/s^2 or g, not '" + unit + "'");
+    }
+    accel.Finish();
+  }
+  std::string why;
+  if (!format.Check(&why)) throw UserError(imu.file() + ": imu: " + why);
+
+  YAML::Node axis = imu.Optional("swing_axis");
+  if (!axis.IsDefined() || axis.IsNull() || (axis.IsScalar() && axis.Scalar() == "auto")) {
+    out->swing_axis_auto = true;
+  } else {
+    const Eigen::Vector3d v = ThreeVector(imu, axis, "swing_axis");
+    if (!(v.norm() > 1e-9)) {
+      throw UserError(imu.Where(axis) + ": 'imu.swing_axis' must be auto or a non-zero vector");
+    }
+    out->swing_axis_auto = false;
+    out->swing_axis_in_imu = v.normalized();
+  }
+
+  if (imu.Has("imu_to_body")) {
+    YamlMap mount = Sub(imu, "imu_to_body");
+    const bool has_matrix = mount.Has("matrix"), has_euler = mount.Has("euler_deg");
+    if (has_matrix == has_euler) {
+      throw UserError(mount.Where(imu.Optional("imu_to_body")) +
+                      ": 'imu.imu_to_body' needs exactly one of 'matrix' or 'euler_deg'");
+    }
+    if (has_euler) {
+      YAML::Node node = mount.Optional("euler_deg");
+      const Eigen::Vector3d rpy = ThreeVector(mount, node, "euler_deg") * (M_PI / 180.0);
+      // Body-from-IMU rotation R = Rz(yaw) Ry(pitch) Rx(roll) (aerospace ZYX order).
+      out->imu_to_body = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+                          Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+                          Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+                             .toRotationMatrix();
+    } else {
+      YAML::Node node = mount.Optional("matrix");
+      if (!node.IsSequence() || node.size() != 3) {
+        throw UserError(mount.Where(node) + ": 'imu.imu_to_body.matrix' must be 3 rows of 3");
+      }
+      Eigen::Matrix3d m;
+      for (int r = 0; r < 3; ++r) m.row(r) = ThreeVector(mount, node[r], "matrix").transpose();
+      if (!((m * m.transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-3 &&
+            m.determinant() > 0.0)) {
+        throw UserError(mount.Where(node) +
+                        ": 'imu.imu_to_body.matrix' must be a rotation (orthonormal, det +1)");
+      }
+      out->imu_to_body = m;
+    }
+    mount.Finish();
+  }
+  imu.Finish();
+}
+
+void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* out) {
+  const int ways = inertia.Has("inertia_kg_m2") + inertia.Has("table") + inertia.Has("tare");
+  if (ways != 1) {
+    throw UserError(inertia.Where(inertia.Optional("__none__")) +
+                    ": 'rig.inertia' needs exactly one of 'inertia_kg_m2', 'table' or 'tare'");
+  }
+  out->inertia_std_kg_m2 = NonNegative(inertia, "inertia_std_kg_m2", 0.0);
+  if (inertia.Has("inertia_kg_m2")) {
+    out->kind = RigInertiaSpec::Kind::kValue;
+    out->inertia_kg_m2 = NonNegative(inertia, "inertia_kg_m2", 0.0);
+  } else if (inertia.Has("table")) {
+    out->kind = RigInertiaSpec::Kind::kTable;
+    YAML::Node table = inertia.Optional("table");
+    if (!table.IsMap() || table.size() == 0) {
+      throw UserError(inertia.Where(table) +
+                      ": 'rig.inertia.table' must map pitch_deg to inertia_kg_m2, e.g. {0: 0.12}");
+    }
+    for (const auto& item : table) {
+      const double pitch = inertia.AsDouble(item.first, "table");
+      const double value = inertia.AsDouble(item.second, "table");
+      if (value < 0.0) throw UserError(inertia.Where(item.second) + ": rig inertia must be >= 0");
+      out->table_kg_m2[pitch] = value;
+    }
+  } else {
+    out->kind = RigInertiaSpec::Kind::kTare;
+    YamlMap tare = Sub(inertia, "tare");
+    YAML::Node logs = tare.Required("logs");
+    if (logs.IsScalar()) {
+      out->tare_patterns = {ResolvePath(folder, logs.Scalar())};
+    } else {
+      for (const std::string& p : tare.OptionalStringList("logs", {})) {
+        out->tare_patterns.push_back(ResolvePath(folder, p));
+      }
+    }
+    if (out->tare_patterns.empty()) {
+      throw UserError(tare.Where(logs) + ": 'rig.inertia.tare.logs' lists no file");
+    }
+    tare.Finish();
+  }
+  inertia.Finish();
+}
+
+}  // namespace
+
+const char* ToString(DisplayUnits units) {
+  return units == DisplayUnits::kSi ? "si" : "imperial";
+}
+const char* ToString(PitchSource source) {
+  return source == PitchSource::kNominal ? "nominal" : "measured";
+}
+
+double InertiaToDisplay(double inertia_kg_m2, DisplayUnits units) {
+  return units == DisplayUnits::kSi ? inertia_kg_m2 : inertia_kg_m2 * kSlugFt2PerKgM2;
+}
+const char* InertiaUnitName(DisplayUnits units) {
+  return units == DisplayUnits::kSi ? "kg m^2" : "slug ft^2";
+}
+
+std::string ResolvePath(const std::string& folder, const std::string& path) {
+  fs::path p(path);
+  if (p.is_relative()) p = fs::path(folder) / p;
+  return p.lexically_normal().string();
+}
+
+RigGeometry CampaignConfig::AircraftGeometry() const {
+  RigGeometry g;
+  g.filar_length_m = filar_length_m;
+  g.filar_separation_m = filar_separation_m;
+  g.mass_kg = rig_mass_kg + aircraft_mass_kg;
+  g.gravity_mps2 = gravity_mps2;
+  return g;
+}
+
+RigGeometry CampaignConfig::TareGeometry() const {
+  RigGeometry g = AircraftGeometry();
+  g.mass_kg = rig_mass_kg;
+  return g;
+}
+
+bool CampaignConfig::Check(std::string* why) const {
+  std::string reason;
+  if (!AircraftGeometry().Check(&reason)) {
+    *why = "rig/aircraft: " + reason;
+    return false;
+  }
+  if (!imu.format.Check(&reason)) {
+    *why = "imu: " + reason;
+    return false;
+  }
+  if (ellipse.bootstrap < 0 || ellipse.min_angles < 3) {
+    *why = "ellipse: bootstrap must be >= 0 and min_angles >= 3";
+    return false;
+  }
+  if (fit.min_amplitude_deg && fit.max_amplitude_deg &&
+      !(*fit.min_amplitude_deg < *fit.max_amplitude_deg)) {
+    *why = "fit: min_amplitude_deg must be below max_amplitude_deg";
+    return false;
+  }
+  return true;
+}
+
+CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptions& options) {
+  CampaignConfig config;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw UserError(path + ": is a folder, not a config file");
+  config.file = fs::absolute(path).lexically_normal().string();
+  config.folder = fs::path(config.file).parent_path().string();
+  config.text = ReadText(path);
+  YamlMap root = YamlMap::LoadFile(path);
+  const std::string& folder = config.folder;
+
+  {
+    YamlMap rig = Sub(root, "rig");
+    if (!root.Has("rig")) throw UserError(path + ": missing required key 'rig'");
+    config.filar_length_m = Positive(rig, "filar_length_m");
+    config.filar_separation_m = Positive(rig, "filar_separation_m");
+    config.rig_mass_kg = Positive(rig, "mass_kg");
+    if (rig.Has("inertia")) {
+      ReadRigInertia(Sub(rig, "inertia"), folder, &config.rig_inertia);
+    } else if (options.require_runs) {
+      throw UserError(path + ": missing required key 'rig.inertia'");
+    }
+    YamlMap unc = Sub(rig, "uncertainties");
+    config.uncertainties.filar_length_std_m = NonNegative(unc, "filar_length_std_m", 0.0);
+    config.uncertainties.filar_separation_std_m = NonNegative(unc, "filar_separation_std_m", 0.0);
+    config.uncertainties.mass_std_kg = NonNegative(unc, "mass_std_kg", 0.0);
+    config.uncertainties.gravity_std_mps2 = NonNegative(unc, "gravity_std_mps2", 0.0);
+    unc.Finish();
+    rig.Finish();
+  }
+  {
+    YamlMap aircraft = Sub(root, "aircraft");
+    if (root.Has("aircraft")) {
+      config.aircraft_mass_kg = Positive(aircraft, "mass_kg");
+      config.aircraft_mass_std_kg = NonNegative(aircraft, "mass_std_kg", 0.0);
+    } else if (options.require_runs) {
+      throw UserError(path + ": missing required key 'aircraft'");
+    }
+    aircraft.Finish();
+  }
+  {
+    YAML::Node g = root.Optional("gravity_mps2");
+    if (g.IsDefined() && !g.IsNull()) {
+      config.gravity_mps2 = root.AsDouble(g, "gravity_mps2");
+      if (!(config.gravity_mps2 > 0.0)) {
+        throw UserError(root.Where(g) + ": 'gravity_mps2' must be > 0");
+      }
+    }
+  }
+  ReadImu(Sub(root, "imu"), &config.imu);
+
+  if (root.Has("runs")) {
+    YamlMap runs = Sub(root, "runs");
+    config.runs.root = ResolvePath(folder, runs.RequiredString("root"));
+    const bool has_pattern = runs.Has("pattern"), has_table = runs.Has("table");
+    if (has_pattern == has_table) {
+      throw UserError(runs.Where(root.Optional("runs")) +
+                      ": 'runs' needs exactly one of 'pattern' or 'table'");
+    }
+    if (has_pattern) {
+      config.runs.pattern = runs.RequiredString("pattern");
+      if (fs::path(config.runs.pattern).is_absolute()) {
+        throw UserError(runs.Where(runs.Optional("pattern")) +
+                        ": 'runs.pattern' must be relative to runs.root");
+      }
+    } else {
+      config.runs.table = ResolvePath(folder, runs.RequiredString("table"));
+    }
+    const std::string source = runs.OptionalString("pitch_source", "nominal");
+    if (source == "nominal") {
+      config.runs.pitch_source = PitchSource::kNominal;
+    } else if (source == "measured") {
+      config.runs.pitch_source = PitchSource::kMeasured;
+    } else {
+      throw UserError(runs.Where(runs.Optional("pitch_source")) +
+                      ": 'runs.pitch_source' must be nominal or measured, not '" + source + "'");
+    }
+    if (config.runs.pitch_source == PitchSource::kMeasured && !config.imu.format.has_accel()) {
+      throw UserError(path + ": 'runs.pitch_source: measured' needs accelerometer columns (imu.accel)");
+    }
+    runs.Finish();
+  } else if (options.require_runs) {
+    throw UserError(path + ": missing required key 'runs'");
+  }
+
+  {
+    YamlMap fit = Sub(root, "fit");
+    const std::string model = fit.OptionalString("model", "full");
+    if (!ParsePendulumModel(model, &config.fit.model)) {
+      throw UserError(fit.Where(fit.Optional("model")) +
+                      ": 'fit.model' must be full, jardin or linear, not '" + model + "'");
+    }
+    YAML::Node windows = fit.Optional("windows");
+    if (windows.IsDefined() && !windows.IsNull()) {
+      if (!windows.IsMap()) {
+        throw UserError(fit.Where(windows) + ": 'fit.windows' must map file to [t0_s, t1_s]");
+      }
+      for (const auto& item : windows) {
+        const std::string key = "windows." + item.first.Scalar();
+        if (!item.second.IsSequence() || item.second.size() != 2) {
+          throw UserError(fit.Where(item.second) + ": 'fit." + key + "' must be [t0_s, t1_s]");
+        }
+        const double t0 = fit.AsDouble(item.second[0], key), t1 = fit.AsDouble(item.second[1], key);
+        if (!(t1 > t0)) {
+          throw UserError(fit.Where(item.second) + ": 'fit." + key + "' needs t0 < t1");
+        }
+        config.fit.windows_s[item.first.Scalar()] = {t0, t1};
+      }
+    }
+    if (fit.Has("max_amplitude_deg")) {
+      config.fit.max_amplitude_deg = fit.RequiredDouble("max_amplitude_deg");
+    }
+    if (fit.Has("min_amplitude_deg")) {
+      config.fit.min_amplitude_deg = fit.RequiredDouble("min_amplitude_deg");
+    }
+    for (const char* key : {"max_amplitude_deg", "min_amplitude_deg"}) {
+      const std::optional<double>& v =
+          std::string(key) == "max_amplitude_deg" ? config.fit.max_amplitude_deg
+                                                  : config.fit.min_amplitude_deg;
+      if (v && !(*v >= 0.0 && *v < 180.0)) {
+        throw UserError(fit.Where(fit.Optional(key)) + ": 'fit." + key + "' must be in [0, 180)");
+      }
+    }
+    YamlMap quality = Sub(fit, "quality");
+    QualityThresholds& q = config.fit.quality;
+    q.max_rms_over_noise = quality.OptionalDouble("max_rms_over_noise", q.max_rms_over_noise);
+    q.max_residual_autocorr =
+        quality.OptionalDouble("max_residual_autocorr", q.max_residual_autocorr);
+    q.whiteness_lags = quality.OptionalInt("whiteness_lags", q.whiteness_lags);
+    q.max_secondary_motion_ratio =
+        quality.OptionalDouble("max_secondary_motion_ratio", q.max_secondary_motion_ratio);
+    q.min_periods = quality.OptionalDouble("min_periods", q.min_periods);
+    if (!(q.max_rms_over_noise > 1.0) || !(q.max_residual_autocorr > 0.0) ||
+        !(q.max_residual_autocorr < 1.0) || q.whiteness_lags < 1 ||
+        !(q.max_secondary_motion_ratio >= 0.0) || !(q.min_periods >= 2.0)) {
+      throw UserError(quality.Where(fit.Optional("quality")) +
+                      ": 'fit.quality' out of range (max_rms_over_noise > 1, "
+                      "0 < max_residual_autocorr < 1, whiteness_lags >= 1, "
+                      "max_secondary_motion_ratio >= 0, min_periods >= 2)");
+    }
+    quality.Finish();
+    fit.Finish();
+  }
+  {
+    YamlMap ellipse = Sub(root, "ellipse");
+    EllipseConfig& e = config.ellipse;
+    e.bootstrap = ellipse.OptionalInt("bootstrap", e.bootstrap);
+    e.seed = static_cast<unsigned>(ellipse.OptionalInt("seed", static_cast<int>(e.seed)));
+    e.confidence = ellipse.OptionalDouble("confidence", e.confidence);
+    e.covariance = ellipse.OptionalString("covariance", e.covariance);
+    e.min_angles = ellipse.OptionalInt("min_angles", e.min_angles);
+    if (e.covariance != "auto" && e.covariance != "points" && e.covariance != "angle_means" &&
+        e.covariance != "absolute") {
+      throw UserError(ellipse.Where(ellipse.Optional("covariance")) +
+                      ": 'ellipse.covariance' must be auto, points, angle_means or absolute");
+    }
+    if (e.bootstrap < 0 || !(e.confidence > 0.0 && e.confidence < 1.0) || e.min_angles < 3) {
+      throw UserError(ellipse.Where(root.Optional("ellipse")) +
+                      ": 'ellipse' out of range (bootstrap >= 0, 0 < confidence < 1, "
+                      "min_angles >= 3)");
+    }
+    ellipse.Finish();
+  }
+  {
+    const std::string units = root.OptionalString("units", "si");
+    if (units == "si") {
+      config.units = DisplayUnits::kSi;
+    } else if (units == "imperial") {
+      config.units = DisplayUnits::kImperial;
+    } else {
+      throw UserError(root.Where(root.Optional("units")) + ": 'units' must be si or imperial, not '" +
+                      units + "'");
+    }
+  }
+  root.Finish();
+
+  std::string why;
+  if (!config.Check(&why)) throw UserError(path + ": " + why);
+  return config;
+}
+
+}  // namespace bifilar

@@ -1,0 +1,139 @@
+// The campaign configuration (YAML), shared by `bifilar process` and `bifilar fit`. Every key is
+// documented in configs/README.md; unknown keys are errors with their dotted path and line
+// (pipeline/yaml_reader.h), missing required keys are named. Relative paths are resolved against
+// the folder of the config file. All values in memory are SI (kg, m, m/s^2, kg m^2, deg for
+// pitch angles); `units` only chooses how the console and the report print them.
+// Conventions (pitch nose-up positive, swing axis = down vertical): ../shared/PHYSICS.md §2, §3.
+#pragma once
+
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pendulum/model.h"
+#include "pipeline/imu_format.h"
+
+namespace bifilar {
+
+enum class DisplayUnits { kSi, kImperial };        // "si" (kg m^2), "imperial" (slug ft^2)
+enum class PitchSource { kNominal, kMeasured };    // "nominal", "measured"
+constexpr double kSlugFt2PerKgM2 = 1.0 / 1.35581795;  // PHYSICS.md §4
+
+// How the rig's own inertia (subtracted from every total) is known: exactly one of three ways.
+struct RigInertiaSpec {
+  enum class Kind { kValue, kTable, kTare };
+  Kind kind = Kind::kValue;
+  double inertia_kg_m2 = 0.0;      // kValue: the rig's inertia about the swing axis (kg m^2)
+  double inertia_std_kg_m2 = 0.0;  // kValue/kTable: its standard uncertainty (kg m^2); >= 0
+  // kTable: pitch (deg) -> rig inertia (kg m^2); linear interpolation between entries, a pitch
+  // outside the table is an error for that trace.
+  std::map<double, double> table_kg_m2;
+  // kTare: the tare logs (absolute paths after discovery; the patterns as written are kept for
+  // the record). Fitted with the rig's own mass; rig inertia = their mean.
+  std::vector<std::string> tare_patterns;  // glob-like patterns relative to the config folder
+};
+
+struct RigUncertainties {
+  double filar_length_std_m = 0.0;      // standard uncertainty of L (m); >= 0; default 0
+  double filar_separation_std_m = 0.0;  // of D (m); >= 0; default 0
+  double mass_std_kg = 0.0;             // of the rig mass (kg); >= 0; default 0
+  double gravity_std_mps2 = 0.0;        // of g (m/s^2); >= 0; default 0
+};
+
+// The CSV layout of the logs and how the IMU sits on the aircraft.
+struct ImuConfig {
+  ImuFormat format;                      // columns and units
+  bool swing_axis_auto = true;           // `swing_axis: auto`
+  Eigen::Vector3d swing_axis_in_imu = Eigen::Vector3d::UnitZ();  // fixed axis (unit) otherwise
+  // Rotation taking IMU-frame vectors to body axes (x fwd, y right, z down); default identity.
+  Eigen::Matrix3d imu_to_body = Eigen::Matrix3d::Identity();
+};
+
+// Where the aircraft logs are and how their pitch is known.
+struct RunsConfig {
+  std::string root;      // absolute folder of the logs (resolved from the config folder)
+  // Pattern relative to root, '/'-separated; '*' matches any run of characters within one path
+  // component, '{pitch_deg}' matches a number (the nominal pitch, deg). Empty when `table` used.
+  std::string pattern;
+  std::string table;     // absolute path of a CSV table "path,pitch_deg" (paths relative to root)
+  PitchSource pitch_source = PitchSource::kNominal;
+};
+
+// Quality thresholds of the trace fit (issue 3 item 8; fit/trace_fit.h TraceFitOptions, same
+// names and defaults): a trace failing one is `rejected` with the reason.
+struct QualityThresholds {
+  double max_rms_over_noise = 1.5;          // residual RMS / noise (dimensionless); > 1
+  double max_residual_autocorr = 0.25;      // max |autocorrelation| of residuals, lags 1..L; (0,1)
+  int whiteness_lags = 10;                  // L (count); >= 1
+  double max_secondary_motion_ratio = 0.1;  // other-axes energy / swing-axis energy; >= 0
+  double min_periods = 2.0;                 // periods the window must hold (count); >= 2
+};
+
+struct FitConfig {
+  PendulumModel model = PendulumModel::kFull;  // `fit.model`: full | jardin | linear
+  // Per-file window overrides [t0, t1] (s), keyed by the path as written (relative to runs root
+  // or to the config folder for tare logs); the file names are resolved at load time.
+  std::map<std::string, std::array<double, 2>> windows_s;
+  std::optional<double> max_amplitude_deg;  // amplitude band, upper (deg); default: fit's own
+  std::optional<double> min_amplitude_deg;  // amplitude band, lower (deg); default: fit's own
+  QualityThresholds quality;
+};
+
+// Options of the ellipse fit (fit/ellipse.h EllipseOptions, same defaults).
+struct EllipseConfig {
+  int bootstrap = 2000;           // parametric bootstrap replicates (0 = covariance intervals)
+  unsigned seed = 1;              // seed of the bootstrap
+  double confidence = 0.95;       // confidence level of the intervals, in (0, 1)
+  std::string covariance = "auto";  // auto | points | angle_means | absolute
+  int min_angles = 3;             // distinct pitch angles needed to fit the ellipse; >= 3
+};
+
+struct CampaignConfig {
+  std::string file;          // absolute path of the config file
+  std::string folder;        // its folder: relative paths are resolved against it
+  std::string text;          // the YAML text as read (stored in results.json)
+
+  double filar_length_m = 0.0;      // L (m)
+  double filar_separation_m = 0.0;  // D (m)
+  double rig_mass_kg = 0.0;         // rig (+ IMU) mass (kg)
+  RigInertiaSpec rig_inertia;
+  RigUncertainties uncertainties;
+  double aircraft_mass_kg = 0.0;      // aircraft mass (kg); 0 when only tare logs are fitted
+  double aircraft_mass_std_kg = 0.0;  // its standard uncertainty (kg)
+  double gravity_mps2 = 9.80665;      // local gravity (m/s^2)
+  ImuConfig imu;
+  RunsConfig runs;       // absent (root empty) for a `fit`-only config
+  FitConfig fit;
+  EllipseConfig ellipse;
+  DisplayUnits units = DisplayUnits::kSi;
+
+  // Geometry of an aircraft trace (mass = aircraft + rig) and of a tare trace (rig alone).
+  RigGeometry AircraftGeometry() const;
+  RigGeometry TareGeometry() const;
+
+  bool Check(std::string* why) const;
+};
+
+struct ConfigLoadOptions {
+  bool require_runs = true;      // `process` needs runs/aircraft; `fit` only geometry + IMU
+};
+
+// Reads and validates `path`. Throws UserError naming the file, line and key on any problem.
+CampaignConfig LoadCampaignConfig(const std::string& path,
+                                  const ConfigLoadOptions& options = ConfigLoadOptions());
+
+const char* ToString(DisplayUnits units);
+const char* ToString(PitchSource source);
+
+// Inertia in the display units, and their name ("kg m^2" or "slug ft^2").
+double InertiaToDisplay(double inertia_kg_m2, DisplayUnits units);
+const char* InertiaUnitName(DisplayUnits units);
+
+// `path` resolved against `folder` unless absolute; lexically normalised.
+std::string ResolvePath(const std::string& folder, const std::string& path);
+
+}  // namespace bifilar

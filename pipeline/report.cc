@@ -1,0 +1,338 @@
+#include "pipeline/report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "pipeline/cache.h"
+#include "pipeline/results_json.h"
+#include "pipeline/user_error.h"
+
+namespace bifilar {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+std::string Escape(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+double Num(const json& j, const char* key) {
+  if (!j.is_object()) return NAN;
+  auto it = j.find(key);
+  return it != j.end() && it->is_number() ? it->get<double>() : NAN;
+}
+
+std::string Str(const json& j, const char* key) {
+  if (!j.is_object()) return "";
+  auto it = j.find(key);
+  return it != j.end() && it->is_string() ? it->get<std::string>() : "";
+}
+
+std::string Fmt(double value, const char* format = "%.4f") {
+  if (!std::isfinite(value)) return "&ndash;";
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), format, value);
+  return buffer;
+}
+
+struct Units {
+  bool imperial = false;
+  double scale = 1.0;  // display per kg m^2
+  std::string name = "kg m<sup>2</sup>";
+  std::string Inertia(double kg_m2, const char* format = "%.4f") const {
+    return Fmt(kg_m2 * scale, format);
+  }
+};
+
+// An estimate object of the ellipse JSON: {"value", "std", "ci_lo", "ci_hi", "defined"}.
+struct Estimate {
+  bool present = false, defined = false;
+  double value = NAN, std = NAN, lo = NAN, hi = NAN;
+};
+Estimate GetEstimate(const json& ellipse, const char* key) {
+  Estimate e;
+  if (!ellipse.is_object() || !ellipse.contains(key)) return e;
+  const json& j = ellipse[key];
+  e.present = true;
+  e.defined = !j.contains("defined") || j["defined"].get<bool>();
+  e.value = Num(j, "value");
+  e.std = Num(j, "std");
+  e.lo = Num(j, "ci_lo");
+  e.hi = Num(j, "ci_hi");
+  return e;
+}
+
+std::string Figure(const std::string& out_dir, const std::string& name, const std::string& alt,
+                   const std::string& css_class) {
+  if (name.empty()) return "<p class=\"note\">(no figure)</p>";
+  std::string bytes, why;
+  const std::string path = (fs::path(out_dir) / "figures" / name).string();
+  if (!ReadFileBytes(path, &bytes, &why)) {
+    return "<p class=\"note\">(figure " + Escape(name) + " missing)</p>";
+  }
+  const std::string ext = fs::path(name).extension().string();
+  const std::string mime = ext == ".png" ? "image/png" : "image/svg+xml";
+  return "<img class=\"" + css_class + "\" alt=\"" + Escape(alt) + "\" src=\"data:" + mime +
+         ";base64," + Base64(bytes) + "\">";
+}
+
+const char* kStyle = R"(
+body { font-family: sans-serif; margin: 2em auto; max-width: 1100px; color: #222; }
+h1 { font-size: 1.6em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: .2em; margin-top: 2em; }
+table { border-collapse: collapse; margin: .5em 0 1em; font-size: .9em; }
+th, td { border: 1px solid #ccc; padding: .25em .6em; text-align: right; }
+th { background: #f2f2f2; } td.l, th.l { text-align: left; }
+tr.rejected td { background: #fff4e0; } tr.error td { background: #fde8e8; }
+.note { color: #666; font-style: italic; }
+img.fig { max-width: 100%; border: 1px solid #ddd; }
+.traces { display: flex; flex-wrap: wrap; gap: 10px; }
+.traces figure { margin: 0; width: 540px; }
+.traces img { width: 540px; border: 1px solid #ddd; }
+figcaption { font-size: .8em; color: #444; }
+pre { background: #f7f7f7; padding: .8em; overflow-x: auto; font-size: .85em; }
+.ok { color: #1a7f37; } .bad { color: #b42318; }
+)";
+
+}  // namespace
+
+std::string Base64(const std::string& bytes) {
+  static const char* kTable = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  size_t i = 0;
+  const auto* b = reinterpret_cast<const unsigned char*>(bytes.data());
+  for (; i + 2 < bytes.size(); i += 3) {
+    const unsigned v = (b[i] << 16) | (b[i + 1] << 8) | b[i + 2];
+    out += kTable[(v >> 18) & 63];
+    out += kTable[(v >> 12) & 63];
+    out += kTable[(v >> 6) & 63];
+    out += kTable[v & 63];
+  }
+  if (i + 1 == bytes.size()) {
+    const unsigned v = b[i] << 16;
+    out += kTable[(v >> 18) & 63];
+    out += kTable[(v >> 12) & 63];
+    out += "==";
+  } else if (i + 2 == bytes.size()) {
+    const unsigned v = (b[i] << 16) | (b[i + 1] << 8);
+    out += kTable[(v >> 18) & 63];
+    out += kTable[(v >> 12) & 63];
+    out += kTable[(v >> 6) & 63];
+    out += '=';
+  }
+  return out;
+}
+
+std::string BuildReportHtml(const json& results, const std::string& out_dir) {
+  Units u;
+  if (Str(results, "units") == "imperial") {
+    u.imperial = true;
+    u.scale = 1.0 / 1.35581795;
+    u.name = "slug ft<sup>2</sup>";
+  }
+  const json& summary = results.contains("summary") ? results["summary"] : json::object();
+  const json& ellipse = results.contains("ellipse") ? results["ellipse"] : json(nullptr);
+  const json traces = results.contains("traces") ? results["traces"] : json::array();
+  const json angles = results.contains("angles") ? results["angles"] : json::array();
+  const json figures = results.contains("figures") ? results["figures"] : json::object();
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+    << "<title>bifilar report</title><style>" << kStyle << "</style></head><body>\n";
+  h << "<h1>Mass properties from bifilar pendulum swings</h1>\n";
+  h << "<p>bifilar " << Escape(Str(results, "version")) << " &middot; config <code>"
+    << Escape(Str(results, "config_file")) << "</code> &middot; pitch source "
+    << Escape(Str(results, "pitch_source")) << ". Traces: " << summary.value("n_traces", 0)
+    << " (<span class=\"ok\">" << summary.value("n_ok", 0) << " ok</span>, "
+    << summary.value("n_rejected", 0) << " rejected, " << summary.value("n_error", 0)
+    << " error); fits reused from cache: " << summary.value("n_reused", 0) << ".</p>\n";
+
+  // Table 2.
+  h << "<h2>Table 2: inertia properties</h2>\n";
+  if (ellipse.is_object()) {
+    h << "<table><tr><th class=\"l\">quantity</th><th>value</th><th>std</th><th>interval</th>"
+         "<th class=\"l\">unit</th></tr>\n";
+    struct Row { const char* key; const char* label; bool angle; };
+    for (const Row& row : {Row{"ix_kg_m2", "I<sub>x</sub>", false}, Row{"iz_kg_m2", "I<sub>z</sub>", false},
+                           Row{"ixz_kg_m2", "I<sub>xz</sub>", false}, Row{"tau_deg", "&tau; (principal inclination)", true},
+                           Row{"ixp_kg_m2", "I<sub>xp</sub> (principal)", false},
+                           Row{"izp_kg_m2", "I<sub>zp</sub> (principal)", false}}) {
+      const Estimate e = GetEstimate(ellipse, row.key);
+      if (!e.present) continue;
+      h << "<tr><td class=\"l\">" << row.label << "</td>";
+      if (!e.defined) {
+        h << "<td colspan=\"3\">ill-defined (I<sub>x</sub> &asymp; I<sub>z</sub>)</td>";
+      } else if (row.angle) {
+        h << "<td>" << Fmt(e.value) << "</td><td>" << Fmt(e.std) << "</td><td>[" << Fmt(e.lo)
+          << ", " << Fmt(e.hi) << "]</td>";
+      } else {
+        h << "<td>" << u.Inertia(e.value) << "</td><td>" << u.Inertia(e.std) << "</td><td>["
+          << u.Inertia(e.lo) << ", " << u.Inertia(e.hi) << "]</td>";
+      }
+      h << "<td class=\"l\">" << (row.angle ? "deg" : u.name) << "</td></tr>\n";
+    }
+    h << "</table>\n";
+    if (ellipse.contains("warnings")) {
+      for (const auto& w : ellipse["warnings"]) {
+        if (w.is_string()) h << "<p class=\"note\">" << Escape(w.get<std::string>()) << "</p>\n";
+      }
+    }
+  } else {
+    h << "<p class=\"bad\">" << Escape(summary.value("ellipse_message", std::string("ellipse not fitted")))
+      << "</p>\n";
+  }
+
+  // Table 1.
+  const json& t1 = results.contains("table1") ? results["table1"] : json::object();
+  h << "<h2>Table 1: data quality</h2>\n<table><tr><th class=\"l\">statistic</th><th>value</th>"
+       "<th class=\"l\">unit</th></tr>\n";
+  h << "<tr><td class=\"l\">raw data &sigma; (mean of per-angle standard deviations)</td><td>"
+    << u.Inertia(Num(t1, "raw_sigma_kg_m2")) << "</td><td class=\"l\">" << u.name << "</td></tr>\n";
+  h << "<tr><td class=\"l\">coefficient of variation (mean per angle)</td><td>"
+    << Fmt(Num(t1, "cv_percent"), "%.4f") << "</td><td class=\"l\">%</td></tr>\n";
+  h << "<tr><td class=\"l\">regression RMSE</td><td>" << u.Inertia(Num(t1, "regression_rmse_kg_m2"))
+    << "</td><td class=\"l\">" << u.name << "</td></tr>\n</table>\n";
+  const json& rig = results.contains("rig") ? results["rig"] : json::object();
+  h << "<p>Rig: L = " << Fmt(Num(rig, "filar_length_m"), "%.4f") << " m, D = "
+    << Fmt(Num(rig, "filar_separation_m"), "%.4f") << " m, rig mass "
+    << Fmt(Num(rig, "mass_kg"), "%.4f") << " kg, aircraft mass "
+    << Fmt(Num(rig, "aircraft_mass_kg"), "%.4f") << " kg, g = "
+    << Fmt(Num(rig, "gravity_mps2"), "%.5f") << " m/s<sup>2</sup>. Rig inertia ("
+    << Escape(Str(rig, "inertia_source")) << "): " << u.Inertia(Num(rig, "inertia_kg_m2"), "%.5f")
+    << " &plusmn; " << u.Inertia(Num(rig, "inertia_std_kg_m2"), "%.5f") << " " << u.name;
+  if (Str(rig, "inertia_source") == "tare") h << " from " << rig.value("tare_n", 0) << " tare log(s)";
+  h << ".</p>\n";
+
+  // Figures 3 and 4.
+  h << "<h2>Figure 3: moment of inertia against pitch</h2>\n"
+    << Figure(out_dir, Str(figures, "moments"), "moments of inertia against pitch angle", "fig")
+    << "\n<h2>Figure 4: ellipse of inertia</h2>\n"
+    << Figure(out_dir, Str(figures, "polar"), "polar plot of the ellipse of inertia", "fig") << "\n";
+
+  // NACA 467.
+  h << "<h2>NACA Report 467 comparison</h2>\n";
+  if (ellipse.is_object() && ellipse.contains("naca467") && !ellipse["naca467"].empty()) {
+    const Estimate ixz = GetEstimate(ellipse, "ixz_kg_m2");
+    h << "<p>I<sub>xz</sub> from one oblique angle (paper Eq. 1) against the multi-angle fit "
+      << u.Inertia(ixz.value) << " &plusmn; " << u.Inertia(ixz.std) << " " << u.name << ".</p>\n"
+      << "<table><tr><th>pitch (deg)</th><th>I<sub>xz</sub> NACA 467</th><th>std</th>"
+         "<th>difference from fit</th></tr>\n";
+    for (const auto& e : ellipse["naca467"]) {
+      const double v = Num(e, "ixz_kg_m2");
+      h << "<tr><td>" << Fmt(Num(e, "pitch_deg"), "%.1f") << "</td><td>" << u.Inertia(v)
+        << "</td><td>" << u.Inertia(Num(e, "ixz_std_kg_m2")) << "</td><td>"
+        << u.Inertia(v - ixz.value) << "</td></tr>\n";
+    }
+    h << "</table>\n";
+  } else {
+    h << "<p class=\"note\">No NACA 467 estimate (needs the ellipse fit and oblique angles).</p>\n";
+  }
+
+  // Per-angle statistics.
+  h << "<h2>Per-angle statistics</h2>\n<table><tr><th>pitch (deg)</th><th>n</th><th>mean ("
+    << u.name << ")</th><th>std</th><th>sem</th><th>CV (%)</th></tr>\n";
+  for (const auto& a : angles) {
+    h << "<tr><td>" << Fmt(Num(a, "pitch_deg"), "%.2f") << "</td><td>" << a.value("n", 0)
+      << "</td><td>" << u.Inertia(Num(a, "inertia_mean_kg_m2")) << "</td><td>"
+      << u.Inertia(Num(a, "inertia_std_kg_m2"), "%.5f") << "</td><td>"
+      << u.Inertia(Num(a, "inertia_sem_kg_m2"), "%.5f") << "</td><td>"
+      << Fmt(Num(a, "cv_percent"), "%.3f") << "</td></tr>\n";
+  }
+  h << "</table>\n";
+
+  // Rejected traces.
+  h << "<h2>Rejected and failed traces</h2>\n";
+  int bad = 0;
+  std::ostringstream rows;
+  for (const auto& t : traces) {
+    const std::string status = Str(t, "status");
+    if (status == "ok") continue;
+    ++bad;
+    rows << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
+         << "</td><td class=\"l\">" << Escape(status) << "</td><td class=\"l\">"
+         << Escape(Str(t, "message")) << "</td></tr>\n";
+  }
+  if (bad == 0) {
+    h << "<p class=\"ok\">None: every trace passed the quality checks.</p>\n";
+  } else {
+    h << "<table><tr><th class=\"l\">file</th><th class=\"l\">status</th><th class=\"l\">reason</th></tr>\n"
+      << rows.str() << "</table>\n";
+  }
+
+  // All traces.
+  h << "<h2>Traces</h2>\n<table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"
+       "<th class=\"l\">status</th><th>pitch (deg)</th><th>I total</th><th>std</th>"
+       "<th>I aircraft</th><th>std</th><th>window (s)</th><th>amplitude (deg)</th>"
+       "<th>rms/noise</th></tr>\n";
+  for (const auto& t : traces) {
+    const std::string status = Str(t, "status");
+    std::string window = "&ndash;", amplitude = "&ndash;";
+    if (t.contains("window_s") && t["window_s"].is_array()) {
+      window = Fmt(t["window_s"][0].get<double>(), "%.2f") + "&ndash;" +
+               Fmt(t["window_s"][1].get<double>(), "%.2f");
+    }
+    if (t.contains("amplitude_deg") && t["amplitude_deg"].is_array()) {
+      amplitude = Fmt(t["amplitude_deg"][0].get<double>(), "%.1f") + "&rarr;" +
+                  Fmt(t["amplitude_deg"][1].get<double>(), "%.1f");
+    }
+    h << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
+      << "</td><td class=\"l\">" << Escape(Str(t, "role")) << "</td><td class=\"l\">"
+      << Escape(status) << "</td><td>" << Fmt(Num(t, "pitch_used_deg"), "%.2f") << "</td><td>"
+      << u.Inertia(Num(t, "inertia_total_kg_m2"), "%.5f") << "</td><td>"
+      << u.Inertia(Num(t, "inertia_total_std_kg_m2"), "%.2e") << "</td><td>"
+      << u.Inertia(Num(t, "inertia_kg_m2"), "%.5f") << "</td><td>"
+      << u.Inertia(Num(t, "inertia_std_kg_m2"), "%.2e") << "</td><td>" << window << "</td><td>"
+      << amplitude << "</td><td>"
+      << Fmt(Num(t, "residual_rms_rad_per_s") / Num(t, "noise_rms_rad_per_s"), "%.2f")
+      << "</td></tr>\n";
+  }
+  h << "</table>\n";
+
+  h << "<h2>Fit and residual of every trace</h2>\n<div class=\"traces\">\n";
+  for (const auto& t : traces) {
+    const std::string fig = Str(t, "figure");
+    if (fig.empty()) continue;
+    h << "<figure>" << Figure(out_dir, fig, "fit of " + Str(t, "file"), "trace")
+      << "<figcaption>" << Escape(Str(t, "file")) << " &middot; " << Escape(Str(t, "status"))
+      << "</figcaption></figure>\n";
+  }
+  h << "</div>\n";
+
+  h << "<h2>Config used</h2>\n<pre>" << Escape(Str(results, "config")) << "</pre>\n";
+  h << "</body></html>\n";
+  return h.str();
+}
+
+void RunReport(const std::string& out_dir) {
+  std::error_code ec;
+  if (!fs::is_directory(out_dir, ec)) throw UserError(out_dir + ": no such folder");
+  const std::string path = (fs::path(out_dir) / "results.json").string();
+  std::string bytes, why;
+  if (!ReadFileBytes(path, &bytes, &why)) throw UserError(why);
+  json results;
+  try {
+    results = json::parse(bytes);
+  } catch (const std::exception& e) {
+    throw UserError(path + ": not valid JSON: " + e.what());
+  }
+  if (!results.is_object() || !results.contains("traces")) {
+    throw UserError(path + ": not a bifilar results file (no 'traces')");
+  }
+  WriteFileAtomically((fs::path(out_dir) / "report.html").string(),
+                      BuildReportHtml(results, out_dir));
+}
+
+}  // namespace bifilar

@@ -1,0 +1,26 @@
+// report.html: one self-contained page for a processed campaign, built from results.json alone
+// (plus the figure files in OUT/figures/, embedded as base64 data URIs, so the page needs no
+// other file): the paper's Table 1 and Table 2 in the chosen units, moments against pitch with
+// the fitted curve (Fig. 3), the polar ellipse with principal axes (Fig. 4), the NACA-467
+// comparison, per-angle statistics, every trace with its fit-and-residual figure, the rejected
+// traces with reasons, and the config used. Conventions: ../shared/PHYSICS.md §3, §4.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace bifilar {
+
+// The page for the results document `results` (ResultsToJson); figures are read from
+// `out_dir`/figures/. A missing figure is shown as a note, never an error.
+std::string BuildReportHtml(const nlohmann::json& results, const std::string& out_dir);
+
+// `bifilar report DIR`: rebuilds DIR/report.html from DIR/results.json (written atomically).
+// Throws UserError when DIR or its results.json is missing or unreadable.
+void RunReport(const std::string& out_dir);
+
+// RFC 4648 base64 of `bytes`.
+std::string Base64(const std::string& bytes);
+
+}  // namespace bifilar

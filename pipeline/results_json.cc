@@ -1,0 +1,257 @@
+#include "pipeline/results_json.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "pipeline/user_error.h"
+
+#ifndef BIFILAR_VERSION
+#define BIFILAR_VERSION "unknown"
+#endif
+
+namespace bifilar {
+namespace {
+
+using nlohmann::json;
+
+json Number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+
+json Pair(const std::array<double, 2>& v) {
+  if (!std::isfinite(v[0]) || !std::isfinite(v[1])) return json(nullptr);
+  return json::array({v[0], v[1]});
+}
+
+double GetNumber(const json& j, const char* key) {
+  auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return NAN;
+  if (!it->is_number()) throw UserError(std::string("trace record: '") + key + "' is not a number");
+  return it->get<double>();
+}
+
+std::array<double, 2> GetPair(const json& j, const char* key) {
+  auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return {NAN, NAN};
+  if (!it->is_array() || it->size() != 2) {
+    throw UserError(std::string("trace record: '") + key + "' is not a pair");
+  }
+  return {(*it)[0].is_number() ? (*it)[0].get<double>() : NAN,
+          (*it)[1].is_number() ? (*it)[1].get<double>() : NAN};
+}
+
+std::string GetString(const json& j, const char* key) {
+  auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return "";
+  if (!it->is_string()) throw UserError(std::string("trace record: '") + key + "' is not text");
+  return it->get<std::string>();
+}
+
+// CSV cell: numbers with full precision, NaN empty; text quoted when needed.
+std::string Cell(double value) {
+  if (!std::isfinite(value)) return "";
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.10g", value);
+  return buffer;
+}
+std::string Cell(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c == '\n' ? ' ' : c;
+  }
+  return quoted + "\"";
+}
+
+}  // namespace
+
+const char* ProgramVersion() { return BIFILAR_VERSION; }
+
+json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
+  json j;
+  j["file"] = r.file;
+  j["status"] = ToString(r.status);
+  j["message"] = r.message;
+  j["inertia_total_kg_m2"] = Number(r.inertia_total_kg_m2);
+  j["inertia_total_std_kg_m2"] = Number(r.inertia_total_std_kg_m2);
+  j["drag_coeff_kg_m2"] = Number(r.drag_coeff_kg_m2);
+  j["viscous_coeff_kg_m2_per_s"] = Number(r.viscous_coeff_kg_m2_per_s);
+  j["window_s"] = Pair(r.window_s);
+  j["amplitude_deg"] = Pair(r.amplitude_deg);
+  j["bias_rad_per_s"] = Number(r.bias_rad_per_s);
+  j["residual_rms_rad_per_s"] = Number(r.residual_rms_rad_per_s);
+  j["noise_rms_rad_per_s"] = Number(r.noise_rms_rad_per_s);
+  j["pitch_measured_deg"] = r.pitch_measured_deg ? Number(*r.pitch_measured_deg) : json(nullptr);
+  j["model"] = r.model;
+  j["iterations"] = r.iterations;
+  j["fit_seconds"] = r.fit_seconds;
+  json budget = json::object();
+  for (const BudgetTerm& term : r.budget) budget[term.name + "_kg_m2"] = Number(term.std_kg_m2);
+  budget["total_kg_m2"] = Number(r.budget_total_std_kg_m2);
+  j["budget"] = budget;
+  j["flags"] = r.flags;
+  j["figure"] = r.figure;
+  if (campaign_fields) {
+    j["role"] = ToString(r.role);
+    j["content_hash"] = r.content_hash;
+    j["cache_key"] = r.cache_key;
+    j["from_cache"] = r.from_cache;
+    j["pitch_nominal_deg"] = r.pitch_nominal_deg ? Number(*r.pitch_nominal_deg) : json(nullptr);
+    j["pitch_used_deg"] = Number(r.pitch_used_deg);
+    j["rig_inertia_kg_m2"] = Number(r.rig_inertia_kg_m2);
+    j["inertia_kg_m2"] = Number(r.inertia_kg_m2);
+    j["inertia_std_kg_m2"] = Number(r.inertia_std_kg_m2);
+  }
+  return j;
+}
+
+TraceRecord TraceRecordFromJson(const json& j) {
+  if (!j.is_object()) throw UserError("trace record: not a JSON object");
+  TraceRecord r;
+  r.file = GetString(j, "file");
+  if (!ParseTraceStatus(GetString(j, "status"), &r.status)) {
+    throw UserError("trace record: bad 'status'");
+  }
+  r.message = GetString(j, "message");
+  r.inertia_total_kg_m2 = GetNumber(j, "inertia_total_kg_m2");
+  r.inertia_total_std_kg_m2 = GetNumber(j, "inertia_total_std_kg_m2");
+  r.drag_coeff_kg_m2 = GetNumber(j, "drag_coeff_kg_m2");
+  r.viscous_coeff_kg_m2_per_s = GetNumber(j, "viscous_coeff_kg_m2_per_s");
+  r.window_s = GetPair(j, "window_s");
+  r.amplitude_deg = GetPair(j, "amplitude_deg");
+  r.bias_rad_per_s = GetNumber(j, "bias_rad_per_s");
+  r.residual_rms_rad_per_s = GetNumber(j, "residual_rms_rad_per_s");
+  r.noise_rms_rad_per_s = GetNumber(j, "noise_rms_rad_per_s");
+  const double pitch = GetNumber(j, "pitch_measured_deg");
+  if (std::isfinite(pitch)) r.pitch_measured_deg = pitch;
+  r.model = GetString(j, "model");
+  r.iterations = j.value("iterations", 0);
+  r.fit_seconds = GetNumber(j, "fit_seconds");
+  if (auto it = j.find("budget"); it != j.end() && it->is_object()) {
+    for (auto& [key, value] : it->items()) {
+      const std::string suffix = "_kg_m2";
+      std::string name = key.size() > suffix.size() ? key.substr(0, key.size() - suffix.size()) : key;
+      const double v = value.is_number() ? value.get<double>() : NAN;
+      if (name == "total") {
+        r.budget_total_std_kg_m2 = v;
+      } else {
+        r.budget.push_back({name, v});
+      }
+    }
+  }
+  if (auto it = j.find("flags"); it != j.end() && it->is_array()) {
+    for (const auto& flag : *it) r.flags.push_back(flag.get<std::string>());
+  }
+  r.figure = GetString(j, "figure");
+  if (j.contains("role")) r.role = GetString(j, "role") == "tare" ? TraceRole::kTare : TraceRole::kAircraft;
+  r.content_hash = GetString(j, "content_hash");
+  r.cache_key = GetString(j, "cache_key");
+  r.from_cache = j.value("from_cache", false);
+  const double nominal = GetNumber(j, "pitch_nominal_deg");
+  if (std::isfinite(nominal)) r.pitch_nominal_deg = nominal;
+  r.pitch_used_deg = GetNumber(j, "pitch_used_deg");
+  r.rig_inertia_kg_m2 = GetNumber(j, "rig_inertia_kg_m2");
+  r.inertia_kg_m2 = GetNumber(j, "inertia_kg_m2");
+  r.inertia_std_kg_m2 = GetNumber(j, "inertia_std_kg_m2");
+  return r;
+}
+
+json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
+  json j;
+  j["program"] = "bifilar";
+  j["version"] = ProgramVersion();
+  j["config_file"] = config.file;
+  j["config"] = config.text;
+  j["units"] = ToString(config.units);
+  j["pitch_source"] = ToString(config.runs.pitch_source);
+  json summary;
+  const CampaignSummary& s = result.summary;
+  summary["n_traces"] = s.n_traces;
+  summary["n_ok"] = s.n_ok;
+  summary["n_rejected"] = s.n_rejected;
+  summary["n_error"] = s.n_error;
+  summary["n_fitted"] = s.n_fitted;
+  summary["n_reused"] = s.n_reused;
+  summary["wall_s"] = s.wall_s;
+  summary["ellipse_fitted"] = s.ellipse_fitted;
+  summary["ellipse_message"] = s.ellipse_message;
+  summary["exit_code"] = s.exit_code;
+  j["summary"] = summary;
+  json rig;
+  rig["filar_length_m"] = config.filar_length_m;
+  rig["filar_separation_m"] = config.filar_separation_m;
+  rig["mass_kg"] = config.rig_mass_kg;
+  rig["aircraft_mass_kg"] = config.aircraft_mass_kg;
+  rig["gravity_mps2"] = config.gravity_mps2;
+  rig["inertia_source"] = config.rig_inertia.kind == RigInertiaSpec::Kind::kValue   ? "value"
+                          : config.rig_inertia.kind == RigInertiaSpec::Kind::kTable ? "table"
+                                                                                    : "tare";
+  rig["inertia_kg_m2"] = Number(result.rig_inertia_kg_m2);
+  rig["inertia_std_kg_m2"] = Number(result.rig_inertia_std_kg_m2);
+  rig["tare_n"] = result.rig_tare_n;
+  j["rig"] = rig;
+  json table1;
+  table1["raw_sigma_kg_m2"] = Number(result.raw_sigma_kg_m2);
+  table1["cv_percent"] = Number(result.cv_percent);
+  table1["regression_rmse_kg_m2"] = Number(result.regression_rmse_kg_m2);
+  j["table1"] = table1;
+  json traces = json::array();
+  for (const TraceRecord& r : result.traces) traces.push_back(TraceRecordToJson(r));
+  j["traces"] = traces;
+  json angles = json::array();
+  for (const AngleStats& a : result.angles) {
+    angles.push_back({{"pitch_deg", Number(a.pitch_deg)},
+                      {"n", a.n},
+                      {"inertia_mean_kg_m2", Number(a.inertia_mean_kg_m2)},
+                      {"inertia_std_kg_m2", Number(a.inertia_std_kg_m2)},
+                      {"inertia_sem_kg_m2", Number(a.inertia_sem_kg_m2)},
+                      {"cv_percent", Number(a.cv_percent)},
+                      {"fit_std_mean_kg_m2", Number(a.fit_std_mean_kg_m2)}});
+  }
+  j["angles"] = angles;
+  j["ellipse"] = result.ellipse;
+  j["figures"] = {{"moments", result.moments_figure}, {"polar", result.polar_figure}};
+  return j;
+}
+
+std::string TracesCsv(const CampaignResult& result) {
+  std::ostringstream out;
+  out << "file,role,status,pitch_nominal_deg,pitch_measured_deg,pitch_used_deg,"
+         "inertia_total_kg_m2,inertia_total_std_kg_m2,rig_inertia_kg_m2,inertia_kg_m2,"
+         "inertia_std_kg_m2,budget_total_std_kg_m2,drag_coeff_kg_m2,viscous_coeff_kg_m2_per_s,"
+         "window_t0_s,window_t1_s,amplitude_start_deg,amplitude_end_deg,bias_rad_per_s,"
+         "residual_rms_rad_per_s,model,iterations,fit_seconds,from_cache,message\n";
+  for (const TraceRecord& r : result.traces) {
+    out << Cell(r.file) << ',' << ToString(r.role) << ',' << ToString(r.status) << ','
+        << Cell(r.pitch_nominal_deg ? *r.pitch_nominal_deg : NAN) << ','
+        << Cell(r.pitch_measured_deg ? *r.pitch_measured_deg : NAN) << ','
+        << Cell(r.pitch_used_deg) << ',' << Cell(r.inertia_total_kg_m2) << ','
+        << Cell(r.inertia_total_std_kg_m2) << ',' << Cell(r.rig_inertia_kg_m2) << ','
+        << Cell(r.inertia_kg_m2) << ',' << Cell(r.inertia_std_kg_m2) << ','
+        << Cell(r.budget_total_std_kg_m2) << ',' << Cell(r.drag_coeff_kg_m2) << ','
+        << Cell(r.viscous_coeff_kg_m2_per_s) << ',' << Cell(r.window_s[0]) << ','
+        << Cell(r.window_s[1]) << ',' << Cell(r.amplitude_deg[0]) << ','
+        << Cell(r.amplitude_deg[1]) << ',' << Cell(r.bias_rad_per_s) << ','
+        << Cell(r.residual_rms_rad_per_s) << ',' << Cell(r.model) << ',' << r.iterations << ','
+        << Cell(r.fit_seconds) << ',' << (r.from_cache ? "true" : "false") << ','
+        << Cell(r.message) << '\n';
+  }
+  return out.str();
+}
+
+std::string AnglesCsv(const CampaignResult& result) {
+  std::ostringstream out;
+  out << "pitch_deg,n,inertia_mean_kg_m2,inertia_std_kg_m2,inertia_sem_kg_m2,cv_percent,"
+         "fit_std_mean_kg_m2\n";
+  for (const AngleStats& a : result.angles) {
+    out << Cell(a.pitch_deg) << ',' << a.n << ',' << Cell(a.inertia_mean_kg_m2) << ','
+        << Cell(a.inertia_std_kg_m2) << ',' << Cell(a.inertia_sem_kg_m2) << ','
+        << Cell(a.cv_percent) << ',' << Cell(a.fit_std_mean_kg_m2) << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace bifilar

@@ -1,0 +1,87 @@
+// One IMU log file -> one trace record: read the CSV, find the swing axis and the measured pitch,
+// the free-oscillation window and the amplitude band, fit the pendulum model, draw the
+// fit-and-residual figure. Used by `bifilar process` (for every log of a campaign, from worker
+// threads) and by `bifilar fit`. Any failure of one file becomes status `error` with a message
+// naming the file; nothing throws out of ProcessTrace.
+// Conventions: ../shared/PHYSICS.md §2 (psi, I total = rig + aircraft), §3 (pitch).
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pipeline/config.h"
+
+namespace bifilar {
+
+enum class TraceStatus { kOk, kRejected, kError };
+const char* ToString(TraceStatus status);  // "ok", "rejected", "error"
+bool ParseTraceStatus(const std::string& name, TraceStatus* status);
+
+enum class TraceRole { kAircraft, kTare };  // an aircraft run, or a tare log of the rig alone
+const char* ToString(TraceRole role);        // "aircraft", "tare"
+
+// One term of the systematic uncertainty budget of I (issue 3 item 7).
+struct BudgetTerm {
+  std::string name;        // "filar_length", "filar_separation", "mass", "gravity", ...
+  double std_kg_m2 = 0.0;  // first-order contribution to the std of I (kg m^2)
+};
+
+// Every field of the per-trace JSON record (issue 3 item 9) plus the campaign's additions.
+// Numbers that do not apply are NaN in memory and null in JSON.
+struct TraceRecord {
+  // --- fit of the log (cached per content hash + fit settings) ---
+  std::string file;                      // path as shown to the user (relative to the config)
+  TraceStatus status = TraceStatus::kError;
+  std::string message;                   // why rejected/error; warnings for ok
+  double inertia_total_kg_m2 = NAN;      // fitted I of everything suspended (kg m^2)
+  double inertia_total_std_kg_m2 = NAN;  // its standard error from the fit (kg m^2)
+  double drag_coeff_kg_m2 = NAN;         // K_D
+  double viscous_coeff_kg_m2_per_s = NAN;  // C
+  std::array<double, 2> window_s = {NAN, NAN};       // fitted window [t0, t1] (s)
+  std::array<double, 2> amplitude_deg = {NAN, NAN};  // amplitude at start/end of the fitted part
+  double bias_rad_per_s = NAN;           // gyro bias b
+  double residual_rms_rad_per_s = NAN;
+  double noise_rms_rad_per_s = NAN;      // gyro noise estimated from the rest segment
+  std::optional<double> pitch_measured_deg;  // from the accelerometer; none without one
+  std::string model;                     // "full", "jardin", "linear"
+  int iterations = 0;
+  double fit_seconds = 0.0;              // wall time of this file's processing (s)
+  std::vector<BudgetTerm> budget;        // systematic contributions (L, D, m, g)
+  double budget_total_std_kg_m2 = NAN;   // root-sum-square of the budget terms
+  std::vector<std::string> flags;        // quality flags raised (a failing one rejects)
+  std::string figure;                    // fit figure file name inside OUT/figures/, "" if none
+
+  // --- campaign bookkeeping (not cached) ---
+  TraceRole role = TraceRole::kAircraft;
+  std::string content_hash;              // 16 hex digits, FNV-1a 64 of the file bytes
+  std::string cache_key;                 // 16 hex digits, content hash + fit settings
+  bool from_cache = false;
+  std::optional<double> pitch_nominal_deg;  // from the path or table
+  double pitch_used_deg = NAN;           // nominal or measured, per runs.pitch_source
+  double rig_inertia_kg_m2 = NAN;        // subtracted tare at this pitch
+  double inertia_kg_m2 = NAN;            // aircraft alone = total - rig (kg m^2)
+  double inertia_std_kg_m2 = NAN;        // sqrt(fit std^2 + rig std^2)
+
+  bool ok() const { return status == TraceStatus::kOk; }
+};
+
+struct TraceProcessOptions {
+  TraceRole role = TraceRole::kAircraft;  // chooses the suspended mass (aircraft + rig, or rig)
+  std::string display_name;               // `file` of the record; default: the path
+  // Window override [t0, t1] (s); takes precedence over the config's per-file windows.
+  std::optional<std::array<double, 2>> window_s;
+  std::string figure_path;  // write the fit figure here (.svg or .png); "" = no figure
+};
+
+// Processes one log. Never throws: every failure is a record with status error naming the file.
+TraceRecord ProcessTrace(const CampaignConfig& config, const std::string& path,
+                         const TraceProcessOptions& options);
+
+// The window override of the config for `path` (absolute), if any: keys of fit.windows are
+// matched relative to runs.root and to the config folder.
+std::optional<std::array<double, 2>> ConfigWindowFor(const CampaignConfig& config,
+                                                     const std::string& path);
+
+}  // namespace bifilar
