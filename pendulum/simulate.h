@@ -185,8 +185,8 @@ struct CampaignSpec {
   double tare_pitch_deg = 0.0;       // rig pitch for the tare logs (nominal)
   double pitch_error_sigma_deg = 0.5;       // true pitch = nominal + N(0, sigma), per log; >= 0
   UniformRange amplitude_deg = {5.0, 30.0}; // |psi(t_release)| (deg); 0 < min, max < 80
-  UniformRange drag_coeff_kg_m2 = {0.002, 0.01};          // K_D per log
-  UniformRange viscous_coeff_kg_m2_per_s = {0.0005, 0.003};  // C per log
+  UniformRange drag_coeff_kg_m2 = {0.02, 0.08};            // K_D per log
+  UniformRange viscous_coeff_kg_m2_per_s = {0.005, 0.02};  // C per log
 
   bool Check(std::string* why) const;
 };

@@ -1,0 +1,676 @@
+#include "pipeline/simulate_spec.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/user_error.h"
+#include "pipeline/yaml_reader.h"
+
+#ifndef BIFILAR_VERSION
+#define BIFILAR_VERSION "unknown"
+#endif
+
+namespace bifilar {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+constexpr double kSlugFt2ToKgM2 = 1.35581795;  // PHYSICS.md §4
+
+// root.Child(key), safe when the section is absent (yaml-cpp's const operator[] returns an
+// invalid "zombie" node for a missing key, on which IsMap() throws).
+YamlMap Section(YamlMap& root, const std::string& key) {
+  if (root.Has(key)) return root.Child(key);
+  root.Optional(key);
+  return YamlMap(YAML::Node(YAML::NodeType::Null), root.file(), root.KeyPath(key));
+}
+
+std::string Num(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%g", value);
+  return buffer;
+}
+
+// Reads a number that must lie in a range; the message names the key, line and range.
+double ReadValue(YamlMap& map, const std::string& key, double fallback, double lower,
+                 bool lower_open, double upper) {
+  const YAML::Node node = map.Optional(key);
+  if (!node.IsDefined() || node.IsNull()) return fallback;
+  const double value = map.AsDouble(node, key);
+  const bool ok = (lower_open ? value > lower : value >= lower) && value <= upper;
+  if (!ok) {
+    throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' = " + Num(value) +
+                    " is out of range; allowed " + (lower_open ? "(" : "[") + Num(lower) + ", " +
+                    (std::isinf(upper) ? std::string("inf)") : Num(upper) + "]"));
+  }
+  return value;
+}
+
+std::optional<double> ReadOptionalValue(YamlMap& map, const std::string& key, double lower,
+                                        bool lower_open, double upper) {
+  if (!map.Has(key)) {
+    map.Optional(key);
+    return std::nullopt;
+  }
+  return ReadValue(map, key, 0.0, lower, lower_open, upper);
+}
+
+// A range: a number (fixed) or a list [min, max].
+UniformRange ReadRange(YamlMap& map, const std::string& key, UniformRange fallback, double lower,
+                       bool lower_open, double upper) {
+  const YAML::Node node = map.Optional(key);
+  if (!node.IsDefined() || node.IsNull()) return fallback;
+  UniformRange r;
+  if (node.IsSequence()) {
+    if (node.size() != 2) {
+      throw UserError(map.Where(node) + ": '" + map.KeyPath(key) +
+                      "' must be a number or a list [min, max]");
+    }
+    r.min = map.AsDouble(node[0], key);
+    r.max = map.AsDouble(node[1], key);
+  } else {
+    r.min = r.max = map.AsDouble(node, key);
+  }
+  const bool ok = (lower_open ? r.min > lower : r.min >= lower) && r.max <= upper && r.min <= r.max;
+  if (!ok) {
+    throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' = [" + Num(r.min) + ", " +
+                    Num(r.max) + "] is out of range; allowed min <= max within " +
+                    (lower_open ? "(" : "[") + Num(lower) + ", " +
+                    (std::isinf(upper) ? std::string("inf)") : Num(upper) + "]"));
+  }
+  return r;
+}
+
+Eigen::Vector3d ReadVector3(YamlMap& map, const std::string& key, Eigen::Vector3d fallback) {
+  const YAML::Node node = map.Optional(key);
+  if (!node.IsDefined() || node.IsNull()) return fallback;
+  if (!node.IsSequence() || node.size() != 3) {
+    throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be a list of 3 numbers");
+  }
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) v[i] = map.AsDouble(node[i], key);
+  return v;
+}
+
+std::array<std::string, 3> ReadColumns(YamlMap& map, const std::string& key,
+                                       const std::array<std::string, 3>& fallback) {
+  const YAML::Node node = map.Optional(key);
+  if (!node.IsDefined() || node.IsNull()) return fallback;
+  if (!node.IsSequence() || node.size() != 3) {
+    throw UserError(map.Where(node) + ": '" + map.KeyPath(key) +
+                    "' must be a list of 3 column names (x, y, z)");
+  }
+  std::array<std::string, 3> out;
+  for (int i = 0; i < 3; ++i) out[i] = map.AsString(node[i], key);
+  return out;
+}
+
+template <typename Unit, typename Parse>
+Unit ReadUnit(YamlMap& map, const std::string& key, Unit fallback, Parse parse, const char* allowed) {
+  const YAML::Node node = map.Optional(key);
+  if (!node.IsDefined() || node.IsNull()) return fallback;
+  const std::string name = map.AsString(node, key);
+  Unit unit = fallback;
+  if (!parse(name, &unit)) {
+    throw UserError(map.Where(node) + ": unknown unit '" + name + "' for '" + map.KeyPath(key) +
+                    "'; allowed " + allowed);
+  }
+  return unit;
+}
+
+void ReadFormat(YamlMap map, SimulateSpec* spec) {
+  ImuFormat& f = spec->format;
+  f.time_column = map.OptionalString("time_column", f.time_column);
+  f.time_unit = ReadUnit(map, "time_unit", f.time_unit,
+                         [](const std::string& n, TimeUnit* u) { return ParseTimeUnit(n, u); },
+                         "s, ms, us");
+  f.gyro_columns = ReadColumns(map, "gyro_columns", f.gyro_columns);
+  f.gyro_unit = ReadUnit(map, "gyro_unit", f.gyro_unit,
+                         [](const std::string& n, RateUnit* u) { return ParseRateUnit(n, u); },
+                         "rad/s, deg/s");
+  f.accel_columns = ReadColumns(map, "accel_columns", f.accel_columns);
+  f.accel_unit = ReadUnit(map, "accel_unit", f.accel_unit,
+                          [](const std::string& n, AccelUnit* u) { return ParseAccelUnit(n, u); },
+                          "m/s^2, g");
+  const YAML::Node delim = map.Optional("delimiter");
+  if (delim.IsDefined() && !delim.IsNull()) {
+    const std::string d = map.AsString(delim, "delimiter");
+    if (d.size() != 1 || d == "\"" || d == "\n" || d == "\r" || std::isalnum(static_cast<unsigned char>(d[0])) ||
+        d == "." || d == "-" || d == "+") {
+      throw UserError(map.Where(delim) + ": 'format.delimiter' must be one character such as "
+                      "',', ';' or a tab");
+    }
+    f.delimiter = d[0];
+  }
+  spec->write.significant_digits =
+      static_cast<int>(ReadValue(map, "significant_digits", 9, 6, false, 17));
+  map.Finish();
+  std::string why;
+  if (!f.Check(&why)) throw UserError(map.Where(YAML::Node()) + ": format: " + why);
+}
+
+void ReadTimeline(YamlMap map, TimelineOptions* t) {
+  const double inf = INFINITY;
+  t->rest_before_s = ReadRange(map, "rest_before_s", t->rest_before_s, 0, false, 3600);
+  t->twist_s = ReadRange(map, "twist_s", t->twist_s, 0, true, 60);
+  t->hold_s = ReadRange(map, "hold_s", t->hold_s, 0, false, 600);
+  t->tremor_deg = ReadValue(map, "tremor_deg", t->tremor_deg, 0, false, 5);
+  t->tremor_hz = ReadRange(map, "tremor_hz", t->tremor_hz, 0, true, 50);
+  t->release_rate_sigma_deg_per_s =
+      ReadValue(map, "release_rate_sigma_deg_per_s", t->release_rate_sigma_deg_per_s, 0, false, 90);
+  t->free_s = ReadRange(map, "free_s", t->free_s, 0, true, 86400);
+  t->stop_probability = ReadValue(map, "stop_probability", t->stop_probability, 0, false, 1);
+  t->stop_time_constant_s =
+      ReadValue(map, "stop_time_constant_s", t->stop_time_constant_s, 0, true, 10);
+  t->rest_after_s = ReadRange(map, "rest_after_s", t->rest_after_s, 0, false, 3600);
+  (void)inf;
+  map.Finish();
+}
+
+void ReadSensor(YamlMap map, SensorOptions* s) {
+  s->sample_rate_hz = ReadValue(map, "sample_rate_hz", s->sample_rate_hz, 0, true, 100000);
+  s->time_jitter_sigma_s =
+      ReadValue(map, "time_jitter_sigma_s", s->time_jitter_sigma_s, 0, false, 1.0 / s->sample_rate_hz);
+  s->drop_fraction = ReadValue(map, "drop_fraction", s->drop_fraction, 0, false, 0.5);
+  s->drop_burst_probability =
+      ReadValue(map, "drop_burst_probability", s->drop_burst_probability, 0, false, 1);
+  s->drop_burst_max_samples = static_cast<int>(
+      ReadValue(map, "drop_burst_max_samples", s->drop_burst_max_samples, 2, false, 100000));
+  s->start_time_s = ReadRange(map, "start_time_s", s->start_time_s, -1e9, false, 1e9);
+  s->gyro_noise_sigma_deg_per_s =
+      ReadValue(map, "gyro_noise_sigma_deg_per_s", s->gyro_noise_sigma_deg_per_s, 0, false, 100);
+  s->gyro_bias_sigma_deg_per_s =
+      ReadValue(map, "gyro_bias_sigma_deg_per_s", s->gyro_bias_sigma_deg_per_s, 0, false, 100);
+  s->gyro_scale_error_sigma =
+      ReadValue(map, "gyro_scale_error_sigma", s->gyro_scale_error_sigma, 0, false, 0.2);
+  s->accelerometer = map.OptionalBool("accelerometer", s->accelerometer);
+  s->accel_noise_sigma_mps2 =
+      ReadValue(map, "accel_noise_sigma_mps2", s->accel_noise_sigma_mps2, 0, false, 10);
+  s->accel_bias_sigma_mps2 =
+      ReadValue(map, "accel_bias_sigma_mps2", s->accel_bias_sigma_mps2, 0, false, 10);
+  s->rocking_max_deg = ReadValue(map, "rocking_max_deg", s->rocking_max_deg, 0, false, 10);
+  s->rocking_frequency_hz =
+      ReadValue(map, "rocking_frequency_hz", s->rocking_frequency_hz, 0, false, s->sample_rate_hz / 4);
+  s->rocking_decay_s = ReadValue(map, "rocking_decay_s", s->rocking_decay_s, 0, true, 1e6);
+  map.Finish();
+}
+
+// Moments of inertia given either in kg m^2 or in slug ft^2 (exactly one of the two keys).
+double ReadInertia(YamlMap& map, const std::string& stem, bool required, double lower,
+                   bool lower_open) {
+  const std::string si = stem + "_kg_m2", imperial = stem + "_slug_ft2";
+  const bool has_si = map.Has(si), has_imperial = map.Has(imperial);
+  if (has_si && has_imperial) {
+    throw UserError(map.Where(map.Optional(imperial)) + ": give either '" + map.KeyPath(si) +
+                    "' or '" + map.KeyPath(imperial) + "', not both");
+  }
+  if (has_imperial) {
+    map.Optional(si);
+    return kSlugFt2ToKgM2 * ReadValue(map, imperial, 0, lower, lower_open, 1e9);
+  }
+  map.Optional(imperial);
+  if (!has_si && required) {
+    throw UserError(map.file() + ": missing required key '" + map.KeyPath(si) + "' (or '" +
+                    map.KeyPath(imperial) + "')");
+  }
+  return ReadValue(map, si, 0.0, lower, lower_open, 1e9);
+}
+
+void ReadGeometry(YamlMap map, std::optional<double>* length, std::optional<double>* separation,
+                  double* gravity) {
+  const double inf = INFINITY;
+  const YAML::Node length_node = map.Optional("filar_length_m");
+  *length = ReadOptionalValue(map, "filar_length_m", 0, true, 1000);
+  *separation = ReadOptionalValue(map, "filar_separation_m", 0, true, 1000);
+  *gravity = ReadValue(map, "gravity_mps2", *gravity, 0, true, 100);
+  (void)inf;
+  if (length->has_value() && separation->has_value() && !(**length > **separation)) {
+    throw UserError(map.Where(length_node) + ": '" + map.KeyPath("filar_length_m") + "' = " +
+                    Num(**length) + " must be greater than '" + map.KeyPath("filar_separation_m") +
+                    "' = " + Num(**separation) + " (the wires would go slack); allowed L > D > 0");
+  }
+  map.Finish();
+}
+
+SimulateSpec ParseSpec(YamlMap root) {
+  SimulateSpec spec;
+  spec.file = root.file();
+  const double inf = INFINITY;
+  {
+    const YAML::Node seed = root.Optional("seed");
+    if (seed.IsDefined() && !seed.IsNull()) {
+      unsigned long long value = 0;
+      if (!seed.IsScalar() || !YAML::convert<unsigned long long>::decode(seed, value)) {
+        throw UserError(root.Where(seed) + ": 'seed' must be a non-negative integer");
+      }
+      spec.seed = value;
+    }
+  }
+  {
+    const YAML::Node model = root.Optional("model");
+    if (model.IsDefined() && !model.IsNull()) {
+      const std::string name = root.AsString(model, "model");
+      if (!ParsePendulumModel(name, &spec.options.model)) {
+        throw UserError(root.Where(model) + ": unknown model '" + name +
+                        "' for 'model'; allowed full, jardin, linear");
+      }
+    }
+  }
+  std::optional<double> length, separation;
+  double gravity = 9.80665;
+  ReadGeometry(Section(root, "geometry"), &length, &separation, &gravity);
+  ReadFormat(Section(root, "format"), &spec);
+  ReadTimeline(Section(root, "timeline"), &spec.options.timeline);
+  ReadSensor(Section(root, "sensor"), &spec.options.sensor);
+
+  CampaignSpec& c = spec.campaign;
+  {
+    YamlMap swing = Section(root, "swing");
+    c.amplitude_deg = ReadRange(swing, "amplitude_deg", c.amplitude_deg, 0, true, 75);
+    spec.options.negative_amplitude_probability =
+        ReadValue(swing, "negative_amplitude_probability",
+                  spec.options.negative_amplitude_probability, 0, false, 1);
+    c.drag_coeff_kg_m2 = ReadRange(swing, "drag_coeff_kg_m2", c.drag_coeff_kg_m2, 0, false, inf);
+    c.viscous_coeff_kg_m2_per_s =
+        ReadRange(swing, "viscous_coeff_kg_m2_per_s", c.viscous_coeff_kg_m2_per_s, 0, false, inf);
+    spec.options.sway_coupling_at_60deg =
+        ReadValue(swing, "sway_coupling_percent_at_60deg", 0.0, 0, false, 50) / 100.0;
+    swing.Finish();
+  }
+
+  const bool has_aircraft = root.Has("aircraft"), has_rig = root.Has("rig"),
+             has_campaign = root.Has("campaign");
+  spec.has_campaign = has_aircraft || has_rig || has_campaign;
+  if (spec.has_campaign) {
+    YamlMap aircraft = Section(root, "aircraft");
+    if (!has_aircraft) root.Required("aircraft");
+    c.aircraft.mass_kg = aircraft.RequiredDouble("mass_kg");
+    c.aircraft.mass_kg = ReadValue(aircraft, "mass_kg", 0, 0, true, 1e6);
+    c.aircraft.ix_kg_m2 = ReadInertia(aircraft, "ix", true, 0, true);
+    c.aircraft.iz_kg_m2 = ReadInertia(aircraft, "iz", true, 0, true);
+    c.aircraft.ixz_kg_m2 = ReadInertia(aircraft, "ixz", true, -1e9, false);
+    aircraft.Finish();
+    std::string why;
+    if (!c.aircraft.Check(&why)) throw UserError(spec.file + ": aircraft: " + why);
+
+    YamlMap rig = Section(root, "rig");
+    if (!has_rig) root.Required("rig");
+    c.rig.mass_kg = rig.RequiredDouble("mass_kg");
+    c.rig.mass_kg = ReadValue(rig, "mass_kg", 0, 0, true, 1e6);
+    c.rig.imu_mass_kg = ReadValue(rig, "imu_mass_kg", 0.0, 0, false, 1e3);
+    const bool has_table = rig.Has("inertia_by_pitch_kg_m2");
+    if (has_table) {
+      const YAML::Node table = rig.Optional("inertia_by_pitch_kg_m2");
+      if (!table.IsMap()) {
+        throw UserError(rig.Where(table) + ": '" + rig.KeyPath("inertia_by_pitch_kg_m2") +
+                        "' must be a mapping pitch_deg: inertia_kg_m2");
+      }
+      for (const auto& item : table) {
+        const double pitch = rig.AsDouble(item.first, "inertia_by_pitch_kg_m2 (pitch)");
+        const double inertia = rig.AsDouble(item.second, "inertia_by_pitch_kg_m2");
+        if (!(inertia > 0)) {
+          throw UserError(rig.Where(item.second) + ": '" + rig.KeyPath("inertia_by_pitch_kg_m2") +
+                          "' at " + Num(pitch) + " deg = " + Num(inertia) +
+                          " is out of range; allowed (0, inf)");
+        }
+        c.rig.inertia_by_pitch_kg_m2.emplace_back(pitch, inertia);
+      }
+      if (rig.Has("inertia_kg_m2")) {
+        throw UserError(rig.Where(rig.Optional("inertia_kg_m2")) + ": give either '" +
+                        rig.KeyPath("inertia_kg_m2") + "' or '" +
+                        rig.KeyPath("inertia_by_pitch_kg_m2") + "', not both");
+      }
+      rig.Optional("inertia_kg_m2");
+    } else {
+      rig.Optional("inertia_by_pitch_kg_m2");
+      c.rig.inertia_kg_m2 = rig.RequiredDouble("inertia_kg_m2");
+      c.rig.inertia_kg_m2 = ReadValue(rig, "inertia_kg_m2", 0, 0, true, 1e9);
+    }
+    c.tare_logs = static_cast<int>(ReadValue(rig, "tare_logs", 0, 0, false, 1000));
+    c.tare_pitch_deg = ReadValue(rig, "tare_pitch_deg", 0, -90, false, 90);
+    c.rig.imu_offset_in_body_m = ReadVector3(rig, "imu_offset_m", Eigen::Vector3d(0.15, 0.10, -0.05));
+    const Eigen::Vector3d rpy = ReadVector3(rig, "imu_mounting_rpy_deg", Eigen::Vector3d::Zero());
+    c.rig.body_from_imu = MountingFromRollPitchYawDeg(rpy[0], rpy[1], rpy[2]);
+    rig.Finish();
+
+    YamlMap campaign = Section(root, "campaign");
+    if (!has_campaign) root.Required("campaign");
+    const YAML::Node pitch_node = campaign.Required("pitch_deg");
+    c.pitch_deg = campaign.OptionalDoubleList("pitch_deg", {});
+    for (double p : c.pitch_deg) {
+      if (p < -90 || p > 90) {
+        throw UserError(campaign.Where(pitch_node) + ": '" + campaign.KeyPath("pitch_deg") +
+                        "' has " + Num(p) + "; allowed [-90, 90]");
+      }
+    }
+    c.trials_per_pitch = static_cast<int>(ReadValue(campaign, "trials_per_pitch", 3, 1, false, 1000));
+    c.pitch_error_sigma_deg =
+        ReadValue(campaign, "pitch_error_sigma_deg", c.pitch_error_sigma_deg, 0, false, 10);
+    campaign.Finish();
+
+    if (!length || !separation) {
+      throw UserError(spec.file + ": missing required key 'geometry.filar_length_m' or "
+                      "'geometry.filar_separation_m' (a campaign needs both)");
+    }
+    c.filar_length_m = *length;
+    c.filar_separation_m = *separation;
+    c.gravity_mps2 = gravity;
+    if (!c.Check(&why)) throw UserError(spec.file + ": " + why);
+  }
+
+  spec.has_trace = root.Has("trace");
+  TraceRequest& t = spec.trace;
+  t.filar_length_m = length;
+  t.filar_separation_m = separation;
+  t.gravity_mps2 = gravity;
+  {
+    YamlMap trace = Section(root, "trace");
+    t.inertia_kg_m2 = ReadOptionalValue(trace, "inertia_kg_m2", 0, true, 1e9);
+    t.mass_kg = ReadOptionalValue(trace, "mass_kg", 0, true, 1e6);
+    t.pitch_deg = ReadValue(trace, "pitch_deg", t.pitch_deg, -90, false, 90);
+    const YAML::Node amp = trace.Optional("amplitude_deg");
+    t.amplitude_deg = ReadValue(trace, "amplitude_deg", t.amplitude_deg, -75, false, 75);
+    if (t.amplitude_deg == 0) {
+      throw UserError(trace.Where(amp) + ": 'trace.amplitude_deg' must not be 0; allowed "
+                      "0 < |amplitude| <= 75");
+    }
+    t.drag_coeff_kg_m2 = ReadValue(trace, "drag_coeff_kg_m2", t.drag_coeff_kg_m2, 0, false, inf);
+    t.viscous_coeff_kg_m2_per_s =
+        ReadValue(trace, "viscous_coeff_kg_m2_per_s", t.viscous_coeff_kg_m2_per_s, 0, false, inf);
+    t.imu_offset_m = ReadVector3(trace, "imu_offset_m", t.imu_offset_m);
+    t.imu_mounting_rpy_deg = ReadVector3(trace, "imu_mounting_rpy_deg", t.imu_mounting_rpy_deg);
+    trace.Finish();
+  }
+  root.Finish();
+  std::string why;
+  if (!spec.options.Check(&why)) throw UserError(spec.file + ": " + why);
+  return spec;
+}
+
+nlohmann::json Vec(const Eigen::Vector3d& v, double scale = 1.0) {
+  return nlohmann::json::array({v[0] * scale, v[1] * scale, v[2] * scale});
+}
+
+nlohmann::json Range(const UniformRange& r) { return nlohmann::json::array({r.min, r.max}); }
+
+nlohmann::json OptionsJson(const SimulateSpec& spec) {
+  const SimulationOptions& o = spec.options;
+  const TimelineOptions& t = o.timeline;
+  const SensorOptions& s = o.sensor;
+  nlohmann::json j;
+  j["model"] = ToString(o.model);
+  j["sway_coupling_percent_at_60deg"] = 100.0 * o.sway_coupling_at_60deg;
+  j["negative_amplitude_probability"] = o.negative_amplitude_probability;
+  j["timeline"] = {{"rest_before_s", Range(t.rest_before_s)},
+                   {"twist_s", Range(t.twist_s)},
+                   {"hold_s", Range(t.hold_s)},
+                   {"tremor_deg", t.tremor_deg},
+                   {"tremor_hz", Range(t.tremor_hz)},
+                   {"release_rate_sigma_deg_per_s", t.release_rate_sigma_deg_per_s},
+                   {"free_s", Range(t.free_s)},
+                   {"stop_probability", t.stop_probability},
+                   {"stop_time_constant_s", t.stop_time_constant_s},
+                   {"rest_after_s", Range(t.rest_after_s)}};
+  j["sensor"] = {{"sample_rate_hz", s.sample_rate_hz},
+                 {"time_jitter_sigma_s", s.time_jitter_sigma_s},
+                 {"drop_fraction", s.drop_fraction},
+                 {"drop_burst_probability", s.drop_burst_probability},
+                 {"drop_burst_max_samples", s.drop_burst_max_samples},
+                 {"start_time_s", Range(s.start_time_s)},
+                 {"gyro_noise_sigma_deg_per_s", s.gyro_noise_sigma_deg_per_s},
+                 {"gyro_bias_sigma_deg_per_s", s.gyro_bias_sigma_deg_per_s},
+                 {"gyro_scale_error_sigma", s.gyro_scale_error_sigma},
+                 {"accelerometer", s.accelerometer},
+                 {"accel_noise_sigma_mps2", s.accel_noise_sigma_mps2},
+                 {"accel_bias_sigma_mps2", s.accel_bias_sigma_mps2},
+                 {"rocking_max_deg", s.rocking_max_deg},
+                 {"rocking_frequency_hz", s.rocking_frequency_hz},
+                 {"rocking_decay_s", s.rocking_decay_s}};
+  const ImuFormat& f = spec.format;
+  j["format"] = {{"time_column", f.time_column},
+                 {"time_unit", ToString(f.time_unit)},
+                 {"gyro_columns", f.gyro_columns},
+                 {"gyro_unit", ToString(f.gyro_unit)},
+                 {"accel_columns", f.has_accel() && s.accelerometer
+                                       ? nlohmann::json(f.accel_columns)
+                                       : nlohmann::json::array()},
+                 {"accel_unit", ToString(f.accel_unit)},
+                 {"delimiter", std::string(1, f.delimiter)},
+                 {"significant_digits", spec.write.significant_digits}};
+  return j;
+}
+
+nlohmann::json TraceJson(const CampaignTrace& ct, const SimulateSpec& spec) {
+  const TraceTruth& t = ct.trace.truth;
+  const TraceSetup& s = ct.setup;
+  const SensorOptions& so = spec.options.sensor;
+  nlohmann::json j;
+  j["file"] = ct.relative_path;
+  j["kind"] = ct.is_tare ? "tare" : "aircraft";
+  j["trial"] = ct.trial;
+  j["nominal_pitch_deg"] = ct.nominal_pitch_deg;
+  j["true_pitch_deg"] = ct.true_pitch_deg;
+  j["mass_kg"] = s.geometry.mass_kg;
+  j["inertia_total_kg_m2"] = s.params.inertia_kg_m2;
+  j["inertia_aircraft_kg_m2"] = ct.inertia_aircraft_kg_m2;
+  j["inertia_rig_kg_m2"] = ct.inertia_rig_kg_m2;
+  j["drag_coeff_kg_m2"] = s.params.drag_coeff_kg_m2;
+  j["viscous_coeff_kg_m2_per_s"] = s.params.viscous_coeff_kg_m2_per_s;
+  j["small_angle_period_s"] = SmallAnglePeriod(s.geometry, s.params.inertia_kg_m2);
+  j["amplitude_deg"] = t.amplitude_rad / kDeg;
+  j["release_rate_deg_per_s"] = t.release_rate_rad_per_s / kDeg;
+  j["amplitude_at_end_deg"] = t.amplitude_at_stop_rad / kDeg;
+  j["start_time_s"] = t.start_time_s;
+  j["t_twist_s"] = t.t_twist_s;
+  j["t_release_s"] = t.t_release_s;
+  j["stopped_by_hand"] = t.stopped;
+  j["t_stop_s"] = t.stopped ? nlohmann::json(t.t_stop_s) : nlohmann::json(nullptr);
+  j["t_free_end_s"] = t.t_stop_s;
+  j["t_end_s"] = t.t_end_s;
+  j["samples"] = ct.trace.imu.size();
+  j["samples_nominal"] = t.samples_nominal;
+  j["samples_dropped"] = t.samples_dropped;
+  j["free_samples"] = t.free_samples;
+  j["swing_axis_in_imu"] = Vec(t.swing_axis_in_imu);
+  j["gyro_bias_deg_per_s"] = Vec(t.gyro_bias_rad_per_s, 1.0 / kDeg);
+  j["gyro_scale_error"] = Vec(t.gyro_scale_error);
+  j["gyro_noise_sigma_deg_per_s"] = so.gyro_noise_sigma_deg_per_s;
+  if (so.accelerometer) {
+    j["accel_bias_mps2"] = Vec(t.accel_bias_mps2);
+    j["accel_noise_sigma_mps2"] = so.accel_noise_sigma_mps2;
+  }
+  j["rocking_amplitude_deg"] = t.rocking_amplitude_rad / kDeg;
+  j["rocking_frequency_hz"] = t.rocking_frequency_hz;
+  j["rocking_axis_in_body"] = Vec(t.rocking_axis_in_body);
+  return j;
+}
+
+void WriteTrace(const std::string& path, const SimulatedTrace& trace, const SimulateSpec& spec) {
+  ImuFormat format = spec.format;
+  if (!spec.options.sensor.accelerometer) format.accel_columns = {"", "", ""};
+  WriteImuLog(path, trace.imu, format, spec.write);
+}
+
+}  // namespace
+
+SimulateSpec ReadSimulateSpec(const std::string& file) {
+  return ParseSpec(YamlMap::LoadFile(file));
+}
+
+SimulateSpec ParseSimulateSpec(const std::string& yaml_text, const std::string& name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw UserError(name + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
+  }
+  return ParseSpec(YamlMap(root, name, ""));
+}
+
+std::string SimulateRunSummary::BriefReport() const {
+  std::ostringstream os;
+  os << files_written << " log" << (files_written == 1 ? "" : "s") << ", " << samples_written
+     << " samples (" << samples_dropped << " dropped), truth in " << truth_path;
+  return os.str();
+}
+
+std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<CampaignTrace>& traces) {
+  const CampaignSpec& c = spec.campaign;
+  nlohmann::json j;
+  j["generator"] = std::string("bifilar simulate ") + BIFILAR_VERSION;
+  j["seed"] = spec.seed;
+  j["spec"] = spec.file;
+  j["geometry"] = {{"filar_length_m", c.filar_length_m},
+                   {"filar_separation_m", c.filar_separation_m},
+                   {"gravity_mps2", c.gravity_mps2}};
+  const double tau = c.aircraft.PrincipalInclinationRad();
+  j["aircraft"] = {{"mass_kg", c.aircraft.mass_kg},
+                   {"ix_kg_m2", c.aircraft.ix_kg_m2},
+                   {"iz_kg_m2", c.aircraft.iz_kg_m2},
+                   {"ixz_kg_m2", c.aircraft.ixz_kg_m2},
+                   {"tau_deg", tau / kDeg},
+                   {"ix_slug_ft2", c.aircraft.ix_kg_m2 / kSlugFt2ToKgM2},
+                   {"iz_slug_ft2", c.aircraft.iz_kg_m2 / kSlugFt2ToKgM2},
+                   {"ixz_slug_ft2", c.aircraft.ixz_kg_m2 / kSlugFt2ToKgM2}};
+  // Principal moments: I(theta) at theta = tau (z principal) and tau + 90 deg (x principal).
+  j["aircraft"]["izp_kg_m2"] = c.aircraft.InertiaAtPitch(tau);
+  j["aircraft"]["ixp_kg_m2"] = c.aircraft.InertiaAtPitch(tau + kPi / 2);
+  nlohmann::json rig = {{"mass_kg", c.rig.mass_kg},
+                        {"imu_mass_kg", c.rig.imu_mass_kg},
+                        {"imu_offset_m", Vec(c.rig.imu_offset_in_body_m)},
+                        {"tare_logs", c.tare_logs},
+                        {"tare_pitch_deg", c.tare_pitch_deg}};
+  if (c.rig.inertia_by_pitch_kg_m2.empty()) {
+    rig["inertia_kg_m2"] = c.rig.inertia_kg_m2;
+  } else {
+    nlohmann::json table = nlohmann::json::object();
+    for (const auto& e : c.rig.inertia_by_pitch_kg_m2) table[FormatPitchDeg(e.first)] = e.second;
+    rig["inertia_by_pitch_kg_m2"] = table;
+  }
+  nlohmann::json mounting = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r) {
+    mounting.push_back({c.rig.body_from_imu(r, 0), c.rig.body_from_imu(r, 1), c.rig.body_from_imu(r, 2)});
+  }
+  rig["body_from_imu"] = mounting;
+  j["rig"] = rig;
+  j["campaign"] = {{"pitch_deg", c.pitch_deg},
+                   {"trials_per_pitch", c.trials_per_pitch},
+                   {"pitch_error_sigma_deg", c.pitch_error_sigma_deg},
+                   {"amplitude_deg", Range(c.amplitude_deg)},
+                   {"drag_coeff_kg_m2", Range(c.drag_coeff_kg_m2)},
+                   {"viscous_coeff_kg_m2_per_s", Range(c.viscous_coeff_kg_m2_per_s)}};
+  j["options"] = OptionsJson(spec);
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& ct : traces) list.push_back(TraceJson(ct, spec));
+  j["traces"] = list;
+  return j.dump(2) + "\n";
+}
+
+SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::string& out_dir) {
+  namespace fs = std::filesystem;
+  if (!spec.has_campaign) {
+    throw UserError((spec.file.empty() ? std::string("spec") : spec.file) +
+                    ": a campaign needs the 'aircraft', 'rig' and 'campaign' sections");
+  }
+  if (out_dir.empty()) throw UserError("--out: empty output folder name");
+  std::error_code ec;
+  if (fs::exists(out_dir, ec) && !fs::is_directory(out_dir, ec)) {
+    throw UserError(out_dir + ": output path exists and is not a folder");
+  }
+  std::vector<CampaignTrace> traces;
+  std::string why;
+  if (!SimulateCampaign(spec.campaign, spec.options, spec.seed, &traces, &why)) {
+    throw UserError((spec.file.empty() ? std::string("simulate") : spec.file) + ": " + why);
+  }
+  const std::string truth = CampaignTruthJson(spec, traces);
+  SimulateRunSummary summary;
+  for (const auto& ct : traces) {
+    WriteTrace((fs::path(out_dir) / ct.relative_path).string(), ct.trace, spec);
+    ++summary.files_written;
+    summary.samples_written += static_cast<long>(ct.trace.imu.size());
+    summary.samples_dropped += ct.trace.truth.samples_dropped;
+  }
+  summary.truth_path = (fs::path(out_dir) / "truth.json").string();
+  WriteFileAtomically(summary.truth_path, truth);
+  return summary;
+}
+
+SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string& csv_path,
+                                    const std::string& truth_path_in) {
+  const TraceRequest& r = spec.trace;
+  auto need = [](const std::optional<double>& v, const char* name, const char* flag) {
+    if (!v) {
+      throw UserError(std::string("missing ") + name + ": give " + flag +
+                      " (or the spec key) for a single trace");
+    }
+    return *v;
+  };
+  const double inertia = need(r.inertia_kg_m2, "the whole suspended inertia", "--inertia-kg-m2");
+  const double mass = need(r.mass_kg, "the whole suspended mass", "--mass-kg");
+  const double length = need(r.filar_length_m, "the filar length L", "-L/--filar-length-m");
+  const double separation = need(r.filar_separation_m, "the filar separation D", "-D/--filar-separation-m");
+  if (csv_path.empty()) throw UserError("--trace: empty output file name");
+  std::string truth_path = truth_path_in;
+  if (truth_path.empty()) {
+    truth_path = csv_path;
+    const std::string ext = ".csv";
+    if (truth_path.size() > ext.size() &&
+        truth_path.compare(truth_path.size() - ext.size(), ext.size(), ext) == 0) {
+      truth_path.resize(truth_path.size() - ext.size());
+    }
+    truth_path += ".truth.json";
+  }
+  CampaignTrace ct;
+  ct.relative_path = std::filesystem::path(csv_path).filename().string();
+  ct.nominal_pitch_deg = ct.true_pitch_deg = r.pitch_deg;
+  ct.trial = 1;
+  TraceSetup& s = ct.setup;
+  s.geometry.filar_length_m = length;
+  s.geometry.filar_separation_m = separation;
+  s.geometry.mass_kg = mass;
+  s.geometry.gravity_mps2 = r.gravity_mps2;
+  s.params.inertia_kg_m2 = inertia;
+  s.params.drag_coeff_kg_m2 = r.drag_coeff_kg_m2;
+  s.params.viscous_coeff_kg_m2_per_s = r.viscous_coeff_kg_m2_per_s;
+  s.pitch_rad = r.pitch_deg * kDeg;
+  s.amplitude_rad = r.amplitude_deg * kDeg;
+  s.imu_offset_in_body_m = r.imu_offset_m;
+  s.body_from_imu = MountingFromRollPitchYawDeg(r.imu_mounting_rpy_deg[0], r.imu_mounting_rpy_deg[1],
+                                                r.imu_mounting_rpy_deg[2]);
+  ct.inertia_aircraft_kg_m2 = 0.0;
+  ct.inertia_rig_kg_m2 = 0.0;
+  std::string why;
+  if (!SimulateTrace(s, spec.options, spec.seed, &ct.trace, &why)) {
+    throw UserError("simulate: " + why);
+  }
+  nlohmann::json j;
+  j["generator"] = std::string("bifilar simulate ") + BIFILAR_VERSION;
+  j["seed"] = spec.seed;
+  j["spec"] = spec.file;
+  j["geometry"] = {{"filar_length_m", length},
+                   {"filar_separation_m", separation},
+                   {"gravity_mps2", r.gravity_mps2}};
+  j["imu_offset_m"] = Vec(r.imu_offset_m);
+  j["imu_mounting_rpy_deg"] = Vec(r.imu_mounting_rpy_deg);
+  j["options"] = OptionsJson(spec);
+  nlohmann::json trace = TraceJson(ct, spec);
+  trace.erase("inertia_aircraft_kg_m2");
+  trace.erase("inertia_rig_kg_m2");
+  trace.erase("kind");
+  trace["file"] = csv_path;
+  j["traces"] = nlohmann::json::array({trace});
+  WriteTrace(csv_path, ct.trace, spec);
+  WriteFileAtomically(truth_path, j.dump(2) + "\n");
+  SimulateRunSummary summary;
+  summary.files_written = 1;
+  summary.samples_written = static_cast<long>(ct.trace.imu.size());
+  summary.samples_dropped = ct.trace.truth.samples_dropped;
+  summary.truth_path = truth_path;
+  return summary;
+}
+
+}  // namespace bifilar
