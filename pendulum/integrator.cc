@@ -1,15 +1,20 @@
-// Integration of the pendulum model with SUNDIALS CVODES (see integrator.h).
+// Integration of the pendulum model (see integrator.h).
 //
-// The 2-state system y = (psi, psi') is not stiff, so CVODES runs Adams-Moulton with the
-// fixed-point nonlinear solver: no Jacobian and no linear solve. The forward sensitivities
-// s_j = dy/dp_j for p = (I, K_D, C, psi(t0), psi'(t0)) obey
+// Both methods integrate y = (psi, psi') together with the forward sensitivities
+// s_j = dy/dp_j for p = (I, K_D, C, psi(t0), psi'(t0)):
 //   s_j' = J s_j + df/dp_j,   J = [[0, 1], [d psi''/d psi, d psi''/d psi']],
 //   df/dp_j = (0, d psi''/dp_j) for I, K_D, C and 0 for the initial conditions,
-// supplied analytically (model.h AngularAccelerationPartials), so CVODES does no finite
-// differences. They start from s_j(t0) = 0 for the parameters and unit vectors for the
-// initial state, and take part in the error test (CVodeSetSensErrCon) so that they are accurate
-// enough for a fit's Jacobian. Outputs are CVODES' interpolants at each requested time
-// (CV_NORMAL), so steps never have to land on samples.
+// from the analytic partials (model.h AngularAccelerationPartials): no finite differences.
+// They start from s_j(t0) = 0 for the parameters and unit vectors for the initial state, and
+// take part in the error test, so that they are accurate enough for a fit's Jacobian. Outputs
+// are the methods' interpolants at each requested time, so steps never land on samples.
+//
+// kRungeKutta: DOP853 (dop853.h) on the 2- or 12-component system, all inlined.
+// kCvodes: the system is not stiff, so CVODES runs Adams-Moulton with the fixed-point nonlinear
+// solver (no Jacobian, no linear solve), CVODES forward sensitivities with the analytic
+// sensitivity right-hand side (CVodeSensInit with an all-at-once CVSensRhsFn), simultaneous
+// corrector, CVodeSetSensErrCon on, CV_NORMAL output with interpolation. The CVODES memory is
+// created once and re-initialised (CVodeReInit, CVodeSensReInit) for each call.
 #include "pendulum/integrator.h"
 
 #include <algorithm>
@@ -21,6 +26,8 @@
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+#include "pendulum/dop853.h"
 
 namespace bifilar {
 namespace {
@@ -37,7 +44,61 @@ bool Fail(std::string* why, const std::string& message) {
   return false;
 }
 
+// Right-hand side of the 2-state system (Sens = false) or of the 12-component system state +
+// 5 sensitivities (Sens = true, layout y[0..1] state, y[2 + 2j], y[3 + 2j] sensitivity j).
+// Returns false for a non-finite state or derivative, which makes the stepper retry smaller.
+template <bool Sens>
+struct AugmentedRhs {
+  PendulumModel model;
+  const RigGeometry* geometry;
+  const PendulumParams* params;
+
+  bool operator()(const double* y, double* dy) const {
+    if (!std::isfinite(y[0]) || !std::isfinite(y[1])) return false;
+    dy[0] = y[1];
+    if (!Sens) {
+      dy[1] = AngularAcceleration(model, *geometry, *params, y[0], y[1]);
+      return std::isfinite(dy[1]);
+    } else {
+      const AccelerationPartials p =
+          AngularAccelerationPartials(model, *geometry, *params, y[0], y[1]);
+      dy[1] = p.accel_rad_per_s2;
+      const double forcing[kNumSensitivities] = {p.d_inertia, p.d_drag, p.d_viscous, 0.0, 0.0};
+      bool finite = std::isfinite(dy[1]);
+      for (int j = 0; j < kNumSensitivities; ++j) {
+        const double* s = y + 2 + 2 * j;
+        double* ds = dy + 2 + 2 * j;
+        ds[0] = s[1];
+        ds[1] = p.d_angle * s[0] + p.d_rate * s[1] + forcing[j];
+        finite = finite && std::isfinite(ds[1]);
+      }
+      return finite;
+    }
+  }
+};
+
 }  // namespace
+
+const char* ToString(IntegratorMethod method) {
+  switch (method) {
+    case IntegratorMethod::kRungeKutta:
+      return "rk853";
+    case IntegratorMethod::kCvodes:
+      return "cvodes";
+  }
+  return "unknown";
+}
+
+bool ParseIntegratorMethod(const std::string& name, IntegratorMethod* method) {
+  if (name == "rk853") {
+    *method = IntegratorMethod::kRungeKutta;
+  } else if (name == "cvodes") {
+    *method = IntegratorMethod::kCvodes;
+  } else {
+    return false;
+  }
+  return true;
+}
 
 bool IntegratorOptions::Check(std::string* why) const {
   if (!std::isfinite(rel_tol) || !(rel_tol > 0.0) || !(rel_tol <= 1e-2)) {
@@ -54,6 +115,9 @@ bool IntegratorOptions::Check(std::string* why) const {
     std::ostringstream os;
     os << "max_steps must be > 0, got " << max_steps;
     return Fail(why, os.str());
+  }
+  if (method != IntegratorMethod::kRungeKutta && method != IntegratorMethod::kCvodes) {
+    return Fail(why, "method must be kRungeKutta or kCvodes");
   }
   return true;
 }
@@ -74,6 +138,7 @@ struct PendulumIntegrator::Impl {
   bool sens_initialized = false;
 
   PendulumParams params;        // of the current Integrate call, read by the RHS
+  IntegratorStats stats;  // of the last Integrate call
   std::string last_cvode_error;  // filled by the CVODES error handler
 
   ~Impl() {
@@ -132,6 +197,11 @@ struct PendulumIntegrator::Impl {
       setup_error = "invalid integrator options: " + why;
       return false;
     }
+    return true;
+  }
+
+  // Creates the CVODES memory on first use.
+  bool SetupCvodes() {
     if (SUNContext_Create(nullptr, &ctx) != 0) {
       setup_error = "SUNContext_Create failed";
       return false;
@@ -166,6 +236,12 @@ struct PendulumIntegrator::Impl {
     cvode_initialized = true;
     return true;
   }
+
+  template <bool Sens>
+  bool IntegrateRk(double angle0_rad, double rate0_rad_per_s, const std::vector<double>& t_s,
+                   size_t first, Trajectory* out, std::string* why);
+  bool IntegrateCvodes(double angle0_rad, double rate0_rad_per_s, const std::vector<double>& t_s,
+                       size_t first, bool with_sensitivities, Trajectory* out, std::string* why);
 
   // Sets s_j(t0): zero for the parameters, unit vectors for psi(t0) and psi'(t0).
   void ResetSensitivities() {
@@ -221,6 +297,7 @@ PendulumIntegrator::PendulumIntegrator(PendulumModel model, const RigGeometry& g
 
 PendulumIntegrator::~PendulumIntegrator() = default;
 
+const IntegratorStats& PendulumIntegrator::last_stats() const { return impl_->stats; }
 PendulumModel PendulumIntegrator::model() const { return impl_->model; }
 const RigGeometry& PendulumIntegrator::geometry() const { return impl_->geometry; }
 
@@ -228,6 +305,7 @@ bool PendulumIntegrator::Integrate(const PendulumParams& params, double angle0_r
                                    double rate0_rad_per_s, const std::vector<double>& t_s,
                                    bool with_sensitivities, Trajectory* out, std::string* why) {
   Impl& im = *impl_;
+  im.stats = IntegratorStats();
   if (!im.setup_error.empty()) return Fail(why, im.setup_error);
   std::string reason;
   if (!params.Check(&reason)) return Fail(why, "invalid pendulum parameters: " + reason);
@@ -261,7 +339,94 @@ bool PendulumIntegrator::Integrate(const PendulumParams& params, double angle0_r
   }
   if (n == 0) return true;
 
+  // Row 0: the initial state; its sensitivities are the identity for (psi0, psi0').
+  out->angle_rad[0] = angle0_rad;
+  out->rate_rad_per_s[0] = rate0_rad_per_s;
+  if (with_sensitivities) {
+    out->d_angle.row(0).setZero();
+    out->d_rate.row(0).setZero();
+    out->d_angle(0, kSensAngle0) = 1.0;
+    out->d_rate(0, kSensRate0) = 1.0;
+  }
+  // Leading times equal to t0 (or indistinguishable from it: a solver cannot take such a step)
+  // copy row 0.
+  const double t0 = t_s[0];
+  const double eps = 4.0 * std::numeric_limits<double>::epsilon();
+  size_t first = 1;
+  while (first < n && t_s[first] - t0 <= eps * std::max(std::abs(t0), std::abs(t_s[first]))) {
+    out->angle_rad[first] = angle0_rad;
+    out->rate_rad_per_s[first] = rate0_rad_per_s;
+    if (with_sensitivities) {
+      out->d_angle.row(first) = out->d_angle.row(0);
+      out->d_rate.row(first) = out->d_rate.row(0);
+    }
+    ++first;
+  }
+  if (first == n) return true;
+
   im.params = params;
+  if (im.options.method == IntegratorMethod::kRungeKutta) {
+    return with_sensitivities ? im.IntegrateRk<true>(angle0_rad, rate0_rad_per_s, t_s, first, out, why)
+                              : im.IntegrateRk<false>(angle0_rad, rate0_rad_per_s, t_s, first, out, why);
+  }
+  return im.IntegrateCvodes(angle0_rad, rate0_rad_per_s, t_s, first, with_sensitivities, out, why);
+}
+
+template <bool Sens>
+bool PendulumIntegrator::Impl::IntegrateRk(double angle0_rad, double rate0_rad_per_s,
+                                           const std::vector<double>& t_s, size_t first,
+                                           Trajectory* out, std::string* why) {
+  constexpr int kN = Sens ? 2 + 2 * kNumSensitivities : 2;
+  typename dop853::Stepper<kN>::Vec y0{};
+  y0[0] = angle0_rad;
+  y0[1] = rate0_rad_per_s;
+  if (Sens) {
+    y0[2 + 2 * kSensAngle0] = 1.0;
+    y0[3 + 2 * kSensRate0] = 1.0;
+  }
+  const AugmentedRhs<Sens> rhs{model, &geometry, &params};
+  double* angle = out->angle_rad.data();
+  double* rate = out->rate_rad_per_s.data();
+  const auto write = [&](int k, const double* y) {
+    angle[k] = y[0];
+    rate[k] = y[1];
+    if (Sens) {
+      for (int j = 0; j < kNumSensitivities; ++j) {
+        out->d_angle(k, j) = y[2 + 2 * j];
+        out->d_rate(k, j) = y[3 + 2 * j];
+      }
+    }
+  };
+  dop853::Stepper<kN> stepper;
+  dop853::Stats rk_stats;
+  double t_fail = t_s[0];
+  const int status = stepper.Integrate(rhs, t_s[0], y0, t_s.data(), static_cast<int>(first),
+                                       static_cast<int>(t_s.size()), options.rel_tol,
+                                       options.abs_tol, options.max_steps, write, &t_fail,
+                                       &rk_stats);
+  stats.steps = rk_stats.steps;
+  stats.rejected_steps = rk_stats.rejected;
+  stats.rhs_evals = rk_stats.rhs_evals;
+  if (status == 0) return true;
+  std::ostringstream os;
+  os.precision(10);
+  if (status == 1) {
+    os << "Runge-Kutta integration took more than max_steps = " << options.max_steps
+       << " steps by t = " << t_fail << " s";
+  } else {
+    os << "Runge-Kutta integration failed at t = " << t_fail << " s (" << ToString(model)
+       << " model): step size underflow (state or its derivative not finite)";
+  }
+  return Fail(why, os.str());
+}
+
+bool PendulumIntegrator::Impl::IntegrateCvodes(double angle0_rad, double rate0_rad_per_s,
+                                               const std::vector<double>& t_s, size_t first,
+                                               bool with_sensitivities, Trajectory* out,
+                                               std::string* why) {
+  Impl& im = *this;
+  if (cvode_mem == nullptr && !SetupCvodes()) return Fail(why, setup_error);
+  const size_t n = t_s.size();
   im.last_cvode_error.clear();
   const double t0 = t_s[0];
   double* yv = N_VGetArrayPointer(im.y);
@@ -276,25 +441,10 @@ bool PendulumIntegrator::Integrate(const PendulumParams& params, double angle0_r
     CVodeSensToggleOff(im.cvode_mem);
   }
 
-  // Row 0: the initial state (and its sensitivities).
-  out->angle_rad[0] = angle0_rad;
-  out->rate_rad_per_s[0] = rate0_rad_per_s;
-  if (with_sensitivities) {
-    for (int j = 0; j < kNumSensitivities; ++j) {
-      out->d_angle(0, j) = N_VGetArrayPointer(im.yS[j])[0];
-      out->d_rate(0, j) = N_VGetArrayPointer(im.yS[j])[1];
-    }
-  }
-
-  bool started = false;  // CVode has been called at least once
-  const double eps = 4.0 * std::numeric_limits<double>::epsilon();
-  for (size_t k = 1; k < n; ++k) {
+  for (size_t k = first; k < n; ++k) {
     const double t = t_s[k];
-    // Repeated times (and, before the first step, times indistinguishable from t0, which
-    // CVODES rejects as "too close") copy the previous row.
-    const bool same = t == t_s[k - 1] ||
-                      (!started && t - t0 <= eps * std::max(std::abs(t0), std::abs(t)));
-    if (same) {
+    // Repeated times copy the previous row.
+    if (t == t_s[k - 1]) {
       out->angle_rad[k] = out->angle_rad[k - 1];
       out->rate_rad_per_s[k] = out->rate_rad_per_s[k - 1];
       if (with_sensitivities) {
@@ -305,10 +455,12 @@ bool PendulumIntegrator::Integrate(const PendulumParams& params, double angle0_r
     }
     realtype t_ret = t0;
     const int flag = CVode(im.cvode_mem, t, im.y, &t_ret, CV_NORMAL);
-    started = true;
     if (flag < 0) {
       std::ostringstream os;
       os.precision(10);
+      if (flag == CV_TOO_MUCH_WORK) {
+        os << "CVODES took more than max_steps = " << im.options.max_steps << " steps; ";
+      }
       os << "CVODES failed at t = " << t_ret << " s (" << ToString(im.model)
          << " model, integrating from " << t0 << " s to " << t << " s): "
          << (im.last_cvode_error.empty() ? "flag " + std::to_string(flag) : im.last_cvode_error);
@@ -345,6 +497,14 @@ bool PendulumIntegrator::Integrate(const PendulumParams& params, double angle0_r
       }
     }
   }
+  long steps = 0, rhs_evals = 0, sens_rhs_evals = 0, test_fails = 0;
+  CVodeGetNumSteps(cvode_mem, &steps);
+  CVodeGetNumRhsEvals(cvode_mem, &rhs_evals);
+  CVodeGetNumErrTestFails(cvode_mem, &test_fails);
+  if (with_sensitivities) CVodeGetSensNumRhsEvals(cvode_mem, &sens_rhs_evals);
+  stats.steps = steps;
+  stats.rejected_steps = test_fails;
+  stats.rhs_evals = std::max(rhs_evals, sens_rhs_evals);
   return true;
 }
 

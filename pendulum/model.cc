@@ -23,11 +23,13 @@ struct Rise {
 Rise ComputeRise(const RigGeometry& g, double psi, bool want_d3) {
   const double L = g.filar_length_m;
   const double k = 0.25 * g.filar_separation_m * g.filar_separation_m;
-  const double sn = std::sin(psi);
-  const double cs = std::cos(psi);
-  // 1 - cos psi = 2 sin^2(psi/2), accurate for small psi.
+  // One sincos of psi/2: sin psi = 2 sin cos, cos psi = 1 - 2 sin^2, and
+  // 1 - cos psi = 2 sin^2(psi/2) is accurate for small psi.
   const double half = std::sin(0.5 * psi);
+  const double half_c = std::cos(0.5 * psi);
+  const double sn = 2.0 * half * half_c;
   const double one_minus_cos = 2.0 * half * half;
+  const double cs = 1.0 - one_minus_cos;
   const double s2 = L * L - 2.0 * k * one_minus_cos;
   const double s = std::sqrt(s2);
   const double inv_s = 1.0 / s;
