@@ -67,6 +67,11 @@ struct TraceRecord {
   bool ok() const { return status == TraceStatus::kOk; }
 };
 
+// Default upper bound of the amplitude band (deg) when the config sets none: the issue's
+// validation range (5-30 deg). Above it, real rigs drift from the ideal model by a bias growing
+// like the square of the amplitude (sway coupling, wire attachment), several percent at 60 deg.
+constexpr double kDefaultMaxAmplitudeDeg = 30.0;
+
 struct TraceProcessOptions {
   TraceRole role = TraceRole::kAircraft;  // chooses the suspended mass (aircraft + rig, or rig)
   std::string display_name;               // `file` of the record; default: the path
