@@ -86,17 +86,24 @@ void FindRest(const std::vector<double>& t, const std::vector<double>& r, double
   // Rest shows no more scatter than the high-frequency noise (x2.5: jitter inflates sigma_hf on a
   // swinging log, never the other way round).
   if (!(sd0 <= 2.5 * sigma_hf) && !(sd0 == 0.0 && sigma_hf == 0.0)) return;
-  double sum = 0.0;
+  // Blocks join the rest while their scatter and mean agree with the rest so far (2x the std;
+  // 5 standard errors of the mean: a false break has a probability of ~1e-6 per block).
+  double sum = 0.0, sum2 = 0.0;
   size_t count = 0, accepted = 0, begin = 0;
-  const double sd_ref = std::max(sd0, 1e-12);
   for (size_t b = 0; b < block_end.size(); ++b) {
     const size_t e = block_end[b];
     double mean, sd;
     stats(begin, e, &mean, &sd);
     const double rest_mean = count ? sum / count : mean0;
+    const double rest_sd =
+        count > 1 ? std::sqrt(std::max(0.0, (sum2 - sum * sum / count) / (count - 1.0))) : sd0;
+    const double sd_ref = std::max(rest_sd, 1e-12);
     const double m = static_cast<double>(e - begin);
-    if (e - begin < 3 || sd > 1.6 * sd_ref || std::abs(mean - rest_mean) > 4.0 * sd_ref / std::sqrt(m)) break;
-    for (size_t k = begin; k < e; ++k) sum += r[k];
+    if (e - begin < 3 || sd > 2.0 * sd_ref || std::abs(mean - rest_mean) > 5.0 * sd_ref / std::sqrt(m)) break;
+    for (size_t k = begin; k < e; ++k) {
+      sum += r[k];
+      sum2 += r[k] * r[k];
+    }
     count += e - begin;
     ++accepted;
     begin = e;
@@ -155,6 +162,21 @@ std::vector<HalfCycle> HalfCycles(const std::vector<double>& t, const std::vecto
   if (!out.empty()) {
     out.back().end_s = t[end - 1];
     out.back().open = true;
+  }
+  // A half-cycle starts at the last zero crossing before its peak (not before its first threshold
+  // crossing): a tremor lobe of the same sign just before the release must not stretch it.
+  for (size_t j = 0; j < out.size(); ++j) {
+    const int s = out[j].sign;
+    const size_t lo = j > 0 ? out[j - 1].peak_index : begin;
+    for (size_t k = out[j].peak_index; k > lo; --k) {
+      if (s * x[k - 1] <= 0.0) {
+        const double x0 = x[k - 1], x1 = x[k];
+        const double f = (x1 != x0) ? -x0 / (x1 - x0) : 0.0;
+        out[j].start_s = t[k - 1] + std::clamp(f, 0.0, 1.0) * (t[k] - t[k - 1]);
+        break;
+      }
+    }
+    if (j > 0) out[j - 1].end_s = out[j].start_s;
   }
   return out;
 }
@@ -338,7 +360,11 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
       WindowEnd reason = WindowEnd::kLogEnd;
       bool broken = false;
       bool restart = false;
-      if (c.peak < floor) {
+      const bool abrupt = !short_open && c.peak < o.stop_drop_factor * rho * prev;
+      if (abrupt) {  // a hand (checked first: a stopped swing also ends below the noise floor)
+        broken = true;
+        reason = WindowEnd::kStopped;
+      } else if (c.peak < floor && !short_open) {
         broken = true;
         reason = WindowEnd::kNoiseFloor;
       } else if (!duration_ok(c)) {
@@ -348,9 +374,6 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
         broken = true;
         reason = WindowEnd::kStopped;  // pushed: the free decay is broken
         restart = true;
-      } else if (!short_open && c.peak < o.stop_drop_factor * rho * prev) {
-        broken = true;
-        reason = WindowEnd::kStopped;
       }
       if (!broken) {
         if (!short_open) ratios.push_back(c.peak / prev);
@@ -511,6 +534,14 @@ std::vector<AngleExtreme> AngleExtremes(const std::vector<double>& t, const std:
     else if (j + 1 == ext.size()) ref = ext[j - 1].second;
     else ref = 0.5 * (ext[j - 1].second + ext[j + 1].second);
     out.push_back({ext[j].first, 0.5 * std::abs(ext[j].second - ref) * kRadToDeg});
+  }
+  // The end extremes have one neighbour, so the value above is the mean of two successive
+  // extremes; with four or more, extrapolate the decay geometrically from the interior ones.
+  const size_t m = out.size();
+  if (m >= 4) {
+    auto extrapolate = [](double a1, double a2) { return a2 > 0.0 ? a1 * a1 / a2 : a1; };
+    out[0].amplitude_deg = extrapolate(out[1].amplitude_deg, out[2].amplitude_deg);
+    out[m - 1].amplitude_deg = extrapolate(out[m - 2].amplitude_deg, out[m - 3].amplitude_deg);
   }
   return out;
 }
