@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <memory>
 #include <sstream>
 
 #include <ceres/ceres.h>
@@ -46,38 +45,133 @@ struct SolveOutcome {
   double initial_cost = 0.0;
   double final_cost = 0.0;
   bool converged = false;
+  bool stopped_at_bound = false;  // a free damping coefficient reached 0
 };
 
-// Levenberg-Marquardt on p (in place) with K_D, C >= 0 and I > 0.
-SolveOutcome SolveLm(const TraceRateCost& cost, int max_iterations, double* p,
-                     ceres::Problem* problem) {
+// Ends the solve when a free damping coefficient lands on its bound (0) after an accepted step:
+// Ceres handles bounds by projecting the step, and with the coefficient pinned there
+// Levenberg-Marquardt crawls (step ratio ~0.2 for tens of iterations). FitTrace then holds it
+// at 0 (active set) and solves the smaller problem, which converges in a few iterations.
+class BoundWatch : public ceres::IterationCallback {
+ public:
+  BoundWatch(const double* p, const bool* fixed) : p_(p), fixed_(fixed) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration == 0 || !summary.step_is_successful) return ceres::SOLVER_CONTINUE;
+    const bool at = (!fixed_[0] && p_[kTraceDrag] <= 0.0) ||
+                    (!fixed_[1] && p_[kTraceViscous] <= 0.0);
+    count_ = at ? count_ + 1 : 0;
+    if (count_ >= 1) {
+      triggered_ = true;
+      return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+  bool triggered() const { return triggered_; }
+
+ private:
+  const double* p_;
+  const bool* fixed_;
+  int count_ = 0;
+  bool triggered_ = false;
+};
+
+// Adds the residual to *problem with I > 0 and K_D, C >= 0, the damping coefficients marked in
+// fixed[0] (K_D), fixed[1] (C) held constant at their current value.
+void AddTraceResidual(const TraceRateCost& cost, const bool fixed[2], double* p,
+                      ceres::Problem* problem) {
   problem->AddResidualBlock(new TraceCeresCost(&cost), nullptr, p);
+  std::vector<int> constant;
+  if (fixed[0]) constant.push_back(kTraceDrag);
+  if (fixed[1]) constant.push_back(kTraceViscous);
+  if (!constant.empty())
+    problem->SetManifold(p, new ceres::SubsetManifold(kNumTraceParams, constant));
   problem->SetParameterLowerBound(p, kTraceInertia, 1e-3);
-  problem->SetParameterLowerBound(p, kTraceDrag, 0.0);
-  problem->SetParameterLowerBound(p, kTraceViscous, 0.0);
+  if (!fixed[0]) problem->SetParameterLowerBound(p, kTraceDrag, 0.0);
+  if (!fixed[1]) problem->SetParameterLowerBound(p, kTraceViscous, 0.0);
+}
+
+// Levenberg-Marquardt on p (in place).
+SolveOutcome SolveLm(const TraceRateCost& cost, int max_iterations, const bool fixed[2],
+                     bool stop_at_bound, double* p) {
+  ceres::Problem problem;
+  AddTraceResidual(cost, fixed, p, &problem);
   ceres::Solver::Options options;
   options.minimizer_type = ceres::TRUST_REGION;
   options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   options.linear_solver_type = ceres::DENSE_QR;
   options.max_num_iterations = max_iterations;
-  // Tight tolerances: the statistical error of I is ~1e-5 relative, the solver must stop far
-  // below it. Each iteration is one integration, so the last few cost little.
-  options.function_tolerance = 1e-12;
-  options.parameter_tolerance = 1e-11;
+  // Stop inside the noise: a relative cost change of 1e-7 is N * 1e-7 = 6e-4 units of chi^2 at
+  // N = 6000 samples (a parameter 0.025 sigma from the optimum), and 1e-9 relative steps are far
+  // below sigma (~1e-5 of I). Tighter is pointless: at the default integrator tolerance the cost
+  // itself carries ~2e-8 relative integration noise, and LM then takes steps of ratio ~1e-3.
+  options.function_tolerance = 1e-7;
+  options.parameter_tolerance = 1e-9;
   options.gradient_tolerance = 1e-14;
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
+  BoundWatch watch(p, fixed);
+  if (stop_at_bound) {
+    options.update_state_every_iteration = true;
+    options.callbacks.push_back(&watch);
+  }
   ceres::Solver::Summary summary;
-  ceres::Solve(options, problem, &summary);
+  ceres::Solve(options, &problem, &summary);
   SolveOutcome out;
   out.iterations = static_cast<int>(summary.iterations.size()) - 1;
   out.initial_cost = summary.initial_cost;
   out.final_cost = summary.final_cost;
+  out.stopped_at_bound = watch.triggered();
   out.converged = summary.termination_type == ceres::CONVERGENCE;
   out.ok = summary.IsSolutionUsable() && std::isfinite(summary.final_cost);
   out.message = summary.message;
   return out;
+}
+
+// Levenberg-Marquardt with an active set for K_D, C >= 0: a coefficient that settles on 0 is
+// held there and the rest re-solved; a held coefficient is released (and the problem re-solved
+// with bounds) when the KKT condition fails, i.e. when freeing it would lower the cost by more
+// than 0.05 sigma^2 (quadratic model with the other parameters re-optimised:
+// g_j^2 (H^-1)_jj / 2, g = J^T r, H = J^T J). fixed[] returns the final active set.
+SolveOutcome SolveWithActiveSet(const TraceRateCost& cost, int max_iterations, double* p,
+                                bool fixed[2]) {
+  fixed[0] = fixed[1] = false;
+  SolveOutcome lm;
+  int iterations = 0;
+  double initial_cost = 0.0;
+  const int n = cost.num_residuals();
+  for (int round = 0; round < 4; ++round) {
+    lm = SolveLm(cost, max_iterations, fixed, round < 3, p);
+    if (round == 0) initial_cost = lm.initial_cost;
+    iterations += lm.iterations;
+    if (!lm.ok) break;
+    if (lm.stopped_at_bound) {
+      if (!fixed[0] && p[kTraceDrag] <= 0.0) fixed[0] = true, p[kTraceDrag] = 0.0;
+      if (!fixed[1] && p[kTraceViscous] <= 0.0) fixed[1] = true, p[kTraceViscous] = 0.0;
+      continue;
+    }
+    if (!fixed[0] && !fixed[1]) break;
+    Eigen::Matrix<double, Eigen::Dynamic, kNumTraceParams, Eigen::RowMajor> jac(n, kNumTraceParams);
+    Eigen::VectorXd r(n);
+    if (!cost.Evaluate(p, r.data(), jac.data(), nullptr)) break;
+    const Eigen::VectorXd g = jac.transpose() * r;
+    const Eigen::MatrixXd h = jac.transpose() * jac;
+    const Eigen::MatrixXd h_inv = h.completeOrthogonalDecomposition().pseudoInverse();
+    const double sigma2 = r.squaredNorm() / std::max(1, n - kNumTraceParams);
+    bool release = false;
+    const int index[2] = {kTraceDrag, kTraceViscous};
+    for (int i = 0; i < 2; ++i) {
+      const int j = index[i];
+      if (fixed[i] && g(j) < 0.0 && 0.5 * g(j) * g(j) * h_inv(j, j) > 0.05 * sigma2) {
+        fixed[i] = false;
+        release = true;
+      }
+    }
+    if (!release) break;
+  }
+  lm.iterations = iterations;
+  lm.initial_cost = initial_cost;
+  return lm;
 }
 
 double Cost(const TraceRateCost& cost, const double* p, std::vector<double>* r) {
@@ -241,16 +335,15 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
   p[kTraceBias] = guess.bias_rad_per_s;
   const double p_guess[kNumTraceParams] = {p[0], p[1], p[2], p[3], p[4], p[5]};
 
-  auto problem = std::make_unique<ceres::Problem>();
-  SolveOutcome lm = SolveLm(cost, options.max_iterations, p, problem.get());
+  bool fixed[2] = {false, false};
+  SolveOutcome lm = SolveWithActiveSet(cost, options.max_iterations, p, fixed);
   if (!lm.ok) {
     // One retry from the guess with K_D, C started at zero (a bad damping guess can make the
     // first integration fail).
     std::copy(p_guess, p_guess + kNumTraceParams, p);
     p[kTraceDrag] = 0.0;
     p[kTraceViscous] = 0.0;
-    problem = std::make_unique<ceres::Problem>();
-    lm = SolveLm(cost, options.max_iterations, p, problem.get());
+    lm = SolveWithActiveSet(cost, options.max_iterations, p, fixed);
   }
   if (!lm.ok) return finish(Error(result, "fit failed: " + lm.message));
   result.initial_cost = lm.initial_cost;
@@ -295,15 +388,16 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
     double p2[kNumTraceParams];
     std::copy(p_guess, p_guess + kNumTraceParams, p2);
     p2[kTraceInertia] = x[0];
-    auto problem2 = std::make_unique<ceres::Problem>();
-    const SolveOutcome lm2 = SolveLm(cost, options.max_iterations, p2, problem2.get());
+    bool fixed2[2];
+    const SolveOutcome lm2 = SolveWithActiveSet(cost, options.max_iterations, p2, fixed2);
     std::vector<double> r2(n);
     const double cost2 = lm2.ok ? Cost(cost, p2, &r2) : HUGE_VAL;
     if (cost2 < final_cost) {
       std::copy(p2, p2 + kNumTraceParams, p);
-      problem = std::move(problem2);
       lm = lm2;
       final_cost = cost2;
+      fixed[0] = fixed2[0];
+      fixed[1] = fixed2[1];
       r.swap(r2);
       result.iterations += lm2.iterations;
     }
@@ -330,7 +424,9 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
     ceres::Covariance covariance(cov_options);
     std::vector<std::pair<const double*, const double*>> blocks = {{p, p}};
     double cov[kNumTraceParams * kNumTraceParams];
-    if (covariance.Compute(blocks, problem.get()) && covariance.GetCovarianceBlock(p, p, cov)) {
+    ceres::Problem cov_problem;  // the same residual, at the chosen solution
+    AddTraceResidual(cost, fixed, p, &cov_problem);
+    if (covariance.Compute(blocks, &cov_problem) && covariance.GetCovarianceBlock(p, p, cov)) {
       auto stdev = [&](int j) { return scale * std::sqrt(std::max(0.0, cov[j * 7]) * sigma2); };
       result.inertia_stat_std_kg_m2 = stdev(kTraceInertia);
       result.drag_coeff_std = stdev(kTraceDrag);

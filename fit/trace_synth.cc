@@ -1,0 +1,42 @@
+#include "fit/trace_synth.h"
+
+#include <cmath>
+#include <random>
+
+namespace bifilar {
+
+bool MakeSyntheticTrace(const SyntheticTraceOptions& o, TraceFitInput* input) {
+  constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
+  std::mt19937_64 rng(o.seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const double dt = 1.0 / o.sample_rate_hz;
+  const long n_nominal = static_cast<long>(std::floor(o.duration_s * o.sample_rate_hz)) + 1;
+  TraceFitInput out;
+  out.geometry = o.geometry;
+  out.t_s.reserve(n_nominal);
+  for (long k = 0; k < n_nominal; ++k) {
+    const bool keep = k == 0 || unit(rng) >= o.drop_fraction;
+    const double jitter = k == 0 ? 0.0 : (2.0 * unit(rng) - 1.0) * o.jitter_fraction * dt;
+    if (keep) out.t_s.push_back(k * dt + jitter);
+  }
+  IntegratorOptions tight;
+  tight.rel_tol = 1e-12;
+  tight.abs_tol = 1e-14;
+  PendulumIntegrator integrator(o.model, o.geometry, tight);
+  Trajectory traj;
+  std::string why;
+  if (!integrator.Integrate(o.params, o.amplitude_deg * kRadPerDeg, o.rate0_deg_per_s * kRadPerDeg,
+                            out.t_s, false, &traj, &why)) {
+    return false;
+  }
+  const double sigma = o.noise_deg_per_s * kRadPerDeg, bias = o.bias_deg_per_s * kRadPerDeg;
+  out.rate_rad_per_s.resize(out.t_s.size());
+  for (size_t k = 0; k < out.t_s.size(); ++k)
+    out.rate_rad_per_s[k] = traj.rate_rad_per_s[k] + bias + sigma * normal(rng);
+  out.noise_rad_per_s = sigma;
+  *input = std::move(out);
+  return true;
+}
+
+}  // namespace bifilar

@@ -1,0 +1,32 @@
+// Synthetic free-oscillation windows with known truth, for the trace-fit tests and benchmarks:
+// the model integrated at jittered timestamps with dropped samples, plus a gyro bias and white
+// noise. Only the free oscillation (no rest, twist or hold: that is pendulum/simulate.h's job).
+// Conventions: ../shared/PHYSICS.md §2.
+#pragma once
+
+#include <cstdint>
+
+#include "fit/trace_fit.h"
+
+namespace bifilar {
+
+struct SyntheticTraceOptions {
+  PendulumModel model = PendulumModel::kFull;  // truth's equation of motion
+  RigGeometry geometry;                        // L, D, m, g
+  PendulumParams params;                       // true I, K_D, C
+  double amplitude_deg = 20.0;                 // psi(t0) (deg)
+  double rate0_deg_per_s = 0.0;                // psi'(t0) (deg/s)
+  double duration_s = 60.0;                    // window length (s); > 0
+  double sample_rate_hz = 100.0;               // nominal rate (Hz); > 0
+  double jitter_fraction = 0.2;                // timestamp jitter, uniform +-this * dt; [0, 0.45]
+  double drop_fraction = 0.01;                 // samples lost at random; [0, 0.5)
+  double noise_deg_per_s = 0.25;               // white gyro noise sigma (deg/s); >= 0
+  double bias_deg_per_s = 0.3;                 // constant gyro bias (deg/s)
+  uint64_t seed = 1;
+};
+
+// The window (t_s, rate_rad_per_s, geometry, noise_rad_per_s = the true sigma). The truth is
+// integrated with CVODES at rel_tol 1e-12. Returns false if the integration fails.
+bool MakeSyntheticTrace(const SyntheticTraceOptions& options, TraceFitInput* input);
+
+}  // namespace bifilar
