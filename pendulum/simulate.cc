@@ -276,7 +276,7 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
   int drop_left = 0, dropped = 0;
   for (int k = 0; k < n_nominal; ++k) {
     double jitter = rng.Normal(so.time_jitter_sigma_s);
-    jitter = std::clamp(jitter, -0.4 * dt, 0.4 * dt);
+    jitter = k == 0 ? 0.0 : std::clamp(jitter, -0.4 * dt, 0.4 * dt);  // the clock starts at sample 0
     const double u = rng.Uniform();
     const double u_burst = rng.Uniform();
     const double u_len = rng.Uniform();

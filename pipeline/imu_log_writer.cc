@@ -59,11 +59,12 @@ std::string FormatImuLog(const ImuData& data, const ImuFormat& format,
   const double gyro_scale = 1.0 / ToSi(format.gyro_unit);
   const double accel_scale = 1.0 / ToSi(format.accel_unit);
   const int digits = options.significant_digits;
+  const int time_digits = digits > 10 ? digits : 10;  // timestamps keep >= 10 digits
   for (size_t k = 0; k < n; ++k) {
     bool finite = std::isfinite(data.t_s[k]) && data.gyro_in_imu[k].allFinite();
     if (format.has_accel()) finite = finite && data.accel_in_imu[k].allFinite();
     if (!finite) throw UserError("IMU log: sample " + std::to_string(k) + " is not finite");
-    AppendNumber(data.t_s[k] * time_scale, digits, &out);
+    AppendNumber(data.t_s[k] * time_scale, time_digits, &out);
     for (int i = 0; i < 3; ++i) {
       out += d;
       AppendNumber(data.gyro_in_imu[k][i] * gyro_scale, digits, &out);

@@ -1,7 +1,7 @@
 // Writing one IMU log (pendulum/imu_data.h, SI) as CSV in a given ImuFormat
 // (pipeline/imu_format.h): the inverse of pipeline/imu_log.h. One header row with the format's
 // column names, then one row per sample, values converted from SI to the format's units and
-// printed with a fixed number of significant digits ("%.{digits}g", locale-independent), so the
+// printed with a fixed number of significant digits ("%.{digits}g", C locale), so the
 // same data always gives the same bytes and reading it back gives the values to that precision.
 // The file is written to a temporary name beside it and renamed (never half-written).
 #pragma once
@@ -14,8 +14,9 @@
 namespace bifilar {
 
 struct ImuLogWriteOptions {
-  // Significant digits of every value; 9 keeps microseconds at 1000 s and is far below any IMU
-  // noise; 17 round-trips doubles exactly. In [6, 17], default 9.
+  // Significant digits of the gyro and accelerometer values (6 is already far below any MEMS
+  // IMU's noise; 17 round-trips doubles exactly). Timestamps always get at least 10 (1 us at
+  // 1000 s). In [6, 17], default 9.
   int significant_digits = 9;
   // Line end: "\n" (default) or "\r\n".
   std::string line_end = "\n";
