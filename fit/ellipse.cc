@@ -578,8 +578,6 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
   }
 
   // --- Per-angle statistics and the paper's Table 1.
-  double pooled_ss = 0.0;
-  int pooled_dof = 0;
   for (int g = 0; g < m; ++g) {
     EllipseAngleStats st;
     st.pitch_deg = groups[g].pitch_deg;
@@ -593,8 +591,6 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
     st.cov_percent = 100.0 * st.std_kg_m2 / st.mean_kg_m2;
     st.fitted_kg_m2 = EllipseMoment(abc(0), abc(1), abc(2), st.pitch_deg);
     if (st.n > 1) {
-      pooled_ss += ss;
-      pooled_dof += st.n - 1;
       res.table1.mean_angle_std_kg_m2 += st.std_kg_m2;
       res.table1.mean_cov_percent += st.cov_percent;
       ++res.table1.n_angles_with_trials;
@@ -609,14 +605,10 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
 
   // --- NACA Report 467 three-axis estimates (paper Eq. 1, phi = 90 deg + theta).
   {
-    // Standard error of a per-angle mean: pooled within-angle std / sqrt(n) when trials repeat,
-    // else the given std, else the point residual scale.
-    auto mean_std = [&](int g) {
-      const int ng = static_cast<int>(groups[g].members.size());
-      if (pooled_dof > 0) return std::sqrt(pooled_ss / pooled_dof / ng);
-      if (res.weighted) return std::sqrt(1.0 / group_w[g]) ;
-      return std::sqrt(point_var / ng);
-    };
+    // Standard error of a per-angle mean: the fit's variance factor over the group's weight, so
+    // it carries whatever the covariance mode estimated (trial scatter, per-angle errors, or the
+    // given std when absolute).
+    auto mean_std = [&](int g) { return std::sqrt(res.variance_factor / group_w[g]); };
     // Measured body-axis moments: the angle groups at 0 (I_z) and +-90 deg (I_x).
     auto measured = [&](double axis_deg, double* value, double* std) {
       double sum = 0, var = 0;
