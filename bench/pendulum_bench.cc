@@ -1,0 +1,81 @@
+// Integration of one 60 s, 100 Hz trace (6000 samples), the unit of work of a trace fit
+// (issue 2: at most 2 ms median with sensitivities). Rig I = 1.5 kg m^2, m = 10 kg, L = 2 m,
+// D = 0.8 m, released from rest at 20 deg, small damping. Default tolerances.
+//
+//   build/bench/bifilar_bench --benchmark_filter=Pendulum --benchmark_repetitions=10 \
+//       --benchmark_report_aggregates_only=true
+//
+// Arguments: model (0 full, 1 jardin, 2 linear), sensitivities (0/1), timestamps (0 uniform,
+// 1 jittered: +-3 ms jitter and 2 % dropped samples, like a wireless IMU log).
+#include <random>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "pendulum/integrator.h"
+
+namespace bifilar {
+namespace {
+
+std::vector<double> TraceTimes(bool jittered) {
+  std::vector<double> t;
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> jitter(-0.003, 0.003);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int k = 0; k < 6000; ++k) {
+    double tk = 0.01 * k;
+    if (jittered && k > 0) {
+      if (unit(rng) < 0.02) continue;  // dropped packet
+      tk += jitter(rng);
+    }
+    t.push_back(tk);
+  }
+  return t;
+}
+
+void BM_PendulumIntegrate(benchmark::State& state, IntegratorMethod method) {
+  const PendulumModel models[] = {PendulumModel::kFull, PendulumModel::kJardin,
+                                  PendulumModel::kLinear};
+  const PendulumModel model = models[state.range(0)];
+  const bool with_sensitivities = state.range(1) != 0;
+  const std::vector<double> t = TraceTimes(state.range(2) != 0);
+  RigGeometry geometry;
+  geometry.filar_length_m = 2.0;
+  geometry.filar_separation_m = 0.8;
+  geometry.mass_kg = 10.0;
+  PendulumParams params;
+  params.inertia_kg_m2 = 1.5;
+  params.drag_coeff_kg_m2 = 0.01;
+  params.viscous_coeff_kg_m2_per_s = 0.005;
+  IntegratorOptions options;
+  options.method = method;
+  PendulumIntegrator integrator(model, geometry, options);
+  Trajectory trajectory;
+  std::string why;
+  for (auto _ : state) {
+    if (!integrator.Integrate(params, 0.349, 0.0, t, with_sensitivities, &trajectory, &why)) {
+      state.SkipWithError(why.c_str());
+      break;
+    }
+    benchmark::DoNotOptimize(trajectory.rate_rad_per_s.data());
+  }
+  state.counters["steps"] = static_cast<double>(integrator.last_stats().steps);
+  state.counters["rejected"] = static_cast<double>(integrator.last_stats().rejected_steps);
+  state.SetLabel(std::string(ToString(model)) + (with_sensitivities ? " +sens" : "") +
+                 (state.range(2) ? " jittered" : ""));
+}
+
+void PendulumArgs(benchmark::internal::Benchmark* b) {
+  for (int model = 0; model < 3; ++model) {
+    for (int sens = 0; sens < 2; ++sens) b->Args({model, sens, 0});
+  }
+  b->Args({0, 1, 1});  // full model, sensitivities, jittered timestamps with drops
+  b->Unit(benchmark::kMillisecond);
+}
+
+BENCHMARK_CAPTURE(BM_PendulumIntegrate, rk853, IntegratorMethod::kRungeKutta)->Apply(PendulumArgs);
+BENCHMARK_CAPTURE(BM_PendulumIntegrate, cvodes, IntegratorMethod::kCvodes)->Apply(PendulumArgs);
+
+}  // namespace
+}  // namespace bifilar

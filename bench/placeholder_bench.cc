@@ -1,1 +1,0 @@
-// Benchmarks live in bench/*_bench.cc; this file keeps the target non-empty.
