@@ -221,7 +221,8 @@ bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
       const Eigen::Vector3d d = data.gyro_in_imu[i] - mean;
       cov += d * d.transpose();
     }
-    if (!(cov.trace() > 0.0) || !cov.allFinite()) {
+    const double tiny = count * std::pow(1e-12 * (1.0 + mean.norm()), 2);  // rounding of the mean
+    if (!(cov.trace() > tiny) || !cov.allFinite()) {
       *why = "swing axis: the gyro signal is constant over " +
              std::string(window_s ? "the window" : "the log") + ", so it shows no swing axis";
       return false;
@@ -251,7 +252,9 @@ double SecondaryMotionRatio(const ImuData& data, const Eigen::Vector3d& axis_in_
     along_ss += along * along;
     orth_ss += (d - along * n).squaredNorm();
   }
-  if (!(along_ss > 0.0)) return orth_ss > 0.0 ? 1e6 : 0.0;  // no swing at all: capped, never inf
+  // Below `tiny` a sum of squares is rounding of the mean, not motion.
+  const double tiny = static_cast<double>(range.second - range.first) * std::pow(1e-12 * (1.0 + mean.norm()), 2);
+  if (!(along_ss > tiny)) return orth_ss > tiny ? 1e6 : 0.0;  // no swing at all: capped, never inf
   return std::min(1e6, std::sqrt(orth_ss / along_ss));
 }
 

@@ -1,0 +1,241 @@
+// Swing axis, measured pitch and secondary motion against known truth: synthetic rotated IMU data
+// built here and the simulator's logs (pendulum/simulate.h), whose truth records the axis.
+#include "fit/swing_axis.h"
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "pendulum/simulate.h"
+
+namespace bifilar {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+constexpr double kG = 9.80665;
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b)) / kDeg;
+}
+
+Eigen::Vector3d DownInBody(double pitch_deg) {
+  return Eigen::Vector3d(-std::sin(pitch_deg * kDeg), 0.0, std::cos(pitch_deg * kDeg));
+}
+
+TEST(SwingAxis, PitchSignConvention) {
+  // PHYSICS.md §3: n_body = (-sin theta, 0, cos theta), nose-up positive.
+  for (double pitch : {-80.0, -30.0, 0.0, 12.5, 45.0, 89.0, 90.0}) {
+    EXPECT_NEAR(PitchFromDownDeg(DownInBody(pitch)), pitch, 1e-12) << pitch;
+    EXPECT_NEAR(RollFromDownDeg(DownInBody(pitch)), 0.0, 1e-9) << pitch;
+  }
+  // Nose up by 30 deg: gravity pulls toward the tail, so the down vector has a negative x.
+  EXPECT_LT(DownInBody(30).x(), 0.0);
+  EXPECT_NEAR(PitchFromDownDeg(Eigen::Vector3d(-0.5, 0.0, std::sqrt(0.75))), 30.0, 1e-12);
+  // A small roll does not change the pitch (Euler pitch = asin(-n_x)).
+  const double th = 20 * kDeg, ph = 3 * kDeg;
+  const Eigen::Vector3d rolled(-std::sin(th), std::sin(ph) * std::cos(th), std::cos(ph) * std::cos(th));
+  EXPECT_NEAR(PitchFromDownDeg(rolled), 20.0, 1e-12);
+  EXPECT_NEAR(RollFromDownDeg(rolled), 3.0, 1e-12);
+}
+
+// Rest, then a swing about the down vertical with a small rocking about a horizontal axis.
+struct Synthetic {
+  ImuData data;
+  Eigen::Vector3d down_in_imu;
+  Eigen::Matrix3d imu_to_body;
+};
+
+Synthetic MakeSynthetic(double pitch_deg, const Eigen::Matrix3d& imu_to_body, bool rest, uint64_t seed,
+                        double rocking = 0.02) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Synthetic s;
+  s.imu_to_body = imu_to_body;
+  s.down_in_imu = imu_to_body.transpose() * DownInBody(pitch_deg);
+  const Eigen::Vector3d horiz_in_imu = imu_to_body.transpose() * Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d bias(0.008, -0.005, 0.006);
+  const double gyro_sigma = 0.25 * kDeg, accel_sigma = 0.02;
+  const double t_release = rest ? 3.0 : 0.0, w = 2 * kPi / 1.8;
+  for (int k = 0; k < 4000; ++k) {
+    const double t = 0.01 * k;
+    double rate = 0.0, rock = 0.0;
+    if (t >= t_release) {
+      rate = 0.4 * std::exp(-0.02 * (t - t_release)) * std::sin(w * (t - t_release));
+      rock = rocking * std::sin(2 * kPi * 0.35 * (t - t_release));
+    }
+    const Eigen::Vector3d noise_g(normal(rng), normal(rng), normal(rng));
+    const Eigen::Vector3d noise_a(normal(rng), normal(rng), normal(rng));
+    s.data.t_s.push_back(t);
+    s.data.gyro_in_imu.push_back(rate * s.down_in_imu + rock * horiz_in_imu + bias + gyro_sigma * noise_g);
+    s.data.accel_in_imu.push_back(-kG * s.down_in_imu + accel_sigma * noise_a);
+  }
+  return s;
+}
+
+TEST(SwingAxis, RotatedImuAccelerometerAtRest) {
+  // Tolerances: 0.02 m/s^2 accelerometer noise averaged over ~250 rest samples tilts the down
+  // vector by ~0.02/9.8/sqrt(250) rad = 0.007 deg; 0.1 deg (pitch) is > 10 sigma.
+  for (double pitch : {-70.0, -20.0, 0.0, 35.0, 80.0}) {
+    const Eigen::Matrix3d mount = MountingFromRollPitchYawDeg(4.0, -9.0, 125.0);
+    const Synthetic s = MakeSynthetic(pitch, mount, true, 11);
+    SwingAxisOptions o;
+    o.imu_to_body = mount;
+    SwingAxis axis;
+    std::string why;
+    ASSERT_TRUE(EstimateSwingAxis(s.data, o, std::nullopt, &axis, &why)) << why;
+    EXPECT_EQ(axis.source, SwingAxisSource::kAccelAtRest);
+    EXPECT_GT(axis.rest_samples, 200);
+    EXPECT_LT(AngleDeg(axis.axis_in_imu, s.down_in_imu), 0.05) << pitch;
+    ASSERT_TRUE(axis.pitch_measured_deg.has_value());
+    EXPECT_NEAR(*axis.pitch_measured_deg, pitch, 0.1);
+    EXPECT_NEAR(*axis.roll_measured_deg, 0.0, 0.1);
+    EXPECT_NEAR(axis.rest_accel_mps2, kG, 0.01);
+    ASSERT_EQ(axis.rate_rad_per_s.size(), s.data.size());
+    EXPECT_NEAR(axis.rate_rad_per_s[100], s.data.gyro_in_imu[100].dot(axis.axis_in_imu), 1e-15);
+  }
+}
+
+TEST(SwingAxis, WithoutRestUsesWindowAverage) {
+  const Eigen::Matrix3d mount = MountingFromRollPitchYawDeg(0.0, 0.0, 0.0);
+  const Synthetic s = MakeSynthetic(15.0, mount, false, 12);
+  SwingAxisOptions o;
+  SwingAxis axis;
+  std::string why;
+  ASSERT_TRUE(EstimateSwingAxis(s.data, o, std::make_pair(5.0, 35.0), &axis, &why)) << why;
+  EXPECT_EQ(axis.source, SwingAxisSource::kAccelOverWindow);
+  EXPECT_FALSE(axis.notes.empty());
+  // No lever arm in this synthetic data, so the window average is as good as rest.
+  EXPECT_NEAR(*axis.pitch_measured_deg, 15.0, 0.1);
+}
+
+TEST(SwingAxis, GyroOnlyPrincipalDirection) {
+  // Gyro noise 0.25 deg/s against a 0.4 rad/s swing over 37 s: the principal direction is good to
+  // ~0.01 deg; the 0.02 rad/s rocking is orthogonal and smaller, so it does not tilt it.
+  const Eigen::Matrix3d mount = MountingFromRollPitchYawDeg(-3.0, 6.0, -50.0);
+  for (double pitch : {-60.0, 10.0, 70.0}) {
+    Synthetic s = MakeSynthetic(pitch, mount, true, 13);
+    s.data.accel_in_imu.clear();
+    SwingAxisOptions o;
+    o.imu_to_body = mount;
+    SwingAxis axis;
+    std::string why;
+    ASSERT_TRUE(EstimateSwingAxis(s.data, o, std::nullopt, &axis, &why)) << why;
+    EXPECT_EQ(axis.source, SwingAxisSource::kGyroPrincipal);
+    EXPECT_FALSE(axis.pitch_measured_deg.has_value());
+    // Sign rule: z >= 0 in body axes, which is the down vertical's sign for |pitch| < 90 deg.
+    EXPECT_LT(AngleDeg(axis.axis_in_imu, s.down_in_imu), 0.5) << pitch;
+    EXPECT_GE(axis.axis_in_body.z(), 0.0);
+  }
+}
+
+TEST(SwingAxis, FixedAxis) {
+  const Synthetic s = MakeSynthetic(0.0, Eigen::Matrix3d::Identity(), true, 14);
+  SwingAxisOptions o;
+  o.mode = SwingAxisMode::kFixed;
+  o.fixed_axis_in_imu = Eigen::Vector3d(0, 0, 2);
+  SwingAxis axis;
+  std::string why;
+  ASSERT_TRUE(EstimateSwingAxis(s.data, o, std::nullopt, &axis, &why)) << why;
+  EXPECT_EQ(axis.source, SwingAxisSource::kFixed);
+  EXPECT_DOUBLE_EQ(axis.axis_in_imu.z(), 1.0);
+  EXPECT_DOUBLE_EQ(axis.rate_rad_per_s[500], s.data.gyro_in_imu[500].z());
+  ASSERT_TRUE(axis.pitch_measured_deg.has_value());  // still measured from the accelerometer
+  EXPECT_NEAR(*axis.pitch_measured_deg, 0.0, 0.1);
+  o.fixed_axis_in_imu.setZero();
+  EXPECT_FALSE(EstimateSwingAxis(s.data, o, std::nullopt, &axis, &why));
+  EXPECT_NE(why.find("fixed axis"), std::string::npos);
+}
+
+TEST(SwingAxis, Rejects) {
+  Synthetic s = MakeSynthetic(0.0, Eigen::Matrix3d::Identity(), true, 15);
+  SwingAxis axis;
+  std::string why;
+  // Accelerometer in g read as m/s^2: |f| = 1, not gravity.
+  ImuData wrong_unit = s.data;
+  for (auto& f : wrong_unit.accel_in_imu) f /= kG;
+  EXPECT_FALSE(EstimateSwingAxis(wrong_unit, SwingAxisOptions(), std::nullopt, &axis, &why));
+  EXPECT_NE(why.find("unit"), std::string::npos) << why;
+  // Constant gyro, no accelerometer: no axis to find.
+  ImuData flat = s.data;
+  flat.accel_in_imu.clear();
+  for (auto& g : flat.gyro_in_imu) g = Eigen::Vector3d(0.01, 0.0, 0.0);
+  EXPECT_FALSE(EstimateSwingAxis(flat, SwingAxisOptions(), std::nullopt, &axis, &why));
+  EXPECT_NE(why.find("constant"), std::string::npos) << why;
+  // Not a rotation.
+  SwingAxisOptions bad;
+  bad.imu_to_body = 2.0 * Eigen::Matrix3d::Identity();
+  EXPECT_FALSE(bad.Check(&why));
+  EXPECT_FALSE(EstimateSwingAxis(ImuData(), SwingAxisOptions(), std::nullopt, &axis, &why));
+}
+
+TEST(SwingAxis, SecondaryMotionRatio) {
+  // Exact: gyro = w(t) n + eps w(t) m + constant bias, m orthogonal to n -> ratio eps.
+  ImuData d;
+  const Eigen::Vector3d n = Eigen::Vector3d(0.2, -0.3, 0.9).normalized();
+  const Eigen::Vector3d m = n.cross(Eigen::Vector3d::UnitX()).normalized();
+  for (int k = 0; k < 3000; ++k) {
+    const double t = 0.01 * k, w = std::sin(3.0 * t);
+    d.t_s.push_back(t);
+    d.gyro_in_imu.push_back(w * n + 0.07 * w * m + Eigen::Vector3d(0.01, 0.02, -0.01));
+  }
+  EXPECT_NEAR(SecondaryMotionRatio(d, n, 2.0, 25.0), 0.07, 1e-12);
+  EXPECT_NEAR(SecondaryMotionRatio(d, -n, 2.0, 25.0), 0.07, 1e-12);
+  EXPECT_DOUBLE_EQ(SecondaryMotionRatio(d, n, 50.0, 60.0), 0.0);  // empty range
+  ImuData still = d;
+  for (auto& g : still.gyro_in_imu) g.setConstant(0.01);
+  EXPECT_DOUBLE_EQ(SecondaryMotionRatio(still, n, 2.0, 25.0), 0.0);
+}
+
+// Simulated logs: tilted IMU at many pitches; the axis against the simulator's truth, the pitch
+// against the true pitch. Accelerometer bias is what limits the pitch: with the simulator's
+// default 0.05 m/s^2 per axis it tilts the down vector by up to ~0.5 deg, so the 0.1 deg check
+// runs with the bias off and a 4-sigma bound (4 * 0.05 / 9.8 rad = 1.2 deg) with it on.
+TEST(SwingAxis, SimulatedLogs) {
+  for (bool accel_bias : {false, true}) {
+    SimulationOptions options;
+    options.timeline.free_s = {15.0, 20.0};
+    if (!accel_bias) options.sensor.accel_bias_sigma_mps2 = 0.0;
+    for (int i = 0; i < 8; ++i) {
+      TraceSetup setup;
+      setup.geometry.filar_length_m = 2.0;
+      setup.geometry.filar_separation_m = 0.7;
+      setup.geometry.mass_kg = 10.0;
+      setup.params.inertia_kg_m2 = 0.8;
+      setup.params.drag_coeff_kg_m2 = 0.005;
+      setup.params.viscous_coeff_kg_m2_per_s = 0.001;
+      setup.pitch_rad = (-75.0 + 21.0 * i) * kDeg;
+      setup.amplitude_rad = (8.0 + 3.0 * i) * kDeg;
+      setup.body_from_imu = MountingFromRollPitchYawDeg(3.0 - i, 2.0 * i - 7.0, 45.0 * i);
+      setup.imu_offset_in_body_m = Eigen::Vector3d(0.25, 0.1, -0.05);
+      SimulatedTrace trace;
+      std::string why;
+      ASSERT_TRUE(SimulateTrace(setup, options, 500 + i, &trace, &why)) << why;
+      SwingAxisOptions o;
+      o.imu_to_body = setup.body_from_imu;
+      SwingAxis axis;
+      ASSERT_TRUE(EstimateSwingAxis(trace.imu, o, std::nullopt, &axis, &why)) << why;
+      SCOPED_TRACE("sim " + std::to_string(i) + (accel_bias ? " with accel bias" : ""));
+      EXPECT_EQ(axis.source, SwingAxisSource::kAccelAtRest);
+      EXPECT_LT(AngleDeg(axis.axis_in_imu, trace.truth.swing_axis_in_imu), accel_bias ? 1.2 : 0.1);
+      ASSERT_TRUE(axis.pitch_measured_deg.has_value());
+      EXPECT_NEAR(*axis.pitch_measured_deg, setup.pitch_rad / kDeg, accel_bias ? 1.2 : 0.1);
+      // Gyro only: the principal direction of the same log, within 0.5 deg of the truth.
+      ImuData gyro_only = trace.imu;
+      gyro_only.accel_in_imu.clear();
+      SwingAxis principal;
+      ASSERT_TRUE(EstimateSwingAxis(gyro_only, o, std::nullopt, &principal, &why)) << why;
+      EXPECT_LT(AngleDeg(principal.axis_in_imu, trace.truth.swing_axis_in_imu), 0.5);
+      // Secondary motion: the simulator's rocking (<= 0.3 deg) is small against the swing.
+      const double ratio = SecondaryMotionRatio(trace.imu, axis.axis_in_imu, trace.truth.t_release_s + 2.0,
+                                                trace.truth.t_release_s + 12.0);
+      EXPECT_LT(ratio, 0.2);
+      EXPECT_GT(ratio, 0.0);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace bifilar
