@@ -15,7 +15,9 @@
 #include <sstream>
 #include <thread>
 
+#include "fit/ellipse_plot.h"
 #include "pipeline/cache.h"
+#include "pipeline/ellipse_json.h"
 #include "pipeline/report.h"
 #include "pipeline/results_json.h"
 #include "pipeline/user_error.h"
@@ -133,10 +135,15 @@ bool ParsePitchText(std::string text, double* pitch_deg) {
   return *pitch_deg >= -180.0 && *pitch_deg <= 180.0;
 }
 
+// How a log is named to the user: relative to runs.root when inside it (pitch_10/trial_1.csv),
+// else relative to the config folder, else the absolute path.
 std::string Display(const CampaignConfig& config, const std::string& path) {
-  const fs::path rel = fs::path(path).lexically_relative(config.folder);
-  const std::string text = rel.string();
-  return text.empty() || text.rfind("..", 0) == 0 ? path : text;
+  for (const std::string& base : {config.runs.root, config.folder}) {
+    if (base.empty()) continue;
+    const std::string rel = fs::path(path).lexically_relative(base).string();
+    if (!rel.empty() && rel.rfind("..", 0) != 0) return rel;
+  }
+  return path;
 }
 
 std::vector<std::string> SplitCsvLine(const std::string& line) {
@@ -313,34 +320,37 @@ void Prune(const std::string& folder, const std::set<std::string>& keep) {
   }
 }
 
-// TEMPORARY until pipeline/ellipse_json.h and fit/ellipse_plot.h land.
-nlohmann::json Estimate(const EllipseEstimate& e) {
-  if (!e.defined) return {{"defined", false}};
-  return {{"value", e.value}, {"std", e.std}, {"ci_lo", e.ci_lo}, {"ci_hi", e.ci_hi},
-          {"defined", true}};
-}
-nlohmann::json EllipseResultJson(const EllipseResult& fit) {
-  nlohmann::json j;
-  j["ix_kg_m2"] = Estimate(fit.ix);
-  j["iz_kg_m2"] = Estimate(fit.iz);
-  j["ixz_kg_m2"] = Estimate(fit.ixz);
-  j["tau_deg"] = Estimate(fit.tau_deg);
-  j["ixp_kg_m2"] = Estimate(fit.ixp);
-  j["izp_kg_m2"] = Estimate(fit.izp);
-  j["coefficients_kg_m2"] = {fit.a_kg_m2, fit.b_kg_m2, fit.c_kg_m2};
-  j["rmse_kg_m2"] = fit.rmse_kg_m2;
-  j["n_points"] = fit.n_points;
-  j["n_angles"] = fit.n_angles;
-  nlohmann::json naca = nlohmann::json::array();
-  for (const EllipseNacaEstimate& e : fit.naca) {
-    naca.push_back({{"pitch_deg", e.pitch_deg}, {"ixz_kg_m2", e.ixz_kg_m2},
-                    {"ixz_std_kg_m2", e.ixz_std_kg_m2}});
+// Fig. 3 and Fig. 4 under names keyed by the ellipse inputs, so an unchanged rerun reuses them.
+void DrawCampaignFigures(const CampaignConfig& config, const EllipseResult& fit,
+                         const std::string& out_dir, CampaignResult* result) {
+  std::ostringstream key;
+  key.precision(17);
+  key << ProgramVersion() << ';' << ToString(config.units) << ';' << fit.a_kg_m2 << ';'
+      << fit.b_kg_m2 << ';' << fit.c_kg_m2 << ';' << fit.bootstrap_replicates << ';';
+  for (const EllipsePoint& p : fit.points) {
+    key << p.pitch_deg << ',' << p.inertia_kg_m2 << ',' << p.std_kg_m2 << ';';
   }
-  j["naca467"] = naca;
-  j["warnings"] = fit.warnings;
-  return j;
+  const std::string hash = HashToHex(Fnv1a64(key.str()));
+  EllipsePlotOptions plot;
+  if (config.units == DisplayUnits::kImperial) {
+    plot.unit_scale = kSlugFt2PerKgM2;
+    plot.unit_label = "slug ft#u2#d";
+  }
+  const fs::path figures = fs::path(out_dir) / "figures";
+  std::error_code ec;
+  std::string why;
+  const std::string moments = "moments_" + hash + ".svg", polar = "polar_" + hash + ".svg";
+  if (fs::exists(figures / moments, ec) ||
+      WriteEllipseMomentFigure(fit, (figures / moments).string(), plot, &why)) {
+    result->moments_figure = moments;
+  }
+  plot.figure.width_px = 1000;
+  plot.figure.height_px = 520;
+  if (fs::exists(figures / polar, ec) ||
+      WriteEllipsePolarFigure(fit, (figures / polar).string(), plot, &why)) {
+    result->polar_figure = polar;
+  }
 }
-void DrawCampaignFigures(const EllipseResult&, const std::string&, CampaignResult*) {}
 
 EllipseOptions MakeEllipseOptions(const CampaignConfig& config) {
   EllipseOptions o;
@@ -395,8 +405,8 @@ void FitCampaignEllipse(const CampaignConfig& config, const CampaignOptions& opt
     result->raw_sigma_kg_m2 = fit.table1.mean_angle_std_kg_m2;
     result->cv_percent = fit.table1.mean_cov_percent;
   }
-  result->ellipse = EllipseResultJson(fit);
-  if (options.figures) DrawCampaignFigures(fit, out_dir, result);
+  result->ellipse = EllipseResultToJson(fit);
+  if (options.figures) DrawCampaignFigures(config, fit, out_dir, result);
   result->ellipse_fit = std::move(fit);
 }
 
@@ -783,7 +793,7 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     out << s.ellipse_message << "\n";
   }
   if (std::isfinite(result.rig_inertia_kg_m2)) {
-    std::snprintf(line, sizeof(line), "Rig inertia %.5f +- %.5f %s", inertia(result.rig_inertia_kg_m2),
+    std::snprintf(line, sizeof(line), "Rig inertia %.5f +- %.2g %s", inertia(result.rig_inertia_kg_m2),
                   inertia(result.rig_inertia_std_kg_m2), unit);
     out << line;
     if (config.rig_inertia.kind == RigInertiaSpec::Kind::kTare) {

@@ -58,21 +58,24 @@ struct Units {
   }
 };
 
-// An estimate object of the ellipse JSON: {"value", "std", "ci_lo", "ci_hi", "defined"}.
+// An estimate of the ellipse JSON (pipeline/ellipse_json.h): KEY, KEY_std, KEY_ci95 [lo, hi];
+// null when undefined (tau, I_xp, I_zp when I_x ~ I_z).
 struct Estimate {
   bool present = false, defined = false;
   double value = NAN, std = NAN, lo = NAN, hi = NAN;
 };
-Estimate GetEstimate(const json& ellipse, const char* key) {
+Estimate GetEstimate(const json& ellipse, const std::string& key) {
   Estimate e;
   if (!ellipse.is_object() || !ellipse.contains(key)) return e;
-  const json& j = ellipse[key];
   e.present = true;
-  e.defined = !j.contains("defined") || j["defined"].get<bool>();
-  e.value = Num(j, "value");
-  e.std = Num(j, "std");
-  e.lo = Num(j, "ci_lo");
-  e.hi = Num(j, "ci_hi");
+  e.defined = ellipse[key].is_number();
+  e.value = Num(ellipse, key.c_str());
+  e.std = Num(ellipse, (key + "_std").c_str());
+  const json ci = ellipse.value(key + "_ci95", json(nullptr));
+  if (ci.is_array() && ci.size() == 2 && ci[0].is_number() && ci[1].is_number()) {
+    e.lo = ci[0].get<double>();
+    e.hi = ci[1].get<double>();
+  }
   return e;
 }
 
@@ -166,10 +169,10 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
     h << "<table><tr><th class=\"l\">quantity</th><th>value</th><th>std</th><th>interval</th>"
          "<th class=\"l\">unit</th></tr>\n";
     struct Row { const char* key; const char* label; bool angle; };
-    for (const Row& row : {Row{"ix_kg_m2", "I<sub>x</sub>", false}, Row{"iz_kg_m2", "I<sub>z</sub>", false},
-                           Row{"ixz_kg_m2", "I<sub>xz</sub>", false}, Row{"tau_deg", "&tau; (principal inclination)", true},
-                           Row{"ixp_kg_m2", "I<sub>xp</sub> (principal)", false},
-                           Row{"izp_kg_m2", "I<sub>zp</sub> (principal)", false}}) {
+    for (const Row& row : {Row{"Ix_kg_m2", "I<sub>x</sub>", false}, Row{"Iz_kg_m2", "I<sub>z</sub>", false},
+                           Row{"Ixz_kg_m2", "I<sub>xz</sub>", false}, Row{"tau_deg", "&tau; (principal inclination)", true},
+                           Row{"Ixp_kg_m2", "I<sub>xp</sub> (principal)", false},
+                           Row{"Izp_kg_m2", "I<sub>zp</sub> (principal)", false}}) {
       const Estimate e = GetEstimate(ellipse, row.key);
       if (!e.present) continue;
       h << "<tr><td class=\"l\">" << row.label << "</td>";
@@ -212,7 +215,7 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
     << Fmt(Num(rig, "aircraft_mass_kg"), "%.4f") << " kg, g = "
     << Fmt(Num(rig, "gravity_mps2"), "%.5f") << " m/s<sup>2</sup>. Rig inertia ("
     << Escape(Str(rig, "inertia_source")) << "): " << u.Inertia(Num(rig, "inertia_kg_m2"), "%.5f")
-    << " &plusmn; " << u.Inertia(Num(rig, "inertia_std_kg_m2"), "%.5f") << " " << u.name;
+    << " &plusmn; " << u.Inertia(Num(rig, "inertia_std_kg_m2"), "%.2e") << " " << u.name;
   if (Str(rig, "inertia_source") == "tare") h << " from " << rig.value("tare_n", 0) << " tare log(s)";
   h << ".</p>\n";
 
@@ -224,16 +227,16 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
 
   // NACA 467.
   h << "<h2>NACA Report 467 comparison</h2>\n";
-  if (ellipse.is_object() && ellipse.contains("naca467") && !ellipse["naca467"].empty()) {
-    const Estimate ixz = GetEstimate(ellipse, "ixz_kg_m2");
+  if (ellipse.is_object() && ellipse.contains("naca") && !ellipse["naca"].empty()) {
+    const Estimate ixz = GetEstimate(ellipse, "Ixz_kg_m2");
     h << "<p>I<sub>xz</sub> from one oblique angle (paper Eq. 1) against the multi-angle fit "
       << u.Inertia(ixz.value) << " &plusmn; " << u.Inertia(ixz.std) << " " << u.name << ".</p>\n"
       << "<table><tr><th>pitch (deg)</th><th>I<sub>xz</sub> NACA 467</th><th>std</th>"
          "<th>difference from fit</th></tr>\n";
-    for (const auto& e : ellipse["naca467"]) {
-      const double v = Num(e, "ixz_kg_m2");
+    for (const auto& e : ellipse["naca"]) {
+      const double v = Num(e, "Ixz_kg_m2");
       h << "<tr><td>" << Fmt(Num(e, "pitch_deg"), "%.1f") << "</td><td>" << u.Inertia(v)
-        << "</td><td>" << u.Inertia(Num(e, "ixz_std_kg_m2")) << "</td><td>"
+        << "</td><td>" << u.Inertia(Num(e, "Ixz_std_kg_m2")) << "</td><td>"
         << u.Inertia(v - ixz.value) << "</td></tr>\n";
     }
     h << "</table>\n";
