@@ -115,16 +115,20 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
       ->required();
   plan->add_option("--ix", *ix, "guess of I_x in --units (default: the paper's PRANDTL-D)");
   plan->add_option("--iz", *iz, "guess of I_z in --units (default: the paper's PRANDTL-D)");
-  plan->add_option("--ixz", *ixz, "guess of I_xz in --units (default 0 when --ix/--iz given)");
+  auto* ixz_option =
+      plan->add_option("--ixz", *ixz, "guess of I_xz in --units (default 0 when --ix/--iz given)");
   plan->add_option("--units", *plan_units, "si (kg m^2, default) or imperial (slug ft^2)");
   plan->add_flag("--json", plan_opts->json, "print JSON (SI)");
-  plan->callback([plan_opts, angles, plan_units, ix, iz, ixz, exit_code] {
+  plan->callback([plan_opts, angles, plan_units, ix, iz, ixz, ixz_option, exit_code] {
     plan_opts->units = Units(*plan_units);
     plan_opts->pitch_deg = ParseAngleList(*angles);
     if (std::isnan(*ix) != std::isnan(*iz)) {
       throw UserError("plan: give both --ix and --iz, or neither (the paper's aircraft)");
     }
     plan_opts->guesses_given = !std::isnan(*ix);
+    if (!plan_opts->guesses_given && ixz_option->count() > 0) {
+      throw UserError("plan: --ixz needs --ix and --iz too");
+    }
     plan_opts->ix = *ix;
     plan_opts->iz = *iz;
     plan_opts->ixz = *ixz;

@@ -213,6 +213,7 @@ TEST_F(EllipseCli, PlanPredictsStandardErrors) {
   EXPECT_EQ(Bifilar("plan --angles 0,x,60 --sigma 0.01").exit_code, 2);
   EXPECT_EQ(Bifilar("plan --angles 0,30,60 --sigma 0.01 --ix 2").exit_code, 2);
   EXPECT_EQ(Bifilar("plan --sigma 0.01").exit_code, 2);
+  EXPECT_EQ(Bifilar("plan --angles 0,30,60 --sigma 0.01 --ixz 0.1").exit_code, 2);
 }
 
 TEST(EllipseTable, ParsesUnitsCommentsAndWhitespace) {
