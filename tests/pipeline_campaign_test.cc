@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "pipeline/simulate_spec.h"
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -331,6 +332,109 @@ TEST(Campaign, RunsTableAndTooFewAngles) {
   EXPECT_FALSE(result.summary.ellipse_fitted);
   EXPECT_NE(result.summary.ellipse_message.find("at least 3 needed"), std::string::npos);
   EXPECT_EQ(result.summary.exit_code, 1);
+}
+
+// ---- With the real trace fit, on logs from the simulator ----
+
+std::string Replace(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  if (at == std::string::npos) ADD_FAILURE() << "sample spec changed: '" << from << "' not found";
+  else text.replace(at, from.size(), to);
+  return text;
+}
+
+// A small campaign simulated from the sample spec (5 angles, 2 trials, 2 tare logs, 20-25 s).
+struct SimulatedCampaign {
+  std::string dir;
+  nlohmann::json truth;
+  SimulatedCampaign() {
+    dir = TempDir();
+    std::string spec = ReadFile(std::string(BIFILAR_SOURCE_DIR) + "/configs/simulate_prandtl_d.yaml");
+    spec = Replace(spec, "pitch_deg: [-80, -70, -60, -50, -40, -30, -20, -10, 0, 10, 20, 30, 40, 50, 60, 70, 80, 90]",
+                   "pitch_deg: [-60, -20, 0, 45, 90]");
+    spec = Replace(spec, "trials_per_pitch: 3", "trials_per_pitch: 2");
+    spec = Replace(spec, "tare_logs: 3", "tare_logs: 2");
+    spec = Replace(spec, "free_s: [40, 50]", "free_s: [20, 25]");
+    RunSimulateCampaign(ParseSimulateSpec(spec, "small_spec.yaml"), dir + "/logs");
+    truth = nlohmann::json::parse(ReadFile(dir + "/logs/truth.json"));
+    WriteConfig("{tare: {logs: logs/tare/*.csv}}", "nominal");
+  }
+  void WriteConfig(const std::string& rig_inertia, const std::string& pitch_source) {
+    WriteFile(dir + "/campaign.yaml",
+              "rig:\n  filar_length_m: 2.0\n  filar_separation_m: 1.8\n  mass_kg: 1.25\n"
+              "  inertia: " + rig_inertia + "\n"
+              "aircraft: {mass_kg: 5.5}\n"
+              "runs: {root: logs, pattern: \"pitch_{pitch_deg}/*.csv\", pitch_source: " +
+              pitch_source + "}\n");
+  }
+  CampaignResult Run() {
+    CampaignOptions options;
+    options.out_dir = dir + "/out";
+    options.jobs = 2;
+    return RunCampaign(LoadCampaignConfig(dir + "/campaign.yaml"), options);
+  }
+};
+
+TEST(CampaignRealFit, RecoversTheSimulatedAircraft) {
+  SimulatedCampaign c;
+  // A log that is not CSV at all, in the middle of the campaign.
+  WriteFile(c.dir + "/logs/pitch_0/trial_9.csv", std::string("\x89PNG\r\n\x1a\n\0\0binary", 16));
+  const CampaignResult result = c.Run();
+  EXPECT_EQ(result.summary.n_ok, 12);  // 10 aircraft + 2 tare
+  EXPECT_EQ(result.summary.n_error, 1);
+  const TraceRecord* bad = Find(result, "pitch_0/trial_9.csv");
+  ASSERT_NE(bad, nullptr);
+  EXPECT_EQ(bad->status, TraceStatus::kError);
+  EXPECT_EQ(bad->message.rfind("pitch_0/trial_9.csv", 0), 0u) << bad->message;
+  // Rig from the tare logs: the simulated 0.25 kg m^2 within 5 std of the mean.
+  EXPECT_NEAR(result.rig_inertia_kg_m2, 0.25, 5 * result.rig_inertia_std_kg_m2 + 1e-4);
+  // Every trace within 5 of its own sigma of the simulated total, plus 0.02 % (below the trace
+  // fit's 0.05 % maximum-error target) for what the statistical sigma does not cover (gyro
+  // scale error, rocking, jitter).
+  for (const auto& t : c.truth["traces"]) {
+    const TraceRecord* r = Find(result, t["file"].get<std::string>());
+    ASSERT_NE(r, nullptr) << t["file"];
+    ASSERT_TRUE(r->ok()) << r->message;
+    EXPECT_NEAR(r->inertia_total_kg_m2, t["inertia_total_kg_m2"].get<double>(),
+                5 * r->inertia_total_std_kg_m2 + 2e-4 * t["inertia_total_kg_m2"].get<double>())
+        << r->file;
+    ASSERT_TRUE(r->pitch_measured_deg.has_value());
+    // Accelerometer pitch: noise 0.02 m/s^2 and bias 0.05 m/s^2 (1 sigma) give ~0.3 deg.
+    if (t["kind"] == "aircraft") {
+      EXPECT_NEAR(*r->pitch_measured_deg, t["true_pitch_deg"].get<double>(), 1.5) << r->file;
+    }
+  }
+  // The ellipse: within 5 reported std of the truth (nominal pitch, 0.5 deg setting errors).
+  ASSERT_TRUE(result.ellipse_fit.has_value()) << result.summary.ellipse_message;
+  const auto& aircraft = c.truth["aircraft"];
+  EXPECT_NEAR(result.ellipse_fit->ix.value, aircraft["ix_kg_m2"].get<double>(),
+              5 * result.ellipse_fit->ix.std);
+  EXPECT_NEAR(result.ellipse_fit->iz.value, aircraft["iz_kg_m2"].get<double>(),
+              5 * result.ellipse_fit->iz.std);
+  EXPECT_NEAR(result.ellipse_fit->ixz.value, aircraft["ixz_kg_m2"].get<double>(),
+              5 * result.ellipse_fit->ixz.std);
+}
+
+TEST(CampaignRealFit, RigLargerThanTotalAndMeasuredPitch) {
+  SimulatedCampaign c;
+  c.WriteConfig("{inertia_kg_m2: 50}", "measured");
+  CampaignResult result = c.Run();
+  EXPECT_EQ(result.summary.exit_code, 1);
+  EXPECT_EQ(result.summary.n_ok, 0);
+  const TraceRecord* r = Find(result, "pitch_0/trial_1.csv");
+  ASSERT_NE(r, nullptr);
+  EXPECT_NE(r->message.find("rig inertia 50 kg m^2 is not below the measured total"),
+            std::string::npos) << r->message;
+  EXPECT_FALSE(result.summary.ellipse_fitted);
+  // Same logs, rig fixed: no trace refitted (the rig is not a fit input); measured pitch used.
+  c.WriteConfig("{inertia_kg_m2: 0.25}", "measured");
+  result = c.Run();
+  EXPECT_EQ(result.summary.n_fitted, 0);
+  EXPECT_EQ(result.summary.n_ok, 10);
+  for (const TraceRecord& t : result.traces) {
+    EXPECT_DOUBLE_EQ(t.pitch_used_deg, *t.pitch_measured_deg);
+  }
+  ASSERT_TRUE(result.ellipse_fit.has_value());
 }
 
 }  // namespace

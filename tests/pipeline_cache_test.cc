@@ -1,0 +1,112 @@
+// Cache: the FNV-1a hash against published test vectors, which config values enter a trace's
+// key (and which do not), and entries surviving a store/load round trip.
+#include "pipeline/cache.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+namespace bifilar {
+namespace {
+
+TEST(Cache, Fnv1a64MatchesReferenceVectors) {
+  // Vectors from the FNV reference (isthe.com/chongo/tech/comp/fnv, test_fnv.c, FNV-1a 64).
+  EXPECT_EQ(Fnv1a64(std::string("")), 0xcbf29ce484222325ULL);
+  EXPECT_EQ(Fnv1a64(std::string("a")), 0xaf63dc4c8601ec8cULL);
+  EXPECT_EQ(Fnv1a64(std::string("foobar")), 0x85944171f73967e8ULL);
+  EXPECT_EQ(HashToHex(0xaf63dc4c8601ec8cULL), "af63dc4c8601ec8c");
+  // Chaining equals hashing the concatenation.
+  EXPECT_EQ(Fnv1a64(std::string("bar"), Fnv1a64(std::string("foo"))),
+            Fnv1a64(std::string("foobar")));
+}
+
+CampaignConfig BaseConfig() {
+  CampaignConfig c;
+  c.filar_length_m = 2.0;
+  c.filar_separation_m = 1.8;
+  c.rig_mass_kg = 1.25;
+  c.aircraft_mass_kg = 5.5;
+  return c;
+}
+
+TEST(Cache, KeyHasEveryFitInputAndNothingElse) {
+  const CampaignConfig base = BaseConfig();
+  const std::string key = FitFingerprint(base, TraceRole::kAircraft, std::nullopt);
+  auto changed = [&](void (*edit)(CampaignConfig*)) {
+    CampaignConfig c = base;
+    edit(&c);
+    return FitFingerprint(c, TraceRole::kAircraft, std::nullopt) != key;
+  };
+  // Fit inputs: every one changes the key.
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->filar_length_m = 2.001; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->filar_separation_m = 1.7; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->rig_mass_kg = 1.3; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->aircraft_mass_kg = 5.6; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->gravity_mps2 = 9.81; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->uncertainties.filar_length_std_m = 0.01; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->fit.model = PendulumModel::kJardin; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->fit.max_amplitude_deg = 20.0; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->fit.quality.max_rms_over_noise = 2.0; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->imu.format.gyro_unit = RateUnit::kDegPerS; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->imu.swing_axis_auto = false; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->imu.imu_to_body(0, 0) = -1.0; }));
+  // Not fit inputs: the rig inertia, pitch source, ellipse, units.
+  EXPECT_FALSE(changed([](CampaignConfig* c) { c->rig_inertia.inertia_kg_m2 = 0.3; }));
+  EXPECT_FALSE(changed([](CampaignConfig* c) { c->rig_inertia.kind = RigInertiaSpec::Kind::kTare; }));
+  EXPECT_FALSE(changed([](CampaignConfig* c) { c->runs.pitch_source = PitchSource::kMeasured; }));
+  EXPECT_FALSE(changed([](CampaignConfig* c) { c->ellipse.bootstrap = 10; }));
+  EXPECT_FALSE(changed([](CampaignConfig* c) { c->units = DisplayUnits::kImperial; }));
+  // A tare log is fitted with the rig mass alone: the aircraft mass is not in its key.
+  CampaignConfig heavier = base;
+  heavier.aircraft_mass_kg = 9.0;
+  EXPECT_EQ(FitFingerprint(base, TraceRole::kTare, std::nullopt),
+            FitFingerprint(heavier, TraceRole::kTare, std::nullopt));
+  EXPECT_NE(FitFingerprint(base, TraceRole::kTare, std::nullopt), key);
+  // The window override of this file.
+  EXPECT_NE(FitFingerprint(base, TraceRole::kAircraft, std::array<double, 2>{1.0, 30.0}), key);
+  // The key mixes content and settings.
+  EXPECT_NE(CacheKey("0123456789abcdef", key), CacheKey("0123456789abcdee", key));
+}
+
+TEST(Cache, StoreAndLoadRoundTrip) {
+  char tmpl[] = "/tmp/bifilar_cache_test_XXXXXX";
+  const std::string dir = mkdtemp(tmpl);
+  const TraceCache cache(dir + "/cache");
+  TraceRecord r;
+  r.file = "pitch_0/trial_1.csv";
+  r.status = TraceStatus::kRejected;
+  r.message = "residuals not white";
+  r.inertia_total_kg_m2 = 4.1;
+  r.inertia_total_std_kg_m2 = 2e-5;
+  r.window_s = {3.5, 44.0};
+  r.amplitude_deg = {25.0, 9.0};
+  r.pitch_measured_deg = 0.3;
+  r.budget = {{"filar_length", 1e-3}, {"mass", 2e-4}};
+  r.budget_total_std_kg_m2 = 1.02e-3;
+  r.flags = {"residual_not_white"};
+  r.iterations = 7;
+  r.model = "full";
+  TraceRecord loaded;
+  EXPECT_FALSE(cache.Load("0000000000000001", &loaded));
+  cache.Store("0000000000000001", r);
+  ASSERT_TRUE(cache.Load("0000000000000001", &loaded));
+  EXPECT_EQ(loaded.file, r.file);
+  EXPECT_EQ(loaded.status, TraceStatus::kRejected);
+  EXPECT_EQ(loaded.message, r.message);
+  EXPECT_DOUBLE_EQ(loaded.inertia_total_kg_m2, 4.1);
+  EXPECT_DOUBLE_EQ(loaded.window_s[1], 44.0);
+  EXPECT_DOUBLE_EQ(*loaded.pitch_measured_deg, 0.3);
+  EXPECT_TRUE(std::isnan(loaded.drag_coeff_kg_m2));  // null stays "not applicable"
+  ASSERT_EQ(loaded.budget.size(), 2u);
+  EXPECT_DOUBLE_EQ(loaded.budget_total_std_kg_m2, 1.02e-3);
+  EXPECT_EQ(loaded.flags, r.flags);
+  EXPECT_EQ(loaded.iterations, 7);
+  // A damaged entry is a miss, not an error.
+  std::ofstream(cache.EntryPath("0000000000000002")) << "{ not json";
+  EXPECT_FALSE(cache.Load("0000000000000002", &loaded));
+}
+
+}  // namespace
+}  // namespace bifilar
