@@ -45,7 +45,7 @@ struct TimelineOptions {
   UniformRange rest_before_s = {2.0, 5.0};   // still on the wires before the twist; >= 0
   UniformRange twist_s = {0.8, 1.2};         // hand twisting to the amplitude; > 0
   UniformRange hold_s = {1.0, 2.0};          // hand holding at the amplitude; >= 0
-  double tremor_deg = 0.15;                  // hand tremor while holding, RMS angle (deg); >= 0
+  double tremor_deg = 0.08;                  // hand tremor while holding, RMS angle (deg); >= 0
   UniformRange tremor_hz = {4.0, 9.0};       // tremor frequencies (Hz); > 0
   double release_rate_sigma_deg_per_s = 0.5;  // psi'(t_release) ~ N(0, sigma) (deg/s); >= 0
   UniformRange free_s = {40.0, 90.0};        // free oscillation until the log ends or the stop; > 0
