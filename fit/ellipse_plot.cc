@@ -76,9 +76,11 @@ bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
   for (double v : py) y_lo = std::min(y_lo, v), y_hi = std::max(y_hi, v);
   for (double v : elo) y_lo = std::min(y_lo, v);
   for (double v : ehi) y_hi = std::max(y_hi, v);
+  // The legend goes where the curve is not: below when the middle (0 deg) is high, else above.
+  const bool legend_below = Curve(r, 0.0) >= Curve(r, 90.0);
   const double pad = 0.06 * (y_hi - y_lo) + 1e-12 * std::fabs(y_hi);
-  y_lo -= 5.5 * pad;  // room for the legend below the curve
-  y_hi += pad;
+  y_lo -= legend_below ? 5.5 * pad : pad;
+  y_hi += legend_below ? pad : 5.5 * pad;
   x_lo -= 5;
   x_hi += 5;
 
@@ -110,8 +112,8 @@ bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
       const double xs[2] = {t, t}, ys[2] = {y_lo, y_hi};
       plline(2, xs, ys);
       const bool right_edge = t > x_hi - 12;
-      plptex(t + (right_edge ? -1.5 : 1.5), y_hi - 0.05 * (y_hi - y_lo), 1, 0, right_edge ? 1 : 0,
-             label.c_str());
+      const double y_text = legend_below ? y_hi - 0.05 * (y_hi - y_lo) : y_lo + 0.06 * (y_hi - y_lo);
+      plptex(t + (right_edge ? -1.5 : 1.5), y_text, 1, 0, right_edge ? 1 : 0, label.c_str());
     }
     pllsty(1);
     // Fitted curve.
@@ -159,7 +161,7 @@ bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
     const char* symbols[4] = {"○", "", "", "×"};
     PLFLT lw, lh;
     pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-             PL_POSITION_BOTTOM | PL_POSITION_INSIDE, 0.0, 0.02, 0.06, 0, kBlack, 1, 4, 1, 4, opts, 0.8, 0.8, 2.0, 0.0, text_colors, texts, nullptr, nullptr, nullptr,
+             (legend_below ? PL_POSITION_BOTTOM : PL_POSITION_TOP) | PL_POSITION_INSIDE, 0.0, 0.02, 0.06, 0, kBlack, 1, 4, 1, 4, opts, 0.8, 0.8, 2.0, 0.0, text_colors, texts, nullptr, nullptr, nullptr,
              nullptr, line_colors, line_styles, line_widths, symbol_colors, symbol_scales,
              symbol_numbers, symbols);
   };
