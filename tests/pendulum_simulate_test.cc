@@ -187,6 +187,10 @@ TEST(Simulate, SwayCouplingRaisesTheApparentInertiaAsAToTheFourth) {
   const double delta = 0.02;
   const double ratio = std::pow(period(delta) / period(0.0), 2);
   EXPECT_NEAR(ratio - 1, delta, 0.2 * delta);
+  // A^4 below 60 deg: at 30 deg the excess is delta / 16.
+  setup.amplitude_rad = 30 * kDeg;
+  const double ratio30 = std::pow(period(delta) / period(0.0), 2);
+  EXPECT_NEAR(ratio30 - 1, delta / 16, 0.2 * delta / 16);
 }
 
 TEST(Simulate, CampaignTruthAndLayout) {
