@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 
 namespace bifilar {
@@ -500,6 +501,32 @@ FreeOscillationWindow ApplyWindowOverride(const std::vector<double>& t,
   FillPeaks(a, &w);
   w.status = WindowStatus::kOk;
   return w;
+}
+
+bool ParseWindowSpec(const std::string& text, double* t0_s, double* t1_s, std::string* why) {
+  const auto fail = [&](const std::string& what) {
+    *why = "--window '" + text + "': " + what;
+    return false;
+  };
+  const size_t colon = text.find(':');
+  if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos) {
+    return fail("expected T0:T1 in seconds, e.g. 12.5:48");
+  }
+  auto parse = [](const std::string& s, double* v) {
+    if (s.empty()) return false;
+    char* end = nullptr;
+    *v = std::strtod(s.c_str(), &end);
+    while (end && (*end == ' ' || *end == '\t')) ++end;
+    return end && *end == '\0' && std::isfinite(*v);
+  };
+  double a, b;
+  if (!parse(text.substr(0, colon), &a) || !parse(text.substr(colon + 1), &b)) {
+    return fail("expected T0:T1 in seconds, e.g. 12.5:48 (two finite numbers)");
+  }
+  if (!(b > a)) return fail("the end T1 must be after the start T0");
+  *t0_s = a;
+  *t1_s = b;
+  return true;
 }
 
 // ---- Amplitude ----

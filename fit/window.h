@@ -97,6 +97,10 @@ FreeOscillationWindow ApplyWindowOverride(const std::vector<double>& t_s,
                                           double t0_s, double t1_s, const WindowOptions& options,
                                           const std::string& name = "");
 
+// Parses "T0:T1" (seconds, the log's own time, e.g. "12.5:48"), as given to --window. False with
+// *why ("--window '12:': expected T0:T1 in seconds, ...") on anything else, including T1 <= T0.
+bool ParseWindowSpec(const std::string& text, double* t0_s, double* t1_s, std::string* why);
+
 // ---- Amplitude (issue 3 item 4) ----
 
 // One extreme of the swing angle inside the window: at a zero crossing of the rate.

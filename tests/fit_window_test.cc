@@ -292,6 +292,20 @@ TEST(Window, Override) {
   EXPECT_EQ(short_window.status, WindowStatus::kRejected) << short_window.BriefReport();
 }
 
+TEST(Window, ParseWindowSpec) {
+  double t0 = 0, t1 = 0;
+  std::string why;
+  ASSERT_TRUE(ParseWindowSpec("12.5:48", &t0, &t1, &why)) << why;
+  EXPECT_DOUBLE_EQ(t0, 12.5);
+  EXPECT_DOUBLE_EQ(t1, 48.0);
+  ASSERT_TRUE(ParseWindowSpec("-1e-3: 7", &t0, &t1, &why)) << why;
+  EXPECT_DOUBLE_EQ(t0, -0.001);
+  for (const char* bad : {"", "12", "12:", ":5", "a:b", "5:3", "1:2:3", "1:inf", "nan:3", "3:3"}) {
+    EXPECT_FALSE(ParseWindowSpec(bad, &t0, &t1, &why)) << bad;
+    EXPECT_NE(why.find("--window"), std::string::npos) << why;
+  }
+}
+
 TEST(Amplitude, ExtremesFollowTheEnvelope) {
   Synth s;
   s.decay_per_s = 0.03;
@@ -405,6 +419,66 @@ TEST(Window, SimulatedLogs) {
   }
   EXPECT_EQ(checked, 16);
   EXPECT_GT(stopped, 2);  // both endings exercised
+}
+
+// A simulated campaign (the simulator's own campaign API: pitches, trials, tare logs, random
+// amplitudes 5-30 deg, damping, pitch errors, stops): every log's window against its truth.
+TEST(Window, SimulatedCampaign) {
+  CampaignSpec spec;
+  spec.aircraft.mass_kg = 6.0;
+  spec.aircraft.ix_kg_m2 = 0.6;
+  spec.aircraft.iz_kg_m2 = 0.9;
+  spec.aircraft.ixz_kg_m2 = 0.03;
+  spec.rig.mass_kg = 3.0;
+  spec.rig.imu_mass_kg = 0.05;
+  spec.rig.inertia_kg_m2 = 0.25;
+  spec.rig.imu_offset_in_body_m = Eigen::Vector3d(0.3, 0.0, -0.1);
+  spec.rig.body_from_imu = MountingFromRollPitchYawDeg(0.0, 0.0, 90.0);
+  spec.filar_length_m = 2.2;
+  spec.filar_separation_m = 0.8;
+  spec.pitch_deg = {-80.0, -30.0, 0.0, 40.0, 90.0};
+  spec.trials_per_pitch = 2;
+  spec.tare_logs = 2;
+  SimulationOptions options;
+  options.timeline.free_s = {20.0, 35.0};
+  std::vector<CampaignTrace> traces;
+  std::string why;
+  ASSERT_TRUE(SimulateCampaign(spec, options, 2024, &traces, &why)) << why;
+  ASSERT_EQ(traces.size(), 12u);
+  for (const auto& ct : traces) {
+    const TraceTruth& truth = ct.trace.truth;
+    const double T = SmallAnglePeriod(ct.setup.geometry, ct.setup.params.inertia_kg_m2);
+    SCOPED_TRACE(ct.relative_path + " T=" + std::to_string(T));
+    SwingAxisOptions axis_options;
+    axis_options.imu_to_body = spec.rig.body_from_imu;
+    SwingAxis axis;
+    ASSERT_TRUE(EstimateSwingAxis(ct.trace.imu, axis_options, std::nullopt, &axis, &why)) << why;
+    const auto w = FindFreeOscillationWindow(ct.trace.imu.t_s, axis.rate_rad_per_s, WindowOptions(), ct.relative_path);
+    ASSERT_TRUE(w.IsUsable()) << w.message;
+    EXPECT_GE(w.t0_s, truth.t_release_s);
+    EXPECT_LE(w.t0_s, truth.t_release_s + 1.1 * T);  // T grows by < 2 % at 30 deg
+    if (truth.stopped) {
+      EXPECT_EQ(w.end_reason, WindowEnd::kStopped) << w.BriefReport();
+      EXPECT_LT(w.t1_s, truth.t_stop_s);
+      EXPECT_GT(w.t1_s, truth.t_stop_s - 2.0 * T);
+    } else {
+      EXPECT_EQ(w.end_reason, WindowEnd::kLogEnd) << w.BriefReport();
+    }
+    // Amplitude at every extreme against the simulator's noise-free angle at the nearest sample
+    // (|psi| is flat at an extreme, so the nearest sample is within 1e-3 relative of it).
+    // Tolerance 2 % + 0.1 deg: the extremes are estimated from noisy rate through the rest bias.
+    const auto band = TrimToAmplitudeBand(ct.trace.imu.t_s, axis.rate_rad_per_s, w, AmplitudeBandOptions());
+    ASSERT_TRUE(band.IsUsable()) << band.message;
+    ASSERT_GT(band.extremes.size(), 10u);
+    const auto& ts = ct.trace.imu.t_s;
+    for (const auto& e : band.extremes) {
+      const size_t k = std::min<size_t>(std::lower_bound(ts.begin(), ts.end(), e.t_s) - ts.begin(), ts.size() - 1);
+      const size_t nearest = (k > 0 && e.t_s - ts[k - 1] < ts[k] - e.t_s) ? k - 1 : k;
+      const double truth_deg = std::abs(ct.trace.angle_rad[nearest]) / kDeg;
+      EXPECT_NEAR(e.amplitude_deg, truth_deg, 0.02 * truth_deg + 0.1) << "t = " << e.t_s;
+    }
+    EXPECT_LE(band.amplitude_start_deg, std::abs(truth.amplitude_rad) / kDeg * 1.01);
+  }
 }
 
 }  // namespace
