@@ -1,0 +1,150 @@
+// report.html: self-contained (figures embedded), every section present, rebuilt from
+// results.json alone, and loading in headless Chromium without console errors where Chromium is
+// installed (/usr/bin/chromium; the test is skipped otherwise).
+#include "pipeline/report.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <plplot/plplot.h>
+
+#include "fit/figure.h"
+#include "pipeline/campaign.h"
+#include "pipeline/user_error.h"
+
+namespace bifilar {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void WriteFile(const std::string& path, const std::string& text) {
+  fs::create_directories(fs::path(path).parent_path());
+  std::ofstream(path) << text;
+}
+
+TEST(Report, Base64MatchesRfc4648Vectors) {
+  EXPECT_EQ(Base64(""), "");
+  EXPECT_EQ(Base64("f"), "Zg==");
+  EXPECT_EQ(Base64("fo"), "Zm8=");
+  EXPECT_EQ(Base64("foo"), "Zm9v");
+  EXPECT_EQ(Base64("foob"), "Zm9vYg==");
+  EXPECT_EQ(Base64("fooba"), "Zm9vYmE=");
+  EXPECT_EQ(Base64("foobar"), "Zm9vYmFy");
+  EXPECT_EQ(Base64(std::string("\xff\x00\x10", 3)), "/wAQ");
+}
+
+// A campaign with a fake fit that draws a small figure per trace, so the report has every kind
+// of figure: 4 angles x 2 trials, one log that fails.
+std::string MakeCampaign() {
+  char tmpl[] = "/tmp/bifilar_report_test_XXXXXX";
+  const std::string dir = mkdtemp(tmpl);
+  for (double p : {-45.0, 0.0, 45.0, 90.0}) {
+    for (int k = 1; k <= 2; ++k) {
+      const double t = p * M_PI / 180.0;
+      const double inertia = 3.0 * std::cos(t) * std::cos(t) + 2.0 * std::sin(t) * std::sin(t) +
+                             0.05 * std::sin(2 * t) + 0.5 + (k == 1 ? 1e-3 : -1e-3);
+      std::ostringstream name;
+      name << dir << "/logs/pitch_" << p << "/trial_" << k << ".csv";
+      WriteFile(name.str(), std::to_string(inertia));
+    }
+  }
+  WriteFile(dir + "/logs/pitch_0/trial_<3>.csv", "broken & <bad>");
+  WriteFile(dir + "/c.yaml",
+            "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.5}}\n"
+            "aircraft: {mass_kg: 5}\nruns: {root: logs, pattern: \"pitch_{pitch_deg}/*.csv\"}\n"
+            "units: imperial\n");
+  CampaignOptions options;
+  options.out_dir = dir + "/out";
+  options.jobs = 2;
+  options.fit_function = [](const CampaignConfig&, const std::string& path,
+                            const TraceProcessOptions& o) {
+    TraceRecord r;
+    const std::string text = ReadFile(path);
+    if (text.find("broken") != std::string::npos) throw UserError("not a number in " + path);
+    r.status = TraceStatus::kOk;
+    r.inertia_total_kg_m2 = std::stod(text);
+    r.inertia_total_std_kg_m2 = 1e-4;
+    r.window_s = {2.0, 40.0};
+    r.amplitude_deg = {20.0, 8.0};
+    std::string why;
+    WriteFigure(o.figure_path, FigureOptions{400, 300}, [] {
+      PLFLT x[2] = {0, 1}, y[2] = {0, 1};
+      plenv(0, 1, 0, 1, 0, 0);
+      pllab("t (s)", "rate", "fake fit");
+      plline(2, x, y);
+    }, &why);
+    return r;
+  };
+  RunCampaign(LoadCampaignConfig(dir + "/c.yaml"), options);
+  return dir + "/out";
+}
+
+TEST(Report, HasEverySectionAndEmbedsEveryFigure) {
+  const std::string out = MakeCampaign();
+  const std::string html = ReadFile(out + "/report.html");
+  for (const char* section : {"Table 2: inertia properties", "Table 1: data quality",
+                              "Figure 3: moment of inertia against pitch",
+                              "Figure 4: ellipse of inertia", "NACA Report 467 comparison",
+                              "Per-angle statistics", "Rejected and failed traces",
+                              "Fit and residual of every trace", "Config used", "slug ft"}) {
+    EXPECT_NE(html.find(section), std::string::npos) << section;
+  }
+  // 8 trace figures + Fig. 3 + Fig. 4, all inline; no reference to another file.
+  // (Counted with find: std::regex recurses per character and overflows on a 1 MB page.)
+  int n = 0;
+  for (size_t at = html.find("src=\"data:image/svg+xml;base64,"); at != std::string::npos;
+       at = html.find("src=\"data:image/svg+xml;base64,", at + 1)) {
+    ++n;
+  }
+  EXPECT_EQ(n, 10);
+  EXPECT_EQ(html.find("src=\"figures/"), std::string::npos);
+  EXPECT_EQ(html.find("(no figure)"), std::string::npos);
+  // The failed log is listed with its reason, escaped.
+  EXPECT_NE(html.find("trial_&lt;3&gt;.csv"), std::string::npos);
+  EXPECT_EQ(html.find("trial_<3>.csv"), std::string::npos);
+  // `bifilar report` rebuilds the same page from results.json alone.
+  fs::remove(out + "/report.html");
+  RunReport(out);
+  EXPECT_EQ(ReadFile(out + "/report.html"), html);
+  EXPECT_THROW(RunReport(out + "/nowhere"), UserError);
+  WriteFile(out + "/results.json", "{ broken");
+  EXPECT_THROW(RunReport(out), UserError);
+}
+
+TEST(Report, LoadsInHeadlessChromiumWithoutConsoleErrors) {
+  if (!fs::exists("/usr/bin/chromium")) GTEST_SKIP() << "/usr/bin/chromium not installed";
+  const std::string out = MakeCampaign();
+  char tmpl[] = "/tmp/bifilar_chromium_XXXXXX";
+  const std::string profile = mkdtemp(tmpl);
+  const std::string shot = out + "/screenshot.png", log = out + "/chromium.log";
+  const std::string command =
+      "timeout 60 /usr/bin/chromium --headless --no-sandbox --disable-gpu --disable-quic "
+      "--no-first-run --disable-background-networking --disable-component-update --disable-sync "
+      "--user-data-dir=" + profile + " --enable-logging=stderr --v=0 --screenshot=" + shot +
+      " --window-size=1200,4000 file://" + out + "/report.html > " + log + " 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << ReadFile(log);
+  const std::string messages = ReadFile(log);
+  // Console errors are logged as "CONSOLE(line)" / "Uncaught ..."; a broken data URI as
+  // "Failed to load" / "ERR_".
+  for (const char* bad : {"CONSOLE", "Uncaught", "Failed to load", "ERR_INVALID_URL"}) {
+    EXPECT_EQ(messages.find(bad), std::string::npos) << bad << " in:\n" << messages;
+  }
+  ASSERT_TRUE(fs::exists(shot));
+  EXPECT_GT(fs::file_size(shot), 50000u);  // a 1200x4000 page with figures, not a blank one
+  fs::remove_all(profile);
+}
+
+}  // namespace
+}  // namespace bifilar
