@@ -555,7 +555,8 @@ bool CampaignSpec::Check(std::string* why) const {
          CheckRange(amplitude_deg, "amplitude_deg", 0.0, true, why) &&
          CheckValue(amplitude_deg.max, "amplitude_deg (max)", 0.0, true, 75.0, why) &&
          CheckRange(drag_coeff_kg_m2, "drag_coeff_kg_m2", 0.0, false, why) &&
-         CheckRange(viscous_coeff_kg_m2_per_s, "viscous_coeff_kg_m2_per_s", 0.0, false, why);
+         CheckRange(viscous_coeff_kg_m2_per_s, "viscous_coeff_kg_m2_per_s", 0.0, false, why) &&
+         CheckValue(tare_damping_scale, "rig.tare_damping_scale", 0.0, false, 1.0, why);
 }
 
 std::string FormatPitchDeg(double pitch_deg) {
@@ -598,8 +599,9 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
     ct.true_pitch_deg = std::clamp(nominal_deg + rng.Normal(spec.pitch_error_sigma_deg), -90.0, 90.0);
     const double amplitude_deg = rng.Uniform(spec.amplitude_deg);
     const double sign = rng.Uniform() < options.negative_amplitude_probability ? -1.0 : 1.0;
-    const double drag = rng.Uniform(spec.drag_coeff_kg_m2);
-    const double viscous = rng.Uniform(spec.viscous_coeff_kg_m2_per_s);
+    const double damping_scale = tare ? spec.tare_damping_scale : 1.0;
+    const double drag = damping_scale * rng.Uniform(spec.drag_coeff_kg_m2);
+    const double viscous = damping_scale * rng.Uniform(spec.viscous_coeff_kg_m2_per_s);
     spec.rig.InertiaAtPitch(nominal_deg, &ct.inertia_rig_kg_m2);
     ct.inertia_aircraft_kg_m2 = tare ? 0.0 : spec.aircraft.InertiaAtPitch(ct.true_pitch_deg * kDeg);
     TraceSetup& s = ct.setup;

@@ -187,6 +187,9 @@ struct CampaignSpec {
   UniformRange amplitude_deg = {5.0, 30.0}; // |psi(t_release)| (deg); 0 < min, max < 80
   UniformRange drag_coeff_kg_m2 = {0.02, 0.08};            // K_D per log
   UniformRange viscous_coeff_kg_m2_per_s = {0.005, 0.02};  // C per log
+  // Tare logs (rig alone, far less aerodynamic area) draw K_D and C from the ranges above times
+  // this factor; in [0, 1], default 0.25.
+  double tare_damping_scale = 0.25;
 
   bool Check(std::string* why) const;
 };

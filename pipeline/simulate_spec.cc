@@ -332,6 +332,7 @@ SimulateSpec ParseSpec(YamlMap root) {
     }
     c.tare_logs = static_cast<int>(ReadValue(rig, "tare_logs", 0, 0, false, 1000));
     c.tare_pitch_deg = ReadValue(rig, "tare_pitch_deg", 0, -90, false, 90);
+    c.tare_damping_scale = ReadValue(rig, "tare_damping_scale", c.tare_damping_scale, 0, false, 1);
     c.rig.imu_offset_in_body_m = ReadVector3(rig, "imu_offset_m", Eigen::Vector3d(0.15, 0.10, -0.05));
     const Eigen::Vector3d rpy = ReadVector3(rig, "imu_mounting_rpy_deg", Eigen::Vector3d::Zero());
     c.rig.body_from_imu = MountingFromRollPitchYawDeg(rpy[0], rpy[1], rpy[2]);
@@ -543,7 +544,8 @@ std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<Campai
                         {"imu_mass_kg", c.rig.imu_mass_kg},
                         {"imu_offset_m", Vec(c.rig.imu_offset_in_body_m)},
                         {"tare_logs", c.tare_logs},
-                        {"tare_pitch_deg", c.tare_pitch_deg}};
+                        {"tare_pitch_deg", c.tare_pitch_deg},
+                        {"tare_damping_scale", c.tare_damping_scale}};
   if (c.rig.inertia_by_pitch_kg_m2.empty()) {
     rig["inertia_kg_m2"] = c.rig.inertia_kg_m2;
   } else {
