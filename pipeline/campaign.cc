@@ -603,7 +603,8 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     trace_options.display_name = run.display;
     trace_options.window_s = windows[i];
     const std::string figure_name = record.cache_key + ".svg";
-    if (options.figures) trace_options.figure_path = (out / "figures" / figure_name).string();
+    const std::string figure_path = (out / "figures" / figure_name).string();
+    if (options.figures) trace_options.figure_paths = {figure_path};
     TraceRecord fitted;
     try {
       fitted = fit(config, run.path, trace_options);
@@ -612,7 +613,7 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
       fitted.message = run.display + ": " + e.what();
     }
     std::error_code ec2;
-    fitted.figure = options.figures && fs::exists(trace_options.figure_path, ec2) ? figure_name : "";
+    fitted.figure = options.figures && fs::exists(figure_path, ec2) ? figure_name : "";
     fitted.file = record.file;
     fitted.role = record.role;
     fitted.pitch_nominal_deg = record.pitch_nominal_deg;

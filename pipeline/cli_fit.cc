@@ -1,15 +1,121 @@
+// `bifilar fit CONFIG LOG... [--json] [--model M] [--window T0:T1] [--max-amplitude DEG]
+// [--plot DIR]`: fits single logs with the campaign's trace processing (pipeline/trace_process.h).
+// The config needs only the rig geometry, the masses and the IMU format (configs/README.md).
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <iostream>
 
+#include <nlohmann/json.hpp>
+
+#include "fit/window.h"
 #include "pipeline/cli_commands.h"
+#include "pipeline/config.h"
+#include "pipeline/results_json.h"
+#include "pipeline/trace_process.h"
 
 namespace bifilar {
+namespace {
 
-// Placeholder until the command lands.
+// "pitch_10/trial_1.csv" -> "pitch_10_trial_1": figure names that do not collide.
+std::string FigureStem(const std::string& log) {
+  std::string stem = std::filesystem::path(log).lexically_normal().replace_extension().string();
+  for (char& c : stem) {
+    if (c == '/' || c == '\\' || c == ' ' || c == ':') c = '_';
+  }
+  while (!stem.empty() && (stem[0] == '.' || stem[0] == '_')) stem.erase(stem.begin());
+  return stem.empty() ? "trace" : stem;
+}
+
+std::string HumanLine(const TraceRecord& r) {
+  char buffer[512];
+  if (r.status == TraceStatus::kError) return r.file + ": error: " + r.message;
+  std::snprintf(buffer, sizeof(buffer),
+                "%s: %s  I = %.6f +- %.2g kg m^2 (budget +- %.2g)  K_D %.3g  C %.3g  "
+                "window [%.2f, %.2f] s  amplitude %.1f -> %.1f deg  rms/noise %.2f  %d it  %.0f ms",
+                r.file.c_str(), ToString(r.status), r.inertia_total_kg_m2,
+                r.inertia_total_std_kg_m2, r.budget_total_std_kg_m2, r.drag_coeff_kg_m2,
+                r.viscous_coeff_kg_m2_per_s, r.window_s[0], r.window_s[1], r.amplitude_deg[0],
+                r.amplitude_deg[1], r.residual_rms_rad_per_s / r.noise_rms_rad_per_s, r.iterations,
+                1e3 * r.fit_seconds);
+  std::string line = buffer;
+  if (r.pitch_measured_deg) {
+    std::snprintf(buffer, sizeof(buffer), "  pitch %.2f deg", *r.pitch_measured_deg);
+    line += buffer;
+  }
+  if (!r.message.empty()) line += "  (" + r.message + ")";
+  return line;
+}
+
+}  // namespace
+
 void RegisterFitCommand(CLI::App& app, int* exit_code) {
-  auto* sub = app.add_subcommand("fit", "(not implemented yet)");
-  sub->callback([exit_code] {
-    std::cerr << "bifilar: error: 'fit' is not implemented yet\n";
-    *exit_code = 2;
+  struct Args {
+    std::string config;
+    std::vector<std::string> logs;
+    bool json = false;
+    std::string model, window, plot_dir;
+    double max_amplitude_deg = NAN;
+  };
+  auto args = std::make_shared<Args>();
+  auto* sub = app.add_subcommand(
+      "fit", "Fit single IMU logs: moment of inertia of everything suspended, with uncertainty");
+  sub->add_option("config", args->config,
+                  "config (YAML): rig geometry, masses, IMU format (configs/README.md)")
+      ->required();
+  sub->add_option("logs", args->logs, "IMU CSV logs")->required();
+  sub->add_flag("--json", args->json, "print a JSON array of trace records instead of lines");
+  sub->add_option("--model", args->model, "full (default), jardin or linear")
+      ->check(CLI::IsMember({"full", "jardin", "linear"}));
+  sub->add_option("--window", args->window, "fit only T0:T1 (s, the log's own time)");
+  sub->add_option("--max-amplitude", args->max_amplitude_deg,
+                  "upper end of the amplitude band (deg)")
+      ->check(CLI::Range(0.1, 90.0));
+  sub->add_option("--plot", args->plot_dir, "write fit figures DIR/<log>.svg and .png");
+  sub->callback([args, exit_code] {
+    ConfigLoadOptions load;
+    load.require_runs = false;
+    CampaignConfig config = LoadCampaignConfig(args->config, load);
+    if (!args->model.empty()) ParsePendulumModel(args->model, &config.fit.model);
+    if (std::isfinite(args->max_amplitude_deg)) {
+      config.fit.max_amplitude_deg = args->max_amplitude_deg;
+      if (config.fit.min_amplitude_deg && *config.fit.min_amplitude_deg >= args->max_amplitude_deg) {
+        throw UserError("--max-amplitude must exceed fit.min_amplitude_deg of the config");
+      }
+    }
+    TraceProcessOptions options;
+    if (!args->window.empty()) {
+      double t0 = 0, t1 = 0;
+      std::string why;
+      if (!ParseWindowSpec(args->window, &t0, &t1, &why)) throw UserError(why);
+      options.window_s = std::array<double, 2>{t0, t1};
+    }
+    if (!args->plot_dir.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(args->plot_dir, ec);
+      if (!std::filesystem::is_directory(args->plot_dir)) {
+        throw UserError("--plot " + args->plot_dir + ": cannot create folder");
+      }
+    }
+    nlohmann::json records = nlohmann::json::array();
+    int failed = 0;
+    for (const std::string& log : args->logs) {
+      TraceProcessOptions trace = options;
+      trace.display_name = log;
+      if (!args->plot_dir.empty()) {
+        const std::string base = (std::filesystem::path(args->plot_dir) / FigureStem(log)).string();
+        trace.figure_paths = {base + ".svg", base + ".png"};
+      }
+      const TraceRecord record = ProcessTrace(config, log, trace);
+      if (!record.ok()) ++failed;
+      if (args->json) {
+        records.push_back(TraceRecordToJson(record, false));
+      } else {
+        std::cout << HumanLine(record) << std::endl;
+      }
+    }
+    if (args->json) std::cout << records.dump(2) << std::endl;
+    *exit_code = failed > 0 ? 1 : 0;
   });
 }
 

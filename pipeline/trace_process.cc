@@ -151,7 +151,7 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
                                 : std::hypot(config.uncertainties.mass_std_kg,
                                              config.aircraft_mass_std_kg);
   fit_options.gravity_std_mps2 = config.uncertainties.gravity_std_mps2;
-  fit_options.keep_series = !options.figure_path.empty();
+  fit_options.keep_series = !options.figure_paths.empty();
   const TraceFitResult fit = FitTrace(input, fit_options);
 
   record.status = fit.status == TraceFitStatus::kOk         ? TraceStatus::kOk
@@ -184,10 +184,11 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
 
   // 6. Figure (only of a fit that ran).
 #ifdef BIFILAR_HAVE_TRACE_PLOT
-  if (!options.figure_path.empty() && !fit.t_s.empty()) {
+  for (const std::string& figure_path : options.figure_paths) {
+    if (fit.t_s.empty()) break;
     TraceFigureOptions figure_options;
     figure_options.title = name;
-    if (!WriteTraceFitFigure(fit, options.figure_path, figure_options, &why)) {
+    if (!WriteTraceFitFigure(fit, figure_path, figure_options, &why)) {
       record.flags.push_back("figure_failed");
     }
   }

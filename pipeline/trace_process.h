@@ -77,7 +77,8 @@ struct TraceProcessOptions {
   std::string display_name;               // `file` of the record; default: the path
   // Window override [t0, t1] (s); takes precedence over the config's per-file windows.
   std::optional<std::array<double, 2>> window_s;
-  std::string figure_path;  // write the fit figure here (.svg or .png); "" = no figure
+  // Write the fit-and-residual figure to each of these (.svg or .png); empty = no figure.
+  std::vector<std::string> figure_paths;
 };
 
 // Processes one log. Never throws: every failure is a record with status error naming the file.

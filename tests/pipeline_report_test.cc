@@ -79,7 +79,7 @@ std::string MakeCampaign() {
     r.window_s = {2.0, 40.0};
     r.amplitude_deg = {20.0, 8.0};
     std::string why;
-    WriteFigure(o.figure_path, FigureOptions{400, 300}, [] {
+    WriteFigure(o.figure_paths.at(0), FigureOptions{400, 300}, [] {
       PLFLT x[2] = {0, 1}, y[2] = {0, 1};
       plenv(0, 1, 0, 1, 0, 0);
       pllab("t (s)", "rate", "fake fit");
