@@ -140,6 +140,12 @@ struct Stats {
 // bool(const double* y, double* dy) (false: the state is outside the model's domain or not
 // finite; the step is retried smaller). Out is a callable void(int k, const double* y) called
 // once per output time t_out[k], k = first..count-1, with the 7th-order dense-output state.
+// Kink is a callable double(const double* y, const double* f, const double* f_prev,
+// double h_prev) returning the (estimated) time from the state y, with derivative f, to the
+// next point where the right-hand side is not smooth, or +inf. A step that would cross such a
+// point fails the error test again and again (the method's order needs a smooth solution), so
+// steps are cut to end there instead; the estimate need not be exact, as a kink a small
+// fraction of a step inside costs little accuracy.
 template <int N>
 class Stepper {
  public:
@@ -149,10 +155,10 @@ class Stepper {
   // Returns 0 on success, 1 when max_steps was exceeded, 2 when the step size underflowed
   // (repeated non-finite right-hand sides or error test failures); *t_fail is then the time
   // reached.
-  template <typename Rhs, typename Out>
+  template <typename Rhs, typename Out, typename Kink>
   int Integrate(Rhs&& rhs, double t0, const Vec& y0, const double* t_out, int first, int count,
-                double rel_tol, double abs_tol, long max_steps, Out&& out, double* t_fail,
-                Stats* stats) {
+                double rel_tol, double abs_tol, long max_steps, Out&& out, Kink&& kink,
+                double* t_fail, Stats* stats) {
     Stats st;
     double t = t0;
     Vec y = y0;
@@ -169,6 +175,7 @@ class Stepper {
     double h = InitialStep(rhs, t, y, k[0], t_end - t, rel_tol, abs_tol, &st);
     int next = first;
     bool rejected_last = false;
+    double h_after_kink = 0.0;  // > 0: the step proposed before it was cut at a kink
     Vec y_new, f_new;
     Vec F[7];
     while (next < count) {
@@ -294,8 +301,18 @@ class Stepper {
       // Step size for the next step: 0.9 err^(-1/8), growth limited to 6, shrink to 1/3.
       // No growth right after a rejection (dop853.f).
       const double fac = err > 0.0 ? 0.9 * std::pow(err, -0.125) : 6.0;
-      const double h_next = h * std::min(rejected_last ? 1.0 : 6.0, std::max(1.0 / 3.0, fac));
+      double h_next = h * std::min(rejected_last ? 1.0 : 6.0, std::max(1.0 / 3.0, fac));
+      if (h_after_kink > 0.0) {
+        // This step was cut at a kink: resume with the step proposed before the cut.
+        h_next = std::max(h_next, h_after_kink);
+        h_after_kink = 0.0;
+      }
       rejected_last = false;
+      const double to_kink = kink(y_new.data(), f_new.data(), k[0].data(), h);
+      if (to_kink > 0.01 * h_next && to_kink < h_next) {
+        h_after_kink = h_next;
+        h_next = to_kink;
+      }
       t = t_new;
       y = y_new;
       k[0] = f_new;

@@ -397,13 +397,29 @@ bool PendulumIntegrator::Impl::IntegrateRk(double angle0_rad, double rate0_rad_p
       }
     }
   };
+  // The right-hand side is not smooth where psi' = 0 (K_D psi'|psi'| in the state equation,
+  // |psi'| and psi'|psi'| in the sensitivity equations). Time to the next turning point from
+  // psi' + psi'' tau + j tau^2 / 2 = 0, with the jerk j estimated from the last step.
+  const auto kink = [](const double* y, const double* f, const double* f_prev, double h_prev) {
+    const double w = y[1], a = f[1];
+    if (!(w * a < 0.0)) return std::numeric_limits<double>::infinity();
+    const double j = (f[1] - f_prev[1]) / h_prev;
+    double tau = -w / a;  // linear estimate, then the quadratic root nearest to it
+    const double disc = a * a - 2.0 * j * w;
+    if (j != 0.0 && disc >= 0.0) {
+      const double q = -0.5 * (a + std::copysign(std::sqrt(disc), a));  // stable root formula
+      const double r = w / q;  // root of (j/2) tau^2 + a tau + w near -w/a
+      if (r > 0.0 && std::isfinite(r)) tau = r;
+    }
+    return tau;
+  };
   dop853::Stepper<kN> stepper;
   dop853::Stats rk_stats;
   double t_fail = t_s[0];
   const int status = stepper.Integrate(rhs, t_s[0], y0, t_s.data(), static_cast<int>(first),
                                        static_cast<int>(t_s.size()), options.rel_tol,
-                                       options.abs_tol, options.max_steps, write, &t_fail,
-                                       &rk_stats);
+                                       options.abs_tol, options.max_steps, write, kink,
+                                       &t_fail, &rk_stats);
   stats.steps = rk_stats.steps;
   stats.rejected_steps = rk_stats.rejected;
   stats.rhs_evals = rk_stats.rhs_evals;
