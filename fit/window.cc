@@ -37,6 +37,7 @@ struct HalfCycle {
   size_t peak_index = 0;
   double peak = 0.0;     // max sign * x
   bool open = false;     // the log ended before it did
+  double max_gap_s = 0.0;  // longest time step between samples inside it (dropped packets)
   double duration() const { return end_s - start_s; }
 };
 
@@ -52,14 +53,29 @@ struct Analysis {
   std::vector<HalfCycle> cycles;
 };
 
-double FourthDifferenceSigma(const std::vector<double>& r, size_t begin, size_t end) {
-  std::vector<double> d;
-  if (end < begin + 5) return 0.0;
-  d.reserve(end - begin - 4);
-  for (size_t k = begin; k + 4 < end; ++k) {
-    d.push_back(std::abs(r[k] - 4 * r[k + 1] + 6 * r[k + 2] - 4 * r[k + 3] + r[k + 4]));
+// Noise of a smooth signal sampled at irregular times: each sample is predicted by the cubic
+// through its two neighbours on each side, at the real timestamps (so jitter and single drops do
+// not count as noise); the residual, divided by sqrt(1 + sum of squared weights) to make its std
+// equal to the sample noise, goes into a MAD (1.4826 * median |r|). The cubic's error,
+// ~|d4x/dt4| (2 dt)^4 / 24, is below 1 % of 0.25 deg/s for any swing in range at 100 Hz.
+double HighFrequencySigma(const std::vector<double>& t, const std::vector<double>& r) {
+  std::vector<double> res;
+  if (t.size() < 5) return 0.0;
+  res.reserve(t.size() - 4);
+  for (size_t k = 2; k + 2 < t.size(); ++k) {
+    const size_t idx[4] = {k - 2, k - 1, k + 1, k + 2};
+    double pred = 0.0, w2 = 0.0;
+    for (int i = 0; i < 4; ++i) {
+      double w = 1.0;
+      for (int j = 0; j < 4; ++j) {
+        if (j != i) w *= (t[k] - t[idx[j]]) / (t[idx[i]] - t[idx[j]]);
+      }
+      pred += w * r[idx[i]];
+      w2 += w * w;
+    }
+    res.push_back(std::abs(r[k] - pred) / std::sqrt(1.0 + w2));
   }
-  return 1.482602218505602 * Median(d) / std::sqrt(70.0);
+  return 1.482602218505602 * Median(res);
 }
 
 // Initial rest: blocks whose scatter and mean agree with the first block.
@@ -213,7 +229,7 @@ bool Analyse(const std::vector<double>& t, const std::vector<double>& r, const W
     w->message = Prefix(name) + "constant data: the swing rate does not change";
     return false;
   }
-  const double sigma_hf = FourthDifferenceSigma(r, 0, n);
+  const double sigma_hf = HighFrequencySigma(t, r);
   FindRest(t, r, sigma_hf, o, a);
   if (!a->from_rest) {
     a->sigma = sigma_hf;
@@ -324,19 +340,39 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
   if (!Analyse(t, r, o, name, &a, &w)) return w;
   const double sigma_eff = std::max({a.sigma, 1e-6 * a.range, 1e-12});
   const double floor = o.noise_floor_sigmas * sigma_eff;
-  const auto& cycles = a.cycles;
   double max_peak = 0.0;
-  for (const auto& c : cycles) max_peak = std::max(max_peak, c.peak);
-  const double half = HalfPeriod(cycles, std::max(floor, 0.1 * max_peak), o);
+  for (const auto& c : a.cycles) max_peak = std::max(max_peak, c.peak);
+  const double half = HalfPeriod(a.cycles, std::max(floor, 0.1 * max_peak), o);
   if (half <= 0.0) {
     w.message = Prefix(name) + Fmt("no oscillation found (no swing with a period in [%g, %g] s above "
                                    "the noise floor of %.3g rad/s)",
                                    o.min_period_s, o.max_period_s, floor);
     return w;
   }
+  // Dropped packets: a half-cycle with a gap longer than 2.5 typical steps may have lost its
+  // peak, so its peak is not compared, and its duration gets the gap as extra slack.
+  std::vector<double> steps(t.size() - 1);
+  for (size_t k = 0; k + 1 < t.size(); ++k) steps[k] = t[k + 1] - t[k];
+  const double dt_typical = Median(steps);
+  std::vector<HalfCycle> cycles = a.cycles;
+  for (auto& c : cycles) {
+    const size_t b = std::lower_bound(t.begin(), t.end(), c.start_s) - t.begin();
+    const size_t e = std::upper_bound(t.begin(), t.end(), c.end_s) - t.begin();
+    for (size_t k = (b > 0 ? b - 1 : 0); k + 1 < t.size() && k < e; ++k) c.max_gap_s = std::max(c.max_gap_s, steps[k]);
+  }
+  auto gappy = [&](const HalfCycle& c) { return c.max_gap_s > 2.5 * dt_typical; };
   auto duration_ok = [&](const HalfCycle& c) {
-    if (c.open) return c.duration() <= (1.0 + o.half_period_tolerance) * half;
-    return std::abs(c.duration() - half) <= o.half_period_tolerance * half;
+    const double slack = gappy(c) ? c.max_gap_s : 0.0;
+    if (c.open) {
+      // The log ended inside it: fine unless the swing should have crossed zero by now (a quarter
+      // period after the peak), which means it was stopped or died out.
+      return c.duration() <= (1.0 + o.half_period_tolerance) * half + slack &&
+             c.end_s - t[c.peak_index] <= 0.5 * (1.0 + o.half_period_tolerance) * half + slack;
+    }
+    // A free half-cycle peaks near its middle: the rate must cross zero again within about a
+    // quarter period of the peak (a hand that grabs near a peak leaves a long, flat tail).
+    return std::abs(c.duration() - half) <= o.half_period_tolerance * half + slack &&
+           c.end_s - t[c.peak_index] <= 0.5 * (1.0 + o.half_period_tolerance) * half + slack;
   };
 
   // Runs of free oscillation.
@@ -347,37 +383,44 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
   std::vector<Run> runs;
   bool in_run = false;
   Run run;
-  std::vector<double> ratios;
+  std::vector<double> ratios;  // peak ratio per half-cycle, from reliable peaks
+  double ref_peak = 0.0;       // last reliable peak of the run and its index
+  size_t ref_index = 0;
   for (size_t j = 0; j < cycles.size(); ++j) {
     const HalfCycle& c = cycles[j];
     if (in_run) {
-      const double prev = cycles[j - 1].peak;
       double rho = 1.0;
       if (!ratios.empty()) {
         std::vector<double> recent(ratios.end() - std::min<size_t>(ratios.size(), 8), ratios.end());
         rho = std::min(1.0, Median(recent));
       }
+      const double n_steps = static_cast<double>(j - ref_index);
+      const double prev = ref_peak * std::pow(rho, n_steps - 1.0);  // expected previous peak
       const bool short_open = c.open && c.duration() < 0.8 * half;  // peak maybe not reached yet
+      const bool unreliable = short_open || gappy(c) || ref_peak <= 0.0;
       WindowEnd reason = WindowEnd::kLogEnd;
       bool broken = false;
       bool restart = false;
-      const bool abrupt = !short_open && c.peak < o.stop_drop_factor * rho * prev;
-      if (abrupt) {  // a hand (checked first: a stopped swing also ends below the noise floor)
-        broken = true;
+      if (!unreliable && c.peak < o.stop_drop_factor * rho * prev) {
+        broken = true;  // a hand (checked first: a stopped swing also ends below the noise floor)
         reason = WindowEnd::kStopped;
-      } else if (c.peak < floor && !short_open) {
+      } else if (!unreliable && c.peak < floor) {
         broken = true;
         reason = WindowEnd::kNoiseFloor;
       } else if (!duration_ok(c)) {
         broken = true;
-        reason = WindowEnd::kStopped;
-      } else if (c.peak > prev * (1.0 + o.growth_tolerance) + 3.0 * sigma_eff) {
+        reason = c.peak < floor || prev < 2.0 * floor ? WindowEnd::kNoiseFloor : WindowEnd::kStopped;
+      } else if (!unreliable && c.peak > prev * (1.0 + o.growth_tolerance) + 3.0 * sigma_eff) {
         broken = true;
         reason = WindowEnd::kStopped;  // pushed: the free decay is broken
         restart = true;
       }
       if (!broken) {
-        if (!short_open) ratios.push_back(c.peak / prev);
+        if (!short_open && !gappy(c)) {
+          if (ref_peak > 0.0) ratios.push_back(std::pow(c.peak / ref_peak, 1.0 / n_steps));
+          ref_peak = c.peak;
+          ref_index = j;
+        }
         run.last = j;
         continue;
       }
@@ -391,6 +434,8 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
       run = Run();
       run.first = run.last = j;
       ratios.clear();
+      ref_peak = gappy(c) ? 0.0 : c.peak;  // 0: no reliable peak yet
+      ref_index = j;
     }
   }
   if (in_run) {

@@ -7,14 +7,18 @@
 //
 // Method (all on x = rate - bias, at the log's real timestamps):
 //  1. Noise: if the log starts with rest (0.25 s blocks whose mean and scatter match the first
-//     block), sigma = std and bias = mean of the rest samples. Otherwise sigma from the scatter of
-//     fourth differences (1.4826 MAD / sqrt(70), immune to the swing but inflated by timestamp
-//     jitter on a fast swing) and bias = median rate.
+//     block), sigma = std and bias = mean of the rest samples. Otherwise sigma from the
+//     high-frequency residual: each sample minus the cubic through its two neighbours on each side
+//     at the real timestamps, normalised, 1.4826 MAD (immune to the swing, to timestamp jitter and
+//     to single drops), and bias = mean rate over whole periods of the free oscillation.
 //  2. Half-cycles: the signal is cut where it crosses zero, with hysteresis (|x| must exceed
 //     hysteresis_sigmas * sigma for a new half-cycle to begin); each half-cycle has a start (zero
 //     crossing, interpolated), a peak |x| and a duration.
 //  3. Half period: the half-cycle duration that covers most of the log's time (segments within
 //     +-20 % of each other), so hand tremor (short) and the hold (long) do not count.
+//     A free half-cycle must also cross zero within about a quarter period after its peak.
+//     Half-cycles with a gap (dropped packets, > 2.5 typical steps) get the gap as slack and
+//     their peaks are not compared (the peak may be in the gap).
 //  4. Runs of free oscillation: consecutive half-cycles of consistent duration (+-
 //     half_period_tolerance) whose peaks decay like a free swing: no growth beyond
 //     growth_tolerance, no drop below stop_drop_factor times the decay seen so far (a hand), and
@@ -69,8 +73,8 @@ struct FreeOscillationWindow {
   double release_s = 0.0;               // detected release (start of the first free half-cycle)
   double period_s = 0.0;                // mean period over the free oscillation (0: unknown)
   double noise_sigma_rad_per_s = 0.0;   // rate noise std
-  bool noise_from_rest = false;         // true: from the rest segment; false: fourth differences
-  double rest_bias_rad_per_s = 0.0;     // mean rate at rest (or median rate without rest)
+  bool noise_from_rest = false;         // true: from the rest segment; false: high-frequency residual
+  double rest_bias_rad_per_s = 0.0;     // mean rate at rest (without rest: over whole periods)
   double rest_end_s = 0.0;              // end of the initial rest (valid when noise_from_rest)
   int rest_samples = 0;
   double peak_rate_start_rad_per_s = 0.0;  // |rate - bias| of the first/last peak in the window
