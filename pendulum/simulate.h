@@ -87,10 +87,16 @@ struct SimulationOptions {
   // weakens the restoring torque, m g h'(psi) (1 - k psi^4), with k chosen so that a fit with the
   // exact model at 60 deg amplitude finds an inertia this fraction too large; the bias scales as
   // A^4 below (harmonic balance: I_apparent ~ I (1 + (5/8) k A^4)). Integrated with a fixed-step
-  // RK4 (<= 1 ms steps) instead of CVODES when non-zero. Fraction, e.g. 0.01 = +1 % at 60 deg;
-  // in [0, 0.5].
+  // RK4 (<= 1 ms steps) instead of PendulumIntegrator when non-zero. Fraction, e.g. 0.01 = +1 %
+  // at 60 deg; in [0, 0.5].
   double sway_coupling_at_60deg = 0.0;
-  IntegratorOptions integrator;
+  // The truth's integrator. Default: CVODES, a different solver from the fit's default
+  // (Runge-Kutta), so that the fit is judged against an independent integration.
+  IntegratorOptions integrator = [] {
+    IntegratorOptions options;
+    options.method = IntegratorMethod::kCvodes;
+    return options;
+  }();
 
   bool Check(std::string* why) const;
 };

@@ -260,6 +260,16 @@ SimulateSpec ParseSpec(YamlMap root) {
       }
     }
   }
+  {
+    const YAML::Node method = root.Optional("integrator");
+    if (method.IsDefined() && !method.IsNull()) {
+      const std::string name = root.AsString(method, "integrator");
+      if (!ParseIntegratorMethod(name, &spec.options.integrator.method)) {
+        throw UserError(root.Where(method) + ": unknown integrator '" + name +
+                        "' for 'integrator'; allowed cvodes (default), rk853");
+      }
+    }
+  }
   std::optional<double> length, separation;
   double gravity = 9.80665;
   ReadGeometry(Section(root, "geometry"), &length, &separation, &gravity);
@@ -404,6 +414,9 @@ nlohmann::json OptionsJson(const SimulateSpec& spec) {
   const SensorOptions& s = o.sensor;
   nlohmann::json j;
   j["model"] = ToString(o.model);
+  j["integrator"] = ToString(o.integrator.method);
+  j["integrator_rel_tol"] = o.integrator.rel_tol;
+  j["integrator_abs_tol"] = o.integrator.abs_tol;
   j["sway_coupling_percent_at_60deg"] = 100.0 * o.sway_coupling_at_60deg;
   j["negative_amplitude_probability"] = o.negative_amplitude_probability;
   j["timeline"] = {{"rest_before_s", Range(t.rest_before_s)},
