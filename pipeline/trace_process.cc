@@ -186,7 +186,7 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
 #ifdef BIFILAR_HAVE_TRACE_PLOT
   for (const std::string& figure_path : options.figure_paths) {
     if (fit.t_s.empty()) break;
-    TraceFigureOptions figure_options;
+    TracePlotOptions figure_options;
     figure_options.title = name;
     if (!WriteTraceFitFigure(fit, figure_path, figure_options, &why)) {
       record.flags.push_back("figure_failed");
