@@ -2,15 +2,18 @@
 // `full` model at jittered timestamps with 1 % dropped samples, a gyro bias and 0.25 deg/s white
 // noise, fitted with FitTrace. Seeds are fixed; tolerances are explained where they are set.
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "fit/trace_fit.h"
 #include "fit/trace_guess.h"
+#include "fit/trace_plot.h"
 #include "fit/trace_synth.h"
 
 namespace bifilar {
@@ -337,6 +340,27 @@ TEST(TraceFit, CvodesAndRungeKuttaGiveTheSameInertia) {
   // Integration error at the default tolerance moves I by far less than its std (~1e-5 of I).
   EXPECT_NEAR(a.params.inertia_kg_m2, c.params.inertia_kg_m2, 1e-6 * c.params.inertia_kg_m2);
   EXPECT_NEAR(b.params.inertia_kg_m2, c.params.inertia_kg_m2, 1e-6 * c.params.inertia_kg_m2);
+}
+
+TEST(TracePlot, WritesPngAndSvgAndRefusesAnEmptyResult) {
+  const TraceFitResult r = FitTrace(Make(Truth(20.0, 81)), TraceFitOptions());
+  ASSERT_TRUE(r.IsUsable());
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("bifilar_trace_plot_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  TracePlotOptions options;
+  options.title = "synthetic.csv";
+  for (const char* ext : {".png", ".svg"}) {
+    const std::string path = (dir / (std::string("trace") + ext)).string();
+    std::string why;
+    ASSERT_TRUE(WriteTraceFitFigure(r, path, options, &why)) << why;
+    EXPECT_GT(std::filesystem::file_size(path), 10000u) << path;
+  }
+  std::string why;
+  EXPECT_FALSE(WriteTraceFitFigure(TraceFitResult(), (dir / "empty.png").string(), options, &why));
+  EXPECT_NE(why.find("no fitted series"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir / "empty.png"));
+  std::filesystem::remove_all(dir);
 }
 
 // --- Bad input ---------------------------------------------------------------------------------

@@ -1,0 +1,23 @@
+// Figure of one trace fit (issue 3 item 10): measured and fitted swing rate over the window
+// (top), the residuals beneath with the +-1 and +-2 noise-sigma bands (bottom). The title carries
+// the file name, the model and I +- std. PNG or SVG by extension, via fit/figure.h.
+#pragma once
+
+#include <string>
+
+#include "fit/trace_fit.h"
+
+namespace bifilar {
+
+struct TracePlotOptions {
+  std::string title;     // usually the log's file name; empty: "trace"
+  int width_px = 1100;   // page width (px); > 0
+  int height_px = 700;   // page height (px); > 0
+};
+
+// Needs the series (TraceFitOptions::keep_series, the default); works for ok and rejected fits.
+// Returns false with *why when there is nothing to draw or the file cannot be written.
+bool WriteTraceFitFigure(const TraceFitResult& result, const std::string& path,
+                         const TracePlotOptions& options, std::string* why);
+
+}  // namespace bifilar
