@@ -170,15 +170,40 @@ bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
       down_at_rest = true;
       axis->rest_samples = count;
     } else {
+      // No rest: average over the turning points of the swing in the window (or the whole log),
+      // where the rate is small. There the centripetal acceleration psi'^2 r, which always points
+      // the same way and would tilt a plain average by ~<psi'^2> r / g (about 1 deg for a 30 deg
+      // swing with the IMU 0.3 m off axis), nearly vanishes, and the tangential psi'' r
+      // alternates in sign from one turning point to the next and averages out.
       axis->notes.push_back("accelerometer: only " + std::to_string(count) +
-                            " samples at rest; down vector averaged over " +
-                            (window_s ? "the window" : "the whole log") +
-                            " (lever-arm accelerations may tilt it)");
-      f_sum.setZero();
-      count = 0;
-      for (size_t i = range.first; i < range.second; ++i) {
-        f_sum += data.accel_in_imu[i];
-        ++count;
+                            " samples at rest; down vector averaged over the swing's turning "
+                            "points in " + (window_s ? "the window" : "the whole log"));
+      Eigen::Vector3d f_all = Eigen::Vector3d::Zero();
+      for (size_t i = range.first; i < range.second; ++i) f_all += data.accel_in_imu[i];
+      const Eigen::Vector3d n0 = f_all.norm() > 0.0 ? Eigen::Vector3d(-f_all.normalized()) : Eigen::Vector3d::UnitZ();
+      double peak = 0.0;
+      for (size_t i = range.first; i < range.second; ++i) peak = std::max(peak, std::abs((data.gyro_in_imu[i] - bias).dot(n0)));
+      // Turning points at +A and at -A are averaged separately (the sign of the rate's slope
+      // tells them apart) and the two means weighted equally, so that one extra turning point of
+      // one sign does not leave a net tangential acceleration.
+      Eigen::Vector3d f_group[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+      int n_group[2] = {0, 0};
+      for (size_t i = std::max<size_t>(range.first, 1); i < range.second && i + 1 < n; ++i) {
+        if (std::abs((data.gyro_in_imu[i] - bias).dot(n0)) <= 0.15 * peak) {
+          const int g = (data.gyro_in_imu[i + 1] - data.gyro_in_imu[i - 1]).dot(n0) > 0.0 ? 1 : 0;
+          f_group[g] += data.accel_in_imu[i];
+          ++n_group[g];
+        }
+      }
+      count = n_group[0] + n_group[1];
+      if (n_group[0] >= 5 && n_group[1] >= 5) {
+        f_sum = 0.5 * count * (f_group[0] / n_group[0] + f_group[1] / n_group[1]);
+      } else {
+        count = 0;
+      }
+      if (count < 10) {
+        f_sum = f_all;
+        count = static_cast<int>(range.second - range.first);
       }
     }
     if (count > 0) {
@@ -198,7 +223,9 @@ bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
       down_in_imu = Eigen::Vector3d(-f_mean / f_mean.norm());
     }
   }
-  if (down_in_imu) {
+  // The pitch is reported from rest, or from the window's turning points; a whole-log average
+  // (no rest, no window) includes the hand and is only used for the axis.
+  if (down_in_imu && (down_at_rest || window_s)) {
     const Eigen::Vector3d down_in_body = options.imu_to_body * *down_in_imu;
     axis->pitch_measured_deg = PitchFromDownDeg(down_in_body);
     axis->roll_measured_deg = RollFromDownDeg(down_in_body);

@@ -28,7 +28,8 @@
 namespace bifilar {
 
 enum class SwingAxisMode {
-  kAuto,   // accelerometer at rest (else over the window), else the gyro's principal direction
+  kAuto,   // accelerometer at rest (else at the swing's turning points in the window, else the
+           // whole log), else the gyro's principal direction
   kFixed,  // SwingAxisOptions::fixed_axis_in_imu
 };
 enum class SwingAxisSource { kAccelAtRest, kAccelOverWindow, kGyroPrincipal, kFixed };

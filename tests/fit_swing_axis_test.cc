@@ -237,5 +237,51 @@ TEST(SwingAxis, SimulatedLogs) {
   }
 }
 
+// A log without rest (logging started during the hold): the pitch comes from the window's turning
+// points. The IMU sits 0.35 m off the swing axis on a 30 deg swing, where a plain average of the
+// accelerometer over the window would be tilted by ~<psi'^2> r / g ~ 1 deg by the centripetal
+// term; at the turning points the residual tilt is < 0.1 deg (no accelerometer bias here).
+TEST(SwingAxis, NoRestPitchFromTurningPoints) {
+  SimulationOptions options;
+  options.timeline.rest_before_s = {0.0, 0.0};
+  options.timeline.stop_probability = 0.0;
+  options.timeline.free_s = {30.0, 30.0};
+  options.sensor.accel_bias_sigma_mps2 = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    TraceSetup setup;
+    setup.geometry.filar_length_m = 2.0;
+    setup.geometry.filar_separation_m = 0.7;
+    setup.geometry.mass_kg = 10.0;
+    setup.params.inertia_kg_m2 = 0.8;
+    setup.params.drag_coeff_kg_m2 = 0.005;
+    setup.params.viscous_coeff_kg_m2_per_s = 0.001;
+    setup.pitch_rad = (-40.0 + 25.0 * i) * kDeg;
+    setup.amplitude_rad = 30.0 * kDeg;
+    setup.body_from_imu = MountingFromRollPitchYawDeg(2.0, -4.0, 60.0 * i);
+    setup.imu_offset_in_body_m = Eigen::Vector3d(0.35, 0.0, 0.0);
+    SimulatedTrace trace;
+    std::string why;
+    ASSERT_TRUE(SimulateTrace(setup, options, 800 + i, &trace, &why)) << why;
+    SCOPED_TRACE("sim " + std::to_string(i));
+    SwingAxisOptions o;
+    o.imu_to_body = setup.body_from_imu;
+    SwingAxis axis;
+    ASSERT_TRUE(EstimateSwingAxis(trace.imu, o, std::nullopt, &axis, &why)) << why;
+    EXPECT_EQ(axis.source, SwingAxisSource::kAccelOverWindow);
+    EXPECT_FALSE(axis.pitch_measured_deg.has_value());  // no rest, no window: no pitch
+    const double t0 = trace.truth.t_release_s + 1.0, t1 = trace.truth.t_release_s + 25.0;
+    ASSERT_TRUE(EstimateSwingAxis(trace.imu, o, std::make_pair(t0, t1), &axis, &why)) << why;
+    ASSERT_TRUE(axis.pitch_measured_deg.has_value());
+    EXPECT_NEAR(*axis.pitch_measured_deg, setup.pitch_rad / kDeg, 0.1);
+    EXPECT_LT(AngleDeg(axis.axis_in_imu, trace.truth.swing_axis_in_imu), 0.1);
+    // The plain window average is visibly worse (this is what the turning points fix).
+    Eigen::Vector3d f = Eigen::Vector3d::Zero();
+    for (size_t k = 0; k < trace.imu.size(); ++k) {
+      if (trace.imu.t_s[k] >= t0 && trace.imu.t_s[k] <= t1) f += trace.imu.accel_in_imu[k];
+    }
+    EXPECT_GT(AngleDeg(-f.normalized(), trace.truth.swing_axis_in_imu), 0.3);
+  }
+}
+
 }  // namespace
 }  // namespace bifilar
