@@ -50,6 +50,7 @@ void Run(const SimulateArgs& a, int* exit_code) {
   positive(a.gravity, "--gravity-mps2");
   SimulateSpec spec = a.spec_file.empty() ? ParseSimulateSpec("{}", "<defaults>")
                                           : ReadSimulateSpec(a.spec_file);
+  if (a.spec_file.empty()) spec.file.clear();
   if (a.seed) spec.seed = *a.seed;
   if (!a.model.empty() && !ParsePendulumModel(a.model, &spec.options.model)) {
     throw UserError("--model: unknown model '" + a.model + "'; allowed full, jardin, linear");
