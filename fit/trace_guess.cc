@@ -233,15 +233,62 @@ bool EstimateTraceGuess(const TraceFitInput& input, PendulumModel model,
     if (std::isfinite(slope)) lambda = std::max(0.0, -slope);
   }
   guess->decay_rate_per_s = lambda;
+  const double omega0 = std::sqrt(omega_d * omega_d + lambda * lambda);
 
-  // First cycle: rate ~ e^{-lambda tau}(a cos w tau + b sin w tau) + c, tau = t - t0.
+  // Split of the decay: the angle amplitude A obeys dA/dt = -(lambda_v + kappa A) A with
+  // lambda_v = C / (2 I) and kappa = (4 / (3 pi)) (K_D / I) omega. Pairs of peaks `stride`
+  // half-cycles apart give the local rate ln(a_i / a_j) / (t_j - t_i) at A = sqrt(a_i a_j) / w;
+  // a straight line through them gives lambda_v (intercept) and kappa (slope), both >= 0.
+  double lambda_v = 0.8 * lambda, kappa = 0.0;
+  {
+    const size_t np = peak_a.size();
+    const size_t stride = std::max<size_t>(1, np / 6);
+    std::vector<double> amp, rate;
+    for (size_t i = 0; i + stride < np; ++i) {
+      const double dt = peak_t[i + stride] - peak_t[i];
+      if (!(dt > 0.0)) continue;
+      amp.push_back(std::sqrt(peak_a[i] * peak_a[i + stride]) / omega0);
+      rate.push_back(std::log(peak_a[i] / peak_a[i + stride]) / dt);
+    }
+    if (amp.size() >= 3) {
+      double sa = 0, sr = 0, saa = 0, sar = 0;
+      const double m_pairs = amp.size();
+      for (size_t i = 0; i < amp.size(); ++i) {
+        sa += amp[i];
+        sr += rate[i];
+        saa += amp[i] * amp[i];
+        sar += amp[i] * rate[i];
+      }
+      const double den = m_pairs * saa - sa * sa;
+      double slope = den > 0.0 ? (m_pairs * sar - sa * sr) / den : 0.0;
+      double intercept = (sr - slope * sa) / m_pairs;
+      if (!std::isfinite(slope) || !std::isfinite(intercept)) slope = 0.0, intercept = lambda;
+      if (slope < 0.0) {
+        slope = 0.0;
+        intercept = sr / m_pairs;
+      }
+      if (intercept < 0.0) {
+        intercept = 0.0;
+        slope = saa > 0.0 ? std::max(0.0, sar / saa) : 0.0;
+      }
+      lambda_v = intercept;
+      kappa = slope;
+    }
+  }
+  // Decay rate at the start of the window (largest amplitude).
+  const double amp_first = peak_a.empty() ? 0.0 : peak_a.front() / omega0;
+  const double lambda0 = std::max(0.0, lambda_v + kappa * amp_first);
+
+  // First cycle: rate ~ e^{-lambda0 tau}(a cos w tau + b sin w tau) + c, tau = t - t0. The angle
+  // psi = e^{-lambda0 tau}(alpha cos + beta sin) with psi' = rate has
+  // alpha = psi(t0) = -(lambda0 a + w b) / (lambda0^2 + w^2) (zero-mean about the equilibrium).
   const double t0 = t.front();
   std::vector<size_t> first;
   for (size_t k = 0; k < n && t[k] <= t0 + period; ++k) first.push_back(k);
   Eigen::MatrixXd A(first.size(), 3);
   Eigen::VectorXd y(first.size());
   for (size_t i = 0; i < first.size(); ++i) {
-    const double tau = t[first[i]] - t0, env = std::exp(-lambda * tau);
+    const double tau = t[first[i]] - t0, env = std::exp(-lambda0 * tau);
     A(i, 0) = env * std::cos(omega_d * tau);
     A(i, 1) = env * std::sin(omega_d * tau);
     A(i, 2) = 1.0;
@@ -250,22 +297,10 @@ bool EstimateTraceGuess(const TraceFitInput& input, PendulumModel model,
   const Eigen::Vector3d coef = A.colPivHouseholderQr().solve(y);
   guess->rate0_rad_per_s = coef(0);
   guess->rate_amplitude_rad_per_s = std::hypot(coef(0), coef(1));
-  // Angle: integrate rate - bias over the first cycle; the mean angle over a cycle is zero.
-  {
-    double angle = 0.0, weighted = 0.0;
-    const size_t kmax = first.size();
-    for (size_t i = 1; i < kmax; ++i) {
-      const double dt = t[i] - t[i - 1];
-      const double a_prev = angle;
-      angle += 0.5 * (x[i] + x[i - 1] - 2.0 * bias) * dt;
-      weighted += 0.5 * (angle + a_prev) * dt;
-    }
-    const double span = t[kmax - 1] - t0;
-    guess->angle0_rad = span > 0.0 ? -weighted / span : 0.0;
-  }
+  guess->angle0_rad =
+      -(lambda0 * coef(0) + omega_d * coef(1)) / (lambda0 * lambda0 + omega_d * omega_d);
 
   // Inertia: small-angle formula at the undamped frequency, then corrected for amplitude.
-  const double omega0 = std::sqrt(omega_d * omega_d + lambda * lambda);
   const double period0 = 2.0 * kPi / omega0;
   double inertia = InertiaFromSmallAnglePeriod(input.geometry, period0);
   double sum_a2 = 0.0;
@@ -284,10 +319,8 @@ bool EstimateTraceGuess(const TraceFitInput& input, PendulumModel model,
     }
   }
   guess->params.inertia_kg_m2 = inertia;
-  guess->params.viscous_coeff_kg_m2_per_s = 0.8 * 2.0 * inertia * lambda;
-  // Quadratic drag: angle amplitude A decays as dA/dt = -(4/(3 pi)) (K_D/I) omega A^2.
-  guess->params.drag_coeff_kg_m2 =
-      amp_rms > 1e-3 ? 0.2 * lambda * inertia * 3.0 * kPi / (4.0 * omega0 * amp_rms) : 0.0;
+  guess->params.viscous_coeff_kg_m2_per_s = 2.0 * inertia * lambda_v;
+  guess->params.drag_coeff_kg_m2 = kappa * inertia * 3.0 * kPi / (4.0 * omega0);
   return true;
 }
 

@@ -4,10 +4,12 @@
 //              interpolation between the real timestamps), so jitter and drops do not matter
 //   bias       mean rate over an integer number of cycles (between the first and the last
 //              upward crossing)
-//   damping    envelope decay rate lambda from the log decrement of the half-cycle peaks;
-//              80 % attributed to viscous C = 2 I lambda, 20 % to quadratic drag K_D
-//   psi'(t0)   damped sinusoid + constant fitted by linear least squares to the first cycle
-//   psi(t0)    minus the mean of the integrated rate over the first cycle (zero-mean angle)
+//   damping    from the half-cycle peaks: the local log decrement against amplitude is a line,
+//              lambda_v + kappa A, whose intercept gives C = 2 I lambda_v and slope the
+//              quadratic drag K_D = 3 pi I kappa / (4 omega)
+//   psi'(t0)   damped sinusoid + constant fitted by linear least squares to the first cycle,
+//              with the decay rate at the first peak's amplitude
+//   psi(t0)    the angle whose derivative is that damped sinusoid (zero mean about equilibrium)
 //   I          small-angle formula from the undamped period, corrected for amplitude by
 //              integrating the chosen model over one period at the window's RMS amplitude
 //              (exact for `jardin`/`linear`, where the period scales with sqrt(I) at fixed
