@@ -146,25 +146,12 @@ std::vector<HalfCycle> HalfCycles(const std::vector<double>& t, const std::vecto
                                   size_t begin, size_t end, double h) {
   std::vector<HalfCycle> out;
   int state = 0;
-  size_t last_peak = begin;
   for (size_t i = begin; i < end; ++i) {
     const int s = x[i] > h ? 1 : (x[i] < -h ? -1 : 0);
-    if (s != 0 && s != state) {
-      // Zero crossing: the last sign change before i, after the previous peak.
-      double start = t[i];
-      for (size_t j = i; j > last_peak && j > begin; --j) {
-        if ((s > 0 && x[j - 1] <= 0.0) || (s < 0 && x[j - 1] >= 0.0)) {
-          const double x0 = x[j - 1], x1 = x[j];
-          const double f = (x1 != x0) ? -x0 / (x1 - x0) : 0.0;
-          start = t[j - 1] + std::clamp(f, 0.0, 1.0) * (t[j] - t[j - 1]);
-          break;
-        }
-      }
-      if (state == 0 && out.empty()) start = std::min(start, t[i]);
-      if (!out.empty()) out.back().end_s = start;
+    if (s != 0 && s != state) {  // a new half-cycle; its start is set below
       HalfCycle c;
       c.sign = s;
-      c.start_s = start;
+      c.start_s = t[i];
       c.peak_index = i;
       c.peak = s * x[i];
       out.push_back(c);
@@ -173,7 +160,6 @@ std::vector<HalfCycle> HalfCycles(const std::vector<double>& t, const std::vecto
     if (!out.empty() && state * x[i] > out.back().peak) {
       out.back().peak = state * x[i];
       out.back().peak_index = i;
-      last_peak = i;
     }
   }
   if (!out.empty()) {
