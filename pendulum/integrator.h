@@ -1,6 +1,7 @@
-// Integration of the pendulum model (pendulum/model.h) with SUNDIALS CVODES, at a log's own,
-// possibly non-uniform timestamps, with forward sensitivities of the state with respect to
-// I, K_D, C, psi(t0) and psi'(t0). Conventions: ../shared/PHYSICS.md §2.
+// Integration of the pendulum model (pendulum/model.h), at a log's own, possibly non-uniform
+// timestamps, with forward sensitivities of the state with respect to I, K_D, C, psi(t0) and
+// psi'(t0), by an inlined DOP853 Runge-Kutta (default) or SUNDIALS CVODES (IntegratorMethod).
+// Conventions: ../shared/PHYSICS.md §2.
 #pragma once
 
 #include <memory>
@@ -17,7 +18,7 @@ namespace bifilar {
 // forward sensitivities, analytic, sensitivities in the error test) to the same tolerances.
 enum class IntegratorMethod {
   // Explicit Runge-Kutta 8(5,3) with 7th-order dense output (Dormand-Prince DOP853), inlined on
-  // the 2- or 12-component system: ~10x faster than CVODES here, the default.
+  // the 2- or 12-component system: ~25x faster than CVODES here (README, Performance).
   kRungeKutta,
   // SUNDIALS CVODES, Adams-Moulton with the fixed-point solver and CVODES forward sensitivities
   // (simultaneous corrector). The reference implementation; slower per step (general N_Vector
