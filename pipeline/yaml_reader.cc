@@ -3,9 +3,18 @@
 #include <cmath>
 
 namespace bifilar {
+namespace {
+
+// An absent key comes back from yaml-cpp as an invalid "zombie" node whose type queries (and
+// assignment) throw: treat it as an empty document.
+YAML::Node ValidOrNull(const YAML::Node& node) {
+  return node.IsDefined() ? node : YAML::Node(YAML::NodeType::Null);
+}
+
+}  // namespace
 
 YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
-    : node_(node), file_(std::move(file)), path_(std::move(path)) {
+    : node_(ValidOrNull(node)), file_(std::move(file)), path_(std::move(path)) {
   if (node_.IsDefined() && !node_.IsNull() && !node_.IsMap()) {
     throw UserError(Where(node_) + ": '" + (path_.empty() ? "<document>" : path_) +
                     "' must be a mapping of keys to values");
