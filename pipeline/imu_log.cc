@@ -48,6 +48,16 @@ bool ParseCell(std::string_view cell, double* value) {
 // trimming them off a cell, which is enough for numeric logs with quoted header names.
 void Split(std::string_view line, char delim, std::vector<std::string_view>* fields) {
   fields->clear();
+  if (delim == ' ') {  // space-separated: runs of spaces (and tabs) are one separator
+    size_t i = 0;
+    while (true) {
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+      if (i >= line.size()) return;
+      const size_t b = i;
+      while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
+      fields->push_back(line.substr(b, i - b));
+    }
+  }
   size_t start = 0;
   while (true) {
     const size_t pos = line.find(delim, start);
@@ -130,13 +140,31 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
                                 " control characters in the first " + std::to_string(n) + " bytes)");
   }
 
+  ImuData data;
   LineReader reader(text);
   std::string_view line;
   std::vector<std::string_view> fields;
 
-  // Header: the first non-blank line.
-  while (reader.Next(&line) && IsBlank(line)) {}
+  // Header: the first non-blank line that is not a comment ('#', '%' or '//' first: logger
+  // metadata above the header is common).
+  int comment_lines = 0;
+  while (reader.Next(&line)) {
+    const std::string_view trimmed = Trim(line);
+    if (trimmed.empty()) continue;
+    if (trimmed[0] == '#' || trimmed[0] == '%' || trimmed.substr(0, 2) == "//") {
+      ++comment_lines;
+      continue;
+    }
+    break;
+  }
   const int header_line = reader.line_number();
+  if (IsBlank(line) || Trim(line)[0] == '#' || Trim(line)[0] == '%' || Trim(line).substr(0, 2) == "//") {
+    Fail(name + ": no header row, only " + std::to_string(comment_lines) + " comment line(s)");
+  }
+  if (comment_lines > 0) {
+    data.warnings.push_back("skipped " + std::to_string(comment_lines) +
+                            " comment line(s) before the header");
+  }
   Split(line, format.delimiter, &fields);
   std::vector<std::string> header;
   for (auto f : fields) header.emplace_back(Unquote(f));
@@ -191,7 +219,6 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
     if (c < 0) missing(n);
     column.push_back(c);
   }
-  ImuData data;
   bool with_accel = false;
   if (format.has_accel()) {
     int present = 0;

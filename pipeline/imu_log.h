@@ -4,7 +4,9 @@
 // (pipeline/imu_format.h) and converted to SI with its units. What the reader tolerates, and
 // what it rejects (UserError naming the file, line and column):
 //   - extra columns are ignored; header names may be quoted ("t") or padded with spaces;
-//   - CRLF line ends, a UTF-8 byte-order mark and blank lines are accepted;
+//   - CRLF line ends, a UTF-8 byte-order mark and blank lines are accepted; comment lines
+//     ('#', '%', '//') above the header are skipped with a warning; with delimiter ' ', runs of
+//     spaces separate columns (whitespace-aligned logs);
 //   - trailing rows that are not numbers (a footer, a line cut short when the logger stopped)
 //     are skipped with a warning in ImuData::warnings;
 //   - a non-numeric cell followed by good rows is an error (file:line:column);

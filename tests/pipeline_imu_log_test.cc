@@ -95,6 +95,20 @@ TEST(ImuLog, CustomNamesExtraColumnsQuotesSpacesCrlfBom) {
   EXPECT_TRUE(d.warnings.empty());
 }
 
+TEST(ImuLog, CommentLinesAboveHeaderAndSpaceAlignedColumns) {
+  const ImuData d = ReadImuLogFromString("# logger v2\n// rate 100 Hz\n\n" + kHeader + Rows(3), "c.csv", ImuFormat());
+  EXPECT_EQ(d.size(), 3u);
+  ASSERT_EQ(d.warnings.size(), 1u);
+  EXPECT_TRUE(Contains(d.warnings[0], "skipped 2 comment line(s)")) << d.warnings[0];
+  EXPECT_TRUE(Contains(ErrorOf("# only a comment\n"), "no header row, only 1 comment line"));
+  ImuFormat f;
+  f.delimiter = ' ';
+  const ImuData s = ReadImuLogFromString("  t    gx    gy   gz  ax ay az\n 0.00  1.0  2.0  3.0 0 0 1\n\t0.01  4.0 5.0  6.0 0 0 1\n",
+                                         "aligned.txt", f);
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(s.gyro_in_imu[1], Eigen::Vector3d(4, 5, 6));
+}
+
 TEST(ImuLog, GapsKeepRealTimestamps) {
   const ImuData d = ReadImuLogFromString(kHeader + "0,0,0,0,0,0,1\n0.01,0,0,0,0,0,1\n0.05,0,0,0,0,0,1\n", "gap.csv", ImuFormat());
   ASSERT_EQ(d.size(), 3u);
