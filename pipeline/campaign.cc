@@ -28,6 +28,7 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
+
 bool HasWildcard(const std::string& component) {
   return component.find_first_of("*?{") != std::string::npos;
 }
@@ -605,6 +606,9 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     const std::string figure_name = record.cache_key + ".svg";
     const std::string figure_path = (out / "figures" / figure_name).string();
     if (options.figures) trace_options.figure_paths = {figure_path};
+    trace_options.compact_figure = true;
+    trace_options.figure_width_px = 640;
+    trace_options.figure_height_px = 400;
     TraceRecord fitted;
     try {
       fitted = fit(config, run.path, trace_options);

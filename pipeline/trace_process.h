@@ -79,6 +79,10 @@ struct TraceProcessOptions {
   std::optional<std::array<double, 2>> window_s;
   // Write the fit-and-residual figure to each of these (.svg or .png); empty = no figure.
   std::vector<std::string> figure_paths;
+  // true: the report's compact line-only thumbnail (a few ms); false: fit/trace_plot.h's full
+  // figure (a symbol per sample).
+  bool compact_figure = false;
+  int figure_width_px = 1100, figure_height_px = 700;  // page size of the figure (px)
 };
 
 // Processes one log. Never throws: every failure is a record with status error naming the file.

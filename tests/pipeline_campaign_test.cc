@@ -437,5 +437,47 @@ TEST(CampaignRealFit, RigLargerThanTotalAndMeasuredPitch) {
   ASSERT_TRUE(result.ellipse_fit.has_value());
 }
 
+// The command line: exit codes 0 / 1 / 2 and one clear line for config errors.
+int RunCli(const std::string& args, const std::string& output) {
+  const std::string command = std::string(BIFILAR_BINARY) + " " + args + " > " + output + " 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(CampaignCli, ExitCodesAndMessages) {
+  SimulatedCampaign c;
+  const std::string log = c.dir + "/cli.txt";
+  const std::string config = c.dir + "/campaign.yaml";
+  EXPECT_EQ(RunCli("process " + config + " --out " + c.dir + "/out --jobs 2", log), 0)
+      << ReadFile(log);
+  EXPECT_NE(ReadFile(log).find("Table 2"), std::string::npos) << ReadFile(log);
+  EXPECT_NE(ReadFile(log).find("reused from cache 0"), std::string::npos) << ReadFile(log);
+  EXPECT_EQ(RunCli("process " + config + " --out " + c.dir + "/out", log), 0);
+  EXPECT_NE(ReadFile(log).find("fits run 0, reused from cache 12"), std::string::npos)
+      << ReadFile(log);
+  EXPECT_EQ(RunCli("report " + c.dir + "/out", log), 0) << ReadFile(log);
+  // Output path that is a file.
+  WriteFile(c.dir + "/afile", "x");
+  EXPECT_EQ(RunCli("process " + config + " --out " + c.dir + "/afile", log), 2);
+  EXPECT_NE(ReadFile(log).find("is not a folder"), std::string::npos) << ReadFile(log);
+  // A typo in a key: file, line and key.
+  WriteFile(config, ReadFile(config) + "fit: {modl: full}\n");
+  EXPECT_EQ(RunCli("process " + config, log), 2);
+  EXPECT_NE(ReadFile(log).find("campaign.yaml:8:7: unknown key 'fit.modl'"), std::string::npos)
+      << ReadFile(log);
+  // A bad log: exit 1, the rest processed.
+  c.WriteConfig("{tare: {logs: logs/tare/*.csv}}", "nominal");
+  WriteFile(c.dir + "/logs/pitch_0/trial_9.csv", "t,gx\n");
+  EXPECT_EQ(RunCli("process " + config + " --out " + c.dir + "/out", log), 1);
+  EXPECT_NE(ReadFile(log).find("pitch_0/trial_9.csv"), std::string::npos) << ReadFile(log);
+  EXPECT_NE(ReadFile(log).find("12 ok, 0 rejected, 1 error"), std::string::npos) << ReadFile(log);
+  // `fit` on one log, JSON.
+  EXPECT_EQ(RunCli("fit " + config + " " + c.dir + "/logs/pitch_45/trial_1.csv --json", log), 0)
+      << ReadFile(log);
+  const nlohmann::json records = nlohmann::json::parse(ReadFile(log));
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0]["status"], "ok");
+}
+
 }  // namespace
 }  // namespace bifilar
