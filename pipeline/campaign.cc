@@ -340,7 +340,7 @@ void DrawCampaignFigures(const CampaignConfig& config, const EllipseResult& fit,
   const fs::path figures = fs::path(out_dir) / "figures";
   std::error_code ec;
   std::string why;
-  const std::string moments = "moments_" + hash + ".svg", polar = "polar_" + hash + ".svg";
+  const std::string moments = "moments_" + hash + ".png", polar = "polar_" + hash + ".png";
   if (fs::exists(figures / moments, ec) ||
       WriteEllipseMomentFigure(fit, (figures / moments).string(), plot, &why)) {
     result->moments_figure = moments;

@@ -79,8 +79,19 @@ Estimate GetEstimate(const json& ellipse, const std::string& key) {
   return e;
 }
 
+// Replaces every occurrence of `from` in `text` by `to`.
+std::string ReplaceAll(std::string text, const std::string& from, const std::string& to) {
+  for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
+    text.replace(at, from.size(), to);
+  }
+  return text;
+}
+
+// A figure file as page content: an SVG inline (its ids prefixed, so the glyph and clip ids that
+// every cairo SVG names alike do not collide; a third smaller than base64), a PNG as a base64
+// data URI.
 std::string Figure(const std::string& out_dir, const std::string& name, const std::string& alt,
-                   const std::string& css_class) {
+                   const std::string& css_class, int* counter) {
   if (name.empty()) return "<p class=\"note\">(no figure)</p>";
   std::string bytes, why;
   const std::string path = (fs::path(out_dir) / "figures" / name).string();
@@ -88,9 +99,19 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
     return "<p class=\"note\">(figure " + Escape(name) + " missing)</p>";
   }
   const std::string ext = fs::path(name).extension().string();
-  const std::string mime = ext == ".png" ? "image/png" : "image/svg+xml";
-  return "<img class=\"" + css_class + "\" alt=\"" + Escape(alt) + "\" src=\"data:" + mime +
-         ";base64," + Base64(bytes) + "\">";
+  if (ext == ".svg") {
+    const size_t start = bytes.find("<svg");
+    if (start == std::string::npos) return "<p class=\"note\">(figure " + Escape(name) + " unreadable)</p>";
+    const std::string prefix = "f" + std::to_string((*counter)++) + "-";
+    std::string svg = bytes.substr(start);
+    svg = ReplaceAll(svg, "id=\"", "id=\"" + prefix);
+    svg = ReplaceAll(svg, "href=\"#", "href=\"#" + prefix);
+    svg = ReplaceAll(svg, "url(#", "url(#" + prefix);
+    svg.replace(0, 4, "<svg class=\"" + css_class + "\" role=\"img\" aria-label=\"" + Escape(alt) + "\"");
+    return svg;
+  }
+  return "<img class=\"" + css_class + "\" alt=\"" + Escape(alt) + "\" src=\"data:image/png;base64," +
+         Base64(bytes) + "\">";
 }
 
 const char* kStyle = R"(
@@ -101,10 +122,10 @@ th, td { border: 1px solid #ccc; padding: .25em .6em; text-align: right; }
 th { background: #f2f2f2; } td.l, th.l { text-align: left; }
 tr.rejected td { background: #fff4e0; } tr.error td { background: #fde8e8; }
 .note { color: #666; font-style: italic; }
-img.fig { max-width: 100%; border: 1px solid #ddd; }
+img.fig, svg.fig { max-width: 100%; height: auto; border: 1px solid #ddd; }
 .traces { display: flex; flex-wrap: wrap; gap: 10px; }
 .traces figure { margin: 0; width: 540px; }
-.traces img { width: 540px; border: 1px solid #ddd; }
+.traces img, .traces svg { width: 540px; height: auto; border: 1px solid #ddd; }
 figcaption { font-size: .8em; color: #444; }
 pre { background: #f7f7f7; padding: .8em; overflow-x: auto; font-size: .85em; }
 .ok { color: #1a7f37; } .bad { color: #b42318; }
@@ -152,6 +173,7 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
   const json traces = results.contains("traces") ? results["traces"] : json::array();
   const json angles = results.contains("angles") ? results["angles"] : json::array();
   const json figures = results.contains("figures") ? results["figures"] : json::object();
+  int figures_drawn = 0;  // numbers the inline SVGs' id prefixes
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
     << "<title>bifilar report</title><style>" << kStyle << "</style></head><body>\n";
@@ -221,9 +243,9 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
 
   // Figures 3 and 4.
   h << "<h2>Figure 3: moment of inertia against pitch</h2>\n"
-    << Figure(out_dir, Str(figures, "moments"), "moments of inertia against pitch angle", "fig")
+    << Figure(out_dir, Str(figures, "moments"), "moments of inertia against pitch angle", "fig", &figures_drawn)
     << "\n<h2>Figure 4: ellipse of inertia</h2>\n"
-    << Figure(out_dir, Str(figures, "polar"), "polar plot of the ellipse of inertia", "fig") << "\n";
+    << Figure(out_dir, Str(figures, "polar"), "polar plot of the ellipse of inertia", "fig", &figures_drawn) << "\n";
 
   // NACA 467.
   h << "<h2>NACA Report 467 comparison</h2>\n";
@@ -308,7 +330,7 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
   for (const auto& t : traces) {
     const std::string fig = Str(t, "figure");
     if (fig.empty()) continue;
-    h << "<figure>" << Figure(out_dir, fig, "fit of " + Str(t, "file"), "trace")
+    h << "<figure>" << Figure(out_dir, fig, "fit of " + Str(t, "file"), "trace", &figures_drawn)
       << "<figcaption>" << Escape(Str(t, "file")) << " &middot; " << Escape(Str(t, "status"))
       << "</figcaption></figure>\n";
   }

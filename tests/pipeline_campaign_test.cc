@@ -158,7 +158,7 @@ TEST(Campaign, RecoversTheEllipseAndWritesEveryOutput) {
   EXPECT_EQ(std::count(angles_csv.begin(), angles_csv.end(), '\n'), 7);
   const std::string html = ReadFile(out + "/report.html");
   EXPECT_NE(html.find("Table 2"), std::string::npos);
-  EXPECT_NE(html.find("data:image/svg+xml;base64,"), std::string::npos);  // Fig. 3/4 embedded
+  EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);  // Fig. 3/4 embedded
   // No temporary file left behind.
   for (const auto& entry : fs::directory_iterator(out)) {
     EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();

@@ -101,14 +101,17 @@ TEST(Report, HasEverySectionAndEmbedsEveryFigure) {
                               "Fit and residual of every trace", "Config used", "slug ft"}) {
     EXPECT_NE(html.find(section), std::string::npos) << section;
   }
-  // 8 trace figures + Fig. 3 + Fig. 4, all inline; no reference to another file.
-  // (Counted with find: std::regex recurses per character and overflows on a 1 MB page.)
-  int n = 0;
-  for (size_t at = html.find("src=\"data:image/svg+xml;base64,"); at != std::string::npos;
-       at = html.find("src=\"data:image/svg+xml;base64,", at + 1)) {
-    ++n;
-  }
-  EXPECT_EQ(n, 10);
+  // 8 trace figures (inline SVG) + Fig. 3 + Fig. 4 (PNG data URIs); no reference to another file.
+  auto count = [&](const std::string& needle) {
+    int n = 0;
+    for (size_t at = html.find(needle); at != std::string::npos; at = html.find(needle, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("<svg class=\"trace\""), 8);
+  EXPECT_EQ(count("src=\"data:image/png;base64,"), 2);
+  // Inline SVGs' ids are made unique (cairo names every file's glyphs alike).
+  EXPECT_NE(html.find("id=\"f0-glyph"), std::string::npos);
+  EXPECT_NE(html.find("id=\"f7-glyph"), std::string::npos);
   EXPECT_EQ(html.find("src=\"figures/"), std::string::npos);
   EXPECT_EQ(html.find("(no figure)"), std::string::npos);
   // The failed log is listed with its reason, escaped.
@@ -157,13 +160,18 @@ TEST(Report, CommittedSampleReportLoadsInChromium) {
   const std::string html = std::string(BIFILAR_SOURCE_DIR) + "/sample_runs/prandtl_d/out/report.html";
   if (!fs::exists("/usr/bin/chromium")) GTEST_SKIP() << "/usr/bin/chromium not installed";
   if (!fs::exists(html)) GTEST_SKIP() << html << " not generated";
-  // Every figure of the sample is embedded: 57 traces + Fig. 3 + Fig. 4.
+  // Every figure of the sample is embedded: 57 traces (inline SVG) + Fig. 3 + Fig. 4 (PNG).
   const std::string page = ReadFile(html);
-  int images = 0;
+  int traces = 0, images = 0;
+  for (size_t at = page.find("<svg class=\"trace\""); at != std::string::npos;
+       at = page.find("<svg class=\"trace\"", at + 1)) {
+    ++traces;
+  }
   for (size_t at = page.find("<img "); at != std::string::npos; at = page.find("<img ", at + 1)) {
     ++images;
   }
-  EXPECT_EQ(images, 59);
+  EXPECT_EQ(traces, 57);
+  EXPECT_EQ(images, 2);
   char tmpl[] = "/tmp/bifilar_sample_shot_XXXXXX";
   EXPECT_GT(ScreenshotInChromium(html, mkdtemp(tmpl)), 50000u);
 }
