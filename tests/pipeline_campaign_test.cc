@@ -72,6 +72,11 @@ struct FakeCampaign {
     WriteConfig(rig_inertia_yaml, extra_yaml);
   }
 
+  ~FakeCampaign() {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+
   void WriteConfig(const std::string& rig_inertia_yaml, const std::string& extra_yaml,
                    double filar_length_m = 2.0) {
     std::ostringstream yaml;
@@ -358,6 +363,10 @@ struct SimulatedCampaign {
     RunSimulateCampaign(ParseSimulateSpec(spec, "small_spec.yaml"), dir + "/logs");
     truth = nlohmann::json::parse(ReadFile(dir + "/logs/truth.json"));
     WriteConfig("{tare: {logs: logs/tare/*.csv}}", "nominal");
+  }
+  ~SimulatedCampaign() {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
   }
   void WriteConfig(const std::string& rig_inertia, const std::string& pitch_source) {
     WriteFile(dir + "/campaign.yaml",

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -16,9 +17,20 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Folders made by the tests, removed at exit.
+struct TempDirs {
+  std::vector<std::string> dirs;
+  ~TempDirs() {
+    std::error_code ec;
+    for (const std::string& d : dirs) fs::remove_all(d, ec);
+  }
+};
+TempDirs temp_dirs;
+
 std::string TempDir() {
   char tmpl[] = "/tmp/bifilar_config_test_XXXXXX";
-  return mkdtemp(tmpl);
+  temp_dirs.dirs.push_back(mkdtemp(tmpl));
+  return temp_dirs.dirs.back();
 }
 
 std::string Write(const std::string& dir, const std::string& name, const std::string& text) {

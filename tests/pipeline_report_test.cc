@@ -124,6 +124,7 @@ TEST(Report, HasEverySectionAndEmbedsEveryFigure) {
   EXPECT_THROW(RunReport(out + "/nowhere"), UserError);
   WriteFile(out + "/results.json", "{ broken");
   EXPECT_THROW(RunReport(out), UserError);
+  fs::remove_all(fs::path(out).parent_path());
 }
 
 // Loads `html` in headless Chromium; fails on console errors; returns the screenshot's size.
@@ -154,6 +155,7 @@ TEST(Report, LoadsInHeadlessChromiumWithoutConsoleErrors) {
   const std::string out = MakeCampaign();
   // A 1200x4000 page with figures, not a blank one (a blank page is ~20 kB).
   EXPECT_GT(ScreenshotInChromium(out + "/report.html", out), 50000u);
+  fs::remove_all(fs::path(out).parent_path());
 }
 
 TEST(Report, CommittedSampleReportLoadsInChromium) {
@@ -173,7 +175,9 @@ TEST(Report, CommittedSampleReportLoadsInChromium) {
   EXPECT_EQ(traces, 57);
   EXPECT_EQ(images, 2);
   char tmpl[] = "/tmp/bifilar_sample_shot_XXXXXX";
-  EXPECT_GT(ScreenshotInChromium(html, mkdtemp(tmpl)), 50000u);
+  const std::string work = mkdtemp(tmpl);
+  EXPECT_GT(ScreenshotInChromium(html, work), 50000u);
+  fs::remove_all(work);
 }
 
 }  // namespace
