@@ -726,6 +726,13 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     a.cv_percent = 100.0 * a.inertia_std_kg_m2 / a.inertia_mean_kg_m2;
     result.angles.push_back(a);
   }
+  std::vector<double> relative_budget;
+  for (const TraceRecord& r : result.traces) {
+    if (r.role == TraceRole::kAircraft && r.ok() && std::isfinite(r.budget_total_std_kg_m2)) {
+      relative_budget.push_back(r.budget_total_std_kg_m2 / r.inertia_total_kg_m2);
+    }
+  }
+  result.systematic_relative_std = Mean(relative_budget);
   FitCampaignEllipse(config, options, out.string(), &result);
 
   if (result.summary.n_rejected + result.summary.n_error > 0 || !result.summary.ellipse_fitted) {
@@ -789,6 +796,12 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
       std::snprintf(line, sizeof(line), "  %-5s  ill-defined (I_x ~ I_z)\n", "tau");
     }
     out << line;
+    if (std::isfinite(result.systematic_relative_std) && result.systematic_relative_std > 0) {
+      std::snprintf(line, sizeof(line),
+                    "  (+- %.2f %% systematic, common to all moments, from rig.uncertainties)\n",
+                    100.0 * result.systematic_relative_std);
+      out << line;
+    }
     std::snprintf(line, sizeof(line),
                   "Table 1: raw sigma %.5f %s, CV %.4f %%, regression RMSE %.5f %s\n",
                   inertia(result.raw_sigma_kg_m2), unit, result.cv_percent,

@@ -63,6 +63,10 @@ struct CampaignResult {
   nlohmann::json ellipse;           // pipeline/ellipse_json.h document, null when not fitted
   std::string moments_figure;       // Fig. 3 file name in OUT/figures/, "" when none
   std::string polar_figure;         // Fig. 4 file name in OUT/figures/, "" when none
+  // Systematic relative uncertainty from rig.uncertainties (L, D, masses, g): the mean over ok
+  // aircraft traces of budget total / inertia total. It scales every moment alike, so it is not
+  // in the ellipse's std; reported beside it. NaN when no budget.
+  double systematic_relative_std = NAN;
   // Table 1 of the paper (kg m^2): mean of per-angle std, mean CV (%), regression RMSE.
   double raw_sigma_kg_m2 = NAN, cv_percent = NAN, regression_rmse_kg_m2 = NAN;
   CampaignSummary summary;

@@ -210,6 +210,11 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
       h << "<td class=\"l\">" << (row.angle ? "deg" : u.name) << "</td></tr>\n";
     }
     h << "</table>\n";
+    const double systematic = Num(results, "systematic_relative_std");
+    h << "<p>Uncertainties above are statistical (scatter between trials and angles). "
+      << "The configured uncertainties of L, D, the masses and g add a systematic &plusmn;"
+      << Fmt(100.0 * systematic, "%.2f")
+      << " % that scales every moment alike and leaves &tau; unchanged (mean per-trace uncertainty budget).</p>\n";
     if (ellipse.contains("warnings")) {
       for (const auto& w : ellipse["warnings"]) {
         if (w.is_string()) h << "<p class=\"note\">" << Escape(w.get<std::string>()) << "</p>\n";

@@ -198,6 +198,7 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   table1["cv_percent"] = Number(result.cv_percent);
   table1["regression_rmse_kg_m2"] = Number(result.regression_rmse_kg_m2);
   j["table1"] = table1;
+  j["systematic_relative_std"] = Number(result.systematic_relative_std);
   json traces = json::array();
   for (const TraceRecord& r : result.traces) traces.push_back(TraceRecordToJson(r));
   j["traces"] = traces;
