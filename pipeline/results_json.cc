@@ -163,7 +163,11 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   json j;
   j["program"] = "bifilar";
   j["version"] = ProgramVersion();
-  j["config_file"] = config.file;
+  // Relative to the working folder when below it (results do not carry the machine's layout).
+  std::error_code ec;
+  const std::string relative =
+      std::filesystem::path(config.file).lexically_relative(std::filesystem::current_path(ec)).string();
+  j["config_file"] = !relative.empty() && relative.rfind("..", 0) != 0 ? relative : config.file;
   j["config"] = config.text;
   j["units"] = ToString(config.units);
   j["pitch_source"] = ToString(config.runs.pitch_source);
