@@ -304,9 +304,9 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
 
   // All traces.
   h << "<h2>Traces</h2>\n<table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"
-       "<th class=\"l\">status</th><th>pitch (deg)</th><th>I total</th><th>std</th>"
-       "<th>I aircraft</th><th>std</th><th>window (s)</th><th>amplitude (deg)</th>"
-       "<th>rms/noise</th></tr>\n";
+       "<th class=\"l\">status</th><th>pitch (deg)</th><th>I total (" << u.name
+    << ")</th><th>std</th><th>I aircraft</th><th>std</th><th>window (s)</th>"
+       "<th>amplitude (deg)</th><th>rms/noise</th></tr>\n";
   for (const auto& t : traces) {
     const std::string status = Str(t, "status");
     std::string window = "&ndash;", amplitude = "&ndash;";
