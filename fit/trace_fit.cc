@@ -243,10 +243,11 @@ bool TraceFitOptions::Check(std::string* why) const {
     return fail("max_amplitude_deg must be in (min_amplitude_deg, 90]");
   if (!(min_periods >= 2.0)) return fail("min_periods must be >= 2");
   if (!(refine_rms_over_noise > 1.0)) return fail("refine_rms_over_noise must be > 1");
-  if (!(filar_length_std_m >= 0.0) || !(filar_separation_std_m >= 0.0) || !(mass_std_kg >= 0.0) ||
-      !(gravity_std_mps2 >= 0.0) || !std::isfinite(filar_length_std_m + filar_separation_std_m +
-                                                   mass_std_kg + gravity_std_mps2))
-    return fail("geometry uncertainties must be finite and >= 0");
+  for (double std_input : {filar_length_std_m, filar_separation_std_m, mass_std_kg,
+                           gravity_std_mps2, gyro_scale_std}) {
+    if (!(std_input >= 0.0) || !std::isfinite(std_input))
+      return fail("budget uncertainties (geometry, gyro scale) must be finite and >= 0");
+  }
   return true;
 }
 
@@ -454,6 +455,7 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
       {"gravity", options.gravity_std_mps2, &RigGeometry::gravity_mps2}};
   bool any_budget = false;
   for (const Input& in : budget_inputs) any_budget = any_budget || in.std_input > 0.0;
+  any_budget = any_budget || options.gyro_scale_std > 0.0;
   if (any_budget) {
     Eigen::Matrix<double, Eigen::Dynamic, kNumTraceParams, Eigen::RowMajor> jac(n, kNumTraceParams);
     std::vector<double> rtmp(n);
@@ -486,6 +488,20 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
         } else {
           result.flags.push_back(std::string("budget_failed_") + in.name);
         }
+        sum_sq += c.contribution_kg_m2 * c.contribution_kg_m2;
+        result.budget.push_back(c);
+      }
+      if (options.gyro_scale_std > 0.0) {
+        // A gyro reading (1 + e) psi' + b: to first order the data move by e psi'(t_k), the
+        // fitted rate, so dp/de = +(J^T J)^{-1} J^T psi' (data, not model, moved). Exact, no refit.
+        Eigen::VectorXd dr(n);
+        for (size_t k = 0; k < n; ++k) dr(k) = traj.rate_rad_per_s[k];
+        const Eigen::VectorXd dp = qr.solve(dr);
+        UncertaintyContribution c;
+        c.name = "gyro_scale";
+        c.std_input = options.gyro_scale_std;
+        c.d_inertia = scale * dp(kTraceInertia);
+        c.contribution_kg_m2 = std::abs(c.d_inertia) * options.gyro_scale_std;
         sum_sq += c.contribution_kg_m2 * c.contribution_kg_m2;
         result.budget.push_back(c);
       }

@@ -59,6 +59,10 @@ struct TraceFitOptions {
   double filar_separation_std_m = 0.0;
   double mass_std_kg = 0.0;
   double gravity_std_mps2 = 0.0;
+  // 1-sigma gyro scale-factor uncertainty (fraction, e.g. 0.005 = 0.5 %); >= 0. I comes from the
+  // frequency, but the amplitude read from the rate sets the nonlinear period correction, so a
+  // scale error e moves I by about -A^2 e / 4 at amplitude A (rad).
+  double gyro_scale_std = 0.0;
 
   // Keep the fitted and residual series in the result (needed by the figure); costs 2N doubles.
   bool keep_series = true;

@@ -520,3 +520,37 @@ TEST(TraceGuess, SampleNoiseOfPureNoiseIsItsSigma) {
 
 }  // namespace
 }  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+TEST(TraceFit, GyroScaleBudgetPredictsTheShiftOfAScaledGyro) {
+  // A gyro reading (1 + e) times the true rate moves the fitted amplitude by e and so the
+  // amplitude correction of the period: I shifts by about -A^2 e / 4. The budget's dI/de must
+  // predict the actual shift of a refit on the scaled data (first order: to a few percent).
+  constexpr double kScaleError = 0.01;
+  const TraceFitInput in = Make(Truth(30.0, 51));
+  TraceFitOptions options;
+  options.gyro_scale_std = kScaleError;
+  const TraceFitResult base = FitTrace(in, options);
+  ASSERT_EQ(base.status, TraceFitStatus::kOk) << base.BriefReport();
+  ASSERT_EQ(base.budget.size(), 1u);
+  EXPECT_EQ(base.budget[0].name, "gyro_scale");
+
+  TraceFitInput scaled = in;
+  for (double& w : scaled.rate_rad_per_s) w *= 1.0 + kScaleError;
+  scaled.noise_rad_per_s *= 1.0 + kScaleError;
+  const TraceFitResult moved = FitTrace(scaled, options);
+  ASSERT_EQ(moved.status, TraceFitStatus::kOk) << moved.BriefReport();
+  const double actual = moved.params.inertia_kg_m2 - base.params.inertia_kg_m2;
+  const double predicted = base.budget[0].d_inertia * kScaleError;
+  EXPECT_NEAR(predicted, actual, 0.05 * std::abs(actual));
+  // Order of magnitude from the small-amplitude expansion, -A^2 e / 4 (A in rad).
+  const double a = 30.0 * kRadPerDeg;
+  const double rough = -a * a * kScaleError / 4.0 * base.params.inertia_kg_m2;
+  EXPECT_NEAR(actual, rough, 0.5 * std::abs(rough));
+  EXPECT_NEAR(base.budget[0].contribution_kg_m2, std::abs(predicted), 1e-15);
+}
+
+}  // namespace
+}  // namespace bifilar
