@@ -634,8 +634,7 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   });
   result.summary.n_fitted = n_fit;
 
-  // 4. The rig: mean of the tare logs (std of the mean between logs, or the fit's own std
-  //    when there is only one), or the configured value / table.
+  // 4. The rig: mean of the tare logs, or the configured value / table.
   std::vector<double> tare_values, tare_stds;
   for (TraceRecord& r : result.traces) {
     if (r.role != TraceRole::kTare || !r.ok()) continue;
@@ -647,8 +646,15 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   double tare_mean = NAN, tare_std = NAN;
   if (!tare_values.empty()) {
     tare_mean = Mean(tare_values);
-    tare_std = tare_values.size() >= 2 ? SampleStd(tare_values) / std::sqrt(tare_values.size())
-                                       : tare_stds[0];
+    // The larger of the between-log standard error and the fits' own (rms std / sqrt(n)): three
+    // logs that happen to agree closely must not claim more than their fits can.
+    double fit_var = 0.0;
+    for (double v : tare_stds) fit_var += v * v / tare_stds.size();
+    const double n_tare = static_cast<double>(tare_values.size());
+    const double fit_sem = std::sqrt(fit_var / n_tare);
+    tare_std = tare_values.size() >= 2
+                   ? std::max(SampleStd(tare_values) / std::sqrt(n_tare), fit_sem)
+                   : fit_sem;
   }
   result.rig_tare_n = static_cast<int>(tare_values.size());
   if (config.rig_inertia.kind == RigInertiaSpec::Kind::kTare) {

@@ -286,7 +286,8 @@ TEST(Campaign, RigHeavierThanTotalIsAClearErrorRow) {
 
 TEST(Campaign, TareLogsGiveTheRigInertia) {
   FakeCampaign c("{tare: {logs: \"logs/tare/*.csv\"}}");
-  // Two tare logs at 0.5 +- 0.002: mean 0.5, std of the mean 0.002 sqrt(2) / sqrt(2) = 0.002.
+  // Two tare logs at 0.5 +- 0.002: mean 0.5, std of the mean 0.002 sqrt(2) / sqrt(2) = 0.002
+  // (above the fits' own 1e-4 / sqrt(2)).
   WriteFile(c.dir + "/logs/tare/tare_1.csv", "I=0.502\n");
   WriteFile(c.dir + "/logs/tare/tare_2.csv", "I=0.498\n");
   // The tare folder also matches the aircraft pattern? No: "tare" has no pitch_ prefix.
