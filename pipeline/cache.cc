@@ -75,6 +75,7 @@ std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
   Put(out, "m_rig_std", config.uncertainties.mass_std_kg);
   if (role == TraceRole::kAircraft) Put(out, "m_aircraft_std", config.aircraft_mass_std_kg);
   Put(out, "g_std", config.uncertainties.gravity_std_mps2);
+  Put(out, "gyro_scale_std", config.imu.gyro_scale_std);
   out << "model=" << ToString(config.fit.model) << ';';
   if (window_s) {
     Put(out, "t0", (*window_s)[0]);

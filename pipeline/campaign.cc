@@ -804,7 +804,7 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     out << line;
     if (std::isfinite(result.systematic_relative_std) && result.systematic_relative_std > 0) {
       std::snprintf(line, sizeof(line),
-                    "  (+- %.2f %% systematic, common to all moments, from rig.uncertainties)\n",
+                    "  (+- %.2f %% systematic, common to all moments, from the configured uncertainties)\n",
                     100.0 * result.systematic_relative_std);
       out << line;
     }

@@ -63,7 +63,8 @@ struct CampaignResult {
   nlohmann::json ellipse;           // pipeline/ellipse_json.h document, null when not fitted
   std::string moments_figure;       // Fig. 3 file name in OUT/figures/, "" when none
   std::string polar_figure;         // Fig. 4 file name in OUT/figures/, "" when none
-  // Systematic relative uncertainty from rig.uncertainties (L, D, masses, g): the mean over ok
+  // Systematic relative uncertainty from the configured uncertainties (L, D, masses, g, gyro
+  // scale): the mean over ok
   // aircraft traces of budget total / inertia total. It scales every moment alike, so it is not
   // in the ellipse's std; reported beside it. NaN when no budget.
   double systematic_relative_std = NAN;

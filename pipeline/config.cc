@@ -81,6 +81,7 @@ void ReadImu(YamlMap imu, ImuConfig* out) {
   {
     YamlMap gyro = Sub(imu, "gyro");
     if (gyro.Has("columns")) format.gyro_columns = ThreeColumns(gyro, "columns");
+    out->gyro_scale_std = NonNegative(gyro, "scale_std", 0.0);
     const std::string unit = gyro.OptionalString("unit", ToString(format.gyro_unit));
     if (!ParseRateUnit(unit, &format.gyro_unit)) {
       throw UserError(gyro.Where(gyro.Optional("unit")) + ": '" + gyro.KeyPath("unit") +

@@ -47,6 +47,7 @@ struct RigUncertainties {
 // The CSV layout of the logs and how the IMU sits on the aircraft.
 struct ImuConfig {
   ImuFormat format;                      // columns and units
+  double gyro_scale_std = 0.0;           // 1-sigma gyro scale-factor uncertainty (fraction); >= 0
   bool swing_axis_auto = true;           // `swing_axis: auto`
   Eigen::Vector3d swing_axis_in_imu = Eigen::Vector3d::UnitZ();  // fixed axis (unit) otherwise
   // Rotation taking IMU-frame vectors to body axes (x fwd, y right, z down); default identity.

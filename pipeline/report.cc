@@ -212,7 +212,7 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
     h << "</table>\n";
     const double systematic = Num(results, "systematic_relative_std");
     h << "<p>Uncertainties above are statistical (scatter between trials and angles). "
-      << "The configured uncertainties of L, D, the masses and g add a systematic &plusmn;"
+      << "The configured uncertainties of L, D, the masses, g and the gyro scale add a systematic &plusmn;"
       << Fmt(100.0 * systematic, "%.2f")
       << " % that scales every moment alike and leaves &tau; unchanged (mean per-trace uncertainty budget).</p>\n";
     if (ellipse.contains("warnings")) {

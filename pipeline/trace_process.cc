@@ -255,6 +255,7 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
                                 : std::hypot(config.uncertainties.mass_std_kg,
                                              config.aircraft_mass_std_kg);
   fit_options.gravity_std_mps2 = config.uncertainties.gravity_std_mps2;
+  fit_options.gyro_scale_std = config.imu.gyro_scale_std;
   fit_options.keep_series = !options.figure_paths.empty();
   const TraceFitResult fit = FitTrace(input, fit_options);
 

@@ -51,6 +51,7 @@ TEST(Cache, KeyHasEveryFitInputAndNothingElse) {
   EXPECT_TRUE(changed([](CampaignConfig* c) { c->fit.quality.max_rms_over_noise = 2.0; }));
   EXPECT_TRUE(changed([](CampaignConfig* c) { c->imu.format.gyro_unit = RateUnit::kDegPerS; }));
   EXPECT_TRUE(changed([](CampaignConfig* c) { c->imu.swing_axis_auto = false; }));
+  EXPECT_TRUE(changed([](CampaignConfig* c) { c->imu.gyro_scale_std = 0.005; }));
   EXPECT_TRUE(changed([](CampaignConfig* c) { c->imu.imu_to_body(0, 0) = -1.0; }));
   // Not fit inputs: the rig inertia, pitch source, ellipse, units.
   EXPECT_FALSE(changed([](CampaignConfig* c) { c->rig_inertia.inertia_kg_m2 = 0.3; }));

@@ -58,7 +58,7 @@ aircraft:
   mass_std_kg: 0.02
 imu:
   time: {column: time_ms, unit: ms}
-  gyro: {columns: [wx, wy, wz], unit: deg/s}
+  gyro: {columns: [wx, wy, wz], unit: deg/s, scale_std: 0.01}
   accel: {columns: [fx, fy, fz], unit: g}
   swing_axis: [0, 0, 2]
   imu_to_body: {euler_deg: [0, 0, 90]}
@@ -106,6 +106,7 @@ TEST(Config, ReadsEveryKey) {
   EXPECT_EQ(c.imu.format.time_unit, TimeUnit::kMilliseconds);
   EXPECT_EQ(c.imu.format.gyro_columns[1], "wy");
   EXPECT_EQ(c.imu.format.gyro_unit, RateUnit::kDegPerS);
+  EXPECT_DOUBLE_EQ(c.imu.gyro_scale_std, 0.01);
   EXPECT_EQ(c.imu.format.accel_unit, AccelUnit::kStandardGravity);
   EXPECT_FALSE(c.imu.swing_axis_auto);
   EXPECT_NEAR(c.imu.swing_axis_in_imu.z(), 1.0, 1e-15);  // normalised
