@@ -1,5 +1,6 @@
 #include "pipeline/imu_log.h"
 
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <fast_float/fast_float.h>
 
 #include "pipeline/user_error.h"
+#include "pipeline/gzip.h"
 
 namespace bifilar {
 namespace {
@@ -363,6 +365,11 @@ std::string ReadWholeFile(const std::string& path) {
   const int err = errno;
   std::fclose(f);
   if (failed) Fail(path + ": cannot read the log: " + std::strerror(err));
+  if (LooksGzipped(text)) {  // a .csv.gz log: inflate it in memory
+    std::string inflated, why;
+    if (!GzipDecompress(text, &inflated, &why)) Fail(path + ": " + why);
+    return inflated;
+  }
   return text;
 }
 

@@ -1,5 +1,6 @@
 #include "pipeline/imu_log_writer.h"
 
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <unistd.h>
 
 #include "pipeline/user_error.h"
+#include "pipeline/gzip.h"
 
 namespace bifilar {
 namespace {
@@ -110,7 +112,9 @@ void WriteFileAtomically(const std::string& path, const std::string& text) {
 
 void WriteImuLog(const std::string& path, const ImuData& data, const ImuFormat& format,
                  const ImuLogWriteOptions& options) {
-  WriteFileAtomically(path, FormatImuLog(data, format, options));
+  const std::string text = FormatImuLog(data, format, options);
+  const bool gzip = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;
+  WriteFileAtomically(path, gzip ? GzipCompress(text) : text);
 }
 
 }  // namespace bifilar

@@ -34,6 +34,7 @@ std::string FormatImuLog(const ImuData& data, const ImuFormat& format,
 void WriteFileAtomically(const std::string& path, const std::string& text);
 
 // FormatImuLog + WriteFileAtomically.
+// A path ending in ".gz" is written gzip-compressed (pipeline/gzip.h); the reader inflates it.
 void WriteImuLog(const std::string& path, const ImuData& data, const ImuFormat& format,
                  const ImuLogWriteOptions& options = ImuLogWriteOptions());
 

@@ -148,6 +148,7 @@ void ReadFormat(YamlMap map, SimulateSpec* spec) {
   }
   spec->write.significant_digits =
       static_cast<int>(ReadValue(map, "significant_digits", 9, 6, false, 17));
+  spec->gzip = map.OptionalBool("gzip", false);
   map.Finish();
   std::string why;
   if (!f.Check(&why)) throw UserError(map.Where(YAML::Node()) + ": format: " + why);
@@ -454,7 +455,8 @@ nlohmann::json OptionsJson(const SimulateSpec& spec) {
                                        : nlohmann::json::array()},
                  {"accel_unit", ToString(f.accel_unit)},
                  {"delimiter", std::string(1, f.delimiter)},
-                 {"significant_digits", spec.write.significant_digits}};
+                 {"significant_digits", spec.write.significant_digits},
+                 {"gzip", spec.gzip}};
   return j;
 }
 
@@ -600,6 +602,9 @@ SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::stri
   std::string why;
   if (!SimulateCampaign(spec.campaign, spec.options, spec.seed, &traces, &why)) {
     throw UserError((spec.file.empty() ? std::string("simulate") : spec.file) + ": " + why);
+  }
+  if (spec.gzip) {
+    for (auto& ct : traces) ct.relative_path += ".gz";
   }
   const std::string truth = CampaignTruthJson(spec, traces);
   SimulateRunSummary summary;

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "pendulum/simulate.h"
+#include "pipeline/gzip.h"
 #include "pipeline/imu_log_writer.h"
 #include "pipeline/user_error.h"
 
@@ -281,6 +282,34 @@ TEST_F(ImuLogFiles, UnreadableFile) {
     std::filesystem::permissions(locked, std::filesystem::perms::none);
     EXPECT_TRUE(Contains(ErrorOfFile(locked), "cannot open the log"));
   }
+}
+
+// A .csv.gz log reads exactly like its plain twin; the writer compresses deterministically; a
+// truncated gzip file is an error naming the file, never a silently short log.
+TEST_F(ImuLogFiles, GzipLogsReadLikePlainOnes) {
+  const std::string text = kHeader + Rows(200);
+  const std::string plain = Write("plain.csv", text);
+  const std::string gz = Write("packed.csv.gz", GzipCompress(text));
+  EXPECT_EQ(GzipCompress(text), GzipCompress(text));  // same text, same bytes
+  const ImuData a = ReadImuLog(plain, ImuFormat());
+  const ImuData b = ReadImuLog(gz, ImuFormat());
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a.t_s[i], b.t_s[i]);
+    EXPECT_EQ(a.gyro_in_imu[i], b.gyro_in_imu[i]);
+  }
+  // The writer picks gzip from the extension.
+  const std::string written = (dir_ / "written.csv.gz").string();
+  WriteImuLog(written, a, ImuFormat());
+  std::string head(2, '\0');
+  std::ifstream(written, std::ios::binary).read(&head[0], 2);
+  EXPECT_TRUE(LooksGzipped(head));
+  EXPECT_EQ(ReadImuLog(written, ImuFormat()).size(), a.size());
+  // Truncated in the middle of the stream.
+  const std::string packed = GzipCompress(text);
+  const std::string cut = Write("cut.csv.gz", packed.substr(0, packed.size() / 2));
+  const std::string e = ErrorOfFile(cut);
+  EXPECT_TRUE(Contains(e, cut + ": not a valid gzip file")) << e;
 }
 
 // Round trip through the simulator and the CSV writer in non-SI units: the reader must give the
