@@ -86,7 +86,8 @@ bool WriteTraceFitFigure(const TraceFitResult& r, const std::string& path,
     plcol0(kBlack);
     plbox("bcst", 0, 0, "bcnstv", 0, 0);
     plmtex("l", 4.2, 0.5, 0.5, "swing rate (deg/s)");
-    plschr(0, 1.1);
+    // Long file names: shrink the title to fit (about 75 characters fit at full size).
+    plschr(0, 1.1 * std::min(1.0, 75.0 / static_cast<double>(title.size())));
     plmtex("t", 2.6, 0.5, 0.5, title.c_str());
     plschr(0, 0.85);
     plmtex("t", 1.0, 0.5, 0.5, subtitle.c_str());

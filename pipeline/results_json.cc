@@ -81,6 +81,7 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
   j["viscous_coeff_kg_m2_per_s"] = Number(r.viscous_coeff_kg_m2_per_s);
   j["window_s"] = Pair(r.window_s);
   j["amplitude_deg"] = Pair(r.amplitude_deg);
+  j["amplitude_band_deg"] = Pair(r.amplitude_band_deg);
   j["bias_rad_per_s"] = Number(r.bias_rad_per_s);
   j["residual_rms_rad_per_s"] = Number(r.residual_rms_rad_per_s);
   j["noise_rms_rad_per_s"] = Number(r.noise_rms_rad_per_s);
@@ -122,6 +123,7 @@ TraceRecord TraceRecordFromJson(const json& j) {
   r.viscous_coeff_kg_m2_per_s = GetNumber(j, "viscous_coeff_kg_m2_per_s");
   r.window_s = GetPair(j, "window_s");
   r.amplitude_deg = GetPair(j, "amplitude_deg");
+  r.amplitude_band_deg = GetPair(j, "amplitude_band_deg");
   r.bias_rad_per_s = GetNumber(j, "bias_rad_per_s");
   r.residual_rms_rad_per_s = GetNumber(j, "residual_rms_rad_per_s");
   r.noise_rms_rad_per_s = GetNumber(j, "noise_rms_rad_per_s");

@@ -218,6 +218,7 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
   band_options.max_amplitude_deg = config.fit.max_amplitude_deg.value_or(kDefaultMaxAmplitudeDeg);
   band_options.min_amplitude_deg = config.fit.min_amplitude_deg.value_or(0.0);
   band_options.min_periods = config.fit.quality.min_periods;
+  record.amplitude_band_deg = {band_options.min_amplitude_deg, band_options.max_amplitude_deg};
   const AmplitudeBand band =
       TrimToAmplitudeBand(data.t_s, axis.rate_rad_per_s, window, band_options, name);
   record.window_s = {window.t0_s, window.t1_s};
