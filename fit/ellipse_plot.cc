@@ -13,16 +13,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegToRad = kPi / 180.0;
 
-// Colour map 0 entries set per figure (figure.h sets 0 = white background, 1 = black).
-enum Colour { kBlack = 1, kBlue = 2, kRed = 3, kGrey = 4, kGreen = 5, kLight = 6 };
-
-void SetColours() {
-  plscol0(kBlue, 31, 90, 180);
-  plscol0(kRed, 200, 30, 30);
-  plscol0(kGrey, 120, 120, 120);
-  plscol0(kGreen, 20, 140, 60);
-  plscol0(kLight, 215, 215, 215);
-}
+enum Colour {
+  kBlack = kFigureBlack, kBlue = kFigureBlue, kRed = kFigureRed, kGrey = kFigureGrey,
+  kGreen = kFigureGreen, kLight = kFigureLight
+};
 
 std::string Fmt(const char* format, double v) {
   char buf[64];
@@ -85,7 +79,6 @@ bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
   x_hi += 5;
 
   auto draw = [&] {
-    SetColours();
     plschr(0, 1.1);
     plcol0(kBlack);
     pladv(0);
@@ -259,7 +252,6 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
   };
 
   auto draw = [&] {
-    SetColours();
     plschr(0, 0.95);
     pladv(0);
     panel(false, 0.1, 0.48);

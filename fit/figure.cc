@@ -44,6 +44,12 @@ bool WriteFigure(const std::string& path, const FigureOptions& options,
     plscol0(1, 0, 0, 0);
     plinit();
     plfontld(1);
+    plscol0(kFigureBlue, 31, 90, 180);
+    plscol0(kFigureRed, 200, 30, 30);
+    plscol0(kFigureGrey, 135, 135, 135);
+    plscol0(kFigureGreen, 20, 140, 60);
+    plscol0(kFigureLight, 220, 220, 220);
+    plscol0(kFigureBand, 120, 160, 220);
     draw();
     plend1();
   }

@@ -12,6 +12,18 @@ struct FigureOptions {
   int height_px = 600;  // page height (px); > 0
 };
 
+// Colour map 0 indices every figure may use: WriteFigure installs this palette after plinit
+// (background white, foreground black).
+enum FigureColour {
+  kFigureBlack = 1,
+  kFigureBlue = 2,   // fits, curves
+  kFigureRed = 3,    // principal axes, warnings
+  kFigureGrey = 4,   // measured data
+  kFigureGreen = 5,  // body-axis markers
+  kFigureLight = 6,  // grid lines
+  kFigureBand = 7,   // noise bands
+};
+
 // Draws `draw` (PLplot C API calls: plenv, plline, ... between plinit and plend) into `path`.
 // The device follows the extension: ".png" -> pngcairo, ".svg" -> svgcairo. The file is written
 // to a temporary name and renamed. Returns false with *why set on failure.

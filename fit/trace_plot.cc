@@ -12,15 +12,10 @@
 namespace bifilar {
 namespace {
 
-enum Colour { kBlack = 1, kBlue = 2, kRed = 3, kGrey = 4, kLight = 5, kBand = 6 };
-
-void SetColours() {
-  plscol0(kBlue, 31, 90, 180);
-  plscol0(kRed, 200, 30, 30);
-  plscol0(kGrey, 150, 150, 150);
-  plscol0(kLight, 225, 225, 225);
-  plscol0(kBand, 120, 160, 220);
-}
+enum Colour {
+  kBlack = kFigureBlack, kBlue = kFigureBlue, kRed = kFigureRed, kGrey = kFigureGrey,
+  kLight = kFigureLight, kBand = kFigureBand
+};
 
 std::string Fmt(const char* format, double v) {
   char buf[64];
@@ -75,7 +70,6 @@ bool WriteTraceFitFigure(const TraceFitResult& r, const std::string& path,
       "),  #gr#d1#u = " + Fmt("%.3f", r.residual_autocorr_lag1);
 
   auto draw = [&] {
-    SetColours();
     pladv(0);
     plschr(0, 0.95);
     // Top panel: rates.
