@@ -29,7 +29,14 @@ std::string FigureStem(const std::string& log) {
 
 std::string HumanLine(const TraceRecord& r) {
   char buffer[512];
-  if (r.status == TraceStatus::kError) return r.file + ": error: " + r.message;
+  // Messages name the file already; say it once at the start of the line.
+  const std::string prefix = r.file + ": ";
+  const std::string message =
+      r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message;
+  // No fit to show (an error, or rejected before fitting): status and reason only, never NaN.
+  if (r.status == TraceStatus::kError || !std::isfinite(r.inertia_total_kg_m2)) {
+    return prefix + ToString(r.status) + ": " + message;
+  }
   std::snprintf(buffer, sizeof(buffer),
                 "%s: %s  I = %.6f +- %.2g kg m^2 (budget +- %.2g)  K_D %.3g  C %.3g  "
                 "window [%.2f, %.2f] s  amplitude %.1f -> %.1f deg  rms/noise %.2f  %d it  %.0f ms",
@@ -43,7 +50,7 @@ std::string HumanLine(const TraceRecord& r) {
     std::snprintf(buffer, sizeof(buffer), "  pitch %.2f deg", *r.pitch_measured_deg);
     line += buffer;
   }
-  if (!r.message.empty()) line += "  (" + r.message + ")";
+  if (!message.empty()) line += "  (" + message + ")";
   return line;
 }
 
