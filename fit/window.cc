@@ -644,7 +644,10 @@ AmplitudeBand TrimToAmplitudeBand(const std::vector<double>& t, const std::vecto
     band.message = Prefix(name) +
                    Fmt("amplitude from %.2f to %.2f deg never inside the band [%g, %g] deg",
                        ex.front().amplitude_deg, ex.back().amplitude_deg, o.min_amplitude_deg,
-                       o.max_amplitude_deg);
+                       o.max_amplitude_deg) +
+                   (ex.back().amplitude_deg > o.max_amplitude_deg
+                        ? " (twist less, log longer, or widen fit.max_amplitude_deg)"
+                        : " (twist more, or lower fit.min_amplitude_deg)");
     return band;
   }
   const size_t last = end - 1;
