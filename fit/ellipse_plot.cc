@@ -18,6 +18,16 @@ enum Colour {
   kGreen = kFigureGreen, kLight = kFigureLight
 };
 
+// The fitted curve: blue, thick, dashed.
+void DrawFittedCurve(const std::vector<double>& x, const std::vector<double>& y) {
+  plcol0(kBlue);
+  plwidth(2.0);
+  pllsty(2);
+  plline(static_cast<PLINT>(x.size()), x.data(), y.data());
+  pllsty(1);
+  plwidth(1.0);
+}
+
 std::string Fmt(const char* format, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, v);
@@ -110,12 +120,7 @@ bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
     }
     pllsty(1);
     // Fitted curve.
-    plcol0(kBlue);
-    plwidth(2.0);
-    pllsty(2);
-    plline(static_cast<PLINT>(cx.size()), cx.data(), cy.data());
-    pllsty(1);
-    plwidth(1.0);
+    DrawFittedCurve(cx, cy);
     // Error bars and trials.
     plcol0(kGrey);
     if (!ex.empty()) plerry(static_cast<PLINT>(ex.size()), ex.data(), elo.data(), ehi.data());
@@ -239,12 +244,7 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
       plptex(0.9 * lim * zy, -0.9 * lim * zx + 0.04 * lim, 1, 0, 0, "x#dp#u");
     }
     // Curve and data.
-    plcol0(kBlue);
-    plwidth(2.0);
-    pllsty(2);
-    plline(static_cast<PLINT>(cx.size()), cx.data(), cy.data());
-    pllsty(1);
-    plwidth(1.0);
+    DrawFittedCurve(cx, cy);
     plcol0(kBlack);
     plssym(0, 0.8);
     plpoin(static_cast<PLINT>(px.size()), px.data(), py.data(), 4);
