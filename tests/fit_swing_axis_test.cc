@@ -189,6 +189,18 @@ TEST(SwingAxis, SecondaryMotionRatio) {
   EXPECT_DOUBLE_EQ(SecondaryMotionRatio(still, n, 2.0, 25.0), 0.0);
 }
 
+// The rig of the simulated-log tests: L = 2 m, D = 0.7 m, 10 kg, 0.8 kg m^2, light damping.
+TraceSetup SimulatedRig() {
+  TraceSetup setup;
+  setup.geometry.filar_length_m = 2.0;
+  setup.geometry.filar_separation_m = 0.7;
+  setup.geometry.mass_kg = 10.0;
+  setup.params.inertia_kg_m2 = 0.8;
+  setup.params.drag_coeff_kg_m2 = 0.005;
+  setup.params.viscous_coeff_kg_m2_per_s = 0.001;
+  return setup;
+}
+
 // Simulated logs: tilted IMU at many pitches; the axis against the simulator's truth, the pitch
 // against the true pitch. Accelerometer bias is what limits the pitch: with the simulator's
 // default 0.05 m/s^2 per axis it tilts the down vector by up to ~0.5 deg, so the 0.1 deg check
@@ -199,13 +211,7 @@ TEST(SwingAxis, SimulatedLogs) {
     options.timeline.free_s = {15.0, 20.0};
     if (!accel_bias) options.sensor.accel_bias_sigma_mps2 = 0.0;
     for (int i = 0; i < 8; ++i) {
-      TraceSetup setup;
-      setup.geometry.filar_length_m = 2.0;
-      setup.geometry.filar_separation_m = 0.7;
-      setup.geometry.mass_kg = 10.0;
-      setup.params.inertia_kg_m2 = 0.8;
-      setup.params.drag_coeff_kg_m2 = 0.005;
-      setup.params.viscous_coeff_kg_m2_per_s = 0.001;
+      TraceSetup setup = SimulatedRig();
       setup.pitch_rad = (-75.0 + 21.0 * i) * kDeg;
       setup.amplitude_rad = (8.0 + 3.0 * i) * kDeg;
       setup.body_from_imu = MountingFromRollPitchYawDeg(3.0 - i, 2.0 * i - 7.0, 45.0 * i);
@@ -248,13 +254,7 @@ TEST(SwingAxis, NoRestPitchFromTurningPoints) {
   options.timeline.free_s = {30.0, 30.0};
   options.sensor.accel_bias_sigma_mps2 = 0.0;
   for (int i = 0; i < 4; ++i) {
-    TraceSetup setup;
-    setup.geometry.filar_length_m = 2.0;
-    setup.geometry.filar_separation_m = 0.7;
-    setup.geometry.mass_kg = 10.0;
-    setup.params.inertia_kg_m2 = 0.8;
-    setup.params.drag_coeff_kg_m2 = 0.005;
-    setup.params.viscous_coeff_kg_m2_per_s = 0.001;
+    TraceSetup setup = SimulatedRig();
     setup.pitch_rad = (-40.0 + 25.0 * i) * kDeg;
     setup.amplitude_rad = 30.0 * kDeg;
     setup.body_from_imu = MountingFromRollPitchYawDeg(2.0, -4.0, 60.0 * i);
