@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <algorithm>
 #include <filesystem>
 #include <string_view>
 #include <system_error>
@@ -109,6 +110,12 @@ class LineReader {
   size_t pos_ = 0;
   int line_number_ = 0;
 };
+
+std::string FormatNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
 
 [[noreturn]] void Fail(const std::string& message) { throw UserError(message); }
 
@@ -247,19 +254,29 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
   int max_column = 0;
   for (int c : column) max_column = std::max(max_column, c);
 
-  // Rows. A bad row is remembered; if a good row follows, it is an error, otherwise it and the
-  // rows after it are trailing junk and are skipped with a warning.
+  // Rows. The time series ends at a break that is not followed by a row continuing it (a later
+  // time): real loggers append footers (a blank line, then summary rows with text, or whose time
+  // is numeric again but jumps back). A blank line followed by a non-numeric row always ends it.
+  // A non-numeric row followed by a row that continues the time series is corruption inside the
+  // data: an error.
   std::vector<double> values;  // row-major, `needed` per row, SI
   std::vector<int> row_line;
   values.reserve(text.size() / 8);
   row_line.reserve(text.size() / 48);
   std::string first_bad;
-  int bad_rows = 0, first_bad_line = 0;
+  int bad_rows = 0, first_bad_line = 0, first_blank_line = 0, lines_after_end = 0;
+  int end_line = 0;  // line of the break that ended the time series (0: the file's end)
+  std::string end_reason;
   double row[7];
   while (reader.Next(&line)) {
-    if (IsBlank(line)) continue;
+    if (IsBlank(line)) {
+      if (first_blank_line == 0 && !row_line.empty()) first_blank_line = reader.line_number();
+      continue;
+    }
     Split(line, format.delimiter, &fields);
     std::string bad;
+    bool non_finite = false;
+    std::string non_finite_message;
     if (static_cast<int>(fields.size()) <= max_column) {
       int k = 0;
       while (column[k] < static_cast<int>(fields.size())) ++k;
@@ -275,10 +292,12 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
                 Printable(Trim(cell)) + "', which is not a number";
           break;
         }
-        if (!std::isfinite(row[k])) {
-          Fail(name + ":" + std::to_string(reader.line_number()) + ":" +
-               std::to_string(column[k] + 1) + ": column '" + names[k] + "' holds '" +
-               Printable(Trim(cell)) + "'; NaN and infinite values are not allowed");
+        if (!std::isfinite(row[k]) && !non_finite) {
+          non_finite = true;
+          non_finite_message = name + ":" + std::to_string(reader.line_number()) + ":" +
+                               std::to_string(column[k] + 1) + ": column '" + names[k] +
+                               "' holds '" + Printable(Trim(cell)) +
+                               "'; NaN and infinite values are not allowed";
         }
       }
     }
@@ -288,9 +307,35 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
         first_bad_line = reader.line_number();
       }
       ++bad_rows;
+      if (first_blank_line > 0 && first_blank_line < first_bad_line) {
+        // A blank line, then a non-numeric row: a footer. The time series ended at the blank.
+        end_line = first_blank_line;
+        end_reason = "a blank line, then a non-numeric row";
+        lines_after_end = bad_rows;
+        while (reader.Next(&line)) lines_after_end += IsBlank(line) ? 0 : 1;
+        break;
+      }
       continue;
     }
-    if (bad_rows > 0) Fail(first_bad);  // a bad cell with good data after it
+    // A numeric row after a break: does it continue the time series?
+    const bool after_break = bad_rows > 0 || first_blank_line > 0;
+    const bool continues = row_line.empty() || row[kTime] * scale[kTime] >
+                                                   values[(row_line.size() - 1) * needed + kTime];
+    if (after_break && !continues) {
+      end_line = bad_rows > 0 && (first_blank_line == 0 || first_bad_line < first_blank_line)
+                     ? first_bad_line
+                     : first_blank_line;
+      end_reason = end_line == first_bad_line && bad_rows > 0
+                       ? "a non-numeric row, then rows whose time does not continue it"
+                       : "a blank line, then rows whose time does not continue it";
+      lines_after_end = 1;
+      while (reader.Next(&line)) lines_after_end += IsBlank(line) ? 0 : 1;
+      lines_after_end += bad_rows;
+      break;
+    }
+    if (bad_rows > 0) Fail(first_bad);  // a bad cell with the time series going on after it
+    if (non_finite) Fail(non_finite_message);
+    first_blank_line = 0;
     for (int k = 0; k < needed; ++k) values.push_back(row[k] * scale[k]);
     row_line.push_back(reader.line_number());
   }
@@ -299,7 +344,12 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
     if (bad_rows > 0) Fail(first_bad);
     Fail(name + ":" + std::to_string(header_line) + ": header only, no data rows");
   }
-  if (bad_rows > 0) {
+  if (end_line > 0) {
+    data.warnings.push_back("the time series ends at line " + std::to_string(end_line) + " (" +
+                            end_reason + "); " +
+                            std::to_string(lines_after_end) +
+                            " row(s) after it (a footer?) are ignored");
+  } else if (bad_rows > 0) {
     data.warnings.push_back("skipped " + std::to_string(bad_rows) +
                             " trailing non-numeric row(s) from line " +
                             std::to_string(first_bad_line) + " (" + first_bad + ")");
@@ -308,6 +358,12 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
   // Timestamps must increase. A sample whose time does not exceed the last kept one is dropped,
   // unless the last kept one was itself a forward glitch (the new time fits between the two
   // before), in which case the glitch is replaced.
+  // A jump back in time after which no row ever passes the last two kept times ends the time
+  // series (a footer of numeric summary rows, or a second log appended): the rest is ignored
+  // with a warning. (The second-last, so that a forward glitch in the last kept row is repaired
+  // below instead.)
+  std::vector<double> later_max(rows + 1, -HUGE_VAL);  // max time over rows r.. (suffix)
+  for (size_t r = rows; r-- > 0;) later_max[r] = std::max(later_max[r + 1], values[r * needed + kTime]);
   std::vector<size_t> keep;
   keep.reserve(rows);
   size_t dropped = 0;
@@ -317,6 +373,13 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
     if (keep.empty() || t > values[keep.back() * needed + kTime]) {
       keep.push_back(r);
       continue;
+    }
+    if (keep.size() >= 2 && !(later_max[r] > values[keep[keep.size() - 2] * needed + kTime])) {
+      data.warnings.push_back("the time series ends at line " + std::to_string(row_line[r]) +
+                              " (time jumps back from " + FormatNumber(values[keep.back() * needed + kTime] / scale[kTime]) +
+                              " to " + FormatNumber(t / scale[kTime]) + " and never passes it again); " +
+                              std::to_string(rows - r) + " row(s) from there are ignored");
+      break;
     }
     if (dropped++ == 0) first_drop_line = row_line[r];
     if (keep.size() >= 2 && t > values[keep[keep.size() - 2] * needed + kTime]) keep.back() = r;

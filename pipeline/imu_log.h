@@ -7,9 +7,14 @@
 //   - CRLF line ends, a UTF-8 byte-order mark and blank lines are accepted; comment lines
 //     ('#', '%', '//') above the header are skipped with a warning; with delimiter ' ', runs of
 //     spaces separate columns (whitespace-aligned logs);
-//   - trailing rows that are not numbers (a footer, a line cut short when the logger stopped)
-//     are skipped with a warning in ImuData::warnings;
-//   - a non-numeric cell followed by good rows is an error (file:line:column);
+//   - the time series ends at a break that nothing continues: a blank line followed by a
+//     non-numeric row, a blank line or non-numeric row followed by rows whose time jumps back,
+//     or a jump back in time that no later row recovers from (a footer of summary rows, a second
+//     log appended). The rest is ignored with a warning in ImuData::warnings that names the line;
+//   - trailing rows that are not numbers (a line cut short when the logger stopped) are skipped
+//     with a warning;
+//   - a non-numeric cell followed by rows that continue the time series is an error
+//     (file:line:column);
 //   - NaN or inf anywhere is an error;
 //   - timestamps that do not increase (duplicates, a packet out of order, a glitch) are repaired
 //     by dropping the offending sample, with a warning; more than

@@ -211,17 +211,54 @@ TEST(ImuLog, NonIncreasingTimestampsRepairedWithWarning) {
 }
 
 TEST(ImuLog, TooManyNonIncreasingTimestampsRejected) {
-  // A clock reset halfway: half the samples would be dropped.
-  const std::string text = kHeader + Rows(100) + Rows(100);
-  const std::string e = ErrorOf(text);
+  // Packets out of order all through the file: every 50th row repeats the time before it.
+  auto with_duplicates = [](int n, int every) {
+    std::string s = kHeader;
+    char buf[96];
+    for (int k = 0; k < n; ++k) {
+      const double t = (k % every == every - 1) ? 0.01 * (k - 1) : 0.01 * k;
+      std::snprintf(buf, sizeof(buf), "%.4f,0,0,0,0,0,1\n", t);
+      s += buf;
+    }
+    return s;
+  };
+  const std::string e = ErrorOf(with_duplicates(200, 2));
   EXPECT_TRUE(Contains(e, "log.csv: 100 of 200 samples")) << e;
   EXPECT_TRUE(Contains(e, "more than 1 %")) << e;
   // Just above the limit: 2 of 100 dropped.
-  std::string two = kHeader + Rows(98) + "0.5,0,0,0,0,0,1\n0.6,0,0,0,0,0,1\n";
-  EXPECT_TRUE(Contains(ErrorOf(two), "2 of 100"));
+  const std::string two = with_duplicates(100, 50);
+  EXPECT_TRUE(Contains(ErrorOf(two), "2 of 100")) << ErrorOf(two);
   ImuLogOptions lenient;
   lenient.max_dropped_fraction = 0.05;
   EXPECT_EQ(ErrorOf(two, ImuFormat(), lenient), "");
+}
+
+TEST(ImuLog, TimeSeriesEndsAtAFooter) {
+  // Real loggers (the Crazyflie logs) end with a blank line, then summary rows whose time is
+  // numeric again but jumps back, and text in other columns.
+  const std::string footer = "\n,,,,,,\n2.089,0.0,0.011,0.0,0,0,1\n0.0,0,0,0,0,0,1\n";
+  const ImuData d = ReadImuLogFromString(kHeader + Rows(100) + footer, "f.csv", ImuFormat());
+  EXPECT_EQ(d.size(), 100u);
+  ASSERT_EQ(d.warnings.size(), 1u);
+  EXPECT_TRUE(Contains(d.warnings[0], "time series ends at line 102 (a blank line, then a non-numeric row)")) << d.warnings[0];
+  EXPECT_TRUE(Contains(d.warnings[0], "3 row(s) after it")) << d.warnings[0];
+  // A non-numeric row, then numeric rows jumping back.
+  const ImuData n = ReadImuLogFromString(kHeader + Rows(100) + "Flip Data,,,,,,\n0.5,0,0,0,0,0,1\n",
+                                         "n.csv", ImuFormat());
+  EXPECT_EQ(n.size(), 100u);
+  EXPECT_TRUE(Contains(n.warnings.at(0), "(a non-numeric row")) << n.warnings[0];
+  // Time jumping back with no break: a second log appended (a clock reset).
+  const ImuData c = ReadImuLogFromString(kHeader + Rows(100) + Rows(60), "c.csv", ImuFormat());
+  EXPECT_EQ(c.size(), 100u);
+  EXPECT_TRUE(Contains(c.warnings.at(0), "time series ends at line 102 (time jumps back from 0.99 to 0"))
+      << c.warnings[0];
+  EXPECT_TRUE(Contains(c.warnings.at(0), "60 row(s)")) << c.warnings[0];
+  // A NaN in a footer row does not matter: the series ended before it.
+  EXPECT_EQ(ReadImuLogFromString(kHeader + Rows(10) + "\n0,nan,0,0,0,0,1\n", "x.csv", ImuFormat()).size(), 10u);
+  // A blank line inside the data (the series goes on) is still just skipped.
+  const ImuData b = ReadImuLogFromString(kHeader + Rows(3) + "\n0.05,0,0,0,0,0,1\n", "b.csv", ImuFormat());
+  EXPECT_EQ(b.size(), 4u);
+  EXPECT_TRUE(b.warnings.empty());
 }
 
 class ImuLogFiles : public ::testing::Test {
