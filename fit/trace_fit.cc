@@ -5,11 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <tuple>
 
 #include <ceres/ceres.h>
 #include <nlopt.hpp>
 #include <Eigen/Dense>
 
+#include "fit/residual_stats.h"
 #include "fit/trace_cost.h"
 #include "fit/trace_guess.h"
 
@@ -181,24 +183,6 @@ double Cost(const TraceRateCost& cost, const double* p, std::vector<double>* r) 
   return 0.5 * s;
 }
 
-// Autocorrelation of the residuals at lags 1..h (sample index lags).
-std::vector<double> Autocorrelation(const std::vector<double>& r, int h) {
-  const size_t n = r.size();
-  double mean = 0.0;
-  for (double v : r) mean += v;
-  mean /= n;
-  double c0 = 0.0;
-  for (double v : r) c0 += (v - mean) * (v - mean);
-  std::vector<double> rho(h, 0.0);
-  if (!(c0 > 0.0)) return rho;
-  for (int k = 1; k <= h && static_cast<size_t>(k) < n; ++k) {
-    double ck = 0.0;
-    for (size_t i = k; i < n; ++i) ck += (r[i] - mean) * (r[i - k] - mean);
-    rho[k - 1] = ck / c0;
-  }
-  return rho;
-}
-
 TraceFitResult Error(TraceFitResult result, const std::string& message) {
   result.status = TraceFitStatus::kError;
   result.message = message;
@@ -209,6 +193,185 @@ std::string Fmt(const char* format, double v) {
   char buf[64];
   std::snprintf(buf, sizeof(buf), format, v);
   return buf;
+}
+
+
+// Jacobian and residuals of `cost` at p, restricted to the free parameters (those not held).
+bool FreeJacobian(const TraceRateCost& cost, const double* p, const std::vector<int>& free,
+                  Eigen::MatrixXd* jac_free, Eigen::VectorXd* residuals) {
+  const int n = cost.num_residuals();
+  Eigen::Matrix<double, Eigen::Dynamic, kNumTraceParams, Eigen::RowMajor> jac(n, kNumTraceParams);
+  residuals->resize(n);
+  if (!cost.Evaluate(p, residuals->data(), jac.data(), nullptr)) return false;
+  jac_free->resize(n, static_cast<Eigen::Index>(free.size()));
+  for (size_t j = 0; j < free.size(); ++j) jac_free->col(j) = jac.col(free[j]);
+  return true;
+}
+
+// Statistical std of the scaled parameter `free[index]` by the HAC sandwich (residual_stats.h),
+// bandwidth from the residuals' own AR(1) coefficient; also the textbook iid std.
+struct StatStd {
+  bool ok = false;
+  std::vector<double> hac;  // per free parameter (scaled units)
+  std::vector<double> iid;
+  int bandwidth = 0;
+};
+StatStd StatisticalStd(const TraceRateCost& cost, const double* p, const std::vector<int>& free) {
+  StatStd out;
+  Eigen::MatrixXd jac;
+  Eigen::VectorXd r;
+  if (!FreeJacobian(cost, p, free, &jac, &r)) return out;
+  const int n = static_cast<int>(r.size()), np = static_cast<int>(free.size());
+  if (n <= np) return out;
+  const std::vector<double> rv(r.data(), r.data() + n);
+  out.bandwidth = HacBandwidth(Ar1Coefficient(rv), n, n / 4);
+  Eigen::MatrixXd cov;
+  if (!HacCovariance(jac, r, out.bandwidth, &cov)) return out;
+  const Eigen::MatrixXd jtj = jac.transpose() * jac;
+  const Eigen::MatrixXd jtj_inv = jtj.ldlt().solve(Eigen::MatrixXd::Identity(np, np));
+  const double sigma2 = r.squaredNorm() / (n - np);
+  for (int j = 0; j < np; ++j) {
+    out.hac.push_back(std::sqrt(std::max(0.0, cov(j, j))));
+    out.iid.push_back(std::sqrt(std::max(0.0, jtj_inv(j, j) * sigma2)));
+  }
+  out.ok = std::all_of(out.hac.begin(), out.hac.end(), [](double v) { return std::isfinite(v); });
+  return out;
+}
+
+// 95 % quantile of chi^2 with dof degrees of freedom (1..30; Wilson-Hilferty beyond).
+double ChiSquare95(int dof) {
+  static const double kTable[] = {3.841, 5.991, 7.815, 9.488, 11.070, 12.592, 14.067, 15.507,
+                                  16.919, 18.307, 19.675, 21.026, 22.362, 23.685, 24.996};
+  if (dof >= 1 && dof <= 15) return kTable[dof - 1];
+  const double k = std::max(1, dof), z = 1.6449;
+  return k * std::pow(1.0 - 2.0 / (9.0 * k) + z * std::sqrt(2.0 / (9.0 * k)), 3);
+}
+
+// Peak |psi| over the first and the last period of a trajectory sampled at t.
+std::pair<double, double> AmplitudeAtEnds(const std::vector<double>& t, const Trajectory& traj,
+                                          double period_s) {
+  double a0 = 0.0, a1 = 0.0;
+  for (size_t k = 0; k < t.size(); ++k) {
+    const double a = std::abs(traj.angle_rad[k]);
+    if (t[k] <= t.front() + period_s) a0 = std::max(a0, a);
+    if (t[k] >= t.back() - period_s) a1 = std::max(a1, a);
+  }
+  return {a0 * kDegPerRad, a1 * kDegPerRad};
+}
+
+// The amplitude sweep: I refitted in successive equal-cycle bands of the window, starting from
+// the window fit's state at each band's first sample, K_D and C held at the window fit.
+AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptions& options,
+                                 const double* p, double scale, const Trajectory& traj,
+                                 double period_s) {
+  AmplitudeSweep sweep;
+  const double t0 = input.t_s.front(), t1 = input.t_s.back();
+  const double cycles = period_s > 0.0 ? (t1 - t0) / period_s : 0.0;
+  const double min_cycles = options.sweep_min_cycles_per_band;
+  const int bands = std::min(options.sweep_max_bands,
+                             static_cast<int>(std::floor(cycles / min_cycles)));
+  if (bands < 2) {
+    sweep.note = "the window holds " + Fmt("%.1f", cycles) + " cycles; a sweep needs 2 bands of " +
+                 Fmt("%g", options.sweep_min_cycles_per_band) + " cycles";
+    return sweep;
+  }
+  const size_t n = input.t_s.size();
+  const std::vector<int> free = {kTraceInertia, kTraceAngle0, kTraceRate0, kTraceBias};
+  const bool fixed[2] = {true, true};
+  size_t first = 0;
+  for (int j = 0; j < bands; ++j) {
+    const double tb = j + 1 == bands ? HUGE_VAL : t0 + (t1 - t0) * (j + 1) / bands;
+    size_t last = first;
+    while (last < n && input.t_s[last] < tb) ++last;  // band = [first, last)
+    AmplitudeSweepBand band;
+    band.num_samples = static_cast<int>(last - first);
+    if (band.num_samples < 20) {
+      first = last;
+      continue;
+    }
+    const std::vector<double> t(input.t_s.begin() + first, input.t_s.begin() + last);
+    const std::vector<double> rate(input.rate_rad_per_s.begin() + first,
+                                   input.rate_rad_per_s.begin() + last);
+    band.t0_s = t.front();
+    band.t1_s = t.back();
+    band.cycles = (band.t1_s - band.t0_s) / period_s;
+    TraceRateCost cost(&t, &rate, options.model, input.geometry, options.integrator, scale);
+    double q[kNumTraceParams];
+    std::copy(p, p + kNumTraceParams, q);
+    q[kTraceAngle0] = traj.angle_rad[first];
+    q[kTraceRate0] = traj.rate_rad_per_s[first];
+    const SolveOutcome lm = SolveLm(cost, options.max_iterations, fixed, false, q);
+    first = last;
+    if (!lm.ok) {
+      sweep.bands.push_back(band);
+      continue;
+    }
+    const StatStd stat = StatisticalStd(cost, q, free);
+    const auto [a0, a1] = AmplitudeAtEnds(t, cost.last_trajectory(), period_s);
+    band.amplitude_start_deg = a0;
+    band.amplitude_end_deg = a1;
+    band.amplitude_mean_deg = 0.5 * (a0 + a1);
+    band.inertia_kg_m2 = scale * q[kTraceInertia];
+    band.inertia_std_kg_m2 = stat.ok ? scale * stat.hac[0] : 0.0;
+    band.ok = lm.ok && stat.ok && band.inertia_std_kg_m2 > 0.0 && std::isfinite(band.inertia_kg_m2);
+    sweep.bands.push_back(band);
+  }
+  // Weighted line of I/I_ref against A^2.
+  std::vector<const AmplitudeSweepBand*> good;
+  for (const AmplitudeSweepBand& b : sweep.bands)
+    if (b.ok) good.push_back(&b);
+  if (good.size() < 2) {
+    sweep.note = "fewer than 2 bands could be fitted";
+    return sweep;
+  }
+  const double ref = scale;
+  Eigen::Matrix2d xtwx = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d xtwy = Eigen::Vector2d::Zero();
+  double a_min = HUGE_VAL, a_max = 0.0;
+  for (const AmplitudeSweepBand* b : good) {
+    const double w = 1.0 / std::pow(b->inertia_std_kg_m2 / ref, 2);
+    const Eigen::Vector2d x(1.0, b->amplitude_mean_deg * b->amplitude_mean_deg);
+    xtwx += w * x * x.transpose();
+    xtwy += w * x * (b->inertia_kg_m2 / ref);
+    a_min = std::min(a_min, b->amplitude_mean_deg);
+    a_max = std::max(a_max, b->amplitude_mean_deg);
+  }
+  if (!(std::abs(xtwx.determinant()) > 0.0) || !(a_max > a_min)) {
+    sweep.note = "the bands do not span a range of amplitudes";
+    return sweep;
+  }
+  const Eigen::Matrix2d cov = xtwx.inverse();
+  const Eigen::Vector2d coef = cov * xtwy;
+  double chi2 = 0.0;
+  for (const AmplitudeSweepBand* b : good) {
+    const double x = b->amplitude_mean_deg * b->amplitude_mean_deg;
+    chi2 += std::pow((b->inertia_kg_m2 / ref - coef(0) - coef(1) * x) / (b->inertia_std_kg_m2 / ref), 2);
+  }
+  const double dof = static_cast<double>(good.size()) - 2.0;
+  const double birge = dof > 0 && chi2 > ChiSquare95(static_cast<int>(dof)) ? chi2 / dof : 1.0;
+  sweep.evaluated = true;
+  {
+    double wsum = 0.0, wi = 0.0;
+    for (const AmplitudeSweepBand* b : good) {
+      const double w = 1.0 / (b->inertia_std_kg_m2 * b->inertia_std_kg_m2);
+      wsum += w;
+      wi += w * b->inertia_kg_m2;
+    }
+    const double mean = wi / wsum;
+    for (const AmplitudeSweepBand* b : good)
+      sweep.chi2_constant += std::pow((b->inertia_kg_m2 - mean) / b->inertia_std_kg_m2, 2);
+    sweep.chi2_dof = static_cast<int>(good.size()) - 1;
+    if (sweep.chi2_constant > ChiSquare95(sweep.chi2_dof))
+      sweep.std_scale = std::sqrt(sweep.chi2_constant / sweep.chi2_dof);
+  }
+  const double c = coef(1) / coef(0);  // relative to I_0
+  sweep.trend_coeff_per_deg2 = c;
+  sweep.trend_coeff_std_per_deg2 = std::sqrt(cov(1, 1) * birge) / coef(0);
+  sweep.trend_z = sweep.trend_coeff_std_per_deg2 > 0.0 ? c / sweep.trend_coeff_std_per_deg2 : 0.0;
+  sweep.trend_percent_per_10deg = 100.0 * c * (a_max * a_max - a_min * a_min) / (a_max - a_min) * 10.0;
+  sweep.inertia_zero_amplitude_kg_m2 = ref * coef(0);
+  sweep.trend_detected = std::abs(sweep.trend_z) > options.sweep_trend_z;
+  return sweep;
 }
 
 }  // namespace
@@ -243,6 +406,14 @@ bool TraceFitOptions::Check(std::string* why) const {
     return fail("max_amplitude_deg must be in (min_amplitude_deg, 90]");
   if (!(min_periods >= 2.0)) return fail("min_periods must be >= 2");
   if (!(refine_rms_over_noise > 1.0)) return fail("refine_rms_over_noise must be > 1");
+  if (!(reject_secondary_motion_ratio >= max_secondary_motion_ratio))
+    return fail("reject_secondary_motion_ratio must be >= max_secondary_motion_ratio");
+  if (!(reject_residual_fraction > 0.0 && reject_residual_fraction <= 1.0))
+    return fail("reject_residual_fraction must be in (0, 1]");
+  if (!(sweep_min_cycles_per_band >= 1.0 && sweep_min_cycles_per_band <= 1000.0))
+    return fail("sweep_min_cycles_per_band must be in [1, 1000]");
+  if (sweep_max_bands < 2 || sweep_max_bands > 20) return fail("sweep_max_bands must be in [2, 20]");
+  if (!(sweep_trend_z > 0.0 && sweep_trend_z < 1e3)) return fail("sweep_trend_z must be in (0, 1000)");
   for (double std_input : {filar_length_std_m, filar_separation_std_m, mass_std_kg,
                            gravity_std_mps2, gyro_scale_std}) {
     if (!(std_input >= 0.0) || !std::isfinite(std_input))
@@ -255,7 +426,7 @@ std::string TraceFitResult::BriefReport() const {
   std::ostringstream s;
   s << ToString(status) << " [" << ToString(model) << "]";
   if (status != TraceFitStatus::kError && params.inertia_kg_m2 > 0.0) {
-    s << " I = " << Fmt("%.6f", params.inertia_kg_m2) << " +- "
+    s << " I = " << Fmt("%.5g", params.inertia_kg_m2) << " +- "
       << Fmt("%.2g", inertia_std_kg_m2) << " kg m^2"
       << " (stat " << Fmt("%.2g", inertia_stat_std_kg_m2) << ")"
       << ", K_D = " << Fmt("%.3g", params.drag_coeff_kg_m2)
@@ -267,6 +438,7 @@ std::string TraceFitResult::BriefReport() const {
       << ", " << Fmt("%.1f", fit_seconds * 1e3) << " ms";
   }
   if (!message.empty()) s << ": " << message;
+  for (const std::string& w : warnings) s << "; warning: " << w;
   return s.str();
 }
 
@@ -415,26 +587,26 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
   result.rms_over_noise = noise > 0.0 ? result.residual_rms_rad_per_s / noise : 0.0;
   const Trajectory traj = cost.last_trajectory();
 
-  // --- Statistical uncertainty: Ceres covariance scaled by the residual variance ---------------
-  const double dof = static_cast<double>(n) - kNumTraceParams;
-  const double sigma2 = dof > 0 ? 2.0 * final_cost / dof : 0.0;
+  // --- Statistical uncertainty: HAC sandwich over the free parameters -------------------------
   {
-    ceres::Covariance::Options cov_options;
-    cov_options.algorithm_type = ceres::DENSE_SVD;
-    cov_options.num_threads = 1;
-    ceres::Covariance covariance(cov_options);
-    std::vector<std::pair<const double*, const double*>> blocks = {{p, p}};
-    double cov[kNumTraceParams * kNumTraceParams];
-    ceres::Problem cov_problem;  // the same residual, at the chosen solution
-    AddTraceResidual(cost, fixed, p, &cov_problem);
-    if (covariance.Compute(blocks, &cov_problem) && covariance.GetCovarianceBlock(p, p, cov)) {
-      auto stdev = [&](int j) { return scale * std::sqrt(std::max(0.0, cov[j * 7]) * sigma2); };
-      result.inertia_stat_std_kg_m2 = stdev(kTraceInertia);
-      result.drag_coeff_std = stdev(kTraceDrag);
-      result.viscous_coeff_std = stdev(kTraceViscous);
+    std::vector<int> free = {kTraceInertia};
+    if (!fixed[0]) free.push_back(kTraceDrag);
+    if (!fixed[1]) free.push_back(kTraceViscous);
+    for (int j : {kTraceAngle0, kTraceRate0, kTraceBias}) free.push_back(j);
+    const StatStd stat = StatisticalStd(cost, p, free);
+    if (stat.ok) {
+      result.inertia_stat_std_kg_m2 = scale * stat.hac[0];
+      result.inertia_iid_std_kg_m2 = scale * stat.iid[0];
+      result.hac_bandwidth = stat.bandwidth;
+      for (size_t j = 0; j < free.size(); ++j) {
+        if (free[j] == kTraceDrag) result.drag_coeff_std = scale * stat.hac[j];
+        if (free[j] == kTraceViscous) result.viscous_coeff_std = scale * stat.hac[j];
+      }
     } else {
       result.flags.push_back("covariance_failed");
+      result.warnings.push_back("the covariance of the fit could not be computed");
     }
+    Cost(cost, p, &r);  // restore the cache at the solution
   }
 
   // --- Uncertainty budget: implicit-function derivative dI/dq -------------------------------
@@ -509,72 +681,127 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
       Cost(cost, p, &rtmp);  // restore the cache at the solution (cheap: cache hit)
     }
   }
-  result.inertia_std_kg_m2 = std::hypot(result.inertia_stat_std_kg_m2,
-                                        result.inertia_budget_std_kg_m2);
-
   // --- Amplitude of the fitted part -----------------------------------------------------------
+  std::tie(result.amplitude_start_deg, result.amplitude_end_deg) =
+      AmplitudeAtEnds(input.t_s, traj, guess.period_s);
   {
-    const double t0 = input.t_s.front(), t1 = input.t_s.back(), T = guess.period_s;
-    double a0 = 0.0, a1 = 0.0;
-    for (size_t k = 0; k < n; ++k) {
-      const double a = std::abs(traj.angle_rad[k]);
-      if (input.t_s[k] <= t0 + T) a0 = std::max(a0, a);
-      if (input.t_s[k] >= t1 - T) a1 = std::max(a1, a);
-    }
-    result.amplitude_start_deg = a0 * kDegPerRad;
-    result.amplitude_end_deg = a1 * kDegPerRad;
+    double mean = 0.0, sq = 0.0;
+    for (double v : traj.rate_rad_per_s) mean += v;
+    mean /= static_cast<double>(n);
+    for (double v : traj.rate_rad_per_s) sq += (v - mean) * (v - mean);
+    result.signal_rms_rad_per_s = std::sqrt(sq / static_cast<double>(n));
   }
 
-  // --- Whiteness ------------------------------------------------------------------------------
+  // --- Amplitude sweep: I against amplitude, and the rule for a rig that departs from the model --
+  result.inertia_window_kg_m2 = result.params.inertia_kg_m2;
+  if (options.amplitude_sweep) {
+    result.sweep = RunAmplitudeSweep(input, options, p, scale, traj, guess.period_s);
+    Cost(cost, p, &r);  // the sweep used its own costs; keep this one's cache at the solution
+  }
+  const AmplitudeSweep& sweep = result.sweep;
+  if (sweep.evaluated && sweep.std_scale > 1.0) {
+    result.inertia_stat_std_kg_m2 *= sweep.std_scale;
+    result.flags.push_back("bands_disagree");
+  }
+  if (sweep.trend_detected) {
+    // The result comes from the lowest-amplitude band; the trend's bias left at that band's
+    // amplitude, |c| A_low^2 I, is the model-inadequacy term (docs/method.md).
+    const AmplitudeSweepBand* low = nullptr;
+    for (const AmplitudeSweepBand& b : sweep.bands)
+      if (b.ok && (low == nullptr || b.amplitude_mean_deg < low->amplitude_mean_deg)) low = &b;
+    result.params.inertia_kg_m2 = low->inertia_kg_m2;
+    result.inertia_stat_std_kg_m2 = low->inertia_std_kg_m2 * sweep.std_scale;
+    result.inertia_source = "low_amplitude_band";
+    result.model_inadequacy_std_kg_m2 = std::abs(sweep.trend_coeff_per_deg2) *
+                                        low->amplitude_mean_deg * low->amplitude_mean_deg *
+                                        low->inertia_kg_m2;
+    result.flags.push_back("amplitude_trend");
+    result.warnings.push_back(
+        "I depends on the amplitude beyond its statistical error (" +
+        Fmt("%+.3g", sweep.trend_percent_per_10deg) + " % per 10 deg between " +
+        Fmt("%.1f", sweep.bands.back().amplitude_mean_deg) + " and " +
+        Fmt("%.1f", sweep.bands.front().amplitude_mean_deg) + " deg, z = " +
+        Fmt("%.1f", sweep.trend_z) + "): the rig departs from the ideal model; I is taken from "
+        "the lowest-amplitude band (" + Fmt("%.1f", low->amplitude_mean_deg) +
+        " deg) with a model-inadequacy std of " + Fmt("%.2g", result.model_inadequacy_std_kg_m2) +
+        " kg m^2. Swing at smaller amplitude, or set fit.max_amplitude_deg");
+  }
+  result.inertia_std_kg_m2 =
+      std::sqrt(result.inertia_stat_std_kg_m2 * result.inertia_stat_std_kg_m2 +
+                result.model_inadequacy_std_kg_m2 * result.model_inadequacy_std_kg_m2 +
+                result.inertia_budget_std_kg_m2 * result.inertia_budget_std_kg_m2);
+
+  // --- Whiteness, against the residual noise's own correlation ----------------------------------
   {
-    const std::vector<double> rho = Autocorrelation(r, options.whiteness_lags);
-    result.residual_autocorr_lag1 = rho.empty() ? 0.0 : rho[0];
-    double q = 0.0, mx = 0.0;
-    for (int k = 1; k <= options.whiteness_lags; ++k) {
-      const double v = rho[k - 1];
-      mx = std::max(mx, std::abs(v));
-      if (static_cast<size_t>(k) < n) q += v * v / (static_cast<double>(n) - k);
-    }
-    result.residual_autocorr_max = mx;
-    result.ljung_box_q = static_cast<double>(n) * (n + 2.0) * q;
+    const WhitenessStats w = ComputeWhiteness(r, options.whiteness_lags);
+    result.residual_autocorr_lag1 = w.raw_autocorr_lag1;
+    result.residual_autocorr_max = w.raw_autocorr_max;
+    result.residual_ar1_phi = w.ar1_phi;
+    result.prewhitened_autocorr_max = w.prewhitened_autocorr_max;
+    result.ljung_box_q = w.ljung_box_q;
   }
 
-  // --- Quality flags --------------------------------------------------------------------------
+  // --- Quality: reasons to reject, and warnings --------------------------------------------------
   std::vector<std::string> reasons;
+  auto reject = [&](const char* flag, const std::string& why) {
+    result.flags.push_back(flag);
+    reasons.push_back(why);
+  };
+  auto warn = [&](const char* flag, const std::string& why) {
+    result.flags.push_back(flag);
+    result.warnings.push_back(why);
+  };
   if (!lm.converged) {
-    result.flags.push_back("not_converged");
-    reasons.push_back("solver did not converge in " + std::to_string(options.max_iterations) +
-                      " iterations");
+    reject("not_converged", "the fit did not converge in " +
+                                std::to_string(options.max_iterations) +
+                                " iterations; set a window (fit.windows or --window) on the "
+                                "free oscillation");
+  }
+  const double residual_fraction = result.signal_rms_rad_per_s > 0.0
+                                       ? result.residual_rms_rad_per_s / result.signal_rms_rad_per_s
+                                       : HUGE_VAL;
+  if (residual_fraction > options.reject_residual_fraction) {
+    reject("fit_does_not_follow_data",
+           "the fit does not follow the data: residual RMS is " + Fmt("%.2f", residual_fraction) +
+               " of the swing rate's RMS (max " + Fmt("%.2f", options.reject_residual_fraction) +
+               "); check the swing axis (imu.swing_axis) and the window");
+  }
+  const double secondary = input.secondary_motion_ratio;
+  if (secondary >= 0.0 && secondary > options.reject_secondary_motion_ratio) {
+    reject("secondary_motion",
+           "heavy secondary motion: " + Fmt("%.3f", secondary) +
+               " of the swing energy on the other axes (max " +
+               Fmt("%.3f", options.reject_secondary_motion_ratio) +
+               "); the swing axis may be wrong (set imu.swing_axis) or the rig sways");
+  } else if (secondary >= 0.0 && secondary > options.max_secondary_motion_ratio) {
+    warn("secondary_motion", "secondary motion " + Fmt("%.3f", secondary) +
+                                 " of the swing energy (warning above " +
+                                 Fmt("%.3f", options.max_secondary_motion_ratio) +
+                                 "); steady the rig before release");
   }
   if (noise > 0.0 && result.rms_over_noise > options.max_rms_over_noise) {
-    result.flags.push_back("rms_above_noise");
-    reasons.push_back("residual RMS " + Fmt("%.3g", result.residual_rms_rad_per_s) +
-                      " rad/s is " + Fmt("%.2f", result.rms_over_noise) + "x the noise (max " +
-                      Fmt("%.2f", options.max_rms_over_noise) + ")");
+    warn("rms_above_noise",
+         "residual RMS " + Fmt("%.3g", result.residual_rms_rad_per_s) + " rad/s is " +
+             Fmt("%.2f", result.rms_over_noise) + "x the noise estimate (warning above " +
+             Fmt("%.2f", options.max_rms_over_noise) + "; raise fit.quality.max_rms_over_noise "
+             "if the gyro is known to be this noisy)");
   }
-  if (result.residual_autocorr_max > options.max_residual_autocorr) {
-    result.flags.push_back("residuals_not_white");
-    reasons.push_back("residuals show structure: max |autocorrelation| " +
-                      Fmt("%.2f", result.residual_autocorr_max) + " at lags 1.." +
-                      std::to_string(options.whiteness_lags) + " (max " +
-                      Fmt("%.2f", options.max_residual_autocorr) + ")");
-  }
-  if (input.secondary_motion_ratio >= 0.0 &&
-      input.secondary_motion_ratio > options.max_secondary_motion_ratio) {
-    result.flags.push_back("secondary_motion");
-    reasons.push_back("secondary motion " + Fmt("%.3f", input.secondary_motion_ratio) +
-                      " of the swing energy (max " +
-                      Fmt("%.3f", options.max_secondary_motion_ratio) + ")");
+  if (result.prewhitened_autocorr_max > options.max_residual_autocorr) {
+    warn("residuals_not_white",
+         "residuals show structure beyond their own AR(1) noise: max |autocorrelation| " +
+             Fmt("%.2f", result.prewhitened_autocorr_max) + " at lags 1.." +
+             std::to_string(options.whiteness_lags) + " after prewhitening (warning above " +
+             Fmt("%.2f", options.max_residual_autocorr) + ")");
   }
   if (result.amplitude_start_deg > options.max_amplitude_deg + 1.0) {
-    result.flags.push_back("amplitude_above_band");
-    reasons.push_back("amplitude " + Fmt("%.1f", result.amplitude_start_deg) +
-                      " deg above the band max " + Fmt("%.1f", options.max_amplitude_deg));
+    warn("amplitude_above_band", "amplitude " + Fmt("%.1f", result.amplitude_start_deg) +
+                                     " deg above the band max " +
+                                     Fmt("%.1f", options.max_amplitude_deg));
   }
   if (result.amplitude_end_deg < options.min_amplitude_deg - 0.5) {
-    result.flags.push_back("amplitude_below_band");
-    reasons.push_back("amplitude " + Fmt("%.2f", result.amplitude_end_deg) +
-                      " deg below the band min " + Fmt("%.2f", options.min_amplitude_deg));
+    warn("amplitude_below_band", "amplitude " + Fmt("%.2f", result.amplitude_end_deg) +
+                                     " deg below the band min " +
+                                     Fmt("%.2f", options.min_amplitude_deg));
   }
 
   // Never NaN in the output.

@@ -98,6 +98,13 @@ std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
   Put(out, "q_lags", q.whiteness_lags);
   Put(out, "q_secondary", q.max_secondary_motion_ratio);
   Put(out, "q_periods", q.min_periods);
+  Put(out, "q_secondary_reject", q.reject_secondary_motion_ratio);
+  Put(out, "q_residual_reject", q.reject_residual_fraction);
+  const SweepConfig& sw = config.fit.sweep;
+  Put(out, "sweep", sw.enabled ? 1.0 : 0.0);
+  Put(out, "sweep_cycles", sw.min_cycles_per_band);
+  Put(out, "sweep_bands", sw.max_bands);
+  Put(out, "sweep_z", sw.trend_z);
   return out.str();
 }
 

@@ -304,7 +304,7 @@ void Progress(const CampaignOptions& options, std::mutex& mutex, int done, int t
         << ToString(record.status);
     if (record.ok()) {
       char buffer[64];
-      std::snprintf(buffer, sizeof(buffer), " I_total = %.6f kg m^2", record.inertia_total_kg_m2);
+      std::snprintf(buffer, sizeof(buffer), " I_total = %#.5g kg m^2", record.inertia_total_kg_m2);
       out << buffer;
     } else {
       out << " (" << record.message << ")";
@@ -787,7 +787,7 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
       if (!est.defined) {
         std::snprintf(line, sizeof(line), "  %-5s  ill-defined (I_x ~ I_z)\n", name);
       } else {
-        std::snprintf(line, sizeof(line), "  %-5s  %10.5f +- %.5f\n", name, inertia(est.value),
+        std::snprintf(line, sizeof(line), "  %-5s  %#10.5g +- %.2g\n", name, inertia(est.value),
                       inertia(est.std));
       }
       out << line;
@@ -809,7 +809,7 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
       out << line;
     }
     std::snprintf(line, sizeof(line),
-                  "Table 1: raw sigma %.5f %s, CV %.4f %%, regression RMSE %.5f %s\n",
+                  "Table 1: raw sigma %#.5g %s, CV %.4f %%, regression RMSE %#.5g %s\n",
                   inertia(result.raw_sigma_kg_m2), unit, result.cv_percent,
                   inertia(result.regression_rmse_kg_m2), unit);
     out << line;
@@ -817,7 +817,7 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     out << s.ellipse_message << "\n";
   }
   if (std::isfinite(result.rig_inertia_kg_m2)) {
-    std::snprintf(line, sizeof(line), "Rig inertia %.5f +- %.2g %s", inertia(result.rig_inertia_kg_m2),
+    std::snprintf(line, sizeof(line), "Rig inertia %#.5g +- %.2g %s", inertia(result.rig_inertia_kg_m2),
                   inertia(result.rig_inertia_std_kg_m2), unit);
     out << line;
     if (config.rig_inertia.kind == RigInertiaSpec::Kind::kTare) {

@@ -38,7 +38,7 @@ std::string HumanLine(const TraceRecord& r) {
     return prefix + ToString(r.status) + ": " + message;
   }
   std::snprintf(buffer, sizeof(buffer),
-                "%s: %s  I = %.6f +- %.2g kg m^2 (budget +- %.2g)  K_D %.3g  C %.3g  "
+                "%s: %s  I = %#.5g +- %.2g kg m^2 (budget +- %.2g)  K_D %.3g  C %.3g  "
                 "window [%.2f, %.2f] s  amplitude %.1f -> %.1f deg  rms/noise %.2f  %d it  %.0f ms",
                 r.file.c_str(), ToString(r.status), r.inertia_total_kg_m2,
                 r.inertia_total_std_kg_m2, r.budget_total_std_kg_m2, r.drag_coeff_kg_m2,
@@ -51,6 +51,21 @@ std::string HumanLine(const TraceRecord& r) {
     line += buffer;
   }
   if (!message.empty()) line += "  (" + message + ")";
+  // I against amplitude (the ideal model is flat), and every warning on its own line.
+  if (!r.sweep.bands.empty()) {
+    line += "\n    I(A): " + SweepSummary(r.sweep);
+    if (r.sweep.evaluated) {
+      std::snprintf(buffer, sizeof(buffer), "  trend %+.3g %% per 10 deg (z = %.1f)%s",
+                    r.sweep.trend_percent_per_10deg, r.sweep.trend_z,
+                    r.sweep.trend_detected ? ": the rig departs from the model" : "");
+      line += buffer;
+    }
+  } else if (!r.sweep.note.empty()) {
+    line += "\n    I(A): no sweep (" + r.sweep.note + ")";
+  }
+  for (const std::string& w : r.warnings) {
+    if (message.find(w) == std::string::npos) line += "\n    warning: " + w;
+  }
   return line;
 }
 

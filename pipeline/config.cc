@@ -382,15 +382,37 @@ CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptio
     q.max_secondary_motion_ratio =
         quality.OptionalDouble("max_secondary_motion_ratio", q.max_secondary_motion_ratio);
     q.min_periods = quality.OptionalDouble("min_periods", q.min_periods);
+    q.reject_secondary_motion_ratio = quality.OptionalDouble(
+        "reject_secondary_motion_ratio", std::max(q.reject_secondary_motion_ratio,
+                                                  q.max_secondary_motion_ratio));
+    q.reject_residual_fraction =
+        quality.OptionalDouble("reject_residual_fraction", q.reject_residual_fraction);
     if (!(q.max_rms_over_noise > 1.0) || !(q.max_residual_autocorr > 0.0) ||
         !(q.max_residual_autocorr < 1.0) || q.whiteness_lags < 1 ||
-        !(q.max_secondary_motion_ratio >= 0.0) || !(q.min_periods >= 2.0)) {
+        !(q.max_secondary_motion_ratio >= 0.0) || !(q.min_periods >= 2.0) ||
+        !(q.reject_secondary_motion_ratio >= q.max_secondary_motion_ratio) ||
+        !(q.reject_residual_fraction > 0.0 && q.reject_residual_fraction <= 1.0)) {
       throw UserError(quality.Where(fit.Optional("quality")) +
                       ": 'fit.quality' out of range (max_rms_over_noise > 1, "
                       "0 < max_residual_autocorr < 1, whiteness_lags >= 1, "
-                      "max_secondary_motion_ratio >= 0, min_periods >= 2)");
+                      "max_secondary_motion_ratio >= 0, min_periods >= 2, "
+                      "reject_secondary_motion_ratio >= max_secondary_motion_ratio, "
+                      "0 < reject_residual_fraction <= 1)");
     }
     quality.Finish();
+    YamlMap sweep = Sub(fit, "amplitude_sweep");
+    SweepConfig& sw = config.fit.sweep;
+    sw.enabled = sweep.OptionalBool("enabled", sw.enabled);
+    sw.min_cycles_per_band = sweep.OptionalDouble("min_cycles_per_band", sw.min_cycles_per_band);
+    sw.max_bands = sweep.OptionalInt("max_bands", sw.max_bands);
+    sw.trend_z = sweep.OptionalDouble("trend_z", sw.trend_z);
+    if (!(sw.min_cycles_per_band >= 1.0 && sw.min_cycles_per_band <= 1000.0) ||
+        sw.max_bands < 2 || sw.max_bands > 20 || !(sw.trend_z > 0.0 && sw.trend_z < 1000.0)) {
+      throw UserError(sweep.Where(fit.Optional("amplitude_sweep")) +
+                      ": 'fit.amplitude_sweep' out of range (min_cycles_per_band in [1, 1000], "
+                      "max_bands in [2, 20], trend_z in (0, 1000))");
+    }
+    sweep.Finish();
     fit.Finish();
   }
   {

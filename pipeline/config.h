@@ -64,14 +64,24 @@ struct RunsConfig {
   PitchSource pitch_source = PitchSource::kNominal;
 };
 
-// Quality thresholds of the trace fit (issue 3 item 8; fit/trace_fit.h TraceFitOptions, same
-// names and defaults): a trace failing one is `rejected` with the reason.
+// Quality thresholds of the trace fit (fit/trace_fit.h TraceFitOptions, same names and
+// defaults): the max_* ones give warnings, the reject_* ones reject.
 struct QualityThresholds {
-  double max_rms_over_noise = 1.5;          // residual RMS / noise (dimensionless); > 1
-  double max_residual_autocorr = 0.25;      // max |autocorrelation| of residuals, lags 1..L; (0,1)
+  double max_rms_over_noise = 3.0;          // residual RMS / noise (dimensionless); > 1
+  double max_residual_autocorr = 0.35;      // prewhitened residual |autocorrelation|; (0,1)
   int whiteness_lags = 10;                  // L (count); >= 1
   double max_secondary_motion_ratio = 0.1;  // other-axes energy / swing-axis energy; >= 0
+  double reject_secondary_motion_ratio = 0.5;  // ... above this: rejected; >= the warning level
+  double reject_residual_fraction = 0.3;    // residual RMS / swing rate RMS above: rejected
   double min_periods = 2.0;                 // periods the window must hold (count); >= 2
+};
+
+// The amplitude sweep (fit/trace_fit.h TraceFitOptions::amplitude_sweep and sweep_*).
+struct SweepConfig {
+  bool enabled = true;
+  double min_cycles_per_band = 3.0;  // [1, 1000]
+  int max_bands = 6;                 // [2, 20]
+  double trend_z = 3.0;              // (0, 1000)
 };
 
 struct FitConfig {
@@ -82,6 +92,7 @@ struct FitConfig {
   std::optional<double> max_amplitude_deg;  // amplitude band, upper (deg); default: fit's own
   std::optional<double> min_amplitude_deg;  // amplitude band, lower (deg); default: fit's own
   QualityThresholds quality;
+  SweepConfig sweep;
 };
 
 // Options of the ellipse fit (fit/ellipse.h EllipseOptions, same defaults).

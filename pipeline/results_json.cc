@@ -49,6 +49,82 @@ std::string GetString(const json& j, const char* key) {
   return it->get<std::string>();
 }
 
+std::vector<std::string> GetStrings(const json& j, const char* key) {
+  std::vector<std::string> out;
+  auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return out;
+  if (!it->is_array()) throw UserError(std::string("trace record: '") + key + "' is not a list");
+  for (const auto& v : *it) {
+    if (!v.is_string()) throw UserError(std::string("trace record: '") + key + "' holds non-text");
+    out.push_back(v.get<std::string>());
+  }
+  return out;
+}
+
+json SweepToJson(const AmplitudeSweep& s) {
+  json bands = json::array();
+  for (const AmplitudeSweepBand& b : s.bands) {
+    bands.push_back({{"window_s", json::array({b.t0_s, b.t1_s})},
+                     {"samples", b.num_samples},
+                     {"cycles", Number(b.cycles)},
+                     {"amplitude_deg", json::array({Number(b.amplitude_start_deg),
+                                                    Number(b.amplitude_end_deg)})},
+                     {"amplitude_mean_deg", Number(b.amplitude_mean_deg)},
+                     {"inertia_kg_m2", b.ok ? Number(b.inertia_kg_m2) : json(nullptr)},
+                     {"inertia_std_kg_m2", b.ok ? Number(b.inertia_std_kg_m2) : json(nullptr)},
+                     {"ok", b.ok}});
+  }
+  json j = {{"evaluated", s.evaluated}, {"note", s.note}, {"bands", bands}};
+  if (s.evaluated) {
+    j["trend_coeff_per_deg2"] = Number(s.trend_coeff_per_deg2);
+    j["trend_coeff_std_per_deg2"] = Number(s.trend_coeff_std_per_deg2);
+    j["trend_z"] = Number(s.trend_z);
+    j["trend_percent_per_10deg"] = Number(s.trend_percent_per_10deg);
+    j["inertia_zero_amplitude_kg_m2"] = Number(s.inertia_zero_amplitude_kg_m2);
+    j["trend_detected"] = s.trend_detected;
+  }
+  return j;
+}
+
+double NumberOr0(const json& j, const char* key) {
+  const double v = GetNumber(j, key);
+  return std::isfinite(v) ? v : 0.0;
+}
+
+AmplitudeSweep SweepFromJson(const json& j) {
+  AmplitudeSweep s;
+  s.evaluated = j.value("evaluated", false);
+  s.note = GetString(j, "note");
+  if (auto it = j.find("bands"); it != j.end() && it->is_array()) {
+    for (const json& b : *it) {
+      if (!b.is_object()) throw UserError("trace record: a sweep band is not an object");
+      AmplitudeSweepBand band;
+      const std::array<double, 2> w = GetPair(b, "window_s");
+      const std::array<double, 2> a = GetPair(b, "amplitude_deg");
+      band.t0_s = w[0];
+      band.t1_s = w[1];
+      band.num_samples = b.value("samples", 0);
+      band.cycles = NumberOr0(b, "cycles");
+      band.amplitude_start_deg = a[0];
+      band.amplitude_end_deg = a[1];
+      band.amplitude_mean_deg = NumberOr0(b, "amplitude_mean_deg");
+      band.inertia_kg_m2 = NumberOr0(b, "inertia_kg_m2");
+      band.inertia_std_kg_m2 = NumberOr0(b, "inertia_std_kg_m2");
+      band.ok = b.value("ok", false);
+      s.bands.push_back(band);
+    }
+  }
+  if (s.evaluated) {
+    s.trend_coeff_per_deg2 = NumberOr0(j, "trend_coeff_per_deg2");
+    s.trend_coeff_std_per_deg2 = NumberOr0(j, "trend_coeff_std_per_deg2");
+    s.trend_z = NumberOr0(j, "trend_z");
+    s.trend_percent_per_10deg = NumberOr0(j, "trend_percent_per_10deg");
+    s.inertia_zero_amplitude_kg_m2 = NumberOr0(j, "inertia_zero_amplitude_kg_m2");
+    s.trend_detected = j.value("trend_detected", false);
+  }
+  return s;
+}
+
 // CSV cell: numbers with full precision, NaN empty; text quoted when needed.
 std::string Cell(double value) {
   if (!std::isfinite(value)) return "";
@@ -66,7 +142,26 @@ std::string Cell(const std::string& text) {
   return quoted + "\"";
 }
 
+std::string Join(const std::vector<std::string>& parts, const char* separator) {
+  std::string out;
+  for (size_t i = 0; i < parts.size(); ++i) out += (i ? separator : "") + parts[i];
+  return out;
+}
+
 }  // namespace
+
+std::string SweepSummary(const AmplitudeSweep& sweep) {
+  // "A_deg:I+-std" per band, amplitude decreasing, separated by spaces.
+  std::string out;
+  char buf[96];
+  for (const AmplitudeSweepBand& b : sweep.bands) {
+    if (!b.ok) continue;
+    std::snprintf(buf, sizeof(buf), "%s%.1f:%.5g+-%.2g", out.empty() ? "" : " ",
+                  b.amplitude_mean_deg, b.inertia_kg_m2, b.inertia_std_kg_m2);
+    out += buf;
+  }
+  return out;
+}
 
 const char* ProgramVersion() { return BIFILAR_VERSION; }
 
@@ -94,7 +189,25 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
   budget["total_kg_m2"] = Number(r.budget_total_std_kg_m2);
   j["budget"] = budget;
   j["flags"] = r.flags;
+  j["warnings"] = r.warnings;
   j["figure"] = r.figure;
+  j["figures"] = r.figures;
+  j["swing_axis_in_imu"] = std::isfinite(r.swing_axis_in_imu[0])
+                               ? json::array({r.swing_axis_in_imu[0], r.swing_axis_in_imu[1],
+                                              r.swing_axis_in_imu[2]})
+                               : json(nullptr);
+  j["secondary_motion_ratio"] = Number(r.secondary_motion_ratio);
+  j["rms_over_noise"] = Number(r.rms_over_noise);
+  j["residual_autocorrelation"] = {{"lag1", Number(r.residual_autocorr_lag1)},
+                                   {"ar1_phi", Number(r.residual_ar1_phi)},
+                                   {"prewhitened_max", Number(r.prewhitened_autocorr_max)}};
+  j["inertia_window_kg_m2"] = Number(r.inertia_window_kg_m2);
+  j["inertia_source"] = r.inertia_source;
+  j["uncertainty"] = {{"statistical_kg_m2", Number(r.inertia_stat_std_kg_m2)},
+                      {"iid_kg_m2", Number(r.inertia_iid_std_kg_m2)},
+                      {"hac_bandwidth", r.hac_bandwidth},
+                      {"model_inadequacy_kg_m2", Number(r.model_inadequacy_std_kg_m2)}};
+  j["amplitude_sweep"] = SweepToJson(r.sweep);
   if (campaign_fields) {
     j["role"] = ToString(r.role);
     j["content_hash"] = r.content_hash;
@@ -148,6 +261,28 @@ TraceRecord TraceRecordFromJson(const json& j) {
     for (const auto& flag : *it) r.flags.push_back(flag.get<std::string>());
   }
   r.figure = GetString(j, "figure");
+  r.warnings = GetStrings(j, "warnings");
+  r.figures = GetStrings(j, "figures");
+  if (auto it = j.find("swing_axis_in_imu"); it != j.end() && it->is_array() && it->size() == 3) {
+    for (int k = 0; k < 3; ++k)
+      r.swing_axis_in_imu[k] = (*it)[k].is_number() ? (*it)[k].get<double>() : NAN;
+  }
+  r.secondary_motion_ratio = GetNumber(j, "secondary_motion_ratio");
+  r.rms_over_noise = GetNumber(j, "rms_over_noise");
+  if (auto it = j.find("residual_autocorrelation"); it != j.end() && it->is_object()) {
+    r.residual_autocorr_lag1 = GetNumber(*it, "lag1");
+    r.residual_ar1_phi = GetNumber(*it, "ar1_phi");
+    r.prewhitened_autocorr_max = GetNumber(*it, "prewhitened_max");
+  }
+  r.inertia_window_kg_m2 = GetNumber(j, "inertia_window_kg_m2");
+  r.inertia_source = GetString(j, "inertia_source");
+  if (auto it = j.find("uncertainty"); it != j.end() && it->is_object()) {
+    r.inertia_stat_std_kg_m2 = GetNumber(*it, "statistical_kg_m2");
+    r.inertia_iid_std_kg_m2 = GetNumber(*it, "iid_kg_m2");
+    r.hac_bandwidth = it->value("hac_bandwidth", 0);
+    r.model_inadequacy_std_kg_m2 = GetNumber(*it, "model_inadequacy_kg_m2");
+  }
+  if (auto it = j.find("amplitude_sweep"); it != j.end() && it->is_object()) r.sweep = SweepFromJson(*it);
   if (j.contains("role")) r.role = GetString(j, "role") == "tare" ? TraceRole::kTare : TraceRole::kAircraft;
   r.content_hash = GetString(j, "content_hash");
   r.cache_key = GetString(j, "cache_key");
@@ -230,7 +365,10 @@ std::string TracesCsv(const CampaignResult& result) {
          "inertia_total_kg_m2,inertia_total_std_kg_m2,rig_inertia_kg_m2,inertia_kg_m2,"
          "inertia_std_kg_m2,budget_total_std_kg_m2,drag_coeff_kg_m2,viscous_coeff_kg_m2_per_s,"
          "window_t0_s,window_t1_s,amplitude_start_deg,amplitude_end_deg,bias_rad_per_s,"
-         "residual_rms_rad_per_s,model,iterations,fit_seconds,from_cache,message\n";
+         "residual_rms_rad_per_s,model,iterations,fit_seconds,from_cache,inertia_source,"
+         "inertia_window_kg_m2,model_inadequacy_std_kg_m2,secondary_motion_ratio,rms_over_noise,"
+         "residual_ar1_phi,sweep_bands,sweep_trend_percent_per_10deg,sweep_trend_z,"
+         "sweep_trend_detected,sweep_inertia_by_amplitude,warnings,message\n";
   for (const TraceRecord& r : result.traces) {
     out << Cell(r.file) << ',' << ToString(r.role) << ',' << ToString(r.status) << ','
         << Cell(r.pitch_nominal_deg ? *r.pitch_nominal_deg : NAN) << ','
@@ -244,6 +382,14 @@ std::string TracesCsv(const CampaignResult& result) {
         << Cell(r.amplitude_deg[1]) << ',' << Cell(r.bias_rad_per_s) << ','
         << Cell(r.residual_rms_rad_per_s) << ',' << Cell(r.model) << ',' << r.iterations << ','
         << Cell(r.fit_seconds) << ',' << (r.from_cache ? "true" : "false") << ','
+        << Cell(r.inertia_source) << ',' << Cell(r.inertia_window_kg_m2) << ','
+        << Cell(r.model_inadequacy_std_kg_m2) << ',' << Cell(r.secondary_motion_ratio) << ','
+        << Cell(r.rms_over_noise) << ',' << Cell(r.residual_ar1_phi) << ','
+        << r.sweep.bands.size() << ','
+        << (r.sweep.evaluated ? Cell(r.sweep.trend_percent_per_10deg) : "") << ','
+        << (r.sweep.evaluated ? Cell(r.sweep.trend_z) : "") << ','
+        << (r.sweep.evaluated ? (r.sweep.trend_detected ? "true" : "false") : "") << ','
+        << Cell(SweepSummary(r.sweep)) << ',' << Cell(Join(r.warnings, " | ")) << ','
         << Cell(r.message) << '\n';
   }
   return out.str();

@@ -25,6 +25,9 @@ nlohmann::json ResultsToJson(const CampaignConfig& config, const CampaignResult&
 std::string TracesCsv(const CampaignResult& result);  // one row per trace
 std::string AnglesCsv(const CampaignResult& result);  // one row per pitch angle
 
+// The amplitude sweep in one cell: "A_deg:I+-std" per band, amplitude decreasing.
+std::string SweepSummary(const AmplitudeSweep& sweep);
+
 // Program version stamped into results and cache keys.
 const char* ProgramVersion();
 

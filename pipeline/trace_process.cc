@@ -177,6 +177,7 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
   if (!TryReadImuLog(path, config.imu.format, ImuLogOptions(), &data, &why)) {
     return fail(TraceStatus::kError, why);
   }
+  record.warnings = data.warnings;
 
   // 2. Swing axis (and the pitch, from the accelerometer at rest).
   const std::optional<std::array<double, 2>> override_s =
@@ -212,6 +213,7 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
     }
   }
   record.pitch_measured_deg = axis.pitch_measured_deg;
+  for (int k = 0; k < 3; ++k) record.swing_axis_in_imu[k] = axis.axis_in_imu[k];
 
   // 4. Amplitude band.
   AmplitudeBandOptions band_options;
@@ -246,6 +248,12 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
   fit_options.max_residual_autocorr = q.max_residual_autocorr;
   fit_options.whiteness_lags = q.whiteness_lags;
   fit_options.max_secondary_motion_ratio = q.max_secondary_motion_ratio;
+  fit_options.reject_secondary_motion_ratio = q.reject_secondary_motion_ratio;
+  fit_options.reject_residual_fraction = q.reject_residual_fraction;
+  fit_options.amplitude_sweep = config.fit.sweep.enabled;
+  fit_options.sweep_min_cycles_per_band = config.fit.sweep.min_cycles_per_band;
+  fit_options.sweep_max_bands = config.fit.sweep.max_bands;
+  fit_options.sweep_trend_z = config.fit.sweep.trend_z;
   fit_options.min_periods = q.min_periods;
   fit_options.max_amplitude_deg = band_options.max_amplitude_deg;
   fit_options.min_amplitude_deg = std::min(fit_options.min_amplitude_deg, band_options.min_amplitude_deg);
@@ -265,11 +273,25 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
                                                             : TraceStatus::kError;
   record.message = fit.message.empty() ? "" : Renamed(fit.message, path, name);
   record.flags = fit.flags;
+  for (const std::string& w : fit.warnings) record.warnings.push_back(w);
   record.model = ToString(fit.model);
   record.iterations = fit.iterations;
-  if (fit.status != TraceFitStatus::kError) {
+  record.secondary_motion_ratio = input.secondary_motion_ratio >= 0.0 ? input.secondary_motion_ratio : NAN;
+  if (fit.HasFit()) {
     record.inertia_total_kg_m2 = fit.params.inertia_kg_m2;
-    record.inertia_total_std_kg_m2 = fit.inertia_stat_std_kg_m2;
+    record.inertia_total_std_kg_m2 =
+        std::hypot(fit.inertia_stat_std_kg_m2, fit.model_inadequacy_std_kg_m2);
+    record.inertia_stat_std_kg_m2 = fit.inertia_stat_std_kg_m2;
+    record.inertia_iid_std_kg_m2 = fit.inertia_iid_std_kg_m2;
+    record.model_inadequacy_std_kg_m2 = fit.model_inadequacy_std_kg_m2;
+    record.hac_bandwidth = fit.hac_bandwidth;
+    record.inertia_window_kg_m2 = fit.inertia_window_kg_m2;
+    record.inertia_source = fit.inertia_source;
+    record.sweep = fit.sweep;
+    record.rms_over_noise = fit.rms_over_noise > 0.0 ? fit.rms_over_noise : NAN;
+    record.residual_autocorr_lag1 = fit.residual_autocorr_lag1;
+    record.residual_ar1_phi = fit.residual_ar1_phi;
+    record.prewhitened_autocorr_max = fit.prewhitened_autocorr_max;
     record.drag_coeff_kg_m2 = fit.params.drag_coeff_kg_m2;
     record.viscous_coeff_kg_m2_per_s = fit.params.viscous_coeff_kg_m2_per_s;
     record.amplitude_deg = {fit.amplitude_start_deg, fit.amplitude_end_deg};
@@ -281,11 +303,11 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
     }
     record.budget_total_std_kg_m2 = fit.inertia_budget_std_kg_m2;
   }
-  if (record.status == TraceStatus::kOk && !data.warnings.empty()) {
-    record.message = name + ": " + data.warnings.front() +
-                     (data.warnings.size() > 1 ? " (+" + std::to_string(data.warnings.size() - 1) +
-                                                     " more warnings)"
-                                               : "");
+  if (record.status == TraceStatus::kOk && !record.warnings.empty()) {
+    record.message = name + ": " + record.warnings.front() +
+                     (record.warnings.size() > 1 ? " (+" + std::to_string(record.warnings.size() - 1) +
+                                                       " more warnings)"
+                                                 : "");
   }
 
   // 6. Figure (only of a fit that ran).
@@ -302,7 +324,12 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
       figure_options.height_px = options.figure_height_px;
       drawn = WriteTraceFitFigure(fit, figure_path, figure_options, &why);
     }
-    if (!drawn) record.flags.push_back("figure_failed");
+    if (!drawn) {
+      record.flags.push_back("figure_failed");
+      record.warnings.push_back("figure " + figure_path + " could not be written: " + why);
+    } else {
+      record.figures.push_back(figure_path);
+    }
   }
   return record;
 }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "fit/trace_fit.h"
 #include "pipeline/config.h"
 
 namespace bifilar {
@@ -36,7 +37,9 @@ struct TraceRecord {
   TraceStatus status = TraceStatus::kError;
   std::string message;                   // why rejected/error; warnings for ok
   double inertia_total_kg_m2 = NAN;      // fitted I of everything suspended (kg m^2)
-  double inertia_total_std_kg_m2 = NAN;  // its standard error from the fit (kg m^2)
+  // Its per-trace std (kg m^2): statistical (HAC) and model-inadequacy terms in quadrature; the
+  // systematic budget (L, D, m, g, gyro scale) is separate (budget_total_std_kg_m2).
+  double inertia_total_std_kg_m2 = NAN;
   double drag_coeff_kg_m2 = NAN;         // K_D
   double viscous_coeff_kg_m2_per_s = NAN;  // C
   std::array<double, 2> window_s = {NAN, NAN};       // fitted window [t0, t1] (s)
@@ -51,8 +54,25 @@ struct TraceRecord {
   double fit_seconds = 0.0;              // wall time of this file's processing (s)
   std::vector<BudgetTerm> budget;        // systematic contributions (L, D, m, g)
   double budget_total_std_kg_m2 = NAN;   // root-sum-square of the budget terms
-  std::vector<std::string> flags;        // quality flags raised (a failing one rejects)
+  std::vector<std::string> flags;        // quality flags raised (rejecting ones and warnings)
+  std::vector<std::string> warnings;     // every warning (reader, window, fit), for every status
   std::string figure;                    // fit figure file name inside OUT/figures/, "" if none
+  std::vector<std::string> figures;      // every figure written for this trace (paths)
+
+  // --- diagnostics (issue 8: what a user needs to judge a real log) ---
+  std::array<double, 3> swing_axis_in_imu = {NAN, NAN, NAN};  // unit swing axis used
+  double secondary_motion_ratio = NAN;   // rate energy off the swing axis / on it
+  double rms_over_noise = NAN;           // residual RMS / noise estimate
+  double residual_autocorr_lag1 = NAN;   // rho_1 of the residuals
+  double residual_ar1_phi = NAN;         // AR(1) coefficient of the residuals
+  double prewhitened_autocorr_max = NAN; // whiteness statistic (after AR(1) prewhitening)
+  double inertia_window_kg_m2 = NAN;     // I of the fit over the whole window
+  std::string inertia_source;            // "window" or "low_amplitude_band"
+  double inertia_stat_std_kg_m2 = NAN;   // statistical (HAC) std of I
+  double inertia_iid_std_kg_m2 = NAN;    // textbook std assuming white residuals (comparison)
+  double model_inadequacy_std_kg_m2 = NAN;  // from the amplitude sweep's trend (0: none)
+  int hac_bandwidth = 0;
+  AmplitudeSweep sweep;                  // I against amplitude
 
   // --- campaign bookkeeping (not cached) ---
   TraceRole role = TraceRole::kAircraft;
@@ -68,11 +88,10 @@ struct TraceRecord {
   bool ok() const { return status == TraceStatus::kOk; }
 };
 
-// Default upper bound of the amplitude band (deg) when the config sets none. Evidence (README,
-// "Amplitude band"): on a simulated rig drifting 3 % from the ideal model at 60 deg (bias ~A^4),
-// 30 deg keeps every trace of a 5-30 deg campaign and bounds the per-trace bias near 0.2 %;
-// 20 deg cuts it to 0.05 % but rejects swings released above 20 deg that never decay into it.
-constexpr double kDefaultMaxAmplitudeDeg = 30.0;
+// Default upper bound of the amplitude band (deg) when the config sets none: the whole free
+// oscillation is fitted, and the amplitude sweep (docs/method.md) decides whether the rig departs
+// from the model at large amplitude; fit.max_amplitude_deg stays as an override.
+constexpr double kDefaultMaxAmplitudeDeg = 90.0;
 
 struct TraceProcessOptions {
   TraceRole role = TraceRole::kAircraft;  // chooses the suspended mass (aircraft + rig, or rig)

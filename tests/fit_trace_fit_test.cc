@@ -257,19 +257,33 @@ TEST(TraceFit, HeavyQuadraticDragFrom56Deg) {
   EXPECT_LT(r.amplitude_end_deg, 10.0);
 }
 
-TEST(TraceFit, LinearModelOnA30DegTraceIsRejectedForStructure) {
-  const TraceFitInput in = Make(Truth(30.0, 21));
+TEST(TraceFit, LinearModelOnA30DegTraceIsFlaggedByTheAmplitudeSweep) {
+  // `linear` misses the amplitude dependence of the period: fitted in successive bands, its I
+  // trends with amplitude far beyond the statistical error. The trace is kept (ok, with warnings),
+  // the result comes from the lowest-amplitude band, and a model-inadequacy term is added.
+  const SyntheticTraceOptions truth = Truth(30.0, 21);
+  const TraceFitInput in = Make(truth);
   TraceFitOptions options;
   options.model = PendulumModel::kLinear;
   const TraceFitResult r = FitTrace(in, options);
-  EXPECT_EQ(r.status, TraceFitStatus::kRejected) << r.BriefReport();
-  EXPECT_TRUE(HasFlag(r, "residuals_not_white")) << r.BriefReport();
-  EXPECT_NE(r.message.find("structure"), std::string::npos);
-  EXPECT_NE(r.message.find("synthetic.csv"), std::string::npos);
+  EXPECT_EQ(r.status, TraceFitStatus::kOk) << r.BriefReport();
+  EXPECT_TRUE(HasFlag(r, "amplitude_trend")) << r.BriefReport();
+  EXPECT_TRUE(r.sweep.trend_detected);
+  EXPECT_GT(r.sweep.trend_z, 5.0);
+  EXPECT_EQ(r.inertia_source, "low_amplitude_band");
+  EXPECT_GT(r.model_inadequacy_std_kg_m2, 0.0);
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_NE(r.warnings[0].find("per 10 deg"), std::string::npos) << r.warnings[0];
+  // The linear model's bias at the low band is covered by the uncertainty it reports.
+  EXPECT_LT(std::abs(r.params.inertia_kg_m2 - truth.params.inertia_kg_m2),
+            3.0 * r.inertia_std_kg_m2) << r.BriefReport();
   EXPECT_TRUE(AllFinite(r));
-  // The same trace with the full model is clean.
+  // The same trace with the full model is clean: flat I(A), no warning.
   const TraceFitResult full = FitTrace(in, TraceFitOptions());
   EXPECT_EQ(full.status, TraceFitStatus::kOk) << full.BriefReport();
+  EXPECT_TRUE(full.sweep.evaluated);
+  EXPECT_FALSE(full.sweep.trend_detected) << full.BriefReport();
+  EXPECT_TRUE(full.warnings.empty()) << full.BriefReport();
 }
 
 TEST(TraceFit, NloptRefinementRunsOnPoorFitsAndNeverMakesThemWorse) {
@@ -352,28 +366,39 @@ TEST(TraceFit, UnknownNoiseIsEstimatedFromTheWindow) {
   EXPECT_NEAR(r.rms_over_noise, 1.0, 0.08);
 }
 
-TEST(TraceFit, RestNoiseBelowTheMotionNoiseIsFlagged) {
+TEST(TraceFit, RestNoiseBelowTheMotionNoiseIsAWarning) {
   TraceFitInput in = Make(Truth(12.0, 42));
-  in.noise_rad_per_s *= 0.5;  // the rest segment was quieter: RMS is 2x "the noise"
+  in.noise_rad_per_s *= 0.25;  // the rest segment was quieter: RMS is 4x "the noise"
   const TraceFitResult r = FitTrace(in, TraceFitOptions());
-  EXPECT_EQ(r.status, TraceFitStatus::kRejected);
+  EXPECT_EQ(r.status, TraceFitStatus::kOk) << r.BriefReport();
   EXPECT_TRUE(HasFlag(r, "rms_above_noise")) << r.BriefReport();
-  EXPECT_NE(r.message.find("noise"), std::string::npos);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("noise"), std::string::npos);
 }
 
 TEST(TraceFit, SecondaryMotionAndAmplitudeBandAreChecked) {
   TraceFitInput in = Make(Truth(30.0, 43));
-  in.secondary_motion_ratio = 0.5;
+  in.secondary_motion_ratio = 0.6;  // heavy: above reject_secondary_motion_ratio (0.5)
   TraceFitResult r = FitTrace(in, TraceFitOptions());
   EXPECT_EQ(r.status, TraceFitStatus::kRejected);
+  EXPECT_TRUE(HasFlag(r, "secondary_motion"));
+  // A rejected trace still reports its fitted number and says what to change.
+  EXPECT_TRUE(r.HasFit());
+  EXPECT_GT(r.params.inertia_kg_m2, 0.0);
+  EXPECT_NE(r.message.find("max 0.500"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("imu.swing_axis"), std::string::npos) << r.message;
+  in.secondary_motion_ratio = 0.2;  // moderate: a warning
+  r = FitTrace(in, TraceFitOptions());
+  EXPECT_EQ(r.status, TraceFitStatus::kOk) << r.BriefReport();
   EXPECT_TRUE(HasFlag(r, "secondary_motion"));
   in.secondary_motion_ratio = 0.01;
   r = FitTrace(in, TraceFitOptions());
   EXPECT_EQ(r.status, TraceFitStatus::kOk) << r.BriefReport();
+  EXPECT_TRUE(r.warnings.empty()) << r.BriefReport();
   TraceFitOptions band;
   band.max_amplitude_deg = 20.0;  // the window code should have trimmed this trace
   r = FitTrace(in, band);
-  EXPECT_EQ(r.status, TraceFitStatus::kRejected);
+  EXPECT_EQ(r.status, TraceFitStatus::kOk);
   EXPECT_TRUE(HasFlag(r, "amplitude_above_band"));
   band.max_amplitude_deg = 45.0;
   band.min_amplitude_deg = 28.0;  // decays to ~26 deg: below the band at the end
