@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include "pendulum/integrator.h"
 #include "pendulum/model.h"
 #include "pipeline/imu_format.h"
 
@@ -76,6 +77,8 @@ struct QualityThresholds {
 
 struct FitConfig {
   PendulumModel model = PendulumModel::kFull;  // `fit.model`: full | jardin | linear
+  // `fit.integrator`: rk853 (default) | cvodes; the fit's ODE solver (pendulum/integrator.h).
+  IntegratorMethod integrator = IntegratorMethod::kRungeKutta;
   // Per-file window overrides [t0, t1] (s), keyed by the path as written (relative to runs root
   // or to the config folder for tare logs); the file names are resolved at load time.
   std::map<std::string, std::array<double, 2>> windows_s;
