@@ -1,7 +1,7 @@
 // Synthetic free-oscillation windows with known truth, for the trace-fit tests and benchmarks:
 // the model integrated at jittered timestamps with dropped samples, plus a gyro bias and white
 // noise. Only the free oscillation (no rest, twist or hold: that is pendulum/simulate.h's job).
-// Conventions: ../shared/PHYSICS.md §2.
+// Conventions: docs/physics.md §2.
 #pragma once
 
 #include <cstdint>
