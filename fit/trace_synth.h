@@ -26,7 +26,7 @@ struct SyntheticTraceOptions {
 };
 
 // The window (t_s, rate_rad_per_s, geometry, noise_rad_per_s = the true sigma). The truth is
-// integrated with CVODES at rel_tol 1e-12. Returns false if the integration fails.
+// integrated with CVODE at rel_tol 1e-12. Returns false if the integration fails.
 bool MakeSyntheticTrace(const SyntheticTraceOptions& options, TraceFitInput* input);
 
 }  // namespace bifilar

@@ -90,7 +90,7 @@ struct SimulationOptions {
   // RK4 (<= 1 ms steps) instead of PendulumIntegrator when non-zero. Fraction, e.g. 0.01 = +1 %
   // at 60 deg; in [0, 0.5].
   double sway_coupling_at_60deg = 0.0;
-  // The truth's integrator. Default: CVODES, a different solver from the fit's default
+  // The truth's integrator. Default: CVODE (kCvodes), a different solver from the fit's default
   // (Runge-Kutta), so that the fit is judged against an independent integration.
   IntegratorOptions integrator = [] {
     IntegratorOptions options;
