@@ -125,15 +125,15 @@ void BM_PendulumIntegratorTable(benchmark::State& state, IntegratorMethod method
   }
   double rate_err = 0.0;
   for (size_t k = 0; k < t.size(); ++k) {
-    rate_err = std::max(rate_err, std::abs(trajectory.rate_rad_per_s[k] -
-                                           reference.rate_rad_per_s[k]));
+    rate_err =
+        std::max(rate_err, std::abs(trajectory.rate_rad_per_s[k] - reference.rate_rad_per_s[k]));
   }
   double sens_err = 0.0;
   for (int j = 0; j < kNumSensitivities; ++j) {
     const double scale = reference.d_rate.col(j).cwiseAbs().maxCoeff();
-    sens_err = std::max(sens_err,
-                        (trajectory.d_rate.col(j) - reference.d_rate.col(j)).cwiseAbs().maxCoeff() /
-                            scale);
+    sens_err = std::max(
+        sens_err,
+        (trajectory.d_rate.col(j) - reference.d_rate.col(j)).cwiseAbs().maxCoeff() / scale);
   }
   state.counters["rel_tol"] = options.rel_tol;
   state.counters["steps"] = static_cast<double>(integrator.last_stats().steps);
