@@ -6,7 +6,7 @@
 //       --benchmark_report_aggregates_only=true
 //
 // Arguments: model (0 full, 1 jardin, 2 linear), amplitude (deg). BM_TraceFitCvodes: the same
-// with the CVODES integrator instead of the default DOP853. BM_TraceFitWithBudget: plus the
+// with the CVODE integrator (`fit.integrator: cvodes`) instead of the default DOP853. BM_TraceFitWithBudget: plus the
 // geometry uncertainty budget (8 extra integrations without sensitivities).
 #include <string>
 
@@ -64,7 +64,7 @@ BENCHMARK(BM_TraceFit)
 
 void BM_TraceFitCvodes(benchmark::State& state) {
   TraceFitOptions options;
-  options.integrator.method = IntegratorMethod::kCvodes;
+  options.integrator = options.integrator.WithMethod(IntegratorMethod::kCvodes);  // as fit.integrator
   RunFit(state, Window(20.0), options);
 }
 BENCHMARK(BM_TraceFitCvodes)->Unit(benchmark::kMillisecond);

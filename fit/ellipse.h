@@ -1,7 +1,7 @@
 // Ellipse of inertia in the aircraft x-z plane: moments measured at many pitch angles in, I_x, I_z,
 // I_xz, the principal inclination angle tau and the principal moments out, with uncertainty.
 //
-// Conventions: ../shared/PHYSICS.md section 3 (body x forward, z down, pitch nose-up positive,
+// Conventions: docs/physics.md section 3 (body x forward, z down, pitch nose-up positive,
 // I_xz = integral of x z dm, tau in (-45, 45] deg, tau > 0: the principal x axis lies tau below
 // body x). The model is paper Eq. 4 written linearly,
 //     I(theta) = A + B cos 2theta + C sin 2theta,  A = (I_x + I_z)/2, B = (I_z - I_x)/2, C = I_xz,

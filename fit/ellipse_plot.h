@@ -1,7 +1,7 @@
 // Figures of an ellipse-of-inertia fit (PLplot through fit/figure.h): the paper's Fig. 3 (moment
 // against pitch with the fitted curve and the principal axes) and Fig. 4 (the moments in polar
 // coordinates, beside the true ellipse of inertia, radius 1/sqrt(I)). Conventions:
-// ../shared/PHYSICS.md section 3; the polar panels draw the body x-z plane with x forward to the
+// docs/physics.md section 3; the polar panels draw the body x-z plane with x forward to the
 // right and z down, so tau > 0 shows the principal x axis below body x.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The swing axis of one log and the swing rate omega_meas = gyro . n (../shared/PHYSICS.md §2),
+// The swing axis of one log and the swing rate omega_meas = gyro . n (docs/physics.md §2),
 // plus the pitch measured by the accelerometer (§3) and the secondary-motion metric.
 //
 // Conventions: n is the unit down vertical expressed in IMU axes; the accelerometer measures

@@ -1,5 +1,5 @@
 // The trace-fit residual, solver-free (Ceres wraps it in fit/trace_fit.cc; the Jacobian test
-// calls it directly). Conventions: ../shared/PHYSICS.md §2.
+// calls it directly). Conventions: docs/physics.md §2.
 //
 // Parameters (kNumTraceParams, scaled so every entry is O(1e-3..1) for the solver):
 //   p[0] = I / I_s,  p[1] = K_D / I_s,  p[2] = C / I_s,  p[3] = psi(t0) (rad),

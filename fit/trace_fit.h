@@ -1,5 +1,5 @@
 // The trace fit: one free-oscillation window of swing rate in, the suspended moment of inertia
-// with an honest uncertainty out. Model, signs and units: ../shared/PHYSICS.md §2.
+// with an honest uncertainty out. Model, signs and units: docs/physics.md §2.
 //
 // Observation model fitted to every sample k of the window (real, possibly jittered timestamps):
 //

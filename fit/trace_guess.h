@@ -1,4 +1,4 @@
-// Initial guess for the trace fit from the data alone (no solver): ../shared/PHYSICS.md §2.
+// Initial guess for the trace fit from the data alone (no solver): docs/physics.md §2.
 //
 //   period     least-squares line through the zero crossings (with hysteresis, linear
 //              interpolation between the real timestamps), so jitter and drops do not matter

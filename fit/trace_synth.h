@@ -1,7 +1,7 @@
 // Synthetic free-oscillation windows with known truth, for the trace-fit tests and benchmarks:
 // the model integrated at jittered timestamps with dropped samples, plus a gyro bias and white
 // noise. Only the free oscillation (no rest, twist or hold: that is pendulum/simulate.h's job).
-// Conventions: ../shared/PHYSICS.md §2.
+// Conventions: docs/physics.md §2.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +26,7 @@ struct SyntheticTraceOptions {
 };
 
 // The window (t_s, rate_rad_per_s, geometry, noise_rad_per_s = the true sigma). The truth is
-// integrated with CVODES at rel_tol 1e-12. Returns false if the integration fails.
+// integrated with CVODE at rel_tol 1e-12. Returns false if the integration fails.
 bool MakeSyntheticTrace(const SyntheticTraceOptions& options, TraceFitInput* input);
 
 }  // namespace bifilar

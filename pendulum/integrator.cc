@@ -10,11 +10,13 @@
 // are the methods' interpolants at each requested time, so steps never land on samples.
 //
 // kRungeKutta: DOP853 (dop853.h) on the 2- or 12-component system, all inlined.
-// kCvodes: the system is not stiff, so CVODES runs Adams-Moulton with the fixed-point nonlinear
-// solver (no Jacobian, no linear solve), CVODES forward sensitivities with the analytic
-// sensitivity right-hand side (CVodeSensInit with an all-at-once CVSensRhsFn), simultaneous
-// corrector, CVodeSetSensErrCon on, CV_NORMAL output with interpolation. The CVODES memory is
-// created once and re-initialised (CVodeReInit, CVodeSensReInit) for each call.
+// kCvodes: plain SUNDIALS CVODE on the same 2- or 12-component system (the variational
+// equations are just more components, so no sensitivity module is needed). The system is not
+// stiff: Adams-Moulton with the fixed-point nonlinear solver (no Jacobian, no linear solve),
+// CV_NORMAL output interpolated at each sample. One CVODE memory per system size, created on
+// first use and re-initialised (CVodeReInit) for each call. This replaced the CVODES forward-
+// sensitivity path (CVodeSensInit, simultaneous corrector), which was 2x slower at equal
+// accuracy: one 12-vector per step instead of 6 two-vectors and their per-vector overhead.
 #include "pendulum/integrator.h"
 
 #include <algorithm>
@@ -22,7 +24,7 @@
 #include <limits>
 #include <sstream>
 
-#include <cvodes/cvodes.h>
+#include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
@@ -31,14 +33,6 @@
 
 namespace bifilar {
 namespace {
-
-// Corrector for state and sensitivities. Measured on the 6000-sample trace, rel 1e-9:
-// simultaneous 27 ms, staggered 25.6 ms, within the noise of a loaded machine; simultaneous
-// kept (one fixed-point iteration for all 12 unknowns, one error test).
-#ifndef BIFILAR_CVODES_SENS_METHOD
-#define BIFILAR_CVODES_SENS_METHOD CV_SIMULTANEOUS
-#endif
-constexpr int kSensMethod = BIFILAR_CVODES_SENS_METHOD;
 
 bool Fail(std::string* why, const std::string& message) {
   if (why != nullptr) *why = message;
@@ -123,63 +117,62 @@ bool IntegratorOptions::Check(std::string* why) const {
   return true;
 }
 
+// One CVODE instance on the 2-component state (Sens = false) or the 12-component augmented
+// system (Sens = true): Adams-Moulton, fixed-point nonlinear solver (the system is not stiff:
+// no Jacobian, no linear solve), created on first use and re-initialised (CVodeReInit) for
+// each call.
+struct CvodeSystem {
+  void* mem = nullptr;
+  N_Vector y = nullptr;
+  SUNNonlinearSolver nls = nullptr;
+
+  ~CvodeSystem() {
+    if (mem != nullptr) CVodeFree(&mem);
+    if (nls != nullptr) SUNNonlinSolFree(nls);
+    if (y != nullptr) N_VDestroy(y);
+  }
+};
+
+IntegratorOptions IntegratorOptions::WithMethod(IntegratorMethod new_method) const {
+  IntegratorOptions out = *this;
+  if (new_method == method) return out;
+  out.method = new_method;
+  if (new_method == IntegratorMethod::kCvodes) {
+    out.rel_tol *= kCvodeToleranceFactor;
+    out.abs_tol *= kCvodeToleranceFactor;
+  } else if (method == IntegratorMethod::kCvodes) {
+    out.rel_tol /= kCvodeToleranceFactor;
+    out.abs_tol /= kCvodeToleranceFactor;
+  }
+  return out;
+}
+
 struct PendulumIntegrator::Impl {
   PendulumModel model;
   RigGeometry geometry;
   IntegratorOptions options;
   std::string setup_error;  // non-empty when construction failed; Integrate reports it
 
-  SUNContext ctx = nullptr;
-  void* cvode_mem = nullptr;
-  N_Vector y = nullptr;
-  N_Vector* yS = nullptr;
-  SUNNonlinearSolver nls = nullptr;
-  SUNNonlinearSolver nls_sens = nullptr;
-  bool cvode_initialized = false;
-  bool sens_initialized = false;
-
-  PendulumParams params;        // of the current Integrate call, read by the RHS
-  IntegratorStats stats;  // of the last Integrate call
-  std::string last_cvode_error;  // filled by the CVODES error handler
-
-  ~Impl() {
-    if (cvode_mem != nullptr) CVodeFree(&cvode_mem);
-    if (nls_sens != nullptr) SUNNonlinSolFree(nls_sens);
-    if (nls != nullptr) SUNNonlinSolFree(nls);
-    if (yS != nullptr) N_VDestroyVectorArray(yS, kNumSensitivities);
-    if (y != nullptr) N_VDestroy(y);
-    if (ctx != nullptr) SUNContext_Free(&ctx);
-  }
-
-  static int Rhs(realtype /*t*/, N_Vector y, N_Vector ydot, void* user_data) {
-    const Impl* self = static_cast<const Impl*>(user_data);
-    const double* yv = N_VGetArrayPointer(y);
-    double* dv = N_VGetArrayPointer(ydot);
-    if (!std::isfinite(yv[0]) || !std::isfinite(yv[1])) return 1;  // recoverable: smaller step
-    const double a =
-        AngularAcceleration(self->model, self->geometry, self->params, yv[0], yv[1]);
-    if (!std::isfinite(a)) return 1;
-    dv[0] = yv[1];
-    dv[1] = a;
-    return 0;
-  }
-
-  static int SensRhs(int ns, realtype /*t*/, N_Vector y, N_Vector /*ydot*/, N_Vector* yS,
-                     N_Vector* ySdot, void* user_data, N_Vector /*tmp1*/, N_Vector /*tmp2*/) {
-    const Impl* self = static_cast<const Impl*>(user_data);
-    const double* yv = N_VGetArrayPointer(y);
-    if (!std::isfinite(yv[0]) || !std::isfinite(yv[1])) return 1;
-    const AccelerationPartials p =
-        AngularAccelerationPartials(self->model, self->geometry, self->params, yv[0], yv[1]);
-    const double forcing[kNumSensitivities] = {p.d_inertia, p.d_drag, p.d_viscous, 0.0, 0.0};
-    for (int j = 0; j < ns; ++j) {
-      const double* s = N_VGetArrayPointer(yS[j]);
-      double* sd = N_VGetArrayPointer(ySdot[j]);
-      sd[0] = s[1];
-      sd[1] = p.d_angle * s[0] + p.d_rate * s[1] + forcing[j];
-      if (!std::isfinite(sd[1])) return 1;
+  // Declared before the CVODE systems, so destroyed after them.
+  struct Context {
+    SUNContext ctx = nullptr;
+    ~Context() {
+      if (ctx != nullptr) SUNContext_Free(&ctx);
     }
-    return 0;
+  } context;
+  CvodeSystem cvode_state;      // 2 components
+  CvodeSystem cvode_augmented;  // 12 components
+
+  PendulumParams params;         // of the current Integrate call, read by the RHS
+  IntegratorStats stats;         // of the last Integrate call
+  std::string last_cvode_error;  // filled by the CVODE error handler
+
+  template <bool Sens>
+  static int CvodeRhs(realtype /*t*/, N_Vector y, N_Vector ydot, void* user_data) {
+    const Impl* self = static_cast<const Impl*>(user_data);
+    const AugmentedRhs<Sens> rhs{self->model, &self->geometry, &self->params};
+    // A non-finite state or derivative is recoverable: CVODE retries with a smaller step.
+    return rhs(N_VGetArrayPointer(y), N_VGetArrayPointer(ydot)) ? 0 : 1;
   }
 
   static void ErrHandler(int /*error_code*/, const char* module, const char* function, char* msg,
@@ -201,90 +194,38 @@ struct PendulumIntegrator::Impl {
     return true;
   }
 
-  // Creates the CVODES memory on first use.
-  bool SetupCvodes() {
-    if (SUNContext_Create(nullptr, &ctx) != 0) {
-      setup_error = "SUNContext_Create failed";
-      return false;
+  // Creates the CVODE memory of *sys for a system of n components on first use.
+  template <bool Sens>
+  bool SetupCvode(CvodeSystem* sys, std::string* why) {
+    constexpr int kN = Sens ? 2 + 2 * kNumSensitivities : 2;
+    SUNContext& ctx = context.ctx;
+    if (ctx == nullptr && SUNContext_Create(nullptr, &ctx) != 0) {
+      return Fail(why, "SUNContext_Create failed");
     }
-    y = N_VNew_Serial(2, ctx);
-    if (y == nullptr) {
-      setup_error = "N_VNew_Serial failed";
-      return false;
+    sys->y = N_VNew_Serial(kN, ctx);
+    sys->mem = CVodeCreate(CV_ADAMS, ctx);
+    if (sys->y == nullptr || sys->mem == nullptr) return Fail(why, "CVODE allocation failed");
+    N_VConst(0.0, sys->y);
+    if (CVodeSetErrHandlerFn(sys->mem, &Impl::ErrHandler, this) != CV_SUCCESS ||
+        CVodeInit(sys->mem, &Impl::CvodeRhs<Sens>, 0.0, sys->y) != CV_SUCCESS ||
+        CVodeSStolerances(sys->mem, options.rel_tol, options.abs_tol) != CV_SUCCESS ||
+        CVodeSetUserData(sys->mem, this) != CV_SUCCESS ||
+        CVodeSetMaxNumSteps(sys->mem, options.max_steps) != CV_SUCCESS) {
+      return Fail(why, "CVODE set-up failed: " + last_cvode_error);
     }
-    N_VConst(0.0, y);
-    // Fused/array vector kernels: one call per operation on all sensitivity vectors.
-    N_VEnableFusedOps_Serial(y, SUNTRUE);
-    yS = N_VCloneVectorArray(kNumSensitivities, y);
-    cvode_mem = CVodeCreate(CV_ADAMS, ctx);
-    if (yS == nullptr || cvode_mem == nullptr) {
-      setup_error = "CVODES allocation failed";
-      return false;
+    sys->nls = SUNNonlinSol_FixedPoint(sys->y, 0, ctx);
+    if (sys->nls == nullptr || CVodeSetNonlinearSolver(sys->mem, sys->nls) != CV_SUCCESS) {
+      return Fail(why, "CVODE fixed-point solver set-up failed: " + last_cvode_error);
     }
-    if (CVodeSetErrHandlerFn(cvode_mem, &Impl::ErrHandler, this) != CV_SUCCESS ||
-        CVodeInit(cvode_mem, &Impl::Rhs, 0.0, y) != CV_SUCCESS ||
-        CVodeSStolerances(cvode_mem, options.rel_tol, options.abs_tol) != CV_SUCCESS ||
-        CVodeSetUserData(cvode_mem, this) != CV_SUCCESS ||
-        CVodeSetMaxNumSteps(cvode_mem, options.max_steps) != CV_SUCCESS) {
-      setup_error = "CVODES set-up failed: " + last_cvode_error;
-      return false;
-    }
-    nls = SUNNonlinSol_FixedPoint(y, 0, ctx);
-    if (nls == nullptr || CVodeSetNonlinearSolver(cvode_mem, nls) != CV_SUCCESS) {
-      setup_error = "CVODES fixed-point solver set-up failed: " + last_cvode_error;
-      return false;
-    }
-    cvode_initialized = true;
     return true;
   }
 
   template <bool Sens>
   bool IntegrateRk(double angle0_rad, double rate0_rad_per_s, const std::vector<double>& t_s,
                    size_t first, Trajectory* out, std::string* why);
-  bool IntegrateCvodes(double angle0_rad, double rate0_rad_per_s, const std::vector<double>& t_s,
-                       size_t first, bool with_sensitivities, Trajectory* out, std::string* why);
-
-  // Sets s_j(t0): zero for the parameters, unit vectors for psi(t0) and psi'(t0).
-  void ResetSensitivities() {
-    for (int j = 0; j < kNumSensitivities; ++j) N_VConst(0.0, yS[j]);
-    N_VGetArrayPointer(yS[kSensAngle0])[0] = 1.0;
-    N_VGetArrayPointer(yS[kSensRate0])[1] = 1.0;
-  }
-
-  bool EnableSensitivities(std::string* why) {
-    ResetSensitivities();
-    if (!sens_initialized) {
-      if (CVodeSensInit(cvode_mem, kNumSensitivities, kSensMethod, &Impl::SensRhs, yS) !=
-          CV_SUCCESS) {
-        return Fail(why, "CVodeSensInit failed: " + last_cvode_error);
-      }
-      realtype abstol_s[kNumSensitivities];
-      for (double& a : abstol_s) a = options.abs_tol;
-      if (CVodeSensSStolerances(cvode_mem, options.rel_tol, abstol_s) != CV_SUCCESS ||
-          CVodeSetSensErrCon(cvode_mem, SUNTRUE) != CV_SUCCESS) {
-        return Fail(why, "CVODES sensitivity set-up failed: " + last_cvode_error);
-      }
-      if (kSensMethod == CV_SIMULTANEOUS) {
-        nls_sens = SUNNonlinSol_FixedPointSens(kNumSensitivities + 1, y, 0, ctx);
-        if (nls_sens == nullptr ||
-            CVodeSetNonlinearSolverSensSim(cvode_mem, nls_sens) != CV_SUCCESS) {
-          return Fail(why, "CVODES sensitivity solver set-up failed: " + last_cvode_error);
-        }
-      } else {
-        nls_sens = SUNNonlinSol_FixedPointSens(kNumSensitivities, y, 0, ctx);
-        if (nls_sens == nullptr ||
-            CVodeSetNonlinearSolverSensStg(cvode_mem, nls_sens) != CV_SUCCESS) {
-          return Fail(why, "CVODES sensitivity solver set-up failed: " + last_cvode_error);
-        }
-      }
-      sens_initialized = true;
-      return true;
-    }
-    if (CVodeSensReInit(cvode_mem, kSensMethod, yS) != CV_SUCCESS) {
-      return Fail(why, "CVodeSensReInit failed: " + last_cvode_error);
-    }
-    return true;
-  }
+  template <bool Sens>
+  bool IntegrateCvode(double angle0_rad, double rate0_rad_per_s, const std::vector<double>& t_s,
+                      size_t first, Trajectory* out, std::string* why);
 };
 
 PendulumIntegrator::PendulumIntegrator(PendulumModel model, const RigGeometry& geometry,
@@ -370,7 +311,9 @@ bool PendulumIntegrator::Integrate(const PendulumParams& params, double angle0_r
     return with_sensitivities ? im.IntegrateRk<true>(angle0_rad, rate0_rad_per_s, t_s, first, out, why)
                               : im.IntegrateRk<false>(angle0_rad, rate0_rad_per_s, t_s, first, out, why);
   }
-  return im.IntegrateCvodes(angle0_rad, rate0_rad_per_s, t_s, first, with_sensitivities, out, why);
+  return with_sensitivities
+             ? im.IntegrateCvode<true>(angle0_rad, rate0_rad_per_s, t_s, first, out, why)
+             : im.IntegrateCvode<false>(angle0_rad, rate0_rad_per_s, t_s, first, out, why);
 }
 
 template <bool Sens>
@@ -437,26 +380,33 @@ bool PendulumIntegrator::Impl::IntegrateRk(double angle0_rad, double rate0_rad_p
   return Fail(why, os.str());
 }
 
-bool PendulumIntegrator::Impl::IntegrateCvodes(double angle0_rad, double rate0_rad_per_s,
-                                               const std::vector<double>& t_s, size_t first,
-                                               bool with_sensitivities, Trajectory* out,
-                                               std::string* why) {
-  Impl& im = *this;
-  // A failed set-up leaves setup_error set, which Integrate reports from then on.
-  if (!cvode_initialized && !SetupCvodes()) return Fail(why, setup_error);
+template <bool Sens>
+bool PendulumIntegrator::Impl::IntegrateCvode(double angle0_rad, double rate0_rad_per_s,
+                                              const std::vector<double>& t_s, size_t first,
+                                              Trajectory* out, std::string* why) {
+  constexpr int kN = Sens ? 2 + 2 * kNumSensitivities : 2;
+  CvodeSystem* sys = Sens ? &cvode_augmented : &cvode_state;
+  // A failed set-up is kept in setup_error, which Integrate reports from then on.
+  if (sys->mem == nullptr) {
+    std::string reason;
+    if (!SetupCvode<Sens>(sys, &reason)) {
+      setup_error = reason;
+      return Fail(why, reason);
+    }
+  }
   const size_t n = t_s.size();
-  im.last_cvode_error.clear();
+  last_cvode_error.clear();
   const double t0 = t_s[0];
-  double* yv = N_VGetArrayPointer(im.y);
+  double* yv = N_VGetArrayPointer(sys->y);
+  std::fill(yv, yv + kN, 0.0);
   yv[0] = angle0_rad;
   yv[1] = rate0_rad_per_s;
-  if (CVodeReInit(im.cvode_mem, t0, im.y) != CV_SUCCESS) {
-    return Fail(why, "CVodeReInit failed: " + im.last_cvode_error);
+  if (Sens) {
+    yv[2 + 2 * kSensAngle0] = 1.0;
+    yv[3 + 2 * kSensRate0] = 1.0;
   }
-  if (with_sensitivities) {
-    if (!im.EnableSensitivities(why)) return false;
-  } else if (im.sens_initialized) {
-    CVodeSensToggleOff(im.cvode_mem);
+  if (CVodeReInit(sys->mem, t0, sys->y) != CV_SUCCESS) {
+    return Fail(why, "CVodeReInit failed: " + last_cvode_error);
   }
 
   for (size_t k = first; k < n; ++k) {
@@ -465,64 +415,57 @@ bool PendulumIntegrator::Impl::IntegrateCvodes(double angle0_rad, double rate0_r
     if (t == t_s[k - 1]) {
       out->angle_rad[k] = out->angle_rad[k - 1];
       out->rate_rad_per_s[k] = out->rate_rad_per_s[k - 1];
-      if (with_sensitivities) {
+      if (Sens) {
         out->d_angle.row(k) = out->d_angle.row(k - 1);
         out->d_rate.row(k) = out->d_rate.row(k - 1);
       }
       continue;
     }
     realtype t_ret = t0;
-    const int flag = CVode(im.cvode_mem, t, im.y, &t_ret, CV_NORMAL);
+    // CV_NORMAL: CVODE steps past t and interpolates back to it.
+    const int flag = CVode(sys->mem, t, sys->y, &t_ret, CV_NORMAL);
     if (flag < 0) {
       std::ostringstream os;
       os.precision(10);
       if (flag == CV_TOO_MUCH_WORK) {
-        os << "CVODES took more than max_steps = " << im.options.max_steps << " steps; ";
+        os << "CVODE took more than max_steps = " << options.max_steps << " steps; ";
       }
-      os << "CVODES failed at t = " << t_ret << " s (" << ToString(im.model)
+      os << "CVODE failed at t = " << t_ret << " s (" << ToString(model)
          << " model, integrating from " << t0 << " s to " << t << " s): "
-         << (im.last_cvode_error.empty() ? "flag " + std::to_string(flag) : im.last_cvode_error);
+         << (last_cvode_error.empty() ? "flag " + std::to_string(flag) : last_cvode_error);
       return Fail(why, os.str());
     }
     long num_steps = 0;
-    CVodeGetNumSteps(im.cvode_mem, &num_steps);
-    if (num_steps > im.options.max_steps) {
+    CVodeGetNumSteps(sys->mem, &num_steps);
+    if (num_steps > options.max_steps) {
       std::ostringstream os;
-      os << "CVODES took more than max_steps = " << im.options.max_steps << " steps by t = " << t
+      os << "CVODE took more than max_steps = " << options.max_steps << " steps by t = " << t
          << " s";
       return Fail(why, os.str());
     }
-    if (!std::isfinite(yv[0]) || !std::isfinite(yv[1])) {
-      std::ostringstream os;
-      os << "non-finite state at t = " << t << " s";
-      return Fail(why, os.str());
+    for (int i = 0; i < kN; ++i) {
+      if (!std::isfinite(yv[i])) {
+        std::ostringstream os;
+        os << "non-finite " << (i < 2 ? "state" : "sensitivity") << " at t = " << t << " s";
+        return Fail(why, os.str());
+      }
     }
     out->angle_rad[k] = yv[0];
     out->rate_rad_per_s[k] = yv[1];
-    if (with_sensitivities) {
-      if (CVodeGetSens(im.cvode_mem, &t_ret, im.yS) != CV_SUCCESS) {
-        return Fail(why, "CVodeGetSens failed: " + im.last_cvode_error);
-      }
+    if (Sens) {
       for (int j = 0; j < kNumSensitivities; ++j) {
-        const double* s = N_VGetArrayPointer(im.yS[j]);
-        if (!std::isfinite(s[0]) || !std::isfinite(s[1])) {
-          std::ostringstream os;
-          os << "non-finite sensitivity at t = " << t << " s";
-          return Fail(why, os.str());
-        }
-        out->d_angle(k, j) = s[0];
-        out->d_rate(k, j) = s[1];
+        out->d_angle(k, j) = yv[2 + 2 * j];
+        out->d_rate(k, j) = yv[3 + 2 * j];
       }
     }
   }
-  long steps = 0, rhs_evals = 0, sens_rhs_evals = 0, test_fails = 0;
-  CVodeGetNumSteps(cvode_mem, &steps);
-  CVodeGetNumRhsEvals(cvode_mem, &rhs_evals);
-  CVodeGetNumErrTestFails(cvode_mem, &test_fails);
-  if (with_sensitivities) CVodeGetSensNumRhsEvals(cvode_mem, &sens_rhs_evals);
+  long steps = 0, rhs_evals = 0, test_fails = 0;
+  CVodeGetNumSteps(sys->mem, &steps);
+  CVodeGetNumRhsEvals(sys->mem, &rhs_evals);
+  CVodeGetNumErrTestFails(sys->mem, &test_fails);
   stats.steps = steps;
   stats.rejected_steps = test_fails;
-  stats.rhs_evals = std::max(rhs_evals, sens_rhs_evals);
+  stats.rhs_evals = rhs_evals;
   return true;
 }
 

@@ -1,7 +1,7 @@
 // Integration of the pendulum model (pendulum/model.h), at a log's own, possibly non-uniform
 // timestamps, with forward sensitivities of the state with respect to I, K_D, C, psi(t0) and
-// psi'(t0), by an inlined DOP853 Runge-Kutta (default) or SUNDIALS CVODES (IntegratorMethod).
-// Conventions: ../shared/PHYSICS.md §2.
+// psi'(t0), by an inlined DOP853 Runge-Kutta (default) or SUNDIALS CVODE (IntegratorMethod).
+// Conventions: docs/physics.md §2 (model), docs/method.md (where the fit uses it).
 #pragma once
 
 #include <memory>
@@ -14,15 +14,19 @@
 
 namespace bifilar {
 
-// The ODE solver behind PendulumIntegrator. Both integrate the same equations (state and
-// forward sensitivities, analytic, sensitivities in the error test) to the same tolerances.
+// The ODE solver behind PendulumIntegrator. Both integrate the same system: the state
+// (psi, psi') alone, or augmented with the 2x5 variational equations of the forward
+// sensitivities (12 components, analytic, all in the error test).
 enum class IntegratorMethod {
   // Explicit Runge-Kutta 8(5,3) with 7th-order dense output (Dormand-Prince DOP853), inlined on
-  // the 2- or 12-component system: ~25x faster than CVODES here (README, Performance).
+  // the 2- or 12-component system: ~15x faster than CVODE here (README, Performance).
   kRungeKutta,
-  // SUNDIALS CVODES, Adams-Moulton with the fixed-point solver and CVODES forward sensitivities
-  // (simultaneous corrector). The reference implementation; slower per step (general N_Vector
-  // machinery) and with larger global error at equal tolerances.
+  // SUNDIALS CVODE on the same 2- or 12-component system: Adams-Moulton, the fixed-point
+  // nonlinear solver, CV_NORMAL output interpolated at the samples. An independent check of
+  // kRungeKutta (and the simulator's truth integrator); slower per step (general N_Vector
+  // machinery, ~8x more steps) and ~20x larger global error at equal tolerances, hence
+  // IntegratorOptions::WithMethod. Named "cvodes" in configs for continuity with earlier
+  // versions, which used the CVODES sensitivity module (2x slower at equal accuracy).
   kCvodes,
 };
 // "rk853", "cvodes".
@@ -35,14 +39,24 @@ struct IntegratorOptions {
   // rad/s (3e-10 without sensitivities), sensitivities to ~1e-8 of their scale, periods to
   // 1e-11 relative and energy kept to 1.2e-9: far below any gyro noise, at ~1 ms per
   // 6000-sample trace with sensitivities (README, Performance). kCvodes at the same values is
-  // ~10x less accurate globally and ~25x slower.
+  // ~18x less accurate globally (rate) and ~14x slower; see WithMethod.
   double rel_tol = 1e-10;     // Relative tolerance (dimensionless); in (0, 1e-2].
   double abs_tol = 1e-12;     // Absolute tolerance (rad, rad/s, and for sensitivities); > 0.
   long max_steps = 1000000;   // Internal steps allowed over the whole trace; > 0.
   IntegratorMethod method = IntegratorMethod::kRungeKutta;  // ODE solver, see above.
 
   bool Check(std::string* why) const;
+
+  // A copy that integrates with `new_method`. For kCvodes the tolerances are multiplied by
+  // kCvodeToleranceFactor: Adams leaves a larger global error at equal nominal tolerances, and
+  // at 0.3x (defaults 1e-10/1e-12 -> 3e-11/3e-13) it matches the former CVODES sensitivity path
+  // at the defaults (rate error 1.4e-9 against 1.2e-9 rad/s on the 60 s benchmark trace,
+  // bench/pendulum_bench.cc) in half its time. Switching back divides again.
+  IntegratorOptions WithMethod(IntegratorMethod new_method) const;
 };
+
+// Tolerance factor of IntegratorOptions::WithMethod for kCvodes (dimensionless, measured).
+constexpr double kCvodeToleranceFactor = 0.3;
 
 // Column order of the sensitivity matrices.
 enum SensitivityIndex {
@@ -70,7 +84,7 @@ struct IntegratorStats {
   long rhs_evals = 0;       // right-hand side evaluations (state, or state + sensitivities)
 };
 
-// Reusable: keeps the CVODES memory between calls, so a fit's tens of integrations allocate
+// Reusable: keeps the CVODE memory between calls, so a fit's tens of integrations allocate
 // once. Not thread-safe; use one per thread.
 class PendulumIntegrator {
  public:

@@ -1,4 +1,4 @@
-// The bifilar pendulum equations of motion: ../shared/PHYSICS.md §2 (see model.h).
+// The bifilar pendulum equations of motion: docs/physics.md §2 (see model.h).
 #include "pendulum/model.h"
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// The bifilar pendulum equations of motion: ../shared/PHYSICS.md §2.
+// The bifilar pendulum equations of motion: docs/physics.md §2.
 //
 // Conventions: psi is the yaw angle (rad) about the down vertical through the CG, rate = psi'
 // (rad/s). m is the whole suspended mass (aircraft + rig + IMU), I the whole suspended inertia
@@ -41,7 +41,7 @@ struct PendulumParams {
   bool Check(std::string* why) const;
 };
 
-// h(psi), h'(psi), h''(psi) of PHYSICS.md §2 (m, m/rad, m/rad^2).
+// h(psi), h'(psi), h''(psi) of docs/physics.md §2 (m, m/rad, m/rad^2).
 double RiseHeight(const RigGeometry& geometry, double angle_rad);
 double RiseSlope(const RigGeometry& geometry, double angle_rad);
 double RiseCurvature(const RigGeometry& geometry, double angle_rad);

@@ -2,15 +2,15 @@
 // Physics and IMU synthesis only (no files, no YAML): pipeline/simulate_spec.h reads the spec and
 // writes the files.
 //
-// Conventions (../shared/PHYSICS.md §2, §3): body axes x forward, y right wing, z down, origin at
+// Conventions (docs/physics.md §2, §3): body axes x forward, y right wing, z down, origin at
 // the CG; pitch theta nose-up positive; the swing axis (down vertical) in body axes is
 // n_body = (-sin theta, 0, cos theta); psi is the yaw angle about n (right-handed about down), so
 // the body's angular velocity is psi' n_body: the swing shows on body z at small pitch and on -x at
 // large nose-up pitch. The IMU is mounted on the rig with rotation body_from_imu
 // (v_body = body_from_imu * v_imu; identity by default), at imu_offset_in_body_m from the CG. The
 // accelerometer measures specific force f = a - g_vec: at rest f = -g n (pointing up), so
-// down = -f/|f| as PHYSICS.md says. Lever-arm terms at offset r: a = psi'' n x r
-// - psi'^2 r_perp - (d^2 h/dt^2) n, with h the rise of the body (PHYSICS.md §2).
+// down = -f/|f| as docs/physics.md says. Lever-arm terms at offset r: a = psi'' n x r
+// - psi'^2 r_perp - (d^2 h/dt^2) n, with h the rise of the body (docs/physics.md §2).
 //
 // One trace, in time order: rest, the hand twisting to the amplitude A (smooth quintic ramp),
 // holding with hand tremor, release (psi(t_release) = A, psi'(t_release) = a small random rate),
@@ -90,7 +90,7 @@ struct SimulationOptions {
   // RK4 (<= 1 ms steps) instead of PendulumIntegrator when non-zero. Fraction, e.g. 0.01 = +1 %
   // at 60 deg; in [0, 0.5].
   double sway_coupling_at_60deg = 0.0;
-  // The truth's integrator. Default: CVODES, a different solver from the fit's default
+  // The truth's integrator. Default: CVODE (kCvodes), a different solver from the fit's default
   // (Runge-Kutta), so that the fit is judged against an independent integration.
   IntegratorOptions integrator = [] {
     IntegratorOptions options;
@@ -155,9 +155,9 @@ struct AircraftTruth {
   double mass_kg = 0.0;       // > 0
   double ix_kg_m2 = 0.0;      // I_x, body axes about the CG; > 0
   double iz_kg_m2 = 0.0;      // I_z; > 0
-  double ixz_kg_m2 = 0.0;     // I_xz = integral x z dm (PHYSICS.md §3)
+  double ixz_kg_m2 = 0.0;     // I_xz = integral x z dm (docs/physics.md §3)
 
-  // I(theta) = I_z cos^2 + I_x sin^2 + I_xz sin 2theta (PHYSICS.md §3, paper Eq. 4).
+  // I(theta) = I_z cos^2 + I_x sin^2 + I_xz sin 2theta (docs/physics.md §3, paper Eq. 4).
   double InertiaAtPitch(double pitch_rad) const;
   // Principal inclination tau = 0.5 atan2(2 I_xz, I_z - I_x), in (-pi/4, pi/4].
   double PrincipalInclinationRad() const;

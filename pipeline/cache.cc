@@ -77,6 +77,10 @@ std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
   Put(out, "g_std", config.uncertainties.gravity_std_mps2);
   Put(out, "gyro_scale_std", config.imu.gyro_scale_std);
   out << "model=" << ToString(config.fit.model) << ';';
+  // Only a non-default integrator enters the key, so rk853 keys stay those of earlier versions.
+  if (config.fit.integrator != IntegratorMethod::kRungeKutta) {
+    out << "integrator=" << ToString(config.fit.integrator) << ';';
+  }
   if (window_s) {
     Put(out, "t0", (*window_s)[0]);
     Put(out, "t1", (*window_s)[1]);

@@ -1,7 +1,7 @@
 // A test campaign: a folder of IMU logs (a few trials per pitch angle) plus the rig's tare logs
 // -> every trace fitted (in parallel, cached), the rig subtracted, per-angle statistics, the
 // ellipse of inertia, and results.json / traces.csv / angles.csv / report.html in OUT.
-// Conventions: ../shared/PHYSICS.md §2 (tare: I_aircraft = I_total - I_rig), §3 (pitch, ellipse).
+// Conventions: docs/physics.md §2 (tare: I_aircraft = I_total - I_rig), §3 (pitch, ellipse).
 #pragma once
 
 #include <functional>

@@ -76,7 +76,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     std::string config;
     std::vector<std::string> logs;
     bool json = false;
-    std::string model, window, plot_dir;
+    std::string model, integrator, window, plot_dir;
     double max_amplitude_deg = NAN;
   };
   auto args = std::make_shared<Args>();
@@ -89,6 +89,9 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
   sub->add_flag("--json", args->json, "print a JSON array of trace records instead of lines");
   sub->add_option("--model", args->model, "full (default), jardin or linear")
       ->check(CLI::IsMember({"full", "jardin", "linear"}));
+  sub->add_option("--integrator", args->integrator,
+                  "ODE solver of the fit: rk853 (default) or cvodes; overrides fit.integrator")
+      ->check(CLI::IsMember({"rk853", "cvodes"}));
   sub->add_option("--window", args->window, "fit only T0:T1 (s, the log's own time)");
   sub->add_option("--max-amplitude", args->max_amplitude_deg,
                   "upper end of the amplitude band (deg)")
@@ -99,6 +102,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     load.require_runs = false;
     CampaignConfig config = LoadCampaignConfig(args->config, load);
     if (!args->model.empty()) ParsePendulumModel(args->model, &config.fit.model);
+    if (!args->integrator.empty()) ParseIntegratorMethod(args->integrator, &config.fit.integrator);
     if (std::isfinite(args->max_amplitude_deg)) {
       config.fit.max_amplitude_deg = args->max_amplitude_deg;
       if (config.fit.min_amplitude_deg && *config.fit.min_amplitude_deg >= args->max_amplitude_deg) {

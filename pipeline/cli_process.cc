@@ -17,6 +17,7 @@ void RegisterProcessCommands(CLI::App& app, int* exit_code) {
     std::string out;
     int jobs = 0;
     bool force = false;
+    std::string integrator;
     std::string report_dir;
   };
   auto args = std::make_shared<Args>();
@@ -30,8 +31,12 @@ void RegisterProcessCommands(CLI::App& app, int* exit_code) {
   process->add_option("--jobs", args->jobs, "worker threads (default: all cores)")
       ->check(CLI::NonNegativeNumber);
   process->add_flag("--force", args->force, "ignore the cache and refit every log");
+  process->add_option("--integrator", args->integrator,
+                      "ODE solver of the fits: rk853 or cvodes; overrides fit.integrator")
+      ->check(CLI::IsMember({"rk853", "cvodes"}));
   process->callback([args, exit_code] {
-    const CampaignConfig config = LoadCampaignConfig(args->config);
+    CampaignConfig config = LoadCampaignConfig(args->config);
+    if (!args->integrator.empty()) ParseIntegratorMethod(args->integrator, &config.fit.integrator);
     CampaignOptions options;
     options.out_dir = args->out.empty()
                           ? (std::filesystem::path(config.folder) / "out").string()

@@ -342,6 +342,11 @@ CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptio
       throw UserError(fit.Where(fit.Optional("model")) +
                       ": 'fit.model' must be full, jardin or linear, not '" + model + "'");
     }
+    const std::string integrator = fit.OptionalString("integrator", "rk853");
+    if (!ParseIntegratorMethod(integrator, &config.fit.integrator)) {
+      throw UserError(fit.Where(fit.Optional("integrator")) +
+                      ": 'fit.integrator' must be rk853 or cvodes, not '" + integrator + "'");
+    }
     YAML::Node windows = fit.Optional("windows");
     if (windows.IsDefined() && !windows.IsNull()) {
       if (!windows.IsMap()) {

@@ -3,7 +3,7 @@
 // (pipeline/yaml_reader.h), missing required keys are named. Relative paths are resolved against
 // the folder of the config file. All values in memory are SI (kg, m, m/s^2, kg m^2, deg for
 // pitch angles); `units` only chooses how the console and the report print them.
-// Conventions (pitch nose-up positive, swing axis = down vertical): ../shared/PHYSICS.md §2, §3.
+// Conventions (pitch nose-up positive, swing axis = down vertical): docs/physics.md §2, §3.
 #pragma once
 
 #include <array>
@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include "pendulum/integrator.h"
 #include "pendulum/model.h"
 #include "pipeline/imu_format.h"
 
@@ -21,7 +22,7 @@ namespace bifilar {
 
 enum class DisplayUnits { kSi, kImperial };        // "si" (kg m^2), "imperial" (slug ft^2)
 enum class PitchSource { kNominal, kMeasured };    // "nominal", "measured"
-constexpr double kSlugFt2PerKgM2 = 1.0 / 1.35581795;  // PHYSICS.md §4
+constexpr double kSlugFt2PerKgM2 = 1.0 / 1.35581795;  // docs/physics.md §4
 
 // How the rig's own inertia (subtracted from every total) is known: exactly one of three ways.
 struct RigInertiaSpec {
@@ -86,6 +87,8 @@ struct SweepConfig {
 
 struct FitConfig {
   PendulumModel model = PendulumModel::kFull;  // `fit.model`: full | jardin | linear
+  // `fit.integrator`: rk853 (default) | cvodes; the fit's ODE solver (pendulum/integrator.h).
+  IntegratorMethod integrator = IntegratorMethod::kRungeKutta;
   // Per-file window overrides [t0, t1] (s), keyed by the path as written (relative to runs root
   // or to the config folder for tare logs); the file names are resolved at load time.
   std::map<std::string, std::array<double, 2>> windows_s;

@@ -2,7 +2,7 @@
 // pitch_deg (nose-up pitch, deg), inertia (moment about the vertical swing axis) and optionally
 // std (its standard error), one row per trial or per angle. Blank lines and lines starting with
 // '#' are skipped. Inertia and std are in the table's units (SI kg m^2 or slug ft^2) and are
-// converted to SI on reading. Conventions: ../shared/PHYSICS.md section 3.
+// converted to SI on reading. Conventions: docs/physics.md section 3.
 #pragma once
 
 #include <string>

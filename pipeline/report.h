@@ -3,7 +3,7 @@
 // other file): the paper's Table 1 and Table 2 in the chosen units, moments against pitch with
 // the fitted curve (Fig. 3), the polar ellipse with principal axes (Fig. 4), the NACA-467
 // comparison, per-angle statistics, every trace with its fit-and-residual figure, the rejected
-// traces with reasons, and the config used. Conventions: ../shared/PHYSICS.md §3, §4.
+// traces with reasons, and the config used. Conventions: docs/physics.md §3, §4.
 #pragma once
 
 #include <string>

@@ -19,7 +19,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
-constexpr double kSlugFt2ToKgM2 = 1.35581795;  // PHYSICS.md §4
+constexpr double kSlugFt2ToKgM2 = 1.35581795;  // docs/physics.md §4
 
 // root.Child(key), safe when the section is absent (yaml-cpp's const operator[] returns an
 // invalid "zombie" node for a missing key, on which IsMap() throws).

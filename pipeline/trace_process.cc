@@ -243,6 +243,7 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
   input.label = name;
   TraceFitOptions fit_options;
   fit_options.model = config.fit.model;
+  fit_options.integrator = fit_options.integrator.WithMethod(config.fit.integrator);
   const QualityThresholds& q = config.fit.quality;
   fit_options.max_rms_over_noise = q.max_rms_over_noise;
   fit_options.max_residual_autocorr = q.max_residual_autocorr;

@@ -3,7 +3,7 @@
 // fit-and-residual figure. Used by `bifilar process` (for every log of a campaign, from worker
 // threads) and by `bifilar fit`. Any failure of one file becomes status `error` with a message
 // naming the file; nothing throws out of ProcessTrace.
-// Conventions: ../shared/PHYSICS.md §2 (psi, I total = rig + aircraft), §3 (pitch).
+// Conventions: docs/physics.md §2 (psi, I total = rig + aircraft), §3 (pitch).
 #pragma once
 
 #include <array>

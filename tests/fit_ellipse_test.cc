@@ -25,7 +25,7 @@ double TrueMoment(const Truth& t, double pitch_deg) {
          t.ixz * std::sin(2 * th);
 }
 
-// tan 2tau = 2 I_xz / (I_z - I_x), tau in (-45, 45] (PHYSICS.md section 3).
+// tan 2tau = 2 I_xz / (I_z - I_x), tau in (-45, 45] (docs/physics.md section 3).
 double TrueTauDeg(const Truth& t) {
   double tau = 0.5 * std::atan2(t.ixz, 0.5 * (t.iz - t.ix)) * 180 / kPi;
   if (tau > 45) tau -= 90;
@@ -109,7 +109,7 @@ TEST(EllipseFit, ExactDataRecoversTruthAndAllFitsAgree) {
 }
 
 TEST(EllipseFit, SignConventionsFollowPhysicsMd) {
-  // PHYSICS.md section 3: tan 2tau = 2 I_xz / (I_z - I_x); tau in (-45, 45]; I_zp about the
+  // docs/physics.md section 3: tan 2tau = 2 I_xz / (I_z - I_x); tau in (-45, 45]; I_zp about the
   // principal axis nearest body z; the curve is I_zp cos^2(theta - tau) + I_xp sin^2(theta - tau).
   const std::vector<Truth> truths = {kPaper, {3.0, 2.0, 0.4}, {3.0, 2.0, -0.4}, {2.0, 2.0, 0.3},
                                      {2.0, 2.0, -0.3}};

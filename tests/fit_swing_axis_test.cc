@@ -26,7 +26,7 @@ Eigen::Vector3d DownInBody(double pitch_deg) {
 }
 
 TEST(SwingAxis, PitchSignConvention) {
-  // PHYSICS.md §3: n_body = (-sin theta, 0, cos theta), nose-up positive.
+  // docs/physics.md §3: n_body = (-sin theta, 0, cos theta), nose-up positive.
   for (double pitch : {-80.0, -30.0, 0.0, 12.5, 45.0, 89.0, 90.0}) {
     EXPECT_NEAR(PitchFromDownDeg(DownInBody(pitch)), pitch, 1e-12) << pitch;
     EXPECT_NEAR(RollFromDownDeg(DownInBody(pitch)), 0.0, 1e-9) << pitch;

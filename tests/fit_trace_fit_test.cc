@@ -23,7 +23,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadPerDeg = kPi / 180.0;
 
-// The PHYSICS.md §2 example rig: D/L = 0.44 and m (D/2)^2 / I = 1 at I = 1.1616 kg m^2, where
+// The docs/physics.md §2 example rig: D/L = 0.44 and m (D/2)^2 / I = 1 at I = 1.1616 kg m^2, where
 // the full model's kinetic term matters (period ~2.8 s).
 RigGeometry TestRig() {
   RigGeometry g;
@@ -172,7 +172,7 @@ TEST(TraceFit, AccuracyOverAmplitudes5To30Deg) {
   // Issue 3 targets: median <= 0.01 %, max <= 0.05 %.
   EXPECT_LE(med, 1e-4);
   EXPECT_LE(mx, 5e-4);
-  // The simpler models are biased on the same traces (PHYSICS.md §2: jardin misses the rise's
+  // The simpler models are biased on the same traces (docs/physics.md §2: jardin misses the rise's
   // kinetic energy, linear the amplitude dependence of the period): their median error is many
   // times the full model's.
   EXPECT_GT(Median(err_jardin), 5 * med);

@@ -1,4 +1,4 @@
-// Known answers for the pendulum integrator (pendulum/integrator.h, ../shared/PHYSICS.md §2):
+// Known answers for the pendulum integrator (pendulum/integrator.h, docs/physics.md §2):
 // small-angle period, the large-amplitude period of each model against an independent
 // quadrature of its energy integral, energy conservation and dissipation, sensitivities against
 // central differences, the full-vs-jardin inertia bias, and bad input.
@@ -362,13 +362,13 @@ TEST(PendulumIntegrator, SensitivitiesMatchCentralDifferences) {
   }
 }
 
-// Issue 2 item 3 and PHYSICS.md §2: with D/L = 0.44 and m (D/2)^2 / I = 1, a jardin fit of a
+// Issue 2 item 3 and docs/physics.md §2.3: with D/L = 0.44 and m (D/2)^2 / I = 1, a jardin fit of a
 // full-model swing reports I_j = I (T_full / T_jardin)^2 (the jardin period scales as sqrt(I)
-// at fixed amplitude). PHYSICS.md: +0.08 %, +0.3 %, +1.4 % at 10, 20, 45 deg. The quadrature
-// gives 0.0733 %, 0.2875 %, 1.311 %: the first two agree at the stated precision; the 45 deg
-// figure should read 1.3 % (reported). Checked here from integrated periods, against the
-// quadrature values to 1e-4 (absolute, in percent: 1e-7 period accuracy, times 2 for the
-// square, times 100).
+// at fixed amplitude). An earlier physics note stated +0.08 %, +0.3 %, +1.4 % at 10, 20, 45 deg
+// (kept below as physics_md_*). The quadrature gives 0.0733 %, 0.2875 %, 1.311 %: the first two
+// agree at the stated precision; the 45 deg figure reads 1.3 % (docs/physics.md §2.3). Checked
+// here from integrated periods, against the quadrature values to 1e-4 (absolute, in percent:
+// 1e-7 period accuracy, times 2 for the square, times 100).
 TEST(PendulumIntegrator, FullVersusJardinInertiaBias) {
   RigGeometry g;
   g.filar_length_m = 1.0;
@@ -394,12 +394,12 @@ TEST(PendulumIntegrator, FullVersusJardinInertiaBias) {
                1);
     EXPECT_NEAR(bias_percent, quad_percent, 1e-4) << c.deg;
     EXPECT_NEAR(quad_percent, c.quadrature_percent, 1e-4) << c.deg;
-    // At the precision PHYSICS.md states (the 45 deg figure passes only at the edge).
+    // At the precision the earlier note stated (the 45 deg figure passes only at the edge).
     EXPECT_NEAR(bias_percent, c.physics_md_percent, c.physics_md_precision) << c.deg;
   }
 }
 
-// PHYSICS.md §2: the small-angle formula overestimates I by about A^2/8 (0.4, 1.5, 7.8 % at
+// docs/physics.md §2: the small-angle formula overestimates I by about A^2/8 (0.4, 1.5, 7.8 % at
 // 10, 20, 45 deg). I_linear = InertiaFromSmallAnglePeriod(T(A)) against the true I:
 //  - A^2/8 is the leading term for a simple pendulum, which the jardin model becomes for
 //    D << L (h -> (D^2/4L)(1 - cos psi)); the exact simple-pendulum value is
@@ -417,7 +417,7 @@ TEST(PendulumIntegrator, SmallAngleFormulaOverestimate) {
   narrow.filar_length_m = 2.0;
   narrow.filar_separation_m = 0.002;
   narrow.mass_kg = 10.0;
-  RigGeometry rig;  // the PHYSICS.md rig
+  RigGeometry rig;  // the docs/physics.md rig
   rig.filar_length_m = 1.0;
   rig.filar_separation_m = 0.44;
   rig.mass_kg = 3.0;

@@ -1,4 +1,4 @@
-// Known answers for the pendulum equations (pendulum/model.h, ../shared/PHYSICS.md §2): the
+// Known answers for the pendulum equations (pendulum/model.h, docs/physics.md §2): the
 // rise h and its derivatives, the analytic partials of psi'' against numeric differentiation,
 // the energy balance, the small-angle period, and the input checks.
 #include "pendulum/model.h"
@@ -84,7 +84,7 @@ TEST(PendulumModel, EquationsOfMotionAsWritten) {
   const double psi = 0.4, w = -1.3;
   const double h1 = RiseSlope(g, psi), h2 = RiseCurvature(g, psi);
   const double damp = K * w * std::abs(w) + C * w;
-  // Residuals of PHYSICS.md §2, with psi'' from the model, vanish to rounding.
+  // Residuals of docs/physics.md §2, with psi'' from the model, vanish to rounding.
   const double a_full = AngularAcceleration(PendulumModel::kFull, g, p, psi, w);
   EXPECT_NEAR((I + m * h1 * h1) * a_full + m * h1 * h2 * w * w + damp + m * g.gravity_mps2 * h1,
               0.0, 1e-13);
@@ -169,7 +169,7 @@ TEST(PendulumModel, EnergyBalanceMatchesDampingPower) {
     EXPECT_GT(MechanicalEnergy(model, g, p, 0.1, 0.0), 0.0);
     EXPECT_GT(MechanicalEnergy(model, g, p, 0.0, 0.1), 0.0);
   }
-  // Values spelled out for one state (PHYSICS.md energies).
+  // Values spelled out for one state (docs/physics.md energies).
   const double psi = 0.5, w = 1.2;
   const double m = g.mass_kg, I = p.inertia_kg_m2, h = RiseHeight(g, psi),
                h1 = RiseSlope(g, psi), gm = g.gravity_mps2;

@@ -111,7 +111,7 @@ TEST(Simulate, AccelerometerAtRestGivesDownForAPitchedTiltedImu) {
     const Eigen::Vector3d n_imu = setup.body_from_imu.transpose() * n_body;
     const Eigen::Vector3d f = trace.imu.accel_in_imu[0];  // at rest, before the twist
     EXPECT_NEAR(f.norm(), setup.geometry.gravity_mps2, 1e-12);
-    // PHYSICS.md §2: down = -f/|f|.
+    // docs/physics.md §2: down = -f/|f|.
     EXPECT_NEAR((-f.normalized() - n_imu).norm(), 0.0, 1e-12) << pitch_deg;
     EXPECT_NEAR((trace.truth.swing_axis_in_imu - n_imu).norm(), 0.0, 1e-12);
   }
