@@ -37,6 +37,7 @@ struct SimulateSpec {
   ImuFormat format;                 // CSV columns and units
   ImuLogWriteOptions write;         // significant digits
   bool gzip = false;                // `format.gzip`: campaign logs written as *.csv.gz
+  bool ulog = false;                // `format.ulog`: campaign logs written as PX4 ULog *.ulg
   bool has_campaign = false;        // `aircraft`, `rig`, `campaign` sections present
   CampaignSpec campaign;
   bool has_trace = false;           // `trace` section present
