@@ -252,8 +252,7 @@ void Parser::OnMessage(uint64_t offset, char type, const unsigned char* body, ui
     case 'R': {
       if (size < 2) Fail(offset, "unsubscribe message too short");
       const uint16_t msg_id = LoadUnsigned<uint16_t>(body);
-      if (msg_role_[msg_id] == kWanted) wanted_.clear();
-      msg_role_[msg_id] = kUnknown;
+      msg_role_[msg_id] = kUnknown;  // later data with this id is an error
       return;
     }
     case 'L': case 'C':
