@@ -7,9 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pipeline/ulog_writer.h"
 #include "pipeline/user_error.h"
 #include "pipeline/yaml_reader.h"
+#include "pipeline/ulog_writer.h"
 
 #ifndef BIFILAR_VERSION
 #define BIFILAR_VERSION "unknown"
@@ -149,8 +149,8 @@ void ReadFormat(YamlMap map, SimulateSpec* spec) {
   }
   spec->write.significant_digits =
       static_cast<int>(ReadValue(map, "significant_digits", 9, 6, false, 17));
-  spec->gzip = map.OptionalBool("gzip", false);
   spec->ulog = map.OptionalBool("ulog", false);
+  spec->gzip = map.OptionalBool("gzip", false);
   map.Finish();
   std::string why;
   if (!f.Check(&why)) throw UserError(map.Where(YAML::Node()) + ": format: " + why);

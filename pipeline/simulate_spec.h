@@ -36,8 +36,8 @@ struct SimulateSpec {
   SimulationOptions options;        // model, timeline, sensor, sway coupling
   ImuFormat format;                 // CSV columns and units
   ImuLogWriteOptions write;         // significant digits
-  bool gzip = false;                // `format.gzip`: campaign logs written as *.csv.gz
   bool ulog = false;                // `format.ulog`: campaign logs written as PX4 ULog *.ulg
+  bool gzip = false;                // `format.gzip`: campaign logs written as *.csv.gz
   bool has_campaign = false;        // `aircraft`, `rig`, `campaign` sections present
   CampaignSpec campaign;
   bool has_trace = false;           // `trace` section present
