@@ -150,6 +150,37 @@ TEST(Ulog, RealLogMissingTopicOrFieldListsWhatThereIs) {
   EXPECT_TRUE(Contains(e, "its fields are: timestamp, gyro_rad[0], gyro_rad[1], gyro_rad[2]")) << e;
 }
 
+TEST(Ulog, RealLogCutOrDamagedNeverCrashes) {
+  const std::string path = Px4Log("sample_log_small.ulg");
+  if (!fs::exists(path)) GTEST_SKIP() << path << " absent";
+  const std::string good = ReadFile(path);
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 400; ++trial) {
+    std::string bytes = good;
+    if (trial < 100) {
+      bytes.resize(std::uniform_int_distribution<size_t>(0, good.size())(rng));
+    } else {
+      for (int f = 0; f < 1 + trial % 3; ++f) {
+        const size_t at = std::uniform_int_distribution<size_t>(0, bytes.size() - 1)(rng);
+        bytes[at] = static_cast<char>(std::uniform_int_distribution<int>(0, 255)(rng));
+      }
+    }
+    try {
+      const ImuData d = ReadUlogImu(bytes, "real.ulg", ImuFormat());
+      EXPECT_LE(d.size(), 1298u) << trial;
+      for (size_t k = 1; k < d.size(); ++k) ASSERT_GT(d.t_s[k], d.t_s[k - 1]) << trial;
+    } catch (const UserError& e) {
+      ASSERT_EQ(std::string(e.what()).rfind("real.ulg: ", 0), 0u) << e.what();
+    }
+  }
+  // Cut in the data section: read up to the cut, with a warning naming the byte.
+  const ImuData half = ReadUlogImu(good.substr(0, good.size() / 2 + 1), "half.ulg", ImuFormat());
+  EXPECT_GT(half.size(), 100u);
+  EXPECT_LT(half.size(), 1298u);
+  ASSERT_FALSE(half.warnings.empty());
+  EXPECT_TRUE(Contains(half.warnings[0], "the log ends inside a message at byte")) << half.warnings[0];
+}
+
 // ---- Files written here ----
 
 // A log of `n` samples at 250 Hz: gyro x = k/1000, accel z = -9.8.
