@@ -93,6 +93,10 @@ std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
       << ',' << ToString(f.gyro_unit) << ';';
   out << "accel=" << f.accel_columns[0] << ',' << f.accel_columns[1] << ',' << f.accel_columns[2]
       << ',' << ToString(f.accel_unit) << ';' << "delim=" << f.delimiter << ';';
+  out << "ulog=" << static_cast<int>(f.container) << ',' << f.ulog.topic << ',' << f.ulog.multi_id << ','
+      << f.ulog.time_field << ',' << f.ulog.gyro_fields[0] << ',' << f.ulog.gyro_fields[1] << ','
+      << f.ulog.gyro_fields[2] << ',' << f.ulog.accel_fields[0] << ',' << f.ulog.accel_fields[1] << ','
+      << f.ulog.accel_fields[2] << ';';
   out << "axis=" << (config.imu.swing_axis_auto ? "auto" : "fixed") << ';';
   for (int i = 0; i < 3; ++i) Put(out, "n", config.imu.swing_axis_in_imu[i]);
   for (int i = 0; i < 9; ++i) Put(out, "R", config.imu.imu_to_body(i / 3, i % 3));

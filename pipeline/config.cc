@@ -3,10 +3,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <Eigen/Geometry>
 
+#include "pipeline/ulog.h"
 #include "pipeline/user_error.h"
 #include "pipeline/yaml_reader.h"
 
@@ -66,6 +68,51 @@ Eigen::Vector3d ThreeVector(const YamlMap& map, const YAML::Node& node, const st
                          map.AsDouble(node[2], key));
 }
 
+// `imu.format` and `imu.ulog`: which reader a log gets and, for PX4 ULog logs, which topic and
+// fields (pipeline/ulog.h).
+void ReadLogContainer(YamlMap& imu, ImuFormat* format) {
+  const std::string container = imu.OptionalString("format", "auto");
+  if (container == "auto") format->container = LogContainer::kAuto;
+  else if (container == "csv") format->container = LogContainer::kCsv;
+  else if (container == "ulog") format->container = LogContainer::kUlog;
+  else {
+    throw UserError(imu.Where(imu.Optional("format")) + ": 'imu.format' must be auto, csv or ulog, not '" +
+                    container + "'");
+  }
+  YamlMap ulog = Sub(imu, "ulog");
+  UlogSelection& sel = format->ulog;
+  const std::string topic = ulog.OptionalString("topic", sel.topic);
+  const bool known = UlogTopicDefaults(topic, &sel);
+  if (topic.empty()) throw UserError(ulog.Where(ulog.Optional("topic")) + ": 'imu.ulog.topic' is empty");
+  const YAML::Node multi = ulog.Optional("multi_id");
+  sel.multi_id = ulog.OptionalInt("multi_id", 0);
+  if (sel.multi_id < 0 || sel.multi_id > 255) {
+    throw UserError(ulog.Where(multi) + ": 'imu.ulog.multi_id' must be in [0, 255]");
+  }
+  sel.time_field = ulog.OptionalString("time_field", sel.time_field);
+  if (ulog.Has("gyro_fields")) {
+    sel.gyro_fields = ThreeColumns(ulog, "gyro_fields");
+  } else if (!known) {
+    throw UserError(ulog.Where(ulog.Optional("topic")) + ": 'imu.ulog.gyro_fields' is needed for topic '" +
+                    topic + "' (defaults exist for sensor_combined, vehicle_angular_velocity and sensor_gyro)");
+  }
+  if (ulog.Has("accel_fields") && ulog.Optional("accel_fields").IsNull()) {
+    sel.accel_fields = {"", "", ""};
+  } else if (ulog.Has("accel_fields")) {
+    sel.accel_fields = ThreeColumns(ulog, "accel_fields");
+  } else if (!known || !format->has_accel()) {
+    sel.accel_fields = {"", "", ""};  // unknown topic, or `imu.accel: null`: gyro only
+  }
+  std::vector<std::string> names = {sel.time_field, sel.gyro_fields[0], sel.gyro_fields[1],
+                                    sel.gyro_fields[2]};
+  if (!sel.accel_fields[0].empty()) names.insert(names.end(), sel.accel_fields.begin(), sel.accel_fields.end());
+  const std::set<std::string> distinct(names.begin(), names.end());
+  if (distinct.count("") || distinct.size() != names.size()) {
+    throw UserError(ulog.Where(YAML::Node()) + ": 'imu.ulog' field names must be non-empty and distinct");
+  }
+  ulog.Finish();
+}
+
 void ReadImu(YamlMap imu, ImuConfig* out) {
   ImuFormat& format = out->format;
   {
@@ -101,6 +148,7 @@ void ReadImu(YamlMap imu, ImuConfig* out) {
     }
     accel.Finish();
   }
+  ReadLogContainer(imu, &format);
   std::string why;
   if (!format.Check(&why)) throw UserError(imu.file() + ": imu: " + why);
 

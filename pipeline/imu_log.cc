@@ -15,6 +15,8 @@
 
 #include "pipeline/user_error.h"
 #include "pipeline/gzip.h"
+#include "pipeline/imu_log_finish.h"
+#include "pipeline/ulog.h"
 
 namespace bifilar {
 namespace {
@@ -355,6 +357,16 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
                             std::to_string(first_bad_line) + " (" + first_bad + ")");
   }
 
+  return FinishImuLog(name, options, values, needed, row_line, scale, with_accel, std::move(data));
+}
+
+}  // namespace
+
+ImuData FinishImuLog(const std::string& name, const ImuLogOptions& options,
+                     const std::vector<double>& values, int needed,
+                     const std::vector<int>& row_line, [[maybe_unused]] const std::vector<double>& scale,
+                     bool with_accel, ImuData data) {
+  const size_t rows = row_line.size();
   // Timestamps must increase. A sample whose time does not exceed the last kept one is dropped,
   // unless the last kept one was itself a forward glitch (the new time fits between the two
   // before), in which case the glitch is replaced.
@@ -415,6 +427,8 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
   return data;
 }
 
+namespace {
+
 std::string ReadWholeFile(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) Fail(path + ": is a directory, not a log file");
@@ -452,12 +466,14 @@ bool ImuLogOptions::Check(std::string* why) const {
 
 ImuData ReadImuLogFromString(const std::string& text, const std::string& name,
                              const ImuFormat& format, const ImuLogOptions& options) {
+  if (UseUlogReader(text, format)) return ReadUlogImu(text, name, format, options);
   return Parse(text, name, format, options);
 }
 
 ImuData ReadImuLog(const std::string& path, const ImuFormat& format,
                    const ImuLogOptions& options) {
   const std::string text = ReadWholeFile(path);
+  if (UseUlogReader(text, format)) return ReadUlogImu(text, path, format, options);
   return Parse(text, path, format, options);
 }
 

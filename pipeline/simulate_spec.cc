@@ -9,6 +9,7 @@
 
 #include "pipeline/user_error.h"
 #include "pipeline/yaml_reader.h"
+#include "pipeline/ulog_writer.h"
 
 #ifndef BIFILAR_VERSION
 #define BIFILAR_VERSION "unknown"
@@ -148,6 +149,7 @@ void ReadFormat(YamlMap map, SimulateSpec* spec) {
   }
   spec->write.significant_digits =
       static_cast<int>(ReadValue(map, "significant_digits", 9, 6, false, 17));
+  spec->ulog = map.OptionalBool("ulog", false);
   spec->gzip = map.OptionalBool("gzip", false);
   map.Finish();
   std::string why;
@@ -506,6 +508,11 @@ nlohmann::json TraceJson(const CampaignTrace& ct, const SimulateSpec& spec) {
 }
 
 void WriteTrace(const std::string& path, const SimulatedTrace& trace, const SimulateSpec& spec) {
+  if (spec.ulog || path.find(".ulg") != std::string::npos) {  // pipeline/ulog_writer.h
+    ImuData imu = trace.imu;
+    if (!spec.options.sensor.accelerometer) imu.accel_in_imu.clear();
+    return WriteImuUlog(path, imu);
+  }
   ImuFormat format = spec.format;
   if (!spec.options.sensor.accelerometer) format.accel_columns = {"", "", ""};
   WriteImuLog(path, trace.imu, format, spec.write);
@@ -602,6 +609,9 @@ SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::stri
   std::string why;
   if (!SimulateCampaign(spec.campaign, spec.options, spec.seed, &traces, &why)) {
     throw UserError((spec.file.empty() ? std::string("simulate") : spec.file) + ": " + why);
+  }
+  if (spec.ulog) {
+    for (auto& ct : traces) ct.relative_path.replace(ct.relative_path.size() - 4, 4, ".ulg");
   }
   if (spec.gzip) {
     for (auto& ct : traces) ct.relative_path += ".gz";

@@ -36,6 +36,7 @@ struct SimulateSpec {
   SimulationOptions options;        // model, timeline, sensor, sway coupling
   ImuFormat format;                 // CSV columns and units
   ImuLogWriteOptions write;         // significant digits
+  bool ulog = false;                // `format.ulog`: campaign logs written as PX4 ULog *.ulg
   bool gzip = false;                // `format.gzip`: campaign logs written as *.csv.gz
   bool has_campaign = false;        // `aircraft`, `rig`, `campaign` sections present
   CampaignSpec campaign;
