@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -156,11 +157,14 @@ double SofteningHarmonicConstant(double exponent) {
 }
 
 double SofteningCoefficient(double excess_at_30deg, double exponent) {
-  return excess_at_30deg / (SofteningHarmonicConstant(exponent) * std::pow(30.0 * kDeg, exponent));
+  // I_app / I = 1 / (1 - x) = 1 + excess at 30 deg, x = c_p k (30 deg)^p.
+  const double x = excess_at_30deg / (1.0 + excess_at_30deg);
+  return x / (SofteningHarmonicConstant(exponent) * std::pow(30.0 * kDeg, exponent));
 }
 
 double ApparentInertiaExcess(double k, double exponent, double amplitude_rad) {
-  return SofteningHarmonicConstant(exponent) * k * std::pow(std::abs(amplitude_rad), exponent);
+  const double x = SofteningHarmonicConstant(exponent) * k * std::pow(std::abs(amplitude_rad), exponent);
+  return x < 1.0 ? x / (1.0 - x) : std::numeric_limits<double>::infinity();
 }
 
 bool TimelineOptions::Check(std::string* why) const {
@@ -429,6 +433,15 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
   if (options.softening_at_30deg > 0) {
     dyn.soft_p = options.softening_exponent;
     dyn.soft_k = SofteningCoefficient(options.softening_at_30deg, options.softening_exponent);
+    // The term must weaken the restoring torque, not reverse it, over the whole swing.
+    const double weakening = dyn.soft_k * std::pow(std::abs(amplitude), dyn.soft_p);
+    if (weakening > 0.5) {
+      return Fail(why, "swing.softening_percent_at_30deg = " + Num(100 * options.softening_at_30deg) +
+                           " with swing.softening_exponent = " + Num(dyn.soft_p) + " removes " +
+                           Num(100 * weakening) + " % of the restoring torque at the amplitude " +
+                           Num(std::abs(amplitude) / kDeg) +
+                           " deg (at most 50 % allowed); lower the softening or the amplitude");
+    }
   }
   std::vector<double> free_angle, free_rate;
   if (dyn.sway_k == 0.0 && dyn.soft_k == 0.0) {

@@ -127,12 +127,14 @@ struct SimulationOptions {
   double sway_coupling_at_60deg = 0.0;
   // Amplitude softening ("non-ideal rig"), off by default: the restoring torque becomes
   // m g h'(psi) (1 - k |psi|^p), p = softening_exponent, so the period grows with amplitude faster
-  // than the ideal model's and a fit of the ideal model finds an inertia too large by about
-  // c_p k A^p at amplitude A (harmonic balance, c_p = 2 Gamma((p+3)/2) / (sqrt(pi) Gamma(p/2+2)):
-  // 3/4 for p = 2, 0.849 for p = 1), i.e. roughly like A^p. k is chosen so that this excess is
-  // softening_at_30deg at A = 30 deg (SofteningCoefficient). Real rigs (pendulum sway, wire
-  // stretch, hooks) show a few percent at 30 deg. Integrated with a fixed-step RK4 (<= 1 ms
-  // steps) when non-zero. Fraction, e.g. 0.028 = +2.8 % at 30 deg; in [0, 0.5]; exponent in [1, 4].
+  // than the ideal model's, and a fit of the ideal model at amplitude A finds
+  // I_app = I / (1 - c_p k A^p) ~ I (1 + c_p k A^p) (harmonic balance, c_p = 2 Gamma((p+3)/2) /
+  // (sqrt(pi) Gamma(p/2+2)): 3/4 for p = 2, 8/(3 pi) for p = 1), i.e. roughly like A^p. k is
+  // chosen so that I_app / I - 1 = softening_at_30deg at A = 30 deg (SofteningCoefficient).
+  // Real rigs (pendulum sway, wire stretch, hooks) show a few percent at 30 deg. The term may
+  // remove at most half the restoring torque at the release amplitude. Integrated with a
+  // fixed-step RK4 (<= 1 ms steps) when non-zero. Fraction, e.g. 0.028 = +2.8 % at 30 deg; in
+  // [0, 0.5]; exponent in [1, 4], default 2.
   double softening_at_30deg = 0.0;
   double softening_exponent = 2.0;
   // The truth's integrator. Default: CVODES, a different solver from the fit's default
@@ -147,8 +149,10 @@ struct SimulationOptions {
 };
 
 // c_p of the softening term (harmonic balance constant, see softening_at_30deg) and k such that
-// c_p k (30 deg)^p = excess. ApparentInertiaExcess(k, p, A) = c_p k |A|^p: the relative excess
-// of the inertia a fit of the ideal model finds at amplitude A.
+// the apparent-inertia excess at 30 deg is `excess_at_30deg`. ApparentInertiaExcess(k, p, A) =
+// x / (1 - x), x = c_p k |A|^p: the relative excess I_app / I - 1 of the inertia a fit of the
+// ideal model finds at amplitude A (tests/pendulum_simulate_test.cc checks it against measured
+// periods to 1 %).
 double SofteningHarmonicConstant(double exponent);
 double SofteningCoefficient(double excess_at_30deg, double exponent);
 double ApparentInertiaExcess(double k, double exponent, double amplitude_rad);
