@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -80,10 +81,12 @@ struct TruthDynamics {
   RigGeometry geometry;
   PendulumParams params;
   double sway_k = 0.0;  // per rad^4
+  double soft_k = 0.0;  // per rad^p (amplitude softening)
+  double soft_p = 2.0;
 
   double Accel(double angle, double rate) const {
     double acc = AngularAcceleration(model, geometry, params, angle, rate);
-    if (sway_k != 0.0) {
+    if (sway_k != 0.0 || soft_k != 0.0) {
       const double slope = model == PendulumModel::kLinear
                                ? geometry.filar_separation_m * geometry.filar_separation_m /
                                      (4.0 * geometry.filar_length_m) * angle
@@ -92,7 +95,10 @@ struct TruthDynamics {
                                  ? params.inertia_kg_m2 + geometry.mass_kg * slope * slope
                                  : params.inertia_kg_m2;
       const double a2 = angle * angle;
-      acc += geometry.mass_kg * geometry.gravity_mps2 * slope * sway_k * a2 * a2 / inertia;
+      // Restoring torque m g h' times (1 - sway_k psi^4 - soft_k |psi|^p): adds m g h' (...) / I.
+      double weakening = sway_k * a2 * a2;
+      if (soft_k != 0.0) weakening += soft_k * std::pow(std::abs(angle), soft_p);
+      acc += geometry.mass_kg * geometry.gravity_mps2 * slope * weakening / inertia;
     }
     return acc;
   }
@@ -119,7 +125,7 @@ bool IntegrateRk4(const TruthDynamics& dyn, double angle0, double rate0,
       v += h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
     }
     now = t[k];
-    if (!std::isfinite(x) || !std::isfinite(v)) return Fail(why, "sway-coupling integration diverged");
+    if (!std::isfinite(x) || !std::isfinite(v)) return Fail(why, "truth integration (RK4) diverged");
     (*angle)[k] = x;
     (*rate)[k] = v;
   }
@@ -129,6 +135,38 @@ bool IntegrateRk4(const TruthDynamics& dyn, double angle0, double rate0,
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
+const char* ToString(SampleSteps steps) {
+  return steps == SampleSteps::kLogNormal ? "lognormal" : "regular";
+}
+
+bool ParseSampleSteps(const std::string& name, SampleSteps* steps) {
+  if (name == "regular") {
+    *steps = SampleSteps::kRegular;
+  } else if (name == "lognormal") {
+    *steps = SampleSteps::kLogNormal;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+double SofteningHarmonicConstant(double exponent) {
+  // <|cos|^(p+2)> / <cos^2> over a cycle: first harmonic of |psi|^p psi for psi = A cos.
+  return 2.0 * std::tgamma((exponent + 3.0) / 2.0) /
+         (std::sqrt(kPi) * std::tgamma(exponent / 2.0 + 2.0));
+}
+
+double SofteningCoefficient(double excess_at_30deg, double exponent) {
+  // I_app / I = 1 / (1 - x) = 1 + excess at 30 deg, x = c_p k (30 deg)^p.
+  const double x = excess_at_30deg / (1.0 + excess_at_30deg);
+  return x / (SofteningHarmonicConstant(exponent) * std::pow(30.0 * kDeg, exponent));
+}
+
+double ApparentInertiaExcess(double k, double exponent, double amplitude_rad) {
+  const double x = SofteningHarmonicConstant(exponent) * k * std::pow(std::abs(amplitude_rad), exponent);
+  return x < 1.0 ? x / (1.0 - x) : std::numeric_limits<double>::infinity();
+}
+
 bool TimelineOptions::Check(std::string* why) const {
   return CheckRange(rest_before_s, "timeline.rest_before_s", 0.0, false, why) &&
          CheckRange(twist_s, "timeline.twist_s", 0.0, true, why) &&
@@ -146,9 +184,33 @@ bool TimelineOptions::Check(std::string* why) const {
 
 bool SensorOptions::Check(std::string* why) const {
   if (!CheckValue(sample_rate_hz, "sensor.sample_rate_hz", 0.0, true, 100000.0, why)) return false;
+  if (!(time_jitter_sigma_s <= 1.0 / sample_rate_hz) && std::isfinite(time_jitter_sigma_s)) {
+    return Fail(why, "sensor.time_jitter_sigma_s = " + Num(time_jitter_sigma_s) +
+                         " s is more than one sample period (1/sensor.sample_rate_hz = " +
+                         Num(1.0 / sample_rate_hz) + " s at " + Num(sample_rate_hz) +
+                         " Hz); lower sensor.time_jitter_sigma_s or the sample rate");
+  }
   if (!CheckValue(time_jitter_sigma_s, "sensor.time_jitter_sigma_s", 0.0, false,
                   1.0 / sample_rate_hz, why))
     return false;
+  if (!CheckValue(step_log_sigma, "sensor.step_log_sigma", 0.0, false, 3.0, why) ||
+      !CheckRange(step_range_s, "sensor.step_range_s", 0.0, true, why) ||
+      !CheckValue(step_range_s.max, "sensor.step_range_s (max)", 0.0, true, 3600.0, why) ||
+      !CheckValue(gyro_noise_ar1_phi, "sensor.gyro_noise_ar1_phi", 0.0, false, 0.99, why) ||
+      !CheckValue(gyro_bias_walk_deg_per_s_per_sqrt_s, "sensor.gyro_bias_walk_deg_per_s_per_sqrt_s",
+                  0.0, false, 10.0, why) ||
+      !CheckValue(spike_count, "sensor.spike_count", 0.0, false, 1000.0, why) ||
+      !CheckValue(spike_rate_rad_per_s, "sensor.spike_rate_rad_per_s", 0.0, true, 1e4, why) ||
+      !CheckRange(gravity_removal_error_deg, "sensor.gravity_removal_error_deg", 0.0, false, why) ||
+      !CheckValue(gravity_removal_error_deg.max, "sensor.gravity_removal_error_deg (max)", 0.0,
+                  false, 30.0, why)) {
+    return false;
+  }
+  if (rocking_frequency_hz > sample_rate_hz / 4.0 && std::isfinite(rocking_frequency_hz)) {
+    return Fail(why, "sensor.rocking_frequency_hz = " + Num(rocking_frequency_hz) +
+                         " Hz is above a quarter of sensor.sample_rate_hz (" +
+                         Num(sample_rate_hz) + " Hz); lower it or raise the sample rate");
+  }
   return CheckValue(drop_fraction, "sensor.drop_fraction", 0.0, false, 0.5, why) &&
          CheckValue(drop_burst_probability, "sensor.drop_burst_probability", 0.0, false, 1.0,
                     why) &&
@@ -178,7 +240,10 @@ bool SimulationOptions::Check(std::string* why) const {
   return timeline.Check(why) && sensor.Check(why) &&
          CheckValue(negative_amplitude_probability, "negative_amplitude_probability", 0.0, false,
                     1.0, why) &&
-         CheckValue(sway_coupling_at_60deg, "sway_coupling_at_60deg", 0.0, false, 0.5, why);
+         CheckValue(sway_coupling_at_60deg, "sway_coupling_at_60deg", 0.0, false, 0.5, why) &&
+         CheckValue(softening_at_30deg, "swing.softening_percent_at_30deg (fraction)", 0.0, false,
+                    0.5, why) &&
+         CheckValue(softening_exponent, "swing.softening_exponent", 1.0, false, 4.0, why);
 }
 
 bool TraceSetup::Check(std::string* why) const {
@@ -263,11 +328,32 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
   const double stop_tau = tl.stop_time_constant_s;
   const double t_end = stopped ? t_stop + 5.0 * stop_tau + rest_after : t_stop;
   const double dt = 1.0 / so.sample_rate_hz;
-  const double samples_real = std::floor((t_end - start_time) * so.sample_rate_hz) + 1.0;
-  if (samples_real > 5e7) return Fail(why, "log too long: more than 5e7 samples");
-  const int n_nominal = static_cast<int>(samples_real);
+  const bool lognormal = so.sample_steps == SampleSteps::kLogNormal;
+  const double samples_real =
+      lognormal ? std::floor((t_end - start_time) / so.step_range_s.min) + 1.0
+                : std::floor((t_end - start_time) * so.sample_rate_hz) + 1.0;
+  if (samples_real > 5e7) {
+    return Fail(why, "log too long: up to " + Num(samples_real) + " samples (" +
+                         Num(t_end - start_time) + " s at " +
+                         (lognormal ? "steps down to " + Num(so.step_range_s.min) + " s"
+                                    : Num(so.sample_rate_hz) + " Hz") +
+                         "); the limit is 5e7: shorten timeline.free_s or lower "
+                         "sensor.sample_rate_hz");
+  }
+  // Irregular (log-normal) steps come from their own stream: the other draws stay as they are.
+  std::vector<double> irregular;
+  if (lognormal) {
+    Rng step_rng(DeriveSeed(seed, "sample_steps"));
+    for (double t = start_time; t <= t_end;) {
+      irregular.push_back(t);
+      const double step = dt * std::exp(step_rng.Normal(so.step_log_sigma));
+      t += std::clamp(step, so.step_range_s.min, so.step_range_s.max);
+    }
+  }
+  const int n_nominal = lognormal ? static_cast<int>(irregular.size()) : static_cast<int>(samples_real);
 
-  // Timestamps: nominal grid + clipped jitter (strictly increasing), then dropped packets.
+  // Timestamps: nominal grid + clipped jitter (strictly increasing), or the irregular steps; then
+  // dropped packets.
   std::vector<double> times;
   times.reserve(n_nominal);
   const double mean_drop_run =
@@ -290,7 +376,7 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
       ++dropped;
       continue;
     }
-    times.push_back(start_time + k * dt + jitter);
+    times.push_back(lognormal ? irregular[k] : start_time + k * dt + jitter);
   }
   const size_t n = times.size();
   if (n < 2) return Fail(why, "the log would have fewer than 2 samples");
@@ -339,13 +425,26 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
   if (free_index.size() < 2) return Fail(why, "the free oscillation has fewer than 2 samples");
   free_times.push_back(t_stop);  // the state at the stop starts the hand's deceleration
 
-  TruthDynamics dyn{options.model, setup.geometry, setup.params, 0.0};
+  TruthDynamics dyn{options.model, setup.geometry, setup.params};
   if (options.sway_coupling_at_60deg > 0) {
     const double a60 = 60.0 * kDeg;
     dyn.sway_k = 8.0 / 5.0 * options.sway_coupling_at_60deg / (a60 * a60 * a60 * a60);
   }
+  if (options.softening_at_30deg > 0) {
+    dyn.soft_p = options.softening_exponent;
+    dyn.soft_k = SofteningCoefficient(options.softening_at_30deg, options.softening_exponent);
+    // The term must weaken the restoring torque, not reverse it, over the whole swing.
+    const double weakening = dyn.soft_k * std::pow(std::abs(amplitude), dyn.soft_p);
+    if (weakening > 0.5) {
+      return Fail(why, "swing.softening_percent_at_30deg = " + Num(100 * options.softening_at_30deg) +
+                           " with swing.softening_exponent = " + Num(dyn.soft_p) + " removes " +
+                           Num(100 * weakening) + " % of the restoring torque at the amplitude " +
+                           Num(std::abs(amplitude) / kDeg) +
+                           " deg (at most 50 % allowed); lower the softening or the amplitude");
+    }
+  }
   std::vector<double> free_angle, free_rate;
-  if (dyn.sway_k == 0.0) {
+  if (dyn.sway_k == 0.0 && dyn.soft_k == 0.0) {
     PendulumIntegrator integrator(options.model, setup.geometry, options.integrator);
     Trajectory trajectory;
     std::string integrator_why;
@@ -395,6 +494,25 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
   const double g = setup.geometry.gravity_mps2;
   const double rock_omega = 2 * kPi * rocking_hz;
   const double gyro_noise = so.gyro_noise_sigma_deg_per_s * kDeg;
+  const double phi_ar = so.gyro_noise_ar1_phi;
+  const double ar_innovation = std::sqrt(1.0 - phi_ar * phi_ar);
+  Eigen::Vector3d ar_state = Eigen::Vector3d::Zero();
+  // Optional realism from streams of their own (off: no draws, the log is as before).
+  const double walk_rate = so.gyro_bias_walk_deg_per_s_per_sqrt_s * kDeg;
+  Rng walk_rng(DeriveSeed(seed, "gyro_bias_walk"));
+  Eigen::Vector3d walk = Eigen::Vector3d::Zero();
+  const bool gravity_removed = so.accelerometer && so.accel_gravity_removed;
+  Eigen::Vector3d down_estimate_in_imu = Eigen::Vector3d::Zero();
+  if (gravity_removed) {
+    // The firmware's static down, tilted by its attitude error about a random horizontal axis.
+    Rng accel_rng(DeriveSeed(seed, "gravity_removed"));
+    truth.gravity_removal_error_rad = accel_rng.Uniform(so.gravity_removal_error_deg) * kDeg;
+    const double beta = 2.0 * kPi * accel_rng.Uniform();
+    const Eigen::Vector3d tilt_axis =
+        (std::cos(beta) * Eigen::Vector3d::UnitY() + std::sin(beta) * horizontal).normalized();
+    down_estimate_in_imu =
+        imu_from_body * (Eigen::AngleAxisd(truth.gravity_removal_error_rad, tilt_axis) * n_body);
+  }
 
   out->imu.t_s = times;
   out->imu.gyro_in_imu.resize(n);
@@ -414,7 +532,22 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
     const Eigen::Vector3d omega_body = dpsi[k] * n_body + dphi * rock_axis;
     Eigen::Vector3d gyro = imu_from_body * omega_body;
     gyro = gyro.cwiseProduct(Eigen::Vector3d::Ones() + gyro_scale) + gyro_bias;
-    for (int i = 0; i < 3; ++i) gyro[i] += rng.Normal(gyro_noise);
+    if (walk_rate > 0) {
+      if (k > 0) {
+        const double step = std::sqrt(times[k] - times[k - 1]);
+        for (int i = 0; i < 3; ++i) walk[i] += walk_rate * step * walk_rng.Normal();
+      }
+      gyro += walk;
+    }
+    for (int i = 0; i < 3; ++i) {
+      const double w = rng.Normal(gyro_noise);
+      if (phi_ar == 0.0) {
+        gyro[i] += w;  // white: exactly the draws of before
+      } else {
+        ar_state[i] = k == 0 ? w : phi_ar * ar_state[i] + ar_innovation * w;
+        gyro[i] += ar_state[i];
+      }
+    }
     out->imu.gyro_in_imu[k] = gyro;
     if (so.accelerometer) {
       const double hdd = RiseCurvature(setup.geometry, psi[k]) * dpsi[k] * dpsi[k] +
@@ -424,10 +557,39 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
       // The body rocked by phi about rock_axis sees the down vertical rotated by -phi.
       const Eigen::Vector3d down_body = Eigen::AngleAxisd(-phi, rock_axis) * n_body;
       Eigen::Vector3d f = imu_from_body * (a_body - g * down_body) + accel_bias;
+      if (gravity_removed) f += g * down_estimate_in_imu;
       for (int i = 0; i < 3; ++i) f[i] += rng.Normal(so.accel_noise_sigma_mps2);
       out->imu.accel_in_imu[k] = f;
     }
   }
+  // Spikes: distinct samples, the first one inside the free oscillation; on the IMU axis that
+  // carries most of the swing, replaced by +-spike_rate_rad_per_s.
+  if (so.spike_count > 0) {
+    if (static_cast<size_t>(so.spike_count) * 2 > n) {
+      return Fail(why, "sensor.spike_count = " + std::to_string(so.spike_count) +
+                           " is more than half the log's " + std::to_string(n) +
+                           " samples; lower it");
+    }
+    Rng spike_rng(DeriveSeed(seed, "spikes"));
+    const Eigen::Vector3d n_imu = imu_from_body * n_body;
+    int axis = 0;
+    n_imu.cwiseAbs().maxCoeff(&axis);
+    std::vector<bool> taken(n, false);
+    for (int i = 0; i < so.spike_count; ++i) {
+      size_t k = 0;
+      do {
+        k = i == 0 ? free_index[static_cast<size_t>(spike_rng.Uniform() * free_index.size())]
+                   : static_cast<size_t>(spike_rng.Uniform() * n);
+      } while (taken[k]);
+      taken[k] = true;
+      const double value = (spike_rng.Uniform() < 0.5 ? -1.0 : 1.0) * so.spike_rate_rad_per_s;
+      out->imu.gyro_in_imu[k][axis] = value;
+      truth.spikes.push_back({static_cast<int>(k), times[k], axis, value});
+    }
+    std::sort(truth.spikes.begin(), truth.spikes.end(),
+              [](const TraceTruth::Spike& a, const TraceTruth::Spike& b) { return a.sample < b.sample; });
+  }
+
   for (size_t k = 0; k < n; ++k) {
     if (!out->imu.gyro_in_imu[k].allFinite() ||
         (so.accelerometer && !out->imu.accel_in_imu[k].allFinite()) || !std::isfinite(times[k])) {
@@ -445,6 +607,8 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
   truth.release_rate_rad_per_s = release_rate;
   truth.amplitude_at_stop_rad = envelope_at_stop;
   truth.gyro_bias_rad_per_s = gyro_bias;
+  truth.gyro_bias_end_rad_per_s = gyro_bias + walk;
+  truth.softening_k = dyn.soft_k;
   truth.gyro_scale_error = gyro_scale;
   truth.accel_bias_mps2 = so.accelerometer ? accel_bias : Eigen::Vector3d::Zero();
   truth.swing_axis_in_imu = imu_from_body * n_body;

@@ -17,7 +17,10 @@
 // free oscillation integrated with PendulumIntegrator (model `full` by default) at the log's own
 // timestamps, and with some probability a hand stopping it (rate decays exponentially) followed by
 // a little rest. A small decaying rocking mode about a horizontal axis perpendicular to n starts at
-// release. Timestamps have jitter and dropped samples (single and in bursts).
+// release. Timestamps have jitter and dropped samples (single and in bursts), or irregular
+// log-normal steps. Optional realism (all off by default, each drawn from its own random stream
+// so that turning one on leaves the rest of the log unchanged): AR(1) coloured gyro noise, a gyro
+// bias random walk, single-sample spikes, a gravity-removed accelerometer, amplitude softening.
 #pragma once
 
 #include <cstdint>
@@ -57,17 +60,49 @@ struct TimelineOptions {
 };
 
 // The sensor and the radio link.
+// How timestamps are spaced.
+//   kRegular: a grid at 1/sample_rate_hz with Gaussian jitter (time_jitter_sigma_s), as before.
+//   kLogNormal: steps drawn independently, ln(step) ~ N(ln(1/sample_rate_hz), step_log_sigma),
+//     clipped to step_range_s, like a radio link that batches packets (a Crazyflie log at
+//     "30 Hz": median 31 ms, ln-std 0.75, 8-160 ms). No jitter; drops still apply on top.
+enum class SampleSteps { kRegular, kLogNormal };
+// "regular", "lognormal".
+const char* ToString(SampleSteps steps);
+bool ParseSampleSteps(const std::string& name, SampleSteps* steps);
+
 struct SensorOptions {
   double sample_rate_hz = 100.0;             // nominal sample rate (Hz); > 0
+  SampleSteps sample_steps = SampleSteps::kRegular;
+  double step_log_sigma = 0.75;              // kLogNormal: std of ln(step) (-); [0, 3]
+  UniformRange step_range_s = {0.008, 0.160};  // kLogNormal: steps clipped to [min, max] (s); > 0
   double time_jitter_sigma_s = 0.001;        // timestamp jitter, clipped to +-0.4/rate (s); >= 0
   double drop_fraction = 0.01;               // fraction of samples lost; [0, 0.5]
   double drop_burst_probability = 0.1;       // chance a loss is a burst rather than one sample; [0,1]
   int drop_burst_max_samples = 25;           // bursts are 2..max samples long; >= 2
   UniformRange start_time_s = {0.0, 0.0};    // time stamp of the first sample (s), e.g. uptime
-  double gyro_noise_sigma_deg_per_s = 0.25;  // white noise per sample per axis (deg/s); >= 0
+  double gyro_noise_sigma_deg_per_s = 0.25;  // noise std per sample per axis (deg/s); >= 0
+  // Coloured gyro noise: AR(1) over the logged samples, e_k = phi e_(k-1) + sqrt(1 - phi^2) w_k,
+  // w_k ~ N(0, gyro_noise_sigma), e_0 = w_0, so the marginal std stays gyro_noise_sigma and the
+  // lag-1 autocorrelation is phi. 0 = white (default); [0, 0.99].
+  double gyro_noise_ar1_phi = 0.0;
+  // Gyro bias random walk (deg/s per sqrt(s)): per axis, b(t_(k+1)) = b(t_k) + rate sqrt(dt) N(0,1),
+  // starting at the constant bias; 0 = off (default); [0, 10].
+  double gyro_bias_walk_deg_per_s_per_sqrt_s = 0.0;
+  // Single-sample gyro glitches: spike_count samples (distinct; the first one inside the free
+  // oscillation, the others anywhere in the log) whose value on the IMU axis most aligned with
+  // the swing axis is replaced by +-spike_rate_rad_per_s (sign random). Count in [0, 1000]
+  // (default 0), rate (rad/s) in (0, 1e4] (default 50).
+  int spike_count = 0;
+  double spike_rate_rad_per_s = 50.0;
   double gyro_bias_sigma_deg_per_s = 0.5;    // constant bias per axis ~ N(0, sigma) (deg/s); >= 0
   double gyro_scale_error_sigma = 0.0;       // scale factor error per axis ~ N(0, sigma) (-); >= 0
   bool accelerometer = true;                 // false: the log has no accelerometer
+  // The accelerometer logs specific force with gravity removed (f + g down_est, as some IMU
+  // firmwares do: the mean is near 0 g), where down_est is the static down (no rocking) tilted
+  // by an attitude-estimate error of gravity_removal_error_deg about a random horizontal axis
+  // (residual ~ g * error). Only with accelerometer = true; default false.
+  bool accel_gravity_removed = false;
+  UniformRange gravity_removal_error_deg = {0.0, 0.0};  // per log ~ U(min, max) (deg); [0, 30]
   double accel_noise_sigma_mps2 = 0.02;      // white noise per sample per axis (m/s^2); >= 0
   double accel_bias_sigma_mps2 = 0.05;       // constant bias per axis ~ N(0, sigma) (m/s^2); >= 0
   double rocking_max_deg = 0.3;              // rocking amplitude ~ U(0, max) at release (deg); >= 0
@@ -90,6 +125,18 @@ struct SimulationOptions {
   // RK4 (<= 1 ms steps) instead of PendulumIntegrator when non-zero. Fraction, e.g. 0.01 = +1 %
   // at 60 deg; in [0, 0.5].
   double sway_coupling_at_60deg = 0.0;
+  // Amplitude softening ("non-ideal rig"), off by default: the restoring torque becomes
+  // m g h'(psi) (1 - k |psi|^p), p = softening_exponent, so the period grows with amplitude faster
+  // than the ideal model's, and a fit of the ideal model at amplitude A finds
+  // I_app = I / (1 - c_p k A^p) ~ I (1 + c_p k A^p) (harmonic balance, c_p = 2 Gamma((p+3)/2) /
+  // (sqrt(pi) Gamma(p/2+2)): 3/4 for p = 2, 8/(3 pi) for p = 1), i.e. roughly like A^p. k is
+  // chosen so that I_app / I - 1 = softening_at_30deg at A = 30 deg (SofteningCoefficient).
+  // Real rigs (pendulum sway, wire stretch, hooks) show a few percent at 30 deg. The term may
+  // remove at most half the restoring torque at the release amplitude. Integrated with a
+  // fixed-step RK4 (<= 1 ms steps) when non-zero. Fraction, e.g. 0.028 = +2.8 % at 30 deg; in
+  // [0, 0.5]; exponent in [1, 4], default 2.
+  double softening_at_30deg = 0.0;
+  double softening_exponent = 2.0;
   // The truth's integrator. Default: CVODE (kCvodes), a different solver from the fit's default
   // (Runge-Kutta), so that the fit is judged against an independent integration.
   IntegratorOptions integrator = [] {
@@ -100,6 +147,15 @@ struct SimulationOptions {
 
   bool Check(std::string* why) const;
 };
+
+// c_p of the softening term (harmonic balance constant, see softening_at_30deg) and k such that
+// the apparent-inertia excess at 30 deg is `excess_at_30deg`. ApparentInertiaExcess(k, p, A) =
+// x / (1 - x), x = c_p k |A|^p: the relative excess I_app / I - 1 of the inertia a fit of the
+// ideal model finds at amplitude A (tests/pendulum_simulate_test.cc checks it against measured
+// periods to 1 %).
+double SofteningHarmonicConstant(double exponent);
+double SofteningCoefficient(double excess_at_30deg, double exponent);
+double ApparentInertiaExcess(double k, double exponent, double amplitude_rad);
 
 // The physical truth of one trace (everything deterministic; the noise comes from the seed).
 struct TraceSetup {
@@ -131,6 +187,16 @@ struct TraceTruth {
   double rocking_amplitude_rad = 0.0;
   double rocking_frequency_hz = 0.0;
   Eigen::Vector3d rocking_axis_in_body = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d gyro_bias_end_rad_per_s = Eigen::Vector3d::Zero();  // bias at the last sample
+  double gravity_removal_error_rad = 0.0;  // attitude error of a gravity-removed accelerometer
+  double softening_k = 0.0;            // k of the softening term (per rad^p); 0 = off
+  struct Spike {
+    int sample = 0;                    // index into the kept samples
+    double t_s = 0.0;
+    int axis = 0;                      // IMU axis 0..2
+    double rate_rad_per_s = 0.0;       // the value written on that axis
+  };
+  std::vector<Spike> spikes;           // in sample order
   int samples_nominal = 0;             // samples the IMU would have sent
   int samples_dropped = 0;
   int free_samples = 0;                // samples in [t_release, t_stop) (or to the end)

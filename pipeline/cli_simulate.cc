@@ -55,7 +55,7 @@ void Run(const SimulateArgs& a, int* exit_code) {
   if (!a.model.empty() && !ParsePendulumModel(a.model, &spec.options.model)) {
     throw UserError("--model: unknown model '" + a.model + "'; allowed full, jardin, linear");
   }
-  if (a.sample_rate) spec.options.sensor.sample_rate_hz = *a.sample_rate;
+  if (a.sample_rate) SetSampleRateFromFlag(&spec, *a.sample_rate);
   if (a.no_accel) spec.options.sensor.accelerometer = false;
   if (!a.trace_csv.empty()) {
     if (!a.out_dir.empty()) throw UserError("give either --trace FILE.csv or --out DIR, not both");

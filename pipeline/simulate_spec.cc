@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pipeline/gzip.h"
 #include "pipeline/user_error.h"
 #include "pipeline/yaml_reader.h"
 #include "pipeline/ulog_writer.h"
@@ -21,6 +22,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 constexpr double kSlugFt2ToKgM2 = 1.35581795;  // docs/physics.md §4
+constexpr int kFooterRows = 4;                  // blank line + 3 summary rows (format.footer)
 
 // root.Child(key), safe when the section is absent (yaml-cpp's const operator[] returns an
 // invalid "zombie" node for a missing key, on which IsMap() throws).
@@ -151,6 +153,7 @@ void ReadFormat(YamlMap map, SimulateSpec* spec) {
       static_cast<int>(ReadValue(map, "significant_digits", 9, 6, false, 17));
   spec->ulog = map.OptionalBool("ulog", false);
   spec->gzip = map.OptionalBool("gzip", false);
+  spec->footer = map.OptionalBool("footer", false);
   map.Finish();
   std::string why;
   if (!f.Check(&why)) throw UserError(map.Where(YAML::Node()) + ": format: " + why);
@@ -174,10 +177,34 @@ void ReadTimeline(YamlMap map, TimelineOptions* t) {
   map.Finish();
 }
 
-void ReadSensor(YamlMap map, SensorOptions* s) {
+void ReadSensor(YamlMap map, SensorOptions* s, bool* time_jitter_given) {
   s->sample_rate_hz = ReadValue(map, "sample_rate_hz", s->sample_rate_hz, 0, true, 100000);
-  s->time_jitter_sigma_s =
-      ReadValue(map, "time_jitter_sigma_s", s->time_jitter_sigma_s, 0, false, 1.0 / s->sample_rate_hz);
+  {
+    const YAML::Node steps = map.Optional("sample_steps");
+    if (steps.IsDefined() && !steps.IsNull()) {
+      const std::string name = map.AsString(steps, "sample_steps");
+      if (!ParseSampleSteps(name, &s->sample_steps)) {
+        throw UserError(map.Where(steps) + ": unknown value '" + name + "' for '" +
+                        map.KeyPath("sample_steps") + "'; allowed regular, lognormal");
+      }
+    }
+  }
+  s->step_log_sigma = ReadValue(map, "step_log_sigma", s->step_log_sigma, 0, false, 3);
+  s->step_range_s = ReadRange(map, "step_range_s", s->step_range_s, 0, true, 3600);
+  *time_jitter_given = map.Has("time_jitter_sigma_s");
+  if (*time_jitter_given) {
+    const YAML::Node jitter = map.Optional("time_jitter_sigma_s");
+    const double value = map.AsDouble(jitter, "time_jitter_sigma_s");
+    if (value > 1.0 / s->sample_rate_hz) {
+      throw UserError(map.Where(jitter) + ": '" + map.KeyPath("time_jitter_sigma_s") + "' = " +
+                      Num(value) + " s is more than one sample period (1/" +
+                      map.KeyPath("sample_rate_hz") + " = " + Num(1.0 / s->sample_rate_hz) +
+                      " s); lower it or the sample rate");
+    }
+  }
+  s->time_jitter_sigma_s = ReadValue(map, "time_jitter_sigma_s",
+                                     DefaultTimeJitterSigmaS(s->sample_rate_hz), 0, false,
+                                     1.0 / s->sample_rate_hz);
   s->drop_fraction = ReadValue(map, "drop_fraction", s->drop_fraction, 0, false, 0.5);
   s->drop_burst_probability =
       ReadValue(map, "drop_burst_probability", s->drop_burst_probability, 0, false, 1);
@@ -186,11 +213,44 @@ void ReadSensor(YamlMap map, SensorOptions* s) {
   s->start_time_s = ReadRange(map, "start_time_s", s->start_time_s, -1e9, false, 1e9);
   s->gyro_noise_sigma_deg_per_s =
       ReadValue(map, "gyro_noise_sigma_deg_per_s", s->gyro_noise_sigma_deg_per_s, 0, false, 100);
+  s->gyro_noise_ar1_phi = ReadValue(map, "gyro_noise_ar1_phi", s->gyro_noise_ar1_phi, 0, false, 0.99);
+  s->gyro_bias_walk_deg_per_s_per_sqrt_s =
+      ReadValue(map, "gyro_bias_walk_deg_per_s_per_sqrt_s", s->gyro_bias_walk_deg_per_s_per_sqrt_s,
+                0, false, 10);
+  s->spike_count = static_cast<int>(ReadValue(map, "spike_count", s->spike_count, 0, false, 1000));
+  {
+    const YAML::Node count = map.Optional("spike_count");
+    if (count.IsDefined() && !count.IsNull() &&
+        map.AsDouble(count, "spike_count") != static_cast<double>(s->spike_count)) {
+      throw UserError(map.Where(count) + ": '" + map.KeyPath("spike_count") +
+                      "' must be a whole number in [0, 1000]");
+    }
+  }
+  s->spike_rate_rad_per_s =
+      ReadValue(map, "spike_rate_rad_per_s", s->spike_rate_rad_per_s, 0, true, 1e4);
   s->gyro_bias_sigma_deg_per_s =
       ReadValue(map, "gyro_bias_sigma_deg_per_s", s->gyro_bias_sigma_deg_per_s, 0, false, 100);
   s->gyro_scale_error_sigma =
       ReadValue(map, "gyro_scale_error_sigma", s->gyro_scale_error_sigma, 0, false, 0.2);
-  s->accelerometer = map.OptionalBool("accelerometer", s->accelerometer);
+  {
+    // true (specific force), false (no accelerometer columns) or gravity_removed.
+    const YAML::Node accel = map.Optional("accelerometer");
+    if (accel.IsDefined() && !accel.IsNull()) {
+      bool present = true;
+      if (accel.IsScalar() && accel.Scalar() == "gravity_removed") {
+        s->accelerometer = true;
+        s->accel_gravity_removed = true;
+      } else if (accel.IsScalar() && YAML::convert<bool>::decode(accel, present)) {
+        s->accelerometer = present;
+        s->accel_gravity_removed = false;
+      } else {
+        throw UserError(map.Where(accel) + ": '" + map.KeyPath("accelerometer") +
+                        "' must be true, false or gravity_removed");
+      }
+    }
+  }
+  s->gravity_removal_error_deg =
+      ReadRange(map, "gravity_removal_error_deg", s->gravity_removal_error_deg, 0, false, 30);
   s->accel_noise_sigma_mps2 =
       ReadValue(map, "accel_noise_sigma_mps2", s->accel_noise_sigma_mps2, 0, false, 10);
   s->accel_bias_sigma_mps2 =
@@ -278,7 +338,7 @@ SimulateSpec ParseSpec(YamlMap root) {
   ReadGeometry(Section(root, "geometry"), &length, &separation, &gravity);
   ReadFormat(Section(root, "format"), &spec);
   ReadTimeline(Section(root, "timeline"), &spec.options.timeline);
-  ReadSensor(Section(root, "sensor"), &spec.options.sensor);
+  ReadSensor(Section(root, "sensor"), &spec.options.sensor, &spec.time_jitter_given);
 
   CampaignSpec& c = spec.campaign;
   {
@@ -292,6 +352,10 @@ SimulateSpec ParseSpec(YamlMap root) {
         ReadRange(swing, "viscous_coeff_kg_m2_per_s", c.viscous_coeff_kg_m2_per_s, 0, false, inf);
     spec.options.sway_coupling_at_60deg =
         ReadValue(swing, "sway_coupling_percent_at_60deg", 0.0, 0, false, 50) / 100.0;
+    spec.options.softening_at_30deg =
+        ReadValue(swing, "softening_percent_at_30deg", 0.0, 0, false, 50) / 100.0;
+    spec.options.softening_exponent =
+        ReadValue(swing, "softening_exponent", spec.options.softening_exponent, 1, false, 4);
     swing.Finish();
   }
 
@@ -447,6 +511,35 @@ nlohmann::json OptionsJson(const SimulateSpec& spec) {
                  {"rocking_max_deg", s.rocking_max_deg},
                  {"rocking_frequency_hz", s.rocking_frequency_hz},
                  {"rocking_decay_s", s.rocking_decay_s}};
+  // Realism settings are recorded when they are on (absent = off), so that a spec without them
+  // gives the same truth.json bytes as before they existed.
+  const SensorOptions off;
+  if (s.sample_steps != off.sample_steps) {
+    j["sensor"]["sample_steps"] = ToString(s.sample_steps);
+    j["sensor"]["step_median_s"] = 1.0 / s.sample_rate_hz;
+    j["sensor"]["step_log_sigma"] = s.step_log_sigma;
+    j["sensor"]["step_range_s"] = Range(s.step_range_s);
+  }
+  if (s.gyro_noise_ar1_phi != off.gyro_noise_ar1_phi) {
+    j["sensor"]["gyro_noise_ar1_phi"] = s.gyro_noise_ar1_phi;
+  }
+  if (s.gyro_bias_walk_deg_per_s_per_sqrt_s != off.gyro_bias_walk_deg_per_s_per_sqrt_s) {
+    j["sensor"]["gyro_bias_walk_deg_per_s_per_sqrt_s"] = s.gyro_bias_walk_deg_per_s_per_sqrt_s;
+  }
+  if (s.spike_count != off.spike_count) {
+    j["sensor"]["spike_count"] = s.spike_count;
+    j["sensor"]["spike_rate_rad_per_s"] = s.spike_rate_rad_per_s;
+  }
+  if (s.accelerometer && s.accel_gravity_removed) {
+    j["sensor"]["accelerometer"] = "gravity_removed";
+    j["sensor"]["gravity_removal_error_deg"] = Range(s.gravity_removal_error_deg);
+  }
+  if (o.softening_at_30deg > 0) {
+    j["softening_percent_at_30deg"] = 100.0 * o.softening_at_30deg;
+    j["softening_exponent"] = o.softening_exponent;
+    j["softening_k_per_rad_p"] = SofteningCoefficient(o.softening_at_30deg, o.softening_exponent);
+    j["softening_harmonic_constant"] = SofteningHarmonicConstant(o.softening_exponent);
+  }
   const ImuFormat& f = spec.format;
   j["format"] = {{"time_column", f.time_column},
                  {"time_unit", ToString(f.time_unit)},
@@ -459,6 +552,7 @@ nlohmann::json OptionsJson(const SimulateSpec& spec) {
                  {"delimiter", std::string(1, f.delimiter)},
                  {"significant_digits", spec.write.significant_digits},
                  {"gzip", spec.gzip}};
+  if (spec.footer) j["format"]["footer"] = true;
   return j;
 }
 
@@ -504,7 +598,56 @@ nlohmann::json TraceJson(const CampaignTrace& ct, const SimulateSpec& spec) {
   j["rocking_amplitude_deg"] = t.rocking_amplitude_rad / kDeg;
   j["rocking_frequency_hz"] = t.rocking_frequency_hz;
   j["rocking_axis_in_body"] = Vec(t.rocking_axis_in_body);
+  // Realism, recorded when on (see OptionsJson).
+  if (so.gyro_bias_walk_deg_per_s_per_sqrt_s > 0) {
+    j["gyro_bias_end_deg_per_s"] = Vec(t.gyro_bias_end_rad_per_s, 1.0 / kDeg);
+  }
+  if (so.gyro_noise_ar1_phi > 0) j["gyro_noise_ar1_phi"] = so.gyro_noise_ar1_phi;
+  if (so.accelerometer && so.accel_gravity_removed) {
+    j["accelerometer"] = "gravity_removed";
+    j["gravity_removal_error_deg"] = t.gravity_removal_error_rad / kDeg;
+  }
+  if (!t.spikes.empty()) {
+    nlohmann::json spikes = nlohmann::json::array();
+    for (const auto& spike : t.spikes) {
+      spikes.push_back({{"sample", spike.sample},
+                        {"t_s", spike.t_s},
+                        {"axis", std::string(1, "xyz"[spike.axis])},
+                        {"column", spec.format.gyro_columns[spike.axis]},
+                        {"rate_rad_per_s", spike.rate_rad_per_s}});
+    }
+    j["spikes"] = spikes;
+  }
+  if (t.softening_k > 0) {
+    // What a fit of the ideal model would find at the release amplitude (harmonic balance); the
+    // true inertia stays inertia_total_kg_m2 (the small-amplitude limit).
+    const double p = spec.options.softening_exponent;
+    j["softening_k_per_rad_p"] = t.softening_k;
+    j["apparent_inertia_excess_at_release"] = ApparentInertiaExcess(t.softening_k, p, t.amplitude_rad);
+    j["apparent_inertia_at_release_kg_m2"] =
+        s.params.inertia_kg_m2 * (1.0 + ApparentInertiaExcess(t.softening_k, p, t.amplitude_rad));
+  }
+  if (spec.footer) j["footer_rows"] = kFooterRows;
   return j;
+}
+
+// The footer of a log that ends like the Crazyflie logs: a blank line, then summary rows whose
+// time column is numeric again (smaller than the last time) and whose last column is text.
+std::string Footer(const SimulatedTrace& trace, const ImuFormat& format, const std::string& eol) {
+  const char d = format.delimiter;
+  const int columns = format.has_accel() ? 7 : 4;
+  const double time_scale = 1.0 / ToSi(format.time_unit);
+  auto row = [&](const std::string& time, const std::string& middle, const std::string& text) {
+    std::string r = time;
+    for (int c = 1; c < columns - 1; ++c) (r += d) += middle;
+    (r += d) += text;
+    return r + eol;
+  };
+  char release[64];
+  std::snprintf(release, sizeof(release), "%.6g",
+                (trace.truth.t_release_s - trace.truth.start_time_s) * time_scale);
+  return eol + row("", "", "Rollout Completed: swing logged") + row(release, "0", "Flip Data") +
+         row("0", "0", "Impact Data");
 }
 
 void WriteTrace(const std::string& path, const SimulatedTrace& trace, const SimulateSpec& spec) {
@@ -515,10 +658,76 @@ void WriteTrace(const std::string& path, const SimulatedTrace& trace, const Simu
   }
   ImuFormat format = spec.format;
   if (!spec.options.sensor.accelerometer) format.accel_columns = {"", "", ""};
-  WriteImuLog(path, trace.imu, format, spec.write);
+  if (!spec.footer) {
+    WriteImuLog(path, trace.imu, format, spec.write);
+    return;
+  }
+  const std::string text =
+      FormatImuLog(trace.imu, format, spec.write) + Footer(trace, format, spec.write.line_end);
+  const bool gzip = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;
+  WriteFileAtomically(path, gzip ? GzipCompress(text) : text);
 }
 
 }  // namespace
+
+double DefaultTimeJitterSigmaS(double sample_rate_hz) {
+  const double fallback = SensorOptions().time_jitter_sigma_s;  // 1 ms
+  return 0.1 / sample_rate_hz < fallback ? 0.1 / sample_rate_hz : fallback;
+}
+
+void SetSampleRateFromFlag(SimulateSpec* spec, double rate_hz) {
+  if (!(rate_hz > 0 && rate_hz <= 100000)) {
+    throw UserError("--sample-rate-hz = " + Num(rate_hz) + " is out of range; allowed (0, 100000]");
+  }
+  SensorOptions& s = spec->options.sensor;
+  const std::string from = spec->file.empty() ? std::string("the spec") : spec->file;
+  if (!spec->time_jitter_given) {
+    s.time_jitter_sigma_s = DefaultTimeJitterSigmaS(rate_hz);
+  } else if (s.time_jitter_sigma_s > 1.0 / rate_hz) {
+    throw UserError("--sample-rate-hz " + Num(rate_hz) + ": 'sensor.time_jitter_sigma_s' = " +
+                    Num(s.time_jitter_sigma_s) + " s in " + from +
+                    " is more than one sample period at that rate (" + Num(1.0 / rate_hz) +
+                    " s); lower it in the spec (or remove it: the default follows the rate), or "
+                    "lower --sample-rate-hz");
+  }
+  if (s.rocking_frequency_hz > rate_hz / 4) {
+    throw UserError("--sample-rate-hz " + Num(rate_hz) + ": 'sensor.rocking_frequency_hz' = " +
+                    Num(s.rocking_frequency_hz) + " Hz in " + from +
+                    " is above a quarter of that rate; raise --sample-rate-hz to at least " +
+                    Num(4 * s.rocking_frequency_hz) + " or lower the rocking frequency");
+  }
+  s.sample_rate_hz = rate_hz;
+}
+
+void CheckOutputFileTarget(const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);  // follows symlinks
+  if (fs::exists(status)) {
+    if (fs::is_directory(status)) {
+      throw UserError(what + " " + path + ": is a folder, expected a file name");
+    }
+    if (!fs::is_regular_file(status)) {
+      throw UserError(what + " " + path +
+                      ": exists and is not a regular file (a device, FIFO or socket); "
+                      "simulate only writes regular files: choose another path");
+    }
+    return;
+  }
+  // A missing file: its nearest existing ancestor must be a folder.
+  for (fs::path parent = fs::path(path).parent_path(); !parent.empty();
+       parent = parent.parent_path()) {
+    const fs::file_status ps = fs::status(parent, ec);
+    if (fs::exists(ps)) {
+      if (!fs::is_directory(ps)) {
+        throw UserError(what + " " + path + ": " + parent.string() +
+                        " exists and is not a folder");
+      }
+      break;
+    }
+    if (parent == parent.parent_path()) break;
+  }
+}
 
 SimulateSpec ReadSimulateSpec(const std::string& file) {
   return ParseSpec(YamlMap::LoadFile(file));
@@ -605,6 +814,7 @@ SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::stri
   if (fs::exists(out_dir, ec) && !fs::is_directory(out_dir, ec)) {
     throw UserError(out_dir + ": output path exists and is not a folder");
   }
+  CheckOutputFileTarget((fs::path(out_dir) / "truth.json").string(), "--out");  // fail early
   std::vector<CampaignTrace> traces;
   std::string why;
   if (!SimulateCampaign(spec.campaign, spec.options, spec.seed, &traces, &why)) {
@@ -617,6 +827,11 @@ SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::stri
     for (auto& ct : traces) ct.relative_path += ".gz";
   }
   const std::string truth = CampaignTruthJson(spec, traces);
+  // Every target is checked before the first file is written.
+  for (const auto& ct : traces) {
+    CheckOutputFileTarget((fs::path(out_dir) / ct.relative_path).string(), "--out");
+  }
+  CheckOutputFileTarget((fs::path(out_dir) / "truth.json").string(), "--out");
   SimulateRunSummary summary;
   for (const auto& ct : traces) {
     WriteTrace((fs::path(out_dir) / ct.relative_path).string(), ct.trace, spec);
@@ -653,6 +868,25 @@ SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string&
       truth_path.resize(truth_path.size() - ext.size());
     }
     truth_path += ".truth.json";
+  }
+  {
+    namespace fs = std::filesystem;
+    CheckOutputFileTarget(csv_path, "--trace");
+    CheckOutputFileTarget(truth_path, "--truth");
+    // The same file under two spellings: compare normalised absolute paths (symlinks resolved
+    // where they exist), then, when both exist, the files themselves (hard links).
+    std::error_code ec;
+    auto normal = [&ec](const std::string& p) {
+      return fs::weakly_canonical(fs::absolute(p, ec), ec).lexically_normal();
+    };
+    const bool same = normal(csv_path) == normal(truth_path) ||
+                      (fs::exists(csv_path, ec) && fs::exists(truth_path, ec) &&
+                       fs::equivalent(csv_path, truth_path, ec));
+    if (same) {
+      throw UserError("--truth " + truth_path + " and --trace " + csv_path +
+                      " are the same file; give the truth JSON another name (default: the CSV "
+                      "name with .truth.json)");
+    }
   }
   CampaignTrace ct;
   ct.relative_path = std::filesystem::path(csv_path).filename().string();

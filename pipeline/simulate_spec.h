@@ -38,11 +38,28 @@ struct SimulateSpec {
   ImuLogWriteOptions write;         // significant digits
   bool ulog = false;                // `format.ulog`: campaign logs written as PX4 ULog *.ulg
   bool gzip = false;                // `format.gzip`: campaign logs written as *.csv.gz
+  bool footer = false;              // `format.footer`: a Crazyflie-like footer after the data
+  bool time_jitter_given = false;   // `sensor.time_jitter_sigma_s` set in the spec
   bool has_campaign = false;        // `aircraft`, `rig`, `campaign` sections present
   CampaignSpec campaign;
   bool has_trace = false;           // `trace` section present
   TraceRequest trace;
 };
+
+// The default timestamp jitter (when the spec does not set sensor.time_jitter_sigma_s): 1 ms, but
+// at most 10 % of a sample period, so that any sample rate works without touching it.
+double DefaultTimeJitterSigmaS(double sample_rate_hz);
+
+// Sets the sample rate from the command line (`--sample-rate-hz`): checks the range, lets a
+// default jitter follow the rate (DefaultTimeJitterSigmaS) and, when a setting the spec made no
+// longer fits the new rate, throws UserError naming the flag, the spec key and what to change.
+void SetSampleRateFromFlag(SimulateSpec* spec, double sample_rate_hz);
+
+// Refuses an output target that `simulate` must not write through: anything but a regular file
+// or nothing (a device such as /dev/null, a FIFO, a socket, a folder, also behind a symlink), or
+// a path below an existing non-folder. `what` names the option in the message ("--trace").
+// Throws UserError.
+void CheckOutputFileTarget(const std::string& path, const std::string& what);
 
 // Reads and validates a spec file. Throws UserError "file:line:col: ..." naming the key.
 SimulateSpec ReadSimulateSpec(const std::string& file);
@@ -59,12 +76,15 @@ struct SimulateRunSummary {
 
 // Campaign: simulates every log in memory first (any error -> UserError, nothing written), then
 // writes OUT/pitch_{P}/trial_{k}.csv, OUT/tare/tare_{k}.csv and OUT/truth.json, each atomically.
-// Requires spec.has_campaign. Throws UserError (also when out_dir is an existing file).
+// Requires spec.has_campaign. Throws UserError, before writing anything, when out_dir exists and
+// is not a folder, or one of the files it would write exists and is not a regular file.
 SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::string& out_dir);
 
 // One trace from spec.trace (flags already merged in): writes `csv_path` and the truth JSON at
 // `truth_path` (default: csv_path with ".csv" replaced by ".truth.json"). Throws UserError naming
-// the parameter on bad input; nothing is written then.
+// the parameter on bad input; nothing is written then. Also refused, before anything is written:
+// a target that is not a regular file (CheckOutputFileTarget) and a truth path that is the CSV
+// path, however spelled (./a.csv, d/../a.csv, a symlink or a hard link to it).
 SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string& csv_path,
                                     const std::string& truth_path = "");
 
