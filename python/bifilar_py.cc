@@ -321,10 +321,11 @@ py::object FitEllipseCore(const Array& pitch_array, const Array& inertia_array,
   }
   EllipseResult result;
   std::string why;
+  if (!options.Check(&why)) throw UserError("ellipse options: " + why);  // as `bifilar ellipse`
   bool ok = false;
   {
     py::gil_scoped_release release;
-    ok = options.Check(&why) && FitEllipse(points, options, &result, &why);
+    ok = FitEllipse(points, options, &result, &why);
   }
   if (!ok) throw UserError(why);
   return ToPython(EllipseResultToJson(result));
