@@ -162,6 +162,10 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
   }, why);
 }
 
+TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, const ImuData& data,
+                        const TraceProcessOptions& options, TraceRecord record,
+                        TraceFitResult* fit_out);
+
 TraceRecord Process(const CampaignConfig& config, const std::string& path,
                     const TraceProcessOptions& options, TraceRecord record) {
   const std::string& name = record.file;
@@ -177,6 +181,19 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
   if (!TryReadImuLog(path, config.imu.format, ImuLogOptions(), &data, &why)) {
     return fail(TraceStatus::kError, why);
   }
+  return ProcessData(config, path, data, options, std::move(record), nullptr);
+}
+
+TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, const ImuData& data,
+                        const TraceProcessOptions& options, TraceRecord record,
+                        TraceFitResult* fit_out) {
+  const std::string& name = record.file;
+  auto fail = [&](TraceStatus status, const std::string& message) {
+    record.status = status;
+    record.message = Renamed(message, path, name);
+    return record;
+  };
+  std::string why;
   record.warnings = data.warnings;
 
   // 2. Swing axis (and the pitch, from the accelerometer at rest).
@@ -266,7 +283,7 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
                                              config.aircraft_mass_std_kg);
   fit_options.gravity_std_mps2 = config.uncertainties.gravity_std_mps2;
   fit_options.gyro_scale_std = config.imu.gyro_scale_std;
-  fit_options.keep_series = !options.figure_paths.empty();
+  fit_options.keep_series = !options.figure_paths.empty() || fit_out != nullptr;
   const TraceFitResult fit = FitTrace(input, fit_options);
 
   record.status = fit.status == TraceFitStatus::kOk         ? TraceStatus::kOk
@@ -311,6 +328,8 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
                                                  : "");
   }
 
+  if (fit_out) *fit_out = fit;
+
   // 6. Figure (only of a fit that ran).
   for (const std::string& figure_path : options.figure_paths) {
     if (fit.t_s.empty()) break;
@@ -335,17 +354,18 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
   return record;
 }
 
-}  // namespace
 
-TraceRecord ProcessTrace(const CampaignConfig& config, const std::string& path,
-                         const TraceProcessOptions& options) {
+// Runs process(record) on a fresh record of `path`, timed; an exception becomes an error record.
+template <typename Process>
+TraceRecord Guarded(const CampaignConfig& config, const std::string& path,
+                    const TraceProcessOptions& options, const Process& process) {
   const auto start = std::chrono::steady_clock::now();
   TraceRecord record;
   record.file = options.display_name.empty() ? path : options.display_name;
   record.role = options.role;
   record.model = ToString(config.fit.model);
   try {
-    record = Process(config, path, options, record);
+    record = process(record);
   } catch (const std::exception& e) {
     record.status = TraceStatus::kError;
     record.message = Renamed(e.what(), path, record.file);
@@ -353,6 +373,23 @@ TraceRecord ProcessTrace(const CampaignConfig& config, const std::string& path,
   record.fit_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return record;
+}
+
+}  // namespace
+
+TraceRecord ProcessTrace(const CampaignConfig& config, const std::string& path,
+                         const TraceProcessOptions& options) {
+  return Guarded(config, path, options, [&](const TraceRecord& record) {
+    return Process(config, path, options, record);
+  });
+}
+
+TraceRecord ProcessTraceData(const CampaignConfig& config, const ImuData& data,
+                             const std::string& path, const TraceProcessOptions& options,
+                             TraceFitResult* fit) {
+  return Guarded(config, path, options, [&](const TraceRecord& record) {
+    return ProcessData(config, path, data, options, record, fit);
+  });
 }
 
 }  // namespace bifilar

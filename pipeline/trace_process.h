@@ -12,9 +12,11 @@
 #include <vector>
 
 #include "fit/trace_fit.h"
+#include "pendulum/imu_data.h"
 #include "pipeline/config.h"
 
 namespace bifilar {
+
 
 enum class TraceStatus { kOk, kRejected, kError };
 const char* ToString(TraceStatus status);  // "ok", "rejected", "error"
@@ -109,6 +111,13 @@ struct TraceProcessOptions {
 // Processes one log. Never throws: every failure is a record with status error naming the file.
 TraceRecord ProcessTrace(const CampaignConfig& config, const std::string& path,
                          const TraceProcessOptions& options);
+
+// The same processing on a log already in memory (the Python module's fit_trace): `path` names
+// it in messages and picks its fit.windows entry. When `fit` is not null it receives the trace
+// fit with its fitted and residual series (left default when no fit ran). Never throws.
+TraceRecord ProcessTraceData(const CampaignConfig& config, const ImuData& data,
+                             const std::string& path, const TraceProcessOptions& options,
+                             TraceFitResult* fit = nullptr);
 
 // The window override of the config for `path` (absolute), if any: keys of fit.windows are
 // matched relative to runs.root and to the config folder.

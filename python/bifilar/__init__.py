@@ -1,0 +1,322 @@
+"""bifilar from Python: the same C++ core as the ``bifilar`` command line.
+
+Functions
+---------
+fit_trace(t, rate, *, length_m, separation_m, mass_kg, ...)
+    Fit one swing-rate series; the record of ``bifilar fit --json`` plus the fitted and
+    residual series as numpy arrays.
+read_log(path, config)
+    Read an IMU log the way ``bifilar fit`` does: the time series a fit uses.
+fit_ellipse(pitch_deg, inertia, std=None)
+    I_x, I_z, I_xz and tau with their uncertainties (``bifilar ellipse --json``).
+process(config_path, out=None, jobs=None)
+    Run a campaign (``bifilar process``); the parsed results.json.
+simulate(...)
+    Realistic logs with known truth (``bifilar simulate``), in memory or on disk.
+
+Units are SI throughout (s, rad/s, m, kg, kg m^2), pitch and amplitudes in degrees. Bad input
+raises ValueError with the command line's message. Results are :class:`Record` objects: dicts
+whose keys are also attributes (``r.inertia_total_kg_m2 == r["inertia_total_kg_m2"]``).
+Conventions and the equations: docs/physics.md.
+"""
+
+from . import _core
+
+try:  # needed by every function; `import bifilar` itself works without it
+    import numpy as _np
+except ImportError:  # pragma: no cover - depends on the interpreter
+    _np = None
+
+__all__ = ["Record", "fit_trace", "read_log", "fit_ellipse", "process", "simulate"]
+__version__ = _core.version
+
+
+class Record(dict):
+    """A result: a dict (JSON-like, as the command line writes it) whose keys are attributes.
+
+    Nested objects are Records too. ``dict(r)`` or ``json.dumps(r)`` give the plain form
+    (numpy arrays excepted).
+    """
+
+    __slots__ = ()
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        for key, value in self.items():
+            dict.__setitem__(self, key, _wrap(value))
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def __dir__(self):
+        return list(self.keys()) + list(super().__dir__())
+
+
+def _wrap(value):
+    if isinstance(value, dict) and not isinstance(value, Record):
+        return Record(value)
+    if isinstance(value, list):
+        return [_wrap(v) for v in value]
+    return value
+
+
+def _series(values, name):
+    """A float64 numpy view/copy of an array-like; ValueError naming the argument otherwise."""
+    if _np is None:
+        raise ImportError("bifilar needs numpy for this interpreter (Debian: python3-numpy, "
+                          "for /usr/bin/python3)")
+    try:
+        return _np.asarray(values, dtype=_np.float64)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{name} must be an array of numbers: {error}") from None
+
+
+def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None, model=None,
+              window=None, config=None, max_amplitude_deg=None, min_amplitude_deg=None,
+              length_std_m=None, separation_std_m=None, mass_std_kg=None, g_std=None,
+              gyro_scale_std=None, max_rms_over_noise=None, max_residual_autocorr=None,
+              whiteness_lags=None, max_secondary_motion_ratio=None, min_periods=None,
+              name="trace"):
+    """Fit the moment of inertia to one swing-rate series, as ``bifilar fit`` does.
+
+    The whole processing of ``bifilar fit`` after reading the log runs on the series: the
+    free-oscillation window (or ``window``), the amplitude band, the pendulum-model fit, the
+    quality checks and the uncertainty budget. The GIL is released during the fit.
+
+    Parameters
+    ----------
+    t : array-like, shape (N,)
+        Sample times (s), finite and strictly increasing (the log's own clock; gaps are fine).
+    rate : array-like, shape (N,)
+        Swing rate about the down vertical (rad/s), e.g. ``read_log(...).rate_rad_per_s``.
+    length_m, separation_m : float
+        Filar length L and separation D (m).
+    mass_kg : float
+        Whole suspended mass: aircraft + rig + IMU (kg).
+    g : float, default 9.80665
+        Local gravity (m/s^2).
+    model : {'full', 'jardin', 'linear'}, default 'full'
+        Equation of motion fitted (docs/physics.md).
+    window : None, (t0, t1) or 'T0:T1'
+        Fit only this window (s, the series' own time) instead of the detected one.
+    config : str, optional
+        A YAML config (configs/README.md): geometry, masses (aircraft + rig), uncertainties,
+        fit settings and quality thresholds are taken from it; keyword arguments given
+        override it. Without it, length_m, separation_m and mass_kg are required.
+    max_amplitude_deg, min_amplitude_deg : float, optional
+        Amplitude band of the fitted part (deg); default as the config's ``fit`` section.
+    length_std_m, separation_std_m, mass_std_kg, g_std, gyro_scale_std : float, optional
+        1-sigma uncertainties of L, D, m, g and the gyro scale factor (fraction) for the
+        uncertainty budget; default 0 (or the config's).
+    max_rms_over_noise, max_residual_autocorr, whiteness_lags, max_secondary_motion_ratio,
+    min_periods : optional
+        Quality thresholds (``fit.quality`` of the config); default the library's.
+    name : str, default 'trace'
+        Stands for the file name in the record and in messages.
+
+    Returns
+    -------
+    Record
+        The fields of ``bifilar fit --json`` (``status``, ``message``, ``inertia_total_kg_m2``,
+        ``inertia_total_std_kg_m2``, ``window_s``, ``budget``, ...; numbers that do not apply
+        are None), plus numpy arrays of the fitted window: ``t_s``, ``measured_rad_per_s``,
+        ``fitted_rad_per_s`` (model rate + bias) and ``residual_rad_per_s`` (fitted -
+        measured); empty when no fit ran. A trace the data cannot support has status
+        ``'rejected'`` with the reason in ``message``.
+
+    Raises
+    ------
+    ValueError
+        t and rate of different lengths, not finite or t not increasing (naming the argument);
+        bad settings; any trace the command line would report as ``error`` (its message).
+    """
+    settings = dict(length_m=length_m, separation_m=separation_m, mass_kg=mass_kg, g=g,
+                    model=model, window=window, config=config,
+                    max_amplitude_deg=max_amplitude_deg, min_amplitude_deg=min_amplitude_deg,
+                    length_std_m=length_std_m, separation_std_m=separation_std_m,
+                    mass_std_kg=mass_std_kg, g_std=g_std, gyro_scale_std=gyro_scale_std,
+                    max_rms_over_noise=max_rms_over_noise,
+                    max_residual_autocorr=max_residual_autocorr, whiteness_lags=whiteness_lags,
+                    max_secondary_motion_ratio=max_secondary_motion_ratio,
+                    min_periods=min_periods, name=name)
+    record, t_s, measured, fitted, residual = _core.fit_trace(
+        _series(t, "t"), _series(rate, "rate"), **settings)
+    result = Record(record)
+    result["t_s"] = t_s
+    result["measured_rad_per_s"] = measured
+    result["fitted_rad_per_s"] = fitted
+    result["residual_rad_per_s"] = residual
+    return result
+
+
+def read_log(path, config):
+    """Read an IMU log as ``bifilar fit`` does: the time series its fit uses.
+
+    Parameters
+    ----------
+    path : str
+        The log (CSV, optionally .gz), as given to ``bifilar fit``.
+    config : str
+        The YAML config naming the columns and units (``imu`` section, configs/README.md).
+
+    Returns
+    -------
+    Record
+        ``t_s`` (N,), ``rate_rad_per_s`` (N,) the swing rate gyro . n, ``gyro_rad_per_s``
+        (N, 3), ``accel_mps2`` (N, 3) or None, all in SI and IMU axes; ``axis_in_imu``,
+        ``axis_in_body``, ``axis_source`` (the swing axis n and how it was found),
+        ``pitch_measured_deg`` (from the accelerometer at rest, or None), ``window_s`` (the
+        config's window for this file, or None), ``warnings`` (repairs made while reading) and
+        ``notes``. ``fit_trace(r.t_s, r.rate_rad_per_s, config=config, name=path)`` then gives
+        the numbers of ``bifilar fit config path``.
+
+    Raises
+    ------
+    ValueError
+        The file or config cannot be read or is malformed (the command line's message, naming
+        the file, line and column or key).
+    """
+    return Record(_core.read_log(str(path), str(config)))
+
+
+def fit_ellipse(pitch_deg, inertia, std=None, *, bootstrap=2000, seed=1, confidence=0.95,
+                covariance="auto"):
+    """Fit the ellipse of inertia to moments measured at several pitch angles.
+
+    I(theta) = I_z cos^2 theta + I_x sin^2 theta + I_xz sin 2 theta (docs/physics.md), as
+    ``bifilar ellipse --json``. The GIL is released during the fit.
+
+    Parameters
+    ----------
+    pitch_deg : array-like, shape (N,)
+        Nose-up pitch of each measurement (deg); at least 3 distinct angles.
+    inertia : array-like, shape (N,)
+        Moment about the swing axis at that pitch (kg m^2), > 0.
+    std : array-like, shape (N,), optional
+        Standard errors of ``inertia`` (kg m^2): weights 1/std^2.
+    bootstrap : int, default 2000
+        Parametric bootstrap replicates for the intervals (0: covariance intervals).
+    seed : int, default 1
+        Seed of the bootstrap.
+    confidence : float, default 0.95
+        Confidence level of the intervals.
+    covariance : {'auto', 'points', 'angle_means', 'absolute'}
+        How the covariance is scaled (README, ``bifilar ellipse``).
+
+    Returns
+    -------
+    Record
+        ``Ix_kg_m2``, ``Iz_kg_m2``, ``Ixz_kg_m2``, ``tau_deg``, ``Ixp_kg_m2``, ``Izp_kg_m2``,
+        each with ``_std`` and ``_ci95`` variants, plus ``rmse_kg_m2``, ``angles``,
+        ``residuals``, ``warnings``, ... (the ``bifilar ellipse --json`` document).
+
+    Raises
+    ------
+    ValueError
+        Arrays of different lengths or not finite (naming the argument), fewer than 3 angles,
+        non-positive inertia, bad options.
+    """
+    std_array = None if std is None else _series(std, "std")
+    return Record(_core.fit_ellipse(_series(pitch_deg, "pitch_deg"), _series(inertia, "inertia"),
+                                    std_array, int(bootstrap), int(seed), float(confidence),
+                                    str(covariance)))
+
+
+def process(config_path, out=None, jobs=None, *, force=False, figures=True, progress=False):
+    """Process a campaign as ``bifilar process CONFIG --out OUT --jobs JOBS``.
+
+    Fits every log (in parallel, with the cache in OUT/cache), subtracts the rig, fits the
+    ellipse and writes results.json, traces.csv, angles.csv, report.html and figures into OUT.
+    The GIL is released while it runs.
+
+    Parameters
+    ----------
+    config_path : str
+        The campaign config (YAML, configs/README.md).
+    out : str, optional
+        Output folder; default ``out/`` beside the config.
+    jobs : int, optional
+        Worker threads; default all cores.
+    force : bool, default False
+        Ignore the cache and refit every log (``--force``).
+    figures : bool, default True
+        Draw the per-trace figures, Fig. 3/4 and report.html (False: results files only).
+    progress : bool, default False
+        Print a progress line per trace to stderr.
+
+    Returns
+    -------
+    Record
+        The parsed OUT/results.json: ``summary``, ``rig``, ``traces`` (one record per log,
+        the fields of ``bifilar fit --json`` plus the campaign's), ``angles``, ``ellipse``,
+        ``table1``, ...
+
+    Raises
+    ------
+    ValueError
+        Config or usage problems (the command line's exit code 2, with its message). Problems
+        with single logs are records with status ``error``, not exceptions.
+    """
+    return Record(_core.process(str(config_path), None if out is None else str(out),
+                                None if jobs is None else int(jobs), bool(force), bool(figures),
+                                bool(progress)))
+
+
+def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=None,
+             inertia_kg_m2=None, mass_kg=None, length_m=None, separation_m=None, g=None,
+             amplitude_deg=None, pitch_deg=None, duration_s=None, sample_rate_hz=None,
+             no_accel=False):
+    """Simulate realistic IMU logs with known truth, as ``bifilar simulate``.
+
+    Three uses:
+
+    * ``simulate(spec, out=DIR)``: a campaign from a spec with ``aircraft``, ``rig`` and
+      ``campaign`` sections (e.g. configs/simulate_prandtl_d.yaml) written to DIR.
+    * ``simulate(inertia_kg_m2=I, mass_kg=m, length_m=L, separation_m=D, trace='x.csv')``: one
+      trace written to a CSV (and its truth JSON beside it, or to ``truth``).
+    * the same without ``trace``: the trace is returned as arrays, nothing is left on disk.
+
+    Parameters
+    ----------
+    spec : str, optional
+        Simulation spec (YAML); sensor, timeline and format settings and the defaults.
+    seed : int, optional
+        Random seed (default: the spec's, or 1).
+    model : {'full', 'jardin', 'linear'}, optional
+        The truth's equation of motion.
+    inertia_kg_m2, mass_kg : float
+        Single trace: whole suspended inertia I (kg m^2) and mass m (kg).
+    length_m, separation_m, g : float
+        Filar length L, separation D (m) and gravity (m/s^2).
+    amplitude_deg, pitch_deg : float
+        Single trace: psi at release (default 20 deg) and the body's true pitch (default 0).
+    duration_s, sample_rate_hz : float
+        Free-oscillation duration (s) and IMU sample rate (Hz).
+    no_accel : bool
+        Write no accelerometer.
+
+    Returns
+    -------
+    Record
+        ``truth`` (the parsed truth JSON), ``samples_written``, ``samples_dropped``,
+        ``truth_path``; for a campaign ``files_written`` and ``out``; for one trace ``t_s``,
+        ``gyro_rad_per_s`` (N, 3) and ``accel_mps2`` (N, 3, or None), as read back from the
+        written CSV (so exactly what ``read_log`` would give), and ``file`` when written.
+
+    Raises
+    ------
+    ValueError
+        Missing or out-of-range parameters, bad spec (naming the key), both out and trace.
+    """
+    settings = dict(spec=spec, out=out, trace=trace, truth=truth, seed=seed, model=model,
+                    inertia_kg_m2=inertia_kg_m2, mass_kg=mass_kg, length_m=length_m,
+                    separation_m=separation_m, g=g, amplitude_deg=amplitude_deg,
+                    pitch_deg=pitch_deg, duration_s=duration_s, sample_rate_hz=sample_rate_hz,
+                    no_accel=bool(no_accel))
+    for key in ("spec", "out", "trace", "truth"):
+        if settings[key] is not None:
+            settings[key] = str(settings[key])
+    return Record(_core.simulate(**settings))
