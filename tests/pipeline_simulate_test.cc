@@ -305,7 +305,7 @@ TEST(SimulateSpec, RealismKeysParseAndBadValuesNameTheKey) {
   EXPECT_TRUE(s.accelerometer);
   EXPECT_TRUE(s.accel_gravity_removed);
   EXPECT_EQ(s.gravity_removal_error_deg.max, 15);
-  EXPECT_NEAR(spec.options.softening_at_30deg, 0.12, 1e-15);
+  EXPECT_NEAR(spec.options.softening_at_30deg, 0.028, 1e-15);
   EXPECT_EQ(spec.options.softening_exponent, 1);
   EXPECT_TRUE(spec.footer);
   // Absent keys: everything off, as before the keys existed.
