@@ -18,9 +18,11 @@
 // timestamps, and with some probability a hand stopping it (rate decays exponentially) followed by
 // a little rest. A small decaying rocking mode about a horizontal axis perpendicular to n starts at
 // release. Timestamps have jitter and dropped samples (single and in bursts), or irregular
-// log-normal steps. Optional realism (all off by default, each drawn from its own random stream
-// so that turning one on leaves the rest of the log unchanged): AR(1) coloured gyro noise, a gyro
-// bias random walk, single-sample spikes, a gravity-removed accelerometer, amplitude softening.
+// log-normal steps. Optional realism, all off by default (and then the log is bit for bit what it
+// was before these options existed): AR(1) coloured gyro noise, a gyro bias random walk,
+// single-sample spikes, a gravity-removed accelerometer, amplitude softening. Each draws from its
+// own random stream (AR(1) reuses the white-noise draws), so turning one on changes only what it
+// models: the timestamps for the steps, the swing for the softening, one channel for the others.
 #pragma once
 
 #include <cstdint>

@@ -580,12 +580,12 @@ TEST(SimulatePresets, QuadrotorLooksLikeTheCrazyflieLogs) {
 TEST(SimulatePresets, NonidealRigRecordsItsSoftening) {
   const SimulateSpec spec =
       ReadSimulateSpec(std::string(BIFILAR_SOURCE_DIR) + "/configs/simulate_nonideal_rig.yaml");
-  EXPECT_NEAR(spec.options.softening_at_30deg, 0.028, 1e-15);
+  EXPECT_NEAR(spec.options.softening_at_30deg, 0.12, 1e-15);
   const fs::path a = TempDir("nonideal_a"), b = TempDir("nonideal_b");
   RunSimulateCampaign(spec, a.string());
   RunSimulateCampaign(spec, b.string());
   const nlohmann::json truth = nlohmann::json::parse(ReadText(a / "truth.json"));
-  EXPECT_EQ(truth["options"]["softening_percent_at_30deg"].get<double>(), 2.8);
+  EXPECT_EQ(truth["options"]["softening_percent_at_30deg"].get<double>(), 12);
   ASSERT_EQ(truth["traces"].size(), 8u);
   for (const auto& t : truth["traces"]) {
     const std::string file = t["file"];
@@ -594,8 +594,9 @@ TEST(SimulatePresets, NonidealRigRecordsItsSoftening) {
     const double expected = t["nominal_pitch_deg"].get<double>() == 0 ? 0.050 : 0.027;
     EXPECT_NEAR(inertia, expected, 1e-4 * expected);  // the TRUE inertia, softening or not
     EXPECT_NEAR(t["mass_kg"].get<double>(), 3.34, 1e-12);
-    // Harmonic balance at the release amplitude: 2.8 % x (A/30)^2, exactly as the header says.
-    const double x30 = 0.028 / 1.028, x = x30 * std::pow(t["amplitude_deg"].get<double>() / 30, 2);
+    // Harmonic balance at the release amplitude: x = x30 (A/30)^2, excess x / (1 - x), as the
+    // header says, with 1 / (1 - x30) = 1.12.
+    const double x30 = 0.12 / 1.12, x = x30 * std::pow(t["amplitude_deg"].get<double>() / 30, 2);
     EXPECT_NEAR(t["apparent_inertia_excess_at_release"].get<double>(), x / (1 - x), 1e-12);
     EXPECT_NEAR(t["apparent_inertia_at_release_kg_m2"].get<double>(), inertia * (1 + x / (1 - x)), 1e-15);
     EXPECT_LT(t["amplitude_at_end_deg"].get<double>(), 8.0);  // the sweep reaches small amplitudes
