@@ -41,21 +41,25 @@ class Record(dict):
     __slots__ = ()
 
     def __init__(self, *args, **kwargs):
+        """Like dict(...); nested dicts (also inside lists) become Records."""
         super().__init__(*args, **kwargs)
         for key, value in self.items():
             dict.__setitem__(self, key, _wrap(value))
 
     def __getattr__(self, name):
+        """r.key is r["key"]; AttributeError for a key that is not there."""
         try:
             return self[name]
         except KeyError:
             raise AttributeError(name) from None
 
     def __dir__(self):
+        """The keys too, for tab completion in notebooks."""
         return list(self.keys()) + list(super().__dir__())
 
 
 def _wrap(value):
+    """Dicts to Records, recursively through lists; anything else unchanged."""
     if isinstance(value, dict) and not isinstance(value, Record):
         return Record(value)
     if isinstance(value, list):
