@@ -41,21 +41,25 @@ class Record(dict):
     __slots__ = ()
 
     def __init__(self, *args, **kwargs):
+        """Like dict(...); nested dicts (also inside lists) become Records."""
         super().__init__(*args, **kwargs)
         for key, value in self.items():
             dict.__setitem__(self, key, _wrap(value))
 
     def __getattr__(self, name):
+        """r.key is r["key"]; AttributeError for a key that is not there."""
         try:
             return self[name]
         except KeyError:
             raise AttributeError(name) from None
 
     def __dir__(self):
+        """The keys too, for tab completion in notebooks."""
         return list(self.keys()) + list(super().__dir__())
 
 
 def _wrap(value):
+    """Dicts to Records, recursively through lists; anything else unchanged."""
     if isinstance(value, dict) and not isinstance(value, Record):
         return Record(value)
     if isinstance(value, list):
@@ -72,6 +76,21 @@ def _series(values, name):
         return _np.asarray(values, dtype=_np.float64)
     except (TypeError, ValueError) as error:
         raise ValueError(f"{name} must be an array of numbers: {error}") from None
+
+
+def _number(function, name, value, kind=float):
+    """None, or the value as a float (or int); ValueError naming the argument otherwise."""
+    if value is None:
+        return None
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{function}: {name} must be a number, got {value!r}") from None
+    if kind is int:
+        if not number.is_integer():
+            raise ValueError(f"{function}: {name} must be a whole number, got {value!r}")
+        return int(number)
+    return number
 
 
 def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None, model=None,
@@ -142,6 +161,13 @@ def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None
                     max_residual_autocorr=max_residual_autocorr, whiteness_lags=whiteness_lags,
                     max_secondary_motion_ratio=max_secondary_motion_ratio,
                     min_periods=min_periods, name=name)
+    for key, value in settings.items():
+        if key not in ("model", "window", "config", "name"):
+            settings[key] = _number("fit_trace", key, value,
+                                    int if key == "whiteness_lags" else float)
+    for key in ("model", "config", "name"):
+        if settings[key] is not None:
+            settings[key] = str(settings[key])
     record, t_s, measured, fitted, residual = _core.fit_trace(
         _series(t, "t"), _series(rate, "rate"), **settings)
     result = Record(record)
@@ -220,8 +246,13 @@ def fit_ellipse(pitch_deg, inertia, std=None, *, bootstrap=2000, seed=1, confide
         non-positive inertia, bad options.
     """
     std_array = None if std is None else _series(std, "std")
+    bootstrap = _number("fit_ellipse", "bootstrap", bootstrap, int)
+    seed = _number("fit_ellipse", "seed", seed, int)
+    if bootstrap < 0 or seed < 0:
+        raise ValueError("fit_ellipse: bootstrap and seed must be >= 0")
     return Record(_core.fit_ellipse(_series(pitch_deg, "pitch_deg"), _series(inertia, "inertia"),
-                                    std_array, int(bootstrap), int(seed), float(confidence),
+                                    std_array, bootstrap, seed,
+                                    _number("fit_ellipse", "confidence", confidence),
                                     str(covariance)))
 
 
@@ -261,7 +292,7 @@ def process(config_path, out=None, jobs=None, *, force=False, figures=True, prog
         with single logs are records with status ``error``, not exceptions.
     """
     return Record(_core.process(str(config_path), None if out is None else str(out),
-                                None if jobs is None else int(jobs), bool(force), bool(figures),
+                                _number("process", "jobs", jobs, int), bool(force), bool(figures),
                                 bool(progress)))
 
 
@@ -316,7 +347,13 @@ def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=No
                     separation_m=separation_m, g=g, amplitude_deg=amplitude_deg,
                     pitch_deg=pitch_deg, duration_s=duration_s, sample_rate_hz=sample_rate_hz,
                     no_accel=bool(no_accel))
-    for key in ("spec", "out", "trace", "truth"):
+    for key in ("spec", "out", "trace", "truth", "model"):
         if settings[key] is not None:
             settings[key] = str(settings[key])
+    for key in ("inertia_kg_m2", "mass_kg", "length_m", "separation_m", "g", "amplitude_deg",
+                "pitch_deg", "duration_s", "sample_rate_hz"):
+        settings[key] = _number("simulate", key, settings[key])
+    settings["seed"] = _number("simulate", "seed", seed, int)
+    if settings["seed"] is not None and settings["seed"] < 0:
+        raise ValueError("simulate: seed must be >= 0")
     return Record(_core.simulate(**settings))

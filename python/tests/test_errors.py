@@ -121,3 +121,15 @@ def test_simulate_errors():
         bifilar.simulate(mass_kg=6, length_m=2, separation_m=0.9)
     with pytest.raises(ValueError, match="either out= or trace="):
         bifilar.simulate(out="a", trace="b.csv")
+
+
+def test_settings_of_the_wrong_type_name_the_argument():
+    t = np.arange(100) * 0.01
+    with pytest.raises(ValueError, match="fit_trace: length_m must be a number, got 'abc'"):
+        bifilar.fit_trace(t, np.zeros(100), length_m="abc", separation_m=0.9, mass_kg=6.0)
+    with pytest.raises(ValueError, match="whiteness_lags must be a whole number"):
+        bifilar.fit_trace(t, np.zeros(100), whiteness_lags=2.5, **GEOMETRY)
+    with pytest.raises(ValueError, match="seed must be >= 0"):
+        bifilar.fit_ellipse([0, 30, 60], [1.0, 1.1, 1.2], seed=-1)
+    with pytest.raises(ValueError, match="simulate: mass_kg must be a number"):
+        bifilar.simulate(inertia_kg_m2=1.0, mass_kg=[1, 2], length_m=2.0, separation_m=0.9)

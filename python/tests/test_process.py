@@ -41,6 +41,17 @@ ellipse: {{bootstrap: 300, seed: 3}}
     return config
 
 
+def outside(value, out_dir):
+    """The results with the output folder in any path written as OUT."""
+    if isinstance(value, dict):
+        return {k: outside(v, out_dir) for k, v in value.items()}
+    if isinstance(value, list):
+        return [outside(v, out_dir) for v in value]
+    if isinstance(value, str):
+        return value.replace(str(out_dir), "OUT")
+    return value
+
+
 def test_process_gives_the_results_json_of_the_cli(cli, small_campaign, tmp_path):
     done = cli("process", small_campaign, "--out", tmp_path / "cli_out", "--jobs", "2")
     assert done.returncode == 0, done.stderr
@@ -48,8 +59,9 @@ def test_process_gives_the_results_json_of_the_cli(cli, small_campaign, tmp_path
     results = bifilar.process(small_campaign, out=tmp_path / "py_out", jobs=2)
     assert results.summary.n_ok == len(PITCHES) + 1
     assert results.ellipse.Ix_kg_m2 > 0
-    # Identical but for wall times and cache bookkeeping of the two runs.
-    assert without_timings(dict(results)) == without_timings(cli_results)
+    # Identical but for wall times and the output folders named in paths.
+    assert (without_timings(outside(dict(results), tmp_path / "py_out")) ==
+            without_timings(outside(cli_results, tmp_path / "cli_out")))
     # The file on disk is what was returned.
     on_disk = json.loads((tmp_path / "py_out" / "results.json").read_text())
     assert on_disk == results
