@@ -72,7 +72,8 @@ TEST(IntegratorChoice, SampleCampaignAgreesBetweenMethods) {
     ASSERT_TRUE(r.ok()) << r.file << ": " << r.message;
     ASSERT_TRUE(c.ok()) << c.file << ": " << c.message;
     EXPECT_NEAR(c.inertia_total_kg_m2 / r.inertia_total_kg_m2, 1.0, kRelTol) << c.file;
-    EXPECT_NEAR(c.inertia_total_std_kg_m2 / r.inertia_total_std_kg_m2, 1.0, 1e-4) << c.file;
+    // The HAC std depends on the residuals through an integer bandwidth: allow 0.1 %.
+    EXPECT_NEAR(c.inertia_total_std_kg_m2 / r.inertia_total_std_kg_m2, 1.0, 1e-3) << c.file;
     EXPECT_NE(c.cache_key, r.cache_key) << c.file;  // the method is part of the key
   }
   ASSERT_TRUE(rk.result.ellipse_fit.has_value());
