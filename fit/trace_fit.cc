@@ -307,6 +307,16 @@ AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptio
       continue;
     }
     const StatStd stat = StatisticalStd(cost, q, free);
+    {
+      std::vector<double> rr(t.size());
+      const double c = Cost(cost, q, &rr);
+      const Trajectory& bt = cost.last_trajectory();
+      double mean = 0.0, sq = 0.0;
+      for (double v : bt.rate_rad_per_s) mean += v;
+      mean /= static_cast<double>(t.size());
+      for (double v : bt.rate_rad_per_s) sq += (v - mean) * (v - mean);
+      band.residual_fraction = sq > 0.0 ? std::sqrt(2.0 * c / sq) : HUGE_VAL;
+    }
     const auto [a0, a1] = AmplitudeAtEnds(t, cost.last_trajectory(), period_s);
     band.amplitude_start_deg = a0;
     band.amplitude_end_deg = a1;
@@ -757,9 +767,15 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
                                 " iterations; set a window (fit.windows or --window) on the "
                                 "free oscillation");
   }
-  const double residual_fraction = result.signal_rms_rad_per_s > 0.0
-                                       ? result.residual_rms_rad_per_s / result.signal_rms_rad_per_s
-                                       : HUGE_VAL;
+  double residual_fraction = result.signal_rms_rad_per_s > 0.0
+                                 ? result.residual_rms_rad_per_s / result.signal_rms_rad_per_s
+                                 : HUGE_VAL;
+  if (sweep.trend_detected) {
+    // The result comes from the low-amplitude band: judge that fit (the window fit of a rig far
+    // from the model may not follow the data at large amplitude, which is what the sweep shows).
+    for (const AmplitudeSweepBand& b : sweep.bands)
+      if (b.ok && b.inertia_kg_m2 == result.params.inertia_kg_m2) residual_fraction = b.residual_fraction;
+  }
   if (residual_fraction > options.reject_residual_fraction) {
     reject("fit_does_not_follow_data",
            "the fit does not follow the data: residual RMS is " + Fmt("%.2f", residual_fraction) +

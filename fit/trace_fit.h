@@ -126,6 +126,7 @@ struct AmplitudeSweepBand {
   double amplitude_mean_deg = 0.0;         // their mean: the band's amplitude
   double inertia_kg_m2 = 0.0;              // I fitted in the band (K_D, C held)
   double inertia_std_kg_m2 = 0.0;          // its statistical (HAC) std
+  double residual_fraction = 0.0;          // residual RMS / swing-rate RMS of the band fit
   bool ok = false;                         // the band fit converged
 };
 

@@ -1,5 +1,6 @@
 #include "fit/trace_synth.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -15,10 +16,17 @@ bool MakeSyntheticTrace(const SyntheticTraceOptions& o, TraceFitInput* input) {
   TraceFitInput out;
   out.geometry = o.geometry;
   out.t_s.reserve(n_nominal);
-  for (long k = 0; k < n_nominal; ++k) {
-    const bool keep = k == 0 || unit(rng) >= o.drop_fraction;
-    const double jitter = k == 0 ? 0.0 : (2.0 * unit(rng) - 1.0) * o.jitter_fraction * dt;
-    if (keep) out.t_s.push_back(k * dt + jitter);
+  if (o.irregular_steps) {
+    for (double t = 0.0; t <= o.duration_s;) {
+      out.t_s.push_back(t);
+      t += std::clamp(dt * std::exp(0.75 * normal(rng)), 0.008, 0.160);
+    }
+  } else {
+    for (long k = 0; k < n_nominal; ++k) {
+      const bool keep = k == 0 || unit(rng) >= o.drop_fraction;
+      const double jitter = k == 0 ? 0.0 : (2.0 * unit(rng) - 1.0) * o.jitter_fraction * dt;
+      if (keep) out.t_s.push_back(k * dt + jitter);
+    }
   }
   IntegratorOptions tight;
   tight.rel_tol = 1e-12;
@@ -32,8 +40,12 @@ bool MakeSyntheticTrace(const SyntheticTraceOptions& o, TraceFitInput* input) {
   }
   const double sigma = o.noise_deg_per_s * kRadPerDeg, bias = o.bias_deg_per_s * kRadPerDeg;
   out.rate_rad_per_s.resize(out.t_s.size());
-  for (size_t k = 0; k < out.t_s.size(); ++k)
-    out.rate_rad_per_s[k] = traj.rate_rad_per_s[k] + bias + sigma * normal(rng);
+  const double phi = o.noise_ar1_phi;
+  double e = normal(rng);
+  for (size_t k = 0; k < out.t_s.size(); ++k) {
+    if (k > 0) e = phi * e + std::sqrt(1.0 - phi * phi) * normal(rng);
+    out.rate_rad_per_s[k] = traj.rate_rad_per_s[k] + bias + sigma * e;
+  }
   out.noise_rad_per_s = sigma;
   *input = std::move(out);
   return true;

@@ -22,6 +22,12 @@ struct SyntheticTraceOptions {
   double drop_fraction = 0.01;                 // samples lost at random; [0, 0.5)
   double noise_deg_per_s = 0.25;               // white gyro noise sigma (deg/s); >= 0
   double bias_deg_per_s = 0.3;                 // constant gyro bias (deg/s)
+  // Coloured noise: AR(1) over the samples, e_k = phi e_(k-1) + sqrt(1 - phi^2) w_k (marginal
+  // std noise_deg_per_s); [0, 0.99].
+  double noise_ar1_phi = 0.0;
+  // Irregular sampling: every step drawn log-normal around 1/sample_rate_hz (ln-std 0.75),
+  // clipped to [8, 160] ms, like a 30 Hz radio link (jitter and drops then unused).
+  bool irregular_steps = false;
   uint64_t seed = 1;
 };
 
