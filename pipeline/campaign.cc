@@ -18,6 +18,7 @@
 #include "fit/ellipse_plot.h"
 #include "pipeline/cache.h"
 #include "pipeline/ellipse_json.h"
+#include "pipeline/output_set.h"
 #include "pipeline/report.h"
 #include "pipeline/results_json.h"
 #include "pipeline/user_error.h"
@@ -314,16 +315,10 @@ void Progress(const CampaignOptions& options, std::mutex& mutex, int done, int t
 }
 
 // Removes OUT/cache and OUT/figures entries no record refers to, so the folder does not grow.
-void Prune(const std::string& folder, const std::set<std::string>& keep) {
-  std::error_code ec;
-  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
-    if (!keep.count(it->path().filename().string())) fs::remove(it->path(), ec);
-  }
-}
-
 // Fig. 3 and Fig. 4 under names keyed by the ellipse inputs, so an unchanged rerun reuses them.
 void DrawCampaignFigures(const CampaignConfig& config, const EllipseResult& fit,
-                         const std::string& out_dir, CampaignResult* result) {
+                         const std::string& out_dir, OutputManifest* manifest,
+                         CampaignResult* result) {
   std::ostringstream key;
   key.precision(17);
   key << ProgramVersion() << ';' << ToString(config.units) << ';' << fit.a_kg_m2 << ';'
@@ -341,6 +336,7 @@ void DrawCampaignFigures(const CampaignConfig& config, const EllipseResult& fit,
   std::error_code ec;
   std::string why;
   const std::string moments = "moments_" + hash + ".png", polar = "polar_" + hash + ".png";
+  manifest->Record({"figures/" + moments, "figures/" + polar});
   if (fs::exists(figures / moments, ec) ||
       WriteEllipseMomentFigure(fit, (figures / moments).string(), plot, &why)) {
     result->moments_figure = moments;
@@ -365,7 +361,8 @@ EllipseOptions MakeEllipseOptions(const CampaignConfig& config) {
 // The ellipse of inertia from every usable aircraft trace (one point per trial, pitch used,
 // aircraft inertia after the tare, its std), plus Table 1 and the Fig. 3/4 figures.
 void FitCampaignEllipse(const CampaignConfig& config, const CampaignOptions& options,
-                        const std::string& out_dir, CampaignResult* result) {
+                        const std::string& out_dir, OutputManifest* manifest,
+                        CampaignResult* result) {
   std::vector<EllipsePoint> points;
   for (const TraceRecord& r : result->traces) {
     if (r.role != TraceRole::kAircraft || !r.ok()) continue;
@@ -407,7 +404,7 @@ void FitCampaignEllipse(const CampaignConfig& config, const CampaignOptions& opt
     result->cv_percent = fit.table1.mean_cov_percent;
   }
   result->ellipse = EllipseResultToJson(fit);
-  if (options.figures) DrawCampaignFigures(config, fit, out_dir, result);
+  if (options.figures) DrawCampaignFigures(config, fit, out_dir, manifest, result);
   result->ellipse_fit = std::move(fit);
 }
 
@@ -522,6 +519,18 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   if (fs::exists(out, ec) && !fs::is_directory(out, ec)) {
     throw UserError(options.out_dir + ": output path exists and is not a folder");
   }
+  fs::create_directories(out, ec);
+  if (ec) throw UserError(options.out_dir + ": cannot create output folder: " + ec.message());
+  // pipeline/output_set.h: one run per folder, nothing removed that bifilar did not write.
+  const OutputFolderLock lock(out.string());
+  OutputManifest manifest(out.string());
+  manifest.CheckOwnedPlaces();
+  if (options.progress) {
+    for (const std::string& problem : CheckOutputSet(out.string(), true)) {
+      *options.progress << "warning: previous outputs are a mixed set (" << problem
+                        << "); all are rewritten now\n";
+    }
+  }
   fs::create_directories(out / "cache", ec);
   if (!ec) fs::create_directories(out / "figures", ec);
   if (ec) throw UserError(options.out_dir + ": cannot create output folder: " + ec.message());
@@ -591,7 +600,13 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     }
   }
 
-  // 3. Fit what is not cached, in parallel.
+  // 3. Fit what is not cached, in parallel (names recorded before the files exist).
+  std::vector<std::string> planned;
+  for (int i : to_fit) {
+    planned.push_back("cache/" + result.traces[i].cache_key + ".json");
+    planned.push_back("figures/" + result.traces[i].cache_key + ".svg");
+  }
+  manifest.Record(planned);
   std::mutex progress_mutex;
   std::atomic<int> done{0};
   const int n_fit = static_cast<int>(to_fit.size());
@@ -739,33 +754,28 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     }
   }
   result.systematic_relative_std = Mean(relative_budget);
-  FitCampaignEllipse(config, options, out.string(), &result);
+  FitCampaignEllipse(config, options, out.string(), &manifest, &result);
 
   if (result.summary.n_rejected + result.summary.n_error > 0 || !result.summary.ellipse_fitted) {
     result.summary.exit_code = 1;
   }
   result.summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
 
-  // 7. Outputs, each atomically; then drop cache entries and figures nobody refers to.
-  nlohmann::json json = ResultsToJson(config, result);
-  WriteFileAtomically((out / "traces.csv").string(), TracesCsv(result));
-  WriteFileAtomically((out / "angles.csv").string(), AnglesCsv(result));
-  if (options.write_report) {
-    WriteFileAtomically((out / "report.html").string(), BuildReportHtml(json, out.string()));
-  }
+  // 7. Outputs, each atomically, results.json last with its siblings' hashes; then drop the
+  // cache entries and figures bifilar wrote that nobody refers to now.
   result.summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
-  json["summary"]["wall_s"] = result.summary.wall_s;
-  WriteFileAtomically((out / "results.json").string(), json.dump(1) + "\n");
-
-  std::set<std::string> keep_cache, keep_figures;
+  nlohmann::json json = ResultsToJson(config, result);
+  std::set<std::string> keep = {"results.json", "traces.csv", "angles.csv", "report.html"};
+  manifest.Record({keep.begin(), keep.end()});
+  WriteOutputSet(out.string(), json, TracesCsv(result), AnglesCsv(result),
+                 options.write_report ? &BuildReportHtml : nullptr);
   for (const TraceRecord& r : result.traces) {
-    if (!r.cache_key.empty()) keep_cache.insert(r.cache_key + ".json");
-    if (!r.figure.empty()) keep_figures.insert(r.figure);
+    if (!r.cache_key.empty()) keep.insert("cache/" + r.cache_key + ".json");
+    if (!r.figure.empty()) keep.insert("figures/" + r.figure);
   }
-  if (!result.moments_figure.empty()) keep_figures.insert(result.moments_figure);
-  if (!result.polar_figure.empty()) keep_figures.insert(result.polar_figure);
-  Prune((out / "cache").string(), keep_cache);
-  Prune((out / "figures").string(), keep_figures);
+  if (!result.moments_figure.empty()) keep.insert("figures/" + result.moments_figure);
+  if (!result.polar_figure.empty()) keep.insert("figures/" + result.polar_figure);
+  manifest.Prune(keep);
   return result;
 }
 
