@@ -415,8 +415,9 @@ bool CampaignOptions::Check(std::string* why) const {
     *why = "output folder not set";
     return false;
   }
-  if (jobs < 0) {
-    *why = "--jobs must be >= 0";
+  if (jobs < 0 || jobs > kMaxJobs) {
+    *why = "--jobs must be in [0, " + std::to_string(kMaxJobs) + "] (0 = all cores), got " +
+           std::to_string(jobs);
     return false;
   }
   return true;

@@ -77,9 +77,11 @@ struct CampaignResult {
 using TraceFitFunction = std::function<TraceRecord(const CampaignConfig&, const std::string& path,
                                                    const TraceProcessOptions&)>;
 
+constexpr int kMaxJobs = 256;  // limit of CampaignOptions::jobs (--jobs)
+
 struct CampaignOptions {
   std::string out_dir;        // output folder (created); an existing non-folder is an error
-  int jobs = 0;               // worker threads; 0 = hardware concurrency
+  int jobs = 0;               // worker threads; 0 = hardware concurrency; <= kMaxJobs
   bool force = false;         // ignore the cache (refit everything)
   bool write_report = true;   // report.html (needs the figures)
   bool figures = true;        // draw per-trace fit figures and Fig. 3/4

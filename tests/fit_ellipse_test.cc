@@ -464,3 +464,34 @@ TEST(EllipseFit, BadInputIsRejectedWithAMessage) {
 
 }  // namespace
 }  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// issue 9 item 3: `--bootstrap 2147483647` ran without end, taking ~450 MB/s.
+TEST(EllipseFit, BootstrapCountIsBoundedAndTheLimitRunsInBoundedMemory) {
+  std::mt19937_64 rng(5);
+  const auto points = Simulate(kPaper, PaperAngles(), 3, 0.006, 0.01, &rng);
+  EllipseOptions options;
+  EllipseResult r;
+  std::string why;
+  for (int bad : {-1, 50, kMaxBootstrapReplicates + 1, 2147483647}) {
+    options.bootstrap_replicates = bad;
+    EXPECT_FALSE(FitEllipse(points, options, &r, &why)) << bad;
+    EXPECT_NE(why.find(std::to_string(kMaxBootstrapReplicates)), std::string::npos) << why;
+  }
+  // The limit itself runs (replicates cost O(angle groups), only the tails are kept), and its
+  // percentile interval of I_xz matches value -+ t * std to its Monte Carlo error (~1 %).
+  options.bootstrap_replicates = kMaxBootstrapReplicates;
+  options.run_ceres = options.run_nelder_mead = false;
+  r = MustFit(points, options);
+  EXPECT_EQ(r.bootstrap_replicates, kMaxBootstrapReplicates);
+  EXPECT_NEAR((r.ixz.ci_hi - r.ixz.ci_lo) / (2 * r.ixz.std), 2.131, 0.03);  // t, 15 dof
+  // Independent points: abc* drawn from its 3x3 covariance; same t check with n - 3 dof.
+  options.covariance = EllipseCovariance::kPointResiduals;
+  r = MustFit(points, options);
+  EXPECT_NEAR((r.ix.ci_hi - r.ix.ci_lo) / (2 * r.ix.std), 2.0049, 0.03);  // t, 51 dof
+}
+
+}  // namespace
+}  // namespace bifilar

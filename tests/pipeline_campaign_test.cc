@@ -181,7 +181,7 @@ TEST(Campaign, CacheRefitsOnlyWhatChanged) {
   EXPECT_EQ(again.summary.n_fitted, 0);
   EXPECT_NEAR(again.ellipse_fit->ix.value, kIx, 1e-9);
   // Rig inertia and ellipse options are not fit inputs.
-  c.WriteConfig("{inertia_kg_m2: 0.4}", "ellipse: {bootstrap: 50, seed: 3}\nunits: imperial\n");
+  c.WriteConfig("{inertia_kg_m2: 0.4}", "ellipse: {bootstrap: 500, seed: 3}\nunits: imperial\n");
   again = c.Run();
   EXPECT_EQ(c.calls, 12);
   EXPECT_NEAR(again.traces[0].inertia_kg_m2, again.traces[0].inertia_total_kg_m2 - 0.4, 1e-15);

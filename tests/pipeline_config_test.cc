@@ -243,3 +243,33 @@ TEST(Config, MissingFileIsNamed) {
 
 }  // namespace
 }  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// issue 9 items 3 and 11: count-like keys are bounded and every range is checked at load,
+// naming the key and line, before any fit (bootstrap 50 and max_amplitude_deg 0 passed).
+TEST(Config, CountsAndRangesAreBoundedAtLoad) {
+  const std::string yaml = kMinimal;
+  ExpectError(yaml + "ellipse:\n  bootstrap: 2147483647\n",
+              {"'ellipse.bootstrap' must be 0 (off) or in [100, 100000]", ":9:"});
+  ExpectError(yaml + "ellipse: {bootstrap: 50}\n", {"ellipse.bootstrap", "got 50"});
+  ExpectError(yaml + "ellipse: {min_angles: 100000}\n", {"ellipse.min_angles", "[3, 1000]"});
+  ExpectError(yaml + "fit: {max_amplitude_deg: 0}\n", {"'fit.max_amplitude_deg' must be in [1, 90]"});
+  ExpectError(yaml + "fit: {max_amplitude_deg: 179.9}\n", {"fit.max_amplitude_deg"});
+  ExpectError(yaml + "fit: {max_amplitude_deg: 20, min_amplitude_deg: 25}\n",
+              {"fit.min_amplitude_deg"});
+  ExpectError(yaml + "fit: {quality: {whiteness_lags: 100000000}}\n", {"whiteness_lags in [1, 1000]"});
+  // Check() holds the same ranges for a config built in code.
+  CampaignConfig config;
+  std::string why;
+  config.ellipse.bootstrap = 50;
+  EXPECT_FALSE(config.ellipse.Check(&why));
+  config.ellipse.bootstrap = 0;
+  config.fit.max_amplitude_deg = 0.0;
+  EXPECT_FALSE(config.fit.Check(&why));
+  EXPECT_NE(why.find("max_amplitude_deg"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace bifilar
