@@ -585,7 +585,14 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     windows[i] = ConfigWindowFor(config, run.path);
     record.cache_key = CacheKey(hashes[i], FitFingerprint(config, run.role, windows[i]));
     TraceRecord cached;
-    if (!options.force && cache.Load(record.cache_key, &cached) &&
+    std::string cache_problem;
+    const bool loaded =
+        !options.force && cache.Load(record.cache_key, hashes[i], &cached, &cache_problem);
+    if (!cache_problem.empty()) {
+      ++result.summary.n_cache_refused;
+      if (options.progress) *options.progress << "warning: " << cache_problem << "; refitting\n";
+    }
+    if (loaded &&
         (!options.figures || cached.figure.empty() ||
          fs::exists(out / "figures" / cached.figure, ec))) {
       cached.role = record.role;
@@ -641,7 +648,7 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     fitted.cache_key = record.cache_key;
     fitted.from_cache = false;
     try {
-      cache.Store(record.cache_key, fitted);
+      cache.Store(record.cache_key, record.content_hash, fitted);
     } catch (const UserError& e) {
       if (fitted.message.empty()) fitted.message = std::string("not cached: ") + e.what();
     }
@@ -850,6 +857,11 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
                 "wall time %.2f s\n",
                 s.n_ok, s.n_rejected, s.n_error, s.n_traces, s.n_fitted, s.n_reused, s.wall_s);
   out << line;
+  if (s.n_cache_refused > 0) {
+    out << "Warning: " << s.n_cache_refused
+        << " cache entr" << (s.n_cache_refused == 1 ? "y was" : "ies were")
+        << " damaged or not theirs and refitted (see the warnings above)\n";
+  }
 }
 
 }  // namespace bifilar

@@ -47,6 +47,7 @@ struct AngleStats {
 struct CampaignSummary {
   int n_traces = 0, n_ok = 0, n_rejected = 0, n_error = 0;  // aircraft + tare
   int n_fitted = 0, n_reused = 0;  // fits run now / taken from the cache
+  int n_cache_refused = 0;         // cache entries refused as damaged or not theirs (refitted)
   double wall_s = 0.0;             // whole run
   bool ellipse_fitted = false;
   std::string ellipse_message;     // why not fitted, if so

@@ -186,5 +186,34 @@ TEST(OutputSet, MixedSetIsDetectedByReportAndRewrittenByProcess) {
   EXPECT_TRUE(CheckOutputSet(c.out, false).empty());
 }
 
+// issue 9 item 6: a cached inertia scaled by 0.9 was used (I_xz moved, exit 0).
+TEST(OutputSet, TamperedCacheEntryIsRefittedNotUsed) {
+  Campaign c;
+  const CampaignResult first = c.Run();
+  ASSERT_TRUE(first.ellipse_fit.has_value());
+  int tampered = 0;
+  for (const auto& entry : fs::directory_iterator(c.out + "/cache")) {
+    std::string text = ReadFile(entry.path().string());
+    const size_t at = text.find("\"inertia_total_kg_m2\": ");
+    ASSERT_NE(at, std::string::npos);
+    const size_t begin = at + 23, end = text.find_first_of(",\n", begin);
+    const double value = std::stod(text.substr(begin, end - begin));
+    std::ostringstream scaled;
+    scaled.precision(17);
+    scaled << 0.9 * value;
+    text.replace(begin, end - begin, scaled.str());
+    WriteFile(entry.path().string(), text);
+    if (++tampered == 3) break;
+  }
+  const CampaignResult again = c.Run();
+  EXPECT_EQ(again.summary.n_cache_refused, 3);
+  EXPECT_EQ(again.summary.n_fitted, 3);
+  EXPECT_EQ(again.summary.n_reused, 9);
+  ASSERT_TRUE(again.ellipse_fit.has_value());
+  EXPECT_DOUBLE_EQ(again.ellipse_fit->ixz.value, first.ellipse_fit->ixz.value);
+  // The refitted entries are good again.
+  EXPECT_EQ(c.Run().summary.n_cache_refused, 0);
+}
+
 }  // namespace
 }  // namespace bifilar
