@@ -116,7 +116,7 @@ namespace {
 
 std::string EntryChecksum(const std::string& key, const std::string& content_hash,
                           const std::string& version, const nlohmann::json& record) {
-  return HashToHex(Fnv1a64(key + ";" + content_hash + ";" + version + ";" + record.dump()));
+  return HashToHex(Fnv1a64(key + ";" + content_hash + ";" + version + ";" + record.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)));
 }
 
 bool FiniteOrNull(const nlohmann::json& j, const char* field) {
@@ -191,7 +191,7 @@ void TraceCache::Store(const std::string& key, const std::string& content_hash,
   entry["version"] = ProgramVersion();
   entry["record"] = TraceRecordToJson(record, false);
   entry["checksum"] = EntryChecksum(key, content_hash, ProgramVersion(), entry["record"]);
-  WriteFileAtomically(EntryPath(key), entry.dump(1) + "\n");
+  WriteFileAtomically(EntryPath(key), entry.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 }  // namespace bifilar

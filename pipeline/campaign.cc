@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -261,18 +262,29 @@ std::vector<RunFile> DiscoverTare(const CampaignConfig& config) {
   return tare;
 }
 
-// Runs fn(i) for i in [0, n) on `jobs` threads.
+// Runs fn(i) for i in [0, n) on `jobs` threads. An exception in any fn stops the handing out of
+// further work and is rethrown on the calling thread once every thread has joined (an escaped
+// exception would otherwise terminate the program).
 template <typename Fn>
 void ParallelFor(int n, int jobs, Fn fn) {
   std::atomic<int> next{0};
+  std::mutex error_mutex;
+  std::exception_ptr error;
   auto worker = [&] {
-    for (int i = next++; i < n; i = next++) fn(i);
+    try {
+      for (int i = next++; i < n; i = next++) fn(i);
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+      next = n;
+    }
   };
   const int threads = std::max(1, std::min(jobs, n));
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
   worker();
   for (std::thread& thread : pool) thread.join();
+  if (error) std::rethrow_exception(error);
 }
 
 double Mean(const std::vector<double>& v) {

@@ -179,7 +179,7 @@ void OutputManifest::Save() const {
   nlohmann::json j;
   j["about"] = "files bifilar wrote in this folder; only these are ever removed by bifilar";
   j["files"] = files_;
-  WriteFileAtomically((fs::path(out_dir_) / kFileName).string(), j.dump(1) + "\n");
+  WriteFileAtomically((fs::path(out_dir_) / kFileName).string(), j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 std::string FileHash(const std::string& path) {
@@ -201,7 +201,7 @@ void WriteOutputSet(const std::string& out_dir, nlohmann::json results,
   const fs::path out(out_dir);
   results["outputs"] = {{"traces.csv", HashToHex(Fnv1a64(traces_csv))},
                         {"angles.csv", HashToHex(Fnv1a64(angles_csv))}};
-  const std::string results_text = results.dump(1) + "\n";
+  const std::string results_text = results.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   WriteFileAtomically((out / "traces.csv").string(), traces_csv);
   WriteFileAtomically((out / "angles.csv").string(), angles_csv);
   if (report_html_builder) {
