@@ -169,10 +169,17 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
       throw UserError(inertia.Where(table) +
                       ": 'rig.inertia.table' must map pitch_deg to inertia_kg_m2, e.g. {0: 0.12}");
     }
+    std::map<double, YAML::Node> first_key;  // "0" and "0.0" are one pitch: both lines named
     for (const auto& item : table) {
       const double pitch = inertia.AsDouble(item.first, "table");
       const double value = inertia.AsDouble(item.second, "table");
       if (value < 0.0) throw UserError(inertia.Where(item.second) + ": rig inertia must be >= 0");
+      auto [it, inserted] = first_key.emplace(pitch, item.first);
+      if (!inserted) {
+        throw UserError(inertia.Where(item.first) + ": 'rig.inertia.table' gives pitch " +
+                        item.first.Scalar() + " deg twice (first at " + inertia.Where(it->second) +
+                        ")");
+      }
       out->table_kg_m2[pitch] = value;
     }
   } else {

@@ -273,3 +273,32 @@ TEST(Config, CountsAndRangesAreBoundedAtLoad) {
 
 }  // namespace
 }  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// issue 9 item 10: repeated keys were accepted silently and the first won.
+TEST(Config, DuplicateKeysDocumentsAndTablePitchesNameBothLines) {
+  // Line 3 repeats line 3's key at line 4 (kMinimal: rig at 1, filar_separation_m at 3).
+  std::string yaml = kMinimal;
+  yaml.insert(yaml.find("  mass_kg: 2.0"), "  filar_separation_m: 2.5\n");
+  ExpectError(yaml, {":4: duplicate key 'rig.filar_separation_m' (first at line 3)"});
+  // A second rig block.
+  ExpectError(std::string(kMinimal) + "rig: {filar_length_m: 3}\n",
+              {":8: duplicate key 'rig' (first at line 1)"});
+  // A second YAML document.
+  ExpectError(std::string(kMinimal) + "---\nunits: imperial\n", {":9:", "second YAML document",
+                                                                  "line 1"});
+  // Duplicate table pitches, written alike or differently.
+  const char* table = "rig:\n  filar_length_m: 2\n  filar_separation_m: 1\n  mass_kg: 1\n"
+                      "  inertia:\n    table:\n      0: 0.1\n      %s: 0.2\n"
+                      "aircraft: {mass_kg: 1}\nruns: {root: ., pattern: 'p{pitch_deg}.csv'}\n";
+  char buffer[400];
+  std::snprintf(buffer, sizeof(buffer), table, "0");
+  ExpectError(buffer, {":8:", "duplicate key 'rig.inertia.table.0' (first at line 7)"});
+  std::snprintf(buffer, sizeof(buffer), table, "0.0");
+  ExpectError(buffer, {":8:", "pitch 0.0 deg twice", ":7:"});
+}
+
+}  // namespace
+}  // namespace bifilar
