@@ -18,6 +18,7 @@
 
 #include "fit/ellipse_plot.h"
 #include "pipeline/cache.h"
+#include "pipeline/campaign_inputs.h"
 #include "pipeline/ellipse_json.h"
 #include "pipeline/output_set.h"
 #include "pipeline/report.h"
@@ -553,7 +554,12 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   const TraceCache cache((out / "cache").string());
 
   // 1. Discovery and content hashes (in parallel: reading is most of the rerun's time).
-  const std::vector<RunFile> runs = DiscoverRuns(config);
+  std::vector<RunFile> runs = DiscoverRuns(config);
+  DropOutputFolder(out.string(), &runs);  // pipeline/campaign_inputs.h: outputs are not inputs
+  if (runs.empty()) {
+    throw UserError("runs: every file found is inside the output folder " + out.string());
+  }
+  const std::vector<std::optional<std::array<double, 2>>> windows = WindowsForRuns(config, runs);
   const int n = static_cast<int>(runs.size());
   CampaignResult result;
   result.traces.resize(n);
@@ -574,7 +580,6 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   // 2. Errors, duplicates, cache look-ups.
   std::map<std::string, std::string> first_with_hash;
   std::vector<int> to_fit;
-  std::vector<std::optional<std::array<double, 2>>> windows(n);
   for (int i = 0; i < n; ++i) {
     const RunFile& run = runs[i];
     TraceRecord& record = result.traces[i];
@@ -594,7 +599,6 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
       record.message = run.display + ": same content as " + it->second + " (duplicate log)";
       continue;
     }
-    windows[i] = ConfigWindowFor(config, run.path);
     record.cache_key = CacheKey(hashes[i], FitFingerprint(config, run.role, windows[i]));
     TraceRecord cached;
     std::string cache_problem;

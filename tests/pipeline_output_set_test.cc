@@ -7,6 +7,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -70,13 +71,16 @@ struct Campaign {
               text.str());
   }
 
+  std::atomic<int> calls{0};
+
   CampaignResult Run() {
     CampaignOptions o;
     o.out_dir = out;
     o.jobs = 2;
     o.figures = false;
-    o.fit_function = [](const CampaignConfig&, const std::string& path,
-                        const TraceProcessOptions& options) {
+    o.fit_function = [this](const CampaignConfig&, const std::string& path,
+                            const TraceProcessOptions& options) {
+      ++calls;  // atomic: the fits run on two threads
       TraceRecord r;
       r.file = options.display_name;
       r.status = TraceStatus::kOk;
@@ -86,6 +90,10 @@ struct Campaign {
       return r;
     };
     return RunCampaign(LoadCampaignConfig(dir + "/campaign.yaml"), o);
+  }
+
+  void AppendConfig(const std::string& yaml) {
+    WriteFile(dir + "/campaign.yaml", ReadFile(dir + "/campaign.yaml") + yaml);
   }
 
   size_t CacheFiles() const {
@@ -213,6 +221,30 @@ TEST(OutputSet, TamperedCacheEntryIsRefittedNotUsed) {
   EXPECT_DOUBLE_EQ(again.ellipse_fit->ixz.value, first.ellipse_fit->ixz.value);
   // The refitted entries are good again.
   EXPECT_EQ(c.Run().summary.n_cache_refused, 0);
+}
+
+// issue 9 item 11: an output folder inside runs.root made the rerun read its own outputs as logs.
+TEST(OutputSet, OutputFolderInsideTheLogsIsNotReadAsLogs) {
+  Campaign c;
+  c.out = c.dir + "/logs/pitch_out";  // matches runs.pattern pitch_{pitch_deg}/*.csv
+  EXPECT_EQ(c.Run().summary.n_traces, 12);
+  const CampaignResult again = c.Run();  // traces.csv and angles.csv now exist in it
+  EXPECT_EQ(again.summary.n_traces, 12);
+  EXPECT_EQ(again.summary.exit_code, 0);
+}
+
+// issue 9 item 11: a fit.windows entry for a file that does not exist was ignored silently.
+TEST(OutputSet, WindowForAMissingFileIsAnErrorBeforeAnyFit) {
+  Campaign c;
+  c.AppendConfig("fit:\n  windows:\n    pitch_0/trial_1.csv: [1, 20]\n    pitch_0/trial_9.csv: [1, 20]\n");
+  try {
+    c.Run();
+    ADD_FAILURE() << "a window for a missing file was accepted";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("'fit.windows.pitch_0/trial_9.csv' names no log"),
+              std::string::npos) << e.what();
+  }
+  EXPECT_EQ(c.calls, 0);
 }
 
 }  // namespace
