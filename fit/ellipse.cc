@@ -339,6 +339,10 @@ bool EllipseOptions::Check(std::string* why) const {
     *why = "tau_test_alpha must be in (0, 1), got " + Num(tau_test_alpha);
     return false;
   }
+  if (!(common_offset_std_kg_m2 >= 0.0 && std::isfinite(common_offset_std_kg_m2))) {
+    *why = "common_offset_std_kg_m2 must be finite and >= 0, got " + Num(common_offset_std_kg_m2);
+    return false;
+  }
   if (!(naca_exclusion_deg >= 0.0 && naca_exclusion_deg < 45.0)) {
     *why = "naca_exclusion_deg must be in [0, 45), got " + Num(naca_exclusion_deg);
     return false;
@@ -409,9 +413,15 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
     std::vector<double> axis;
     for (const auto& p : points) axis.push_back(AxisAngleDeg(p.pitch_deg));
     std::sort(axis.begin(), axis.end());
+    // A cluster spans at most the tolerance from its first axis (as the angle groups below):
+    // chaining neighbours would make a dense sweep (0.5 deg steps) one "angle".
     int distinct = 0;
+    double cluster_start = 0.0;
     for (size_t i = 0; i < axis.size(); ++i) {
-      if (i == 0 || axis[i] - axis[i - 1] > options.angle_group_tol_deg) ++distinct;
+      if (i == 0 || axis[i] - cluster_start > options.angle_group_tol_deg) {
+        ++distinct;
+        cluster_start = axis[i];
+      }
     }
     if (distinct > 1 && axis.front() + 180.0 - axis.back() <= options.angle_group_tol_deg) {
       --distinct;
@@ -528,7 +538,10 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
       res.dof = kInf;
       break;
   }
-  const Eigen::Matrix3d cov = normal_inv * res.variance_factor;
+  // The common offset adds to A alone (see EllipseOptions::common_offset_std_kg_m2).
+  Eigen::Matrix3d cov = normal_inv * res.variance_factor;
+  const double offset_var = options.common_offset_std_kg_m2 * options.common_offset_std_kg_m2;
+  cov(0, 0) += offset_var;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) res.cov_abc[r][c] = cov(r, c);
 
@@ -551,11 +564,18 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
                           : kInf;
   }
   const double chi2_threshold = -2.0 * std::log(options.tau_test_alpha);
-  res.tau_defined = r_abs > 0 && res.circle_chi2 > chi2_threshold;
+  // Below 1e-9 of A the radius is rounding, not a measurement (inputs carry ~16 digits, every
+  // real rig fewer than 6): there (B, C) and their covariance are both noise and the chi^2 test
+  // alone would give tau from rounding, with an interval that need not contain it.
+  constexpr double kRoundingRadius = 1e-9;
+  res.tau_defined = r_abs > kRoundingRadius * std::fabs(abc(0)) && res.circle_chi2 > chi2_threshold;
   if (!res.tau_defined) {
     res.warnings.push_back(
         "tau is ill-defined: the data do not distinguish the ellipse from a circle (I_x ~ I_z and "
-        "I_xz ~ 0; chi^2 " + Num(res.circle_chi2) + " < " + Num(chi2_threshold) + "); I_xz is "
+        "I_xz ~ 0; " +
+        (res.circle_chi2 > chi2_threshold ? std::string("a circle to rounding")
+                                          : "chi^2 " + Num(res.circle_chi2) + " < " + Num(chi2_threshold)) +
+        "); I_xz is "
         "still reported, tau, I_xp and I_zp are not");
   }
   res.linear.method = "linear_ls";
@@ -610,6 +630,7 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
         for (int k = 0; k < 3; ++k) z(k) = normal(rng);
         abc_b += std::sqrt(vf) * (chol * z);
       }
+      if (offset_var > 0.0) abc_b(0) += options.common_offset_std_kg_m2 * normal(rng);
       const Vec6 v = ToVec(SixFromAbc(abc_b(0), abc_b(1), abc_b(2), 2 * best.tau_deg * kDegToRad));
       for (int k = 0; k < 6; ++k) tails[k].Add(v(k));
     }

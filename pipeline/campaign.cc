@@ -382,9 +382,16 @@ void FitCampaignEllipse(const CampaignConfig& config, const CampaignOptions& opt
     EllipsePoint p;
     p.pitch_deg = r.pitch_used_deg;
     p.inertia_kg_m2 = r.inertia_kg_m2;
-    p.std_kg_m2 = r.inertia_std_kg_m2;
+    // The fit's own std: the rig's is one offset shared by every point, not independent noise
+    // per point; it is propagated below as EllipseOptions::common_offset_std_kg_m2.
+    p.std_kg_m2 = r.inertia_total_std_kg_m2;
     points.push_back(p);
   }
+  EllipseOptions ellipse_options = MakeEllipseOptions(config);
+  const double rig_std = config.rig_inertia.kind == RigInertiaSpec::Kind::kTare
+                             ? result->rig_inertia_std_kg_m2
+                             : config.rig_inertia.inertia_std_kg_m2;
+  ellipse_options.common_offset_std_kg_m2 = std::isfinite(rig_std) ? rig_std : 0.0;
   // Table 1 from the angle groups (replaced by the ellipse fit's own when it runs).
   std::vector<double> stds, cvs;
   for (const AngleStats& a : result->angles) {
@@ -405,7 +412,7 @@ void FitCampaignEllipse(const CampaignConfig& config, const CampaignOptions& opt
   }
   EllipseResult fit;
   std::string why;
-  if (!FitEllipse(points, MakeEllipseOptions(config), &fit, &why) || !fit.IsUsable()) {
+  if (!FitEllipse(points, ellipse_options, &fit, &why) || !fit.IsUsable()) {
     summary.ellipse_fitted = false;
     summary.ellipse_message = "ellipse not fitted: " + (why.empty() ? "fit not usable" : why);
     return;

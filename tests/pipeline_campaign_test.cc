@@ -492,3 +492,25 @@ TEST(CampaignCli, ExitCodesAndMessages) {
 
 }  // namespace
 }  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// issue 9 item 9: `rig.inertia.inertia_std_kg_m2: 0.05` made the std of I_x shrink and moved
+// I_xz: it was used as a relative weight. A constant rig offset moves I_x and I_z together and
+// leaves I_xz alone: its std adds in quadrature to theirs, and I_xz (value and std) is unchanged.
+TEST(Campaign, RigInertiaStdEntersIxAndIzNotIxz) {
+  FakeCampaign without("{inertia_kg_m2: 0.5, inertia_std_kg_m2: 0.0}", "ellipse: {bootstrap: 0}\n");
+  FakeCampaign with("{inertia_kg_m2: 0.5, inertia_std_kg_m2: 0.05}", "ellipse: {bootstrap: 0}\n");
+  const CampaignResult a = without.Run(), b = with.Run();
+  ASSERT_TRUE(a.ellipse_fit && b.ellipse_fit);
+  const EllipseResult &ea = *a.ellipse_fit, &eb = *b.ellipse_fit;
+  EXPECT_NEAR(eb.ix.std, std::hypot(ea.ix.std, 0.05), 1e-12);
+  EXPECT_NEAR(eb.iz.std, std::hypot(ea.iz.std, 0.05), 1e-12);
+  EXPECT_DOUBLE_EQ(eb.ixz.value, ea.ixz.value);
+  EXPECT_DOUBLE_EQ(eb.ixz.std, ea.ixz.std);
+  EXPECT_DOUBLE_EQ(eb.ix.value, ea.ix.value);
+}
+
+}  // namespace
+}  // namespace bifilar
