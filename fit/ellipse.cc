@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <queue>
 #include <random>
 #include <sstream>
 
@@ -94,6 +95,64 @@ double SortedQuantile(const std::vector<double>& sorted, double p) {
   const size_t hi = std::min(lo + 1, sorted.size() - 1);
   return sorted[lo] + (h - lo) * (sorted[hi] - sorted[lo]);
 }
+
+// The two interpolated quantiles p_lo < p_hi (SortedQuantile of all the values) of a stream of
+// `count` values, keeping only the tails they need: the smallest floor(p_lo (count - 1)) + 2 and
+// the largest count - floor(p_hi (count - 1)) values. Memory does not grow with the data.
+class TailQuantiles {
+ public:
+  TailQuantiles(int count, double p_lo, double p_hi)
+      : count_(count), p_lo_(p_lo), p_hi_(p_hi),
+        keep_lo_(static_cast<size_t>(std::floor(p_lo * (count - 1))) + 2),
+        keep_hi_(static_cast<size_t>(count) - static_cast<size_t>(std::floor(p_hi * (count - 1)))) {}
+
+  void Add(double v) {
+    if (low_.size() < keep_lo_) {
+      low_.push(v);
+    } else if (v < low_.top()) {
+      low_.pop();
+      low_.push(v);
+    }
+    if (high_.size() < keep_hi_) {
+      high_.push(v);
+    } else if (v > high_.top()) {
+      high_.pop();
+      high_.push(v);
+    }
+  }
+
+  double Low() const { return FromLow(p_lo_); }
+  double High() const { return FromHigh(p_hi_); }
+
+ private:
+  // The kept smallest values are sorted[0 .. keep_lo_), the largest sorted[count - keep_hi_ ..
+  // count): both hold the two order statistics SortedQuantile interpolates between.
+  double FromLow(double p) const { return Interpolate(Drain(low_), 0, p); }
+  double FromHigh(double p) const {
+    std::vector<double> v = Drain(high_);
+    const size_t first = static_cast<size_t>(count_) - v.size();
+    return Interpolate(std::move(v), first, p);
+  }
+  double Interpolate(std::vector<double> v, size_t first, double p) const {
+    std::sort(v.begin(), v.end());
+    const double h = p * (count_ - 1);
+    const size_t lo = static_cast<size_t>(std::floor(h));
+    const size_t hi = std::min(lo + 1, static_cast<size_t>(count_) - 1);
+    return v[lo - first] + (h - lo) * (v[hi - first] - v[lo - first]);
+  }
+  template <typename Heap>
+  static std::vector<double> Drain(Heap heap) {
+    std::vector<double> v;
+    for (; !heap.empty(); heap.pop()) v.push_back(heap.top());
+    return v;
+  }
+
+  int count_;
+  double p_lo_, p_hi_;
+  size_t keep_lo_, keep_hi_;
+  std::priority_queue<double> low_;                                            // max on top
+  std::priority_queue<double, std::vector<double>, std::greater<double>> high_;  // min on top
+};
 
 // The six quantities as a vector: Ix, Iz, Ixz, tau_deg, Ixp, Izp.
 using Vec6 = Eigen::Matrix<double, 6, 1>;
@@ -255,8 +314,12 @@ bool ParseEllipseCovariance(const std::string& name, EllipseCovariance* mode) {
 }
 
 bool EllipseOptions::Check(std::string* why) const {
-  if (bootstrap_replicates < 0 || (bootstrap_replicates > 0 && bootstrap_replicates < 100)) {
-    *why = "bootstrap_replicates must be 0 (off) or >= 100, got " +
+  if (bootstrap_replicates < 0 ||
+      (bootstrap_replicates > 0 && bootstrap_replicates < kMinBootstrapReplicates) ||
+      bootstrap_replicates > kMaxBootstrapReplicates) {
+    *why = "bootstrap replicates must be 0 (off) or in [" +
+           std::to_string(kMinBootstrapReplicates) + ", " +
+           std::to_string(kMaxBootstrapReplicates) + "], got " +
            std::to_string(bootstrap_replicates);
     return false;
   }
@@ -274,6 +337,10 @@ bool EllipseOptions::Check(std::string* why) const {
   }
   if (!(tau_test_alpha > 0.0 && tau_test_alpha < 1.0)) {
     *why = "tau_test_alpha must be in (0, 1), got " + Num(tau_test_alpha);
+    return false;
+  }
+  if (!(common_offset_std_kg_m2 >= 0.0 && std::isfinite(common_offset_std_kg_m2))) {
+    *why = "common_offset_std_kg_m2 must be finite and >= 0, got " + Num(common_offset_std_kg_m2);
     return false;
   }
   if (!(naca_exclusion_deg >= 0.0 && naca_exclusion_deg < 45.0)) {
@@ -346,9 +413,15 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
     std::vector<double> axis;
     for (const auto& p : points) axis.push_back(AxisAngleDeg(p.pitch_deg));
     std::sort(axis.begin(), axis.end());
+    // A cluster spans at most the tolerance from its first axis (as the angle groups below):
+    // chaining neighbours would make a dense sweep (0.5 deg steps) one "angle".
     int distinct = 0;
+    double cluster_start = 0.0;
     for (size_t i = 0; i < axis.size(); ++i) {
-      if (i == 0 || axis[i] - axis[i - 1] > options.angle_group_tol_deg) ++distinct;
+      if (i == 0 || axis[i] - cluster_start > options.angle_group_tol_deg) {
+        ++distinct;
+        cluster_start = axis[i];
+      }
     }
     if (distinct > 1 && axis.front() + 180.0 - axis.back() <= options.angle_group_tol_deg) {
       --distinct;
@@ -465,7 +538,10 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
       res.dof = kInf;
       break;
   }
-  const Eigen::Matrix3d cov = normal_inv * res.variance_factor;
+  // The common offset adds to A alone (see EllipseOptions::common_offset_std_kg_m2).
+  Eigen::Matrix3d cov = normal_inv * res.variance_factor;
+  const double offset_var = options.common_offset_std_kg_m2 * options.common_offset_std_kg_m2;
+  cov(0, 0) += offset_var;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) res.cov_abc[r][c] = cov(r, c);
 
@@ -488,11 +564,18 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
                           : kInf;
   }
   const double chi2_threshold = -2.0 * std::log(options.tau_test_alpha);
-  res.tau_defined = r_abs > 0 && res.circle_chi2 > chi2_threshold;
+  // Below 1e-9 of A the radius is rounding, not a measurement (inputs carry ~16 digits, every
+  // real rig fewer than 6): there (B, C) and their covariance are both noise and the chi^2 test
+  // alone would give tau from rounding, with an interval that need not contain it.
+  constexpr double kRoundingRadius = 1e-9;
+  res.tau_defined = r_abs > kRoundingRadius * std::fabs(abc(0)) && res.circle_chi2 > chi2_threshold;
   if (!res.tau_defined) {
     res.warnings.push_back(
         "tau is ill-defined: the data do not distinguish the ellipse from a circle (I_x ~ I_z and "
-        "I_xz ~ 0; chi^2 " + Num(res.circle_chi2) + " < " + Num(chi2_threshold) + "); I_xz is "
+        "I_xz ~ 0; " +
+        (res.circle_chi2 > chi2_threshold ? std::string("a circle to rounding")
+                                          : "chi^2 " + Num(res.circle_chi2) + " < " + Num(chi2_threshold)) +
+        "); I_xz is "
         "still reported, tau, I_xp and I_zp are not");
   }
   res.linear.method = "linear_ls";
@@ -515,32 +598,45 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
     // the estimate (dof degrees of freedom), so the linear quantities' bootstrap distribution is
     // the Student-t one and the intervals stay honest with few angles. Angle-means mode draws
     // one error per angle group, shared by its trials.
+    //
+    // The refit is linear, abc* = abc + S e with S = (X^T W X)^-1 X^T W, so a replicate costs
+    // O(1) (independent points: S e ~ N(0, vf (X^T W X)^-1), drawn through its Cholesky factor)
+    // or O(angle groups) (one error per group: S summed over each group's members), not O(n);
+    // and only the tails of the replicates are kept (TailQuantiles), so memory does not grow
+    // with the replicate count.
     const int nb = options.bootstrap_replicates;
     std::mt19937_64 rng(options.seed);
     std::normal_distribution<double> normal(0.0, 1.0);
     std::chi_squared_distribution<double> chi2_dist(std::isfinite(res.dof) ? res.dof : 1.0);
-    const Eigen::MatrixXd solve = normal_inv * x.transpose() * w.asDiagonal();  // 3 x n
-    std::vector<std::vector<double>> samples(6, std::vector<double>(nb));
-    Eigen::VectorXd ystar(n);
+    Eigen::MatrixXd group_solve;  // 3 x m, angle-means mode
+    if (mode == EllipseCovariance::kAngleMeans) {
+      group_solve = Eigen::MatrixXd::Zero(3, m);
+      for (int g = 0; g < m; ++g) {
+        for (int i : groups[g].members) group_solve.col(g) += normal_inv * x.row(i).transpose() * w(i);
+      }
+    }
+    const Eigen::Matrix3d chol = Eigen::LLT<Eigen::Matrix3d>(normal_inv).matrixL();
+    std::vector<TailQuantiles> tails(6, TailQuantiles(nb, alpha / 2, 1 - alpha / 2));
     for (int b = 0; b < nb; ++b) {
       double vf = res.variance_factor;
       if (std::isfinite(res.dof)) vf *= res.dof / chi2_dist(rng);
+      Eigen::Vector3d abc_b = abc;
       if (mode == EllipseCovariance::kAngleMeans) {
         for (int g = 0; g < m; ++g) {
-          const double e = std::sqrt(vf / group_w[g]) * normal(rng);
-          for (int i : groups[g].members) ystar(i) = fitted(i) + e;
+          abc_b += group_solve.col(g) * (std::sqrt(vf / group_w[g]) * normal(rng));
         }
       } else {
-        for (int i = 0; i < n; ++i) ystar(i) = fitted(i) + std::sqrt(vf / w(i)) * normal(rng);
+        Eigen::Vector3d z;
+        for (int k = 0; k < 3; ++k) z(k) = normal(rng);
+        abc_b += std::sqrt(vf) * (chol * z);
       }
-      const Eigen::Vector3d abc_b = solve * ystar;
+      if (offset_var > 0.0) abc_b(0) += options.common_offset_std_kg_m2 * normal(rng);
       const Vec6 v = ToVec(SixFromAbc(abc_b(0), abc_b(1), abc_b(2), 2 * best.tau_deg * kDegToRad));
-      for (int k = 0; k < 6; ++k) samples[k][b] = v(k);
+      for (int k = 0; k < 6; ++k) tails[k].Add(v(k));
     }
     for (int k = 0; k < 6; ++k) {
-      std::sort(samples[k].begin(), samples[k].end());
-      lo(k) = SortedQuantile(samples[k], alpha / 2);
-      hi(k) = SortedQuantile(samples[k], 1 - alpha / 2);
+      lo(k) = tails[k].Low();
+      hi(k) = tails[k].High();
     }
   } else {
     const double t = StudentQuantile(1 - alpha / 2, res.dof);

@@ -1,6 +1,7 @@
 #include "pipeline/cache.h"
 
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -126,22 +127,86 @@ std::string TraceCache::EntryPath(const std::string& key) const {
   return (std::filesystem::path(folder_) / (key + ".json")).string();
 }
 
-bool TraceCache::Load(const std::string& key, TraceRecord* record) const {
+namespace {
+
+std::string EntryChecksum(const std::string& key, const std::string& content_hash,
+                          const std::string& version, const nlohmann::json& record) {
+  return HashToHex(Fnv1a64(key + ";" + content_hash + ";" + version + ";" + record.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)));
+}
+
+bool FiniteOrNull(const nlohmann::json& j, const char* field) {
+  return !j.contains(field) || j[field].is_null() ||
+         (j[field].is_number() && std::isfinite(j[field].get<double>()));
+}
+
+}  // namespace
+
+bool TraceCache::Load(const std::string& key, const std::string& content_hash,
+                      TraceRecord* record, std::string* problem) const {
+  problem->clear();
+  const std::string path = EntryPath(key);
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return false;
   std::string bytes, why;
-  if (!ReadFileBytes(EntryPath(key), &bytes, &why)) return false;
+  if (!ReadFileBytes(path, &bytes, &why)) {
+    *problem = why;
+    return false;
+  }
+  auto refuse = [&](const std::string& reason) {
+    *problem = path + ": cache entry refused (" + reason + ")";
+    return false;
+  };
+  nlohmann::json entry;
   try {
-    *record = TraceRecordFromJson(nlohmann::json::parse(bytes));
+    entry = nlohmann::json::parse(bytes);
   } catch (const std::exception&) {
-    return false;  // a damaged entry is refitted and overwritten
+    return refuse("not valid JSON");
+  }
+  if (!entry.is_object() || !entry.contains("bifilar_cache") || entry["bifilar_cache"] != kFormat ||
+      !entry.contains("record") || !entry["record"].is_object()) {
+    return refuse("not a bifilar cache entry of format " + std::to_string(kFormat));
+  }
+  auto text = [&](const char* field) {
+    return entry.contains(field) && entry[field].is_string() ? entry[field].get<std::string>()
+                                                             : std::string();
+  };
+  if (text("key") != key) return refuse("it belongs to key '" + text("key") + "'");
+  if (text("content_hash") != content_hash) return refuse("it is of another log's content");
+  if (text("version") != ProgramVersion()) return refuse("written by version " + text("version"));
+  const nlohmann::json& fields = entry["record"];
+  if (text("checksum") != EntryChecksum(key, content_hash, ProgramVersion(), fields)) {
+    return refuse("checksum mismatch: the entry was changed after it was written");
+  }
+  try {
+    *record = TraceRecordFromJson(fields);
+  } catch (const std::exception& e) {
+    return refuse(e.what());
+  }
+  for (const char* field : {"inertia_total_kg_m2", "inertia_total_std_kg_m2"}) {
+    if (!FiniteOrNull(fields, field)) return refuse(std::string(field) + " is not a finite number");
+  }
+  if (record->ok() && !(record->inertia_total_kg_m2 > 0.0 &&
+                        std::isfinite(record->inertia_total_kg_m2) &&
+                        record->inertia_total_std_kg_m2 >= 0.0 &&
+                        std::isfinite(record->inertia_total_std_kg_m2))) {
+    return refuse("an ok record needs a finite inertia > 0 and a finite std >= 0");
   }
   return true;
 }
 
-void TraceCache::Store(const std::string& key, const TraceRecord& record) const {
+void TraceCache::Store(const std::string& key, const std::string& content_hash,
+                       const TraceRecord& record) const {
   std::error_code ec;
   std::filesystem::create_directories(folder_, ec);
   if (ec) throw UserError(folder_ + ": cannot create cache folder: " + ec.message());
-  WriteFileAtomically(EntryPath(key), TraceRecordToJson(record, false).dump(1) + "\n");
+  nlohmann::json entry;
+  entry["bifilar_cache"] = kFormat;
+  entry["key"] = key;
+  entry["content_hash"] = content_hash;
+  entry["version"] = ProgramVersion();
+  entry["record"] = TraceRecordToJson(record, false);
+  entry["checksum"] = EntryChecksum(key, content_hash, ProgramVersion(), entry["record"]);
+  WriteFileAtomically(EntryPath(key), entry.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 }  // namespace bifilar

@@ -37,13 +37,27 @@ std::string CacheKey(const std::string& content_hash_hex, const std::string& fin
 
 // Folder of cache entries (one JSON file per key). Thread-safe: entries are separate files
 // written atomically.
+//
+// An entry proves it belongs to its key and is intact: it holds its key, the content hash of
+// the log, the program version and a checksum (FNV-1a 64 of key, hash, version and the record's
+// compact JSON), besides the record. This catches damage and editing (a scaled value, another
+// trace's entry copied in, NaN); it is not a defence against someone who recomputes the
+// checksum on purpose.
 class TraceCache {
  public:
+  static constexpr int kFormat = 2;  // "bifilar_cache" of the entries written now
+
   explicit TraceCache(std::string folder);  // created on first Store
-  // True and fills *record (fit fields) when an entry exists and parses.
-  bool Load(const std::string& key, TraceRecord* record) const;
+  // True and fills *record (fit fields) when the entry of `key` exists, proves it belongs to
+  // `key` and `content_hash` (and this program version), its checksum matches and its values
+  // are plausible (an ok record has a finite inertia > 0 and a finite std >= 0). False
+  // otherwise: *problem empty when there is no entry, else why the entry was refused (the
+  // caller refits and warns; the entry is overwritten).
+  bool Load(const std::string& key, const std::string& content_hash, TraceRecord* record,
+            std::string* problem) const;
   // Throws UserError when the folder cannot be written.
-  void Store(const std::string& key, const TraceRecord& record) const;
+  void Store(const std::string& key, const std::string& content_hash,
+             const TraceRecord& record) const;
   std::string EntryPath(const std::string& key) const;
   const std::string& folder() const { return folder_; }
 

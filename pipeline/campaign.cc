@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -17,7 +18,9 @@
 
 #include "fit/ellipse_plot.h"
 #include "pipeline/cache.h"
+#include "pipeline/campaign_inputs.h"
 #include "pipeline/ellipse_json.h"
+#include "pipeline/output_set.h"
 #include "pipeline/report.h"
 #include "pipeline/results_json.h"
 #include "pipeline/user_error.h"
@@ -260,18 +263,29 @@ std::vector<RunFile> DiscoverTare(const CampaignConfig& config) {
   return tare;
 }
 
-// Runs fn(i) for i in [0, n) on `jobs` threads.
+// Runs fn(i) for i in [0, n) on `jobs` threads. An exception in any fn stops the handing out of
+// further work and is rethrown on the calling thread once every thread has joined (an escaped
+// exception would otherwise terminate the program).
 template <typename Fn>
 void ParallelFor(int n, int jobs, Fn fn) {
   std::atomic<int> next{0};
+  std::mutex error_mutex;
+  std::exception_ptr error;
   auto worker = [&] {
-    for (int i = next++; i < n; i = next++) fn(i);
+    try {
+      for (int i = next++; i < n; i = next++) fn(i);
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+      next = n;
+    }
   };
   const int threads = std::max(1, std::min(jobs, n));
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
   worker();
   for (std::thread& thread : pool) thread.join();
+  if (error) std::rethrow_exception(error);
 }
 
 double Mean(const std::vector<double>& v) {
@@ -314,16 +328,10 @@ void Progress(const CampaignOptions& options, std::mutex& mutex, int done, int t
 }
 
 // Removes OUT/cache and OUT/figures entries no record refers to, so the folder does not grow.
-void Prune(const std::string& folder, const std::set<std::string>& keep) {
-  std::error_code ec;
-  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
-    if (!keep.count(it->path().filename().string())) fs::remove(it->path(), ec);
-  }
-}
-
 // Fig. 3 and Fig. 4 under names keyed by the ellipse inputs, so an unchanged rerun reuses them.
 void DrawCampaignFigures(const CampaignConfig& config, const EllipseResult& fit,
-                         const std::string& out_dir, CampaignResult* result) {
+                         const std::string& out_dir, OutputManifest* manifest,
+                         CampaignResult* result) {
   std::ostringstream key;
   key.precision(17);
   key << ProgramVersion() << ';' << ToString(config.units) << ';' << fit.a_kg_m2 << ';'
@@ -341,6 +349,7 @@ void DrawCampaignFigures(const CampaignConfig& config, const EllipseResult& fit,
   std::error_code ec;
   std::string why;
   const std::string moments = "moments_" + hash + ".png", polar = "polar_" + hash + ".png";
+  manifest->Record({"figures/" + moments, "figures/" + polar});
   if (fs::exists(figures / moments, ec) ||
       WriteEllipseMomentFigure(fit, (figures / moments).string(), plot, &why)) {
     result->moments_figure = moments;
@@ -365,16 +374,24 @@ EllipseOptions MakeEllipseOptions(const CampaignConfig& config) {
 // The ellipse of inertia from every usable aircraft trace (one point per trial, pitch used,
 // aircraft inertia after the tare, its std), plus Table 1 and the Fig. 3/4 figures.
 void FitCampaignEllipse(const CampaignConfig& config, const CampaignOptions& options,
-                        const std::string& out_dir, CampaignResult* result) {
+                        const std::string& out_dir, OutputManifest* manifest,
+                        CampaignResult* result) {
   std::vector<EllipsePoint> points;
   for (const TraceRecord& r : result->traces) {
     if (r.role != TraceRole::kAircraft || !r.ok()) continue;
     EllipsePoint p;
     p.pitch_deg = r.pitch_used_deg;
     p.inertia_kg_m2 = r.inertia_kg_m2;
-    p.std_kg_m2 = r.inertia_std_kg_m2;
+    // The fit's own std: the rig's is one offset shared by every point, not independent noise
+    // per point; it is propagated below as EllipseOptions::common_offset_std_kg_m2.
+    p.std_kg_m2 = r.inertia_total_std_kg_m2;
     points.push_back(p);
   }
+  EllipseOptions ellipse_options = MakeEllipseOptions(config);
+  const double rig_std = config.rig_inertia.kind == RigInertiaSpec::Kind::kTare
+                             ? result->rig_inertia_std_kg_m2
+                             : config.rig_inertia.inertia_std_kg_m2;
+  ellipse_options.common_offset_std_kg_m2 = std::isfinite(rig_std) ? rig_std : 0.0;
   // Table 1 from the angle groups (replaced by the ellipse fit's own when it runs).
   std::vector<double> stds, cvs;
   for (const AngleStats& a : result->angles) {
@@ -395,7 +412,7 @@ void FitCampaignEllipse(const CampaignConfig& config, const CampaignOptions& opt
   }
   EllipseResult fit;
   std::string why;
-  if (!FitEllipse(points, MakeEllipseOptions(config), &fit, &why) || !fit.IsUsable()) {
+  if (!FitEllipse(points, ellipse_options, &fit, &why) || !fit.IsUsable()) {
     summary.ellipse_fitted = false;
     summary.ellipse_message = "ellipse not fitted: " + (why.empty() ? "fit not usable" : why);
     return;
@@ -407,7 +424,7 @@ void FitCampaignEllipse(const CampaignConfig& config, const CampaignOptions& opt
     result->cv_percent = fit.table1.mean_cov_percent;
   }
   result->ellipse = EllipseResultToJson(fit);
-  if (options.figures) DrawCampaignFigures(config, fit, out_dir, result);
+  if (options.figures) DrawCampaignFigures(config, fit, out_dir, manifest, result);
   result->ellipse_fit = std::move(fit);
 }
 
@@ -418,8 +435,9 @@ bool CampaignOptions::Check(std::string* why) const {
     *why = "output folder not set";
     return false;
   }
-  if (jobs < 0) {
-    *why = "--jobs must be >= 0";
+  if (jobs < 0 || jobs > kMaxJobs) {
+    *why = "--jobs must be in [0, " + std::to_string(kMaxJobs) + "] (0 = all cores), got " +
+           std::to_string(jobs);
     return false;
   }
   return true;
@@ -522,6 +540,18 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   if (fs::exists(out, ec) && !fs::is_directory(out, ec)) {
     throw UserError(options.out_dir + ": output path exists and is not a folder");
   }
+  fs::create_directories(out, ec);
+  if (ec) throw UserError(options.out_dir + ": cannot create output folder: " + ec.message());
+  // pipeline/output_set.h: one run per folder, nothing removed that bifilar did not write.
+  const OutputFolderLock lock(out.string());
+  OutputManifest manifest(out.string());
+  manifest.CheckOwnedPlaces();
+  if (options.progress) {
+    for (const std::string& problem : CheckOutputSet(out.string(), true)) {
+      *options.progress << "warning: previous outputs are a mixed set (" << problem
+                        << "); all are rewritten now\n";
+    }
+  }
   fs::create_directories(out / "cache", ec);
   if (!ec) fs::create_directories(out / "figures", ec);
   if (ec) throw UserError(options.out_dir + ": cannot create output folder: " + ec.message());
@@ -531,7 +561,12 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   const TraceCache cache((out / "cache").string());
 
   // 1. Discovery and content hashes (in parallel: reading is most of the rerun's time).
-  const std::vector<RunFile> runs = DiscoverRuns(config);
+  std::vector<RunFile> runs = DiscoverRuns(config);
+  DropOutputFolder(out.string(), &runs);  // pipeline/campaign_inputs.h: outputs are not inputs
+  if (runs.empty()) {
+    throw UserError("runs: every file found is inside the output folder " + out.string());
+  }
+  const std::vector<std::optional<std::array<double, 2>>> windows = WindowsForRuns(config, runs);
   const int n = static_cast<int>(runs.size());
   CampaignResult result;
   result.traces.resize(n);
@@ -552,7 +587,6 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   // 2. Errors, duplicates, cache look-ups.
   std::map<std::string, std::string> first_with_hash;
   std::vector<int> to_fit;
-  std::vector<std::optional<std::array<double, 2>>> windows(n);
   for (int i = 0; i < n; ++i) {
     const RunFile& run = runs[i];
     TraceRecord& record = result.traces[i];
@@ -572,10 +606,16 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
       record.message = run.display + ": same content as " + it->second + " (duplicate log)";
       continue;
     }
-    windows[i] = ConfigWindowFor(config, run.path);
     record.cache_key = CacheKey(hashes[i], FitFingerprint(config, run.role, windows[i]));
     TraceRecord cached;
-    if (!options.force && cache.Load(record.cache_key, &cached) &&
+    std::string cache_problem;
+    const bool loaded =
+        !options.force && cache.Load(record.cache_key, hashes[i], &cached, &cache_problem);
+    if (!cache_problem.empty()) {
+      ++result.summary.n_cache_refused;
+      if (options.progress) *options.progress << "warning: " << cache_problem << "; refitting\n";
+    }
+    if (loaded &&
         (!options.figures || cached.figure.empty() ||
          fs::exists(out / "figures" / cached.figure, ec))) {
       cached.role = record.role;
@@ -591,7 +631,13 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     }
   }
 
-  // 3. Fit what is not cached, in parallel.
+  // 3. Fit what is not cached, in parallel (names recorded before the files exist).
+  std::vector<std::string> planned;
+  for (int i : to_fit) {
+    planned.push_back("cache/" + result.traces[i].cache_key + ".json");
+    planned.push_back("figures/" + result.traces[i].cache_key + ".svg");
+  }
+  manifest.Record(planned);
   std::mutex progress_mutex;
   std::atomic<int> done{0};
   const int n_fit = static_cast<int>(to_fit.size());
@@ -625,7 +671,7 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     fitted.cache_key = record.cache_key;
     fitted.from_cache = false;
     try {
-      cache.Store(record.cache_key, fitted);
+      cache.Store(record.cache_key, record.content_hash, fitted);
     } catch (const UserError& e) {
       if (fitted.message.empty()) fitted.message = std::string("not cached: ") + e.what();
     }
@@ -739,33 +785,28 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     }
   }
   result.systematic_relative_std = Mean(relative_budget);
-  FitCampaignEllipse(config, options, out.string(), &result);
+  FitCampaignEllipse(config, options, out.string(), &manifest, &result);
 
   if (result.summary.n_rejected + result.summary.n_error > 0 || !result.summary.ellipse_fitted) {
     result.summary.exit_code = 1;
   }
   result.summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
 
-  // 7. Outputs, each atomically; then drop cache entries and figures nobody refers to.
-  nlohmann::json json = ResultsToJson(config, result);
-  WriteFileAtomically((out / "traces.csv").string(), TracesCsv(result));
-  WriteFileAtomically((out / "angles.csv").string(), AnglesCsv(result));
-  if (options.write_report) {
-    WriteFileAtomically((out / "report.html").string(), BuildReportHtml(json, out.string()));
-  }
+  // 7. Outputs, each atomically, results.json last with its siblings' hashes; then drop the
+  // cache entries and figures bifilar wrote that nobody refers to now.
   result.summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
-  json["summary"]["wall_s"] = result.summary.wall_s;
-  WriteFileAtomically((out / "results.json").string(), json.dump(1) + "\n");
-
-  std::set<std::string> keep_cache, keep_figures;
+  nlohmann::json json = ResultsToJson(config, result);
+  std::set<std::string> keep = {"results.json", "traces.csv", "angles.csv", "report.html"};
+  manifest.Record({keep.begin(), keep.end()});
+  WriteOutputSet(out.string(), json, TracesCsv(result), AnglesCsv(result),
+                 options.write_report ? &BuildReportHtml : nullptr);
   for (const TraceRecord& r : result.traces) {
-    if (!r.cache_key.empty()) keep_cache.insert(r.cache_key + ".json");
-    if (!r.figure.empty()) keep_figures.insert(r.figure);
+    if (!r.cache_key.empty()) keep.insert("cache/" + r.cache_key + ".json");
+    if (!r.figure.empty()) keep.insert("figures/" + r.figure);
   }
-  if (!result.moments_figure.empty()) keep_figures.insert(result.moments_figure);
-  if (!result.polar_figure.empty()) keep_figures.insert(result.polar_figure);
-  Prune((out / "cache").string(), keep_cache);
-  Prune((out / "figures").string(), keep_figures);
+  if (!result.moments_figure.empty()) keep.insert("figures/" + result.moments_figure);
+  if (!result.polar_figure.empty()) keep.insert("figures/" + result.polar_figure);
+  manifest.Prune(keep);
   return result;
 }
 
@@ -839,6 +880,11 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
                 "wall time %.2f s\n",
                 s.n_ok, s.n_rejected, s.n_error, s.n_traces, s.n_fitted, s.n_reused, s.wall_s);
   out << line;
+  if (s.n_cache_refused > 0) {
+    out << "Warning: " << s.n_cache_refused
+        << " cache entr" << (s.n_cache_refused == 1 ? "y was" : "ies were")
+        << " damaged or not theirs and refitted (see the warnings above)\n";
+  }
 }
 
 }  // namespace bifilar

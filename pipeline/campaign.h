@@ -47,6 +47,7 @@ struct AngleStats {
 struct CampaignSummary {
   int n_traces = 0, n_ok = 0, n_rejected = 0, n_error = 0;  // aircraft + tare
   int n_fitted = 0, n_reused = 0;  // fits run now / taken from the cache
+  int n_cache_refused = 0;         // cache entries refused as damaged or not theirs (refitted)
   double wall_s = 0.0;             // whole run
   bool ellipse_fitted = false;
   std::string ellipse_message;     // why not fitted, if so
@@ -77,9 +78,11 @@ struct CampaignResult {
 using TraceFitFunction = std::function<TraceRecord(const CampaignConfig&, const std::string& path,
                                                    const TraceProcessOptions&)>;
 
+constexpr int kMaxJobs = 256;  // limit of CampaignOptions::jobs (--jobs)
+
 struct CampaignOptions {
   std::string out_dir;        // output folder (created); an existing non-folder is an error
-  int jobs = 0;               // worker threads; 0 = hardware concurrency
+  int jobs = 0;               // worker threads; 0 = hardware concurrency; <= kMaxJobs
   bool force = false;         // ignore the cache (refit everything)
   bool write_report = true;   // report.html (needs the figures)
   bool figures = true;        // draw per-trace fit figures and Fig. 3/4

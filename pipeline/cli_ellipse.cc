@@ -82,7 +82,8 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
   ellipse->add_option("--seed", opts->fit.seed, "bootstrap seed (default 1)");
   ellipse->add_option("--bootstrap", opts->fit.bootstrap_replicates,
                       "parametric bootstrap replicates for the 95% intervals; 0 = t intervals "
-                      "(default 2000)");
+                      "(default 2000)")
+      ->check(CLI::Range(0, kMaxBootstrapReplicates));
   ellipse->add_option("--covariance", *covariance,
                       "auto (default), points, angle_means or absolute (trust the std column)");
   ellipse->add_option("--outlier-threshold", opts->fit.outlier_threshold,
@@ -110,7 +111,8 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
                    "pitch angles in deg: a list and/or ranges first:last:step, e.g. "
                    "--angles=-80:90:10 (use '=' when the list starts with '-')")
       ->required();
-  plan->add_option("--trials", plan_opts->trials_per_angle, "trials per angle (default 3)");
+  plan->add_option("--trials", plan_opts->trials_per_angle, "trials per angle (default 3)")
+      ->check(CLI::Range(1, 1000000));
   plan->add_option("--sigma", plan_opts->sigma, "per-trial standard deviation of a moment, in --units")
       ->required();
   plan->add_option("--ix", *ix, "guess of I_x in --units (default: the paper's PRANDTL-D)");

@@ -140,7 +140,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
         std::cout << HumanLine(record) << std::endl;
       }
     }
-    if (args->json) std::cout << records.dump(2) << std::endl;
+    if (args->json) std::cout << records.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
     *exit_code = failed > 0 ? 1 : 0;
   });
 }

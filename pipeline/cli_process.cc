@@ -29,7 +29,7 @@ void RegisterProcessCommands(CLI::App& app, int* exit_code) {
       ->required();
   process->add_option("--out", args->out, "output folder (default: out/ beside the config)");
   process->add_option("--jobs", args->jobs, "worker threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, kMaxJobs));
   process->add_flag("--force", args->force, "ignore the cache and refit every log");
   process->add_option("--integrator", args->integrator,
                       "ODE solver of the fits: rk853 or cvodes; overrides fit.integrator")

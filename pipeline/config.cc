@@ -1,5 +1,7 @@
 #include "pipeline/config.h"
 
+#include "fit/ellipse.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -215,10 +217,17 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
       throw UserError(inertia.Where(table) +
                       ": 'rig.inertia.table' must map pitch_deg to inertia_kg_m2, e.g. {0: 0.12}");
     }
+    std::map<double, YAML::Node> first_key;  // "0" and "0.0" are one pitch: both lines named
     for (const auto& item : table) {
       const double pitch = inertia.AsDouble(item.first, "table");
       const double value = inertia.AsDouble(item.second, "table");
       if (value < 0.0) throw UserError(inertia.Where(item.second) + ": rig inertia must be >= 0");
+      auto [it, inserted] = first_key.emplace(pitch, item.first);
+      if (!inserted) {
+        throw UserError(inertia.Where(item.first) + ": 'rig.inertia.table' gives pitch " +
+                        item.first.Scalar() + " deg twice (first at " + inertia.Where(it->second) +
+                        ")");
+      }
       out->table_kg_m2[pitch] = value;
     }
   } else {
@@ -287,13 +296,62 @@ bool CampaignConfig::Check(std::string* why) const {
     *why = "imu: " + reason;
     return false;
   }
-  if (ellipse.bootstrap < 0 || ellipse.min_angles < 3) {
-    *why = "ellipse: bootstrap must be >= 0 and min_angles >= 3";
+  return fit.Check(why) && ellipse.Check(why);
+}
+
+bool FitConfig::Check(std::string* why) const {
+  char buffer[200];
+  const double max_deg = max_amplitude_deg.value_or(kMaxMaxAmplitudeDeg);
+  if (max_amplitude_deg && !(*max_amplitude_deg >= kMinMaxAmplitudeDeg &&
+                             *max_amplitude_deg <= kMaxMaxAmplitudeDeg)) {
+    std::snprintf(buffer, sizeof(buffer), "'fit.max_amplitude_deg' must be in [%g, %g] deg, got %g",
+                  kMinMaxAmplitudeDeg, kMaxMaxAmplitudeDeg, *max_amplitude_deg);
+    *why = buffer;
     return false;
   }
-  if (fit.min_amplitude_deg && fit.max_amplitude_deg &&
-      !(*fit.min_amplitude_deg < *fit.max_amplitude_deg)) {
-    *why = "fit: min_amplitude_deg must be below max_amplitude_deg";
+  if (min_amplitude_deg && !(*min_amplitude_deg >= 0.0 && *min_amplitude_deg < max_deg)) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "'fit.min_amplitude_deg' must be in [0, max_amplitude_deg = %g) deg, got %g",
+                  max_deg, *min_amplitude_deg);
+    *why = buffer;
+    return false;
+  }
+  const QualityThresholds& q = quality;
+  if (!(q.max_rms_over_noise > 1.0) || !(q.max_residual_autocorr > 0.0) ||
+      !(q.max_residual_autocorr < 1.0) || q.whiteness_lags < 1 ||
+      q.whiteness_lags > kMaxWhitenessLags || !(q.max_secondary_motion_ratio >= 0.0) ||
+      !std::isfinite(q.max_secondary_motion_ratio) || !std::isfinite(q.max_rms_over_noise) ||
+      !(q.min_periods >= 2.0 && q.min_periods <= kMaxMinPeriods)) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "'fit.quality' out of range (max_rms_over_noise > 1, 0 < max_residual_autocorr "
+                  "< 1, whiteness_lags in [1, %d], max_secondary_motion_ratio >= 0, min_periods "
+                  "in [2, %g])", kMaxWhitenessLags, kMaxMinPeriods);
+    *why = buffer;
+    return false;
+  }
+  return true;
+}
+
+bool EllipseConfig::Check(std::string* why) const {
+  if (bootstrap != 0 &&
+      !(bootstrap >= kMinBootstrapReplicates && bootstrap <= kMaxBootstrapReplicates)) {
+    *why = "'ellipse.bootstrap' must be 0 (off) or in [" +
+           std::to_string(kMinBootstrapReplicates) + ", " +
+           std::to_string(kMaxBootstrapReplicates) + "], got " + std::to_string(bootstrap);
+    return false;
+  }
+  if (!(confidence > 0.0 && confidence < 1.0)) {
+    *why = "'ellipse.confidence' must be in (0, 1)";
+    return false;
+  }
+  if (min_angles < 3 || min_angles > kMaxMinAngles) {
+    *why = "'ellipse.min_angles' must be in [3, " + std::to_string(kMaxMinAngles) + "], got " +
+           std::to_string(min_angles);
+    return false;
+  }
+  if (covariance != "auto" && covariance != "points" && covariance != "angle_means" &&
+      covariance != "absolute") {
+    *why = "'ellipse.covariance' must be auto, points, angle_means or absolute";
     return false;
   }
   return true;
@@ -418,14 +476,6 @@ CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptio
     if (fit.Has("min_amplitude_deg")) {
       config.fit.min_amplitude_deg = fit.RequiredDouble("min_amplitude_deg");
     }
-    for (const char* key : {"max_amplitude_deg", "min_amplitude_deg"}) {
-      const std::optional<double>& v =
-          std::string(key) == "max_amplitude_deg" ? config.fit.max_amplitude_deg
-                                                  : config.fit.min_amplitude_deg;
-      if (v && !(*v >= 0.0 && *v < 180.0)) {
-        throw UserError(fit.Where(fit.Optional(key)) + ": 'fit." + key + "' must be in [0, 180)");
-      }
-    }
     YamlMap quality = Sub(fit, "quality");
     QualityThresholds& q = config.fit.quality;
     q.max_rms_over_noise = quality.OptionalDouble("max_rms_over_noise", q.max_rms_over_noise);
@@ -466,6 +516,13 @@ CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptio
                       "max_bands in [2, 20], trend_z in (0, 1000))");
     }
     sweep.Finish();
+    std::string why;
+    if (!config.fit.Check(&why)) {
+      const char* key = why.find("max_amplitude") != std::string::npos ? "max_amplitude_deg"
+                        : why.find("min_amplitude") != std::string::npos ? "min_amplitude_deg"
+                                                                         : "quality";
+      throw UserError(fit.Where(fit.Optional(key)) + ": " + why);
+    }
     fit.Finish();
   }
   {
@@ -476,15 +533,13 @@ CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptio
     e.confidence = ellipse.OptionalDouble("confidence", e.confidence);
     e.covariance = ellipse.OptionalString("covariance", e.covariance);
     e.min_angles = ellipse.OptionalInt("min_angles", e.min_angles);
-    if (e.covariance != "auto" && e.covariance != "points" && e.covariance != "angle_means" &&
-        e.covariance != "absolute") {
-      throw UserError(ellipse.Where(ellipse.Optional("covariance")) +
-                      ": 'ellipse.covariance' must be auto, points, angle_means or absolute");
-    }
-    if (e.bootstrap < 0 || !(e.confidence > 0.0 && e.confidence < 1.0) || e.min_angles < 3) {
-      throw UserError(ellipse.Where(root.Optional("ellipse")) +
-                      ": 'ellipse' out of range (bootstrap >= 0, 0 < confidence < 1, "
-                      "min_angles >= 3)");
+    std::string why;
+    if (!e.Check(&why)) {
+      const char* key = why.find("bootstrap") != std::string::npos    ? "bootstrap"
+                        : why.find("confidence") != std::string::npos ? "confidence"
+                        : why.find("min_angles") != std::string::npos ? "min_angles"
+                                                                      : "covariance";
+      throw UserError(ellipse.Where(ellipse.Optional(key)) + ": " + why);
     }
     ellipse.Finish();
   }

@@ -96,15 +96,28 @@ struct FitConfig {
   std::optional<double> min_amplitude_deg;  // amplitude band, lower (deg); default: fit's own
   QualityThresholds quality;
   SweepConfig sweep;
+
+  bool Check(std::string* why) const;  // amplitude band and quality ranges; *why names the key
 };
 
 // Options of the ellipse fit (fit/ellipse.h EllipseOptions, same defaults).
+// Limits of the count-like keys (configs/README.md); ellipse.bootstrap's are in fit/ellipse.h
+// (kMinBootstrapReplicates, kMaxBootstrapReplicates). One set of ranges, checked when the config
+// is loaded (naming the line) and by CampaignConfig::Check before any fit runs.
+constexpr int kMaxMinAngles = 1000;        // ellipse.min_angles in [3, 1000]
+constexpr int kMaxWhitenessLags = 1000;    // fit.quality.whiteness_lags in [1, 1000]
+constexpr double kMaxMinPeriods = 10000;   // fit.quality.min_periods in [2, 10000]
+constexpr double kMinMaxAmplitudeDeg = 1;  // fit.max_amplitude_deg in [1, 90]: the trace fit's
+constexpr double kMaxMaxAmplitudeDeg = 90; //   model holds to 90 deg; below 1 deg is noise
+
 struct EllipseConfig {
   int bootstrap = 2000;           // parametric bootstrap replicates (0 = covariance intervals)
   unsigned seed = 1;              // seed of the bootstrap
   double confidence = 0.95;       // confidence level of the intervals, in (0, 1)
   std::string covariance = "auto";  // auto | points | angle_means | absolute
   int min_angles = 3;             // distinct pitch angles needed to fit the ellipse; >= 3
+
+  bool Check(std::string* why) const;  // the ranges above; *why names the key
 };
 
 struct CampaignConfig {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "pipeline/cache.h"
+#include "pipeline/output_set.h"
 #include "pipeline/results_json.h"
 #include "pipeline/user_error.h"
 
@@ -349,6 +350,7 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
 void RunReport(const std::string& out_dir) {
   std::error_code ec;
   if (!fs::is_directory(out_dir, ec)) throw UserError(out_dir + ": no such folder");
+  const OutputFolderLock lock(out_dir);
   const std::string path = (fs::path(out_dir) / "results.json").string();
   std::string bytes, why;
   if (!ReadFileBytes(path, &bytes, &why)) throw UserError(why);
@@ -361,8 +363,16 @@ void RunReport(const std::string& out_dir) {
   if (!results.is_object() || !results.contains("traces")) {
     throw UserError(path + ": not a bifilar results file (no 'traces')");
   }
+  // A mixed set (a run killed between two renames) is reported, not turned into a page.
+  const std::vector<std::string> problems = CheckOutputSet(out_dir, false);
+  if (!problems.empty()) {
+    throw UserError(out_dir + ": the outputs are a mixed set from different runs (" +
+                    problems.front() +
+                    (problems.size() > 1 ? ", and " + std::to_string(problems.size() - 1) + " more" : "") +
+                    "); rerun `bifilar process` to rewrite them");
+  }
   WriteFileAtomically((fs::path(out_dir) / "report.html").string(),
-                      BuildReportHtml(results, out_dir));
+                      StampReport(BuildReportHtml(results, out_dir), HashToHex(Fnv1a64(bytes))));
 }
 
 }  // namespace bifilar

@@ -1,6 +1,8 @@
 #include "pipeline/yaml_reader.h"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 
 namespace bifilar {
 namespace {
@@ -9,6 +11,35 @@ namespace {
 // assignment) throw: treat it as an empty document.
 YAML::Node ValidOrNull(const YAML::Node& node) {
   return node.IsDefined() ? node : YAML::Node(YAML::NodeType::Null);
+}
+
+// Line (1-based) of a node, 0 when unknown.
+int Line(const YAML::Node& node) { return node.Mark().is_null() ? 0 : node.Mark().line + 1; }
+
+// yaml-cpp keeps both entries of a repeated key and answers lookups with the first: a repeated
+// key anywhere in the tree is an error naming both lines.
+void RejectDuplicateKeys(const YAML::Node& node, const std::string& file, const std::string& path) {
+  if (node.IsSequence()) {
+    for (size_t i = 0; i < node.size(); ++i) {
+      RejectDuplicateKeys(node[i], file, path + "[" + std::to_string(i) + "]");
+    }
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::map<std::string, int> first_line;
+  for (const auto& item : node) {
+    const std::string key = item.first.IsScalar() ? item.first.Scalar() : std::string();
+    const std::string key_path = path.empty() ? key : path + "." + key;
+    if (item.first.IsScalar()) {
+      auto [it, inserted] = first_line.emplace(key, Line(item.first));
+      if (!inserted) {
+        throw UserError(file + ":" + std::to_string(Line(item.first)) + ": duplicate key '" +
+                        key_path + "' (first at line " + std::to_string(it->second) +
+                        "); give each key once");
+      }
+    }
+    RejectDuplicateKeys(item.second, file, key_path);
+  }
 }
 
 }  // namespace
@@ -22,14 +53,22 @@ YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
 }
 
 YamlMap YamlMap::LoadFile(const std::string& file) {
-  YAML::Node root;
+  std::vector<YAML::Node> documents;
   try {
-    root = YAML::LoadFile(file);
+    documents = YAML::LoadAllFromFile(file);
   } catch (const YAML::BadFile&) {
     throw UserError(file + ": cannot open file");
   } catch (const YAML::Exception& e) {
     throw UserError(file + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
   }
+  if (documents.size() > 1) {
+    throw UserError(file + ":" + std::to_string(Line(documents[1])) +
+                    ": a second YAML document (the first starts at line " +
+                    std::to_string(std::max(1, Line(documents[0]))) +
+                    "); a config is one document: remove the '---' and merge the keys");
+  }
+  const YAML::Node root = documents.empty() ? YAML::Node(YAML::NodeType::Null) : documents[0];
+  RejectDuplicateKeys(root, file, "");
   return YamlMap(root, file, "");
 }
 

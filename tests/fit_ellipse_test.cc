@@ -464,3 +464,129 @@ TEST(EllipseFit, BadInputIsRejectedWithAMessage) {
 
 }  // namespace
 }  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// issue 9 item 3: `--bootstrap 2147483647` ran without end, taking ~450 MB/s.
+TEST(EllipseFit, BootstrapCountIsBoundedAndTheLimitRunsInBoundedMemory) {
+  std::mt19937_64 rng(5);
+  const auto points = Simulate(kPaper, PaperAngles(), 3, 0.006, 0.01, &rng);
+  EllipseOptions options;
+  EllipseResult r;
+  std::string why;
+  for (int bad : {-1, 50, kMaxBootstrapReplicates + 1, 2147483647}) {
+    options.bootstrap_replicates = bad;
+    EXPECT_FALSE(FitEllipse(points, options, &r, &why)) << bad;
+    EXPECT_NE(why.find(std::to_string(kMaxBootstrapReplicates)), std::string::npos) << why;
+  }
+  // The limit itself runs (replicates cost O(angle groups), only the tails are kept), and its
+  // percentile interval of I_xz matches value -+ t * std to its Monte Carlo error (~1 %).
+  options.bootstrap_replicates = kMaxBootstrapReplicates;
+  options.run_ceres = options.run_nelder_mead = false;
+  r = MustFit(points, options);
+  EXPECT_EQ(r.bootstrap_replicates, kMaxBootstrapReplicates);
+  EXPECT_NEAR((r.ixz.ci_hi - r.ixz.ci_lo) / (2 * r.ixz.std), 2.131, 0.03);  // t, 15 dof
+  // Independent points: abc* drawn from its 3x3 covariance; same t check with n - 3 dof.
+  options.covariance = EllipseCovariance::kPointResiduals;
+  r = MustFit(points, options);
+  EXPECT_NEAR((r.ix.ci_hi - r.ix.ci_lo) / (2 * r.ix.std), 2.0049, 0.03);  // t, 51 dof
+}
+
+}  // namespace
+}  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// issue 9 item 7: -90..90 deg in 0.5 deg steps was "1 distinct angle" (neighbours chained).
+TEST(EllipseFit, DenseAngleSweepIsManyAngles) {
+  std::vector<EllipsePoint> points;
+  for (int k = 0; k <= 360; ++k) {
+    const double pitch = -90.0 + 0.5 * k;
+    points.push_back({pitch, TrueMoment(kPaper, pitch) * (1 + 1e-4 * std::sin(7.0 * k)), 0.0});
+  }
+  EllipseOptions options;
+  options.bootstrap_replicates = 0;
+  const EllipseResult r = MustFit(points, options);
+  EXPECT_GT(r.n_angles, 100);
+  EXPECT_NEAR(r.ixz.value, kPaper.ixz, 1e-3);
+}
+
+// issue 9 item 8: a perfect circle with a std column gave tau = -10.000 +- 0.000 deg and an
+// interval [27.54, 27.54] that did not contain it. tau is undefined there.
+TEST(EllipseFit, PerfectCircleWithStdColumnHasNoTau) {
+  // Circles written the way a table of I_z cos^2 + I_x sin^2 comes out: exact to rounding only,
+  // so (B, C) and their covariance are both rounding noise and the chi^2 test alone is a coin.
+  for (int k = 0; k < 40; ++k) {
+    const double radius = 0.3 + 0.37 * k;
+    const double stdev = k % 2 ? 0.01 : 0.0;
+    std::vector<EllipsePoint> points;
+    for (int d = -80; d <= 90; d += 10) {
+      const double t = d * kPi / 180;
+      points.push_back({double(d), radius * std::cos(t) * std::cos(t) + radius * std::sin(t) * std::sin(t), stdev});
+    }
+    for (auto mode : {EllipseCovariance::kAuto, EllipseCovariance::kPointResiduals}) {
+      EllipseOptions options;
+      options.covariance = mode;
+      const EllipseResult r = MustFit(points, options);
+      EXPECT_FALSE(r.tau_defined) << "radius " << radius << " std " << stdev << " tau "
+                                  << r.tau_deg.value << " [" << r.tau_deg.ci_lo << ", "
+                                  << r.tau_deg.ci_hi << "]";
+      EXPECT_FALSE(r.tau_deg.defined);
+      EXPECT_NEAR(r.ix.value, radius, 1e-12);
+      EXPECT_NEAR(r.ixz.value, 0.0, 1e-12);
+      EXPECT_LE(r.ixz.ci_lo, r.ixz.value);
+      EXPECT_GE(r.ixz.ci_hi, r.ixz.value);
+    }
+  }
+}
+
+// issue 9 item 9: a constant rig offset (std sigma_r) shared by every moment. Monte Carlo of
+// campaigns with that offset drawn once per campaign: the reported std of I_x and I_z must match
+// the scatter of the estimates (the offset included), and I_xz must be untouched by it.
+TEST(EllipseFit, CommonOffsetStdEntersIxIzNotIxzAgainstMonteCarlo) {
+  constexpr double kTrialSigma = 0.004, kRigSigma = 0.01;
+  constexpr int kCampaigns = 3000;
+  std::mt19937_64 rng(99);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<double> ix, ixz;
+  double reported_ix_var = 0, reported_ixz_var = 0, reported_ixz_var_no_offset = 0;
+  for (int c = 0; c < kCampaigns; ++c) {
+    auto points = Simulate(kPaper, PaperAngles(), 3, kTrialSigma, 0.0, &rng);
+    const double offset = kRigSigma * normal(rng);
+    for (auto& p : points) {
+      p.inertia_kg_m2 += offset;
+      p.std_kg_m2 = kTrialSigma;
+    }
+    EllipseOptions options;
+    options.bootstrap_replicates = 0;
+    options.run_ceres = options.run_nelder_mead = false;
+    options.covariance = EllipseCovariance::kAbsolute;
+    options.common_offset_std_kg_m2 = kRigSigma;
+    const EllipseResult r = MustFit(points, options);
+    ix.push_back(r.ix.value);
+    ixz.push_back(r.ixz.value);
+    reported_ix_var += r.ix.std * r.ix.std / kCampaigns;
+    reported_ixz_var += r.ixz.std * r.ixz.std / kCampaigns;
+    options.common_offset_std_kg_m2 = 0.0;
+    const EllipseResult r0 = MustFit(points, options);
+    reported_ixz_var_no_offset += r0.ixz.std * r0.ixz.std / kCampaigns;
+    EXPECT_DOUBLE_EQ(r0.ixz.value, r.ixz.value);
+  }
+  auto sample_std = [](const std::vector<double>& v) {
+    double m = 0, s = 0;
+    for (double x : v) m += x / v.size();
+    for (double x : v) s += (x - m) * (x - m) / (v.size() - 1);
+    return std::sqrt(s);
+  };
+  // 3000 campaigns: the sample std is within ~1.3 % (1 sigma) of the truth; 5 % is ~4 sigma.
+  constexpr double kRelTol = 0.05;
+  EXPECT_NEAR(sample_std(ix) / std::sqrt(reported_ix_var), 1.0, kRelTol);
+  EXPECT_NEAR(sample_std(ixz) / std::sqrt(reported_ixz_var), 1.0, kRelTol);
+  EXPECT_DOUBLE_EQ(reported_ixz_var, reported_ixz_var_no_offset);  // not in I_xz at all
+  EXPECT_GT(std::sqrt(reported_ix_var), kRigSigma);                 // dominated by the rig here
+}
+
+}  // namespace
+}  // namespace bifilar

@@ -5,11 +5,19 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
 namespace bifilar {
 namespace {
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
 
 TEST(Cache, Fnv1a64MatchesReferenceVectors) {
   // Vectors from the FNV reference (isthe.com/chongo/tech/comp/fnv, test_fnv.c, FNV-1a 64).
@@ -90,9 +98,11 @@ TEST(Cache, StoreAndLoadRoundTrip) {
   r.iterations = 7;
   r.model = "full";
   TraceRecord loaded;
-  EXPECT_FALSE(cache.Load("0000000000000001", &loaded));
-  cache.Store("0000000000000001", r);
-  ASSERT_TRUE(cache.Load("0000000000000001", &loaded));
+  std::string problem;
+  EXPECT_FALSE(cache.Load("0000000000000001", "00000000000000aa", &loaded, &problem));
+  EXPECT_TRUE(problem.empty()) << problem;
+  cache.Store("0000000000000001", "00000000000000aa", r);
+  ASSERT_TRUE(cache.Load("0000000000000001", "00000000000000aa", &loaded, &problem)) << problem;
   EXPECT_EQ(loaded.file, r.file);
   EXPECT_EQ(loaded.status, TraceStatus::kRejected);
   EXPECT_EQ(loaded.message, r.message);
@@ -104,9 +114,57 @@ TEST(Cache, StoreAndLoadRoundTrip) {
   EXPECT_DOUBLE_EQ(loaded.budget_total_std_kg_m2, 1.02e-3);
   EXPECT_EQ(loaded.flags, r.flags);
   EXPECT_EQ(loaded.iterations, 7);
-  // A damaged entry is a miss, not an error.
+  // A damaged entry is refused with a reason, not an error.
   std::ofstream(cache.EntryPath("0000000000000002")) << "{ not json";
-  EXPECT_FALSE(cache.Load("0000000000000002", &loaded));
+  EXPECT_FALSE(cache.Load("0000000000000002", "00000000000000aa", &loaded, &problem));
+  EXPECT_NE(problem.find("not valid JSON"), std::string::npos) << problem;
+}
+
+// issue 9 item 6: the cache was trusted blindly. Each tampering is refused with its reason.
+TEST(Cache, EntryProvesItsKeyAndIntegrity) {
+  char tmpl[] = "/tmp/bifilar_cache_test_XXXXXX";
+  const std::string dir = mkdtemp(tmpl);
+  const TraceCache cache(dir + "/cache");
+  TraceRecord r;
+  r.file = "pitch_0/trial_1.csv";
+  r.status = TraceStatus::kOk;
+  r.inertia_total_kg_m2 = 4.1;
+  r.inertia_total_std_kg_m2 = 2e-5;
+  r.model = "full";
+  const std::string key = "00000000000000k1", other = "00000000000000k2", hash = "00000000000000aa";
+  cache.Store(key, hash, r);
+  cache.Store(other, "00000000000000bb", r);
+  const std::string good = ReadText(cache.EntryPath(key));
+  TraceRecord loaded;
+  std::string problem;
+  auto refused = [&](const std::string& text, std::string content_hash = "") {
+    if (content_hash.empty()) content_hash = hash;
+    std::ofstream(cache.EntryPath(key)) << text;
+    const bool ok = cache.Load(key, content_hash, &loaded, &problem);
+    return !ok && !problem.empty() ? problem : std::string();
+  };
+  EXPECT_EQ(refused(good), "");
+  EXPECT_TRUE(cache.Load(key, hash, &loaded, &problem)) << problem;
+  // A value scaled by 0.9: the checksum no longer matches.
+  std::string scaled = good;
+  scaled.replace(scaled.find("4.1"), 3, "3.69");
+  EXPECT_NE(refused(scaled).find("checksum mismatch"), std::string::npos);
+  // Another trace's entry copied into this key's file.
+  EXPECT_NE(refused(ReadText(cache.EntryPath(other))).find("belongs to key"), std::string::npos);
+  // The right key, a different log content (the log was replaced).
+  EXPECT_NE(refused(good, "00000000000000cc").find("another log"), std::string::npos);
+  // NaN and a negative inertia written over the value (checksum fixed up or not): refused.
+  std::string nan_entry = good;
+  nan_entry.replace(nan_entry.find("4.1"), 3, "NaN");
+  EXPECT_NE(refused(nan_entry), "");
+  std::string negative = good;
+  negative.replace(negative.find("4.1"), 3, "-5");
+  EXPECT_NE(refused(negative), "");
+  // A record without the envelope (an older entry, or hand-made).
+  EXPECT_NE(refused(R"({"status": "ok", "inertia_total_kg_m2": 4.1})").find("format 2"),
+            std::string::npos);
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
 }
 
 }  // namespace

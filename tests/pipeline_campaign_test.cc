@@ -181,7 +181,7 @@ TEST(Campaign, CacheRefitsOnlyWhatChanged) {
   EXPECT_EQ(again.summary.n_fitted, 0);
   EXPECT_NEAR(again.ellipse_fit->ix.value, kIx, 1e-9);
   // Rig inertia and ellipse options are not fit inputs.
-  c.WriteConfig("{inertia_kg_m2: 0.4}", "ellipse: {bootstrap: 50, seed: 3}\nunits: imperial\n");
+  c.WriteConfig("{inertia_kg_m2: 0.4}", "ellipse: {bootstrap: 500, seed: 3}\nunits: imperial\n");
   again = c.Run();
   EXPECT_EQ(c.calls, 12);
   EXPECT_NEAR(again.traces[0].inertia_kg_m2, again.traces[0].inertia_total_kg_m2 - 0.4, 1e-15);
@@ -488,6 +488,28 @@ TEST(CampaignCli, ExitCodesAndMessages) {
   const nlohmann::json records = nlohmann::json::parse(ReadFile(log));
   ASSERT_EQ(records.size(), 1u);
   EXPECT_EQ(records[0]["status"], "ok");
+}
+
+}  // namespace
+}  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// issue 9 item 9: `rig.inertia.inertia_std_kg_m2: 0.05` made the std of I_x shrink and moved
+// I_xz: it was used as a relative weight. A constant rig offset moves I_x and I_z together and
+// leaves I_xz alone: its std adds in quadrature to theirs, and I_xz (value and std) is unchanged.
+TEST(Campaign, RigInertiaStdEntersIxAndIzNotIxz) {
+  FakeCampaign without("{inertia_kg_m2: 0.5, inertia_std_kg_m2: 0.0}", "ellipse: {bootstrap: 0}\n");
+  FakeCampaign with("{inertia_kg_m2: 0.5, inertia_std_kg_m2: 0.05}", "ellipse: {bootstrap: 0}\n");
+  const CampaignResult a = without.Run(), b = with.Run();
+  ASSERT_TRUE(a.ellipse_fit && b.ellipse_fit);
+  const EllipseResult &ea = *a.ellipse_fit, &eb = *b.ellipse_fit;
+  EXPECT_NEAR(eb.ix.std, std::hypot(ea.ix.std, 0.05), 1e-12);
+  EXPECT_NEAR(eb.iz.std, std::hypot(ea.iz.std, 0.05), 1e-12);
+  EXPECT_DOUBLE_EQ(eb.ixz.value, ea.ixz.value);
+  EXPECT_DOUBLE_EQ(eb.ixz.std, ea.ixz.std);
+  EXPECT_DOUBLE_EQ(eb.ix.value, ea.ix.value);
 }
 
 }  // namespace

@@ -243,3 +243,62 @@ TEST(Config, MissingFileIsNamed) {
 
 }  // namespace
 }  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// issue 9 items 3 and 11: count-like keys are bounded and every range is checked at load,
+// naming the key and line, before any fit (bootstrap 50 and max_amplitude_deg 0 passed).
+TEST(Config, CountsAndRangesAreBoundedAtLoad) {
+  const std::string yaml = kMinimal;
+  ExpectError(yaml + "ellipse:\n  bootstrap: 2147483647\n",
+              {"'ellipse.bootstrap' must be 0 (off) or in [100, 100000]", ":9:"});
+  ExpectError(yaml + "ellipse: {bootstrap: 50}\n", {"ellipse.bootstrap", "got 50"});
+  ExpectError(yaml + "ellipse: {min_angles: 100000}\n", {"ellipse.min_angles", "[3, 1000]"});
+  ExpectError(yaml + "fit: {max_amplitude_deg: 0}\n", {"'fit.max_amplitude_deg' must be in [1, 90]"});
+  ExpectError(yaml + "fit: {max_amplitude_deg: 179.9}\n", {"fit.max_amplitude_deg"});
+  ExpectError(yaml + "fit: {max_amplitude_deg: 20, min_amplitude_deg: 25}\n",
+              {"fit.min_amplitude_deg"});
+  ExpectError(yaml + "fit: {quality: {whiteness_lags: 100000000}}\n", {"whiteness_lags in [1, 1000]"});
+  // Check() holds the same ranges for a config built in code.
+  CampaignConfig config;
+  std::string why;
+  config.ellipse.bootstrap = 50;
+  EXPECT_FALSE(config.ellipse.Check(&why));
+  config.ellipse.bootstrap = 0;
+  config.fit.max_amplitude_deg = 0.0;
+  EXPECT_FALSE(config.fit.Check(&why));
+  EXPECT_NE(why.find("max_amplitude_deg"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// issue 9 item 10: repeated keys were accepted silently and the first won.
+TEST(Config, DuplicateKeysDocumentsAndTablePitchesNameBothLines) {
+  // Line 3 repeats line 3's key at line 4 (kMinimal: rig at 1, filar_separation_m at 3).
+  std::string yaml = kMinimal;
+  yaml.insert(yaml.find("  mass_kg: 2.0"), "  filar_separation_m: 2.5\n");
+  ExpectError(yaml, {":4: duplicate key 'rig.filar_separation_m' (first at line 3)"});
+  // A second rig block.
+  ExpectError(std::string(kMinimal) + "rig: {filar_length_m: 3}\n",
+              {":8: duplicate key 'rig' (first at line 1)"});
+  // A second YAML document.
+  ExpectError(std::string(kMinimal) + "---\nunits: imperial\n", {":9:", "second YAML document",
+                                                                  "line 1"});
+  // Duplicate table pitches, written alike or differently.
+  const char* table = "rig:\n  filar_length_m: 2\n  filar_separation_m: 1\n  mass_kg: 1\n"
+                      "  inertia:\n    table:\n      0: 0.1\n      %s: 0.2\n"
+                      "aircraft: {mass_kg: 1}\nruns: {root: ., pattern: 'p{pitch_deg}.csv'}\n";
+  char buffer[400];
+  std::snprintf(buffer, sizeof(buffer), table, "0");
+  ExpectError(buffer, {":8:", "duplicate key 'rig.inertia.table.0' (first at line 7)"});
+  std::snprintf(buffer, sizeof(buffer), table, "0.0");
+  ExpectError(buffer, {":8:", "pitch 0.0 deg twice", ":7:"});
+}
+
+}  // namespace
+}  // namespace bifilar

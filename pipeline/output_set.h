@@ -1,0 +1,84 @@
+// The output folder of `bifilar process` (OUT) as a unit that is never shared, never holds a
+// mixed set, and from which bifilar removes only what it wrote itself.
+//
+// - Lock: OUT/.bifilar.lock is held with flock(2) for the whole run (and by `bifilar report`).
+//   A second run on the same OUT fails at once, naming the holder's pid and start time.
+// - Manifest: OUT/.bifilar-manifest.json lists every file bifilar wrote in the places it owns
+//   (OUT/cache/, OUT/figures/ and the four result files). Names are recorded before the files
+//   are created (write-ahead, temporary names included), so a run killed at any point leaves
+//   nothing unrecorded. Clean-up removes only recorded files; a file in an owned place that is
+//   not recorded (the user's) makes the run refuse the folder before any work. A folder written
+//   before the manifest existed is adopted through its results.json: the files it names.
+// - Consistent set: results.json is written last and carries the FNV-1a 64 hashes of
+//   traces.csv and angles.csv; report.html carries the hash of the results.json it was built
+//   from. CheckOutputSet finds a mixed set (a run killed between two renames).
+#pragma once
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace bifilar {
+
+// Holds OUT/.bifilar.lock (created) until destroyed. Throws UserError when another process
+// holds it ("OUT is in use by bifilar pid N, started T") or the folder cannot be written.
+class OutputFolderLock {
+ public:
+  explicit OutputFolderLock(const std::string& out_dir);
+  ~OutputFolderLock();
+  OutputFolderLock(const OutputFolderLock&) = delete;
+  OutputFolderLock& operator=(const OutputFolderLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+// The record of what bifilar wrote in OUT. Paths are relative to OUT ("cache/<key>.json").
+class OutputManifest {
+ public:
+  static constexpr const char* kFileName = ".bifilar-manifest.json";
+  // Reads OUT/.bifilar-manifest.json when present. Throws UserError when it is damaged.
+  explicit OutputManifest(std::string out_dir);
+
+  // Throws UserError naming the first foreign entries when OUT/cache/ or OUT/figures/ hold
+  // anything not recorded, or a result file (results.json, traces.csv, angles.csv,
+  // report.html) exists that bifilar did not write.
+  void CheckOwnedPlaces() const;
+
+  // Records `relative` paths (and their temporary names) before they are written; saves.
+  void Record(const std::vector<std::string>& relative);
+  bool Contains(const std::string& relative) const { return files_.count(relative) > 0; }
+
+  // Removes every recorded file not in `keep` (relative paths), forgets recorded files that no
+  // longer exist, and saves. Never touches an unrecorded file.
+  void Prune(const std::set<std::string>& keep);
+
+ private:
+  void Save() const;
+  void AdoptLegacy();
+  std::string out_dir_;
+  std::set<std::string> files_;
+};
+
+// FNV-1a 64 of a file's bytes as 16 hex digits ("" when it cannot be read).
+std::string FileHash(const std::string& path);
+
+// Writes traces.csv, angles.csv, report.html (when `report_html_builder` is set; else an old
+// report.html is removed) and, last, results.json with "outputs": {name: hash} of its siblings.
+// The report is built from the final document and stamped with the hash of its text.
+// Each file is written atomically.
+void WriteOutputSet(const std::string& out_dir, nlohmann::json results, const std::string& traces_csv,
+                    const std::string& angles_csv,
+                    std::string (*report_html_builder)(const nlohmann::json&, const std::string&));
+
+// The report page stamped with the hash of the results.json text it shows.
+std::string StampReport(const std::string& html, const std::string& results_hash);
+
+// Problems of the set in OUT: a sibling that does not match the hash in results.json, a figure
+// named in results.json that is missing, and (with `check_report`) a report built from another
+// results.json. Empty when consistent (or when results.json predates the hashes).
+std::vector<std::string> CheckOutputSet(const std::string& out_dir, bool check_report);
+
+}  // namespace bifilar

@@ -1,0 +1,251 @@
+// The output folder (pipeline/output_set.h): the user's files are never removed, one run at a
+// time, a mixed set is detected. A fake trace fit (the "log" holds its total inertia) keeps the
+// runs instant.
+#include "pipeline/output_set.h"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/campaign.h"
+#include "pipeline/report.h"
+#include "pipeline/user_error.h"
+
+namespace bifilar {
+namespace {
+
+namespace fs = std::filesystem;
+
+void WriteFile(const std::string& path, const std::string& text) {
+  fs::create_directories(fs::path(path).parent_path());
+  std::ofstream(path) << text;
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Six angles, two trials each, of I(theta) = 3 cos^2 + 2 sin^2 + 0.1 sin 2theta plus a 0.5 rig.
+struct Campaign {
+  std::string dir;
+  std::string out;
+
+  Campaign() {
+    char tmpl[] = "/tmp/bifilar_output_set_test_XXXXXX";
+    dir = mkdtemp(tmpl);
+    out = dir + "/out";
+    for (int pitch : {-60, -30, 0, 30, 60, 90}) {
+      for (int k = 1; k <= 2; ++k) SetLog(pitch, k, 0.0);
+    }
+    WriteFile(dir + "/campaign.yaml",
+              "rig: {filar_length_m: 2.0, filar_separation_m: 1.0, mass_kg: 2.0,\n"
+              "      inertia: {inertia_kg_m2: 0.5}}\n"
+              "aircraft: {mass_kg: 10}\n"
+              "runs: {root: logs, pattern: \"pitch_{pitch_deg}/*.csv\"}\n");
+  }
+  ~Campaign() {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+
+  void SetLog(int pitch, int trial, double offset) {
+    const double t = pitch * M_PI / 180.0;
+    std::ostringstream text;
+    text.precision(17);
+    text << "I=" << 3 * std::cos(t) * std::cos(t) + 2 * std::sin(t) * std::sin(t) +
+                        0.1 * std::sin(2 * t) + 0.5 + (trial == 1 ? 1e-3 : -1e-3) + offset
+         << "\n";
+    WriteFile(dir + "/logs/pitch_" + std::to_string(pitch) + "/trial_" + std::to_string(trial) +
+                  ".csv",
+              text.str());
+  }
+
+  std::atomic<int> calls{0};
+
+  CampaignResult Run() {
+    CampaignOptions o;
+    o.out_dir = out;
+    o.jobs = 2;
+    o.figures = false;
+    o.fit_function = [this](const CampaignConfig&, const std::string& path,
+                            const TraceProcessOptions& options) {
+      ++calls;  // atomic: the fits run on two threads
+      TraceRecord r;
+      r.file = options.display_name;
+      r.status = TraceStatus::kOk;
+      r.inertia_total_kg_m2 = std::stod(ReadFile(path).substr(2));
+      r.inertia_total_std_kg_m2 = 1e-4;
+      r.model = "full";
+      return r;
+    };
+    return RunCampaign(LoadCampaignConfig(dir + "/campaign.yaml"), o);
+  }
+
+  void AppendConfig(const std::string& yaml) {
+    WriteFile(dir + "/campaign.yaml", ReadFile(dir + "/campaign.yaml") + yaml);
+  }
+
+  size_t CacheFiles() const {
+    size_t n = 0;
+    for (const auto& entry : fs::directory_iterator(out + "/cache")) n += entry.is_regular_file();
+    return n;
+  }
+};
+
+// issue 9 item 1: `process` removed every unused file in OUT/figures/ and OUT/cache/.
+TEST(OutputSet, UserFilesAreNeverRemovedAndTheFolderIsRefused) {
+  Campaign c;
+  WriteFile(c.out + "/figures/my_plot.png", "mine");
+  try {
+    c.Run();
+    ADD_FAILURE() << "a folder holding the user's file was used";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("figures/my_plot.png"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("did not write"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(ReadFile(c.out + "/figures/my_plot.png"), "mine");
+
+  // A folder of bifilar's own: its stale entries are removed, a file added later is refused.
+  fs::remove(c.out + "/figures/my_plot.png");
+  c.Run();
+  EXPECT_EQ(c.CacheFiles(), 12u);
+  c.SetLog(0, 1, 0.01);  // one log changed: its old cache entry is stale and removed
+  c.Run();
+  EXPECT_EQ(c.CacheFiles(), 12u);
+  WriteFile(c.out + "/cache/notes.txt", "mine too");
+  EXPECT_THROW(c.Run(), UserError);
+  EXPECT_EQ(ReadFile(c.out + "/cache/notes.txt"), "mine too");
+}
+
+// A folder written before the manifest existed is adopted through its results.json.
+TEST(OutputSet, FolderFromBeforeTheManifestIsAdopted) {
+  Campaign c;
+  c.Run();
+  fs::remove(c.out + "/" + OutputManifest::kFileName);
+  const CampaignResult again = c.Run();
+  EXPECT_EQ(again.summary.n_reused, 12);
+}
+
+// issue 9 item 2: two runs on one OUT interleaved and left cache/ and figures/ empty.
+TEST(OutputSet, SecondRunOnTheSameFolderFailsNamingTheHolder) {
+  Campaign c;
+  fs::create_directories(c.out);
+  // Another process's lock, as `bifilar` takes it: flock on OUT/.bifilar.lock.
+  const std::string lock_path = c.out + "/.bifilar.lock";
+  const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  const std::string holder = "pid 4242, started 2026-01-01 00:00:00 UTC\n";
+  ASSERT_EQ(::write(fd, holder.data(), holder.size()), static_cast<ssize_t>(holder.size()));
+  try {
+    c.Run();
+    ADD_FAILURE() << "ran while another run held the folder";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("in use by another bifilar run (pid 4242, started "
+                                         "2026-01-01 00:00:00 UTC)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(c.out + "/results.json"));
+  EXPECT_THROW(RunReport(c.out), UserError);
+  ::close(fd);  // released: the next run works
+  EXPECT_EQ(c.Run().summary.n_ok, 12);
+}
+
+// issue 9 item 5: a kill -9 between renames left a new traces.csv beside an old results.json.
+TEST(OutputSet, MixedSetIsDetectedByReportAndRewrittenByProcess) {
+  Campaign c;
+  c.Run();
+  EXPECT_TRUE(CheckOutputSet(c.out, true).empty());
+  RunReport(c.out);  // consistent: rebuilt and still consistent
+  EXPECT_TRUE(CheckOutputSet(c.out, true).empty());
+  const std::string old_results = ReadFile(c.out + "/results.json");
+  c.SetLog(30, 2, 0.05);
+  c.Run();
+  // What a kill between the traces.csv and results.json renames leaves behind.
+  WriteFile(c.out + "/results.json", old_results);
+  const std::vector<std::string> problems = CheckOutputSet(c.out, true);
+  ASSERT_FALSE(problems.empty());
+  EXPECT_NE(problems.front().find(".csv does not belong to"), std::string::npos)
+      << problems.front();
+  try {
+    RunReport(c.out);
+    ADD_FAILURE() << "report built from a mixed set";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("mixed set"), std::string::npos) << e.what();
+  }
+  // The next process rewrites the whole set.
+  c.Run();
+  EXPECT_TRUE(CheckOutputSet(c.out, true).empty());
+  // A report from another results.json is found too.
+  WriteFile(c.out + "/report.html", "<!DOCTYPE html>\n<html></html>\n");
+  EXPECT_FALSE(CheckOutputSet(c.out, true).empty());
+  EXPECT_TRUE(CheckOutputSet(c.out, false).empty());
+}
+
+// issue 9 item 6: a cached inertia scaled by 0.9 was used (I_xz moved, exit 0).
+TEST(OutputSet, TamperedCacheEntryIsRefittedNotUsed) {
+  Campaign c;
+  const CampaignResult first = c.Run();
+  ASSERT_TRUE(first.ellipse_fit.has_value());
+  int tampered = 0;
+  for (const auto& entry : fs::directory_iterator(c.out + "/cache")) {
+    std::string text = ReadFile(entry.path().string());
+    const size_t at = text.find("\"inertia_total_kg_m2\": ");
+    ASSERT_NE(at, std::string::npos);
+    const size_t begin = at + 23, end = text.find_first_of(",\n", begin);
+    const double value = std::stod(text.substr(begin, end - begin));
+    std::ostringstream scaled;
+    scaled.precision(17);
+    scaled << 0.9 * value;
+    text.replace(begin, end - begin, scaled.str());
+    WriteFile(entry.path().string(), text);
+    if (++tampered == 3) break;
+  }
+  const CampaignResult again = c.Run();
+  EXPECT_EQ(again.summary.n_cache_refused, 3);
+  EXPECT_EQ(again.summary.n_fitted, 3);
+  EXPECT_EQ(again.summary.n_reused, 9);
+  ASSERT_TRUE(again.ellipse_fit.has_value());
+  EXPECT_DOUBLE_EQ(again.ellipse_fit->ixz.value, first.ellipse_fit->ixz.value);
+  // The refitted entries are good again.
+  EXPECT_EQ(c.Run().summary.n_cache_refused, 0);
+}
+
+// issue 9 item 11: an output folder inside runs.root made the rerun read its own outputs as logs.
+TEST(OutputSet, OutputFolderInsideTheLogsIsNotReadAsLogs) {
+  Campaign c;
+  c.out = c.dir + "/logs/pitch_out";  // matches runs.pattern pitch_{pitch_deg}/*.csv
+  EXPECT_EQ(c.Run().summary.n_traces, 12);
+  const CampaignResult again = c.Run();  // traces.csv and angles.csv now exist in it
+  EXPECT_EQ(again.summary.n_traces, 12);
+  EXPECT_EQ(again.summary.exit_code, 0);
+}
+
+// issue 9 item 11: a fit.windows entry for a file that does not exist was ignored silently.
+TEST(OutputSet, WindowForAMissingFileIsAnErrorBeforeAnyFit) {
+  Campaign c;
+  c.AppendConfig("fit:\n  windows:\n    pitch_0/trial_1.csv: [1, 20]\n    pitch_0/trial_9.csv: [1, 20]\n");
+  try {
+    c.Run();
+    ADD_FAILURE() << "a window for a missing file was accepted";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("'fit.windows.pitch_0/trial_9.csv' names no log"),
+              std::string::npos) << e.what();
+  }
+  EXPECT_EQ(c.calls, 0);
+}
+
+}  // namespace
+}  // namespace bifilar

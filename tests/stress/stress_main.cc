@@ -1,0 +1,718 @@
+// The stress test of issue 9 ("a test that stays"): `bifilar` driven as a careful, hostile user
+// would, from a fixed seed and a fixed number of cases, on a small copy of the sample campaign
+// (sample_runs/prandtl_d: 6 angles x 2 trials + 3 tare logs, plain CSV) in a temporary folder.
+//
+// Case kinds: random mutations of the logs (byte flips, truncation, duplicated and shuffled rows,
+// huge, NaN and empty values, BOM, CRLF) and of the config (hostile values, duplicated lines,
+// byte flips, truncation); cache tampering; kill -9 at a random time of `process` followed by a
+// rerun; two concurrent runs on one output folder; a user's file in a folder bifilar owns; and,
+// when ../shared/data/crazyflie is beside the repository, mutations of real logs through
+// `bifilar fit`.
+//
+// Asserted for every run: no crash (signal), no hang (each run is bounded by --run-timeout-s,
+// default 60 s, far above the ~0.3 s a run takes), exit code 0, 1 or 2, no NaN or inf written
+// (results.json, traces.csv, angles.csv, `fit --json`), the user's files untouched, a consistent
+// output set (pipeline/output_set.h CheckOutputSet) after every run that finished; after cache
+// tampering, a kill or concurrent runs on the pristine campaign, the ellipse equals the baseline.
+//
+//   bifilar_stress --binary build/bifilar --source . [--seed 1] [--cases 150] [--keep]
+// CTest runs `stress/short` (150 cases, ~60 s on 2 cores); the long mode is --cases 3000.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/gzip.h"
+#include "pipeline/output_set.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct Args {
+  std::string binary;
+  std::string source;
+  uint64_t seed = 1;
+  int cases = 150;
+  double run_timeout_s = 60.0;
+  bool keep = false;
+};
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void WriteFile(const std::string& path, const std::string& text) {
+  fs::create_directories(fs::path(path).parent_path());
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
+}
+
+// ---- Running bifilar ----
+
+struct Process {
+  pid_t pid = -1;
+  std::string out_path, err_path;
+  Clock::time_point start;
+};
+
+struct Outcome {
+  bool timed_out = false;
+  bool killed = false;  // by us, on purpose
+  int signal = 0;       // terminated by a signal we did not send
+  int exit_code = -1;
+  std::string out, err;
+  double seconds = 0.0;
+};
+
+Process Start(const std::vector<std::string>& argv, const std::string& log_prefix) {
+  Process p;
+  p.out_path = log_prefix + ".stdout";
+  p.err_path = log_prefix + ".stderr";
+  p.start = Clock::now();
+  p.pid = fork();
+  if (p.pid == 0) {
+    const int out = open(p.out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = open(p.err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(out, 1);
+    dup2(err, 2);
+    std::vector<char*> c_argv;
+    for (const std::string& a : argv) c_argv.push_back(const_cast<char*>(a.c_str()));
+    c_argv.push_back(nullptr);
+    execv(c_argv[0], c_argv.data());
+    _exit(127);
+  }
+  return p;
+}
+
+// Waits for p; kills it with SIGKILL after kill_after_s (>= 0) or, as a hang, after timeout_s.
+Outcome Wait(const Process& p, double timeout_s, double kill_after_s = -1.0) {
+  Outcome o;
+  int status = 0;
+  for (;;) {
+    const pid_t r = waitpid(p.pid, &status, WNOHANG);
+    if (r == p.pid) break;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - p.start).count();
+    if (kill_after_s >= 0.0 && elapsed >= kill_after_s) {
+      kill(p.pid, SIGKILL);
+      waitpid(p.pid, &status, 0);
+      o.killed = true;
+      break;
+    }
+    if (elapsed > timeout_s) {
+      kill(p.pid, SIGKILL);
+      waitpid(p.pid, &status, 0);
+      o.timed_out = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  o.seconds = std::chrono::duration<double>(Clock::now() - p.start).count();
+  if (!o.killed && !o.timed_out) {
+    if (WIFSIGNALED(status)) o.signal = WTERMSIG(status);
+    if (WIFEXITED(status)) o.exit_code = WEXITSTATUS(status);
+  }
+  o.out = ReadFile(p.out_path);
+  o.err = ReadFile(p.err_path);
+  return o;
+}
+
+// ---- Checks ----
+
+bool IsNonFiniteToken(std::string cell) {
+  while (!cell.empty() && (cell.front() == ' ' || cell.front() == '"')) cell.erase(cell.begin());
+  while (!cell.empty() && (cell.back() == ' ' || cell.back() == '"' || cell.back() == '\r')) {
+    cell.pop_back();
+  }
+  std::transform(cell.begin(), cell.end(), cell.begin(), ::tolower);
+  if (!cell.empty() && (cell[0] == '-' || cell[0] == '+')) cell.erase(cell.begin());
+  return cell == "nan" || cell == "inf" || cell == "infinity";
+}
+
+// A NaN or inf written as a number: a bare JSON token, or an unquoted CSV cell.
+std::string NonFiniteIn(const std::string& text, bool csv) {
+  if (!csv) {
+    try {
+      const nlohmann::json parsed = nlohmann::json::parse(text);  // NaN, inf: not JSON
+      (void)parsed;
+    } catch (const std::exception& e) {
+      return std::string("not valid JSON: ") + e.what();
+    }
+    return "";
+  }
+  std::istringstream in(text);
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    std::string cell;
+    bool quoted = false;
+    for (size_t i = 0; i <= line.size(); ++i) {
+      const char c = i < line.size() ? line[i] : ',';
+      if (c == '"') quoted = !quoted;
+      if (c == ',' && !quoted) {
+        if (cell.find('"') == std::string::npos && IsNonFiniteToken(cell)) {
+          return "line " + std::to_string(line_no) + ": '" + cell + "'";
+        }
+        cell.clear();
+      } else {
+        cell += c;
+      }
+    }
+  }
+  return "";
+}
+
+struct Failures {
+  int count = 0;
+  void Add(int case_no, const std::string& kind, const std::string& what) {
+    ++count;
+    std::cerr << "FAIL case " << case_no << " (" << kind << "): " << what << "\n";
+  }
+};
+
+// ---- Mutations ----
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) lines.push_back(line);
+  return lines;
+}
+
+std::string Join(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const std::string& l : lines) out += l + "\n";
+  return out;
+}
+
+template <typename T>
+const T& Pick(const std::vector<T>& v, std::mt19937_64& rng) {
+  return v[std::uniform_int_distribution<size_t>(0, v.size() - 1)(rng)];
+}
+
+int Uniform(std::mt19937_64& rng, int lo, int hi) {
+  return std::uniform_int_distribution<int>(lo, hi)(rng);
+}
+
+// One random mutation of a CSV log; `what` says which.
+std::string MutateLog(const std::string& text, std::mt19937_64& rng, std::string* what) {
+  std::vector<std::string> lines = Lines(text);
+  const int n = static_cast<int>(lines.size());
+  auto data_line = [&] { return Uniform(rng, 1, std::max(1, n - 1)); };
+  switch (Uniform(rng, 0, 10)) {
+    case 0: {
+      std::string t = text;
+      const int k = Uniform(rng, 1, 40);
+      for (int i = 0; i < k && !t.empty(); ++i) {
+        t[Uniform(rng, 0, static_cast<int>(t.size()) - 1)] = static_cast<char>(Uniform(rng, 0, 255));
+      }
+      *what = "byte flips x" + std::to_string(k);
+      return t;
+    }
+    case 1: {
+      const int at = Uniform(rng, 0, static_cast<int>(text.size()));
+      *what = "truncated at byte " + std::to_string(at);
+      return text.substr(0, at);
+    }
+    case 2: {
+      const int k = Uniform(rng, 1, 200);
+      for (int i = 0; i < k && n > 1; ++i) {
+        const int at = data_line();
+        lines.insert(lines.begin() + at, lines[at]);
+      }
+      *what = "duplicated rows x" + std::to_string(k);
+      return Join(lines);
+    }
+    case 3: {
+      if (n > 2) std::shuffle(lines.begin() + 1, lines.end(), rng);
+      *what = "all rows shuffled";
+      return Join(lines);
+    }
+    case 4: {
+      const int k = Uniform(rng, 1, 50);
+      for (int i = 0; i < k && n > 2; ++i) std::swap(lines[data_line()], lines[data_line()]);
+      *what = "rows swapped x" + std::to_string(k);
+      return Join(lines);
+    }
+    case 5:
+    case 6: {
+      static const std::vector<std::string> huge = {"1e308", "-1e308", "1e300", "3e38",
+                                                    "1e-320", "-0", "99999999999999999999"};
+      static const std::vector<std::string> bad = {"nan", "NaN", "inf", "-inf", "", "x", "1e999"};
+      const std::vector<std::string>& values = Uniform(rng, 0, 1) ? huge : bad;
+      const int k = Uniform(rng, 1, 30);
+      for (int i = 0; i < k && n > 1; ++i) {
+        std::string& line = lines[data_line()];
+        std::vector<size_t> commas = {0};
+        for (size_t j = 0; j < line.size(); ++j) {
+          if (line[j] == ',') commas.push_back(j + 1);
+        }
+        const size_t begin = Pick(commas, rng);
+        const size_t end = std::min(line.find(',', begin), line.size());
+        line.replace(begin, end - begin, Pick(values, rng));
+      }
+      *what = std::string(&values == &huge ? "huge" : "NaN/inf/empty") + " values x" + std::to_string(k);
+      return Join(lines);
+    }
+    case 7:
+      *what = "header removed";
+      if (n > 0) lines.erase(lines.begin());
+      return Join(lines);
+    case 8:
+      *what = Uniform(rng, 0, 1) ? "only the header" : "empty file";
+      return *what == "empty file" || n == 0 ? "" : lines[0] + "\n";
+    case 9: {
+      *what = "BOM and CRLF";
+      std::string t = "\xEF\xBB\xBF";
+      for (const std::string& l : lines) t += l + "\r\n";
+      return t;
+    }
+    default: {
+      *what = "a log of a few rows";
+      lines.resize(std::min(n, Uniform(rng, 1, 12)));
+      return Join(lines);
+    }
+  }
+}
+
+std::string MutateConfig(const std::string& text, std::mt19937_64& rng, std::string* what) {
+  std::vector<std::string> lines = Lines(text);
+  static const std::vector<std::string> values = {
+      "0", "-1", "1e308", "-1e308", ".nan", "nan", "2147483647", "-2147483648", "1e-320", "\"\"",
+      "[]", "{}", "~", "abc", "99999999999999999999", "/", "../../..", "[1, 2, 3]", "0.5"};
+  switch (Uniform(rng, 0, 4)) {
+    case 0:
+    case 1: {
+      std::vector<int> with_value;
+      for (int i = 0; i < static_cast<int>(lines.size()); ++i) {
+        const size_t colon = lines[i].find(": ");
+        if (colon != std::string::npos && lines[i].find('#') != 0) with_value.push_back(i);
+      }
+      const int i = Pick(with_value, rng);
+      std::string& line = lines[i];
+      const size_t colon = line.find(": ");
+      const size_t comment = line.find(" #", colon);
+      const std::string value = Pick(values, rng);
+      line = line.substr(0, colon + 2) + value + (comment == std::string::npos ? "" : line.substr(comment));
+      *what = "line " + std::to_string(i + 1) + " value -> " + value;
+      return Join(lines);
+    }
+    case 2: {
+      const int i = Uniform(rng, 0, static_cast<int>(lines.size()) - 1);
+      lines.insert(lines.begin() + i, lines[i]);
+      *what = "line " + std::to_string(i + 1) + " duplicated";
+      return Join(lines);
+    }
+    case 3: {
+      std::string t = text;
+      const int k = Uniform(rng, 1, 5);
+      for (int j = 0; j < k; ++j) {
+        t[Uniform(rng, 0, static_cast<int>(t.size()) - 1)] = static_cast<char>(Uniform(rng, 32, 126));
+      }
+      *what = "byte flips x" + std::to_string(k);
+      return t;
+    }
+    default: {
+      const int at = Uniform(rng, 0, static_cast<int>(text.size()));
+      *what = "truncated at byte " + std::to_string(at);
+      return text.substr(0, at);
+    }
+  }
+}
+
+// ---- The campaign ----
+
+struct Workspace {
+  std::string dir, logs, out, config_path, config_text;
+  std::map<std::string, std::string> pristine;  // path -> content of every log
+  std::map<std::string, std::string> user_files;  // path -> content, must never change
+  double ixz_kg_m2 = NAN, ix_kg_m2 = NAN;        // baseline ellipse
+
+  void RestoreLogs() const {
+    for (const auto& [path, text] : pristine) {
+      if (ReadFile(path) != text) WriteFile(path, text);
+    }
+    // Files a mutation may have added.
+    for (const auto& entry : fs::recursive_directory_iterator(logs)) {
+      if (entry.is_regular_file() && !pristine.count(entry.path().string())) fs::remove(entry.path());
+    }
+  }
+  void RestoreConfig() const { WriteFile(config_path, config_text); }
+};
+
+bool Replace(std::string* text, const std::string& from, const std::string& to) {
+  const size_t at = text->find(from);
+  if (at == std::string::npos) return false;
+  text->replace(at, from.size(), to);
+  return true;
+}
+
+Workspace MakeWorkspace(const Args& args) {
+  Workspace w;
+  char tmpl[] = "/tmp/bifilar_stress_XXXXXX";
+  w.dir = mkdtemp(tmpl);
+  w.logs = w.dir + "/logs";
+  w.out = w.dir + "/out";
+  w.config_path = w.dir + "/campaign.yaml";
+  const std::string sample = args.source + "/sample_runs/prandtl_d/logs";
+  std::vector<std::string> names;
+  for (int pitch : {-60, -30, 0, 30, 60, 90}) {
+    for (int k = 1; k <= 2; ++k) {
+      names.push_back("pitch_" + std::to_string(pitch) + "/trial_" + std::to_string(k));
+    }
+  }
+  for (int k = 1; k <= 3; ++k) names.push_back("tare/tare_" + std::to_string(k));
+  for (const std::string& name : names) {
+    std::string text, why;
+    if (!bifilar::GzipDecompress(ReadFile(sample + "/" + name + ".csv.gz"), &text, &why)) {
+      throw std::runtime_error(sample + "/" + name + ".csv.gz: " + why);
+    }
+    w.pristine[w.logs + "/" + name + ".csv"] = text;
+  }
+  std::string config = ReadFile(args.source + "/configs/prandtl_d.yaml");
+  if (!Replace(&config, "../sample_runs/prandtl_d/logs/tare/*.csv.gz", "logs/tare/*.csv") ||
+      !Replace(&config, "../sample_runs/prandtl_d/logs", "logs") ||
+      !Replace(&config, "*.csv.gz", "*.csv") || !Replace(&config, "bootstrap: 2000", "bootstrap: 200")) {
+    throw std::runtime_error("configs/prandtl_d.yaml changed: update MakeWorkspace in " __FILE__);
+  }
+  w.config_text = config;
+  w.RestoreLogs();
+  w.RestoreConfig();
+  // The user's own files beside and above the outputs: never to be touched.
+  w.user_files[w.out + "/my_notes.txt"] = "my notes\n";
+  w.user_files[w.dir + "/results_backup.json"] = "{}\n";
+  for (const auto& [path, text] : w.user_files) WriteFile(path, text);
+  return w;
+}
+
+std::vector<std::string> ProcessArgv(const Args& args, const Workspace& w, bool force) {
+  std::vector<std::string> argv = {args.binary, "process", w.config_path, "--out", w.out, "--jobs", "2"};
+  if (force) argv.push_back("--force");
+  return argv;
+}
+
+// The ellipse in results.json, NaN when none.
+void ReadEllipse(const std::string& out, double* ix, double* ixz) {
+  *ix = *ixz = NAN;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(ReadFile(out + "/results.json"));
+    if (j.contains("ellipse") && j["ellipse"].is_object()) {
+      *ix = j["ellipse"]["Ix_kg_m2"].get<double>();
+      *ixz = j["ellipse"]["Ixz_kg_m2"].get<double>();
+    }
+  } catch (const std::exception&) {
+  }
+}
+
+// Checks common to every finished `process`: exit code, no NaN, consistent set, user files.
+void CheckRun(const Outcome& o, const Workspace& w, int case_no, const std::string& kind,
+              Failures* failures) {
+  if (o.timed_out) failures->Add(case_no, kind, "no answer within the bound: a hang");
+  if (o.signal) failures->Add(case_no, kind, "crashed with signal " + std::to_string(o.signal) + "\n" + o.err);
+  if (!o.killed && !o.timed_out && !o.signal && (o.exit_code < 0 || o.exit_code > 2)) {
+    failures->Add(case_no, kind, "exit code " + std::to_string(o.exit_code) + "\n" + o.err);
+  }
+  if (o.exit_code == 2 && o.err.find("error") == std::string::npos) {
+    failures->Add(case_no, kind, "exit 2 without an error message");
+  }
+  for (const auto& [path, text] : w.user_files) {
+    if (ReadFile(path) != text) failures->Add(case_no, kind, "user file changed or removed: " + path);
+  }
+  if (o.killed || !(o.exit_code == 0 || o.exit_code == 1)) return;
+  for (const char* name : {"results.json", "traces.csv", "angles.csv"}) {
+    const std::string path = w.out + "/" + name;
+    if (!fs::exists(path)) {
+      failures->Add(case_no, kind, std::string(name) + " missing after exit " + std::to_string(o.exit_code));
+      continue;
+    }
+    const std::string bad = NonFiniteIn(ReadFile(path), std::string(name) != "results.json");
+    if (!bad.empty()) failures->Add(case_no, kind, std::string(name) + ": non-finite number, " + bad);
+  }
+  for (const std::string& problem : bifilar::CheckOutputSet(w.out, true)) {
+    failures->Add(case_no, kind, "inconsistent output set: " + problem);
+  }
+}
+
+void CheckBaseline(const Workspace& w, int case_no, const std::string& kind, Failures* failures) {
+  double ix = NAN, ixz = NAN;
+  ReadEllipse(w.out, &ix, &ixz);
+  if (!(std::fabs(ixz - w.ixz_kg_m2) <= 1e-12 && std::fabs(ix - w.ix_kg_m2) <= 1e-12)) {
+    char buffer[200];
+    std::snprintf(buffer, sizeof(buffer), "ellipse differs from the baseline: I_x %.9g (%.9g), I_xz %.9g (%.9g)",
+                  ix, w.ix_kg_m2, ixz, w.ixz_kg_m2);
+    failures->Add(case_no, kind, buffer);
+  }
+}
+
+// One random tampering of a cache entry.
+std::string TamperCache(const Workspace& w, std::mt19937_64& rng) {
+  std::vector<std::string> entries;
+  if (fs::is_directory(w.out + "/cache")) {
+    for (const auto& e : fs::directory_iterator(w.out + "/cache")) entries.push_back(e.path().string());
+  }
+  std::sort(entries.begin(), entries.end());
+  if (entries.empty()) return "no cache entry";
+  const std::string path = Pick(entries, rng);
+  std::string text = ReadFile(path);
+  const size_t at = text.find("\"inertia_total_kg_m2\": ");
+  switch (Uniform(rng, 0, 4)) {
+    case 0:
+      if (at != std::string::npos) {
+        const size_t b = at + 23, e = text.find_first_of(",\n", b);
+        const double v = std::atof(text.substr(b, e - b).c_str());
+        char buffer[40];
+        std::snprintf(buffer, sizeof(buffer), "%.17g", 0.9 * v);
+        text.replace(b, e - b, buffer);
+      }
+      WriteFile(path, text);
+      return "inertia scaled by 0.9 in " + path;
+    case 1:
+      WriteFile(path, ReadFile(Pick(entries, rng)));
+      return "another entry copied over " + path;
+    case 2:
+      if (at != std::string::npos) {
+        const size_t b = at + 23, e = text.find_first_of(",\n", b);
+        text.replace(b, e - b, Uniform(rng, 0, 1) ? "NaN" : "-5");
+      }
+      WriteFile(path, text);
+      return "NaN or -5 written in " + path;
+    case 3:
+      text[Uniform(rng, 0, static_cast<int>(text.size()) - 1)] ^= 0x20;
+      WriteFile(path, text);
+      return "one bit flipped in " + path;
+    default:
+      WriteFile(path, text.substr(0, Uniform(rng, 0, static_cast<int>(text.size()))));
+      return "truncated " + path;
+  }
+}
+
+// The first time series of a Crazyflie log: up to the first row whose `t` is empty (the footer).
+std::string CrazyflieSeries(const std::string& text) {
+  std::vector<std::string> lines = Lines(text);
+  std::vector<std::string> kept;
+  int t_col = -1;
+  for (const std::string& line : lines) {
+    std::vector<std::string> cells;
+    std::stringstream in(line);
+    std::string cell;
+    while (std::getline(in, cell, ',')) cells.push_back(cell);
+    if (t_col < 0) {
+      for (size_t i = 0; i < cells.size(); ++i) {
+        if (cells[i] == "t") t_col = static_cast<int>(i);
+      }
+    } else if (static_cast<int>(cells.size()) <= t_col || cells[t_col].empty()) {
+      break;
+    }
+    kept.push_back(line);
+  }
+  return Join(kept);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args args;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::cerr << a << " needs a value\n";
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--binary") args.binary = next();
+    else if (a == "--source") args.source = next();
+    else if (a == "--seed") args.seed = std::stoull(next());
+    else if (a == "--cases") args.cases = std::stoi(next());
+    else if (a == "--run-timeout-s") args.run_timeout_s = std::stod(next());
+    else if (a == "--keep") args.keep = true;
+    else {
+      std::cerr << "usage: bifilar_stress --binary BIFILAR --source REPO [--seed N] [--cases N] "
+                   "[--run-timeout-s S] [--keep]\n";
+      return 2;
+    }
+  }
+  if (args.binary.empty() || args.source.empty()) {
+    std::cerr << "bifilar_stress: --binary and --source are required\n";
+    return 2;
+  }
+  const Clock::time_point start = Clock::now();
+  Workspace w = MakeWorkspace(args);
+  Failures failures;
+  std::mt19937_64 rng(args.seed);
+
+  // Baseline: the pristine campaign, fitted from scratch; its duration times the kills.
+  Outcome base = Wait(Start(ProcessArgv(args, w, true), w.dir + "/baseline"), args.run_timeout_s);
+  CheckRun(base, w, 0, "baseline", &failures);
+  ReadEllipse(w.out, &w.ix_kg_m2, &w.ixz_kg_m2);
+  if (base.exit_code != 0 || !std::isfinite(w.ixz_kg_m2)) {
+    std::cerr << "bifilar_stress: the pristine campaign did not process (exit " << base.exit_code
+              << "):\n" << base.err << "\n";
+    return 1;
+  }
+  const double forced_s = base.seconds;
+
+  // Real logs (optional).
+  const std::string crazyflie = args.source + "/../shared/data/crazyflie";
+  std::vector<std::string> real_logs;
+  if (fs::is_directory(crazyflie)) {
+    for (const auto& e : fs::directory_iterator(crazyflie)) {
+      if (e.path().extension() == ".csv") real_logs.push_back(e.path().string());
+    }
+    std::sort(real_logs.begin(), real_logs.end());
+    WriteFile(w.dir + "/crazyflie.yaml",
+              "gravity_mps2: 9.8066\n"
+              "rig: {filar_length_m: 0.594, filar_separation_m: 0.030, mass_kg: 0.0343}\n"
+              "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [wx, wy, wz], unit: rad/s}\n"
+              "  swing_axis: [0, 0, 1]\n");
+  }
+
+  std::map<std::string, int> kinds_run;
+  for (int c = 1; c <= args.cases; ++c) {
+    const int roll = Uniform(rng, 0, 99);
+    std::string kind, what;
+    const std::string prefix = w.dir + "/run";
+    if (roll < 25) {
+      kind = "log mutation";
+      const int k = Uniform(rng, 1, 3);
+      std::vector<std::string> paths;
+      for (const auto& [path, text] : w.pristine) paths.push_back(path);
+      for (int i = 0; i < k; ++i) {
+        const std::string& path = Pick(paths, rng);
+        std::string how;
+        WriteFile(path, MutateLog(ReadFile(path), rng, &how));
+        what += fs::path(path).filename().string() + ": " + how + "; ";
+      }
+      const Outcome o = Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s);
+      CheckRun(o, w, c, kind + " (" + what + ")", &failures);
+      if (o.exit_code == 2) {  // a bad log is an error row, never the end of the run
+        failures.Add(c, kind + " (" + what + ")", "exit 2 for a bad log:\n" + o.err);
+      }
+      w.RestoreLogs();
+    } else if (roll < 40) {
+      kind = "config mutation";
+      WriteFile(w.config_path, MutateConfig(w.config_text, rng, &what));
+      CheckRun(Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s), w, c,
+               kind + " (" + what + ")", &failures);
+      w.RestoreConfig();
+    } else if (roll < 55) {
+      kind = "cache tampering";
+      const int k = Uniform(rng, 1, 4);
+      for (int i = 0; i < k; ++i) what += TamperCache(w, rng) + "; ";
+      const Outcome o = Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s);
+      CheckRun(o, w, c, kind + " (" + what + ")", &failures);
+      if (o.exit_code == 0) {
+        CheckBaseline(w, c, kind + " (" + what + ")", &failures);
+      } else {
+        failures.Add(c, kind + " (" + what + ")", "exit " + std::to_string(o.exit_code) + "\n" + o.err);
+      }
+    } else if (roll < 75) {
+      kind = "kill -9";
+      const bool force = Uniform(rng, 0, 1) == 1;
+      const double at_s = std::uniform_real_distribution<double>(0.0, 1.2 * forced_s)(rng);
+      what = (force ? "--force, " : "") + std::to_string(at_s) + " s";
+      const Outcome killed =
+          Wait(Start(ProcessArgv(args, w, force), prefix), args.run_timeout_s, at_s);
+      CheckRun(killed, w, c, kind + " (" + what + ")", &failures);
+      const Outcome rerun = Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s);
+      CheckRun(rerun, w, c, kind + " then rerun (" + what + ")", &failures);
+      if (rerun.exit_code == 0) {
+        CheckBaseline(w, c, kind + " then rerun (" + what + ")", &failures);
+      } else {
+        failures.Add(c, kind + " then rerun (" + what + ")",
+                     "rerun exit " + std::to_string(rerun.exit_code) + "\n" + rerun.err);
+      }
+    } else if (roll < 87) {
+      kind = "two concurrent runs";
+      const bool force_a = Uniform(rng, 0, 1), force_b = Uniform(rng, 0, 1);
+      const Process a = Start(ProcessArgv(args, w, force_a), prefix + "_a");
+      const Process b = Start(ProcessArgv(args, w, force_b), prefix + "_b");
+      const Outcome oa = Wait(a, args.run_timeout_s), ob = Wait(b, args.run_timeout_s);
+      CheckRun(oa, w, c, kind + " (first)", &failures);
+      CheckRun(ob, w, c, kind + " (second)", &failures);
+      int ok = 0;
+      for (const Outcome* o : {&oa, &ob}) {
+        if (o->exit_code == 0) ++ok;
+        else if (!(o->exit_code == 2 && o->err.find("in use by another bifilar run") != std::string::npos)) {
+          failures.Add(c, kind, "a run neither succeeded nor was refused for the lock: exit " +
+                                    std::to_string(o->exit_code) + "\n" + o->err);
+        }
+      }
+      if (ok == 0) failures.Add(c, kind, "neither run succeeded");
+      CheckRun(Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s), w, c,
+               kind + " then rerun", &failures);
+      CheckBaseline(w, c, kind, &failures);
+    } else if (roll < 92) {
+      kind = "user file in figures/";
+      const std::string path = w.out + "/" + (Uniform(rng, 0, 1) ? "figures" : "cache") +
+                               "/user_" + std::to_string(c) + ".png";
+      WriteFile(path, "mine");
+      const Outcome o = Wait(Start(ProcessArgv(args, w, Uniform(rng, 0, 1)), prefix), args.run_timeout_s);
+      CheckRun(o, w, c, kind, &failures);
+      if (o.exit_code != 2 || o.err.find("did not write") == std::string::npos) {
+        failures.Add(c, kind, "a folder holding a user's file was used: exit " + std::to_string(o.exit_code));
+      }
+      if (ReadFile(path) != "mine") failures.Add(c, kind, "the user's file was removed: " + path);
+      fs::remove(path);
+    } else if (!real_logs.empty()) {
+      kind = "real log mutation";
+      const std::string& source = Pick(real_logs, rng);
+      const std::string path = w.dir + "/real/" + fs::path(source).filename().string();
+      WriteFile(path, MutateLog(CrazyflieSeries(ReadFile(source)), rng, &what));
+      const Outcome o = Wait(Start({args.binary, "fit", w.dir + "/crazyflie.yaml", path, "--json"}, prefix),
+                             args.run_timeout_s);
+      const std::string label = kind + " (" + fs::path(source).filename().string() + ": " + what + ")";
+      if (o.timed_out) failures.Add(c, label, "no answer within the bound: a hang");
+      if (o.signal) failures.Add(c, label, "crashed with signal " + std::to_string(o.signal) + "\n" + o.err);
+      if (!o.timed_out && !o.signal && (o.exit_code < 0 || o.exit_code > 2)) {
+        failures.Add(c, label, "exit code " + std::to_string(o.exit_code));
+      }
+      if (o.exit_code == 0 || o.exit_code == 1) {
+        const std::string bad = NonFiniteIn(o.out, false);
+        if (!bad.empty()) failures.Add(c, label, "fit --json: " + bad);
+      }
+      fs::remove(path);
+    } else {
+      kind = "rerun";
+      CheckRun(Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s), w, c, kind, &failures);
+    }
+    ++kinds_run[kind];
+  }
+  const double total_s = std::chrono::duration<double>(Clock::now() - start).count();
+  std::cout << "bifilar_stress: seed " << args.seed << ", " << args.cases << " cases in "
+            << total_s << " s (one forced run " << forced_s << " s):";
+  for (const auto& [kind, n] : kinds_run) std::cout << " " << kind << " " << n << ";";
+  std::cout << " failures " << failures.count << "\n";
+  if (!args.keep) {
+    std::error_code ec;
+    fs::remove_all(w.dir, ec);
+  } else {
+    std::cout << "workspace kept: " << w.dir << "\n";
+  }
+  return failures.count == 0 ? 0 : 1;
+}
