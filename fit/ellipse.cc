@@ -1,5 +1,7 @@
 #include "fit/ellipse.h"
 
+#include "fit/solver_logging.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -384,6 +386,7 @@ std::string EllipseResult::BriefReport() const {
 bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& options,
                 EllipseResult* result, std::string* why) {
   const auto start = Clock::now();
+  QuietSolverLogging();
   if (!options.Check(why)) return false;
   *result = EllipseResult();
   EllipseResult& res = *result;
@@ -404,6 +407,15 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
     }
     if (p.std_kg_m2 < 0.0 || std::isinf(p.std_kg_m2)) {
       *why = where + "std must be >= 0 and finite (0 or NaN = unknown), got " + Num(p.std_kg_m2);
+      return false;
+    }
+    // Beyond these the squares and weights of the fit overflow or vanish (the fit would see a
+    // "rank-deficient design"); no real moment comes near them, so it is a unit or typing error.
+    constexpr double kTiny = 1e-100, kHuge = 1e100;
+    if (p.inertia_kg_m2 < kTiny || p.inertia_kg_m2 > kHuge ||
+        (p.std_kg_m2 > 0.0 && (p.std_kg_m2 < kTiny || p.std_kg_m2 > kHuge))) {
+      *why = where + "inertia " + Num(p.inertia_kg_m2) + " / std " + Num(p.std_kg_m2) +
+             " kg m^2 is outside [1e-100, 1e100]: check the units and values of this point";
       return false;
     }
     if (p.std_kg_m2 > 0.0) ++n_std_given;
@@ -843,6 +855,7 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
     solver_options.parameter_tolerance = 1e-16;
     solver_options.max_num_iterations = 200;
     solver_options.num_threads = 1;
+    solver_options.logging_type = ceres::SILENT;
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
     s.converged = summary.IsSolutionUsable();
