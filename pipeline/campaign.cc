@@ -654,6 +654,10 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   std::mutex progress_mutex;
   std::atomic<int> done{0};
   const int n_fit = static_cast<int>(to_fit.size());
+  // Windows are resolved above (WindowsForRuns): the fit gets each in its options, and a config
+  // without the list, so no fit searches fit.windows again (cost entries x traces).
+  CampaignConfig fit_config = config;
+  fit_config.fit.windows_s.clear();
   ParallelFor(n_fit, jobs, [&](int k) {
     const int i = to_fit[k];
     const RunFile& run = runs[i];
@@ -670,7 +674,7 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     trace_options.figure_height_px = 400;
     TraceRecord fitted;
     try {
-      fitted = fit(config, run.path, trace_options);
+      fitted = fit(fit_config, run.path, trace_options);
     } catch (const std::bad_alloc&) {
       fitted.status = TraceStatus::kError;
       fitted.message = run.display + ": out of memory while reading or fitting this log (is it "
