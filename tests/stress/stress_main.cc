@@ -16,7 +16,8 @@
 // tampering, a kill or concurrent runs on the pristine campaign, the ellipse equals the baseline.
 //
 //   bifilar_stress --binary build/bifilar --source . [--seed 1] [--cases 150] [--keep]
-// CTest runs `stress/short` (250 cases, ~60 s on 2 cores); the long mode is --cases 3000.
+// CTest runs `stress/short` (500 cases, 40-60 s on 2 cores); the long mode is --cases 3000
+// (or more, and other seeds: --seed N).
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
