@@ -90,23 +90,17 @@ double StudentQuantile(double p, double dof) {
   return z + g1 / n + g2 / (n * n) + g3 / (n * n * n) + g4 / (n * n * n * n);
 }
 
-// Quantile of sorted values with linear interpolation.
-double SortedQuantile(const std::vector<double>& sorted, double p) {
-  const double h = p * (sorted.size() - 1);
-  const size_t lo = static_cast<size_t>(std::floor(h));
-  const size_t hi = std::min(lo + 1, sorted.size() - 1);
-  return sorted[lo] + (h - lo) * (sorted[hi] - sorted[lo]);
-}
-
-// The two interpolated quantiles p_lo < p_hi (SortedQuantile of all the values) of a stream of
-// `count` values, keeping only the tails they need: the smallest floor(p_lo (count - 1)) + 2 and
-// the largest count - floor(p_hi (count - 1)) values. Memory does not grow with the data.
+// The two quantiles p_lo < p_hi of a stream of `count` values, interpolated linearly between the
+// order statistics around p (count - 1) as for a sorted list, keeping only the tails they need:
+// the smallest floor(p_lo (count - 1)) + 2 and the largest count - floor(p_hi (count - 1))
+// values. Memory does not grow with the data.
 class TailQuantiles {
  public:
   TailQuantiles(int count, double p_lo, double p_hi)
       : count_(count), p_lo_(p_lo), p_hi_(p_hi),
         keep_lo_(static_cast<size_t>(std::floor(p_lo * (count - 1))) + 2),
-        keep_hi_(static_cast<size_t>(count) - static_cast<size_t>(std::floor(p_hi * (count - 1)))) {}
+        keep_hi_(static_cast<size_t>(count) -
+                 static_cast<size_t>(std::floor(p_hi * (count - 1)))) {}
 
   void Add(double v) {
     if (low_.size() < keep_lo_) {
@@ -128,7 +122,7 @@ class TailQuantiles {
 
  private:
   // The kept smallest values are sorted[0 .. keep_lo_), the largest sorted[count - keep_hi_ ..
-  // count): both hold the two order statistics SortedQuantile interpolates between.
+  // count): both hold the two order statistics the interpolation reads.
   double FromLow(double p) const { return Interpolate(Drain(low_), 0, p); }
   double FromHigh(double p) const {
     std::vector<double> v = Drain(high_);
@@ -625,8 +619,9 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
     res.warnings.push_back(
         "tau is ill-defined: the data do not distinguish the ellipse from a circle (I_x ~ I_z and "
         "I_xz ~ 0; " +
-        (res.circle_chi2 > chi2_threshold ? std::string("a circle to rounding")
-                                          : "chi^2 " + Num(res.circle_chi2) + " < " + Num(chi2_threshold)) +
+        (res.circle_chi2 > chi2_threshold
+             ? std::string("a circle to rounding")
+             : "chi^2 " + Num(res.circle_chi2) + " < " + Num(chi2_threshold)) +
         "); I_xz is "
         "still reported, tau, I_xp and I_zp are not");
   }
@@ -664,7 +659,9 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
     if (mode == EllipseCovariance::kAngleMeans) {
       group_solve = Eigen::MatrixXd::Zero(3, m);
       for (int g = 0; g < m; ++g) {
-        for (int i : groups[g].members) group_solve.col(g) += normal_inv * x.row(i).transpose() * w(i);
+        for (int i : groups[g].members) {
+          group_solve.col(g) += normal_inv * x.row(i).transpose() * w(i);
+        }
       }
     }
     const Eigen::Matrix3d chol = Eigen::LLT<Eigen::Matrix3d>(normal_inv).matrixL();
@@ -826,7 +823,10 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
     }
   }
   const double scale = std::max(std::fabs(best.ix_kg_m2), std::fabs(best.iz_kg_m2));
-  Eq7Data data{&pitch_rad, &inertia, &weight};
+  Eq7Data data;
+  data.pitch_rad = &pitch_rad;
+  data.inertia = &inertia;
+  data.weight = &weight;
   data.compressed = n > kCompressAbovePoints;
   if (data.compressed) {
     // U from the normal matrix (X^T W X)^-1's inverse: the upper Cholesky factor of X^T W X.

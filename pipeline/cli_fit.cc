@@ -121,6 +121,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
         std::cout << HumanLine(record) << std::endl;
       }
     }
+    // Invalid UTF-8 (a log's bytes in a message) is replaced, never a json exception.
     if (args->json) std::cout << records.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
     *exit_code = failed > 0 ? 1 : 0;
   });

@@ -179,7 +179,8 @@ void OutputManifest::Save() const {
   nlohmann::json j;
   j["about"] = "files bifilar wrote in this folder; only these are ever removed by bifilar";
   j["files"] = files_;
-  WriteFileAtomically((fs::path(out_dir_) / kFileName).string(), j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  const std::string text = j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace);
+  WriteFileAtomically((fs::path(out_dir_) / kFileName).string(), text + "\n");
 }
 
 std::string FileHash(const std::string& path) {
@@ -201,7 +202,8 @@ void WriteOutputSet(const std::string& out_dir, nlohmann::json results,
   const fs::path out(out_dir);
   results["outputs"] = {{"traces.csv", HashToHex(Fnv1a64(traces_csv))},
                         {"angles.csv", HashToHex(Fnv1a64(angles_csv))}};
-  const std::string results_text = results.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  const std::string results_text =
+      results.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   WriteFileAtomically((out / "traces.csv").string(), traces_csv);
   WriteFileAtomically((out / "angles.csv").string(), angles_csv);
   if (report_html_builder) {
@@ -250,7 +252,9 @@ std::vector<std::string> CheckOutputSet(const std::string& out_dir, bool check_r
   auto check_figure = [&](const nlohmann::json& name) {
     if (!name.is_string() || name.get<std::string>().empty()) return;
     const fs::path path = out / "figures" / name.get<std::string>();
-    if (!fs::exists(path, ec)) problems.push_back(path.string() + " (named in results.json) is missing");
+    if (!fs::exists(path, ec)) {
+      problems.push_back(path.string() + " (named in results.json) is missing");
+    }
   };
   if (results.contains("traces") && results["traces"].is_array()) {
     for (const auto& trace : results["traces"]) {
