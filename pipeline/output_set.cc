@@ -88,6 +88,14 @@ OutputFolderLock::~OutputFolderLock() {
 OutputManifest::OutputManifest(std::string out_dir) : out_dir_(std::move(out_dir)) {
   const std::string path = (fs::path(out_dir_) / kFileName).string();
   std::error_code ec;
+  // Temporary copies of the manifest itself left by a killed run (the name is bifilar's own).
+  const std::string stale_prefix = std::string(kFileName) + ".tmp.";
+  for (fs::directory_iterator it(out_dir_, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->path().filename().string().rfind(stale_prefix, 0) == 0) {
+      std::error_code ignored;
+      fs::remove(it->path(), ignored);
+    }
+  }
   if (!fs::exists(path, ec)) {
     AdoptLegacy();
     return;
