@@ -131,7 +131,8 @@ namespace {
 
 std::string EntryChecksum(const std::string& key, const std::string& content_hash,
                           const std::string& version, const nlohmann::json& record) {
-  return HashToHex(Fnv1a64(key + ";" + content_hash + ";" + version + ";" + record.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)));
+  const std::string text = record.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return HashToHex(Fnv1a64(key + ";" + content_hash + ";" + version + ";" + text));
 }
 
 bool FiniteOrNull(const nlohmann::json& j, const char* field) {
@@ -206,7 +207,9 @@ void TraceCache::Store(const std::string& key, const std::string& content_hash,
   entry["version"] = ProgramVersion();
   entry["record"] = TraceRecordToJson(record, false);
   entry["checksum"] = EntryChecksum(key, content_hash, ProgramVersion(), entry["record"]);
-  WriteFileAtomically(EntryPath(key), entry.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  // Invalid UTF-8 (a log's bytes in a message) is replaced, never a json exception.
+  const std::string text = entry.dump(1, ' ', false, nlohmann::json::error_handler_t::replace);
+  WriteFileAtomically(EntryPath(key), text + "\n");
 }
 
 }  // namespace bifilar

@@ -483,7 +483,20 @@ std::vector<RunFile> DiscoverRuns(const CampaignConfig& config) {
     std::vector<RunFile> tare = DiscoverTare(config);
     runs.insert(runs.end(), tare.begin(), tare.end());
   }
-  return runs;
+  // A file matched twice (two tare patterns, a table row repeated) is one log; matched as an
+  // aircraft run and as a tare log it is an error row, not "the same content as" itself.
+  std::map<std::string, TraceRole> seen;
+  std::vector<RunFile> unique;
+  for (RunFile& run : runs) {
+    auto [it, inserted] = seen.emplace(run.path, run.role);
+    if (inserted) {
+      unique.push_back(std::move(run));
+    } else if (it->second != run.role && run.error.empty()) {
+      run.error = run.display + ": listed both as an aircraft run and as a tare log";
+      unique.push_back(std::move(run));
+    }
+  }
+  return unique;
 }
 
 bool RigInertiaAt(const CampaignConfig& config, double tare_mean_kg_m2, double tare_std_kg_m2,
@@ -641,6 +654,10 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   std::mutex progress_mutex;
   std::atomic<int> done{0};
   const int n_fit = static_cast<int>(to_fit.size());
+  // Windows are resolved above (WindowsForRuns): the fit gets each in its options, and a config
+  // without the list, so no fit searches fit.windows again (cost entries x traces).
+  CampaignConfig fit_config = config;
+  fit_config.fit.windows_s.clear();
   ParallelFor(n_fit, jobs, [&](int k) {
     const int i = to_fit[k];
     const RunFile& run = runs[i];
@@ -657,7 +674,11 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     trace_options.figure_height_px = 400;
     TraceRecord fitted;
     try {
-      fitted = fit(config, run.path, trace_options);
+      fitted = fit(fit_config, run.path, trace_options);
+    } catch (const std::bad_alloc&) {
+      fitted.status = TraceStatus::kError;
+      fitted.message = run.display + ": out of memory while reading or fitting this log (is it "
+                                     "far larger than a pendulum log?)";
     } catch (const std::exception& e) {
       fitted.status = TraceStatus::kError;
       fitted.message = run.display + ": " + e.what();

@@ -26,8 +26,8 @@ int DropOutputFolder(const std::string& out_dir, std::vector<RunFile>* runs) {
   return static_cast<int>(before - runs->size());
 }
 
-std::vector<std::optional<std::array<double, 2>>> WindowsForRuns(const CampaignConfig& config,
-                                                                  const std::vector<RunFile>& runs) {
+std::vector<std::optional<std::array<double, 2>>> WindowsForRuns(
+    const CampaignConfig& config, const std::vector<RunFile>& runs) {
   // Each entry resolved the two ways ConfigWindowFor does: against runs.root, then the config
   // folder.
   std::map<std::string, std::string> key_of;  // resolved path -> entry

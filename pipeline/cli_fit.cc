@@ -95,7 +95,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
   sub->add_option("--window", args->window, "fit only T0:T1 (s, the log's own time)");
   sub->add_option("--max-amplitude", args->max_amplitude_deg,
                   "upper end of the amplitude band (deg)")
-      ->check(CLI::Range(0.1, 90.0));
+      ->check(CLI::Range(kMinMaxAmplitudeDeg, kMaxMaxAmplitudeDeg));  // as fit.max_amplitude_deg
   sub->add_option("--plot", args->plot_dir, "write fit figures DIR/<log>.svg and .png");
   sub->callback([args, exit_code] {
     ConfigLoadOptions load;
@@ -140,6 +140,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
         std::cout << HumanLine(record) << std::endl;
       }
     }
+    // Invalid UTF-8 (a log's bytes in a message) is replaced, never a json exception.
     if (args->json) std::cout << records.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
     *exit_code = failed > 0 ? 1 : 0;
   });

@@ -3,6 +3,7 @@
 #include "fit/ellipse.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -296,6 +297,31 @@ bool CampaignConfig::Check(std::string* why) const {
     *why = "imu: " + reason;
     return false;
   }
+  // A standard uncertainty is below the quantity it qualifies (a 100 % uncertainty says nothing;
+  // 1e308 overflowed the budget into a "non-finite value" naming no key).
+  const struct {
+    const char* key;
+    double std, of;
+  } stds[] = {
+      {"rig.uncertainties.filar_length_std_m", uncertainties.filar_length_std_m, filar_length_m},
+      {"rig.uncertainties.filar_separation_std_m", uncertainties.filar_separation_std_m,
+       filar_separation_m},
+      {"rig.uncertainties.mass_std_kg", uncertainties.mass_std_kg, rig_mass_kg},
+      {"rig.uncertainties.gravity_std_mps2", uncertainties.gravity_std_mps2, gravity_mps2},
+      {"aircraft.mass_std_kg", aircraft_mass_std_kg,
+       aircraft_mass_kg > 0 ? aircraft_mass_kg : INFINITY},
+      {"imu.gyro.scale_std", imu.gyro_scale_std, 1.0},
+      {"rig.inertia.inertia_std_kg_m2", rig_inertia.inertia_std_kg_m2, kMaxRigInertiaStdKgM2},
+  };
+  for (const auto& s : stds) {
+    if (!(s.std >= 0.0 && s.std < s.of)) {
+      char buffer[240];
+      std::snprintf(buffer, sizeof(buffer), "'%s' must be >= 0 and below %g (the quantity it "
+                    "qualifies), got %g", s.key, s.of, s.std);
+      *why = buffer;
+      return false;
+    }
+  }
   return fit.Check(why) && ellipse.Check(why);
 }
 
@@ -420,6 +446,13 @@ CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptio
       if (fs::path(config.runs.pattern).is_absolute()) {
         throw UserError(runs.Where(runs.Optional("pattern")) +
                         ": 'runs.pattern' must be relative to runs.root");
+      }
+      for (const auto& part : fs::path(config.runs.pattern)) {
+        if (part == "..") {
+          throw UserError(runs.Where(runs.Optional("pattern")) +
+                          ": 'runs.pattern' must stay inside runs.root (no '..'): set runs.root "
+                          "to the folder that holds the logs instead");
+        }
       }
     } else {
       config.runs.table = ResolvePath(folder, runs.RequiredString("table"));

@@ -109,6 +109,9 @@ constexpr int kMaxWhitenessLags = 1000;    // fit.quality.whiteness_lags in [1, 
 constexpr double kMaxMinPeriods = 10000;   // fit.quality.min_periods in [2, 10000]
 constexpr double kMinMaxAmplitudeDeg = 1;  // fit.max_amplitude_deg in [1, 90]: the trace fit's
 constexpr double kMaxMaxAmplitudeDeg = 90; //   model holds to 90 deg; below 1 deg is noise
+constexpr double kMaxRigInertiaStdKgM2 = 1e3;  // rig.inertia.inertia_std_kg_m2 below this
+// The other std keys (rig.uncertainties.*, aircraft.mass_std_kg, imu.gyro.scale_std) must be
+// below the quantity they qualify (L, D, the masses, g; 1 for the scale factor).
 
 struct EllipseConfig {
   int bootstrap = 2000;           // parametric bootstrap replicates (0 = covariance intervals)

@@ -180,10 +180,7 @@ int RunEllipseCommand(const EllipseCommandOptions& options, std::ostream& out) {
   std::vector<std::string> plots;
   if (!options.plot_dir.empty()) plots = WriteEllipsePlots(result, options.units, options.plot_dir);
   if (options.json) {
-    nlohmann::json j = EllipseResultToJson(result);
-    j["table"] = options.table_path;
-    j["figures"] = plots;
-    out << j.dump(2) << "\n";
+    WriteEllipseResultJson(result, {{"table", options.table_path}, {"figures", plots}}, out);
   } else {
     out << options.table_path << "\n";
     PrintEllipseReport(result, options.units, out);

@@ -44,9 +44,35 @@ json SolverToJson(const EllipseSolverSummary& s, bool tau_defined) {
   return j;
 }
 
+json ResidualToJson(const EllipseResidual& e) {
+  return {{"index", e.index},
+          {"pitch_deg", Num(e.pitch_deg)},
+          {"inertia_kg_m2", Num(e.inertia_kg_m2)},
+          {"fitted_kg_m2", Num(e.fitted_kg_m2)},
+          {"residual_kg_m2", Num(e.residual_kg_m2)},
+          {"studentized", Num(e.studentized)},
+          {"outlier", e.outlier}};
+}
+
+constexpr const char* kResidualsPlaceholder = "@@bifilar residuals@@";
+
 }  // namespace
 
-json EllipseResultToJson(const EllipseResult& r) {
+void WriteEllipseResultJson(const EllipseResult& result, const json& extra, std::ostream& out) {
+  json j = EllipseResultToJson(result, false);
+  for (const auto& [key, value] : extra.items()) j[key] = value;
+  j["residuals"] = kResidualsPlaceholder;
+  const std::string text = j.dump(2, ' ', false, json::error_handler_t::replace);
+  const std::string quoted = std::string("\"") + kResidualsPlaceholder + "\"";
+  const size_t at = text.find(quoted);
+  out << text.substr(0, at) << "[";
+  for (size_t i = 0; i < result.residuals.size(); ++i) {
+    out << (i ? ",\n    " : "\n    ") << ResidualToJson(result.residuals[i]).dump();
+  }
+  out << (result.residuals.empty() ? "]" : "\n  ]") << text.substr(at + quoted.size()) << "\n";
+}
+
+json EllipseResultToJson(const EllipseResult& r, bool with_residuals) {
   json j;
   PutEstimate(&j, "Ix_kg_m2", r.ix);
   PutEstimate(&j, "Iz_kg_m2", r.iz);
@@ -99,15 +125,8 @@ json EllipseResultToJson(const EllipseResult& r) {
   json residuals = json::array();
   json outliers = json::array();
   for (const auto& e : r.residuals) {
-    json row = {{"index", e.index},
-                {"pitch_deg", Num(e.pitch_deg)},
-                {"inertia_kg_m2", Num(e.inertia_kg_m2)},
-                {"fitted_kg_m2", Num(e.fitted_kg_m2)},
-                {"residual_kg_m2", Num(e.residual_kg_m2)},
-                {"studentized", Num(e.studentized)},
-                {"outlier", e.outlier}};
-    if (e.outlier) outliers.push_back(row);
-    residuals.push_back(row);
+    if (e.outlier) outliers.push_back(ResidualToJson(e));
+    if (with_residuals) residuals.push_back(ResidualToJson(e));
   }
   j["residuals"] = residuals;
   j["outliers"] = outliers;

@@ -3,6 +3,8 @@
 // or not finite are null, with the reason in "warnings"; never NaN.
 #pragma once
 
+#include <ostream>
+
 #include <nlohmann/json.hpp>
 
 #include "fit/ellipse.h"
@@ -14,7 +16,14 @@ namespace bifilar {
 // covariance, dof, variance_factor, confidence_interval_method; fits (linear_ls, nelder_mead,
 // ceres summaries), table1, table2, angles (per-angle stats), residuals, outliers, naca,
 // warnings, time_s.
-nlohmann::json EllipseResultToJson(const EllipseResult& result);
+// The result as JSON; with_residuals false leaves "residuals" empty (one row per point: a
+// million-point table would hold a DOM of a gigabyte).
+nlohmann::json EllipseResultToJson(const EllipseResult& result, bool with_residuals = true);
+
+// Writes EllipseResultToJson(result) plus the keys of `extra` to `out`, the residuals streamed
+// row by row: memory stays proportional to the points, not to a JSON tree of them.
+void WriteEllipseResultJson(const EllipseResult& result, const nlohmann::json& extra,
+                            std::ostream& out);
 
 // The plan: n_points and the predicted *_std of the six quantities.
 nlohmann::json EllipsePlanToJson(const EllipsePlan& plan);

@@ -6,6 +6,7 @@
 
 #include <fast_float/fast_float.h>
 
+#include "pipeline/gzip.h"
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -36,6 +37,15 @@ bool ParseNumber(const std::string& cell, double* value) {
   return res.ec == std::errc() && res.ptr == cell.data() + cell.size();
 }
 
+// A cell as it may appear in a message: printable ASCII only (other bytes as '?'), at most 40
+// characters, so a binary file never prints raw bytes into the terminal.
+std::string Shown(const std::string& cell) {
+  std::string out;
+  for (char c : cell.substr(0, 40)) out += (c >= 32 && c < 127) ? c : '?';
+  if (cell.size() > 40) out += "...";
+  return out;
+}
+
 }  // namespace
 
 bool ParseInertiaUnits(const std::string& name, InertiaUnits* units) {
@@ -61,7 +71,9 @@ const char* InertiaUnitLabel(InertiaUnits units) {
 std::vector<EllipsePoint> ParseEllipseTable(const std::string& text, const std::string& name,
                                             InertiaUnits units) {
   const double to_si = InertiaToSi(units);
-  std::istringstream in(text);
+  // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
+  const bool bom = text.compare(0, 3, "\xEF\xBB\xBF") == 0;
+  std::istringstream in(bom ? text.substr(3) : text);
   std::string line;
   int line_no = 0;
   int pitch_col = -1, inertia_col = -1, std_col = -1;
@@ -83,8 +95,8 @@ std::vector<EllipsePoint> ParseEllipseTable(const std::string& text, const std::
         if (fields[c] == "inertia") slot = &inertia_col;
         if (fields[c] == "std") slot = &std_col;
         if (slot == nullptr) {
-          throw UserError(where + "unknown column '" + fields[c] +
-                          "' (expected pitch_deg, inertia and optionally std)");
+          throw UserError(where + "unknown column '" + Shown(fields[c]) +
+                          "' (expected a header 'pitch_deg,inertia' or 'pitch_deg,inertia,std')");
         }
         if (*slot >= 0) throw UserError(where + "column '" + fields[c] + "' appears twice");
         *slot = static_cast<int>(c);
@@ -100,7 +112,8 @@ std::vector<EllipsePoint> ParseEllipseTable(const std::string& text, const std::
     auto get = [&](int col, const char* what) {
       double v = 0;
       if (!ParseNumber(fields[col], &v)) {
-        throw UserError(where + "column '" + what + "': '" + fields[col] + "' is not a number");
+        throw UserError(where + "column '" + what + "': '" + Shown(fields[col]) +
+                        "' is not a number");
       }
       return v;
     };
@@ -137,7 +150,19 @@ std::vector<EllipsePoint> ReadEllipseTable(const std::string& path, InertiaUnits
   std::ostringstream text;
   text << file.rdbuf();
   if (file.bad()) throw UserError(path + ": read error");
-  return ParseEllipseTable(text.str(), path, units);
+  std::string bytes = text.str();
+  if (LooksGzipped(bytes)) {  // a .csv.gz table is read like a .csv.gz log
+    std::string inflated, why;
+    if (!GzipDecompress(bytes, &inflated, &why)) {
+      throw UserError(path + ": gzip-compressed but cannot be inflated: " + why);
+    }
+    bytes = std::move(inflated);
+  }
+  if (bytes.find('\0') != std::string::npos) {
+    throw UserError(path + ": binary data, not a CSV table (expected a header "
+                    "'pitch_deg,inertia[,std]' and one row per moment)");
+  }
+  return ParseEllipseTable(bytes, path, units);
 }
 
 }  // namespace bifilar

@@ -88,6 +88,14 @@ OutputFolderLock::~OutputFolderLock() {
 OutputManifest::OutputManifest(std::string out_dir) : out_dir_(std::move(out_dir)) {
   const std::string path = (fs::path(out_dir_) / kFileName).string();
   std::error_code ec;
+  // Temporary copies of the manifest itself left by a killed run (the name is bifilar's own).
+  const std::string stale_prefix = std::string(kFileName) + ".tmp.";
+  for (fs::directory_iterator it(out_dir_, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->path().filename().string().rfind(stale_prefix, 0) == 0) {
+      std::error_code ignored;
+      fs::remove(it->path(), ignored);
+    }
+  }
   if (!fs::exists(path, ec)) {
     AdoptLegacy();
     return;
@@ -179,7 +187,8 @@ void OutputManifest::Save() const {
   nlohmann::json j;
   j["about"] = "files bifilar wrote in this folder; only these are ever removed by bifilar";
   j["files"] = files_;
-  WriteFileAtomically((fs::path(out_dir_) / kFileName).string(), j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  const std::string text = j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace);
+  WriteFileAtomically((fs::path(out_dir_) / kFileName).string(), text + "\n");
 }
 
 std::string FileHash(const std::string& path) {
@@ -201,7 +210,8 @@ void WriteOutputSet(const std::string& out_dir, nlohmann::json results,
   const fs::path out(out_dir);
   results["outputs"] = {{"traces.csv", HashToHex(Fnv1a64(traces_csv))},
                         {"angles.csv", HashToHex(Fnv1a64(angles_csv))}};
-  const std::string results_text = results.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  const std::string results_text =
+      results.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   WriteFileAtomically((out / "traces.csv").string(), traces_csv);
   WriteFileAtomically((out / "angles.csv").string(), angles_csv);
   if (report_html_builder) {
@@ -250,7 +260,9 @@ std::vector<std::string> CheckOutputSet(const std::string& out_dir, bool check_r
   auto check_figure = [&](const nlohmann::json& name) {
     if (!name.is_string() || name.get<std::string>().empty()) return;
     const fs::path path = out / "figures" / name.get<std::string>();
-    if (!fs::exists(path, ec)) problems.push_back(path.string() + " (named in results.json) is missing");
+    if (!fs::exists(path, ec)) {
+      problems.push_back(path.string() + " (named in results.json) is missing");
+    }
   };
   if (results.contains("traces") && results["traces"].is_array()) {
     for (const auto& trace : results["traces"]) {

@@ -69,8 +69,8 @@ std::string FileHash(const std::string& path);
 // report.html is removed) and, last, results.json with "outputs": {name: hash} of its siblings.
 // The report is built from the final document and stamped with the hash of its text.
 // Each file is written atomically.
-void WriteOutputSet(const std::string& out_dir, nlohmann::json results, const std::string& traces_csv,
-                    const std::string& angles_csv,
+void WriteOutputSet(const std::string& out_dir, nlohmann::json results,
+                    const std::string& traces_csv, const std::string& angles_csv,
                     std::string (*report_html_builder)(const nlohmann::json&, const std::string&));
 
 // The report page stamped with the hash of the results.json text it shows.

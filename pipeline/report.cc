@@ -371,8 +371,15 @@ void RunReport(const std::string& out_dir) {
                     (problems.size() > 1 ? ", and " + std::to_string(problems.size() - 1) + " more" : "") +
                     "); rerun `bifilar process` to rewrite them");
   }
+  std::string html;
+  try {
+    html = BuildReportHtml(results, out_dir);
+  } catch (const json::exception& e) {  // a field of the wrong type: name the file, not json
+    throw UserError(path + ": not a results file bifilar can read (" + e.what() +
+                    "); rerun `bifilar process` to rewrite it");
+  }
   WriteFileAtomically((fs::path(out_dir) / "report.html").string(),
-                      StampReport(BuildReportHtml(results, out_dir), HashToHex(Fnv1a64(bytes))));
+                      StampReport(html, HashToHex(Fnv1a64(bytes))));
 }
 
 }  // namespace bifilar

@@ -118,6 +118,8 @@ TEST(Cache, StoreAndLoadRoundTrip) {
   std::ofstream(cache.EntryPath("0000000000000002")) << "{ not json";
   EXPECT_FALSE(cache.Load("0000000000000002", "00000000000000aa", &loaded, &problem));
   EXPECT_NE(problem.find("not valid JSON"), std::string::npos) << problem;
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
 }
 
 // issue 9 item 6: the cache was trusted blindly. Each tampering is refused with its reason.

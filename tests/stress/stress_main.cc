@@ -16,7 +16,8 @@
 // tampering, a kill or concurrent runs on the pristine campaign, the ellipse equals the baseline.
 //
 //   bifilar_stress --binary build/bifilar --source . [--seed 1] [--cases 150] [--keep]
-// CTest runs `stress/short` (150 cases, ~60 s on 2 cores); the long mode is --cases 3000.
+// CTest runs `stress/short` (500 cases, 40-60 s on 2 cores); the long mode is --cases 3000
+// (or more, and other seeds: --seed N).
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -639,6 +640,16 @@ int main(int argc, char** argv) {
       const Outcome killed =
           Wait(Start(ProcessArgv(args, w, force), prefix), args.run_timeout_s, at_s);
       CheckRun(killed, w, c, kind + " (" + what + ")", &failures);
+      // `report` on what the kill left: a page from a consistent set, or a refusal naming it.
+      const bool mixed = !bifilar::CheckOutputSet(w.out, false).empty();
+      const Outcome report = Wait(Start({args.binary, "report", w.out}, prefix), args.run_timeout_s);
+      if (report.signal || report.timed_out || (report.exit_code != 0 && report.exit_code != 2) ||
+          (mixed && report.exit_code != 2) ||
+          (report.exit_code == 2 && report.err.find("error") == std::string::npos)) {
+        failures.Add(c, kind + " then report (" + what + ")",
+                     std::string(mixed ? "mixed set, " : "") + "report exit " +
+                         std::to_string(report.exit_code) + "\n" + report.err);
+      }
       const Outcome rerun = Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s);
       CheckRun(rerun, w, c, kind + " then rerun (" + what + ")", &failures);
       if (rerun.exit_code == 0) {

@@ -1,0 +1,13 @@
+// The solvers' own logging (Ceres logs through glog). Without this, the first warning prints
+// "Logging before InitGoogleLogging() is written to STDERR" and solver chatter such as "Residual
+// and Jacobian evaluation failed" reaches the user's terminal; our results carry the solvers'
+// outcome in their summaries instead (issue 9 item 13).
+#pragma once
+
+namespace bifilar {
+
+// Initialises glog once per process (to stderr only, never log files) and keeps only errors.
+// Thread-safe and idempotent; called by the command line and by FitEllipse.
+void QuietSolverLogging();
+
+}  // namespace bifilar

@@ -1,0 +1,161 @@
+// issue 9 item 13: each bad input gets a message that names the file (and key or line) and says
+// what to do; never raw bytes, a bare exception name, a glog preamble or a 300-digit range.
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/campaign.h"
+#include "pipeline/config.h"
+#include "pipeline/ellipse_table.h"
+#include "pipeline/gzip.h"
+#include "pipeline/user_error.h"
+
+namespace bifilar {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct TempDir {
+  std::string path;
+  TempDir() {
+    char tmpl[] = "/tmp/bifilar_messages_test_XXXXXX";
+    path = mkdtemp(tmpl);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+void WriteFile(const std::string& path, const std::string& text) {
+  fs::create_directories(fs::path(path).parent_path());
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs bifilar; returns the exit code, *output gets stdout and stderr.
+int Cli(const TempDir& dir, const std::string& args, std::string* output) {
+  const std::string log = dir.path + "/cli.txt";
+  const int status = std::system((std::string(BIFILAR_BINARY) + " " + args + " > " + log + " 2>&1").c_str());
+  *output = ReadFile(log);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string ErrorOf(const std::function<void()>& fn) {
+  try {
+    fn();
+  } catch (const UserError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool Printable(const std::string& text) {
+  for (unsigned char c : text) {
+    if ((c < 32 && c != '\n' && c != '\t') || c >= 127) return false;
+  }
+  return true;
+}
+
+const char kTable[] = "pitch_deg,inertia\n0,2.8\n45,2.6\n90,2.3\n-45,2.5\n-20,2.7\n";
+
+TEST(Messages, EllipseTableWithBomGzipOrBinary) {
+  TempDir dir;
+  // A BOM (spreadsheet export) is not part of 'pitch_deg'.
+  WriteFile(dir.path + "/bom.csv", std::string("\xEF\xBB\xBF") + kTable);
+  EXPECT_EQ(ReadEllipseTable(dir.path + "/bom.csv", InertiaUnits::kSi).size(), 5u);
+  // A .csv.gz table is inflated like a .csv.gz log.
+  WriteFile(dir.path + "/t.csv.gz", GzipCompress(kTable));
+  EXPECT_EQ(ReadEllipseTable(dir.path + "/t.csv.gz", InertiaUnits::kSi).size(), 5u);
+  // Binary: named, no raw bytes in the message.
+  std::string binary = "\x01\x02\xff\xfe,\x00\x07\x80";
+  binary += std::string(100, '\x9c');
+  WriteFile(dir.path + "/b.csv", binary);
+  std::string message = ErrorOf([&] { ReadEllipseTable(dir.path + "/b.csv", InertiaUnits::kSi); });
+  EXPECT_NE(message.find("b.csv"), std::string::npos) << message;
+  EXPECT_TRUE(Printable(message)) << message;
+  WriteFile(dir.path + "/c.csv", "p\xc3\xa9tch,\x9c\x9d\n1,2\n");
+  message = ErrorOf([&] { ReadEllipseTable(dir.path + "/c.csv", InertiaUnits::kSi); });
+  EXPECT_NE(message.find("c.csv:1"), std::string::npos) << message;
+  EXPECT_TRUE(Printable(message)) << message;
+}
+
+TEST(Messages, ExtremeValuesNameThePointAndNoSolverChatter) {
+  TempDir dir;
+  WriteFile(dir.path + "/x.csv", "pitch_deg,inertia,std\n0,1e300,1e-300\n45,2.6,0.01\n90,2.3,0.01\n"
+                                 "-45,2.5,0.01\n");
+  std::string out;
+  EXPECT_EQ(Cli(dir, "ellipse " + dir.path + "/x.csv", &out), 2);
+  EXPECT_NE(out.find("x.csv"), std::string::npos) << out;
+  EXPECT_NE(out.find("check the units"), std::string::npos) << out;
+  EXPECT_EQ(out.find("rank-deficient"), std::string::npos) << out;
+  EXPECT_EQ(out.find("InitGoogleLogging"), std::string::npos) << out;
+  // Large but representable values fit without any solver chatter.
+  WriteFile(dir.path + "/y.csv", "pitch_deg,inertia\n0,1e90\n45,2e90\n90,3e90\n-45,1.5e90\n10,1.1e90\n");
+  Cli(dir, "ellipse " + dir.path + "/y.csv", &out);
+  EXPECT_EQ(out.find("InitGoogleLogging"), std::string::npos) << out;
+  EXPECT_EQ(out.find("Residual and Jacobian"), std::string::npos) << out;
+}
+
+TEST(Messages, HugeStdNamesTheKeyAndJobsRangeIsShort) {
+  TempDir dir;
+  WriteFile(dir.path + "/c.yaml",
+            "rig:\n  filar_length_m: 2\n  filar_separation_m: 1\n  mass_kg: 1\n"
+            "  inertia: {inertia_kg_m2: 0.1}\n  uncertainties: {filar_separation_std_m: 1e308}\n"
+            "aircraft: {mass_kg: 1}\nruns: {root: ., pattern: 'p{pitch_deg}.csv'}\n");
+  const std::string message = ErrorOf([&] { LoadCampaignConfig(dir.path + "/c.yaml"); });
+  EXPECT_NE(message.find("c.yaml"), std::string::npos) << message;
+  EXPECT_NE(message.find("'rig.uncertainties.filar_separation_std_m'"), std::string::npos) << message;
+  std::string out;
+  EXPECT_EQ(Cli(dir, "process " + dir.path + "/c.yaml --jobs -1", &out), 2);
+  EXPECT_NE(out.find("--jobs"), std::string::npos) << out;
+  EXPECT_LT(out.size(), 200u) << out;
+}
+
+TEST(Messages, RunsPatternCannotLeaveTheRoot) {
+  TempDir dir;
+  WriteFile(dir.path + "/c.yaml",
+            "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.1}}\n"
+            "aircraft: {mass_kg: 1}\nruns:\n  root: .\n  pattern: '../../../bin/{pitch_deg}*'\n");
+  const std::string message = ErrorOf([&] { LoadCampaignConfig(dir.path + "/c.yaml"); });
+  EXPECT_NE(message.find("c.yaml:5"), std::string::npos) << message;
+  EXPECT_NE(message.find("must stay inside runs.root"), std::string::npos) << message;
+}
+
+TEST(Messages, TareLogListedTwiceIsOneLog) {
+  TempDir dir;
+  WriteFile(dir.path + "/logs/p0.csv", "x");
+  WriteFile(dir.path + "/tare/t1.csv", "t");
+  WriteFile(dir.path + "/c.yaml",
+            "rig:\n  filar_length_m: 2\n  filar_separation_m: 1\n  mass_kg: 1\n"
+            "  inertia: {tare: {logs: [tare/t1.csv, tare/*.csv]}}\n"
+            "aircraft: {mass_kg: 1}\nruns: {root: logs, pattern: 'p{pitch_deg}.csv'}\n");
+  const std::vector<RunFile> runs = DiscoverRuns(LoadCampaignConfig(dir.path + "/c.yaml"));
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[1].role, TraceRole::kTare);
+  EXPECT_TRUE(runs[1].error.empty()) << runs[1].error;
+}
+
+TEST(Messages, ReportOfAMalformedResultsFileNamesIt) {
+  TempDir dir;
+  WriteFile(dir.path + "/out/results.json",
+            R"({"version": "x", "traces": [{"file": "a", "window_s": ["a", "b"], "status": "ok"}]})");
+  std::string out;
+  EXPECT_EQ(Cli(dir, "report " + dir.path + "/out", &out), 2);
+  EXPECT_NE(out.find("results.json"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace bifilar
