@@ -247,6 +247,16 @@ double ChiSquare95(int dof) {
   return k * std::pow(1.0 - 2.0 / (9.0 * k) + z * std::sqrt(2.0 / (9.0 * k)), 3);
 }
 
+// RMS of v about its mean (0 for an empty v).
+double RmsAboutMean(const std::vector<double>& v) {
+  if (v.empty()) return 0.0;
+  double mean = 0.0, sq = 0.0;
+  for (double x : v) mean += x;
+  mean /= static_cast<double>(v.size());
+  for (double x : v) sq += (x - mean) * (x - mean);
+  return std::sqrt(sq / static_cast<double>(v.size()));
+}
+
 // Peak |psi| over the first and the last period of a trajectory sampled at t.
 std::pair<double, double> AmplitudeAtEnds(const std::vector<double>& t, const Trajectory& traj,
                                           double period_s) {
@@ -309,13 +319,9 @@ AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptio
     const StatStd stat = StatisticalStd(cost, q, free);
     {
       std::vector<double> rr(t.size());
-      const double c = Cost(cost, q, &rr);
-      const Trajectory& bt = cost.last_trajectory();
-      double mean = 0.0, sq = 0.0;
-      for (double v : bt.rate_rad_per_s) mean += v;
-      mean /= static_cast<double>(t.size());
-      for (double v : bt.rate_rad_per_s) sq += (v - mean) * (v - mean);
-      band.residual_fraction = sq > 0.0 ? std::sqrt(2.0 * c / sq) : HUGE_VAL;
+      const double residual_rms = std::sqrt(2.0 * Cost(cost, q, &rr) / static_cast<double>(t.size()));
+      const double signal_rms = RmsAboutMean(cost.last_trajectory().rate_rad_per_s);
+      band.residual_fraction = signal_rms > 0.0 ? residual_rms / signal_rms : HUGE_VAL;
     }
     const auto [a0, a1] = AmplitudeAtEnds(t, cost.last_trajectory(), period_s);
     band.amplitude_start_deg = a0;
@@ -328,8 +334,13 @@ AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptio
   }
   // Weighted line of I/I_ref against A^2.
   std::vector<const AmplitudeSweepBand*> good;
-  for (const AmplitudeSweepBand& b : sweep.bands)
-    if (b.ok) good.push_back(&b);
+  for (size_t j = 0; j < sweep.bands.size(); ++j) {
+    const AmplitudeSweepBand& b = sweep.bands[j];
+    if (!b.ok) continue;
+    good.push_back(&b);
+    if (sweep.low_band < 0 || b.amplitude_mean_deg < sweep.bands[sweep.low_band].amplitude_mean_deg)
+      sweep.low_band = static_cast<int>(j);
+  }
   if (good.size() < 2) {
     sweep.note = "fewer than 2 bands could be fitted";
     return sweep;
@@ -616,7 +627,6 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
       result.flags.push_back("covariance_failed");
       result.warnings.push_back("the covariance of the fit could not be computed");
     }
-    Cost(cost, p, &r);  // restore the cache at the solution
   }
 
   // --- Uncertainty budget: implicit-function derivative dI/dq -------------------------------
@@ -694,19 +704,12 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
   // --- Amplitude of the fitted part -----------------------------------------------------------
   std::tie(result.amplitude_start_deg, result.amplitude_end_deg) =
       AmplitudeAtEnds(input.t_s, traj, guess.period_s);
-  {
-    double mean = 0.0, sq = 0.0;
-    for (double v : traj.rate_rad_per_s) mean += v;
-    mean /= static_cast<double>(n);
-    for (double v : traj.rate_rad_per_s) sq += (v - mean) * (v - mean);
-    result.signal_rms_rad_per_s = std::sqrt(sq / static_cast<double>(n));
-  }
+  result.signal_rms_rad_per_s = RmsAboutMean(traj.rate_rad_per_s);
 
   // --- Amplitude sweep: I against amplitude, and the rule for a rig that departs from the model --
   result.inertia_window_kg_m2 = result.params.inertia_kg_m2;
   if (options.amplitude_sweep) {
     result.sweep = RunAmplitudeSweep(input, options, p, scale, traj, guess.period_s);
-    Cost(cost, p, &r);  // the sweep used its own costs; keep this one's cache at the solution
   }
   const AmplitudeSweep& sweep = result.sweep;
   if (sweep.evaluated && sweep.std_scale > 1.0) {
@@ -716,9 +719,7 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
   if (sweep.trend_detected) {
     // The result comes from the lowest-amplitude band; the trend's bias left at that band's
     // amplitude, |c| A_low^2 I, is the model-inadequacy term (docs/method.md).
-    const AmplitudeSweepBand* low = nullptr;
-    for (const AmplitudeSweepBand& b : sweep.bands)
-      if (b.ok && (low == nullptr || b.amplitude_mean_deg < low->amplitude_mean_deg)) low = &b;
+    const AmplitudeSweepBand* low = &sweep.bands[sweep.low_band];
     result.params.inertia_kg_m2 = low->inertia_kg_m2;
     result.inertia_stat_std_kg_m2 = low->inertia_std_kg_m2 * sweep.std_scale;
     result.inertia_source = "low_amplitude_band";
@@ -773,8 +774,7 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
   if (sweep.trend_detected) {
     // The result comes from the low-amplitude band: judge that fit (the window fit of a rig far
     // from the model may not follow the data at large amplitude, which is what the sweep shows).
-    for (const AmplitudeSweepBand& b : sweep.bands)
-      if (b.ok && b.inertia_kg_m2 == result.params.inertia_kg_m2) residual_fraction = b.residual_fraction;
+    residual_fraction = sweep.bands[sweep.low_band].residual_fraction;
   }
   if (residual_fraction > options.reject_residual_fraction) {
     reject("fit_does_not_follow_data",

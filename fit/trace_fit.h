@@ -144,6 +144,7 @@ struct AmplitudeSweep {
   double trend_percent_per_10deg = 0.0;
   double inertia_zero_amplitude_kg_m2 = 0.0;  // I_0, the trend extrapolated to zero amplitude
   bool trend_detected = false;                // |z| > sweep_trend_z
+  int low_band = -1;  // index in `bands` of the fitted band with the lowest amplitude (-1: none)
   // Consistency of the bands with one constant I: chi^2 about their weighted mean, its degrees of
   // freedom, and the scale applied to the statistical std (sqrt(chi^2/dof) when chi^2 exceeds
   // its 95 % quantile, else 1): segments of the same swing that disagree beyond their stds show
