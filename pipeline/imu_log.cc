@@ -113,6 +113,15 @@ class LineReader {
   int line_number_ = 0;
 };
 
+// Non-blank lines the reader has not yet returned (consumes them): the rows after the end of the
+// time series, for the warning.
+int CountNonBlankLinesLeft(LineReader* reader) {
+  int count = 0;
+  std::string_view line;
+  while (reader->Next(&line)) count += IsBlank(line) ? 0 : 1;
+  return count;
+}
+
 std::string FormatNumber(double v) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%g", v);
@@ -313,8 +322,7 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
         // A blank line, then a non-numeric row: a footer. The time series ended at the blank.
         end_line = first_blank_line;
         end_reason = "a blank line, then a non-numeric row";
-        lines_after_end = bad_rows;
-        while (reader.Next(&line)) lines_after_end += IsBlank(line) ? 0 : 1;
+        lines_after_end = bad_rows + CountNonBlankLinesLeft(&reader);
         break;
       }
       continue;
@@ -330,9 +338,7 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
       end_reason = end_line == first_bad_line && bad_rows > 0
                        ? "a non-numeric row, then rows whose time does not continue it"
                        : "a blank line, then rows whose time does not continue it";
-      lines_after_end = 1;
-      while (reader.Next(&line)) lines_after_end += IsBlank(line) ? 0 : 1;
-      lines_after_end += bad_rows;
+      lines_after_end = 1 + bad_rows + CountNonBlankLinesLeft(&reader);
       break;
     }
     if (bad_rows > 0) Fail(first_bad);  // a bad cell with the time series going on after it
