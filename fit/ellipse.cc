@@ -402,11 +402,13 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
 
   PreparedData data;
   if (!PrepareData(points, options, &data, why)) return false;
-  ClosedFormFit closed;                                                 // (a)
+  // (a) the primary result, then (b) and (c) on paper Eq. 7 from the paper's start.
+  ClosedFormFit closed;
   if (!FitClosedForm(data, &closed, why)) return false;
   const Eq7Problem eq7 = MakeEq7Problem(data, closed);
-  const Eq7Fit nelder_mead = options.run_nelder_mead ? FitNelderMead(eq7) : Eq7Fit();  // (b)
-  const Eq7Fit ceres = options.run_ceres ? FitCeres(eq7) : Eq7Fit();                  // (c)
+  const Eq7Fit nelder_mead = options.run_nelder_mead ? FitNelderMead(eq7) : Eq7Fit();
+  const Eq7Fit ceres = options.run_ceres ? FitCeres(eq7) : Eq7Fit();
+  // Uncertainty and what the fit says about the data.
   const CovarianceEstimate cov = EstimateCovariance(data, closed, ceres, options);
   const Intervals intervals = ComputeIntervals(data, closed, cov, options);
   Diagnostics diagnostics = Diagnose(data, closed, cov, nelder_mead, ceres, options);

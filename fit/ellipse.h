@@ -14,7 +14,8 @@
 //   (b) paper Eq. 7 minimised with NLopt Nelder-Mead from the paper's start (the parity check
 //       with MATLAB fminsearch);
 //   (c) Ceres on Eq. 7 with ceres::Covariance.
-// Solver types stay inside fit/ellipse.cc; this header is plain C++ and Eigen-free.
+// FitEllipse runs the steps listed in fit/ellipse_steps.h (private to fit/, one file per idea);
+// solver types stay inside fit/ellipse_eq7.cc, and this header is plain C++ and Eigen-free.
 #pragma once
 
 #include <cstdint>

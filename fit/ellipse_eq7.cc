@@ -106,6 +106,7 @@ const char* NloptResultName(nlopt_result r) {
 nlopt_result RunNelderMead(const Eq7Problem& problem, double step_scale, double p[3],
                            double* cost, int* evaluations) {
   nlopt_opt opt = nlopt_create(NLOPT_LN_NELDERMEAD, 3);
+  // NLopt passes its data as void*; Eq7Cost only reads it.
   nlopt_set_min_objective(opt, Eq7Cost, const_cast<Eq7Problem*>(&problem));
   const double steps[3] = {std::max(1e-3, 0.05 * std::fabs(p[0])) * step_scale,
                            std::max(1e-3, 0.05 * std::fabs(p[1])) * step_scale,
@@ -167,7 +168,7 @@ Eq7Fit FitNelderMead(const Eq7Problem& problem) {
   s.method = "nelder_mead";
   s.ran = true;
   double p[3] = {problem.start[0], problem.start[1], problem.start[2]};
-  s.initial_cost = Eq7Cost(3, p, nullptr, const_cast<Eq7Problem*>(&problem));
+  s.initial_cost = Eq7Cost(3, p, nullptr, const_cast<Eq7Problem*>(&problem));  // read only
   nlopt_result status = NLOPT_FAILURE;
   double cost = s.initial_cost;
   // Nelder-Mead stalls on its shrinking simplex before full precision; restarting from its own

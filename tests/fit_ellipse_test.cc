@@ -1,6 +1,7 @@
 // Ellipse-of-inertia fit against known truth: exact data, noisy data, the paper's PRANDTL-D case
 // (Table 2), interval coverage, NACA three-axis estimates, planning and bad input.
 #include "fit/ellipse.h"
+#include "fit/ellipse_steps.h"
 
 #include <cmath>
 #include <random>
@@ -545,6 +546,57 @@ TEST(EllipseFit, PerfectCircleWithStdColumnHasNoTau) {
 // issue 9 item 9: a constant rig offset (std sigma_r) shared by every moment. Monte Carlo of
 // campaigns with that offset drawn once per campaign: the reported std of I_x and I_z must match
 // the scatter of the estimates (the offset included), and I_xz must be untouched by it.
+// The steps of FitEllipse one by one: above kCompressAbovePoints, fits (b) and (c) run on the
+// sufficient statistics of the least-squares cost. That must be the same problem as point by
+// point: same optimum, same cost, same (J^T J)^-1.
+TEST(EllipseSteps, CompressedEq7IsThePointByPointProblem) {
+  std::mt19937_64 rng(7);
+  const double kSigma = 0.005;  // kg m^2 per trial
+  std::vector<double> angles;
+  for (double a = -85; a <= 90; a += 5) angles.push_back(a);
+  const int trials = ellipse::kCompressAbovePoints / static_cast<int>(angles.size()) + 1;
+  const std::vector<EllipsePoint> points = Simulate(kPaper, angles, trials, kSigma, 0.0, &rng);
+  ASSERT_GT(static_cast<int>(points.size()), ellipse::kCompressAbovePoints);
+
+  EllipseOptions options;
+  ellipse::PreparedData data;
+  ellipse::ClosedFormFit closed;
+  std::string why;
+  ASSERT_TRUE(ellipse::PrepareData(points, options, &data, &why)) << why;
+  ASSERT_TRUE(ellipse::FitClosedForm(data, &closed, &why)) << why;
+  const ellipse::Eq7Problem compressed = ellipse::MakeEq7Problem(data, closed);
+  ASSERT_TRUE(compressed.compressed);
+  ellipse::Eq7Problem by_point = compressed;
+  by_point.compressed = false;
+
+  // Both forms reach the same optimum to the solver's precision: measured, Ceres to ~1e-16 of
+  // the moments, Nelder-Mead (derivative-free) to ~4e-11; costs and covariances agree to
+  // ~1e-14 relative. 1e-9 leaves 25x room over Nelder-Mead and still catches a difference in
+  // the problem itself (a dropped constant, weight or wrong factor of N moves them by > 1e-3).
+  constexpr double kRelTol = 1e-9;
+  const double scale = ellipse::MomentScale(closed);
+  for (auto fit : {ellipse::FitCeres, ellipse::FitNelderMead}) {
+    const ellipse::Eq7Fit a = fit(compressed), b = fit(by_point);
+    SCOPED_TRACE(a.summary.method);
+    ASSERT_TRUE(a.summary.converged && b.summary.converged);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_LT(std::fabs(a.abc(k) - b.abc(k)) / scale, kRelTol) << "coefficient " << k;
+      EXPECT_LT(std::fabs(a.abc(k) - closed.abc(k)) / scale, kRelTol) << "coefficient " << k;
+    }
+    EXPECT_NEAR(a.summary.initial_cost, b.summary.initial_cost,
+                kRelTol * b.summary.initial_cost);
+    EXPECT_NEAR(a.summary.final_cost, b.summary.final_cost, kRelTol * b.summary.final_cost);
+    EXPECT_NEAR(a.summary.final_cost, 0.5 * closed.chi2, kRelTol * closed.chi2);
+  }
+  const ellipse::Eq7Fit a = ellipse::FitCeres(compressed), b = ellipse::FitCeres(by_point);
+  ASSERT_TRUE(a.has_covariance && b.has_covariance);
+  const Eigen::Matrix3d cov_a = a.jac_abc * a.cov_eq7 * a.jac_abc.transpose();
+  const Eigen::Matrix3d cov_b = b.jac_abc * b.cov_eq7 * b.jac_abc.transpose();
+  // ... and both equal the closed form's (X^T W X)^-1 (Eq. 7 is the linear model reparametrised).
+  EXPECT_LT((cov_a - cov_b).norm() / cov_b.norm(), kRelTol);
+  EXPECT_LT((cov_a - closed.normal_inv).norm() / closed.normal_inv.norm(), kRelTol);
+}
+
 TEST(EllipseFit, CommonOffsetStdEntersIxIzNotIxzAgainstMonteCarlo) {
   constexpr double kTrialSigma = 0.004, kRigSigma = 0.01;
   constexpr int kCampaigns = 3000;
