@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <exception>
 #include <filesystem>
 
+#include "fit/glitch.h"
 #include "fit/swing_axis.h"
 #include "fit/trace_fit.h"
 #include "fit/trace_plot.h"
@@ -166,6 +168,39 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                         const TraceProcessOptions& options, TraceRecord record,
                         TraceFitResult* fit_out);
 
+// A user window that does not lie inside the log, said in the log's own terms (its span in
+// seconds, and the window read as ms or us when that would fit), before the swing axis or the
+// window code look inside it. Empty when the window is inside the log (up to half a mean sample
+// step, as ApplyWindowOverride allows).
+std::string WindowOutsideLog(const ImuData& data, const std::array<double, 2>& window_s,
+                             bool from_cli, TimeUnit time_unit) {
+  const std::vector<double>& t = data.t_s;
+  if (t.size() < 2) return "";
+  const double half_dt = 0.5 * (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+  auto inside = [&](double t0, double t1) {
+    return t0 >= t.front() - half_dt && t1 <= t.back() + half_dt;
+  };
+  if (inside(window_s[0], window_s[1])) return "";
+  const char* key = from_cli ? "--window" : "fit.windows";
+  char buf[512];
+  std::snprintf(buf, sizeof(buf), "window %g-%g s is outside the log (%g-%g s); %s takes seconds",
+                window_s[0], window_s[1], t.front(), t.back(), key);
+  std::string message = buf;
+  if (time_unit != TimeUnit::kSeconds) {
+    message += std::string(" (the file's time column is in ") + ToString(time_unit) +
+               ", converted to seconds)";
+  }
+  for (const auto& [factor, unit] : {std::make_pair(1e-3, "ms"), std::make_pair(1e-6, "us")}) {
+    const double t0 = window_s[0] * factor, t1 = window_s[1] * factor;
+    if (inside(t0, t1)) {
+      std::snprintf(buf, sizeof(buf), "; if these are %s, give %g:%g", unit, t0, t1);
+      message += buf;
+      break;
+    }
+  }
+  return message;
+}
+
 TraceRecord Process(const CampaignConfig& config, const std::string& path,
                     const TraceProcessOptions& options, TraceRecord record) {
   const std::string& name = record.file;
@@ -184,7 +219,7 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
   return ProcessData(config, path, data, options, std::move(record), nullptr);
 }
 
-TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, const ImuData& data,
+TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, const ImuData& raw,
                         const TraceProcessOptions& options, TraceRecord record,
                         TraceFitResult* fit_out) {
   const std::string& name = record.file;
@@ -194,11 +229,25 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
     return record;
   };
   std::string why;
-  record.warnings = data.warnings;
+  record.warnings = raw.warnings;
+
+  // 1b. Isolated glitch samples (fit/glitch.h) are dropped before anything looks at the data.
+  const std::vector<size_t> glitches = FindGyroGlitches(raw, GlitchOptions());
+  ImuData cleaned;
+  if (!glitches.empty()) {
+    record.warnings.push_back(DescribeGlitches(raw, glitches));
+    cleaned = WithoutSamples(raw, glitches);
+  }
+  const ImuData& data = glitches.empty() ? raw : cleaned;
 
   // 2. Swing axis (and the pitch, from the accelerometer at rest).
   const std::optional<std::array<double, 2>> override_s =
       options.window_s ? options.window_s : ConfigWindowFor(config, path);
+  if (override_s) {
+    const std::string outside = WindowOutsideLog(data, *override_s, options.window_s.has_value(),
+                                                 config.imu.format.time_unit);
+    if (!outside.empty()) return fail(TraceStatus::kError, name + ": " + outside);
+  }
   SwingAxisOptions axis_options;
   axis_options.mode = config.imu.swing_axis_auto ? SwingAxisMode::kAuto : SwingAxisMode::kFixed;
   axis_options.fixed_axis_in_imu = config.imu.swing_axis_in_imu;
