@@ -258,6 +258,7 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   if (!EstimateSwingAxis(data, axis_options, axis_window, &axis, &why)) {
     return fail(TraceStatus::kError, why);
   }
+  for (const std::string& w : axis.warnings) record.warnings.push_back(w);
 
   // 3. Free-oscillation window.
   WindowOptions window_options;
@@ -271,7 +272,7 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                 window.message);
   }
   // No rest seen: the accelerometer averaged over the window still gives the pitch.
-  if (!axis.pitch_measured_deg && data.has_accel() && !axis_window) {
+  if (!axis.pitch_measured_deg && data.has_accel() && !axis.accel_ignored && !axis_window) {
     SwingAxis again;
     if (EstimateSwingAxis(data, axis_options, std::make_pair(window.t0_s, window.t1_s), &again,
                           &why)) {
