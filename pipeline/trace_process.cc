@@ -333,8 +333,50 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                                              config.aircraft_mass_std_kg);
   fit_options.gravity_std_mps2 = config.uncertainties.gravity_std_mps2;
   fit_options.gyro_scale_std = config.imu.gyro_scale_std;
-  fit_options.keep_series = !options.figure_paths.empty() || fit_out != nullptr;
-  const TraceFitResult fit = FitTrace(input, fit_options);
+  // The residual series is kept for the second glitch pass below (and dropped after it when
+  // neither a figure nor the caller wants it).
+  const bool keep_series = !options.figure_paths.empty() || fit_out != nullptr;
+  fit_options.keep_series = true;
+  TraceFitResult fit = FitTrace(input, fit_options);
+  // 5b. Glitches too small for the raw-series test (below half the swing) but isolated and far
+  // outside the fit's residual noise: the same test on the residual series (fit/glitch.h), whose
+  // noise is the gyro's, not the swing's. Dropped, and the window fitted again.
+  if (fit.HasFit() && fit.residual_rad_per_s.size() == input.t_s.size()) {
+    const std::vector<size_t> more = FindGlitches(fit.t_s, fit.residual_rad_per_s, GlitchOptions());
+    if (!more.empty()) {
+      double largest = 0.0;
+      for (size_t k : more) largest = std::max(largest, std::abs(fit.residual_rad_per_s[k]));
+      char text[160];
+      std::snprintf(text, sizeof(text), "%zu glitch sample%s ignored (isolated readings off the "
+                    "fit by up to %.3g rad/s) at t =", more.size(), more.size() == 1 ? "" : "s",
+                    largest);
+      std::string warning = text;
+      for (size_t i = 0; i < more.size() && i < 5; ++i) {
+        std::snprintf(text, sizeof(text), "%s %.6g", i ? "," : "", input.t_s[more[i]]);
+        warning += text;
+      }
+      record.warnings.push_back(warning + (more.size() > 5 ? ", ... s" : " s"));
+      std::vector<double> t, rate;
+      size_t next = 0;
+      for (size_t k = 0; k < input.t_s.size(); ++k) {
+        if (next < more.size() && more[next] == k) {
+          ++next;
+          continue;
+        }
+        t.push_back(input.t_s[k]);
+        rate.push_back(input.rate_rad_per_s[k]);
+      }
+      input.t_s = std::move(t);
+      input.rate_rad_per_s = std::move(rate);
+      fit = FitTrace(input, fit_options);
+    }
+  }
+  if (!keep_series) {
+    fit.t_s.clear();
+    fit.measured_rate_rad_per_s.clear();
+    fit.fitted_rate_rad_per_s.clear();
+    fit.residual_rad_per_s.clear();
+  }
 
   record.status = fit.status == TraceFitStatus::kOk         ? TraceStatus::kOk
                   : fit.status == TraceFitStatus::kRejected ? TraceStatus::kRejected
