@@ -67,6 +67,24 @@ std::vector<char> RestMask(const ImuData& data, const Eigen::Vector3d& bias, dou
   return rest;
 }
 
+// Principal direction (unit, sign arbitrary) of the gyro signal over [begin, end); nullopt when
+// the signal is constant there (up to the rounding of its mean).
+std::optional<Eigen::Vector3d> GyroPrincipalDirection(const ImuData& data, size_t begin, size_t end) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (size_t i = begin; i < end; ++i) mean += data.gyro_in_imu[i];
+  const double count = static_cast<double>(std::max<size_t>(1, end - begin));
+  mean /= count;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (size_t i = begin; i < end; ++i) {
+    const Eigen::Vector3d d = data.gyro_in_imu[i] - mean;
+    cov += d * d.transpose();
+  }
+  const double tiny = count * std::pow(1e-12 * (1.0 + mean.norm()), 2);  // rounding of the mean
+  if (!(cov.trace() > tiny) || !cov.allFinite()) return std::nullopt;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+  return Eigen::Vector3d(solver.eigenvectors().col(2).normalized());
+}
+
 Eigen::Vector3d BodySignedAxis(Eigen::Vector3d axis, const Eigen::Matrix3d& imu_to_body) {
   const Eigen::Vector3d body = imu_to_body * axis;
   const double key = std::abs(body.z()) > 1e-3 ? body.z() : -body.x();
@@ -104,6 +122,10 @@ bool SwingAxisOptions::Check(std::string* why) const {
   }
   if (min_rest_samples < 1) {
     *why = "swing axis: min_rest_samples must be >= 1";
+    return false;
+  }
+  if (!(gravity_removed_below_g >= 0.0 && gravity_removed_below_g < 1.0 - gravity_tolerance)) {
+    *why = "swing axis: gravity_removed_below_g must be in [0, 1 - gravity_tolerance)";
     return false;
   }
   if (!(gravity_tolerance > 0.0 && gravity_tolerance < 1.0)) {
@@ -209,18 +231,42 @@ bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
     if (count > 0) {
       const Eigen::Vector3d f_mean = f_sum / count;
       axis->rest_accel_mps2 = f_mean.norm();
-      if (!f_mean.allFinite() ||
+      // Gravity removed by the logger (f + g n_est): the residual g (n_est - n) of its tilt
+      // estimate is small and nearly perpendicular to the down vertical n (|n| = |n_est| = 1),
+      // which is the swing axis, while gravity in a wrong unit (g read as m/s^2, also ~0.1 g)
+      // lies along it. So: below gravity_removed_below_g and more than 60 deg from the gyro's
+      // principal direction -> continue gyro-only with a warning.
+      const double g_read = f_mean.norm() / kStandardGravityMps2;  // in standard gravities
+      bool gravity_removed = false;
+      if (f_mean.allFinite() && g_read < options.gravity_removed_below_g && g_read > 0.0) {
+        const std::optional<Eigen::Vector3d> principal =
+            GyroPrincipalDirection(data, range.first, range.second);
+        gravity_removed = principal && std::abs(principal->dot(f_mean.normalized())) < 0.5;
+      }
+      if (gravity_removed) {
+        char buf[512];
+        std::snprintf(buf, sizeof(buf),
+                      "the accelerometer reads %.3g g (%.3g m/s^2) %s instead of 1 g: gravity "
+                      "removed by the logger? The accelerometer is ignored (swing axis from the "
+                      "gyro, no measured pitch); set imu.accel: null to say so",
+                      g_read, f_mean.norm(), down_at_rest ? "at rest" : "over the swing");
+        axis->warnings.push_back(buf);
+        axis->accel_ignored = true;
+        axis->rest_samples = 0;
+        count = 0;
+      } else if (!f_mean.allFinite() ||
           std::abs(f_mean.norm() - kStandardGravityMps2) > options.gravity_tolerance * kStandardGravityMps2) {
         char buf[512];
         std::snprintf(buf, sizeof(buf),
                       "swing axis: the mean accelerometer reading %s is %.4g m/s^2, not gravity "
-                      "(9.81 +- %.0f %%): check the accelerometer unit (m/s^2 or g) and columns",
+                      "(9.81 +- %.0f %%): check the accelerometer unit (m/s^2 or g) and columns, "
+                      "or set imu.accel: null to fit gyro-only",
                       down_at_rest ? "at rest" : "over the window", f_mean.norm(),
                       100.0 * options.gravity_tolerance);
         *why = buf;
         return false;
       }
-      down_in_imu = Eigen::Vector3d(-f_mean / f_mean.norm());
+      if (!axis->accel_ignored) down_in_imu = Eigen::Vector3d(-f_mean / f_mean.norm());
     }
   }
   // The pitch is reported from rest, or from the window's turning points; a whole-log average
@@ -239,23 +285,14 @@ bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
     axis->source = down_at_rest ? SwingAxisSource::kAccelAtRest : SwingAxisSource::kAccelOverWindow;
   } else {
     // Principal direction of the gyro signal over the window (or the whole log).
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (size_t i = range.first; i < range.second; ++i) mean += data.gyro_in_imu[i];
-    const double count = static_cast<double>(std::max<size_t>(1, range.second - range.first));
-    mean /= count;
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (size_t i = range.first; i < range.second; ++i) {
-      const Eigen::Vector3d d = data.gyro_in_imu[i] - mean;
-      cov += d * d.transpose();
-    }
-    const double tiny = count * std::pow(1e-12 * (1.0 + mean.norm()), 2);  // rounding of the mean
-    if (!(cov.trace() > tiny) || !cov.allFinite()) {
+    const std::optional<Eigen::Vector3d> principal =
+        GyroPrincipalDirection(data, range.first, range.second);
+    if (!principal) {
       *why = "swing axis: the gyro signal is constant over " +
              std::string(window_s ? "the window" : "the log") + ", so it shows no swing axis";
       return false;
     }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
-    axis->axis_in_imu = BodySignedAxis(solver.eigenvectors().col(2).normalized(), options.imu_to_body);
+    axis->axis_in_imu = BodySignedAxis(*principal, options.imu_to_body);
     axis->source = SwingAxisSource::kGyroPrincipal;
   }
   axis->axis_in_body = options.imu_to_body * axis->axis_in_imu;

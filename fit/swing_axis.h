@@ -54,6 +54,14 @@ struct SwingAxisOptions {
   // |f| at rest must be within this fraction of standard gravity for the accelerometer to be
   // trusted (units or a broken sensor). Default 0.1.
   double gravity_tolerance = 0.1;
+  // A mean reading below this many standard gravities, pointing more than 60 deg away from the
+  // gyro's principal direction (the swing axis), is an accelerometer with gravity removed by the
+  // logger's firmware: what is left is the residual g (n_est - n) of its tilt estimate (real
+  // logs read 0.07-0.27 g), nearly perpendicular to the down vertical n. The accelerometer is
+  // then ignored (gyro-only, as with imu.accel: null) with a warning in SwingAxis::warnings. A
+  // small reading along the swing axis is gravity in a wrong unit (g read as m/s^2) and stays an
+  // error. In [0, 1 - gravity_tolerance); 0 turns the detection off. Default 0.5.
+  double gravity_removed_below_g = 0.5;
 
   bool Check(std::string* why) const;
 };
@@ -70,12 +78,17 @@ struct SwingAxis {
   int rest_samples = 0;          // samples used for the accelerometer down vector (0: none)
   double rest_accel_mps2 = 0.0;  // |mean f| over them (should be ~9.8)
   std::vector<std::string> notes;  // fallbacks taken (no rest -> window, ...)
+  // The accelerometer read far below 1 g (gravity removed) and was ignored: no pitch, the axis
+  // from the gyro. The sentence for the user is in `warnings`.
+  bool accel_ignored = false;
+  std::vector<std::string> warnings;  // for the trace's record
 };
 
 // Estimates the swing axis and the swing rate. The optional window [t0, t1] (s) is used by kAuto
 // when the log shows no rest (accelerometer averaged over the window) and for the gyro principal
 // direction (default: the whole log). Returns false with *why on invalid options, an empty log, a
-// zero fixed axis or an accelerometer whose magnitude is not gravity.
+// zero fixed axis or an accelerometer whose magnitude is neither gravity nor near zero (a
+// reading below gravity_removed_below_g is ignored with a warning, see SwingAxisOptions).
 bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
                        std::optional<std::pair<double, double>> window_s, SwingAxis* axis,
                        std::string* why);

@@ -309,6 +309,20 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
                                std::to_string(column[k] + 1) + ": column '" + names[k] +
                                "' holds '" + Printable(Trim(cell)) +
                                "'; NaN and infinite values are not allowed";
+        } else if (k != kTime && !non_finite) {
+          // A reading no sensor gives (imu_log.h): an error like NaN, if the row is data.
+          const bool gyro = k <= 3;
+          const double bound = gyro ? kMaxGyroRateRadPerS : kMaxAccelMps2;
+          if (std::abs(row[k] * scale[k]) > bound) {
+            non_finite = true;
+            non_finite_message = name + ":" + std::to_string(reader.line_number()) + ":" +
+                                 std::to_string(column[k] + 1) + ": column '" + names[k] +
+                                 "' holds '" + Printable(Trim(cell)) + "' = " +
+                                 FormatNumber(row[k] * scale[k]) +
+                                 (gyro ? " rad/s, beyond any gyro (|rate| <= 1e4 rad/s)"
+                                       : " m/s^2, beyond any accelerometer (|f| <= 1e5 m/s^2)") +
+                                 ": a corrupt value, or the wrong unit or column";
+          }
         }
       }
     }
@@ -349,7 +363,11 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
   }
   const size_t rows = row_line.size();
   if (rows == 0) {
-    if (bad_rows > 0) Fail(first_bad);
+    if (bad_rows > 0) {
+      Fail(name + ": no numeric data rows after the header (line " + std::to_string(header_line) +
+           "): " + std::to_string(bad_rows) + " row(s), none of them numbers (a footer only, or "
+           "the wrong columns?); the first: " + first_bad);
+    }
     Fail(name + ":" + std::to_string(header_line) + ": header only, no data rows");
   }
   if (end_line > 0) {

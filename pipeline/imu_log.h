@@ -15,7 +15,9 @@
 //     with a warning;
 //   - a non-numeric cell followed by rows that continue the time series is an error
 //     (file:line:column);
-//   - NaN or inf anywhere is an error;
+//   - NaN or inf anywhere is an error, and so is a value no sensor reads: a gyro rate beyond
+//     kMaxGyroRateRadPerS or a specific force beyond kMaxAccelMps2 (a corrupt cell or a wrong
+//     unit), naming the line and column;
 //   - timestamps that do not increase (duplicates, a packet out of order, a glitch) are repaired
 //     by dropping the offending sample, with a warning; more than
 //     ImuLogOptions::max_dropped_fraction of the samples dropped is an error;
@@ -31,6 +33,13 @@
 #include "pipeline/imu_format.h"
 
 namespace bifilar {
+
+// Physical bounds of a reading (SI, after the unit conversion). 1e4 rad/s is 95 000 rpm, 150x
+// the range of the widest MEMS gyros (+-4000 deg/s); 1e5 m/s^2 is ~10 000 g, 25x the widest
+// accelerometers (+-400 g). Beyond them the cell is corrupt or the unit wrong (deg/s read as
+// rad/s stays below 1e4 for any real swing).
+constexpr double kMaxGyroRateRadPerS = 1e4;
+constexpr double kMaxAccelMps2 = 1e5;
 
 struct ImuLogOptions {
   // Largest fraction of the data rows that may be dropped because their timestamp does not

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <exception>
 #include <filesystem>
 
+#include "fit/glitch.h"
 #include "fit/swing_axis.h"
 #include "fit/trace_fit.h"
 #include "fit/trace_plot.h"
@@ -166,6 +168,39 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                         const TraceProcessOptions& options, TraceRecord record,
                         TraceFitResult* fit_out);
 
+// A user window that does not lie inside the log, said in the log's own terms (its span in
+// seconds, and the window read as ms or us when that would fit), before the swing axis or the
+// window code look inside it. Empty when the window is inside the log (up to half a mean sample
+// step, as ApplyWindowOverride allows).
+std::string WindowOutsideLog(const ImuData& data, const std::array<double, 2>& window_s,
+                             bool from_cli, TimeUnit time_unit) {
+  const std::vector<double>& t = data.t_s;
+  if (t.size() < 2) return "";
+  const double half_dt = 0.5 * (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+  auto inside = [&](double t0, double t1) {
+    return t0 >= t.front() - half_dt && t1 <= t.back() + half_dt;
+  };
+  if (inside(window_s[0], window_s[1])) return "";
+  const char* key = from_cli ? "--window" : "fit.windows";
+  char buf[512];
+  std::snprintf(buf, sizeof(buf), "window %g-%g s is outside the log (%g-%g s); %s takes seconds",
+                window_s[0], window_s[1], t.front(), t.back(), key);
+  std::string message = buf;
+  if (time_unit != TimeUnit::kSeconds) {
+    message += std::string(" (the file's time column is in ") + ToString(time_unit) +
+               ", converted to seconds)";
+  }
+  for (const auto& [factor, unit] : {std::make_pair(1e-3, "ms"), std::make_pair(1e-6, "us")}) {
+    const double t0 = window_s[0] * factor, t1 = window_s[1] * factor;
+    if (inside(t0, t1)) {
+      std::snprintf(buf, sizeof(buf), "; if these are %s, give %g:%g", unit, t0, t1);
+      message += buf;
+      break;
+    }
+  }
+  return message;
+}
+
 TraceRecord Process(const CampaignConfig& config, const std::string& path,
                     const TraceProcessOptions& options, TraceRecord record) {
   const std::string& name = record.file;
@@ -184,7 +219,7 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
   return ProcessData(config, path, data, options, std::move(record), nullptr);
 }
 
-TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, const ImuData& data,
+TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, const ImuData& raw,
                         const TraceProcessOptions& options, TraceRecord record,
                         TraceFitResult* fit_out) {
   const std::string& name = record.file;
@@ -194,11 +229,25 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
     return record;
   };
   std::string why;
-  record.warnings = data.warnings;
+  record.warnings = raw.warnings;
+
+  // 1b. Isolated glitch samples (fit/glitch.h) are dropped before anything looks at the data.
+  const std::vector<size_t> glitches = FindGyroGlitches(raw, GlitchOptions());
+  ImuData cleaned;
+  if (!glitches.empty()) {
+    record.warnings.push_back(DescribeGlitches(raw, glitches));
+    cleaned = WithoutSamples(raw, glitches);
+  }
+  const ImuData& data = glitches.empty() ? raw : cleaned;
 
   // 2. Swing axis (and the pitch, from the accelerometer at rest).
   const std::optional<std::array<double, 2>> override_s =
       options.window_s ? options.window_s : ConfigWindowFor(config, path);
+  if (override_s) {
+    const std::string outside = WindowOutsideLog(data, *override_s, options.window_s.has_value(),
+                                                 config.imu.format.time_unit);
+    if (!outside.empty()) return fail(TraceStatus::kError, name + ": " + outside);
+  }
   SwingAxisOptions axis_options;
   axis_options.mode = config.imu.swing_axis_auto ? SwingAxisMode::kAuto : SwingAxisMode::kFixed;
   axis_options.fixed_axis_in_imu = config.imu.swing_axis_in_imu;
@@ -209,6 +258,7 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   if (!EstimateSwingAxis(data, axis_options, axis_window, &axis, &why)) {
     return fail(TraceStatus::kError, why);
   }
+  for (const std::string& w : axis.warnings) record.warnings.push_back(w);
 
   // 3. Free-oscillation window.
   WindowOptions window_options;
@@ -222,7 +272,7 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                 window.message);
   }
   // No rest seen: the accelerometer averaged over the window still gives the pitch.
-  if (!axis.pitch_measured_deg && data.has_accel() && !axis_window) {
+  if (!axis.pitch_measured_deg && data.has_accel() && !axis.accel_ignored && !axis_window) {
     SwingAxis again;
     if (EstimateSwingAxis(data, axis_options, std::make_pair(window.t0_s, window.t1_s), &again,
                           &why)) {
@@ -283,8 +333,50 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                                              config.aircraft_mass_std_kg);
   fit_options.gravity_std_mps2 = config.uncertainties.gravity_std_mps2;
   fit_options.gyro_scale_std = config.imu.gyro_scale_std;
-  fit_options.keep_series = !options.figure_paths.empty() || fit_out != nullptr;
-  const TraceFitResult fit = FitTrace(input, fit_options);
+  // The residual series is kept for the second glitch pass below (and dropped after it when
+  // neither a figure nor the caller wants it).
+  const bool keep_series = !options.figure_paths.empty() || fit_out != nullptr;
+  fit_options.keep_series = true;
+  TraceFitResult fit = FitTrace(input, fit_options);
+  // 5b. Glitches too small for the raw-series test (below half the swing) but isolated and far
+  // outside the fit's residual noise: the same test on the residual series (fit/glitch.h), whose
+  // noise is the gyro's, not the swing's. Dropped, and the window fitted again.
+  if (fit.HasFit() && fit.residual_rad_per_s.size() == input.t_s.size()) {
+    const std::vector<size_t> more = FindGlitches(fit.t_s, fit.residual_rad_per_s, GlitchOptions());
+    if (!more.empty()) {
+      double largest = 0.0;
+      for (size_t k : more) largest = std::max(largest, std::abs(fit.residual_rad_per_s[k]));
+      char text[160];
+      std::snprintf(text, sizeof(text), "%zu glitch sample%s ignored (isolated readings off the "
+                    "fit by up to %.3g rad/s) at t =", more.size(), more.size() == 1 ? "" : "s",
+                    largest);
+      std::string warning = text;
+      for (size_t i = 0; i < more.size() && i < 5; ++i) {
+        std::snprintf(text, sizeof(text), "%s %.6g", i ? "," : "", input.t_s[more[i]]);
+        warning += text;
+      }
+      record.warnings.push_back(warning + (more.size() > 5 ? ", ... s" : " s"));
+      std::vector<double> t, rate;
+      size_t next = 0;
+      for (size_t k = 0; k < input.t_s.size(); ++k) {
+        if (next < more.size() && more[next] == k) {
+          ++next;
+          continue;
+        }
+        t.push_back(input.t_s[k]);
+        rate.push_back(input.rate_rad_per_s[k]);
+      }
+      input.t_s = std::move(t);
+      input.rate_rad_per_s = std::move(rate);
+      fit = FitTrace(input, fit_options);
+    }
+  }
+  if (!keep_series) {
+    fit.t_s.clear();
+    fit.measured_rate_rad_per_s.clear();
+    fit.fitted_rate_rad_per_s.clear();
+    fit.residual_rad_per_s.clear();
+  }
 
   record.status = fit.status == TraceFitStatus::kOk         ? TraceStatus::kOk
                   : fit.status == TraceFitStatus::kRejected ? TraceStatus::kRejected

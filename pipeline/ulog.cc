@@ -566,6 +566,15 @@ ImuData ReadUlogImu(std::string_view bytes, const std::string& name, const ImuFo
                         " = " + (std::isnan(v[k]) ? "nan" : "inf") +
                         "; NaN and infinite values are not allowed");
       }
+      if (k > 0 && std::abs(v[k]) > (k <= 3 ? kMaxGyroRateRadPerS : kMaxAccelMps2)) {
+        char value[32];
+        std::snprintf(value, sizeof(value), "%g", v[k]);
+        throw UserError(name + ": byte " + std::to_string(log.value_offsets[r]) + ": sample " +
+                        std::to_string(r + 1) + " of the " + what + " has " + request.fields[k] +
+                        " = " + value +
+                        (k <= 3 ? " rad/s, beyond any gyro (|rate| <= 1e4 rad/s)"
+                                : " m/s^2, beyond any accelerometer (|f| <= 1e5 m/s^2)"));
+      }
     }
     v[0] *= time_scale;
     row_number[r] = static_cast<int>(std::min<size_t>(r + 1, 2147483647));

@@ -171,6 +171,43 @@ TEST(SwingAxis, Rejects) {
   EXPECT_FALSE(EstimateSwingAxis(ImuData(), SwingAxisOptions(), std::nullopt, &axis, &why));
 }
 
+// A logger that removes gravity leaves g (n_est - n): ~0.1-0.3 g, nearly perpendicular to the
+// down vertical (the swing axis). It is ignored with a warning, the axis comes from the gyro; the
+// same small reading along the swing axis (g read as m/s^2) stays an error (test above).
+TEST(SwingAxis, GravityRemovedAccelerometerIsIgnoredWithAWarning) {
+  const Eigen::Matrix3d mount = MountingFromRollPitchYawDeg(0, 0, 30);
+  Synthetic s = MakeSynthetic(15.0, mount, true, 21);
+  const Eigen::Vector3d across = s.down_in_imu.unitOrthogonal();
+  for (double tilt_deg : {4.0, 15.0}) {
+    // Residual of a tilt error of tilt_deg about `across x n`: 2 g sin(tilt/2), at 90 - tilt/2
+    // deg from n.
+    const Eigen::Vector3d n_est =
+        Eigen::AngleAxisd(tilt_deg * kDeg, across.cross(s.down_in_imu).normalized()) * s.down_in_imu;
+    ImuData removed = s.data;
+    for (auto& f : removed.accel_in_imu) f += kG * n_est;  // f + g n_est: gravity removed
+    SwingAxis axis;
+    std::string why;
+    ASSERT_TRUE(EstimateSwingAxis(removed, SwingAxisOptions(), std::nullopt, &axis, &why)) << why;
+    EXPECT_TRUE(axis.accel_ignored);
+    EXPECT_EQ(axis.source, SwingAxisSource::kGyroPrincipal);
+    EXPECT_FALSE(axis.pitch_measured_deg.has_value());
+    ASSERT_EQ(axis.warnings.size(), 1u);
+    EXPECT_NE(axis.warnings[0].find("gravity removed"), std::string::npos) << axis.warnings[0];
+    EXPECT_NE(axis.warnings[0].find("imu.accel: null"), std::string::npos) << axis.warnings[0];
+    // The axis is the swing's, within the rocking's pull on the principal direction (~0.5 deg).
+    EXPECT_LT(std::min(AngleDeg(axis.axis_in_imu, s.down_in_imu), AngleDeg(-axis.axis_in_imu, s.down_in_imu)), 1.0);
+  }
+  // With detection off (0), the old error.
+  SwingAxisOptions off;
+  off.gravity_removed_below_g = 0.0;
+  ImuData removed = s.data;
+  for (auto& f : removed.accel_in_imu) f += kG * (s.down_in_imu + 0.2 * s.down_in_imu.unitOrthogonal()).normalized();
+  SwingAxis axis;
+  std::string why;
+  EXPECT_FALSE(EstimateSwingAxis(removed, off, std::nullopt, &axis, &why));
+  EXPECT_NE(why.find("imu.accel: null"), std::string::npos) << why;
+}
+
 TEST(SwingAxis, SecondaryMotionRatio) {
   // Exact: gyro = w(t) n + eps w(t) m + constant bias, m orthogonal to n -> ratio eps.
   ImuData d;
