@@ -80,7 +80,8 @@ bool WriteAmplitudeSweepFigure(const AmplitudeSweep& sweep, double inertia_kg_m2
     for (int j = 0; j <= 60; ++j) {
       const double a = x_lo + (x_hi - x_lo) * j / 60.0;
       tx.push_back(a);
-      ty.push_back(sweep.inertia_zero_amplitude_kg_m2 * (1.0 + sweep.trend_coeff_per_deg2 * a * a) * k);
+      const double relative = 1.0 + sweep.trend_coeff_per_deg2 * a * a;
+      ty.push_back(sweep.inertia_zero_amplitude_kg_m2 * relative * k);
     }
   }
   const double y_ref = inertia_kg_m2 * k, y_ref_std = inertia_std_kg_m2 * k;
@@ -130,7 +131,8 @@ bool WriteAmplitudeSweepFigure(const AmplitudeSweep& sweep, double inertia_kg_m2
     // The reported I and its band.
     {
       const PLFLT fx[4] = {x_lo, x_hi, x_hi, x_lo};
-      const PLFLT fy[4] = {y_ref - y_ref_std, y_ref - y_ref_std, y_ref + y_ref_std, y_ref + y_ref_std};
+      const double lo = y_ref - y_ref_std, hi = y_ref + y_ref_std;
+      const PLFLT fy[4] = {lo, lo, hi, hi};
       plcol0(kBandFill);
       plfill(4, fx, fy);
       const PLFLT lx[2] = {x_lo, x_hi}, ly[2] = {y_ref, y_ref};

@@ -119,17 +119,18 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
 // or a note saying why there is none: a trace without a sweep gets no figure and no link.
 std::string SweepFigure(const json& t, const std::string& out_dir, int* counter) {
   const std::string name = Str(t, "sweep_figure"), file = Escape(Str(t, "file"));
+  const json sweep = t.contains("amplitude_sweep") ? t["amplitude_sweep"] : json::object();
   if (name.empty()) {
-    const std::string note = t.contains("amplitude_sweep") ? Str(t["amplitude_sweep"], "note") : "";
+    const std::string note = Str(sweep, "note");
     return "<figure><p class=\"note\">" + file + ": no amplitude sweep" +
            (note.empty() ? std::string() : " (" + Escape(note) + ")") + ".</p></figure>\n";
   }
   // The compact figure has no legend: the caption is its legend.
-  const json sweep = t.contains("amplitude_sweep") ? t["amplitude_sweep"] : json::object();
   const bool trend = sweep.is_object() && sweep.value("trend_detected", false);
-  return "<figure>" + Figure(out_dir, name, "I against amplitude, " + Str(t, "file"), "sweep", counter) +
-         "<figcaption>" + file + " &middot; I against amplitude, flat for the ideal model: each band "
-         "&plusmn; 1&sigma; over its amplitude range; blue, the result &plusmn; 1&sigma;" +
+  const std::string alt = "I against amplitude, " + Str(t, "file");
+  return "<figure>" + Figure(out_dir, name, alt, "sweep", counter) + "<figcaption>" + file +
+         " &middot; I against amplitude, flat for the ideal model: each band &plusmn; 1&sigma; "
+         "over its amplitude range; blue, the result &plusmn; 1&sigma;" +
          (trend ? "; red, the trend I<sub>0</sub>(1 + c A<sup>2</sup>) and a ring on the band the "
                   "result is taken from"
                 : "") +

@@ -357,7 +357,8 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
     SweepPlotOptions sweep_options;
     sweep_options.title = name;
     sweep_options.unit_scale = InertiaToDisplay(1.0, config.units);
-    sweep_options.unit_label = config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+    sweep_options.unit_label =
+        config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
     sweep_options.figure.width_px = options.figure_width_px;
     sweep_options.figure.height_px = options.figure_height_px;
     sweep_options.compact = options.compact_figure;  // the report explains it in the caption

@@ -1,8 +1,8 @@
 // One IMU log file -> one trace record: read the CSV, find the swing axis and the measured pitch,
 // the free-oscillation window and the amplitude band, fit the pendulum model, draw the
-// fit-and-residual figure and I against amplitude (fit/sweep_plot.h). Used by `bifilar process` (for every log of a campaign, from worker
-// threads) and by `bifilar fit`. Any failure of one file becomes status `error` with a message
-// naming the file; nothing throws out of ProcessTrace.
+// fit-and-residual figure and I against amplitude (fit/sweep_plot.h). Used by `bifilar process`
+// (for every log of a campaign, from worker threads) and by `bifilar fit`. Any failure of one
+// file becomes status `error` with a message naming the file; nothing throws out of ProcessTrace.
 // Conventions: docs/physics.md §2 (psi, I total = rig + aircraft), §3 (pitch).
 #pragma once
 

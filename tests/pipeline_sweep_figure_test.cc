@@ -89,7 +89,9 @@ TEST(SweepFigure, NoneForATraceTooShortForASweep) {
   EXPECT_FALSE(fs::exists(dir + "/short_sweep.svg"));  // no sweep figure
   const nlohmann::json j = TraceRecordToJson(r, false);
   EXPECT_FALSE(Contains(j["figures"], dir + "/short_sweep.svg"));
-  for (const std::string& w : r.warnings) EXPECT_EQ(w.find("could not be written"), std::string::npos) << w;
+  for (const std::string& w : r.warnings) {
+    EXPECT_EQ(w.find("could not be written"), std::string::npos) << w;
+  }
   fs::remove_all(dir);
 }
 
