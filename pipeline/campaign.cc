@@ -628,9 +628,13 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
       ++result.summary.n_cache_refused;
       if (options.progress) *options.progress << "warning: " << cache_problem << "; refitting\n";
     }
+    // Reused only with its figures: a record with a sweep and no sweep figure (an older run's)
+    // is refitted, so the report shows I against amplitude for every trace that has a sweep.
     if (loaded &&
-        (!options.figures || cached.figure.empty() ||
-         fs::exists(out / "figures" / cached.figure, ec))) {
+        (!options.figures ||
+         ((cached.figure.empty() || fs::exists(out / "figures" / cached.figure, ec)) &&
+          (cached.sweep_figure.empty() ? !cached.sweep.evaluated
+                                       : fs::exists(out / "figures" / cached.sweep_figure, ec))))) {
       cached.role = record.role;
       cached.pitch_nominal_deg = record.pitch_nominal_deg;
       cached.content_hash = record.content_hash;
@@ -649,6 +653,7 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   for (int i : to_fit) {
     planned.push_back("cache/" + result.traces[i].cache_key + ".json");
     planned.push_back("figures/" + result.traces[i].cache_key + ".svg");
+    planned.push_back("figures/" + result.traces[i].cache_key + "_sweep.svg");
   }
   manifest.Record(planned);
   std::mutex progress_mutex;
@@ -668,7 +673,10 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     trace_options.window_s = windows[i];
     const std::string figure_name = record.cache_key + ".svg";
     const std::string figure_path = (out / "figures" / figure_name).string();
+    const std::string sweep_name = record.cache_key + "_sweep.svg";
+    const std::string sweep_path = (out / "figures" / sweep_name).string();
     if (options.figures) trace_options.figure_paths = {figure_path};
+    if (options.figures) trace_options.sweep_figure_paths = {sweep_path};
     trace_options.compact_figure = true;
     trace_options.figure_width_px = 640;
     trace_options.figure_height_px = 400;
@@ -685,6 +693,7 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
     }
     std::error_code ec2;
     fitted.figure = options.figures && fs::exists(figure_path, ec2) ? figure_name : "";
+    fitted.sweep_figure = options.figures && fs::exists(sweep_path, ec2) ? sweep_name : "";
     fitted.file = record.file;
     fitted.role = record.role;
     fitted.pitch_nominal_deg = record.pitch_nominal_deg;
@@ -824,6 +833,7 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   for (const TraceRecord& r : result.traces) {
     if (!r.cache_key.empty()) keep.insert("cache/" + r.cache_key + ".json");
     if (!r.figure.empty()) keep.insert("figures/" + r.figure);
+    if (!r.sweep_figure.empty()) keep.insert("figures/" + r.sweep_figure);
   }
   if (!result.moments_figure.empty()) keep.insert("figures/" + result.moments_figure);
   if (!result.polar_figure.empty()) keep.insert("figures/" + result.polar_figure);

@@ -96,7 +96,9 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
   sub->add_option("--max-amplitude", args->max_amplitude_deg,
                   "upper end of the amplitude band (deg)")
       ->check(CLI::Range(kMinMaxAmplitudeDeg, kMaxMaxAmplitudeDeg));  // as fit.max_amplitude_deg
-  sub->add_option("--plot", args->plot_dir, "write fit figures DIR/<log>.svg and .png");
+  sub->add_option("--plot", args->plot_dir,
+                  "write fit figures DIR/<log>.svg and .png, and the amplitude sweep (I against "
+                  "amplitude) DIR/<log>_sweep.svg and .png when the trace has one");
   sub->callback([args, exit_code] {
     ConfigLoadOptions load;
     load.require_runs = false;
@@ -131,6 +133,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       if (!args->plot_dir.empty()) {
         const std::string base = (std::filesystem::path(args->plot_dir) / FigureStem(log)).string();
         trace.figure_paths = {base + ".svg", base + ".png"};
+        trace.sweep_figure_paths = {base + "_sweep.svg", base + "_sweep.png"};
       }
       const TraceRecord record = ProcessTrace(config, log, trace);
       if (!record.ok()) ++failed;

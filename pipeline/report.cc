@@ -115,6 +115,28 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
          Base64(bytes) + "\">";
 }
 
+// The amplitude-sweep figure beside trace `t`'s fit figure (I against amplitude, fit/sweep_plot.h),
+// or a note saying why there is none: a trace without a sweep gets no figure and no link.
+std::string SweepFigure(const json& t, const std::string& out_dir, int* counter) {
+  const std::string name = Str(t, "sweep_figure"), file = Escape(Str(t, "file"));
+  const json sweep = t.contains("amplitude_sweep") ? t["amplitude_sweep"] : json::object();
+  if (name.empty()) {
+    const std::string note = Str(sweep, "note");
+    return "<figure><p class=\"note\">" + file + ": no amplitude sweep" +
+           (note.empty() ? std::string() : " (" + Escape(note) + ")") + ".</p></figure>\n";
+  }
+  // The compact figure has no legend: the caption is its legend.
+  const bool trend = sweep.is_object() && sweep.value("trend_detected", false);
+  const std::string alt = "I against amplitude, " + Str(t, "file");
+  return "<figure>" + Figure(out_dir, name, alt, "sweep", counter) + "<figcaption>" + file +
+         " &middot; I against amplitude, flat for the ideal model: each band &plusmn; 1&sigma; "
+         "over its amplitude range; blue, the result &plusmn; 1&sigma;" +
+         (trend ? "; red, the trend I<sub>0</sub>(1 + c A<sup>2</sup>) and a ring on the band the "
+                  "result is taken from"
+                : "") +
+         "</figcaption></figure>\n";
+}
+
 const char* kStyle = R"(
 body { font-family: sans-serif; margin: 2em auto; max-width: 1100px; color: #222; }
 h1 { font-size: 1.6em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: .2em; margin-top: 2em; }
@@ -338,7 +360,7 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
     if (fig.empty()) continue;
     h << "<figure>" << Figure(out_dir, fig, "fit of " + Str(t, "file"), "trace", &figures_drawn)
       << "<figcaption>" << Escape(Str(t, "file")) << " &middot; " << Escape(Str(t, "status"))
-      << "</figcaption></figure>\n";
+      << "</figcaption></figure>\n" << SweepFigure(t, out_dir, &figures_drawn);
   }
   h << "</div>\n";
 

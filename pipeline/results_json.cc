@@ -192,6 +192,7 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
   j["warnings"] = r.warnings;
   j["figure"] = r.figure;
   j["figures"] = r.figures;
+  j["sweep_figure"] = r.sweep_figure;
   j["swing_axis_in_imu"] = std::isfinite(r.swing_axis_in_imu[0])
                                ? json::array({r.swing_axis_in_imu[0], r.swing_axis_in_imu[1],
                                               r.swing_axis_in_imu[2]})
@@ -263,6 +264,7 @@ TraceRecord TraceRecordFromJson(const json& j) {
   r.figure = GetString(j, "figure");
   r.warnings = GetStrings(j, "warnings");
   r.figures = GetStrings(j, "figures");
+  r.sweep_figure = GetString(j, "sweep_figure");
   if (auto it = j.find("swing_axis_in_imu"); it != j.end() && it->is_array() && it->size() == 3) {
     for (int k = 0; k < 3; ++k)
       r.swing_axis_in_imu[k] = (*it)[k].is_number() ? (*it)[k].get<double>() : NAN;

@@ -10,6 +10,7 @@
 #include "fit/glitch.h"
 #include "fit/swing_axis.h"
 #include "fit/trace_fit.h"
+#include "fit/sweep_plot.h"
 #include "fit/trace_plot.h"
 #include "fit/window.h"
 #include "pipeline/imu_log.h"
@@ -441,6 +442,27 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
       record.warnings.push_back("figure " + figure_path + " could not be written: " + why);
     } else {
       record.figures.push_back(figure_path);
+    }
+  }
+  // 7. I against amplitude (only when the sweep was evaluated: no figure, and no link, without).
+  if (fit.HasFit() && fit.sweep.evaluated) {
+    SweepPlotOptions sweep_options;
+    sweep_options.title = name;
+    sweep_options.unit_scale = InertiaToDisplay(1.0, config.units);
+    sweep_options.unit_label =
+        config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+    sweep_options.figure.width_px = options.figure_width_px;
+    sweep_options.figure.height_px = options.figure_height_px;
+    sweep_options.compact = options.compact_figure;  // the report explains it in the caption
+    for (const std::string& figure_path : options.sweep_figure_paths) {
+      if (WriteAmplitudeSweepFigure(fit.sweep, record.inertia_total_kg_m2,
+                                    record.inertia_total_std_kg_m2, figure_path, sweep_options,
+                                    &why)) {
+        record.figures.push_back(figure_path);
+      } else {
+        record.flags.push_back("figure_failed");
+        record.warnings.push_back("figure " + figure_path + " could not be written: " + why);
+      }
     }
   }
   return record;

@@ -1,8 +1,8 @@
 // One IMU log file -> one trace record: read the CSV, find the swing axis and the measured pitch,
 // the free-oscillation window and the amplitude band, fit the pendulum model, draw the
-// fit-and-residual figure. Used by `bifilar process` (for every log of a campaign, from worker
-// threads) and by `bifilar fit`. Any failure of one file becomes status `error` with a message
-// naming the file; nothing throws out of ProcessTrace.
+// fit-and-residual figure and I against amplitude (fit/sweep_plot.h). Used by `bifilar process`
+// (for every log of a campaign, from worker threads) and by `bifilar fit`. Any failure of one
+// file becomes status `error` with a message naming the file; nothing throws out of ProcessTrace.
 // Conventions: docs/physics.md §2 (psi, I total = rig + aircraft), §3 (pitch).
 #pragma once
 
@@ -60,6 +60,7 @@ struct TraceRecord {
   std::vector<std::string> warnings;     // every warning (reader, window, fit), for every status
   std::string figure;                    // fit figure file name inside OUT/figures/, "" if none
   std::vector<std::string> figures;      // every figure written for this trace (paths)
+  std::string sweep_figure;              // amplitude-sweep figure name in OUT/figures/, "" if none
 
   // --- diagnostics (issue 8: what a user needs to judge a real log) ---
   std::array<double, 3> swing_axis_in_imu = {NAN, NAN, NAN};  // unit swing axis used
@@ -102,10 +103,13 @@ struct TraceProcessOptions {
   std::optional<std::array<double, 2>> window_s;
   // Write the fit-and-residual figure to each of these (.svg or .png); empty = no figure.
   std::vector<std::string> figure_paths;
-  // true: the report's compact line-only thumbnail (a few ms); false: fit/trace_plot.h's full
-  // figure (a symbol per sample).
+  // true: the report's compact line-only thumbnail (a few ms) and a sweep figure without legend;
+  // false: fit/trace_plot.h's full figure (a symbol per sample) and the sweep with its legend.
   bool compact_figure = false;
-  int figure_width_px = 1100, figure_height_px = 700;  // page size of the figure (px)
+  // Write the amplitude-sweep figure (fit/sweep_plot.h: I against amplitude) to each of these
+  // (.svg or .png) when the sweep was evaluated; a trace without a sweep gets none.
+  std::vector<std::string> sweep_figure_paths;
+  int figure_width_px = 1100, figure_height_px = 700;  // page size of both figures (px)
 };
 
 // Processes one log. Never throws: every failure is a record with status error naming the file.

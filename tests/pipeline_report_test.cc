@@ -85,6 +85,16 @@ std::string MakeCampaign() {
       pllab("t (s)", "rate", "fake fit");
       plline(2, x, y);
     }, &why);
+    // Trial 1 of each angle has an amplitude sweep (and its figure), trial 2 is too short.
+    if (path.find("trial_1") != std::string::npos) {
+      r.sweep.evaluated = true;
+      WriteFigure(o.sweep_figure_paths.at(0), FigureOptions{400, 300}, [] {
+        plenv(0, 1, 0, 1, 0, 0);
+        pllab("amplitude (deg)", "I", "fake sweep");
+      }, &why);
+    } else {
+      r.sweep.note = "the window holds 4.0 cycles";
+    }
     return r;
   };
   RunCampaign(LoadCampaignConfig(dir + "/c.yaml"), options);
@@ -108,6 +118,23 @@ TEST(Report, HasEverySectionAndEmbedsEveryFigure) {
     return n;
   };
   EXPECT_EQ(count("<svg class=\"trace\""), 8);
+  // I against amplitude beside the fit of the 4 traces with a sweep; a note for the 4 without.
+  EXPECT_EQ(count("<svg class=\"sweep\""), 4);
+  EXPECT_EQ(count("no amplitude sweep (the window holds 4.0 cycles)"), 4);
+  EXPECT_EQ(html.find("missing)"), std::string::npos);
+  {
+    std::ifstream in(out + "/results.json");
+    const nlohmann::json results = nlohmann::json::parse(in);
+    int with_sweep = 0;
+    for (const auto& t : results["traces"]) {
+      const std::string name = t.value("sweep_figure", "");
+      if (name.empty()) continue;
+      ++with_sweep;
+      EXPECT_TRUE(fs::exists(out + "/figures/" + name)) << name;
+      EXPECT_NE(t.value("file", "").find("trial_1"), std::string::npos) << name;
+    }
+    EXPECT_EQ(with_sweep, 4);
+  }
   EXPECT_EQ(count("src=\"data:image/png;base64,"), 2);
   // Inline SVGs' ids are made unique (cairo names every file's glyphs alike).
   EXPECT_NE(html.find("id=\"f0-glyph"), std::string::npos);
