@@ -369,7 +369,7 @@ AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptio
     chi2 += std::pow((b->inertia_kg_m2 / ref - coef(0) - coef(1) * x) / (b->inertia_std_kg_m2 / ref), 2);
   }
   const double dof = static_cast<double>(good.size()) - 2.0;
-  const double birge = dof > 0 && chi2 > ChiSquare95(static_cast<int>(dof)) ? chi2 / dof : 1.0;
+  const double birge = dof > 0 && chi2 > dof ? chi2 / dof : 1.0;  // Birge ratio, PDG rule
   sweep.evaluated = true;
   {
     double wsum = 0.0, wi = 0.0;
@@ -382,8 +382,11 @@ AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptio
     for (const AmplitudeSweepBand* b : good)
       sweep.chi2_constant += std::pow((b->inertia_kg_m2 - mean) / b->inertia_std_kg_m2, 2);
     sweep.chi2_dof = static_cast<int>(good.size()) - 1;
-    if (sweep.chi2_constant > ChiSquare95(sweep.chi2_dof))
+    // The std is scaled whenever the bands scatter more than their stds (the PDG rule); the
+    // flag says so only when the scatter is significant at 5 %.
+    if (sweep.chi2_constant > sweep.chi2_dof)
       sweep.std_scale = std::sqrt(sweep.chi2_constant / sweep.chi2_dof);
+    sweep.bands_disagree = sweep.chi2_constant > ChiSquare95(sweep.chi2_dof);
   }
   const double c = coef(1) / coef(0);  // relative to I_0
   sweep.trend_coeff_per_deg2 = c;
@@ -712,10 +715,8 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
     result.sweep = RunAmplitudeSweep(input, options, p, scale, traj, guess.period_s);
   }
   const AmplitudeSweep& sweep = result.sweep;
-  if (sweep.evaluated && sweep.std_scale > 1.0) {
-    result.inertia_stat_std_kg_m2 *= sweep.std_scale;
-    result.flags.push_back("bands_disagree");
-  }
+  if (sweep.evaluated && sweep.std_scale > 1.0) result.inertia_stat_std_kg_m2 *= sweep.std_scale;
+  if (sweep.bands_disagree) result.flags.push_back("bands_disagree");
   if (sweep.trend_detected) {
     // The result comes from the lowest-amplitude band; the trend's bias left at that band's
     // amplitude, |c| A_low^2 I, is the model-inadequacy term (docs/method.md).

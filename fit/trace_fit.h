@@ -60,9 +60,9 @@ struct TraceFitOptions {
   // slope of I against A^2) means the rig departs from the model: a warning, the result taken
   // from the lowest-amplitude band, and a model-inadequacy term added to its uncertainty.
   bool amplitude_sweep = true;
-  double sweep_min_cycles_per_band = 3.0;  // (cycles) >= 1
+  double sweep_min_cycles_per_band = 2.0;  // (cycles) >= 1
   int sweep_max_bands = 6;                 // (count) >= 2
-  double sweep_trend_z = 3.0;              // (dimensionless) > 0
+  double sweep_trend_z = 4.0;              // (dimensionless) > 0
   // Amplitude band of the fitted part (deg). The window code trims the trace to the band; here
   // the fitted amplitude is checked against it: start <= max + 1 deg and end >= min - 0.5 deg.
   double max_amplitude_deg = 90.0;  // > min_amplitude_deg, <= 90.
@@ -147,9 +147,10 @@ struct AmplitudeSweep {
   int low_band = -1;  // index in `bands` of the fitted band with the lowest amplitude (-1: none)
   // Consistency of the bands with one constant I: chi^2 about their weighted mean, its degrees of
   // freedom, and the scale applied to the statistical std (sqrt(chi^2/dof) when chi^2 exceeds
-  // its 95 % quantile, else 1): segments of the same swing that disagree beyond their stds show
+  // its degrees of freedom, else 1: the Birge ratio as the Particle Data Group applies it): segments of the same swing that disagree beyond their stds show
   // the real error of the fit (unmodelled motion, coloured disturbances).
   double chi2_constant = 0.0;
+  bool bands_disagree = false;  // chi2_constant above its 95 % quantile
   int chi2_dof = 0;
   double std_scale = 1.0;
 };

@@ -80,9 +80,9 @@ struct QualityThresholds {
 // The amplitude sweep (fit/trace_fit.h TraceFitOptions::amplitude_sweep and sweep_*).
 struct SweepConfig {
   bool enabled = true;
-  double min_cycles_per_band = 3.0;  // [1, 1000]
+  double min_cycles_per_band = 2.0;  // [1, 1000]
   int max_bands = 6;                 // [2, 20]
-  double trend_z = 3.0;              // (0, 1000)
+  double trend_z = 4.0;              // (0, 1000)
 };
 
 struct FitConfig {
