@@ -22,7 +22,14 @@ void WriteFileAtomically(const std::string& path, const std::string& text) {
     fs::create_directories(target.parent_path(), ec);
     if (ec) throw UserError(path + ": cannot create folder " + target.parent_path().string() + ": " + ec.message());
   }
-  if (fs::is_directory(target, ec)) throw UserError(path + ": is a folder, expected a file name");
+  // A rename would replace a folder, device, FIFO or socket by a file (or fail half-way for a
+  // folder); refuse before writing anything. A link to a regular file is replaced like a file.
+  const fs::file_status status = fs::status(target, ec);  // follows symlinks
+  if (fs::is_directory(status)) throw UserError(path + ": is a folder, expected a file name");
+  if (fs::exists(status) && !fs::is_regular_file(status)) {
+    throw UserError(path + ": exists and is not a regular file (a device, FIFO or socket); "
+                    "bifilar writes only regular files: move it away or choose another path");
+  }
   const std::string temp = AtomicTemporaryName(path);
   {
     std::ofstream file(temp, std::ios::binary | std::ios::trunc);

@@ -11,7 +11,9 @@ namespace bifilar {
 std::string AtomicTemporaryName(const std::string& path);
 
 // Writes `text` to `path` atomically (temporary file in the same folder, then rename); creates
-// missing parent folders. Throws UserError naming the path on failure.
+// missing parent folders. Throws UserError naming the path on failure, and before writing
+// anything when `path` exists and is not a regular file (a folder, device, FIFO or socket; a
+// symbolic link counts as what it points to).
 void WriteFileAtomically(const std::string& path, const std::string& text);
 
 }  // namespace bifilar
