@@ -35,9 +35,11 @@ void ParallelFor(int n, int jobs, const std::function<void(int)>& fn) {
 }
 
 void ProgressReporter::TaskDone(const std::string& line) {
-  const int done = ++done_;
   if (out_ == nullptr) return;
+  // Counted under the lock, so the lines (and the bar) show 1, 2, ... n in order and the bar's
+  // final newline comes last.
   const std::lock_guard<std::mutex> lock(mutex_);
+  const int done = ++done_;
   std::ostream& out = *out_;
   if (bar_) {
     const int width = 30;

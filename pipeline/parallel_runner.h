@@ -1,7 +1,6 @@
 // Parallel execution with progress: the worker pool of `bifilar process` and its console lines.
 #pragma once
 
-#include <atomic>
 #include <functional>
 #include <iosfwd>
 #include <mutex>
@@ -32,7 +31,7 @@ class ProgressReporter {
   std::ostream* out_;
   bool bar_;
   int total_;
-  std::atomic<int> done_{0};
+  int done_ = 0;  // guarded by mutex_
   std::mutex mutex_;
 };
 
