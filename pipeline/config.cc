@@ -462,6 +462,11 @@ void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& o
       throw UserError(runs.Where(runs.Optional("pattern")) +
                       ": 'runs.pattern' must be relative to runs.root");
     }
+    const size_t first = r.pattern.find("{pitch_deg}");
+    if (first != std::string::npos && r.pattern.find("{pitch_deg}", first + 1) != std::string::npos) {
+      throw UserError(runs.Where(runs.Optional("pattern")) +
+                      ": 'runs.pattern' may hold {pitch_deg} only once, not in two components");
+    }
     for (const auto& part : fs::path(r.pattern)) {
       if (part == "..") {
         throw UserError(runs.Where(runs.Optional("pattern")) +
