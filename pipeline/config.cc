@@ -116,7 +116,8 @@ void ReadLogContainer(YamlMap& imu, ImuFormat* format) {
   ulog.Finish();
 }
 
-void ReadImu(YamlMap imu, ImuConfig* out) {
+// `imu.time`, `imu.gyro`, `imu.accel`, `imu.format`/`imu.ulog`: the columns and units of a log.
+void ReadImuColumns(YamlMap& imu, ImuConfig* out) {
   ImuFormat& format = out->format;
   {
     YamlMap time = Sub(imu, "time");
@@ -154,7 +155,10 @@ void ReadImu(YamlMap imu, ImuConfig* out) {
   ReadLogContainer(imu, &format);
   std::string why;
   if (!format.Check(&why)) throw UserError(imu.file() + ": imu: " + why);
+}
 
+// `imu.swing_axis` (auto or a vector in IMU axes) and `imu.imu_to_body` (matrix or Euler angles).
+void ReadImuMounting(YamlMap& imu, ImuConfig* out) {
   YAML::Node axis = imu.Optional("swing_axis");
   if (!axis.IsDefined() || axis.IsNull() || (axis.IsScalar() && axis.Scalar() == "auto")) {
     out->swing_axis_auto = true;
@@ -198,6 +202,12 @@ void ReadImu(YamlMap imu, ImuConfig* out) {
     }
     mount.Finish();
   }
+}
+
+// `imu`: columns and units, then how the IMU hangs.
+void ReadImu(YamlMap imu, ImuConfig* out) {
+  ReadImuColumns(imu, out);
+  ReadImuMounting(imu, out);
   imu.Finish();
 }
 
