@@ -20,14 +20,17 @@ void WriteFileAtomically(const std::string& path, const std::string& text) {
   std::error_code ec;
   if (target.has_parent_path()) {
     fs::create_directories(target.parent_path(), ec);
-    if (ec) throw UserError(path + ": cannot create folder " + target.parent_path().string() + ": " + ec.message());
+    if (ec)
+      throw UserError(path + ": cannot create folder " + target.parent_path().string() + ": " +
+                      ec.message());
   }
   // A rename would replace a folder, device, FIFO or socket by a file (or fail half-way for a
   // folder); refuse before writing anything. A link to a regular file is replaced like a file.
   const fs::file_status status = fs::status(target, ec);  // follows symlinks
   if (fs::is_directory(status)) throw UserError(path + ": is a folder, expected a file name");
   if (fs::exists(status) && !fs::is_regular_file(status)) {
-    throw UserError(path + ": exists and is not a regular file (a device, FIFO or socket); "
+    throw UserError(path +
+                    ": exists and is not a regular file (a device, FIFO or socket); "
                     "bifilar writes only regular files: move it away or choose another path");
   }
   const std::string temp = AtomicTemporaryName(path);

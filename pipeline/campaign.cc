@@ -209,8 +209,9 @@ TraceRecord FitOneTrace(const TraceFitFunction& fit, const CampaignConfig& fit_c
     fitted = fit(fit_config, run.path, trace_options);
   } catch (const std::bad_alloc&) {
     fitted.status = TraceStatus::kError;
-    fitted.message = run.display + ": out of memory while reading or fitting this log (is it "
-                                   "far larger than a pendulum log?)";
+    fitted.message = run.display +
+                     ": out of memory while reading or fitting this log (is it "
+                     "far larger than a pendulum log?)";
   } catch (const std::exception& e) {
     fitted.status = TraceStatus::kError;
     fitted.message = run.display + ": " + e.what();
@@ -299,14 +300,13 @@ TareEstimate EstimateTare(std::vector<TraceRecord>* traces) {
   for (double v : stds) fit_var += v * v / stds.size();
   const double n = static_cast<double>(values.size());
   const double fit_sem = std::sqrt(fit_var / n);
-  tare.std_kg_m2 = values.size() >= 2 ? std::max(SampleStd(values) / std::sqrt(n), fit_sem)
-                                      : fit_sem;
+  tare.std_kg_m2 =
+      values.size() >= 2 ? std::max(SampleStd(values) / std::sqrt(n), fit_sem) : fit_sem;
   return tare;
 }
 
 // The rig reported in the results: the tare mean, or the configured value (a table has none).
-void SetRigInertia(const CampaignConfig& config, const TareEstimate& tare,
-                   CampaignResult* result) {
+void SetRigInertia(const CampaignConfig& config, const TareEstimate& tare, CampaignResult* result) {
   result->rig_tare_n = tare.n;
   if (config.rig_inertia.kind == RigInertiaSpec::Kind::kTare) {
     result->rig_inertia_kg_m2 = tare.mean_kg_m2;
@@ -375,8 +375,8 @@ std::vector<AngleStats> GroupByAngle(const std::vector<TraceRecord>& traces) {
   std::map<double, std::vector<const TraceRecord*>> groups;
   for (const TraceRecord& r : traces) {
     if (r.role != TraceRole::kAircraft || !r.ok()) continue;
-    const double key = r.pitch_nominal_deg ? *r.pitch_nominal_deg
-                                           : std::round(r.pitch_used_deg * 2.0) / 2.0;
+    const double key =
+        r.pitch_nominal_deg ? *r.pitch_nominal_deg : std::round(r.pitch_used_deg * 2.0) / 2.0;
     groups[key].push_back(&r);
   }
   std::vector<AngleStats> angles;
@@ -414,8 +414,8 @@ double SystematicRelativeStd(const std::vector<TraceRecord>& traces) {
 // ---- Step 5: ellipse --------------------------------------------------------------------------
 
 // Fig. 3 and Fig. 4 under names keyed by the ellipse inputs, so an unchanged rerun reuses them.
-void DrawCampaignFigures(const CampaignConfig& config, const EllipseResult& fit,
-                         OutputFolder* out, CampaignResult* result) {
+void DrawCampaignFigures(const CampaignConfig& config, const EllipseResult& fit, OutputFolder* out,
+                         CampaignResult* result) {
   std::ostringstream key;
   key.precision(17);
   key << ProgramVersion() << ';' << ToString(config.units) << ';' << fit.a_kg_m2 << ';'
@@ -580,8 +580,8 @@ bool RigInertiaAt(const CampaignConfig& config, double tare_mean_kg_m2, double t
       } else if (hi == table.begin() || hi == table.end()) {
         char buffer[160];
         std::snprintf(buffer, sizeof(buffer),
-                      "pitch %.3g deg is outside the rig inertia table [%.3g, %.3g] deg",
-                      pitch_deg, table.begin()->first, table.rbegin()->first);
+                      "pitch %.3g deg is outside the rig inertia table [%.3g, %.3g] deg", pitch_deg,
+                      table.begin()->first, table.rbegin()->first);
         *why = buffer;
         return false;
       } else {

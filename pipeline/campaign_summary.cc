@@ -1,8 +1,8 @@
-#include "pipeline/campaign.h"
-
 #include <cmath>
 #include <cstdio>
 #include <ostream>
+
+#include "pipeline/campaign.h"
 
 namespace bifilar {
 
@@ -36,9 +36,10 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     }
     out << line;
     if (std::isfinite(result.systematic_relative_std) && result.systematic_relative_std > 0) {
-      std::snprintf(line, sizeof(line),
-                    "  (+- %.2f %% systematic, common to all moments, from the configured uncertainties)\n",
-                    100.0 * result.systematic_relative_std);
+      std::snprintf(
+          line, sizeof(line),
+          "  (+- %.2f %% systematic, common to all moments, from the configured uncertainties)\n",
+          100.0 * result.systematic_relative_std);
       out << line;
     }
     std::snprintf(line, sizeof(line),
@@ -50,8 +51,8 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     out << s.ellipse_message << "\n";
   }
   if (std::isfinite(result.rig_inertia_kg_m2)) {
-    std::snprintf(line, sizeof(line), "Rig inertia %#.5g +- %.2g %s", inertia(result.rig_inertia_kg_m2),
-                  inertia(result.rig_inertia_std_kg_m2), unit);
+    std::snprintf(line, sizeof(line), "Rig inertia %#.5g +- %.2g %s",
+                  inertia(result.rig_inertia_kg_m2), inertia(result.rig_inertia_std_kg_m2), unit);
     out << line;
     if (config.rig_inertia.kind == RigInertiaSpec::Kind::kTare) {
       out << " (mean of " << result.rig_tare_n << " tare logs)";
@@ -73,8 +74,8 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
                 s.n_ok, s.n_rejected, s.n_error, s.n_traces, s.n_fitted, s.n_reused, s.wall_s);
   out << line;
   if (s.n_cache_refused > 0) {
-    out << "Warning: " << s.n_cache_refused
-        << " cache entr" << (s.n_cache_refused == 1 ? "y was" : "ies were")
+    out << "Warning: " << s.n_cache_refused << " cache entr"
+        << (s.n_cache_refused == 1 ? "y was" : "ies were")
         << " damaged or not theirs and refitted (see the warnings above)\n";
   }
 }

@@ -17,8 +17,8 @@ namespace bifilar {
 // One log found by discovery. A file that was found but cannot be used (pitch not readable from
 // its path, listed in the table but missing, same content as an earlier log) carries `error`.
 struct RunFile {
-  std::string path;                         // absolute
-  std::string display;                      // relative to the config folder
+  std::string path;     // absolute
+  std::string display;  // relative to the config folder
   TraceRole role = TraceRole::kAircraft;
   std::optional<double> pitch_nominal_deg;  // from the path pattern or the table
   std::string error;                        // non-empty: becomes an error row

@@ -1,8 +1,7 @@
 // WriteFileAtomically (pipeline/atomic_file.h): the file appears whole or not at all, and a
 // target that is not a regular file (folder, device, FIFO) is refused with its path named and
 // left as it was.
-#include "pipeline/atomic_file.h"
-
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -11,8 +10,7 @@
 #include <fstream>
 #include <sstream>
 
-#include <gtest/gtest.h>
-
+#include "pipeline/atomic_file.h"
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -87,8 +85,9 @@ TEST(AtomicFile, RefusesAFifoAndLeavesItAFifo) {
   ExpectOnly(dir.path, {"traces.csv"});
   // A link to it is the same target.
   fs::create_symlink(fifo, dir.path / "link.csv");
-  EXPECT_NE(ErrorOf([&] { WriteFileAtomically((dir.path / "link.csv").string(), "x"); })
-                .find("is not a regular file"),
+  EXPECT_NE(ErrorOf([&] {
+              WriteFileAtomically((dir.path / "link.csv").string(), "x");
+            }).find("is not a regular file"),
             std::string::npos);
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir.path / "link.csv")));
 }

@@ -1,16 +1,14 @@
 // Run discovery (pipeline/run_discovery.h): the pattern rules of configs/README.md (`runs`) —
 // `*` and `?` within one component, `{pitch_deg}` capturing the pitch, '[' and '\' literal,
 // names starting with '.' matched, folders never matched as logs, results in path order.
-#include "pipeline/run_discovery.h"
-
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <map>
 
-#include <gtest/gtest.h>
-
+#include "pipeline/run_discovery.h"
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -55,8 +53,9 @@ TEST(RunDiscovery, StarAndQuestionMarkStayWithinOneComponent) {
     t.Add(f);
   }
   const std::vector<RunFile> runs = t.Discover("pitch_{pitch_deg}/trial_?.csv");
-  EXPECT_EQ(Displays(runs), (std::vector<std::string>{"pitch_-5/trial_1.csv", "pitch_10/trial_1.csv",
-                                                      "pitch_10/trial_2.csv"}));
+  EXPECT_EQ(Displays(runs),
+            (std::vector<std::string>{"pitch_-5/trial_1.csv", "pitch_10/trial_1.csv",
+                                      "pitch_10/trial_2.csv"}));
   ASSERT_EQ(runs.size(), 3u);
   EXPECT_EQ(*runs[0].pitch_nominal_deg, -5.0);
   EXPECT_EQ(*runs[2].pitch_nominal_deg, 10.0);
@@ -96,7 +95,8 @@ TEST(RunDiscovery, BracketsAndBackslashesAreLiteralDotFilesMatchFoldersDoNot) {
   t.Add("p0/1.csv");
   t.Add("p0/.hidden.csv");
   fs::create_directories(t.root / "p0" / "folder.csv");
-  EXPECT_EQ(Displays(t.Discover("p{pitch_deg}/[1]*.csv")), (std::vector<std::string>{"p0/[1].csv"}));
+  EXPECT_EQ(Displays(t.Discover("p{pitch_deg}/[1]*.csv")),
+            (std::vector<std::string>{"p0/[1].csv"}));
   EXPECT_EQ(Displays(t.Discover("p{pitch_deg}/*.csv")),
             (std::vector<std::string>{"p0/.hidden.csv", "p0/1.csv", "p0/[1].csv"}));
 }
