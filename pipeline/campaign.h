@@ -1,6 +1,9 @@
 // A test campaign: a folder of IMU logs (a few trials per pitch angle) plus the rig's tare logs
 // -> every trace fitted (in parallel, cached), the rig subtracted, per-angle statistics, the
 // ellipse of inertia, and results.json / traces.csv / angles.csv / report.html in OUT.
+// RunCampaign's steps: discover (pipeline/run_discovery.h) -> fit traces (in parallel,
+// pipeline/parallel_runner.h, cached) -> tare -> group by angle -> ellipse -> write
+// (pipeline/output_set.h, atomically: pipeline/atomic_file.h).
 // Conventions: docs/physics.md §2 (tare: I_aircraft = I_total - I_rig), §3 (pitch, ellipse).
 #pragma once
 
@@ -14,23 +17,10 @@
 
 #include "fit/ellipse.h"
 #include "pipeline/config.h"
+#include "pipeline/run_discovery.h"  // RunFile, DiscoverRuns
 #include "pipeline/trace_process.h"
 
 namespace bifilar {
-
-// One log found by discovery. A file that was found but cannot be used (pitch not readable from
-// its path, listed in the table but missing, same content as an earlier log) carries `error`.
-struct RunFile {
-  std::string path;                         // absolute
-  std::string display;                      // relative to the config folder
-  TraceRole role = TraceRole::kAircraft;
-  std::optional<double> pitch_nominal_deg;  // from the path pattern or the table
-  std::string error;                        // non-empty: becomes an error row
-};
-
-// Aircraft runs (runs.pattern or runs.table) then tare logs, sorted by path within each.
-// Throws UserError when runs.root (or the table) does not exist or nothing at all is found.
-std::vector<RunFile> DiscoverRuns(const CampaignConfig& config);
 
 // Per-angle statistics of the usable (ok) traces of one pitch group.
 struct AngleStats {

@@ -116,7 +116,8 @@ void ReadLogContainer(YamlMap& imu, ImuFormat* format) {
   ulog.Finish();
 }
 
-void ReadImu(YamlMap imu, ImuConfig* out) {
+// `imu.time`, `imu.gyro`, `imu.accel`, `imu.format`/`imu.ulog`: the columns and units of a log.
+void ReadImuColumns(YamlMap& imu, ImuConfig* out) {
   ImuFormat& format = out->format;
   {
     YamlMap time = Sub(imu, "time");
@@ -154,7 +155,10 @@ void ReadImu(YamlMap imu, ImuConfig* out) {
   ReadLogContainer(imu, &format);
   std::string why;
   if (!format.Check(&why)) throw UserError(imu.file() + ": imu: " + why);
+}
 
+// `imu.swing_axis` (auto or a vector in IMU axes) and `imu.imu_to_body` (matrix or Euler angles).
+void ReadImuMounting(YamlMap& imu, ImuConfig* out) {
   YAML::Node axis = imu.Optional("swing_axis");
   if (!axis.IsDefined() || axis.IsNull() || (axis.IsScalar() && axis.Scalar() == "auto")) {
     out->swing_axis_auto = true;
@@ -198,6 +202,12 @@ void ReadImu(YamlMap imu, ImuConfig* out) {
     }
     mount.Finish();
   }
+}
+
+// `imu`: columns and units, then how the IMU hangs.
+void ReadImu(YamlMap imu, ImuConfig* out) {
+  ReadImuColumns(imu, out);
+  ReadImuMounting(imu, out);
   imu.Finish();
 }
 
@@ -383,212 +393,251 @@ bool EllipseConfig::Check(std::string* why) const {
   return true;
 }
 
-CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptions& options) {
-  CampaignConfig config;
+namespace {
+
+// ---- The steps of LoadCampaignConfig, in the order of the file's sections ---------------------
+
+// The file itself: its absolute path, folder (relative paths in it are relative to this) and
+// text (kept for the results).
+void ReadConfigFile(const std::string& path, CampaignConfig* config) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw UserError(path + ": is a folder, not a config file");
-  config.file = fs::absolute(path).lexically_normal().string();
-  config.folder = fs::path(config.file).parent_path().string();
-  config.text = ReadText(path);
-  YamlMap root = YamlMap::LoadFile(path);
-  const std::string& folder = config.folder;
+  config->file = fs::absolute(path).lexically_normal().string();
+  config->folder = fs::path(config->file).parent_path().string();
+  config->text = ReadText(path);
+}
 
-  {
-    YamlMap rig = Sub(root, "rig");
-    if (!root.Has("rig")) throw UserError(path + ": missing required key 'rig'");
-    config.filar_length_m = Positive(rig, "filar_length_m");
-    config.filar_separation_m = Positive(rig, "filar_separation_m");
-    config.rig_mass_kg = Positive(rig, "mass_kg");
-    if (rig.Has("inertia")) {
-      ReadRigInertia(Sub(rig, "inertia"), folder, &config.rig_inertia);
-    } else if (options.require_runs) {
-      throw UserError(path + ": missing required key 'rig.inertia'");
-    }
-    YamlMap unc = Sub(rig, "uncertainties");
-    config.uncertainties.filar_length_std_m = NonNegative(unc, "filar_length_std_m", 0.0);
-    config.uncertainties.filar_separation_std_m = NonNegative(unc, "filar_separation_std_m", 0.0);
-    config.uncertainties.mass_std_kg = NonNegative(unc, "mass_std_kg", 0.0);
-    config.uncertainties.gravity_std_mps2 = NonNegative(unc, "gravity_std_mps2", 0.0);
-    unc.Finish();
-    rig.Finish();
-  }
-  {
-    YamlMap aircraft = Sub(root, "aircraft");
-    if (root.Has("aircraft")) {
-      config.aircraft_mass_kg = Positive(aircraft, "mass_kg");
-      config.aircraft_mass_std_kg = NonNegative(aircraft, "mass_std_kg", 0.0);
-    } else if (options.require_runs) {
-      throw UserError(path + ": missing required key 'aircraft'");
-    }
-    aircraft.Finish();
-  }
-  {
-    YAML::Node g = root.Optional("gravity_mps2");
-    if (g.IsDefined() && !g.IsNull()) {
-      config.gravity_mps2 = root.AsDouble(g, "gravity_mps2");
-      if (!(config.gravity_mps2 > 0.0)) {
-        throw UserError(root.Where(g) + ": 'gravity_mps2' must be > 0");
-      }
-    }
-  }
-  ReadImu(Sub(root, "imu"), &config.imu);
-
-  if (root.Has("runs")) {
-    YamlMap runs = Sub(root, "runs");
-    config.runs.root = ResolvePath(folder, runs.RequiredString("root"));
-    const bool has_pattern = runs.Has("pattern"), has_table = runs.Has("table");
-    if (has_pattern == has_table) {
-      throw UserError(runs.Where(root.Optional("runs")) +
-                      ": 'runs' needs exactly one of 'pattern' or 'table'");
-    }
-    if (has_pattern) {
-      config.runs.pattern = runs.RequiredString("pattern");
-      if (fs::path(config.runs.pattern).is_absolute()) {
-        throw UserError(runs.Where(runs.Optional("pattern")) +
-                        ": 'runs.pattern' must be relative to runs.root");
-      }
-      for (const auto& part : fs::path(config.runs.pattern)) {
-        if (part == "..") {
-          throw UserError(runs.Where(runs.Optional("pattern")) +
-                          ": 'runs.pattern' must stay inside runs.root (no '..'): set runs.root "
-                          "to the folder that holds the logs instead");
-        }
-      }
-    } else {
-      config.runs.table = ResolvePath(folder, runs.RequiredString("table"));
-    }
-    const std::string source = runs.OptionalString("pitch_source", "nominal");
-    if (source == "nominal") {
-      config.runs.pitch_source = PitchSource::kNominal;
-    } else if (source == "measured") {
-      config.runs.pitch_source = PitchSource::kMeasured;
-    } else {
-      throw UserError(runs.Where(runs.Optional("pitch_source")) +
-                      ": 'runs.pitch_source' must be nominal or measured, not '" + source + "'");
-    }
-    if (config.runs.pitch_source == PitchSource::kMeasured && !config.imu.format.has_accel()) {
-      throw UserError(path + ": 'runs.pitch_source: measured' needs accelerometer columns (imu.accel)");
-    }
-    runs.Finish();
+// `rig`: geometry and mass, how its inertia is known (rig.inertia), its uncertainties.
+void ReadRig(YamlMap& root, const std::string& path, const ConfigLoadOptions& options,
+             CampaignConfig* config) {
+  YamlMap rig = Sub(root, "rig");
+  if (!root.Has("rig")) throw UserError(path + ": missing required key 'rig'");
+  config->filar_length_m = Positive(rig, "filar_length_m");
+  config->filar_separation_m = Positive(rig, "filar_separation_m");
+  config->rig_mass_kg = Positive(rig, "mass_kg");
+  if (rig.Has("inertia")) {
+    ReadRigInertia(Sub(rig, "inertia"), config->folder, &config->rig_inertia);
   } else if (options.require_runs) {
-    throw UserError(path + ": missing required key 'runs'");
+    throw UserError(path + ": missing required key 'rig.inertia'");
   }
+  YamlMap unc = Sub(rig, "uncertainties");
+  RigUncertainties& u = config->uncertainties;
+  u.filar_length_std_m = NonNegative(unc, "filar_length_std_m", 0.0);
+  u.filar_separation_std_m = NonNegative(unc, "filar_separation_std_m", 0.0);
+  u.mass_std_kg = NonNegative(unc, "mass_std_kg", 0.0);
+  u.gravity_std_mps2 = NonNegative(unc, "gravity_std_mps2", 0.0);
+  unc.Finish();
+  rig.Finish();
+}
 
-  {
-    YamlMap fit = Sub(root, "fit");
-    const std::string model = fit.OptionalString("model", "full");
-    if (!ParsePendulumModel(model, &config.fit.model)) {
-      throw UserError(fit.Where(fit.Optional("model")) +
-                      ": 'fit.model' must be full, jardin or linear, not '" + model + "'");
+// `aircraft` (mass and its std) and `gravity_mps2`.
+void ReadAircraftAndGravity(YamlMap& root, const std::string& path,
+                            const ConfigLoadOptions& options, CampaignConfig* config) {
+  YamlMap aircraft = Sub(root, "aircraft");
+  if (root.Has("aircraft")) {
+    config->aircraft_mass_kg = Positive(aircraft, "mass_kg");
+    config->aircraft_mass_std_kg = NonNegative(aircraft, "mass_std_kg", 0.0);
+  } else if (options.require_runs) {
+    throw UserError(path + ": missing required key 'aircraft'");
+  }
+  aircraft.Finish();
+  YAML::Node g = root.Optional("gravity_mps2");
+  if (g.IsDefined() && !g.IsNull()) {
+    config->gravity_mps2 = root.AsDouble(g, "gravity_mps2");
+    if (!(config->gravity_mps2 > 0.0)) {
+      throw UserError(root.Where(g) + ": 'gravity_mps2' must be > 0");
     }
-    const std::string integrator = fit.OptionalString("integrator", "rk853");
-    if (!ParseIntegratorMethod(integrator, &config.fit.integrator)) {
-      throw UserError(fit.Where(fit.Optional("integrator")) +
-                      ": 'fit.integrator' must be rk853 or cvodes, not '" + integrator + "'");
+  }
+}
+
+// `runs`: where the aircraft logs are (root + pattern, which may not leave the root, or a
+// table) and which pitch the ellipse uses.
+void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& options,
+              CampaignConfig* config) {
+  if (!root.Has("runs")) {
+    if (options.require_runs) throw UserError(path + ": missing required key 'runs'");
+    return;
+  }
+  YamlMap runs = Sub(root, "runs");
+  RunsConfig& r = config->runs;
+  r.root = ResolvePath(config->folder, runs.RequiredString("root"));
+  const bool has_pattern = runs.Has("pattern"), has_table = runs.Has("table");
+  if (has_pattern == has_table) {
+    throw UserError(runs.Where(root.Optional("runs")) +
+                    ": 'runs' needs exactly one of 'pattern' or 'table'");
+  }
+  if (has_pattern) {
+    r.pattern = runs.RequiredString("pattern");
+    if (fs::path(r.pattern).is_absolute()) {
+      throw UserError(runs.Where(runs.Optional("pattern")) +
+                      ": 'runs.pattern' must be relative to runs.root");
     }
-    YAML::Node windows = fit.Optional("windows");
-    if (windows.IsDefined() && !windows.IsNull()) {
-      if (!windows.IsMap()) {
-        throw UserError(fit.Where(windows) + ": 'fit.windows' must map file to [t0_s, t1_s]");
+    const size_t first = r.pattern.find("{pitch_deg}");
+    if (first != std::string::npos && r.pattern.find("{pitch_deg}", first + 1) != std::string::npos) {
+      throw UserError(runs.Where(runs.Optional("pattern")) +
+                      ": 'runs.pattern' may hold {pitch_deg} only once, not in two components");
+    }
+    for (const auto& part : fs::path(r.pattern)) {
+      if (part == "..") {
+        throw UserError(runs.Where(runs.Optional("pattern")) +
+                        ": 'runs.pattern' must stay inside runs.root (no '..'): set runs.root "
+                        "to the folder that holds the logs instead");
       }
-      for (const auto& item : windows) {
-        const std::string key = "windows." + item.first.Scalar();
-        if (!item.second.IsSequence() || item.second.size() != 2) {
-          throw UserError(fit.Where(item.second) + ": 'fit." + key + "' must be [t0_s, t1_s]");
-        }
-        const double t0 = fit.AsDouble(item.second[0], key), t1 = fit.AsDouble(item.second[1], key);
-        if (!(t1 > t0)) {
-          throw UserError(fit.Where(item.second) + ": 'fit." + key + "' needs t0 < t1");
-        }
-        config.fit.windows_s[item.first.Scalar()] = {t0, t1};
-      }
     }
-    if (fit.Has("max_amplitude_deg")) {
-      config.fit.max_amplitude_deg = fit.RequiredDouble("max_amplitude_deg");
-    }
-    if (fit.Has("min_amplitude_deg")) {
-      config.fit.min_amplitude_deg = fit.RequiredDouble("min_amplitude_deg");
-    }
-    YamlMap quality = Sub(fit, "quality");
-    QualityThresholds& q = config.fit.quality;
-    q.max_rms_over_noise = quality.OptionalDouble("max_rms_over_noise", q.max_rms_over_noise);
-    q.max_residual_autocorr =
-        quality.OptionalDouble("max_residual_autocorr", q.max_residual_autocorr);
-    q.whiteness_lags = quality.OptionalInt("whiteness_lags", q.whiteness_lags);
-    q.max_secondary_motion_ratio =
-        quality.OptionalDouble("max_secondary_motion_ratio", q.max_secondary_motion_ratio);
-    q.min_periods = quality.OptionalDouble("min_periods", q.min_periods);
-    q.reject_secondary_motion_ratio = quality.OptionalDouble(
-        "reject_secondary_motion_ratio", std::max(q.reject_secondary_motion_ratio,
-                                                  q.max_secondary_motion_ratio));
-    q.reject_residual_fraction =
-        quality.OptionalDouble("reject_residual_fraction", q.reject_residual_fraction);
-    if (!(q.max_rms_over_noise > 1.0) || !(q.max_residual_autocorr > 0.0) ||
-        !(q.max_residual_autocorr < 1.0) || q.whiteness_lags < 1 ||
-        !(q.max_secondary_motion_ratio >= 0.0) || !(q.min_periods >= 2.0) ||
-        !(q.reject_secondary_motion_ratio >= q.max_secondary_motion_ratio) ||
-        !(q.reject_residual_fraction > 0.0 && q.reject_residual_fraction <= 1.0)) {
-      throw UserError(quality.Where(fit.Optional("quality")) +
-                      ": 'fit.quality' out of range (max_rms_over_noise > 1, "
-                      "0 < max_residual_autocorr < 1, whiteness_lags >= 1, "
-                      "max_secondary_motion_ratio >= 0, min_periods >= 2, "
-                      "reject_secondary_motion_ratio >= max_secondary_motion_ratio, "
-                      "0 < reject_residual_fraction <= 1)");
-    }
-    quality.Finish();
-    YamlMap sweep = Sub(fit, "amplitude_sweep");
-    SweepConfig& sw = config.fit.sweep;
-    sw.enabled = sweep.OptionalBool("enabled", sw.enabled);
-    sw.min_cycles_per_band = sweep.OptionalDouble("min_cycles_per_band", sw.min_cycles_per_band);
-    sw.max_bands = sweep.OptionalInt("max_bands", sw.max_bands);
-    sw.trend_z = sweep.OptionalDouble("trend_z", sw.trend_z);
-    if (!(sw.min_cycles_per_band >= 1.0 && sw.min_cycles_per_band <= 1000.0) ||
-        sw.max_bands < 2 || sw.max_bands > 20 || !(sw.trend_z > 0.0 && sw.trend_z < 1000.0)) {
-      throw UserError(sweep.Where(fit.Optional("amplitude_sweep")) +
-                      ": 'fit.amplitude_sweep' out of range (min_cycles_per_band in [1, 1000], "
-                      "max_bands in [2, 20], trend_z in (0, 1000))");
-    }
-    sweep.Finish();
-    std::string why;
-    if (!config.fit.Check(&why)) {
-      const char* key = why.find("max_amplitude") != std::string::npos ? "max_amplitude_deg"
-                        : why.find("min_amplitude") != std::string::npos ? "min_amplitude_deg"
-                                                                         : "quality";
-      throw UserError(fit.Where(fit.Optional(key)) + ": " + why);
-    }
-    fit.Finish();
+  } else {
+    r.table = ResolvePath(config->folder, runs.RequiredString("table"));
   }
-  {
-    YamlMap ellipse = Sub(root, "ellipse");
-    EllipseConfig& e = config.ellipse;
-    e.bootstrap = ellipse.OptionalInt("bootstrap", e.bootstrap);
-    e.seed = static_cast<unsigned>(ellipse.OptionalInt("seed", static_cast<int>(e.seed)));
-    e.confidence = ellipse.OptionalDouble("confidence", e.confidence);
-    e.covariance = ellipse.OptionalString("covariance", e.covariance);
-    e.min_angles = ellipse.OptionalInt("min_angles", e.min_angles);
-    std::string why;
-    if (!e.Check(&why)) {
-      const char* key = why.find("bootstrap") != std::string::npos    ? "bootstrap"
-                        : why.find("confidence") != std::string::npos ? "confidence"
-                        : why.find("min_angles") != std::string::npos ? "min_angles"
-                                                                      : "covariance";
-      throw UserError(ellipse.Where(ellipse.Optional(key)) + ": " + why);
-    }
-    ellipse.Finish();
+  const std::string source = runs.OptionalString("pitch_source", "nominal");
+  if (source == "nominal") {
+    r.pitch_source = PitchSource::kNominal;
+  } else if (source == "measured") {
+    r.pitch_source = PitchSource::kMeasured;
+  } else {
+    throw UserError(runs.Where(runs.Optional("pitch_source")) +
+                    ": 'runs.pitch_source' must be nominal or measured, not '" + source + "'");
   }
-  {
-    const std::string units = root.OptionalString("units", "si");
-    if (units == "si") {
-      config.units = DisplayUnits::kSi;
-    } else if (units == "imperial") {
-      config.units = DisplayUnits::kImperial;
-    } else {
-      throw UserError(root.Where(root.Optional("units")) + ": 'units' must be si or imperial, not '" +
-                      units + "'");
-    }
+  if (r.pitch_source == PitchSource::kMeasured && !config->imu.format.has_accel()) {
+    throw UserError(path + ": 'runs.pitch_source: measured' needs accelerometer columns (imu.accel)");
   }
+  runs.Finish();
+}
+
+// `fit.windows`: file -> [t0_s, t1_s].
+void ReadFitWindows(YamlMap& fit, FitConfig* out) {
+  YAML::Node windows = fit.Optional("windows");
+  if (!windows.IsDefined() || windows.IsNull()) return;
+  if (!windows.IsMap()) {
+    throw UserError(fit.Where(windows) + ": 'fit.windows' must map file to [t0_s, t1_s]");
+  }
+  for (const auto& item : windows) {
+    const std::string key = "windows." + item.first.Scalar();
+    if (!item.second.IsSequence() || item.second.size() != 2) {
+      throw UserError(fit.Where(item.second) + ": 'fit." + key + "' must be [t0_s, t1_s]");
+    }
+    const double t0 = fit.AsDouble(item.second[0], key), t1 = fit.AsDouble(item.second[1], key);
+    if (!(t1 > t0)) {
+      throw UserError(fit.Where(item.second) + ": 'fit." + key + "' needs t0 < t1");
+    }
+    out->windows_s[item.first.Scalar()] = {t0, t1};
+  }
+}
+
+// `fit.quality`: the thresholds of the quality checks, each in its range.
+void ReadFitQuality(YamlMap& fit, QualityThresholds* q) {
+  YamlMap quality = Sub(fit, "quality");
+  q->max_rms_over_noise = quality.OptionalDouble("max_rms_over_noise", q->max_rms_over_noise);
+  q->max_residual_autocorr =
+      quality.OptionalDouble("max_residual_autocorr", q->max_residual_autocorr);
+  q->whiteness_lags = quality.OptionalInt("whiteness_lags", q->whiteness_lags);
+  q->max_secondary_motion_ratio =
+      quality.OptionalDouble("max_secondary_motion_ratio", q->max_secondary_motion_ratio);
+  q->min_periods = quality.OptionalDouble("min_periods", q->min_periods);
+  q->reject_secondary_motion_ratio = quality.OptionalDouble(
+      "reject_secondary_motion_ratio", std::max(q->reject_secondary_motion_ratio,
+                                                q->max_secondary_motion_ratio));
+  q->reject_residual_fraction =
+      quality.OptionalDouble("reject_residual_fraction", q->reject_residual_fraction);
+  if (!(q->max_rms_over_noise > 1.0) || !(q->max_residual_autocorr > 0.0) ||
+      !(q->max_residual_autocorr < 1.0) || q->whiteness_lags < 1 ||
+      !(q->max_secondary_motion_ratio >= 0.0) || !(q->min_periods >= 2.0) ||
+      !(q->reject_secondary_motion_ratio >= q->max_secondary_motion_ratio) ||
+      !(q->reject_residual_fraction > 0.0 && q->reject_residual_fraction <= 1.0)) {
+    throw UserError(quality.Where(fit.Optional("quality")) +
+                    ": 'fit.quality' out of range (max_rms_over_noise > 1, "
+                    "0 < max_residual_autocorr < 1, whiteness_lags >= 1, "
+                    "max_secondary_motion_ratio >= 0, min_periods >= 2, "
+                    "reject_secondary_motion_ratio >= max_secondary_motion_ratio, "
+                    "0 < reject_residual_fraction <= 1)");
+  }
+  quality.Finish();
+}
+
+// `fit.amplitude_sweep`: I against amplitude band.
+void ReadFitSweep(YamlMap& fit, SweepConfig* sw) {
+  YamlMap sweep = Sub(fit, "amplitude_sweep");
+  sw->enabled = sweep.OptionalBool("enabled", sw->enabled);
+  sw->min_cycles_per_band = sweep.OptionalDouble("min_cycles_per_band", sw->min_cycles_per_band);
+  sw->max_bands = sweep.OptionalInt("max_bands", sw->max_bands);
+  sw->trend_z = sweep.OptionalDouble("trend_z", sw->trend_z);
+  if (!(sw->min_cycles_per_band >= 1.0 && sw->min_cycles_per_band <= 1000.0) ||
+      sw->max_bands < 2 || sw->max_bands > 20 || !(sw->trend_z > 0.0 && sw->trend_z < 1000.0)) {
+    throw UserError(sweep.Where(fit.Optional("amplitude_sweep")) +
+                    ": 'fit.amplitude_sweep' out of range (min_cycles_per_band in [1, 1000], "
+                    "max_bands in [2, 20], trend_z in (0, 1000))");
+  }
+  sweep.Finish();
+}
+
+// `fit`: model, integrator, windows, amplitude limits, quality, sweep; then FitConfig::Check.
+void ReadFit(YamlMap fit, FitConfig* out) {
+  const std::string model = fit.OptionalString("model", "full");
+  if (!ParsePendulumModel(model, &out->model)) {
+    throw UserError(fit.Where(fit.Optional("model")) +
+                    ": 'fit.model' must be full, jardin or linear, not '" + model + "'");
+  }
+  const std::string integrator = fit.OptionalString("integrator", "rk853");
+  if (!ParseIntegratorMethod(integrator, &out->integrator)) {
+    throw UserError(fit.Where(fit.Optional("integrator")) +
+                    ": 'fit.integrator' must be rk853 or cvodes, not '" + integrator + "'");
+  }
+  ReadFitWindows(fit, out);
+  if (fit.Has("max_amplitude_deg")) out->max_amplitude_deg = fit.RequiredDouble("max_amplitude_deg");
+  if (fit.Has("min_amplitude_deg")) out->min_amplitude_deg = fit.RequiredDouble("min_amplitude_deg");
+  ReadFitQuality(fit, &out->quality);
+  ReadFitSweep(fit, &out->sweep);
+  std::string why;
+  if (!out->Check(&why)) {
+    const char* key = why.find("max_amplitude") != std::string::npos ? "max_amplitude_deg"
+                      : why.find("min_amplitude") != std::string::npos ? "min_amplitude_deg"
+                                                                       : "quality";
+    throw UserError(fit.Where(fit.Optional(key)) + ": " + why);
+  }
+  fit.Finish();
+}
+
+// `ellipse`: bootstrap, seed, confidence, covariance, min_angles; then EllipseConfig::Check.
+void ReadEllipse(YamlMap ellipse, EllipseConfig* e) {
+  e->bootstrap = ellipse.OptionalInt("bootstrap", e->bootstrap);
+  e->seed = static_cast<unsigned>(ellipse.OptionalInt("seed", static_cast<int>(e->seed)));
+  e->confidence = ellipse.OptionalDouble("confidence", e->confidence);
+  e->covariance = ellipse.OptionalString("covariance", e->covariance);
+  e->min_angles = ellipse.OptionalInt("min_angles", e->min_angles);
+  std::string why;
+  if (!e->Check(&why)) {
+    const char* key = why.find("bootstrap") != std::string::npos    ? "bootstrap"
+                      : why.find("confidence") != std::string::npos ? "confidence"
+                      : why.find("min_angles") != std::string::npos ? "min_angles"
+                                                                    : "covariance";
+    throw UserError(ellipse.Where(ellipse.Optional(key)) + ": " + why);
+  }
+  ellipse.Finish();
+}
+
+// `units`: si or imperial (display only; files stay SI).
+DisplayUnits ReadUnits(YamlMap& root) {
+  const std::string units = root.OptionalString("units", "si");
+  if (units == "si") return DisplayUnits::kSi;
+  if (units == "imperial") return DisplayUnits::kImperial;
+  throw UserError(root.Where(root.Optional("units")) + ": 'units' must be si or imperial, not '" +
+                  units + "'");
+}
+
+}  // namespace
+
+// read the file -> rig -> aircraft, gravity -> imu -> runs -> fit -> ellipse -> units -> no
+// unknown key -> the ranges that involve several keys (CampaignConfig::Check).
+CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptions& options) {
+  CampaignConfig config;
+  ReadConfigFile(path, &config);
+  YamlMap root = YamlMap::LoadFile(path);
+  ReadRig(root, path, options, &config);
+  ReadAircraftAndGravity(root, path, options, &config);
+  ReadImu(Sub(root, "imu"), &config.imu);
+  ReadRuns(root, path, options, &config);
+  ReadFit(Sub(root, "fit"), &config.fit);
+  ReadEllipse(Sub(root, "ellipse"), &config.ellipse);
+  config.units = ReadUnits(root);
   root.Finish();
-
   std::string why;
   if (!config.Check(&why)) throw UserError(path + ": " + why);
   return config;

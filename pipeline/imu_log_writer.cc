@@ -1,16 +1,10 @@
 #include "pipeline/imu_log_writer.h"
 
-
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <system_error>
 
-#include <unistd.h>
-
-#include "pipeline/user_error.h"
 #include "pipeline/gzip.h"
+#include "pipeline/user_error.h"
 
 namespace bifilar {
 namespace {
@@ -80,34 +74,6 @@ std::string FormatImuLog(const ImuData& data, const ImuFormat& format,
     out += options.line_end;
   }
   return out;
-}
-
-void WriteFileAtomically(const std::string& path, const std::string& text) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  std::error_code ec;
-  if (target.has_parent_path()) {
-    fs::create_directories(target.parent_path(), ec);
-    if (ec) throw UserError(path + ": cannot create folder " + target.parent_path().string() + ": " + ec.message());
-  }
-  if (fs::is_directory(target, ec)) throw UserError(path + ": is a folder, expected a file name");
-  const std::string temp = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream file(temp, std::ios::binary | std::ios::trunc);
-    if (!file) throw UserError(path + ": cannot write (temporary file " + temp + ")");
-    file.write(text.data(), static_cast<std::streamsize>(text.size()));
-    file.flush();
-    if (!file) {
-      fs::remove(temp, ec);
-      throw UserError(path + ": write failed (disk full?)");
-    }
-  }
-  fs::rename(temp, target, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(temp, ignored);
-    throw UserError(path + ": cannot rename the temporary file into place: " + ec.message());
-  }
 }
 
 void WriteImuLog(const std::string& path, const ImuData& data, const ImuFormat& format,

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "pendulum/imu_data.h"
+#include "pipeline/atomic_file.h"  // WriteFileAtomically, used by several writers
 #include "pipeline/imu_format.h"
 
 namespace bifilar {
@@ -29,11 +30,7 @@ struct ImuLogWriteOptions {
 std::string FormatImuLog(const ImuData& data, const ImuFormat& format,
                          const ImuLogWriteOptions& options = ImuLogWriteOptions());
 
-// Writes `text` to `path` atomically (temporary file in the same folder, then rename); creates
-// missing parent folders. Throws UserError naming the path on failure.
-void WriteFileAtomically(const std::string& path, const std::string& text);
-
-// FormatImuLog + WriteFileAtomically.
+// FormatImuLog + WriteFileAtomically (pipeline/atomic_file.h).
 // A path ending in ".gz" is written gzip-compressed (pipeline/gzip.h); the reader inflates it.
 void WriteImuLog(const std::string& path, const ImuData& data, const ImuFormat& format,
                  const ImuLogWriteOptions& options = ImuLogWriteOptions());

@@ -10,7 +10,7 @@
 #include <filesystem>
 
 #include "pipeline/cache.h"
-#include "pipeline/imu_log_writer.h"  // WriteFileAtomically
+#include "pipeline/atomic_file.h"
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -31,7 +31,7 @@ std::string ReadAll(const std::string& path) {
 // The temporary names bifilar's writers use: WriteFileAtomically (".tmp.<pid>") and
 // WriteFigure (".tmp").
 std::vector<std::string> WithTemporaries(const std::string& relative) {
-  return {relative, relative + ".tmp", relative + ".tmp." + std::to_string(::getpid())};
+  return {relative, relative + ".tmp", AtomicTemporaryName(relative)};
 }
 
 bool IsBifilarResults(const std::string& path) {

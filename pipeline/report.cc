@@ -154,6 +154,228 @@ pre { background: #f7f7f7; padding: .8em; overflow-x: auto; font-size: .85em; }
 .ok { color: #1a7f37; } .bad { color: #b42318; }
 )";
 
+// What every section reads: the results document, its parts, the units, and the number of
+// figures embedded so far (the inline SVGs' id prefixes).
+struct ReportPage {
+  ReportPage(const json& results_in, const std::string& out_dir_in)
+      : results(results_in), out_dir(out_dir_in) {
+    if (Str(results, "units") == "imperial") {
+      u.imperial = true;
+      u.scale = 1.0 / 1.35581795;
+      u.name = "slug ft<sup>2</sup>";
+    }
+  }
+  json Part(const char* key, const json& fallback) const {
+    return results.contains(key) ? results[key] : fallback;
+  }
+  const json& results;
+  const std::string& out_dir;
+  Units u;
+  const json summary = Part("summary", json::object());
+  const json ellipse = Part("ellipse", json(nullptr));
+  const json traces = Part("traces", json::array());
+  const json angles = Part("angles", json::array());
+  const json figures = Part("figures", json::object());
+  int figures_drawn = 0;
+};
+
+// Title, version, config and the trace counts.
+void WriteHeader(const ReportPage& p, std::ostream& h) {
+  const json& summary = p.summary;
+  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+    << "<title>bifilar report</title><style>" << kStyle << "</style></head><body>\n";
+  h << "<h1>Mass properties from bifilar pendulum swings</h1>\n";
+  h << "<p>bifilar " << Escape(Str(p.results, "version")) << " &middot; config <code>"
+    << Escape(Str(p.results, "config_file")) << "</code> &middot; pitch source "
+    << Escape(Str(p.results, "pitch_source")) << ". Traces: " << summary.value("n_traces", 0)
+    << " (<span class=\"ok\">" << summary.value("n_ok", 0) << " ok</span>, "
+    << summary.value("n_rejected", 0) << " rejected, " << summary.value("n_error", 0)
+    << " error); fits reused from cache: " << summary.value("n_reused", 0) << ".</p>\n";
+}
+
+// Table 2: I_x, I_z, I_xz, tau and the principal moments with std and interval, the systematic
+// share, the ellipse's warnings; or why there is no ellipse.
+void WriteTable2(const ReportPage& p, std::ostream& h) {
+  const Units& u = p.u;
+  const json& ellipse = p.ellipse;
+  h << "<h2>Table 2: inertia properties</h2>\n";
+  if (!ellipse.is_object()) {
+    h << "<p class=\"bad\">"
+      << Escape(p.summary.value("ellipse_message", std::string("ellipse not fitted"))) << "</p>\n";
+    return;
+  }
+  h << "<table><tr><th class=\"l\">quantity</th><th>value</th><th>std</th><th>interval</th>"
+       "<th class=\"l\">unit</th></tr>\n";
+  struct Row { const char* key; const char* label; bool angle; };
+  for (const Row& row : {Row{"Ix_kg_m2", "I<sub>x</sub>", false}, Row{"Iz_kg_m2", "I<sub>z</sub>", false},
+                         Row{"Ixz_kg_m2", "I<sub>xz</sub>", false}, Row{"tau_deg", "&tau; (principal inclination)", true},
+                         Row{"Ixp_kg_m2", "I<sub>xp</sub> (principal)", false},
+                         Row{"Izp_kg_m2", "I<sub>zp</sub> (principal)", false}}) {
+    const Estimate e = GetEstimate(ellipse, row.key);
+    if (!e.present) continue;
+    h << "<tr><td class=\"l\">" << row.label << "</td>";
+    if (!e.defined) {
+      h << "<td colspan=\"3\">ill-defined (I<sub>x</sub> &asymp; I<sub>z</sub>)</td>";
+    } else if (row.angle) {
+      h << "<td>" << Fmt(e.value) << "</td><td>" << Fmt(e.std) << "</td><td>[" << Fmt(e.lo)
+        << ", " << Fmt(e.hi) << "]</td>";
+    } else {
+      h << "<td>" << u.Inertia(e.value) << "</td><td>" << u.Inertia(e.std) << "</td><td>["
+        << u.Inertia(e.lo) << ", " << u.Inertia(e.hi) << "]</td>";
+    }
+    h << "<td class=\"l\">" << (row.angle ? "deg" : u.name) << "</td></tr>\n";
+  }
+  h << "</table>\n";
+  const double systematic = Num(p.results, "systematic_relative_std");
+  h << "<p>Uncertainties above are statistical (scatter between trials and angles). "
+    << "The configured uncertainties of L, D, the masses, g and the gyro scale add a systematic &plusmn;"
+    << Fmt(100.0 * systematic, "%.2f")
+    << " % that scales every moment alike and leaves &tau; unchanged (mean per-trace uncertainty budget).</p>\n";
+  if (ellipse.contains("warnings")) {
+    for (const auto& w : ellipse["warnings"]) {
+      if (w.is_string()) h << "<p class=\"note\">" << Escape(w.get<std::string>()) << "</p>\n";
+    }
+  }
+}
+
+// Table 1 (data quality) and the rig line.
+void WriteTable1AndRig(const ReportPage& p, std::ostream& h) {
+  const Units& u = p.u;
+  const json t1 = p.Part("table1", json::object());
+  h << "<h2>Table 1: data quality</h2>\n<table><tr><th class=\"l\">statistic</th><th>value</th>"
+       "<th class=\"l\">unit</th></tr>\n";
+  h << "<tr><td class=\"l\">raw data &sigma; (mean of per-angle standard deviations)</td><td>"
+    << u.Inertia(Num(t1, "raw_sigma_kg_m2")) << "</td><td class=\"l\">" << u.name << "</td></tr>\n";
+  h << "<tr><td class=\"l\">coefficient of variation (mean per angle)</td><td>"
+    << Fmt(Num(t1, "cv_percent"), "%.4f") << "</td><td class=\"l\">%</td></tr>\n";
+  h << "<tr><td class=\"l\">regression RMSE</td><td>" << u.Inertia(Num(t1, "regression_rmse_kg_m2"))
+    << "</td><td class=\"l\">" << u.name << "</td></tr>\n</table>\n";
+  const json rig = p.Part("rig", json::object());
+  h << "<p>Rig: L = " << Fmt(Num(rig, "filar_length_m"), "%.4f") << " m, D = "
+    << Fmt(Num(rig, "filar_separation_m"), "%.4f") << " m, rig mass "
+    << Fmt(Num(rig, "mass_kg"), "%.4f") << " kg, aircraft mass "
+    << Fmt(Num(rig, "aircraft_mass_kg"), "%.4f") << " kg, g = "
+    << Fmt(Num(rig, "gravity_mps2"), "%.5f") << " m/s<sup>2</sup>. Rig inertia ("
+    << Escape(Str(rig, "inertia_source")) << "): " << u.Inertia(Num(rig, "inertia_kg_m2"), "%.5f")
+    << " &plusmn; " << u.Inertia(Num(rig, "inertia_std_kg_m2"), "%.2e") << " " << u.name;
+  if (Str(rig, "inertia_source") == "tare") h << " from " << rig.value("tare_n", 0) << " tare log(s)";
+  h << ".</p>\n";
+}
+
+// Figures 3 and 4, and the NACA Report 467 comparison of I_xz.
+void WriteEllipseSection(ReportPage& p, std::ostream& h) {
+  const Units& u = p.u;
+  const json& ellipse = p.ellipse;
+  h << "<h2>Figure 3: moment of inertia against pitch</h2>\n"
+    << Figure(p.out_dir, Str(p.figures, "moments"), "moments of inertia against pitch angle", "fig", &p.figures_drawn)
+    << "\n<h2>Figure 4: ellipse of inertia</h2>\n"
+    << Figure(p.out_dir, Str(p.figures, "polar"), "polar plot of the ellipse of inertia", "fig", &p.figures_drawn) << "\n";
+  h << "<h2>NACA Report 467 comparison</h2>\n";
+  if (!(ellipse.is_object() && ellipse.contains("naca") && !ellipse["naca"].empty())) {
+    h << "<p class=\"note\">No NACA 467 estimate (needs the ellipse fit and oblique angles).</p>\n";
+    return;
+  }
+  const Estimate ixz = GetEstimate(ellipse, "Ixz_kg_m2");
+  h << "<p>I<sub>xz</sub> from one oblique angle (paper Eq. 1) against the multi-angle fit "
+    << u.Inertia(ixz.value) << " &plusmn; " << u.Inertia(ixz.std) << " " << u.name << ".</p>\n"
+    << "<table><tr><th>pitch (deg)</th><th>I<sub>xz</sub> NACA 467</th><th>std</th>"
+       "<th>difference from fit</th></tr>\n";
+  for (const auto& e : ellipse["naca"]) {
+    const double v = Num(e, "Ixz_kg_m2");
+    h << "<tr><td>" << Fmt(Num(e, "pitch_deg"), "%.1f") << "</td><td>" << u.Inertia(v)
+      << "</td><td>" << u.Inertia(Num(e, "Ixz_std_kg_m2")) << "</td><td>"
+      << u.Inertia(v - ixz.value) << "</td></tr>\n";
+  }
+  h << "</table>\n";
+}
+
+void WriteAngleTable(const ReportPage& p, std::ostream& h) {
+  const Units& u = p.u;
+  h << "<h2>Per-angle statistics</h2>\n<table><tr><th>pitch (deg)</th><th>n</th><th>mean ("
+    << u.name << ")</th><th>std</th><th>sem</th><th>CV (%)</th></tr>\n";
+  for (const auto& a : p.angles) {
+    h << "<tr><td>" << Fmt(Num(a, "pitch_deg"), "%.2f") << "</td><td>" << a.value("n", 0)
+      << "</td><td>" << u.Inertia(Num(a, "inertia_mean_kg_m2")) << "</td><td>"
+      << u.Inertia(Num(a, "inertia_std_kg_m2"), "%.5f") << "</td><td>"
+      << u.Inertia(Num(a, "inertia_sem_kg_m2"), "%.5f") << "</td><td>"
+      << Fmt(Num(a, "cv_percent"), "%.3f") << "</td></tr>\n";
+  }
+  h << "</table>\n";
+}
+
+// The traces that are not ok, with the reason.
+void WriteRejectedTraces(const ReportPage& p, std::ostream& h) {
+  h << "<h2>Rejected and failed traces</h2>\n";
+  int bad = 0;
+  std::ostringstream rows;
+  for (const auto& t : p.traces) {
+    const std::string status = Str(t, "status");
+    if (status == "ok") continue;
+    ++bad;
+    rows << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
+         << "</td><td class=\"l\">" << Escape(status) << "</td><td class=\"l\">"
+         << Escape(Str(t, "message")) << "</td></tr>\n";
+  }
+  if (bad == 0) {
+    h << "<p class=\"ok\">None: every trace passed the quality checks.</p>\n";
+  } else {
+    h << "<table><tr><th class=\"l\">file</th><th class=\"l\">status</th><th class=\"l\">reason</th></tr>\n"
+      << rows.str() << "</table>\n";
+  }
+}
+
+// One row per trace: role, status, pitch, total and aircraft inertia, window, amplitude.
+void WriteTraceTable(const ReportPage& p, std::ostream& h) {
+  const Units& u = p.u;
+  h << "<h2>Traces</h2>\n<table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"
+       "<th class=\"l\">status</th><th>pitch (deg)</th><th>I total (" << u.name
+    << ")</th><th>std</th><th>I aircraft</th><th>std</th><th>window (s)</th>"
+       "<th>amplitude (deg)</th><th>rms/noise</th></tr>\n";
+  for (const auto& t : p.traces) {
+    const std::string status = Str(t, "status");
+    std::string window = "&ndash;", amplitude = "&ndash;";
+    if (t.contains("window_s") && t["window_s"].is_array()) {
+      window = Fmt(t["window_s"][0].get<double>(), "%.2f") + "&ndash;" +
+               Fmt(t["window_s"][1].get<double>(), "%.2f");
+    }
+    if (t.contains("amplitude_deg") && t["amplitude_deg"].is_array()) {
+      amplitude = Fmt(t["amplitude_deg"][0].get<double>(), "%.1f") + "&rarr;" +
+                  Fmt(t["amplitude_deg"][1].get<double>(), "%.1f");
+    }
+    h << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
+      << "</td><td class=\"l\">" << Escape(Str(t, "role")) << "</td><td class=\"l\">"
+      << Escape(status) << "</td><td>" << Fmt(Num(t, "pitch_used_deg"), "%.2f") << "</td><td>"
+      << u.Inertia(Num(t, "inertia_total_kg_m2"), "%.5f") << "</td><td>"
+      << u.Inertia(Num(t, "inertia_total_std_kg_m2"), "%.2e") << "</td><td>"
+      << u.Inertia(Num(t, "inertia_kg_m2"), "%.5f") << "</td><td>"
+      << u.Inertia(Num(t, "inertia_std_kg_m2"), "%.2e") << "</td><td>" << window << "</td><td>"
+      << amplitude << "</td><td>"
+      << Fmt(Num(t, "residual_rms_rad_per_s") / Num(t, "noise_rms_rad_per_s"), "%.2f")
+      << "</td></tr>\n";
+  }
+  h << "</table>\n";
+}
+
+// The per-trace section: every trace's figures (fit and residual) with its caption.
+void WriteTraceFigures(ReportPage& p, std::ostream& h) {
+  h << "<h2>Fit and residual of every trace</h2>\n<div class=\"traces\">\n";
+  for (const auto& t : p.traces) {
+    const std::string fig = Str(t, "figure");
+    if (fig.empty()) continue;
+    h << "<figure>" << Figure(p.out_dir, fig, "fit of " + Str(t, "file"), "trace", &p.figures_drawn)
+      << "<figcaption>" << Escape(Str(t, "file")) << " &middot; " << Escape(Str(t, "status"))
+      << "</figcaption></figure>\n"
+      << SweepFigure(t, p.out_dir, &p.figures_drawn);
+  }
+  h << "</div>\n";
+}
+
+// The config text used, and the end of the page.
+void WriteFooter(const ReportPage& p, std::ostream& h) {
+  h << "<h2>Config used</h2>\n<pre>" << Escape(Str(p.results, "config")) << "</pre>\n";
+  h << "</body></html>\n";
+}
+
 }  // namespace
 
 std::string Base64(const std::string& bytes) {
@@ -184,188 +406,20 @@ std::string Base64(const std::string& bytes) {
   return out;
 }
 
+// header -> Table 2 -> Table 1 and rig -> ellipse figures and NACA 467 -> per-angle table ->
+// rejected traces -> trace table -> per-trace figures -> footer.
 std::string BuildReportHtml(const json& results, const std::string& out_dir) {
-  Units u;
-  if (Str(results, "units") == "imperial") {
-    u.imperial = true;
-    u.scale = 1.0 / 1.35581795;
-    u.name = "slug ft<sup>2</sup>";
-  }
-  const json& summary = results.contains("summary") ? results["summary"] : json::object();
-  const json& ellipse = results.contains("ellipse") ? results["ellipse"] : json(nullptr);
-  const json traces = results.contains("traces") ? results["traces"] : json::array();
-  const json angles = results.contains("angles") ? results["angles"] : json::array();
-  const json figures = results.contains("figures") ? results["figures"] : json::object();
-  int figures_drawn = 0;  // numbers the inline SVGs' id prefixes
+  ReportPage page(results, out_dir);
   std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-    << "<title>bifilar report</title><style>" << kStyle << "</style></head><body>\n";
-  h << "<h1>Mass properties from bifilar pendulum swings</h1>\n";
-  h << "<p>bifilar " << Escape(Str(results, "version")) << " &middot; config <code>"
-    << Escape(Str(results, "config_file")) << "</code> &middot; pitch source "
-    << Escape(Str(results, "pitch_source")) << ". Traces: " << summary.value("n_traces", 0)
-    << " (<span class=\"ok\">" << summary.value("n_ok", 0) << " ok</span>, "
-    << summary.value("n_rejected", 0) << " rejected, " << summary.value("n_error", 0)
-    << " error); fits reused from cache: " << summary.value("n_reused", 0) << ".</p>\n";
-
-  // Table 2.
-  h << "<h2>Table 2: inertia properties</h2>\n";
-  if (ellipse.is_object()) {
-    h << "<table><tr><th class=\"l\">quantity</th><th>value</th><th>std</th><th>interval</th>"
-         "<th class=\"l\">unit</th></tr>\n";
-    struct Row { const char* key; const char* label; bool angle; };
-    for (const Row& row : {Row{"Ix_kg_m2", "I<sub>x</sub>", false}, Row{"Iz_kg_m2", "I<sub>z</sub>", false},
-                           Row{"Ixz_kg_m2", "I<sub>xz</sub>", false}, Row{"tau_deg", "&tau; (principal inclination)", true},
-                           Row{"Ixp_kg_m2", "I<sub>xp</sub> (principal)", false},
-                           Row{"Izp_kg_m2", "I<sub>zp</sub> (principal)", false}}) {
-      const Estimate e = GetEstimate(ellipse, row.key);
-      if (!e.present) continue;
-      h << "<tr><td class=\"l\">" << row.label << "</td>";
-      if (!e.defined) {
-        h << "<td colspan=\"3\">ill-defined (I<sub>x</sub> &asymp; I<sub>z</sub>)</td>";
-      } else if (row.angle) {
-        h << "<td>" << Fmt(e.value) << "</td><td>" << Fmt(e.std) << "</td><td>[" << Fmt(e.lo)
-          << ", " << Fmt(e.hi) << "]</td>";
-      } else {
-        h << "<td>" << u.Inertia(e.value) << "</td><td>" << u.Inertia(e.std) << "</td><td>["
-          << u.Inertia(e.lo) << ", " << u.Inertia(e.hi) << "]</td>";
-      }
-      h << "<td class=\"l\">" << (row.angle ? "deg" : u.name) << "</td></tr>\n";
-    }
-    h << "</table>\n";
-    const double systematic = Num(results, "systematic_relative_std");
-    h << "<p>Uncertainties above are statistical (scatter between trials and angles). "
-      << "The configured uncertainties of L, D, the masses, g and the gyro scale add a systematic &plusmn;"
-      << Fmt(100.0 * systematic, "%.2f")
-      << " % that scales every moment alike and leaves &tau; unchanged (mean per-trace uncertainty budget).</p>\n";
-    if (ellipse.contains("warnings")) {
-      for (const auto& w : ellipse["warnings"]) {
-        if (w.is_string()) h << "<p class=\"note\">" << Escape(w.get<std::string>()) << "</p>\n";
-      }
-    }
-  } else {
-    h << "<p class=\"bad\">" << Escape(summary.value("ellipse_message", std::string("ellipse not fitted")))
-      << "</p>\n";
-  }
-
-  // Table 1.
-  const json& t1 = results.contains("table1") ? results["table1"] : json::object();
-  h << "<h2>Table 1: data quality</h2>\n<table><tr><th class=\"l\">statistic</th><th>value</th>"
-       "<th class=\"l\">unit</th></tr>\n";
-  h << "<tr><td class=\"l\">raw data &sigma; (mean of per-angle standard deviations)</td><td>"
-    << u.Inertia(Num(t1, "raw_sigma_kg_m2")) << "</td><td class=\"l\">" << u.name << "</td></tr>\n";
-  h << "<tr><td class=\"l\">coefficient of variation (mean per angle)</td><td>"
-    << Fmt(Num(t1, "cv_percent"), "%.4f") << "</td><td class=\"l\">%</td></tr>\n";
-  h << "<tr><td class=\"l\">regression RMSE</td><td>" << u.Inertia(Num(t1, "regression_rmse_kg_m2"))
-    << "</td><td class=\"l\">" << u.name << "</td></tr>\n</table>\n";
-  const json& rig = results.contains("rig") ? results["rig"] : json::object();
-  h << "<p>Rig: L = " << Fmt(Num(rig, "filar_length_m"), "%.4f") << " m, D = "
-    << Fmt(Num(rig, "filar_separation_m"), "%.4f") << " m, rig mass "
-    << Fmt(Num(rig, "mass_kg"), "%.4f") << " kg, aircraft mass "
-    << Fmt(Num(rig, "aircraft_mass_kg"), "%.4f") << " kg, g = "
-    << Fmt(Num(rig, "gravity_mps2"), "%.5f") << " m/s<sup>2</sup>. Rig inertia ("
-    << Escape(Str(rig, "inertia_source")) << "): " << u.Inertia(Num(rig, "inertia_kg_m2"), "%.5f")
-    << " &plusmn; " << u.Inertia(Num(rig, "inertia_std_kg_m2"), "%.2e") << " " << u.name;
-  if (Str(rig, "inertia_source") == "tare") h << " from " << rig.value("tare_n", 0) << " tare log(s)";
-  h << ".</p>\n";
-
-  // Figures 3 and 4.
-  h << "<h2>Figure 3: moment of inertia against pitch</h2>\n"
-    << Figure(out_dir, Str(figures, "moments"), "moments of inertia against pitch angle", "fig", &figures_drawn)
-    << "\n<h2>Figure 4: ellipse of inertia</h2>\n"
-    << Figure(out_dir, Str(figures, "polar"), "polar plot of the ellipse of inertia", "fig", &figures_drawn) << "\n";
-
-  // NACA 467.
-  h << "<h2>NACA Report 467 comparison</h2>\n";
-  if (ellipse.is_object() && ellipse.contains("naca") && !ellipse["naca"].empty()) {
-    const Estimate ixz = GetEstimate(ellipse, "Ixz_kg_m2");
-    h << "<p>I<sub>xz</sub> from one oblique angle (paper Eq. 1) against the multi-angle fit "
-      << u.Inertia(ixz.value) << " &plusmn; " << u.Inertia(ixz.std) << " " << u.name << ".</p>\n"
-      << "<table><tr><th>pitch (deg)</th><th>I<sub>xz</sub> NACA 467</th><th>std</th>"
-         "<th>difference from fit</th></tr>\n";
-    for (const auto& e : ellipse["naca"]) {
-      const double v = Num(e, "Ixz_kg_m2");
-      h << "<tr><td>" << Fmt(Num(e, "pitch_deg"), "%.1f") << "</td><td>" << u.Inertia(v)
-        << "</td><td>" << u.Inertia(Num(e, "Ixz_std_kg_m2")) << "</td><td>"
-        << u.Inertia(v - ixz.value) << "</td></tr>\n";
-    }
-    h << "</table>\n";
-  } else {
-    h << "<p class=\"note\">No NACA 467 estimate (needs the ellipse fit and oblique angles).</p>\n";
-  }
-
-  // Per-angle statistics.
-  h << "<h2>Per-angle statistics</h2>\n<table><tr><th>pitch (deg)</th><th>n</th><th>mean ("
-    << u.name << ")</th><th>std</th><th>sem</th><th>CV (%)</th></tr>\n";
-  for (const auto& a : angles) {
-    h << "<tr><td>" << Fmt(Num(a, "pitch_deg"), "%.2f") << "</td><td>" << a.value("n", 0)
-      << "</td><td>" << u.Inertia(Num(a, "inertia_mean_kg_m2")) << "</td><td>"
-      << u.Inertia(Num(a, "inertia_std_kg_m2"), "%.5f") << "</td><td>"
-      << u.Inertia(Num(a, "inertia_sem_kg_m2"), "%.5f") << "</td><td>"
-      << Fmt(Num(a, "cv_percent"), "%.3f") << "</td></tr>\n";
-  }
-  h << "</table>\n";
-
-  // Rejected traces.
-  h << "<h2>Rejected and failed traces</h2>\n";
-  int bad = 0;
-  std::ostringstream rows;
-  for (const auto& t : traces) {
-    const std::string status = Str(t, "status");
-    if (status == "ok") continue;
-    ++bad;
-    rows << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
-         << "</td><td class=\"l\">" << Escape(status) << "</td><td class=\"l\">"
-         << Escape(Str(t, "message")) << "</td></tr>\n";
-  }
-  if (bad == 0) {
-    h << "<p class=\"ok\">None: every trace passed the quality checks.</p>\n";
-  } else {
-    h << "<table><tr><th class=\"l\">file</th><th class=\"l\">status</th><th class=\"l\">reason</th></tr>\n"
-      << rows.str() << "</table>\n";
-  }
-
-  // All traces.
-  h << "<h2>Traces</h2>\n<table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"
-       "<th class=\"l\">status</th><th>pitch (deg)</th><th>I total (" << u.name
-    << ")</th><th>std</th><th>I aircraft</th><th>std</th><th>window (s)</th>"
-       "<th>amplitude (deg)</th><th>rms/noise</th></tr>\n";
-  for (const auto& t : traces) {
-    const std::string status = Str(t, "status");
-    std::string window = "&ndash;", amplitude = "&ndash;";
-    if (t.contains("window_s") && t["window_s"].is_array()) {
-      window = Fmt(t["window_s"][0].get<double>(), "%.2f") + "&ndash;" +
-               Fmt(t["window_s"][1].get<double>(), "%.2f");
-    }
-    if (t.contains("amplitude_deg") && t["amplitude_deg"].is_array()) {
-      amplitude = Fmt(t["amplitude_deg"][0].get<double>(), "%.1f") + "&rarr;" +
-                  Fmt(t["amplitude_deg"][1].get<double>(), "%.1f");
-    }
-    h << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
-      << "</td><td class=\"l\">" << Escape(Str(t, "role")) << "</td><td class=\"l\">"
-      << Escape(status) << "</td><td>" << Fmt(Num(t, "pitch_used_deg"), "%.2f") << "</td><td>"
-      << u.Inertia(Num(t, "inertia_total_kg_m2"), "%.5f") << "</td><td>"
-      << u.Inertia(Num(t, "inertia_total_std_kg_m2"), "%.2e") << "</td><td>"
-      << u.Inertia(Num(t, "inertia_kg_m2"), "%.5f") << "</td><td>"
-      << u.Inertia(Num(t, "inertia_std_kg_m2"), "%.2e") << "</td><td>" << window << "</td><td>"
-      << amplitude << "</td><td>"
-      << Fmt(Num(t, "residual_rms_rad_per_s") / Num(t, "noise_rms_rad_per_s"), "%.2f")
-      << "</td></tr>\n";
-  }
-  h << "</table>\n";
-
-  h << "<h2>Fit and residual of every trace</h2>\n<div class=\"traces\">\n";
-  for (const auto& t : traces) {
-    const std::string fig = Str(t, "figure");
-    if (fig.empty()) continue;
-    h << "<figure>" << Figure(out_dir, fig, "fit of " + Str(t, "file"), "trace", &figures_drawn)
-      << "<figcaption>" << Escape(Str(t, "file")) << " &middot; " << Escape(Str(t, "status"))
-      << "</figcaption></figure>\n" << SweepFigure(t, out_dir, &figures_drawn);
-  }
-  h << "</div>\n";
-
-  h << "<h2>Config used</h2>\n<pre>" << Escape(Str(results, "config")) << "</pre>\n";
-  h << "</body></html>\n";
+  WriteHeader(page, h);
+  WriteTable2(page, h);
+  WriteTable1AndRig(page, h);
+  WriteEllipseSection(page, h);
+  WriteAngleTable(page, h);
+  WriteRejectedTraces(page, h);
+  WriteTraceTable(page, h);
+  WriteTraceFigures(page, h);
+  WriteFooter(page, h);
   return h.str();
 }
 

@@ -134,6 +134,17 @@ TEST(Messages, RunsPatternCannotLeaveTheRoot) {
   EXPECT_NE(message.find("must stay inside runs.root"), std::string::npos) << message;
 }
 
+TEST(Messages, RunsPatternHoldsThePitchOnce) {
+  // It used to be checked per component only: the second one silently won.
+  TempDir dir;
+  WriteFile(dir.path + "/c.yaml",
+            "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.1}}\n"
+            "aircraft: {mass_kg: 1}\nruns:\n  root: .\n  pattern: 'p{pitch_deg}/{pitch_deg}.csv'\n");
+  const std::string message = ErrorOf([&] { LoadCampaignConfig(dir.path + "/c.yaml"); });
+  EXPECT_NE(message.find("c.yaml:5"), std::string::npos) << message;
+  EXPECT_NE(message.find("{pitch_deg} only once"), std::string::npos) << message;
+}
+
 TEST(Messages, TareLogListedTwiceIsOneLog) {
   TempDir dir;
   WriteFile(dir.path + "/logs/p0.csv", "x");

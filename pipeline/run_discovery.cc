@@ -1,0 +1,350 @@
+#include "pipeline/run_discovery.h"
+
+#include <fnmatch.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "pipeline/user_error.h"
+
+namespace bifilar {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---- Patterns ---------------------------------------------------------------------------------
+// Matching a name is fnmatch(3)'s job. The walk over folders is our own, in a few lines, because
+// glob(3) does not fit the rules: without GLOB_PERIOD its `*` skips names starting with '.',
+// with it `*` also matches the "." and ".." entries (so `*/x.csv` would look above runs.root),
+// and it cannot say what text {pitch_deg} stood for.
+
+bool HasWildcard(const std::string& component) {
+  return component.find_first_of("*?{") != std::string::npos;
+}
+
+std::vector<std::string> SplitPath(const std::string& pattern) {
+  std::vector<std::string> parts;
+  std::string part;
+  for (char c : pattern) {
+    if (c == '/') {
+      if (!part.empty()) parts.push_back(part);
+      part.clear();
+    } else {
+      part += c;
+    }
+  }
+  if (!part.empty()) parts.push_back(part);
+  return parts;
+}
+
+// One wildcard component as fnmatch(3) patterns. '[' and '\' are literal in our rules, so they
+// are escaped; {pitch_deg} splits the component into the parts before and after the capture.
+struct ComponentPattern {
+  std::string whole;          // the component, {pitch_deg} as '*'
+  bool captures = false;      // holds {pitch_deg}
+  std::string before, after;  // around {pitch_deg} (when `captures`)
+};
+
+ComponentPattern ParseComponent(const std::string& component) {
+  ComponentPattern p;
+  std::string* side = &p.before;
+  for (size_t i = 0; i < component.size(); ++i) {
+    const char c = component[i];
+    if (c == '{') {
+      const size_t end = component.find('}', i);
+      const std::string name = end == std::string::npos ? "" : component.substr(i + 1, end - i - 1);
+      if (name != "pitch_deg") {
+        throw UserError("runs.pattern: unknown placeholder in '" + component +
+                        "' (only {pitch_deg} is known)");
+      }
+      if (p.captures) throw UserError("runs.pattern: {pitch_deg} may appear only once");
+      p.captures = true;
+      p.whole += '*';
+      side = &p.after;
+      i = end;
+      continue;
+    }
+    const std::string literal = c == '[' || c == '\\' ? std::string("\\") + c : std::string(1, c);
+    p.whole += literal;
+    *side += literal;
+  }
+  return p;
+}
+
+bool FnMatch(const std::string& pattern, const std::string& name) {
+  return ::fnmatch(pattern.c_str(), name.c_str(), 0) == 0;
+}
+
+// Whether `name` matches; with {pitch_deg}, *pitch_text is the shortest text after the longest
+// prefix that matches the part before it.
+bool MatchComponent(const ComponentPattern& p, const std::string& name,
+                    std::optional<std::string>* pitch_text) {
+  if (!FnMatch(p.whole, name)) return false;
+  if (!p.captures) return true;
+  for (size_t i = name.size() + 1; i-- > 0;) {
+    if (!FnMatch(p.before, name.substr(0, i))) continue;
+    for (size_t j = i; j <= name.size(); ++j) {
+      if (FnMatch(p.after, name.substr(j))) {
+        *pitch_text = name.substr(i, j - i);
+        return true;
+      }
+    }
+  }
+  return false;  // unreachable: `whole` matched
+}
+
+struct PatternHit {
+  std::string path;
+  std::optional<std::string> pitch_text;  // what {pitch_deg} stood for
+};
+
+// Depth-first from `dir`, entries in name order: files (not folders) matching the last
+// component, through folders matching the others. A literal component is looked up directly.
+void WalkPattern(const fs::path& dir, const std::vector<std::string>& parts, size_t index,
+                 const std::optional<std::string>& pitch_text, std::vector<PatternHit>* hits) {
+  const bool last = index + 1 == parts.size();
+  const std::string& part = parts[index];
+  std::error_code ec;
+  if (!HasWildcard(part)) {
+    const fs::path next = dir / part;
+    if (last) {
+      if (fs::exists(next, ec)) hits->push_back({next.string(), pitch_text});
+    } else if (fs::is_directory(next, ec)) {
+      WalkPattern(next, parts, index + 1, pitch_text, hits);
+    }
+    return;
+  }
+  const ComponentPattern pattern = ParseComponent(part);
+  std::vector<fs::path> entries;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    entries.push_back(it->path());
+  }
+  std::sort(entries.begin(), entries.end());
+  for (const fs::path& entry : entries) {
+    std::optional<std::string> text = pitch_text;
+    if (!MatchComponent(pattern, entry.filename().string(), &text)) continue;
+    if (last) {
+      if (!fs::is_directory(entry, ec)) hits->push_back({entry.string(), text});
+    } else if (fs::is_directory(entry, ec)) {
+      WalkPattern(entry, parts, index + 1, text, hits);
+    }
+  }
+}
+
+// ---- Names and pitches ------------------------------------------------------------------------
+
+// A pitch written in a path: "-80", "10", "12.5", "+5", "m80" (minus), "p10" (plus).
+bool ParsePitchText(std::string text, double* pitch_deg) {
+  double sign = 1.0;
+  if (!text.empty() && (text[0] == 'm' || text[0] == 'n')) {
+    sign = -1.0;
+    text = text.substr(1);
+  } else if (!text.empty() && text[0] == 'p') {
+    text = text.substr(1);
+  }
+  if (text.empty()) return false;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size() || !std::isfinite(value)) return false;
+  *pitch_deg = sign * value;
+  return *pitch_deg >= -180.0 && *pitch_deg <= 180.0;
+}
+
+// How a log is named to the user: relative to runs.root when inside it (pitch_10/trial_1.csv),
+// else relative to the config folder, else the absolute path.
+std::string Display(const CampaignConfig& config, const std::string& path) {
+  for (const std::string& base : {config.runs.root, config.folder}) {
+    if (base.empty()) continue;
+    const std::string rel = fs::path(path).lexically_relative(base).string();
+    if (!rel.empty() && rel.rfind("..", 0) != 0) return rel;
+  }
+  return path;
+}
+
+std::vector<std::string> SplitCsvLine(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  bool quoted = false;
+  for (char c : line) {
+    if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      cells.push_back(cell);
+      cell.clear();
+    } else if (c != '\r') {
+      cell += c;
+    }
+  }
+  cells.push_back(cell);
+  for (std::string& s : cells) {
+    while (!s.empty() && s.front() == ' ') s.erase(s.begin());
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+  }
+  return cells;
+}
+
+// ---- The three sources ------------------------------------------------------------------------
+
+// runs.table: one row per log, its pitch in a column.
+std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
+  std::ifstream in(config.runs.table);
+  if (!in) throw UserError(config.runs.table + ": cannot open runs table (runs.table)");
+  std::vector<RunFile> runs;
+  std::string line;
+  int line_no = 0;
+  int path_col = -1, pitch_col = -1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.find_first_not_of(" \r\t") == std::string::npos) continue;
+    const std::vector<std::string> cells = SplitCsvLine(line);
+    if (path_col < 0) {
+      for (size_t i = 0; i < cells.size(); ++i) {
+        if (cells[i] == "path" || cells[i] == "file") path_col = static_cast<int>(i);
+        if (cells[i] == "pitch_deg") pitch_col = static_cast<int>(i);
+      }
+      if (path_col < 0 || pitch_col < 0) {
+        throw UserError(config.runs.table + ":" + std::to_string(line_no) +
+                        ": runs table needs a header with columns 'path' and 'pitch_deg'");
+      }
+      continue;
+    }
+    RunFile run;
+    const std::string rel = static_cast<int>(cells.size()) > path_col ? cells[path_col] : "";
+    run.path = ResolvePath(config.runs.root, rel);
+    run.display = Display(config, run.path);
+    double pitch = 0.0;
+    if (rel.empty()) {
+      run.display = config.runs.table + ":" + std::to_string(line_no);
+      run.error = run.display + ": empty path in runs table";
+    } else if (static_cast<int>(cells.size()) <= pitch_col ||
+               !ParsePitchText(cells[pitch_col], &pitch)) {
+      run.error = config.runs.table + ":" + std::to_string(line_no) + ": pitch of '" + rel +
+                  "' is not a number in [-180, 180]";
+    } else {
+      run.pitch_nominal_deg = pitch;
+      std::error_code ec;
+      if (!fs::exists(run.path, ec)) {
+        run.error = run.display + ": listed in " + config.runs.table + ":" +
+                    std::to_string(line_no) + " but not found";
+      }
+    }
+    runs.push_back(run);
+  }
+  return runs;
+}
+
+// runs.pattern under runs.root, the pitch from {pitch_deg}.
+std::vector<RunFile> DiscoverPattern(const CampaignConfig& config) {
+  const std::vector<std::string> parts = SplitPath(config.runs.pattern);
+  if (parts.empty()) throw UserError("runs.pattern is empty");
+  std::vector<PatternHit> hits;
+  WalkPattern(config.runs.root, parts, 0, std::nullopt, &hits);
+  std::vector<RunFile> runs;
+  for (const PatternHit& hit : hits) {
+    RunFile run;
+    run.path = fs::path(hit.path).lexically_normal().string();
+    run.display = Display(config, run.path);
+    double pitch = 0.0;
+    if (hit.pitch_text) {
+      if (ParsePitchText(*hit.pitch_text, &pitch)) {
+        run.pitch_nominal_deg = pitch;
+      } else {
+        run.error = run.display + ": cannot read the pitch from the path ('" + *hit.pitch_text +
+                    "' in pattern " + config.runs.pattern + " is not a number in [-180, 180])";
+      }
+    } else if (config.runs.pitch_source == PitchSource::kNominal) {
+      run.error = run.display + ": runs.pattern has no {pitch_deg} and pitch_source is nominal";
+    }
+    runs.push_back(run);
+  }
+  if (runs.empty()) {
+    throw UserError("runs: no file matches '" + config.runs.pattern + "' under " +
+                    config.runs.root);
+  }
+  return runs;
+}
+
+// rig.inertia.tare.logs: plain file names, or patterns whose leading literal folders must exist.
+std::vector<RunFile> DiscoverTare(const CampaignConfig& config) {
+  std::vector<RunFile> tare;
+  for (const std::string& pattern : config.rig_inertia.tare_patterns) {
+    const std::vector<std::string> parts = SplitPath(pattern);
+    size_t fixed = 0;
+    while (fixed < parts.size() && !HasWildcard(parts[fixed])) ++fixed;
+    if (fixed == parts.size()) {  // a plain file name
+      RunFile run;
+      run.path = pattern;
+      run.display = Display(config, pattern);
+      run.role = TraceRole::kTare;
+      std::error_code ec;
+      if (!fs::exists(pattern, ec)) run.error = run.display + ": tare log not found";
+      tare.push_back(run);
+      continue;
+    }
+    fs::path dir = pattern.rfind('/', 0) == 0 ? fs::path("/") : fs::path(".");
+    for (size_t i = 0; i < fixed; ++i) dir /= parts[i];
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) {
+      throw UserError("rig.inertia.tare.logs: folder '" + dir.string() + "' does not exist");
+    }
+    const std::vector<std::string> rest(parts.begin() + fixed, parts.end());
+    for (const std::string& part : rest) {
+      if (part.find('{') != std::string::npos) {
+        throw UserError("rig.inertia.tare.logs: placeholders are not allowed in tare patterns");
+      }
+    }
+    std::vector<PatternHit> hits;
+    WalkPattern(dir, rest, 0, std::nullopt, &hits);
+    if (hits.empty()) {
+      throw UserError("rig.inertia.tare.logs: no file matches '" + pattern + "'");
+    }
+    for (const PatternHit& hit : hits) {
+      RunFile run;
+      run.path = fs::path(hit.path).lexically_normal().string();
+      run.display = Display(config, run.path);
+      run.role = TraceRole::kTare;
+      tare.push_back(run);
+    }
+  }
+  return tare;
+}
+
+// A file matched twice (two tare patterns, a table row repeated) is one log; matched as an
+// aircraft run and as a tare log it is an error row, not "the same content as" itself.
+std::vector<RunFile> OncePerPath(std::vector<RunFile> runs) {
+  std::map<std::string, TraceRole> seen;
+  std::vector<RunFile> unique;
+  for (RunFile& run : runs) {
+    auto [it, inserted] = seen.emplace(run.path, run.role);
+    if (inserted) {
+      unique.push_back(std::move(run));
+    } else if (it->second != run.role && run.error.empty()) {
+      run.error = run.display + ": listed both as an aircraft run and as a tare log";
+      unique.push_back(std::move(run));
+    }
+  }
+  return unique;
+}
+
+}  // namespace
+
+std::vector<RunFile> DiscoverRuns(const CampaignConfig& config) {
+  if (config.runs.root.empty()) throw UserError(config.file + ": no 'runs' section");
+  std::error_code ec;
+  if (!fs::is_directory(config.runs.root, ec)) {
+    throw UserError("runs.root: folder '" + config.runs.root + "' does not exist");
+  }
+  std::vector<RunFile> runs =
+      config.runs.table.empty() ? DiscoverPattern(config) : DiscoverTable(config);
+  if (config.rig_inertia.kind == RigInertiaSpec::Kind::kTare) {
+    std::vector<RunFile> tare = DiscoverTare(config);
+    runs.insert(runs.end(), tare.begin(), tare.end());
+  }
+  return OncePerPath(std::move(runs));
+}
+
+}  // namespace bifilar

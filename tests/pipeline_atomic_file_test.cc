@@ -1,0 +1,119 @@
+// WriteFileAtomically (pipeline/atomic_file.h): the file appears whole or not at all, and a
+// target that is not a regular file (folder, device, FIFO) is refused with its path named and
+// left as it was.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "pipeline/atomic_file.h"
+#include "pipeline/user_error.h"
+
+namespace bifilar {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct TempDir {
+  TempDir() {
+    path = fs::temp_directory_path() / ("bifilar_atomic_" + std::to_string(::getpid()));
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+  fs::path path;
+};
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The message of the UserError `fn` throws ("" when it throws none).
+template <typename Fn>
+std::string ErrorOf(Fn fn) {
+  try {
+    fn();
+  } catch (const UserError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Nothing but `expected` in `dir`: no temporary file left behind.
+void ExpectOnly(const fs::path& dir, const std::vector<std::string>& expected) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, expected);
+}
+
+TEST(AtomicFile, WritesAndReplacesARegularFileAndCreatesFolders) {
+  TempDir dir;
+  const fs::path file = dir.path / "sub" / "a.txt";
+  WriteFileAtomically(file.string(), "first");
+  EXPECT_EQ(ReadFile(file), "first");
+  WriteFileAtomically(file.string(), std::string("second\0with nul", 15));
+  EXPECT_EQ(ReadFile(file), std::string("second\0with nul", 15));
+  ExpectOnly(dir.path / "sub", {"a.txt"});
+  EXPECT_EQ(AtomicTemporaryName("x/y.json"), "x/y.json.tmp." + std::to_string(::getpid()));
+}
+
+TEST(AtomicFile, RefusesAFolder) {
+  TempDir dir;
+  fs::create_directories(dir.path / "results.json");
+  const std::string target = (dir.path / "results.json").string();
+  const std::string message = ErrorOf([&] { WriteFileAtomically(target, "x"); });
+  EXPECT_EQ(message, target + ": is a folder, expected a file name");
+  EXPECT_TRUE(fs::is_directory(target));
+  ExpectOnly(dir.path, {"results.json"});
+}
+
+TEST(AtomicFile, RefusesAFifoAndLeavesItAFifo) {
+  TempDir dir;
+  const fs::path fifo = dir.path / "traces.csv";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string message = ErrorOf([&] { WriteFileAtomically(fifo.string(), "x"); });
+  EXPECT_EQ(message.rfind(fifo.string() + ": exists and is not a regular file", 0), 0u) << message;
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+  ExpectOnly(dir.path, {"traces.csv"});
+  // A link to it is the same target.
+  fs::create_symlink(fifo, dir.path / "link.csv");
+  EXPECT_NE(ErrorOf([&] {
+              WriteFileAtomically((dir.path / "link.csv").string(), "x");
+            }).find("is not a regular file"),
+            std::string::npos);
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir.path / "link.csv")));
+}
+
+TEST(AtomicFile, RefusesADevice) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full here";
+  // Through a link in our own folder: were the check ever lost, the rename would replace the
+  // link, never /dev/full itself (the tests may run as root).
+  TempDir dir;
+  const fs::path link = dir.path / "report.html";
+  fs::create_symlink("/dev/full", link);
+  const std::string message = ErrorOf([&] { WriteFileAtomically(link.string(), "x"); });
+  EXPECT_EQ(message.rfind(link.string() + ": exists and is not a regular file", 0), 0u) << message;
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+  ExpectOnly(dir.path, {"report.html"});
+}
+
+TEST(AtomicFile, ReplacesTheLinkToARegularFileNotItsTarget) {
+  TempDir dir;
+  std::ofstream(dir.path / "real.txt") << "real";
+  fs::create_symlink(dir.path / "real.txt", dir.path / "link.txt");
+  WriteFileAtomically((dir.path / "link.txt").string(), "new");
+  EXPECT_EQ(ReadFile(dir.path / "link.txt"), "new");
+  EXPECT_EQ(ReadFile(dir.path / "real.txt"), "real");  // unchanged: rename replaced the link
+  EXPECT_FALSE(fs::is_symlink(fs::symlink_status(dir.path / "link.txt")));
+}
+
+}  // namespace
+}  // namespace bifilar
