@@ -11,6 +11,7 @@
 #include "fit/window.h"
 #include "pipeline/cli_commands.h"
 #include "pipeline/config.h"
+#include "pipeline/repeats.h"
 #include "pipeline/results_json.h"
 #include "pipeline/trace_process.h"
 
@@ -69,6 +70,26 @@ std::string HumanLine(const TraceRecord& r) {
   return line;
 }
 
+nlohmann::json RepeatGroupsToJson(const std::vector<RepeatGroup>& groups) {
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  nlohmann::json out = nlohmann::json::array();
+  for (const RepeatGroup& g : groups) {
+    out.push_back({{"name", g.name},
+                   {"members", g.members},
+                   {"n_used", g.n_used},
+                   {"mean_kg_m2", number(g.mean_kg_m2)},
+                   {"mean_std_kg_m2", number(g.mean_std_kg_m2)},
+                   {"plain_mean_kg_m2", number(g.plain_mean_kg_m2)},
+                   {"q", number(g.q)},
+                   {"tau_kg_m2", number(g.tau_kg_m2)},
+                   {"max_abs_z", number(g.max_abs_z)},
+                   {"amplitude_trend_percent_per_10deg", number(g.amplitude_trend_percent_per_10deg)},
+                   {"amplitude_trend_z", number(g.amplitude_trend_z)},
+                   {"note", g.note}});
+  }
+  return out;
+}
+
 }  // namespace
 
 void RegisterFitCommand(CLI::App& app, int* exit_code) {
@@ -76,6 +97,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     std::string config;
     std::vector<std::string> logs;
     bool json = false;
+    bool repeats = false;
     std::string model, integrator, window, plot_dir;
     double max_amplitude_deg = NAN;
   };
@@ -99,6 +121,9 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
   sub->add_option("--plot", args->plot_dir,
                   "write fit figures DIR/<log>.svg and .png, and the amplitude sweep (I against "
                   "amplitude) DIR/<log>_sweep.svg and .png when the trace has one");
+  sub->add_flag("--repeats", args->repeats,
+                "combine repeats: logs whose paths differ only in the last number of the file "
+                "name are swings of one set-up; their scatter beyond their stds is added to each");
   sub->callback([args, exit_code] {
     ConfigLoadOptions load;
     load.require_runs = false;
@@ -125,7 +150,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
         throw UserError("--plot " + args->plot_dir + ": cannot create folder");
       }
     }
-    nlohmann::json records = nlohmann::json::array();
+    std::vector<TraceRecord> records;
     int failed = 0;
     for (const std::string& log : args->logs) {
       TraceProcessOptions trace = options;
@@ -135,16 +160,27 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
         trace.figure_paths = {base + ".svg", base + ".png"};
         trace.sweep_figure_paths = {base + "_sweep.svg", base + "_sweep.png"};
       }
-      const TraceRecord record = ProcessTrace(config, log, trace);
-      if (!record.ok()) ++failed;
-      if (args->json) {
-        records.push_back(TraceRecordToJson(record, false));
-      } else {
-        std::cout << HumanLine(record) << std::endl;
-      }
+      records.push_back(ProcessTrace(config, log, trace));
+      if (!records.back().ok()) ++failed;
+      // Without --repeats each line is printed as soon as its log is fitted.
+      if (!args->json && !args->repeats) std::cout << HumanLine(records.back()) << std::endl;
     }
-    // Invalid UTF-8 (a log's bytes in a message) is replaced, never a json exception.
-    if (args->json) std::cout << records.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+    std::vector<RepeatGroup> groups;
+    if (args->repeats) {
+      groups = GroupRepeats(args->logs);
+      CombineRepeats(&groups, &records);
+    }
+    if (args->json) {
+      nlohmann::json traces = nlohmann::json::array();
+      for (const TraceRecord& r : records) traces.push_back(TraceRecordToJson(r, false));
+      nlohmann::json out = traces;
+      if (args->repeats) out = {{"traces", traces}, {"repeats", RepeatGroupsToJson(groups)}};
+      // Invalid UTF-8 (a log's bytes in a message) is replaced, never a json exception.
+      std::cout << out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+    } else if (args->repeats) {
+      for (const TraceRecord& r : records) std::cout << HumanLine(r) << std::endl;
+      for (const RepeatGroup& g : groups) std::cout << RepeatGroupLine(g) << std::endl;
+    }
     *exit_code = failed > 0 ? 1 : 0;
   });
 }

@@ -208,6 +208,8 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
                       {"iid_kg_m2", Number(r.inertia_iid_std_kg_m2)},
                       {"hac_bandwidth", r.hac_bandwidth},
                       {"model_inadequacy_kg_m2", Number(r.model_inadequacy_std_kg_m2)}};
+  if (std::isfinite(r.repeat_scatter_std_kg_m2))
+    j["uncertainty"]["repeat_scatter_kg_m2"] = r.repeat_scatter_std_kg_m2;
   j["amplitude_sweep"] = SweepToJson(r.sweep);
   if (campaign_fields) {
     j["role"] = ToString(r.role);
@@ -283,6 +285,8 @@ TraceRecord TraceRecordFromJson(const json& j) {
     r.inertia_iid_std_kg_m2 = GetNumber(*it, "iid_kg_m2");
     r.hac_bandwidth = it->value("hac_bandwidth", 0);
     r.model_inadequacy_std_kg_m2 = GetNumber(*it, "model_inadequacy_kg_m2");
+    if (it->contains("repeat_scatter_kg_m2"))
+      r.repeat_scatter_std_kg_m2 = GetNumber(*it, "repeat_scatter_kg_m2");
   }
   if (auto it = j.find("amplitude_sweep"); it != j.end() && it->is_object()) r.sweep = SweepFromJson(*it);
   if (j.contains("role")) r.role = GetString(j, "role") == "tare" ? TraceRole::kTare : TraceRole::kAircraft;

@@ -74,6 +74,8 @@ struct TraceRecord {
   double inertia_stat_std_kg_m2 = NAN;   // statistical (HAC) std of I
   double inertia_iid_std_kg_m2 = NAN;    // textbook std assuming white residuals (comparison)
   double model_inadequacy_std_kg_m2 = NAN;  // from the amplitude sweep's trend (0: none)
+  // Between-repeat std added by `bifilar fit --repeats` (pipeline/repeats.h); NaN: not combined.
+  double repeat_scatter_std_kg_m2 = NAN;
   int hac_bandwidth = 0;
   AmplitudeSweep sweep;                  // I against amplitude
 

@@ -1,0 +1,182 @@
+#include "pipeline/repeats.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+
+#include <Eigen/Dense>
+
+namespace bifilar {
+namespace {
+
+// "logs/BaseModel_Ixx_Log-3.csv" -> "logs/BaseModel_Ixx_Log-*.csv": the last run of digits in
+// the file name (not the folders) becomes '*'.
+std::string RepeatKey(const std::string& path) {
+  const size_t name_start = path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1;
+  size_t end = path.size();
+  while (end > name_start && !std::isdigit(static_cast<unsigned char>(path[end - 1]))) --end;
+  if (end == name_start) return path;
+  size_t begin = end;
+  while (begin > name_start && std::isdigit(static_cast<unsigned char>(path[begin - 1]))) --begin;
+  return path.substr(0, begin) + "*" + path.substr(end);
+}
+
+bool Usable(const TraceRecord& r) {
+  return r.ok() && std::isfinite(r.inertia_total_kg_m2) && std::isfinite(r.inertia_total_std_kg_m2) &&
+         r.inertia_total_std_kg_m2 > 0.0;
+}
+
+// Mean squared amplitude (deg^2) of the part of the log the result comes from.
+double ResultAmplitudeSquared(const TraceRecord& r) {
+  if (r.inertia_source == "low_amplitude_band" && r.sweep.low_band >= 0 &&
+      r.sweep.low_band < static_cast<int>(r.sweep.bands.size())) {
+    const double a = r.sweep.bands[r.sweep.low_band].amplitude_mean_deg;
+    return a * a;
+  }
+  return 0.5 * (r.amplitude_deg[0] * r.amplitude_deg[0] + r.amplitude_deg[1] * r.amplitude_deg[1]);
+}
+
+// Weighted line of I / reference against A^2 over the used members: the slope in % per 10 deg
+// at the members' amplitudes and its z (std scaled by the Birge ratio when the points scatter
+// about the line more than their stds).
+void AmplitudeTrend(const std::vector<const TraceRecord*>& used, double reference,
+                    RepeatGroup* group) {
+  if (used.size() < 3) return;
+  Eigen::Matrix2d xtwx = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d xtwy = Eigen::Vector2d::Zero();
+  double a_min = HUGE_VAL, a_max = 0.0;
+  for (const TraceRecord* r : used) {
+    const double x = ResultAmplitudeSquared(*r), s = r->inertia_total_std_kg_m2 / reference;
+    if (!std::isfinite(x)) return;
+    const Eigen::Vector2d row(1.0, x);
+    xtwx += row * row.transpose() / (s * s);
+    xtwy += row * (r->inertia_total_kg_m2 / reference) / (s * s);
+    a_min = std::min(a_min, std::sqrt(x));
+    a_max = std::max(a_max, std::sqrt(x));
+  }
+  if (!(a_max > a_min + 0.1) || !(std::abs(xtwx.determinant()) > 0.0)) return;
+  const Eigen::Matrix2d cov = xtwx.inverse();
+  const Eigen::Vector2d coef = cov * xtwy;
+  double chi2 = 0.0;
+  for (const TraceRecord* r : used) {
+    const double s = r->inertia_total_std_kg_m2 / reference;
+    chi2 += std::pow((r->inertia_total_kg_m2 / reference - coef(0) - coef(1) * ResultAmplitudeSquared(*r)) / s, 2);
+  }
+  const double dof = static_cast<double>(used.size()) - 2.0;
+  const double birge = chi2 > dof ? chi2 / dof : 1.0;
+  const double c = coef(1) / coef(0), c_std = std::sqrt(cov(1, 1) * birge) / coef(0);
+  group->amplitude_trend_percent_per_10deg = 100.0 * c * (a_max + a_min) * 10.0;
+  group->amplitude_trend_z = c_std > 0.0 ? c / c_std : NAN;
+}
+
+void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
+  std::vector<const TraceRecord*> used;
+  for (int i : group->members) {
+    if (Usable((*records)[i])) used.push_back(&(*records)[i]);
+  }
+  group->n_used = static_cast<int>(used.size());
+  if (used.size() < 2) {
+    group->note = std::to_string(used.size()) + " usable repeat(s) of " +
+                  std::to_string(group->members.size()) + ": nothing to combine";
+    return;
+  }
+  // DerSimonian-Laird: Q about the fixed-effect mean, tau^2 = max(0, (Q - (k - 1)) / c).
+  double sw = 0.0, sw2 = 0.0, swy = 0.0, plain = 0.0;
+  for (const TraceRecord* r : used) {
+    const double w = 1.0 / (r->inertia_total_std_kg_m2 * r->inertia_total_std_kg_m2);
+    sw += w;
+    sw2 += w * w;
+    swy += w * r->inertia_total_kg_m2;
+    plain += r->inertia_total_kg_m2;
+  }
+  const double k = static_cast<double>(used.size());
+  const double fixed_mean = swy / sw;
+  group->plain_mean_kg_m2 = plain / k;
+  double q = 0.0;
+  for (const TraceRecord* r : used) {
+    q += std::pow((r->inertia_total_kg_m2 - fixed_mean) / r->inertia_total_std_kg_m2, 2);
+  }
+  group->q = q;
+  const double tau2 = std::max(0.0, (q - (k - 1.0)) / (sw - sw2 / sw));
+  group->tau_kg_m2 = std::sqrt(tau2);
+  // The trend is judged on the per-log stds, before tau (which would absorb it).
+  AmplitudeTrend(used, group->plain_mean_kg_m2, group);
+  double sw_re = 0.0, swy_re = 0.0;
+  group->max_abs_z = 0.0;
+  for (int i : group->members) {
+    TraceRecord& r = (*records)[i];
+    if (!Usable(r)) continue;
+    r.repeat_scatter_std_kg_m2 = group->tau_kg_m2;
+    r.inertia_total_std_kg_m2 = std::hypot(r.inertia_total_std_kg_m2, group->tau_kg_m2);
+    const double w = 1.0 / (r.inertia_total_std_kg_m2 * r.inertia_total_std_kg_m2);
+    sw_re += w;
+    swy_re += w * r.inertia_total_kg_m2;
+    group->max_abs_z = std::max(
+        group->max_abs_z,
+        std::abs(r.inertia_total_kg_m2 - group->plain_mean_kg_m2) / r.inertia_total_std_kg_m2);
+    if (tau2 > 0.0) {
+      char text[320];
+      std::snprintf(text, sizeof(text),
+                    "the %d repeats of %s scatter beyond their own stds (Q = %.1f on %d dof): "
+                    "a between-repeat std of %.3g kg m^2 (%.2f %%) is added to this log's std",
+                    group->n_used, group->name.c_str(), q, group->n_used - 1, group->tau_kg_m2,
+                    100.0 * group->tau_kg_m2 / group->plain_mean_kg_m2);
+      r.warnings.push_back(text);
+      r.flags.push_back("repeat_scatter");
+    }
+  }
+  group->mean_kg_m2 = swy_re / sw_re;
+  group->mean_std_kg_m2 = 1.0 / std::sqrt(sw_re);
+}
+
+}  // namespace
+
+std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths) {
+  std::vector<RepeatGroup> groups;
+  std::map<std::string, size_t> index;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    const std::string key = RepeatKey(paths[i]);
+    auto [it, inserted] = index.emplace(key, groups.size());
+    if (inserted) {
+      groups.emplace_back();
+      groups.back().name = key;
+    }
+    groups[it->second].members.push_back(static_cast<int>(i));
+  }
+  return groups;
+}
+
+void CombineRepeats(std::vector<RepeatGroup>* groups, std::vector<TraceRecord>* records) {
+  for (RepeatGroup& g : *groups) Combine(&g, records);
+}
+
+std::string RepeatGroupLine(const RepeatGroup& g) {
+  char buffer[640];
+  if (!g.note.empty()) {
+    std::snprintf(buffer, sizeof(buffer), "repeats %s: %s", g.name.c_str(), g.note.c_str());
+    return buffer;
+  }
+  std::snprintf(buffer, sizeof(buffer),
+                "repeats %s: I = %#.5g +- %.2g kg m^2 (random-effects mean of %d; Q = %.1f on %d "
+                "dof; between-repeat std %.2g kg m^2 = %.2f %% added to each log; every log within "
+                "%.1f sigma of the mean)",
+                g.name.c_str(), g.mean_kg_m2, g.mean_std_kg_m2, g.n_used, g.q, g.n_used - 1,
+                g.tau_kg_m2, 100.0 * g.tau_kg_m2 / g.plain_mean_kg_m2, g.max_abs_z);
+  std::string line = buffer;
+  if (std::isfinite(g.amplitude_trend_z)) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "\n    across the repeats I changes by %+.2g %% per 10 deg of amplitude (z = %.1f)%s",
+                  g.amplitude_trend_percent_per_10deg, g.amplitude_trend_z,
+                  std::abs(g.amplitude_trend_z) > 3.0
+                      ? ": the rig departs from the ideal model; release every repeat at the same "
+                        "small amplitude"
+                      : "");
+    line += buffer;
+  }
+  return line;
+}
+
+}  // namespace bifilar
