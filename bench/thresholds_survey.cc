@@ -389,7 +389,10 @@ void PrintTable(const std::vector<DataSet>& sets) {
       if (!s.reason.empty()) {
         // Up to the first number, so that one reason with different values is counted once.
         std::string r = s.reason.substr(0, s.reason.find_first_of("0123456789"));
-        if (r.size() > 100) r = r.substr(0, 100) + "…";
+        const bool cut = r.size() < s.reason.size();
+        while (!r.empty() && std::string(" ([:=").find(r.back()) != std::string::npos) r.pop_back();
+        if (r.size() > 100) r = r.substr(0, 100);
+        if (cut) r += " …";
         ++reasons[set.name + ": " + r];
       }
   if (!reasons.empty()) std::printf("\nRejected / error:\n\n");
