@@ -4,7 +4,10 @@
 // and irregular 30 Hz sampling, on deliberately bad simulated data, and on the sample campaign.
 // Prints one Markdown table (README, "What the defaults pass and reject").
 //
-//   build/bifilar_thresholds_survey [DATA_DIR]     (DATA_DIR default: <source>/../shared/data)
+//   build/bench/bifilar_thresholds_survey [DATA_DIR]
+//
+// DATA_DIR holds crazyflie/*.csv (the 24 public Crazyflie logs) and px4/*.ulg; without it the
+// real-log rows say "absent".
 //
 // Every threshold is the default of TraceFitOptions / GlitchOptions: nothing here sets one.
 // Data sets that are absent are listed as such. Seeds are fixed: the table is reproducible.
@@ -400,7 +403,7 @@ void PrintTable(const std::vector<DataSet>& sets) {
 }
 
 int Main(int argc, char** argv) {
-  const std::string data = argc > 1 ? argv[1] : kSource + "/../shared/data";
+  const std::string data = argc > 1 ? argv[1] : "";
   std::vector<DataSet> sets;
   std::fprintf(stderr, "real logs...\n");
   {
@@ -413,7 +416,7 @@ int Main(int argc, char** argv) {
         const bool is_narrow = fs::path(path).filename().string().rfind("Narrow", 0) == 0;
         set.traces.push_back(SurveyLog(is_narrow ? narrow : base, path));
       }
-      if (set.traces.empty()) set.absent = data + "/crazyflie has no .csv";
+      if (set.traces.empty()) set.absent = "no DATA_DIR/crazyflie/*.csv";
     } catch (const std::exception& e) {
       set.absent = e.what();
     }
@@ -424,7 +427,7 @@ int Main(int argc, char** argv) {
           dir, "px4.yaml", "rig: {filar_length_m: 0.594, filar_separation_m: 0.030, mass_kg: 1}\n");
       for (const std::string& path : FilesUnder(data + "/px4", ".ulg"))
         px4.traces.push_back(SurveyLog(config, path));
-      if (px4.traces.empty()) px4.absent = data + "/px4 has no .ulg";
+      if (px4.traces.empty()) px4.absent = "no DATA_DIR/px4/*.ulg";
     } catch (const std::exception& e) {
       px4.absent = e.what();
     }
