@@ -1,4 +1,4 @@
-// The trace-fit residual, solver-free (Ceres wraps it in fit/trace_fit.cc; the Jacobian test
+// The trace-fit residual, solver-free (Ceres wraps it in fit/trace_solve.cc; the Jacobian test
 // calls it directly). Conventions: docs/physics.md §2.
 //
 // Parameters (kNumTraceParams, scaled so every entry is O(1e-3..1) for the solver):

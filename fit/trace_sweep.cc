@@ -1,0 +1,201 @@
+// Step 8 of FitTrace (fit/trace_fit_steps.h): the amplitude sweep (I refitted in equal-cycle
+// bands of the window, and the trend of I against A^2) and its rule: a trend gives the
+// lowest-amplitude band's I with a model-inadequacy term; bands that scatter beyond their stds
+// scale the statistical std by the Birge ratio (docs/method.md §4).
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "fit/trace_fit_steps.h"
+
+namespace bifilar {
+namespace trace {
+namespace {
+
+// 95 % quantile of chi^2 with dof degrees of freedom (table for 1..15; Wilson-Hilferty beyond).
+double ChiSquare95(int dof) {
+  static const double kTable[] = {3.841, 5.991, 7.815, 9.488, 11.070, 12.592, 14.067, 15.507,
+                                  16.919, 18.307, 19.675, 21.026, 22.362, 23.685, 24.996};
+  if (dof >= 1 && dof <= 15) return kTable[dof - 1];
+  const double k = std::max(1, dof), z = 1.6449;
+  return k * std::pow(1.0 - 2.0 / (9.0 * k) + z * std::sqrt(2.0 / (9.0 * k)), 3);
+}
+
+// One band [first, last) of the window: I refitted from the window fit's state at the band's
+// first sample, K_D and C held. ok false when the fit or its std fails.
+AmplitudeSweepBand FitBand(const TraceFitInput& input, const TraceFitOptions& options,
+                           const double* p, double scale, const Trajectory& traj, double period_s,
+                           size_t first, size_t last) {
+  const std::vector<int> free = {kTraceInertia, kTraceAngle0, kTraceRate0, kTraceBias};
+  const bool fixed[2] = {true, true};
+  AmplitudeSweepBand band;
+  band.num_samples = static_cast<int>(last - first);
+  const std::vector<double> t(input.t_s.begin() + first, input.t_s.begin() + last);
+  const std::vector<double> rate(input.rate_rad_per_s.begin() + first,
+                                 input.rate_rad_per_s.begin() + last);
+  band.t0_s = t.front();
+  band.t1_s = t.back();
+  band.cycles = (band.t1_s - band.t0_s) / period_s;
+  TraceRateCost cost(&t, &rate, options.model, input.geometry, options.integrator, scale);
+  double q[kNumTraceParams];
+  std::copy(p, p + kNumTraceParams, q);
+  q[kTraceAngle0] = traj.angle_rad[first];
+  q[kTraceRate0] = traj.rate_rad_per_s[first];
+  const SolveOutcome lm = SolveLm(cost, options.max_iterations, fixed, false, q);
+  if (!lm.ok) return band;
+  const FreeParamStd stat = StatisticalStd(cost, q, free);
+  {
+    std::vector<double> rr(t.size());
+    const double residual_rms = std::sqrt(2.0 * Cost(cost, q, &rr) / static_cast<double>(t.size()));
+    const double signal_rms = RmsAboutMean(cost.last_trajectory().rate_rad_per_s);
+    band.residual_fraction = signal_rms > 0.0 ? residual_rms / signal_rms : HUGE_VAL;
+  }
+  const auto [a0, a1] = AmplitudeAtEnds(t, cost.last_trajectory(), period_s);
+  band.amplitude_start_deg = a0;
+  band.amplitude_end_deg = a1;
+  band.amplitude_mean_deg = 0.5 * (a0 + a1);
+  band.inertia_kg_m2 = scale * q[kTraceInertia];
+  band.inertia_std_kg_m2 = stat.ok ? scale * stat.hac[0] : 0.0;
+  band.ok = lm.ok && stat.ok && band.inertia_std_kg_m2 > 0.0 && std::isfinite(band.inertia_kg_m2);
+  return band;
+}
+
+// Consistency of the fitted bands with one constant I: chi^2 about their weighted mean, and the
+// Birge scale of the statistical std.
+void TestConstant(const std::vector<const AmplitudeSweepBand*>& good, AmplitudeSweep* sweep) {
+  double wsum = 0.0, wi = 0.0;
+  for (const AmplitudeSweepBand* b : good) {
+    const double w = 1.0 / (b->inertia_std_kg_m2 * b->inertia_std_kg_m2);
+    wsum += w;
+    wi += w * b->inertia_kg_m2;
+  }
+  const double mean = wi / wsum;
+  for (const AmplitudeSweepBand* b : good)
+    sweep->chi2_constant += std::pow((b->inertia_kg_m2 - mean) / b->inertia_std_kg_m2, 2);
+  sweep->chi2_dof = static_cast<int>(good.size()) - 1;
+  // The std is scaled whenever the bands scatter more than their stds (the PDG rule); the
+  // flag says so only when the scatter is significant at 5 %.
+  if (sweep->chi2_constant > sweep->chi2_dof)
+    sweep->std_scale = std::sqrt(sweep->chi2_constant / sweep->chi2_dof);
+  sweep->bands_disagree = sweep->chi2_constant > ChiSquare95(sweep->chi2_dof);
+}
+
+// The trend over the fitted bands: weighted line I_j / I_ref = I_0 (1 + c A_j^2) / I_ref, its
+// std scaled by the Birge ratio of the line; the lowest-amplitude band; the constancy test.
+// Leaves sweep->evaluated false (with a note) when the bands cannot support a line.
+void FitTrend(const TraceFitOptions& options, double ref, AmplitudeSweep* sweep) {
+  std::vector<const AmplitudeSweepBand*> good;
+  for (size_t j = 0; j < sweep->bands.size(); ++j) {
+    const AmplitudeSweepBand& b = sweep->bands[j];
+    if (!b.ok) continue;
+    good.push_back(&b);
+    if (sweep->low_band < 0 ||
+        b.amplitude_mean_deg < sweep->bands[sweep->low_band].amplitude_mean_deg)
+      sweep->low_band = static_cast<int>(j);
+  }
+  if (good.size() < 2) {
+    sweep->note = "fewer than 2 bands could be fitted";
+    return;
+  }
+  Eigen::Matrix2d xtwx = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d xtwy = Eigen::Vector2d::Zero();
+  double a_min = HUGE_VAL, a_max = 0.0;
+  for (const AmplitudeSweepBand* b : good) {
+    const double w = 1.0 / std::pow(b->inertia_std_kg_m2 / ref, 2);
+    const Eigen::Vector2d x(1.0, b->amplitude_mean_deg * b->amplitude_mean_deg);
+    xtwx += w * x * x.transpose();
+    xtwy += w * x * (b->inertia_kg_m2 / ref);
+    a_min = std::min(a_min, b->amplitude_mean_deg);
+    a_max = std::max(a_max, b->amplitude_mean_deg);
+  }
+  if (!(std::abs(xtwx.determinant()) > 0.0) || !(a_max > a_min)) {
+    sweep->note = "the bands do not span a range of amplitudes";
+    return;
+  }
+  const Eigen::Matrix2d cov = xtwx.inverse();
+  const Eigen::Vector2d coef = cov * xtwy;
+  double chi2 = 0.0;
+  for (const AmplitudeSweepBand* b : good) {
+    const double x = b->amplitude_mean_deg * b->amplitude_mean_deg;
+    chi2 += std::pow((b->inertia_kg_m2 / ref - coef(0) - coef(1) * x) / (b->inertia_std_kg_m2 / ref), 2);
+  }
+  const double dof = static_cast<double>(good.size()) - 2.0;
+  const double birge = dof > 0 && chi2 > dof ? chi2 / dof : 1.0;  // Birge ratio, PDG rule
+  sweep->evaluated = true;
+  TestConstant(good, sweep);
+  const double c = coef(1) / coef(0);  // relative to I_0
+  sweep->trend_coeff_per_deg2 = c;
+  sweep->trend_coeff_std_per_deg2 = std::sqrt(cov(1, 1) * birge) / coef(0);
+  sweep->trend_z =
+      sweep->trend_coeff_std_per_deg2 > 0.0 ? c / sweep->trend_coeff_std_per_deg2 : 0.0;
+  sweep->trend_percent_per_10deg =
+      100.0 * c * (a_max * a_max - a_min * a_min) / (a_max - a_min) * 10.0;
+  sweep->inertia_zero_amplitude_kg_m2 = ref * coef(0);
+  sweep->trend_detected = std::abs(sweep->trend_z) > options.sweep_trend_z;
+}
+
+}  // namespace
+
+AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptions& options,
+                                 const double* p, double scale, const Trajectory& traj,
+                                 double period_s) {
+  AmplitudeSweep sweep;
+  const double t0 = input.t_s.front(), t1 = input.t_s.back();
+  const double cycles = period_s > 0.0 ? (t1 - t0) / period_s : 0.0;
+  const double min_cycles = options.sweep_min_cycles_per_band;
+  const int bands = std::min(options.sweep_max_bands,
+                             static_cast<int>(std::floor(cycles / min_cycles)));
+  if (bands < 2) {
+    sweep.note = "the window holds " + Fmt("%.1f", cycles) + " cycles; a sweep needs 2 bands of " +
+                 Fmt("%g", options.sweep_min_cycles_per_band) + " cycles";
+    return sweep;
+  }
+  // Bands of equal duration, hence equal cycles, in time order; one under 20 samples is skipped.
+  const size_t n = input.t_s.size();
+  size_t first = 0;
+  for (int j = 0; j < bands; ++j) {
+    const double tb = j + 1 == bands ? HUGE_VAL : t0 + (t1 - t0) * (j + 1) / bands;
+    size_t last = first;
+    while (last < n && input.t_s[last] < tb) ++last;  // band = [first, last)
+    if (last - first >= 20)
+      sweep.bands.push_back(FitBand(input, options, p, scale, traj, period_s, first, last));
+    first = last;
+  }
+  FitTrend(options, scale, &sweep);
+  return sweep;
+}
+
+SweepRule ApplySweepRule(const AmplitudeSweep& sweep, const Solution& solution,
+                         const StatisticalUncertainty& stat) {
+  SweepRule rule;
+  rule.inertia_kg_m2 = solution.params.inertia_kg_m2;
+  rule.inertia_stat_std_kg_m2 = stat.inertia_std_kg_m2;
+  if (sweep.evaluated && sweep.std_scale > 1.0) rule.inertia_stat_std_kg_m2 *= sweep.std_scale;
+  if (sweep.bands_disagree) rule.findings.flags.push_back("bands_disagree");
+  if (!sweep.trend_detected) return rule;
+  // The result comes from the lowest-amplitude band; the trend's bias left at that band's
+  // amplitude, |c| A_low^2 I, is the model-inadequacy term (docs/method.md).
+  const AmplitudeSweepBand* low = &sweep.bands[sweep.low_band];
+  rule.inertia_kg_m2 = low->inertia_kg_m2;
+  rule.inertia_stat_std_kg_m2 = low->inertia_std_kg_m2 * sweep.std_scale;
+  rule.inertia_source = "low_amplitude_band";
+  rule.model_inadequacy_std_kg_m2 = std::abs(sweep.trend_coeff_per_deg2) *
+                                    low->amplitude_mean_deg * low->amplitude_mean_deg *
+                                    low->inertia_kg_m2;
+  rule.findings.Warn(
+      "amplitude_trend",
+      "I depends on the amplitude beyond its statistical error (" +
+          Fmt("%+.3g", sweep.trend_percent_per_10deg) + " % per 10 deg between " +
+          Fmt("%.1f", sweep.bands.back().amplitude_mean_deg) + " and " +
+          Fmt("%.1f", sweep.bands.front().amplitude_mean_deg) + " deg, z = " +
+          Fmt("%.1f", sweep.trend_z) + "): the rig departs from the ideal model; I is taken from "
+          "the lowest-amplitude band (" + Fmt("%.1f", low->amplitude_mean_deg) +
+          " deg) with a model-inadequacy std of " + Fmt("%.2g", rule.model_inadequacy_std_kg_m2) +
+          " kg m^2. Swing at smaller amplitude, or set fit.max_amplitude_deg");
+  return rule;
+}
+
+}  // namespace trace
+}  // namespace bifilar
