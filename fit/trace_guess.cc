@@ -55,6 +55,33 @@ std::vector<Crossing> FindCrossings(const std::vector<double>& t, const std::vec
   return out;
 }
 
+// A single sample of the other sign (a glitch too small for fit/glitch.h, e.g. 0.4 rad/s on a
+// 1 rad/s swing) makes two crossings around it. A half-cycle is never one sample nor a quarter
+// of the others, so such pairs are dropped: only the median crossing spacing and the samples
+// beyond the band between the two decide, so a clean series keeps all its crossings.
+std::vector<Crossing> WithoutGlitchPairs(const std::vector<double>& t, const std::vector<double>& x,
+                                         double bias, double band, std::vector<Crossing> cross) {
+  if (cross.size() < 4) return cross;
+  std::vector<double> spacing(cross.size() - 1);
+  for (size_t i = 0; i + 1 < cross.size(); ++i) spacing[i] = cross[i + 1].t_s - cross[i].t_s;
+  const double typical = Median(spacing);
+  std::vector<Crossing> out;
+  for (size_t i = 0; i < cross.size(); ++i) {
+    if (i + 1 < cross.size() && cross[i + 1].t_s - cross[i].t_s < 0.25 * typical) {
+      const auto b = std::upper_bound(t.begin(), t.end(), cross[i].t_s) - t.begin();
+      const auto e = std::upper_bound(t.begin(), t.end(), cross[i + 1].t_s) - t.begin();
+      int beyond = 0;
+      for (auto k = b; k < e; ++k) beyond += std::abs(x[k] - bias) > band;
+      if (beyond == 1) {
+        ++i;  // both crossings of the one-sample lobe
+        continue;
+      }
+    }
+    out.push_back(cross[i]);
+  }
+  return out;
+}
+
 // Mean of x over [ta, tb] by the trapezoid rule on the samples inside (ends interpolated).
 double MeanOver(const std::vector<double>& t, const std::vector<double>& x, double ta, double tb) {
   auto interp = [&](double tq) {
@@ -160,7 +187,7 @@ bool EstimateTraceGuess(const TraceFitInput& input, PendulumModel model,
   double bias = std::accumulate(x.begin(), x.end(), 0.0) / n;
   std::vector<Crossing> cross;
   for (int pass = 0; pass < 2; ++pass) {
-    cross = FindCrossings(t, x, bias, band);
+    cross = WithoutGlitchPairs(t, x, bias, band, FindCrossings(t, x, bias, band));
     if (cross.size() < 3) break;
     // Whole cycles: from the first crossing to the last crossing of the same direction.
     size_t last = cross.size() - 1;

@@ -38,6 +38,10 @@ struct HalfCycle {
   double peak = 0.0;     // max sign * x
   bool open = false;     // the log ended before it did
   double max_gap_s = 0.0;  // longest time step between samples inside it (dropped packets)
+  size_t samples_beyond = 0;  // samples with sign * x above the hysteresis threshold
+  // max sign * x over samples capped at their larger neighbour: one glitch sample cannot raise it
+  double robust_peak = 0.0;
+  size_t robust_peak_index = 0;
   double duration() const { return end_s - start_s; }
 };
 
@@ -154,14 +158,28 @@ std::vector<HalfCycle> HalfCycles(const std::vector<double>& t, const std::vecto
       c.start_s = t[i];
       c.peak_index = i;
       c.peak = s * x[i];
+      c.robust_peak = -HUGE_VAL;
+      c.robust_peak_index = i;
       out.push_back(c);
       state = s;
     }
+    if (!out.empty() && s == state) ++out.back().samples_beyond;
     if (!out.empty() && state * x[i] > out.back().peak) {
       out.back().peak = state * x[i];
       out.back().peak_index = i;
     }
+    if (!out.empty()) {
+      double neighbour = -HUGE_VAL;
+      if (i > begin) neighbour = std::max(neighbour, state * x[i - 1]);
+      if (i + 1 < end) neighbour = std::max(neighbour, state * x[i + 1]);
+      const double capped = std::min(state * x[i], neighbour);
+      if (capped > out.back().robust_peak) {
+        out.back().robust_peak = capped;
+        out.back().robust_peak_index = i;
+      }
+    }
   }
+  for (HalfCycle& c : out) c.robust_peak = std::max(c.robust_peak, 0.0);
   if (!out.empty()) {
     out.back().end_s = t[end - 1];
     out.back().open = true;
@@ -180,6 +198,51 @@ std::vector<HalfCycle> HalfCycles(const std::vector<double>& t, const std::vecto
       }
     }
     if (j > 0) out[j - 1].end_s = out[j].start_s;
+  }
+  return out;
+}
+
+// A glitch sample of the other sign (one reading, too small for fit/glitch.h, e.g. 0.4 rad/s on
+// a 1 rad/s swing just after a long timestamp gap) splits a half-cycle in three: two pieces of
+// the same sign around a one-sample half-cycle. Such a blip (closed, a single sample beyond the
+// hysteresis, shorter than `blip_max_s`) is merged with its neighbours into one half-cycle when
+// `accept(joined, before, after, outer_before, outer_after)` says the joined one is a half-cycle
+// the pieces are not (the outer half-cycles around them, null at the ends, tell a swing from hand
+// tremor). A real swing half-cycle holds many samples (>= 10 at 30 Hz for the shortest period in
+// range), so only hand tremor and glitches make blips.
+template <typename Accept>
+std::vector<HalfCycle> MergeGlitchSplits(const std::vector<HalfCycle>& cycles, double blip_max_s,
+                                         Accept accept) {
+  std::vector<HalfCycle> out;
+  out.reserve(cycles.size());
+  for (size_t j = 0; j < cycles.size(); ++j) {
+    const HalfCycle& blip = cycles[j];
+    if (!out.empty() && j + 1 < cycles.size() && !blip.open && blip.samples_beyond == 1 &&
+        blip.duration() < blip_max_s) {
+      const HalfCycle& before = out.back();
+      const HalfCycle& after = cycles[j + 1];
+      HalfCycle joined = before;
+      joined.end_s = after.end_s;
+      joined.open = after.open;
+      joined.max_gap_s = std::max({before.max_gap_s, blip.max_gap_s, after.max_gap_s});
+      joined.samples_beyond = before.samples_beyond + after.samples_beyond;
+      if (after.peak > joined.peak) {
+        joined.peak = after.peak;
+        joined.peak_index = after.peak_index;
+      }
+      if (after.robust_peak > joined.robust_peak) {
+        joined.robust_peak = after.robust_peak;
+        joined.robust_peak_index = after.robust_peak_index;
+      }
+      const HalfCycle* outer_before = out.size() >= 2 ? &out[out.size() - 2] : nullptr;
+      const HalfCycle* outer_after = j + 2 < cycles.size() ? &cycles[j + 2] : nullptr;
+      if (accept(joined, before, after, outer_before, outer_after)) {
+        out.back() = joined;
+        ++j;  // `after` is inside `joined`
+        continue;
+      }
+    }
+    out.push_back(blip);
   }
   return out;
 }
@@ -308,6 +371,7 @@ bool WindowOptions::Check(std::string* why) const {
   if (!(noise_floor_sigmas > 0.0)) return fail("noise_floor_sigmas must be > 0");
   if (!(start_delay_periods >= 0.0 && end_margin_periods >= 0.0)) return fail("start_delay_periods and end_margin_periods must be >= 0");
   if (!(min_periods > 0.0)) return fail("min_periods must be > 0");
+  if (!(blip_fraction >= 0.0 && blip_fraction < 0.5)) return fail("blip_fraction must be in [0, 0.5)");
   return true;
 }
 
@@ -353,13 +417,25 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
       // The log ended inside it: fine unless the swing should have crossed zero by now (a quarter
       // period after the peak), which means it was stopped or died out.
       return c.duration() <= (1.0 + o.half_period_tolerance) * half + slack &&
-             c.end_s - t[c.peak_index] <= 0.5 * (1.0 + o.half_period_tolerance) * half + slack;
+             c.end_s - t[c.robust_peak_index] <= 0.5 * (1.0 + o.half_period_tolerance) * half + slack;
     }
     // A free half-cycle peaks near its middle: the rate must cross zero again within about a
     // quarter period of the peak (a hand that grabs near a peak leaves a long, flat tail).
     return std::abs(c.duration() - half) <= o.half_period_tolerance * half + slack &&
-           c.end_s - t[c.peak_index] <= 0.5 * (1.0 + o.half_period_tolerance) * half + slack;
+           c.end_s - t[c.robust_peak_index] <= 0.5 * (1.0 + o.half_period_tolerance) * half + slack;
   };
+  // 3b. A glitch that split a half-cycle inside the swing (between two whole half-cycles, or one
+  // and the log's end): merged back, so it neither breaks the run nor moves t0. Tremor lobes
+  // (around the release or a stop) have short lobes around them and stay as they are.
+  cycles = MergeGlitchSplits(
+      cycles, o.blip_fraction * half,
+      [&](const HalfCycle& joined, const HalfCycle& before, const HalfCycle& after,
+          const HalfCycle* outer_before, const HalfCycle* outer_after) {
+        return duration_ok(joined) && joined.robust_peak >= floor &&
+               !(duration_ok(before) && duration_ok(after)) && outer_before &&
+               !outer_before->open && duration_ok(*outer_before) &&
+               (!outer_after || duration_ok(*outer_after));
+      });
 
   // Runs of free oscillation.
   struct Run {
@@ -387,24 +463,24 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
       WindowEnd reason = WindowEnd::kLogEnd;
       bool broken = false;
       bool restart = false;
-      if (!unreliable && c.peak < o.stop_drop_factor * rho * prev) {
+      if (!unreliable && c.robust_peak < o.stop_drop_factor * rho * prev) {
         broken = true;  // a hand (checked first: a stopped swing also ends below the noise floor)
         reason = WindowEnd::kStopped;
-      } else if (!unreliable && c.peak < floor) {
+      } else if (!unreliable && c.robust_peak < floor) {
         broken = true;
         reason = WindowEnd::kNoiseFloor;
       } else if (!duration_ok(c)) {
         broken = true;
-        reason = c.peak < floor || prev < 2.0 * floor ? WindowEnd::kNoiseFloor : WindowEnd::kStopped;
-      } else if (!unreliable && c.peak > prev * (1.0 + o.growth_tolerance) + 3.0 * sigma_eff) {
+        reason = c.robust_peak < floor || prev < 2.0 * floor ? WindowEnd::kNoiseFloor : WindowEnd::kStopped;
+      } else if (!unreliable && c.robust_peak > prev * (1.0 + o.growth_tolerance) + 3.0 * sigma_eff) {
         broken = true;
         reason = WindowEnd::kStopped;  // pushed: the free decay is broken
         restart = true;
       }
       if (!broken) {
         if (!short_open && !gappy(c)) {
-          if (ref_peak > 0.0) ratios.push_back(std::pow(c.peak / ref_peak, 1.0 / n_steps));
-          ref_peak = c.peak;
+          if (ref_peak > 0.0) ratios.push_back(std::pow(c.robust_peak / ref_peak, 1.0 / n_steps));
+          ref_peak = c.robust_peak;
           ref_index = j;
         }
         run.last = j;
@@ -415,12 +491,12 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
       in_run = false;
       if (!restart) continue;
     }
-    if (!c.open && duration_ok(c) && c.peak >= floor) {
+    if (!c.open && duration_ok(c) && c.robust_peak >= floor) {
       in_run = true;
       run = Run();
       run.first = run.last = j;
       ratios.clear();
-      ref_peak = gappy(c) ? 0.0 : c.peak;  // 0: no reliable peak yet
+      ref_peak = gappy(c) ? 0.0 : c.robust_peak;  // 0: no reliable peak yet
       ref_index = j;
     }
   }
@@ -575,7 +651,18 @@ std::vector<AngleExtreme> AngleExtremes(const std::vector<double>& t, const std:
   double range = 0.0;
   for (size_t k = b; k < e; ++k) range = std::max(range, std::abs(x[k]));
   const double h = std::max(4.0 * w.noise_sigma_rad_per_s, 1e-6 * range);
-  const std::vector<HalfCycle> cycles = HalfCycles(t, x, b, e, h);
+  std::vector<HalfCycle> cycles = HalfCycles(t, x, b, e, h);
+  // A glitch that splits a half-cycle (MergeGlitchSplits) would add two false extremes.
+  if (w.period_s > 0.0) {
+    const double half = 0.5 * w.period_s;
+    const double tol = WindowOptions().half_period_tolerance;
+    cycles = MergeGlitchSplits(cycles, WindowOptions().blip_fraction * half,
+                               [&](const HalfCycle&, const HalfCycle& before, const HalfCycle& after,
+                                   const HalfCycle*, const HalfCycle*) {
+                                 return before.duration() < (1.0 - tol) * half ||
+                                        after.duration() < (1.0 - tol) * half;
+                               });
+  }
   // Angle at each interior zero crossing (start of every half-cycle but the first).
   std::vector<std::pair<double, double>> ext;  // (t, psi)
   for (size_t j = 1; j < cycles.size(); ++j) {

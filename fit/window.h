@@ -54,6 +54,11 @@ struct WindowOptions {
   double start_delay_periods = 0.25;  // t0 after the first extreme after release (periods); >= 0.
   double end_margin_periods = 0.25;   // t1 before the last clean peak after a stop (periods); >= 0.
   double min_periods = 2.0;  // windows shorter than this many periods are rejected; > 0.
+  // A one-sample half-cycle shorter than this fraction of T/2 between two pieces of the same sign
+  // is a glitch that split a half-cycle: the three are merged when the pieces are not half-cycles
+  // but their union is (step 3b). [0, 0.5); 0 disables. Default 0.25: a real half-cycle is never
+  // a quarter of its neighbours' length, nor a single sample.
+  double blip_fraction = 0.25;
 
   bool Check(std::string* why) const;
 };

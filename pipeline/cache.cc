@@ -114,6 +114,15 @@ std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
   Put(out, "sweep_cycles", sw.min_cycles_per_band);
   Put(out, "sweep_bands", sw.max_bands);
   Put(out, "sweep_z", sw.trend_z);
+  // Only non-default glitch settings enter the key, so default keys stay those of 0.2.0.
+  const GlitchConfig& gl = config.fit.glitch;
+  if (!gl.IsDefault()) {
+    Put(out, "glitch", gl.enabled ? 1.0 : 0.0);
+    Put(out, "glitch_sigmas", gl.threshold_sigmas);
+    Put(out, "glitch_range", gl.range_factor);
+    Put(out, "glitch_excursion", gl.excursion_fraction);
+    Put(out, "glitch_fraction", gl.max_fraction);
+  }
   return out.str();
 }
 

@@ -335,6 +335,55 @@ bool CampaignConfig::Check(std::string* why) const {
   return fit.Check(why) && ellipse.Check(why);
 }
 
+GlitchOptions GlitchConfig::Options() const {
+  GlitchOptions o;
+  o.threshold_sigmas = enabled ? threshold_sigmas : 0.0;
+  o.range_factor = range_factor;
+  o.excursion_fraction = excursion_fraction;
+  o.max_fraction = max_fraction;
+  return o;
+}
+
+bool GlitchConfig::IsDefault() const {
+  const GlitchConfig d;
+  return enabled == d.enabled && threshold_sigmas == d.threshold_sigmas &&
+         range_factor == d.range_factor && excursion_fraction == d.excursion_fraction &&
+         max_fraction == d.max_fraction;
+}
+
+namespace {
+
+// The first `fit.glitch` value outside its range: its key (below fit.glitch) and the message.
+bool CheckGlitch(const GlitchConfig& g, std::string* key, std::string* why) {
+  char buffer[200];
+  auto fail = [&](const char* name, const char* range, double value) {
+    *key = name;
+    std::snprintf(buffer, sizeof(buffer), "'fit.glitch.%s' must be in %s, got %g", name, range, value);
+    *why = buffer;
+    return false;
+  };
+  char range[64];
+  std::snprintf(range, sizeof(range), "[%g, %g]", kMinGlitchSigmas, kMaxGlitchSigmas);
+  if (!(g.threshold_sigmas >= kMinGlitchSigmas && g.threshold_sigmas <= kMaxGlitchSigmas)) {
+    return fail("threshold_sigmas", range, g.threshold_sigmas);
+  }
+  std::snprintf(range, sizeof(range), "[%g, %g]", kMinGlitchRange, kMaxGlitchRange);
+  if (!(g.range_factor >= kMinGlitchRange && g.range_factor <= kMaxGlitchRange)) {
+    return fail("range_factor", range, g.range_factor);
+  }
+  std::snprintf(range, sizeof(range), "[0, %g]", kMaxGlitchExcursion);
+  if (!(g.excursion_fraction >= 0.0 && g.excursion_fraction <= kMaxGlitchExcursion)) {
+    return fail("excursion_fraction", range, g.excursion_fraction);
+  }
+  std::snprintf(range, sizeof(range), "(0, %g]", kMaxGlitchFraction);
+  if (!(g.max_fraction > 0.0 && g.max_fraction <= kMaxGlitchFraction)) {
+    return fail("max_fraction", range, g.max_fraction);
+  }
+  return true;
+}
+
+}  // namespace
+
 bool FitConfig::Check(std::string* why) const {
   char buffer[200];
   const double max_deg = max_amplitude_deg.value_or(kMaxMaxAmplitudeDeg);
@@ -365,7 +414,8 @@ bool FitConfig::Check(std::string* why) const {
     *why = buffer;
     return false;
   }
-  return true;
+  std::string key;
+  return CheckGlitch(glitch, &key, why);
 }
 
 bool EllipseConfig::Check(std::string* why) const {
@@ -568,7 +618,21 @@ void ReadFitSweep(YamlMap& fit, SweepConfig* sw) {
   sweep.Finish();
 }
 
-// `fit`: model, integrator, windows, amplitude limits, quality, sweep; then FitConfig::Check.
+// `fit.glitch`: the single-sample glitch detector, each value in its range (error at its line).
+void ReadFitGlitch(YamlMap& fit, GlitchConfig* g) {
+  YamlMap glitch = Sub(fit, "glitch");
+  g->enabled = glitch.OptionalBool("enabled", g->enabled);
+  g->threshold_sigmas = glitch.OptionalDouble("threshold_sigmas", g->threshold_sigmas);
+  g->range_factor = glitch.OptionalDouble("range_factor", g->range_factor);
+  g->excursion_fraction = glitch.OptionalDouble("excursion_fraction", g->excursion_fraction);
+  g->max_fraction = glitch.OptionalDouble("max_fraction", g->max_fraction);
+  std::string key, why;
+  if (!CheckGlitch(*g, &key, &why)) throw UserError(glitch.Where(glitch.Optional(key)) + ": " + why);
+  glitch.Finish();
+}
+
+// `fit`: model, integrator, windows, amplitude limits, quality, sweep, glitch; then
+// FitConfig::Check.
 void ReadFit(YamlMap fit, FitConfig* out) {
   const std::string model = fit.OptionalString("model", "full");
   if (!ParsePendulumModel(model, &out->model)) {
@@ -585,6 +649,7 @@ void ReadFit(YamlMap fit, FitConfig* out) {
   if (fit.Has("min_amplitude_deg")) out->min_amplitude_deg = fit.RequiredDouble("min_amplitude_deg");
   ReadFitQuality(fit, &out->quality);
   ReadFitSweep(fit, &out->sweep);
+  ReadFitGlitch(fit, &out->glitch);
   std::string why;
   if (!out->Check(&why)) {
     const char* key = why.find("max_amplitude") != std::string::npos ? "max_amplitude_deg"

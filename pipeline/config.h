@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include "fit/glitch.h"
 #include "pendulum/integrator.h"
 #include "pendulum/model.h"
 #include "pipeline/imu_format.h"
@@ -85,6 +86,23 @@ struct SweepConfig {
   double trend_z = 4.0;              // (0, 1000)
 };
 
+// `fit.glitch`: isolated single-sample gyro glitches (fit/glitch.h), dropped before the swing
+// axis, window and fit, and again on the fit's residuals. Same defaults as GlitchOptions.
+struct GlitchConfig {
+  bool enabled = true;                                            // both passes
+  double threshold_sigmas = GlitchOptions().threshold_sigmas;     // [3, 1000] robust sigmas
+  double range_factor = GlitchOptions().range_factor;             // [1, 100] x neighbours' range
+  double excursion_fraction = GlitchOptions().excursion_fraction; // [0, 10] x series' excursion
+  double max_fraction = GlitchOptions().max_fraction;             // (0, 0.1] of the samples
+
+  GlitchOptions Options() const;  // the detector's options; threshold 0 (off) when !enabled
+  bool IsDefault() const;         // every value at its default (the cache key leaves it out)
+};
+constexpr double kMinGlitchSigmas = 3, kMaxGlitchSigmas = 1000;  // fit.glitch.threshold_sigmas
+constexpr double kMinGlitchRange = 1, kMaxGlitchRange = 100;     // fit.glitch.range_factor
+constexpr double kMaxGlitchExcursion = 10;                       // fit.glitch.excursion_fraction
+constexpr double kMaxGlitchFraction = 0.1;                       // fit.glitch.max_fraction
+
 struct FitConfig {
   PendulumModel model = PendulumModel::kFull;  // `fit.model`: full | jardin | linear
   // `fit.integrator`: rk853 (default) | cvodes; the fit's ODE solver (pendulum/integrator.h).
@@ -96,8 +114,9 @@ struct FitConfig {
   std::optional<double> min_amplitude_deg;  // amplitude band, lower (deg); default: fit's own
   QualityThresholds quality;
   SweepConfig sweep;
+  GlitchConfig glitch;
 
-  bool Check(std::string* why) const;  // amplitude band and quality ranges; *why names the key
+  bool Check(std::string* why) const;  // amplitude band, quality, glitch ranges; *why names the key
 };
 
 // Options of the ellipse fit (fit/ellipse.h EllipseOptions, same defaults).

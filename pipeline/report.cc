@@ -187,7 +187,17 @@ void WriteHeader(const ReportPage& p, std::ostream& h) {
   h << "<h1>Mass properties from bifilar pendulum swings</h1>\n";
   h << "<p>bifilar " << Escape(Str(p.results, "version")) << " &middot; config <code>"
     << Escape(Str(p.results, "config_file")) << "</code> &middot; pitch source "
-    << Escape(Str(p.results, "pitch_source")) << ". Traces: " << summary.value("n_traces", 0)
+    << Escape(Str(p.results, "pitch_source"));
+  // The fit's model and ODE solver (fit.integrator or --integrator), and glitch removal when off.
+  const json settings = p.results.is_object() ? p.results.value("fit_settings", json::object())
+                                              : json::object();
+  if (settings.is_object() && settings.contains("integrator")) {
+    h << " &middot; fit model " << Escape(Str(settings, "model")) << ", integrator <code>"
+      << Escape(Str(settings, "integrator")) << "</code>";
+    const json glitch = settings.value("glitch", json::object());
+    if (glitch.is_object() && !glitch.value("enabled", true)) h << ", glitch removal off";
+  }
+  h << ". Traces: " << summary.value("n_traces", 0)
     << " (<span class=\"ok\">" << summary.value("n_ok", 0) << " ok</span>, "
     << summary.value("n_rejected", 0) << " rejected, " << summary.value("n_error", 0)
     << " error); fits reused from cache: " << summary.value("n_reused", 0) << ".</p>\n";

@@ -314,6 +314,18 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   j["config"] = config.text;
   j["units"] = ToString(config.units);
   j["pitch_source"] = ToString(config.runs.pitch_source);
+  // The fit settings in effect: the config's, with the command line's overrides (--integrator),
+  // which the config text above does not show.
+  const GlitchConfig& glitch = config.fit.glitch;
+  j["fit_settings"] = {
+      {"model", ToString(config.fit.model)},
+      {"integrator", ToString(config.fit.integrator)},
+      {"amplitude_sweep", config.fit.sweep.enabled},
+      {"glitch", {{"enabled", glitch.enabled},
+                  {"threshold_sigmas", glitch.threshold_sigmas},
+                  {"range_factor", glitch.range_factor},
+                  {"excursion_fraction", glitch.excursion_fraction},
+                  {"max_fraction", glitch.max_fraction}}}};
   json summary;
   const CampaignSummary& s = result.summary;
   summary["n_traces"] = s.n_traces;

@@ -232,8 +232,9 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   std::string why;
   record.warnings = raw.warnings;
 
-  // 1b. Isolated glitch samples (fit/glitch.h) are dropped before anything looks at the data.
-  const std::vector<size_t> glitches = FindGyroGlitches(raw, GlitchOptions());
+  // 1b. Isolated glitch samples (fit/glitch.h, `fit.glitch`) are dropped before anything looks at
+  // the data.
+  const std::vector<size_t> glitches = FindGyroGlitches(raw, config.fit.glitch.Options());
   ImuData cleaned;
   if (!glitches.empty()) {
     record.warnings.push_back(DescribeGlitches(raw, glitches));
@@ -343,7 +344,8 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   // outside the fit's residual noise: the same test on the residual series (fit/glitch.h), whose
   // noise is the gyro's, not the swing's. Dropped, and the window fitted again.
   if (fit.HasFit() && fit.residual_rad_per_s.size() == input.t_s.size()) {
-    const std::vector<size_t> more = FindGlitches(fit.t_s, fit.residual_rad_per_s, GlitchOptions());
+    const std::vector<size_t> more = FindGlitches(fit.t_s, fit.residual_rad_per_s,
+                                                     config.fit.glitch.Options());
     if (!more.empty()) {
       double largest = 0.0;
       for (size_t k : more) largest = std::max(largest, std::abs(fit.residual_rad_per_s[k]));
