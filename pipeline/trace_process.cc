@@ -6,6 +6,7 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <new>
 
 #include "fit/block_mean.h"
 #include "fit/swing_axis.h"
@@ -377,6 +378,10 @@ TraceRecord Guarded(const CampaignConfig& config, const std::string& path,
   record.model = ToString(config.fit.model);
   try {
     record = process(record);
+  } catch (const std::bad_alloc&) {  // never a bare "std::bad_alloc"
+    record.status = TraceStatus::kError;
+    record.message = record.file + ": out of memory while reading or fitting this log (is it far "
+                                   "larger than a pendulum log?)";
   } catch (const std::exception& e) {
     record.status = TraceStatus::kError;
     record.message = Renamed(e.what(), path, record.file);
