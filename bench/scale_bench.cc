@@ -2,7 +2,10 @@
 //   - an ellipse table of N rows, parsed and fitted with the default 2000 bootstrap replicates
 //     (a 1e6-row table took 50 s and 1.6 GB);
 //   - `process` with T logs and a fit.windows entry for each (cost grew with entries x traces);
-//   - `process` with a tare list of K entries (150 k took over 30 s).
+//   - `process` with a tare list of K entries (150 k took over 30 s);
+//   - `bifilar fit` of one long log: 60 s of swing at 11.7 / 23.3 / 46.7 kHz (0.7 / 1.4 / 2.8 M
+//     rows, 7 columns; a 2.8 M-sample log took 69 s and 1.4 GB): read, swing axis, window, fit on
+//     block means (fit/block_mean.h), amplitude sweep, residual statistics.
 // The campaign benchmarks use a fake trace fit, so they time the pipeline around the fits.
 // Run: build/bench/bifilar_bench --benchmark_filter='Scale'
 // Each reports its complexity fit (BigO); linear means the per-item time stays flat.
@@ -19,7 +22,10 @@
 
 #include "fit/ellipse.h"
 #include "pipeline/campaign.h"
+#include "pipeline/config.h"
 #include "pipeline/ellipse_table.h"
+#include "pipeline/simulate_spec.h"
+#include "pipeline/trace_process.h"
 
 namespace bifilar {
 namespace {
@@ -132,6 +138,49 @@ void BM_ScaleTareList(benchmark::State& state) {
 }
 BENCHMARK(BM_ScaleTareList)->RangeMultiplier(4)->Range(1000, 16000)
     ->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+
+// One simulated log of 60 s free swing at `rate_hz` (the `bifilar simulate --trace` defaults:
+// I = 4.1 kg m^2, m = 6.75 kg, L = 2 m, D = 1.8 m, 20 deg, gyro and accelerometer) and its config.
+struct LongLogDir {
+  std::string dir, log, config;
+  explicit LongLogDir(double rate_hz) {
+    char tmpl[] = "/tmp/bifilar_scale_log_XXXXXX";
+    dir = mkdtemp(tmpl);
+    log = dir + "/long.csv";
+    config = dir + "/fit.yaml";
+    SimulateSpec spec = ParseSimulateSpec("seed: 1\n", "bench");
+    spec.trace.inertia_kg_m2 = 4.1;
+    spec.trace.mass_kg = 6.75;
+    spec.trace.filar_length_m = 2.0;
+    spec.trace.filar_separation_m = 1.8;
+    spec.options.timeline.free_s = {60.0, 60.0};
+    SetSampleRateFromFlag(&spec, rate_hz);
+    RunSimulateTrace(spec, log);
+    std::ofstream(config) << "rig: {filar_length_m: 2.0, filar_separation_m: 1.8, mass_kg: 6.75}\n";
+  }
+  ~LongLogDir() {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+};
+
+void BM_ScaleLongLogFit(benchmark::State& state) {
+  const LongLogDir files(static_cast<double>(state.range(0)));
+  ConfigLoadOptions load;
+  load.require_runs = false;
+  const CampaignConfig config = LoadCampaignConfig(files.config, load);
+  TraceRecord record;
+  for (auto _ : state) {
+    record = ProcessTrace(config, files.log, TraceProcessOptions());
+    if (!record.ok()) state.SkipWithError(record.message.c_str());
+  }
+  const size_t rows = static_cast<size_t>(60.0 * state.range(0));  // ~ samples (1 % dropped)
+  state.SetComplexityN(static_cast<int64_t>(rows));
+  state.counters["rows"] = static_cast<double>(rows);
+  state.counters["I_kg_m2"] = record.inertia_total_kg_m2;
+}
+BENCHMARK(BM_ScaleLongLogFit)->Arg(11667)->Arg(23333)->Arg(46667)
+    ->Unit(benchmark::kMillisecond)->Iterations(2)->Complexity(benchmark::oN);
 
 }  // namespace
 }  // namespace bifilar

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "pipeline/json_error.h"
 #include "pipeline/results_json.h"
 #include "pipeline/user_error.h"
 
@@ -190,7 +191,7 @@ bool TraceCache::Load(const std::string& key, const std::string& content_hash,
   try {
     *record = TraceRecordFromJson(fields);
   } catch (const std::exception& e) {
-    return refuse(e.what());
+    return refuse(DescribeJsonError(e));
   }
   for (const char* field : {"inertia_total_kg_m2", "inertia_total_std_kg_m2"}) {
     if (!FiniteOrNull(fields, field)) return refuse(std::string(field) + " is not a finite number");

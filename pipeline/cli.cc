@@ -1,13 +1,38 @@
 #include "pipeline/cli.h"
 
 #include <exception>
+#include <filesystem>
 #include <new>
 #include <iostream>
+#include <string>
 
 #include "fit/solver_logging.h"
 #include "pipeline/cli_commands.h"
+#include "pipeline/json_error.h"
+
+#include <nlohmann/json.hpp>
 
 namespace bifilar {
+namespace {
+
+// The command and the files it was given ("bifilar ellipse on table.csv"), for a message that
+// has no other context (an allocation failing outside any per-file handler).
+std::string CommandAndInputs(int argc, char** argv) {
+  std::string command = "bifilar";
+  std::string files;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    std::error_code ec;
+    if (i == 1 && arg.rfind("-", 0) != 0) {
+      command += " " + arg;
+    } else if (std::filesystem::is_regular_file(arg, ec)) {
+      files += (files.empty() ? "" : ", ") + arg;
+    }
+  }
+  return command + (files.empty() ? std::string() : " on " + files);
+}
+
+}  // namespace
 
 int RunCommandLine(int argc, char** argv) {
   QuietSolverLogging();  // fit/solver_logging.h: no glog preamble or solver chatter
@@ -25,9 +50,14 @@ int RunCommandLine(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
   } catch (const std::bad_alloc&) {
-    std::cerr << "bifilar: error: out of memory: an input (a file, or a count in the config or "
-                 "options) is far larger than this machine can hold; see the limits in "
-                 "configs/README.md\n";
+    std::cerr << "bifilar: error: out of memory in `" << CommandAndInputs(argc, argv)
+              << "`: one of these inputs (a file, or a count in the config or options) is far "
+                 "larger than this machine can hold; see the limits in configs/README.md\n";
+    return 2;
+  } catch (const nlohmann::json::exception& e) {  // a path without its own handler
+    std::cerr << "bifilar: error: in `" << CommandAndInputs(argc, argv)
+              << "`: a JSON value could not be read or written (" << DescribeJsonError(e)
+              << "); check the files named, or report this with them\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "bifilar: error: " << e.what() << "\n";

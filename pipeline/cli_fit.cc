@@ -64,6 +64,13 @@ std::string HumanLine(const TraceRecord& r) {
   } else if (!r.sweep.note.empty()) {
     line += "\n    I(A): no sweep (" + r.sweep.note + ")";
   }
+  for (const std::string& flag : r.flags) {
+    if (flag.rfind("block_means_of_", 0) == 0) {
+      line += "\n    note: a dense log; the fit used means of " +
+              flag.substr(std::string("block_means_of_").size(), flag.find("_samples") - 15) +
+              " consecutive samples (docs/method.md, section 6)";
+    }
+  }
   for (const std::string& w : r.warnings) {
     if (message.find(w) == std::string::npos) line += "\n    warning: " + w;
   }

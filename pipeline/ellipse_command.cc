@@ -208,7 +208,7 @@ int RunPlanCommand(const PlanCommandOptions& options, std::ostream& out) {
   std::string why;
   if (!PlanEllipse(plan_options, &plan, &why)) throw UserError("plan: " + why);
   if (options.json) {
-    out << EllipsePlanToJson(plan).dump(2) << "\n";
+    out << EllipsePlanToJson(plan).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
     return 0;
   }
   const double k = 1.0 / to_si;

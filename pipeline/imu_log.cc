@@ -130,8 +130,10 @@ std::string FormatNumber(double v) {
 
 [[noreturn]] void Fail(const std::string& message) { throw UserError(message); }
 
+// `owner`, when given, holds the bytes `text` views; it is released once the rows are parsed, so a
+// long log's text and its samples are not both held while the samples are finished.
 ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& format,
-              const ImuLogOptions& options) {
+              const ImuLogOptions& options, std::string* owner = nullptr) {
   std::string why;
   if (!format.Check(&why)) Fail(name + ": invalid IMU format: " + why);
   if (!options.Check(&why)) Fail(name + ": invalid log options: " + why);
@@ -361,6 +363,7 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
     for (int k = 0; k < needed; ++k) values.push_back(row[k] * scale[k]);
     row_line.push_back(reader.line_number());
   }
+  if (owner != nullptr) std::string().swap(*owner);  // `text` and `line` are not used below
   const size_t rows = row_line.size();
   if (rows == 0) {
     if (bad_rows > 0) {
@@ -459,6 +462,9 @@ std::string ReadWholeFile(const std::string& path) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) Fail(path + ": cannot open the log: " + std::strerror(errno));
   std::string text;
+  // Reserved at the file's size: a long log is read without the doubling copies.
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size < (std::uintmax_t{1} << 40)) text.reserve(static_cast<size_t>(size));
   char buffer[1 << 16];
   size_t n;
   while ((n = std::fread(buffer, 1, sizeof(buffer), f)) > 0) text.append(buffer, n);
@@ -496,9 +502,9 @@ ImuData ReadImuLogFromString(const std::string& text, const std::string& name,
 
 ImuData ReadImuLog(const std::string& path, const ImuFormat& format,
                    const ImuLogOptions& options) {
-  const std::string text = ReadWholeFile(path);
+  std::string text = ReadWholeFile(path);
   if (UseUlogReader(text, format)) return ReadUlogImu(text, path, format, options);
-  return Parse(text, path, format, options);
+  return Parse(text, path, format, options, &text);
 }
 
 bool TryReadImuLog(const std::string& path, const ImuFormat& format, const ImuLogOptions& options,

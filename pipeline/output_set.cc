@@ -11,6 +11,7 @@
 
 #include "pipeline/cache.h"
 #include "pipeline/atomic_file.h"
+#include "pipeline/json_error.h"
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -102,9 +103,12 @@ OutputManifest::OutputManifest(std::string out_dir) : out_dir_(std::move(out_dir
   }
   try {
     const nlohmann::json j = nlohmann::json::parse(ReadAll(path));
+    if (!j.is_object() || !j.contains("files") || !j["files"].is_array()) {
+      throw UserError("no list 'files'");
+    }
     for (const auto& name : j.at("files")) files_.insert(name.get<std::string>());
   } catch (const std::exception& e) {
-    throw UserError(path + ": damaged manifest of the files bifilar wrote (" + e.what() +
+    throw UserError(path + ": damaged manifest of the files bifilar wrote (" + DescribeJsonError(e) +
                     "); move the output folder away or choose another --out");
   }
 }

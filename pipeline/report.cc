@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "pipeline/cache.h"
+#include "pipeline/json_error.h"
 #include "pipeline/output_set.h"
 #include "pipeline/results_json.h"
 #include "pipeline/user_error.h"
@@ -444,7 +445,8 @@ void RunReport(const std::string& out_dir) {
   try {
     results = json::parse(bytes);
   } catch (const std::exception& e) {
-    throw UserError(path + ": not valid JSON: " + e.what());
+    throw UserError(path + ": not valid JSON (" + DescribeJsonError(e) +
+                    "); rerun `bifilar process` to rewrite it");
   }
   if (!results.is_object() || !results.contains("traces")) {
     throw UserError(path + ": not a bifilar results file (no 'traces')");
@@ -461,7 +463,7 @@ void RunReport(const std::string& out_dir) {
   try {
     html = BuildReportHtml(results, out_dir);
   } catch (const json::exception& e) {  // a field of the wrong type: name the file, not json
-    throw UserError(path + ": not a results file bifilar can read (" + e.what() +
+    throw UserError(path + ": not a results file bifilar can read (" + DescribeJsonError(e) +
                     "); rerun `bifilar process` to rewrite it");
   }
   WriteFileAtomically((fs::path(out_dir) / "report.html").string(),

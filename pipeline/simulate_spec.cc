@@ -800,7 +800,7 @@ std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<Campai
   nlohmann::json list = nlohmann::json::array();
   for (const auto& ct : traces) list.push_back(TraceJson(ct, spec));
   j["traces"] = list;
-  return j.dump(2) + "\n";
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::string& out_dir) {
@@ -928,7 +928,7 @@ SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string&
   trace["file"] = csv_path;
   j["traces"] = nlohmann::json::array({trace});
   WriteTrace(csv_path, ct.trace, spec);
-  WriteFileAtomically(truth_path, j.dump(2) + "\n");
+  WriteFileAtomically(truth_path, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   SimulateRunSummary summary;
   summary.files_written = 1;
   summary.samples_written = static_cast<long>(ct.trace.imu.size());

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <new>
 
+#include "fit/block_mean.h"
 #include "fit/glitch.h"
 #include "fit/swing_axis.h"
 #include "fit/trace_fit.h"
@@ -301,10 +303,14 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
 
   // 5. Fit.
   TraceFitInput input;
-  input.t_s.assign(data.t_s.begin() + band.first_index, data.t_s.begin() + band.last_index + 1);
-  input.rate_rad_per_s.assign(axis.rate_rad_per_s.begin() + band.first_index,
-                              axis.rate_rad_per_s.begin() + band.last_index + 1);
-  input.noise_rad_per_s = window.noise_from_rest ? window.noise_sigma_rad_per_s : 0.0;
+  // The band's samples, or their block means when the log is dense (fit/block_mean.h).
+  FitSeries series = MakeFitSeries(data.t_s, axis.rate_rad_per_s, band.first_index,
+                                   band.last_index, window.period_s,
+                                   window.noise_from_rest ? window.noise_sigma_rad_per_s : 0.0,
+                                   window.rest_end_s);
+  input.t_s = std::move(series.t_s);
+  input.rate_rad_per_s = std::move(series.rate_rad_per_s);
+  input.noise_rad_per_s = series.noise_rad_per_s;
   input.secondary_motion_ratio =
       SecondaryMotionRatio(data, axis.axis_in_imu, band.t0_s, band.t1_s);
   input.geometry = options.role == TraceRole::kTare ? config.TareGeometry()
@@ -386,6 +392,11 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                                                             : TraceStatus::kError;
   record.message = fit.message.empty() ? "" : Renamed(fit.message, path, name);
   record.flags = fit.flags;
+  if (series.block_means()) {
+    char flag[64];
+    std::snprintf(flag, sizeof(flag), "block_means_of_%.0f_samples", series.samples_per_point);
+    record.flags.push_back(flag);
+  }
   for (const std::string& w : fit.warnings) record.warnings.push_back(w);
   record.model = ToString(fit.model);
   record.iterations = fit.iterations;
@@ -482,6 +493,10 @@ TraceRecord Guarded(const CampaignConfig& config, const std::string& path,
   record.model = ToString(config.fit.model);
   try {
     record = process(record);
+  } catch (const std::bad_alloc&) {  // never a bare "std::bad_alloc"
+    record.status = TraceStatus::kError;
+    record.message = record.file + ": out of memory while reading or fitting this log (is it far "
+                                   "larger than a pendulum log?)";
   } catch (const std::exception& e) {
     record.status = TraceStatus::kError;
     record.message = Renamed(e.what(), path, record.file);

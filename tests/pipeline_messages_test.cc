@@ -6,14 +6,17 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "pipeline/campaign.h"
 #include "pipeline/config.h"
 #include "pipeline/ellipse_table.h"
 #include "pipeline/gzip.h"
+#include "pipeline/json_error.h"
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -166,6 +169,78 @@ TEST(Messages, ReportOfAMalformedResultsFileNamesIt) {
   std::string out;
   EXPECT_EQ(Cli(dir, "report " + dir.path + "/out", &out), 2);
   EXPECT_NE(out.find("results.json"), std::string::npos) << out;
+  // The key, in words; never the library's exception code.
+  EXPECT_NE(out.find("window_s"), std::string::npos) << out;
+  EXPECT_NE(out.find("rerun `bifilar process`"), std::string::npos) << out;
+  EXPECT_EQ(out.find("json.exception"), std::string::npos) << out;
+  // Not JSON at all: the line and column, and what to do.
+  WriteFile(dir.path + "/out/results.json", "{\"traces\": 5");
+  EXPECT_EQ(Cli(dir, "report " + dir.path + "/out", &out), 2);
+  EXPECT_NE(out.find("results.json: not valid JSON (parse error at line"), std::string::npos) << out;
+  EXPECT_EQ(out.find("json.exception"), std::string::npos) << out;
+}
+
+TEST(Messages, DamagedManifestNamesTheFileAndKey) {
+  TempDir dir;
+  WriteFile(dir.path + "/logs/p0.csv", "x");
+  WriteFile(dir.path + "/c.yaml",
+            "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.1}}\n"
+            "aircraft: {mass_kg: 1}\nruns: {root: logs, pattern: 'p{pitch_deg}.csv'}\n");
+  const std::string out_dir = dir.path + "/out";
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"files": [1, 2]})", "at key /files/0: type must be string"},
+      {R"({"files": 5})", "no list 'files'"},
+      {"\xff\xfe{", "parse error at line 1, column 1"}};
+  for (const auto& [manifest, expected] : cases) {
+    WriteFile(out_dir + "/.bifilar-manifest.json", manifest);
+    std::string out;
+    EXPECT_EQ(Cli(dir, "process " + dir.path + "/c.yaml --out " + out_dir, &out), 2) << out;
+    EXPECT_NE(out.find(".bifilar-manifest.json: damaged manifest"), std::string::npos) << out;
+    EXPECT_NE(out.find(expected), std::string::npos) << out;
+    EXPECT_NE(out.find("choose another --out"), std::string::npos) << out;
+    EXPECT_EQ(out.find("json.exception"), std::string::npos) << out;
+    EXPECT_TRUE(Printable(out)) << out;
+  }
+}
+
+TEST(Messages, JsonErrorsInPlainWords) {
+  try {
+    (void)nlohmann::json::parse(R"({"a": [1, "x"]})")["a"][1].get<double>();
+    FAIL() << "no exception";
+  } catch (const nlohmann::json::exception& e) {
+    EXPECT_EQ(DescribeJsonError(e), "at key /a/1: type must be number, but is string");
+  }
+  EXPECT_EQ(DescribeJsonError(std::runtime_error("bad \xff byte")), "bad ? byte");
+}
+
+TEST(Messages, SpecNameThatIsNotUtf8IsNoJsonError) {
+  TempDir dir;
+  const std::string spec = dir.path + "/q\xff.yaml";
+  WriteFile(spec, ReadFile(std::string(BIFILAR_SOURCE_DIR) + "/configs/simulate_quadrotor.yaml"));
+  std::string out;
+  EXPECT_EQ(Cli(dir, "simulate '" + spec + "' --out " + dir.path + "/sim", &out), 0) << out;
+  EXPECT_EQ(out.find("json.exception"), std::string::npos) << out;
+  EXPECT_TRUE(fs::exists(dir.path + "/sim/truth.json"));
+}
+
+// An allocation that fails outside any per-file handler names the command and its input, never a
+// bare "std::bad_alloc". The address space is capped (ulimit -v) at 120 MB: the program starts in
+// ~60 MB, and a 1e6-row ellipse table needs ~250 MB.
+TEST(Messages, OutOfMemoryNamesTheInput) {
+  TempDir dir;
+  std::ostringstream table;
+  table << "pitch_deg,inertia\n";
+  for (int i = 0; i < 1000000; ++i) table << (i % 181) - 90 << ',' << 2.5 + 1e-7 * i << '\n';
+  WriteFile(dir.path + "/big.csv", table.str());
+  const std::string log = dir.path + "/oom.txt";
+  const int status = std::system(("ulimit -v 120000; " + std::string(BIFILAR_BINARY) + " ellipse " +
+                                  dir.path + "/big.csv > " + log + " 2>&1").c_str());
+  const std::string out = ReadFile(log);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2) << out;
+  EXPECT_NE(out.find("out of memory in `bifilar ellipse on " + dir.path + "/big.csv`"),
+            std::string::npos) << out;
+  EXPECT_EQ(out.find("std::bad_alloc"), std::string::npos) << out;
 }
 
 }  // namespace
