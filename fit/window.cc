@@ -529,7 +529,21 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
   w.end_reason = best->end;
   w.t0_s = cycles[best->first].end_s + o.start_delay_periods * period;
   switch (best->end) {
-    case WindowEnd::kLogEnd: w.t1_s = t.back(); break;
+    case WindowEnd::kLogEnd: {
+      w.t1_s = t.back();
+      // A swing stopped by hand shortly before the log ends leaves a quiet tail inside the last,
+      // open half-cycle: 3 or more samples with |rate| below the noise floor over more than a
+      // tenth of a period, which a free swing never shows (it is below the floor for about
+      // floor/peak of a period around each crossing). The window then ends half a period
+      // before the tail, clear of the hand.
+      size_t k = a.x.size();
+      while (k > 0 && std::abs(a.x[k - 1]) < floor) --k;
+      if (k > 0 && a.x.size() - k >= 3 && t.back() - t[k - 1] > 0.1 * period) {
+        w.t1_s = t[k - 1] - 0.5 * period;
+        w.end_reason = WindowEnd::kStopped;
+      }
+      break;
+    }
     case WindowEnd::kNoiseFloor: w.t1_s = cycles[best->last].end_s; break;
     default: w.t1_s = t[cycles[best->last].peak_index] - o.end_margin_periods * period; break;
   }

@@ -159,6 +159,28 @@ TEST(Window, HandStop) {
   ExpectWindowMatches(FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions()), log, s);
 }
 
+// A hand stop less than a half-period before the log ends: the quiet tail sits inside the last,
+// open half-cycle, where no peak test applies; the window must still end before the hand.
+TEST(Window, HandStopShortlyBeforeTheLogEnds) {
+  // The hand's 0.1 s decay leaves a quiet tail of 0.2-0.8 s.
+  for (const double rest_after_s : {0.6, 0.8, 1.2}) {
+    Synth s;
+    s.stop = true;
+    s.period_s = 3.0;
+    s.rest_after_s = rest_after_s;
+    for (uint64_t seed = 1; seed <= 6; ++seed) {
+      s.seed = seed;
+      s.free_s = 20.0 + 0.37 * seed;  // the stop at different phases of the swing
+      const SynthLog log = MakeLog(s);
+      const auto w = FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions());
+      ASSERT_TRUE(w.IsUsable()) << w.message;
+      EXPECT_LT(w.t1_s, log.t_stop_s) << "rest after " << rest_after_s << ", seed " << seed << ": "
+                                      << w.BriefReport();
+      EXPECT_GT(w.t1_s, log.t_stop_s - 2 * s.period_s) << w.BriefReport();
+    }
+  }
+}
+
 TEST(Window, ManySyntheticLogs) {
   // 40 seeded logs over the realistic range: period 1-3 s, amplitude 5-40 deg, light to moderate
   // damping, half of them stopped by hand, twist/hold durations varied.
