@@ -6,8 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include <Eigen/Dense>
-
+#include "fit/amplitude_trend.h"
 #include "fit/trace_fit_steps.h"
 
 namespace bifilar {
@@ -99,40 +98,21 @@ void FitTrend(const TraceFitOptions& options, double ref, AmplitudeSweep* sweep)
     sweep->note = "fewer than 2 bands could be fitted";
     return;
   }
-  Eigen::Matrix2d xtwx = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d xtwy = Eigen::Vector2d::Zero();
-  double a_min = HUGE_VAL, a_max = 0.0;
-  for (const AmplitudeSweepBand* b : good) {
-    const double w = 1.0 / std::pow(b->inertia_std_kg_m2 / ref, 2);
-    const Eigen::Vector2d x(1.0, b->amplitude_mean_deg * b->amplitude_mean_deg);
-    xtwx += w * x * x.transpose();
-    xtwy += w * x * (b->inertia_kg_m2 / ref);
-    a_min = std::min(a_min, b->amplitude_mean_deg);
-    a_max = std::max(a_max, b->amplitude_mean_deg);
-  }
-  if (!(std::abs(xtwx.determinant()) > 0.0) || !(a_max > a_min)) {
+  std::vector<AmplitudePoint> points;
+  for (const AmplitudeSweepBand* b : good)
+    points.push_back({b->amplitude_mean_deg, b->inertia_kg_m2, b->inertia_std_kg_m2});
+  AmplitudeTrend trend;
+  if (!FitAmplitudeTrend(points, ref, &trend)) {
     sweep->note = "the bands do not span a range of amplitudes";
     return;
   }
-  const Eigen::Matrix2d cov = xtwx.inverse();
-  const Eigen::Vector2d coef = cov * xtwy;
-  double chi2 = 0.0;
-  for (const AmplitudeSweepBand* b : good) {
-    const double x = b->amplitude_mean_deg * b->amplitude_mean_deg;
-    chi2 += std::pow((b->inertia_kg_m2 / ref - coef(0) - coef(1) * x) / (b->inertia_std_kg_m2 / ref), 2);
-  }
-  const double dof = static_cast<double>(good.size()) - 2.0;
-  const double birge = dof > 0 && chi2 > dof ? chi2 / dof : 1.0;  // Birge ratio, PDG rule
   sweep->evaluated = true;
   TestConstant(good, sweep);
-  const double c = coef(1) / coef(0);  // relative to I_0
-  sweep->trend_coeff_per_deg2 = c;
-  sweep->trend_coeff_std_per_deg2 = std::sqrt(cov(1, 1) * birge) / coef(0);
-  sweep->trend_z =
-      sweep->trend_coeff_std_per_deg2 > 0.0 ? c / sweep->trend_coeff_std_per_deg2 : 0.0;
-  sweep->trend_percent_per_10deg =
-      100.0 * c * (a_max * a_max - a_min * a_min) / (a_max - a_min) * 10.0;
-  sweep->inertia_zero_amplitude_kg_m2 = ref * coef(0);
+  sweep->trend_coeff_per_deg2 = trend.coeff_per_deg2;
+  sweep->trend_coeff_std_per_deg2 = trend.coeff_std_per_deg2;
+  sweep->trend_z = trend.z;
+  sweep->trend_percent_per_10deg = trend.percent_per_10deg;
+  sweep->inertia_zero_amplitude_kg_m2 = trend.inertia_zero_amplitude_kg_m2;
   sweep->trend_detected = std::abs(sweep->trend_z) > options.sweep_trend_z;
 }
 

@@ -4,11 +4,9 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <map>
 
-#include <Eigen/Dense>
-
+#include "fit/amplitude_trend.h"
 namespace bifilar {
 namespace {
 
@@ -39,37 +37,24 @@ double ResultAmplitudeSquared(const TraceRecord& r) {
   return 0.5 * (r.amplitude_deg[0] * r.amplitude_deg[0] + r.amplitude_deg[1] * r.amplitude_deg[1]);
 }
 
-// Weighted line of I / reference against A^2 over the used members: the slope in % per 10 deg
-// at the members' amplitudes and its z (std scaled by the Birge ratio when the points scatter
-// about the line more than their stds).
-void AmplitudeTrend(const std::vector<const TraceRecord*>& used, double reference,
-                    RepeatGroup* group) {
+// I against each used member's result amplitude across the repeats (fit/amplitude_trend.h, on
+// the per-log stds): the slope in % per 10 deg at the members' amplitudes and its z.
+void AmplitudeTrendAcrossRepeats(const std::vector<const TraceRecord*>& used, double reference,
+                                 RepeatGroup* group) {
   if (used.size() < 3) return;
-  Eigen::Matrix2d xtwx = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d xtwy = Eigen::Vector2d::Zero();
-  double a_min = HUGE_VAL, a_max = 0.0;
+  std::vector<AmplitudePoint> points;
   for (const TraceRecord* r : used) {
-    const double x = ResultAmplitudeSquared(*r), s = r->inertia_total_std_kg_m2 / reference;
+    const double x = ResultAmplitudeSquared(*r);
     if (!std::isfinite(x)) return;
-    const Eigen::Vector2d row(1.0, x);
-    xtwx += row * row.transpose() / (s * s);
-    xtwy += row * (r->inertia_total_kg_m2 / reference) / (s * s);
-    a_min = std::min(a_min, std::sqrt(x));
-    a_max = std::max(a_max, std::sqrt(x));
+    points.push_back({std::sqrt(x), r->inertia_total_kg_m2, r->inertia_total_std_kg_m2});
   }
-  if (!(a_max > a_min + 0.1) || !(std::abs(xtwx.determinant()) > 0.0)) return;
-  const Eigen::Matrix2d cov = xtwx.inverse();
-  const Eigen::Vector2d coef = cov * xtwy;
-  double chi2 = 0.0;
-  for (const TraceRecord* r : used) {
-    const double s = r->inertia_total_std_kg_m2 / reference;
-    chi2 += std::pow((r->inertia_total_kg_m2 / reference - coef(0) - coef(1) * ResultAmplitudeSquared(*r)) / s, 2);
+  AmplitudeTrend trend;
+  if (!FitAmplitudeTrend(points, reference, &trend) ||
+      !(trend.amplitude_max_deg > trend.amplitude_min_deg + 0.1)) {
+    return;
   }
-  const double dof = static_cast<double>(used.size()) - 2.0;
-  const double birge = chi2 > dof ? chi2 / dof : 1.0;
-  const double c = coef(1) / coef(0), c_std = std::sqrt(cov(1, 1) * birge) / coef(0);
-  group->amplitude_trend_percent_per_10deg = 100.0 * c * (a_max + a_min) * 10.0;
-  group->amplitude_trend_z = c_std > 0.0 ? c / c_std : NAN;
+  group->amplitude_trend_percent_per_10deg = trend.percent_per_10deg;
+  group->amplitude_trend_z = trend.coeff_std_per_deg2 > 0.0 ? trend.z : NAN;
 }
 
 void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
@@ -103,7 +88,7 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
   const double tau2 = std::max(0.0, (q - (k - 1.0)) / (sw - sw2 / sw));
   group->tau_kg_m2 = std::sqrt(tau2);
   // The trend is judged on the per-log stds, before tau (which would absorb it).
-  AmplitudeTrend(used, group->plain_mean_kg_m2, group);
+  AmplitudeTrendAcrossRepeats(used, group->plain_mean_kg_m2, group);
   double sw_re = 0.0, swy_re = 0.0;
   group->max_abs_z = 0.0;
   for (int i : group->members) {
