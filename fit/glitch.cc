@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "fit/window.h"
+
 namespace bifilar {
 namespace {
 
@@ -56,16 +58,7 @@ std::vector<size_t> FindGlitches(const std::vector<double>& t, const std::vector
   size_t idx[4];
   for (size_t k = 0; k < n; ++k) {
     Neighbours(k, n, idx);
-    double pred = 0.0, w2 = 0.0;
-    for (int i = 0; i < 4; ++i) {
-      double w = 1.0;
-      for (int j = 0; j < 4; ++j) {
-        if (j != i) w *= (t[k] - t[idx[j]]) / (t[idx[i]] - t[idx[j]]);
-      }
-      pred += w * x[idx[i]];
-      w2 += w * w;
-    }
-    e[k] = (x[k] - pred) / std::sqrt(1.0 + w2);
+    e[k] = NeighbourCubicResidual(t, x, k, idx);
   }
   // Robust scale with its floors.
   std::vector<double> work(n);

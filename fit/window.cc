@@ -57,6 +57,24 @@ struct Analysis {
   std::vector<HalfCycle> cycles;
 };
 
+}  // namespace
+
+double NeighbourCubicResidual(const std::vector<double>& t, const std::vector<double>& x, size_t k,
+                              const size_t idx[4]) {
+  double pred = 0.0, w2 = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    double w = 1.0;
+    for (int j = 0; j < 4; ++j) {
+      if (j != i) w *= (t[k] - t[idx[j]]) / (t[idx[i]] - t[idx[j]]);
+    }
+    pred += w * x[idx[i]];
+    w2 += w * w;
+  }
+  return (x[k] - pred) / std::sqrt(1.0 + w2);
+}
+
+namespace {
+
 // Noise of a smooth signal sampled at irregular times: each sample is predicted by the cubic
 // through its two neighbours on each side, at the real timestamps (so jitter and single drops do
 // not count as noise); the residual, divided by sqrt(1 + sum of squared weights) to make its std
@@ -68,16 +86,7 @@ double HighFrequencySigma(const std::vector<double>& t, const std::vector<double
   res.reserve(t.size() - 4);
   for (size_t k = 2; k + 2 < t.size(); ++k) {
     const size_t idx[4] = {k - 2, k - 1, k + 1, k + 2};
-    double pred = 0.0, w2 = 0.0;
-    for (int i = 0; i < 4; ++i) {
-      double w = 1.0;
-      for (int j = 0; j < 4; ++j) {
-        if (j != i) w *= (t[k] - t[idx[j]]) / (t[idx[i]] - t[idx[j]]);
-      }
-      pred += w * r[idx[i]];
-      w2 += w * w;
-    }
-    res.push_back(std::abs(r[k] - pred) / std::sqrt(1.0 + w2));
+    res.push_back(std::abs(NeighbourCubicResidual(t, r, k, idx)));
   }
   return 1.482602218505602 * Median(res);
 }

@@ -91,6 +91,13 @@ struct FreeOscillationWindow {
   std::string BriefReport() const;
 };
 
+// Residual of x[k] against the cubic through its neighbours x[idx[0..3]], evaluated at the real
+// timestamps t (so jitter and single drops do not count), divided by sqrt(1 + sum of squared
+// Lagrange weights) so that its std equals the sample noise. Shared by the window's noise
+// estimate and the glitch detector (fit/glitch.h).
+double NeighbourCubicResidual(const std::vector<double>& t, const std::vector<double>& x, size_t k,
+                              const size_t idx[4]);
+
 // Finds the window on a swing-rate series (t strictly increasing, same size, finite). `name`
 // (the log's file name) prefixes messages. Never throws; bad series -> kError.
 FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t_s,
