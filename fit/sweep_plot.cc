@@ -22,6 +22,19 @@ std::string Fmt(const char* format, double v) {
   return buf;
 }
 
+// A red ring of radii (rx, ry) in world units around (mx, my), 2 px wide.
+void DrawRing(double mx, double my, double rx, double ry) {
+  PLFLT cx[41], cy[41];
+  for (int j = 0; j <= 40; ++j) {
+    cx[j] = mx + rx * std::cos(2.0 * M_PI * j / 40.0);
+    cy[j] = my + ry * std::sin(2.0 * M_PI * j / 40.0);
+  }
+  plcol0(kRed);
+  plwidth(2.0);
+  plline(41, cx, cy);
+  plwidth(1.0);
+}
+
 }  // namespace
 
 bool WriteAmplitudeSweepFigure(const AmplitudeSweep& sweep, double inertia_kg_m2,
@@ -156,15 +169,7 @@ bool WriteAmplitudeSweepFigure(const AmplitudeSweep& sweep, double inertia_kg_m2
     if (marked) {  // the band the result was taken from: a red ring around its point
       const AmplitudeSweepBand& low = sweep.bands[sweep.low_band];
       const double mx = low.amplitude_mean_deg, my = low.inertia_kg_m2 * k;
-      const double rx = ring_px * (x_hi - x_lo) / px_w, ry = ring_px * (y_hi - y_lo) / px_h;
-      PLFLT cx[41], cy[41];
-      for (int j = 0; j <= 40; ++j) {
-        cx[j] = mx + rx * std::cos(2.0 * M_PI * j / 40.0);
-        cy[j] = my + ry * std::sin(2.0 * M_PI * j / 40.0);
-      }
-      plcol0(kRed);
-      plwidth(2.0);
-      plline(41, cx, cy);
+      DrawRing(mx, my, ring_px * (x_hi - x_lo) / px_w, ring_px * (y_hi - y_lo) / px_h);
     }
     plwidth(1.0);
     // Axes: I on the left, its deviation from the result in % on the right.
@@ -221,17 +226,8 @@ bool WriteAmplitudeSweepFigure(const AmplitudeSweep& sweep, double inertia_kg_m2
     }
     if (marked) {
       const double mx = col[1] + 0.5 * w, my = row[1];
-      const double rx = 0.75 * ring_px / options.figure.width_px;
-      const double ry = 0.75 * ring_px / options.figure.height_px;
-      PLFLT cx[41], cy[41];
-      for (int j = 0; j <= 40; ++j) {
-        cx[j] = mx + rx * std::cos(2.0 * M_PI * j / 40.0);
-        cy[j] = my + ry * std::sin(2.0 * M_PI * j / 40.0);
-      }
-      plcol0(kRed);
-      plwidth(2.0);
-      plline(41, cx, cy);
-      plwidth(1.0);
+      DrawRing(mx, my, 0.75 * ring_px / options.figure.width_px,
+               0.75 * ring_px / options.figure.height_px);
       text(col[1], row[1], "band used for the result");
     }
   };
