@@ -133,6 +133,17 @@ struct FitPlan {
   std::vector<int> to_fit;  // indices into CampaignInputs, in discovery order
 };
 
+// A fitted or cached record takes the fields discovery knows (file, role, nominal pitch, content
+// hash, cache key) from the planned record, and says where it came from.
+void KeepDiscoveryFields(const TraceRecord& planned, bool from_cache, TraceRecord* r) {
+  r->file = planned.file;
+  r->role = planned.role;
+  r->pitch_nominal_deg = planned.pitch_nominal_deg;
+  r->content_hash = planned.content_hash;
+  r->cache_key = planned.cache_key;
+  r->from_cache = from_cache;
+}
+
 // One record per run: an error row (discovery error, unreadable, duplicate content), a cache
 // hit, or a record to fit (listed in the plan). Counts reuse and refused cache entries.
 FitPlan PlanFits(const CampaignConfig& config, const CampaignOptions& options,
@@ -177,12 +188,7 @@ FitPlan PlanFits(const CampaignConfig& config, const CampaignOptions& options,
          ((cached.figure.empty() || fs::exists(out.figures() / cached.figure, ec)) &&
           (cached.sweep_figure.empty() ? !cached.sweep.evaluated
                                        : fs::exists(out.figures() / cached.sweep_figure, ec))))) {
-      cached.role = record.role;
-      cached.pitch_nominal_deg = record.pitch_nominal_deg;
-      cached.content_hash = record.content_hash;
-      cached.cache_key = record.cache_key;
-      cached.file = record.file;
-      cached.from_cache = true;
+      KeepDiscoveryFields(record, /*from_cache=*/true, &cached);
       record = cached;
       ++result->summary.n_reused;
     } else {
@@ -227,12 +233,7 @@ TraceRecord FitOneTrace(const TraceFitFunction& fit, const CampaignConfig& fit_c
   std::error_code ec;
   fitted.figure = options.figures && fs::exists(figure_path, ec) ? figure_name : "";
   fitted.sweep_figure = options.figures && fs::exists(sweep_path, ec) ? sweep_name : "";
-  fitted.file = planned.file;
-  fitted.role = planned.role;
-  fitted.pitch_nominal_deg = planned.pitch_nominal_deg;
-  fitted.content_hash = planned.content_hash;
-  fitted.cache_key = planned.cache_key;
-  fitted.from_cache = false;
+  KeepDiscoveryFields(planned, /*from_cache=*/false, &fitted);
   try {
     cache.Store(planned.cache_key, planned.content_hash, fitted);
   } catch (const UserError& e) {
