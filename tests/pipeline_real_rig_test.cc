@@ -16,6 +16,7 @@
 #include "fit/trace_synth.h"
 #include "pipeline/config.h"
 #include "pipeline/trace_process.h"
+#include "tests/test_support.h"
 
 namespace bifilar {
 namespace {
@@ -43,14 +44,8 @@ std::string WriteConfig(const std::string& dir, const std::string& name, const s
 
 // The Crazyflie rig of ../shared/data/README.md, with only geometry, mass and format configured.
 std::string CrazyflieConfig(const std::string& dir, double mass_kg) {
-  char text[512];
-  std::snprintf(text, sizeof(text),
-                "gravity_mps2: 9.8066\n"
-                "rig: {filar_length_m: 0.594, filar_separation_m: 0.030, mass_kg: %.4f}\n"
-                "imu:\n  time: {column: t, unit: s}\n"
-                "  gyro: {columns: [wx, wy, wz], unit: rad/s}\n  accel: null\n",
-                mass_kg);
-  return WriteConfig(dir, mass_kg < 0.036 ? "base.yaml" : "narrow.yaml", text);
+  return WriteConfig(dir, mass_kg < 0.036 ? "base.yaml" : "narrow.yaml",
+                     test_support::QuadrotorFitConfig(mass_kg));
 }
 
 TEST(RealRig, CrazyflieLogsAllGiveANumberWithDefaults) {

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/config.h"
+#include "tests/test_support.h"
 
 namespace bifilar {
 namespace {
@@ -110,10 +111,7 @@ TEST(Repeats, FitCommandCombinesSimulatedQuadrotorRepeats) {
   const std::string simulate = std::string(BIFILAR_BINARY) + " simulate " + kSource +
                                "/configs/simulate_quadrotor.yaml --out " + dir + "/logs > /dev/null";
   ASSERT_EQ(std::system(simulate.c_str()), 0);
-  std::ofstream(dir + "/fit.yaml")
-      << "gravity_mps2: 9.8066\nrig: {filar_length_m: 0.594, filar_separation_m: 0.030, "
-         "mass_kg: 0.0343}\nimu:\n  time: {column: t, unit: s}\n"
-         "  gyro: {columns: [wx, wy, wz], unit: rad/s}\n  accel: null\n";
+  std::ofstream(dir + "/fit.yaml") << test_support::QuadrotorFitConfig();
   const std::string fit = std::string(BIFILAR_BINARY) + " fit " + dir + "/fit.yaml " + dir +
                           "/logs/pitch_0/trial_*.csv " + dir + "/logs/pitch_90/trial_*.csv" +
                           " --repeats --json > " + dir + "/out.json";
@@ -138,15 +136,8 @@ TEST(Repeats, QuadrotorRepeatsAreWithinTheirStd) {
   int logs = 0, beyond = 0, beyond_before = 0;
   for (const char* airframe : {"BaseModel", "NarrowMedium"}) {
     const double mass = std::string(airframe) == "BaseModel" ? 0.0343 : 0.0381;
-    char text[512];
-    std::snprintf(text, sizeof(text),
-                  "gravity_mps2: 9.8066\n"
-                  "rig: {filar_length_m: 0.594, filar_separation_m: 0.030, mass_kg: %.4f}\n"
-                  "imu:\n  time: {column: t, unit: s}\n"
-                  "  gyro: {columns: [wx, wy, wz], unit: rad/s}\n  accel: null\n",
-                  mass);
     const std::string config_path = dir + "/" + airframe + ".yaml";
-    std::ofstream(config_path) << text;
+    std::ofstream(config_path) << test_support::QuadrotorFitConfig(mass);
     ConfigLoadOptions load;
     load.require_runs = false;
     const CampaignConfig config = LoadCampaignConfig(config_path, load);

@@ -18,36 +18,23 @@
 
 #include "pipeline/config.h"
 #include "pipeline/trace_process.h"
+#include "tests/test_support.h"
 
 namespace bifilar {
 namespace {
 
 namespace fs = std::filesystem;
 const std::string kSource = BIFILAR_SOURCE_DIR;
+using test_support::LoadFitConfig;
+using test_support::ReadFile;
+using test_support::SimulateQuadrotor;
+using test_support::WriteFile;
+const std::string kQuadrotorFit = test_support::QuadrotorFitConfig();
 
-struct TempDir {
-  std::string path;
-  TempDir() {
-    char tmpl[] = "/tmp/bifilar_robust_input_XXXXXX";
-    path = mkdtemp(tmpl);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
+// Each test's own folder, removed at the end.
+struct TempDir : test_support::TempDir {
+  TempDir() : test_support::TempDir("bifilar_robust_input") {}
 };
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void WriteFile(const std::string& path, const std::string& text) {
-  fs::create_directories(fs::path(path).parent_path());
-  std::ofstream(path, std::ios::binary) << text;
-}
 
 // Runs bifilar; returns the exit code, *output gets stdout and stderr.
 int Cli(const TempDir& dir, const std::string& args, std::string* output) {
@@ -61,39 +48,6 @@ int Cli(const TempDir& dir, const std::string& args, std::string* output) {
 bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
-
-CampaignConfig LoadFitConfig(const std::string& path) {
-  ConfigLoadOptions options;
-  options.require_runs = false;  // what `bifilar fit` reads: geometry, mass, IMU format
-  return LoadCampaignConfig(path, options);
-}
-
-// The quadrotor preset (30 Hz radio timestamps of 8-160 ms, coloured noise, a footer) simulated
-// with its one glitch replaced by `spike_count` glitches of `rate` rad/s (same seed, so the logs
-// differ only in the glitch samples: tests/pendulum_simulate_test.cc).
-std::string SimulateQuadrotor(const TempDir& dir, int spike_count, double rate) {
-  std::string preset = ReadFile(kSource + "/configs/simulate_quadrotor.yaml");
-  const size_t count_at = preset.find("spike_count: 1");
-  const size_t rate_at = preset.find("spike_rate_rad_per_s: 5");
-  EXPECT_NE(count_at, std::string::npos);
-  EXPECT_NE(rate_at, std::string::npos);
-  char rate_text[64];
-  std::snprintf(rate_text, sizeof(rate_text), "spike_rate_rad_per_s: %g", rate);
-  preset.replace(rate_at, std::strlen("spike_rate_rad_per_s: 5"), rate_text);
-  preset.replace(count_at, std::strlen("spike_count: 1"), "spike_count: " + std::to_string(spike_count));
-  const std::string name = "q_" + std::to_string(spike_count) + "_" + std::to_string(static_cast<int>(rate));
-  WriteFile(dir.path + "/" + name + ".yaml", preset);
-  const std::string command = std::string(BIFILAR_BINARY) + " simulate " + dir.path + "/" + name +
-                              ".yaml --out " + dir.path + "/" + name + " > /dev/null";
-  EXPECT_EQ(std::system(command.c_str()), 0);
-  return dir.path + "/" + name;
-}
-
-const char kQuadrotorFit[] =
-    "gravity_mps2: 9.8066\n"
-    "rig: {filar_length_m: 0.594, filar_separation_m: 0.030, mass_kg: 0.0343}\n"
-    "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [wx, wy, wz], unit: rad/s}\n"
-    "  accel: null\n";
 
 std::string GlitchWarning(const TraceRecord& r) {
   for (const std::string& w : r.warnings) {

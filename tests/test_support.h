@@ -1,0 +1,96 @@
+// What several tests share: files, a temporary folder, the `bifilar fit` config of the
+// quadrotor rig (the Crazyflie logs of ../shared/data and the simulator's preset), and that preset
+// simulated with its glitches changed. Header-only; include from tests only.
+#pragma once
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/config.h"
+
+namespace bifilar {
+namespace test_support {
+
+inline std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Writes `text` to `path` (creating its folder) and returns the path.
+inline std::string WriteFile(const std::string& path, const std::string& text) {
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+// A fresh folder /tmp/<prefix>_XXXXXX, removed with everything in it at the end of the scope.
+struct TempDir {
+  std::string path;
+  explicit TempDir(const std::string& prefix = "bifilar_test") {
+    std::string tmpl = "/tmp/" + prefix + "_XXXXXX";
+    path = mkdtemp(tmpl.data());
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+};
+
+// The config `bifilar fit` reads: geometry, mass, IMU format (no runs).
+inline CampaignConfig LoadFitConfig(const std::string& path) {
+  ConfigLoadOptions options;
+  options.require_runs = false;
+  return LoadCampaignConfig(path, options);
+}
+
+// The quadrotor rig with only geometry, mass and format configured: l 0.594 m, D 0.030 m,
+// g 9.8066, time t (s), gyro wx, wy, wz (rad/s), no accelerometer. Mass 34.3 g: the BaseModel
+// logs and the simulator's preset; 38.1 g: the NarrowMedium logs.
+inline std::string QuadrotorFitConfig(double mass_kg = 0.0343) {
+  char text[512];
+  std::snprintf(text, sizeof(text),
+                "gravity_mps2: 9.8066\n"
+                "rig: {filar_length_m: 0.594, filar_separation_m: 0.030, mass_kg: %.4f}\n"
+                "imu:\n  time: {column: t, unit: s}\n"
+                "  gyro: {columns: [wx, wy, wz], unit: rad/s}\n  accel: null\n",
+                mass_kg);
+  return text;
+}
+
+// The quadrotor preset (30 Hz radio timestamps of 8-160 ms, coloured noise, a footer) simulated
+// into `dir` with its one glitch replaced by `spike_count` glitches of `rate` rad/s (same seed,
+// so the logs differ only in the glitch samples). Returns the output folder.
+inline std::string SimulateQuadrotor(const TempDir& dir, int spike_count, double rate) {
+  std::string preset =
+      ReadFile(std::string(BIFILAR_SOURCE_DIR) + "/configs/simulate_quadrotor.yaml");
+  const size_t count_at = preset.find("spike_count: 1");
+  const size_t rate_at = preset.find("spike_rate_rad_per_s: 5");
+  EXPECT_NE(count_at, std::string::npos);
+  EXPECT_NE(rate_at, std::string::npos);
+  char rate_text[64];
+  std::snprintf(rate_text, sizeof(rate_text), "spike_rate_rad_per_s: %g", rate);
+  preset.replace(rate_at, std::strlen("spike_rate_rad_per_s: 5"), rate_text);
+  preset.replace(count_at, std::strlen("spike_count: 1"),
+                 "spike_count: " + std::to_string(spike_count));
+  const std::string name =
+      "q_" + std::to_string(spike_count) + "_" + std::to_string(static_cast<int>(rate));
+  WriteFile(dir.path + "/" + name + ".yaml", preset);
+  const std::string command = std::string(BIFILAR_BINARY) + " simulate " + dir.path + "/" + name +
+                              ".yaml --out " + dir.path + "/" + name + " > /dev/null";
+  EXPECT_EQ(std::system(command.c_str()), 0);
+  return dir.path + "/" + name;
+}
+
+}  // namespace test_support
+}  // namespace bifilar
