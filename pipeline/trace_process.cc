@@ -252,10 +252,7 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                                                  config.imu.format.time_unit);
     if (!outside.empty()) return fail(TraceStatus::kError, name + ": " + outside);
   }
-  SwingAxisOptions axis_options;
-  axis_options.mode = config.imu.swing_axis_auto ? SwingAxisMode::kAuto : SwingAxisMode::kFixed;
-  axis_options.fixed_axis_in_imu = config.imu.swing_axis_in_imu;
-  axis_options.imu_to_body = config.imu.imu_to_body;
+  const SwingAxisOptions axis_options = SwingAxisOptionsFor(config.imu);
   std::optional<std::pair<double, double>> axis_window;
   if (override_s) axis_window = std::make_pair((*override_s)[0], (*override_s)[1]);
   SwingAxis axis;
@@ -521,6 +518,14 @@ TraceRecord ProcessTraceData(const CampaignConfig& config, const ImuData& data,
   return Guarded(config, path, options, [&](const TraceRecord& record) {
     return ProcessData(config, path, data, options, record, fit);
   });
+}
+
+SwingAxisOptions SwingAxisOptionsFor(const ImuConfig& imu) {
+  SwingAxisOptions options;
+  options.mode = imu.swing_axis_auto ? SwingAxisMode::kAuto : SwingAxisMode::kFixed;
+  options.fixed_axis_in_imu = imu.swing_axis_in_imu;
+  options.imu_to_body = imu.imu_to_body;
+  return options;
 }
 
 }  // namespace bifilar

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "fit/swing_axis.h"
 #include "fit/trace_fit.h"
 #include "pendulum/imu_data.h"
 #include "pipeline/config.h"
@@ -129,5 +130,8 @@ TraceRecord ProcessTraceData(const CampaignConfig& config, const ImuData& data,
 // matched relative to runs.root and to the config folder.
 std::optional<std::array<double, 2>> ConfigWindowFor(const CampaignConfig& config,
                                                      const std::string& path);
+
+// The swing-axis settings of the config's `imu` section (auto or fixed axis, mounting).
+SwingAxisOptions SwingAxisOptionsFor(const ImuConfig& imu);
 
 }  // namespace bifilar

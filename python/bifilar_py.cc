@@ -265,10 +265,7 @@ py::dict ReadLogCore(const std::string& path, const std::string& config_path) {
     // settings, over the config's window for this file when it has one (matched as
     // `bifilar fit` matches it, on the path as given).
     window = ConfigWindowFor(config, path);
-    SwingAxisOptions axis_options;
-    axis_options.mode = config.imu.swing_axis_auto ? SwingAxisMode::kAuto : SwingAxisMode::kFixed;
-    axis_options.fixed_axis_in_imu = config.imu.swing_axis_in_imu;
-    axis_options.imu_to_body = config.imu.imu_to_body;
+    const SwingAxisOptions axis_options = SwingAxisOptionsFor(config.imu);
     std::optional<std::pair<double, double>> axis_window;
     if (window) axis_window = std::make_pair((*window)[0], (*window)[1]);
     std::string why;
