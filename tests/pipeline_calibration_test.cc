@@ -409,6 +409,27 @@ TEST(CalibrationRealFit, MisMeasuredRigIsCorrected) {
   std::printf("%s\n  relative std parts: reference %.4f %%, swings %.4f %%, rig %.4f %%\n",
               c.BriefReport().c_str(), 100 * c.rel_std_reference, 100 * c.rel_std_swings,
               100 * c.rel_std_rig);
+  // `bifilar fit` honours the same section: one log, calibrated, within 0.3 % of its truth.
+  WriteFile(dir.path + "/fit.yaml",
+            "rig:\n  filar_length_m: 1.5\n  filar_separation_m: 0.5\n  mass_kg: 0.52\n"
+            "  inertia: {tare: {logs: logs/tare/*.csv}}\n"
+            "  calibration: {logs: logs/calibration/*.csv, reference_inertia_kg_m2: 0.2, "
+            "reference_inertia_std_kg_m2: 0.0001, reference_mass_kg: 2.0}\n"
+            "aircraft: {mass_kg: 3.0}\n");
+  const std::string out = dir.path + "/fit.json";
+  const std::string command = std::string(BIFILAR_BINARY) + " fit " + dir.path + "/fit.yaml " +
+                              dir.path + "/logs/pitch_0/trial_1.csv --json > " + out;
+  ASSERT_EQ(std::system(command.c_str()), 0) << ReadFile(out);
+  const nlohmann::json fitted = nlohmann::json::parse(ReadFile(out));
+  EXPECT_NEAR(fitted["calibration"]["factor"].get<double>(), c.factor, 1e-9);
+  double truth_total = NAN;
+  for (const auto& t : truth["traces"]) {
+    if (t["file"] == "pitch_0/trial_1.csv") truth_total = t["inertia_total_kg_m2"];
+  }
+  const double fit_total = fitted["traces"][0]["inertia_total_kg_m2"];
+  EXPECT_NEAR(fit_total, truth_total, 0.003 * truth_total);
+  EXPECT_TRUE(fitted["traces"][0]["budget"].contains("calibration_kg_m2"));
+
   // L, D (and g) are absorbed: no such budget term remains; the calibration's is there.
   for (const TraceRecord& r : cal.traces) {
     if (r.role == TraceRole::kCalibration) continue;
@@ -421,6 +442,50 @@ TEST(CalibrationRealFit, MisMeasuredRigIsCorrected) {
                             [](const BudgetTerm& t) { return t.name == "calibration"; }))
         << r.file;
   }
+}
+
+// The simulator's new keys are checked like the others: named, with the allowed range.
+TEST(CalibrationSimulator, BadKeysAreNamed) {
+  auto error = [](const std::string& yaml) {
+    try {
+      ParseSimulateSpec(yaml, "spec.yaml");
+    } catch (const UserError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string spec = kMisMeasuredSpec;
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = spec;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  EXPECT_NE(error(with("reference_mass_kg: 2.0", "reference_mass_kg: 0")).find("reference_mass_kg"),
+            std::string::npos);
+  EXPECT_NE(error(with("reference_inertia_kg_m2: 0.2", "reference_inertia_kg_m2: -1"))
+                .find("reference_inertia_kg_m2"),
+            std::string::npos);
+  EXPECT_NE(error(with("true_filar_separation_m: 0.5075", "true_filar_separation_m: 1.6"))
+                .find("true_filar_separation_m"),
+            std::string::npos);
+  // A single trace has no "configured" geometry to differ from: the keys are refused.
+  EXPECT_NE(error("geometry: {filar_length_m: 1, filar_separation_m: 0.5, "
+                  "true_filar_separation_m: 0.51}\ntrace: {inertia_kg_m2: 1, mass_kg: 1}\n")
+                .find("need the 'aircraft', 'rig' and 'campaign' sections"),
+            std::string::npos);
+  // Without the new keys the logs are those of the configured geometry (bit for bit as before).
+  std::vector<CampaignTrace> a, b;
+  std::string why;
+  SimulateSpec plain = ParseSimulateSpec(with("true_filar_separation_m: 0.5075", ""), "a.yaml");
+  SimulateSpec same = plain;
+  same.campaign.true_filar_separation_m = 0.5;
+  plain.campaign.calibration_logs = same.campaign.calibration_logs = 0;
+  plain.campaign.trials_per_pitch = same.campaign.trials_per_pitch = 1;
+  plain.campaign.pitch_deg = same.campaign.pitch_deg = {0};
+  ASSERT_TRUE(SimulateCampaign(plain.campaign, plain.options, 1, &a, &why)) << why;
+  ASSERT_TRUE(SimulateCampaign(same.campaign, same.options, 1, &b, &why)) << why;
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_TRUE(a[0].trace.imu.gyro_in_imu == b[0].trace.imu.gyro_in_imu);
 }
 
 }  // namespace
