@@ -46,8 +46,8 @@ void MeanAndStandardError(const std::vector<double>& values, const std::vector<d
   for (double s : stds) fit_var += s * s / stds.size();
   *mean = sum / n;
   const double fit_sem = std::sqrt(fit_var / n);
-  *standard_error = values.size() >= 2 ? std::max(SampleStd(values) / std::sqrt(n), fit_sem)
-                                       : fit_sem;
+  *standard_error =
+      values.size() >= 2 ? std::max(SampleStd(values) / std::sqrt(n), fit_sem) : fit_sem;
 }
 
 GeometryCalibration RigCalibrationResult::Applied() const {
@@ -79,7 +79,7 @@ RigCalibrationResult CalibrateRig(const CampaignConfig& config, const Calibratio
   out.reference_mass_kg = spec.reference_mass_kg;
   out.filar_length_m = config.filar_length_m;
   out.nominal_separation_m = config.filar_separation_m;
-  out.rig_inertia_source = from_tare ? "tare"
+  out.rig_inertia_source = from_tare                                  ? "tare"
                            : rig_kind == RigInertiaSpec::Kind::kTable ? "table"
                                                                       : "value";
   // A given rig inertia does not depend on k: look it up once.
@@ -126,8 +126,9 @@ RigCalibrationResult CalibrateRig(const CampaignConfig& config, const Calibratio
     out.swings_scatter_kg_m2 = SampleStd(swing);
     if (from_tare) {
       if (tare.empty()) {
-        throw UserError("rig.calibration: no usable tare log (rig.inertia.tare.logs): the rig's "
-                        "own inertia is needed to calibrate; the campaign stops");
+        throw UserError(
+            "rig.calibration: no usable tare log (rig.inertia.tare.logs): the rig's "
+            "own inertia is needed to calibrate; the campaign stops");
       }
       MeanAndStandardError(tare, tare_std, &out.rig_inertia_kg_m2, &out.rig_inertia_std_kg_m2);
     } else {
@@ -137,24 +138,25 @@ RigCalibrationResult CalibrateRig(const CampaignConfig& config, const Calibratio
     // The reference's share of the swings' inertia, which must come out as its known inertia.
     const double measured_reference = out.swings_total_kg_m2 - out.rig_inertia_kg_m2;
     if (!(measured_reference > 0.0)) {
-      throw UserError(Format("rig.calibration: the reference swings (I = %.6g kg m^2) are not "
-                             "above the rig alone (%.6g kg m^2): check rig.calibration.logs, "
-                             "reference_mass_kg and rig.inertia",
-                             out.swings_total_kg_m2, out.rig_inertia_kg_m2));
+      throw UserError(
+          Format("rig.calibration: the reference swings (I = %.6g kg m^2) are not "
+                 "above the rig alone (%.6g kg m^2): check rig.calibration.logs, "
+                 "reference_mass_kg and rig.inertia",
+                 out.swings_total_kg_m2, out.rig_inertia_kg_m2));
     }
     // Tare: I_rig scales with k too, so target/fitted = I_ref / (I_swings - I_tare); given rig:
     // (I_rig + I_ref) / I_swings.
-    const double ratio = from_tare ? spec.reference_inertia_kg_m2 / measured_reference
-                                   : (rig_given + spec.reference_inertia_kg_m2) /
-                                         out.swings_total_kg_m2;
+    const double ratio = from_tare
+                             ? spec.reference_inertia_kg_m2 / measured_reference
+                             : (rig_given + spec.reference_inertia_kg_m2) / out.swings_total_kg_m2;
     const double next = k * ratio;
     if (!(next >= kMinCalibrationFactor && next <= kMaxCalibrationFactor)) {
-      throw UserError(Format(
-          "rig.calibration: the reference swings give an effective D^2/L %.4g times the "
-          "configured one (allowed %g to %g): not a tape-measure error. Check "
-          "reference_inertia_kg_m2 (about the swing axis, kg m^2), reference_mass_kg (kg), "
-          "rig.inertia and rig.mass_kg",
-          next, kMinCalibrationFactor, kMaxCalibrationFactor));
+      throw UserError(
+          Format("rig.calibration: the reference swings give an effective D^2/L %.4g times the "
+                 "configured one (allowed %g to %g): not a tape-measure error. Check "
+                 "reference_inertia_kg_m2 (about the swing axis, kg m^2), reference_mass_kg (kg), "
+                 "rig.inertia and rig.mass_kg",
+                 next, kMinCalibrationFactor, kMaxCalibrationFactor));
     }
     if (std::abs(ratio - 1.0) <= kCalibrationTolerance) {
       converged = true;  // the records are those of k: keep k

@@ -23,7 +23,7 @@
 
 namespace bifilar {
 
-constexpr double kCalibrationTolerance = 1e-6;   // |target / fitted - 1| at convergence
+constexpr double kCalibrationTolerance = 1e-6;  // |target / fitted - 1| at convergence
 constexpr int kCalibrationMaxIterations = 8;
 // A calibration that moves D^2/L by more than a factor 2 is not a tape-measure error: a wrong
 // reference inertia or mass, a unit slip, or the wrong rig inertia. It is an error.
@@ -33,12 +33,12 @@ constexpr int kRecommendedReferenceSwings = 3;  // fewer: a warning (the scatter
 // What the calibration found. All inertias are of the final iteration (the calibrated geometry).
 struct RigCalibrationResult {
   bool applied = false;
-  double factor = 1.0;            // k = effective D^2/L over the configured D^2/L
-  double factor_std = 0.0;        // std of k
-  double factor_rel_std = 0.0;    // std(k) / k, from the three parts below in quadrature
-  double rel_std_reference = 0.0; // from reference_inertia_std_kg_m2
-  double rel_std_swings = 0.0;    // from the reference swings' scatter (or their fits' std)
-  double rel_std_rig = 0.0;       // from the rig inertia's std (tare mean or configured std)
+  double factor = 1.0;                  // k = effective D^2/L over the configured D^2/L
+  double factor_std = 0.0;              // std of k
+  double factor_rel_std = 0.0;          // std(k) / k, from the three parts below in quadrature
+  double rel_std_reference = 0.0;       // from reference_inertia_std_kg_m2
+  double rel_std_swings = 0.0;          // from the reference swings' scatter (or their fits' std)
+  double rel_std_rig = 0.0;             // from the rig inertia's std (tare mean or configured std)
   double filar_length_m = 0.0;          // L, as configured (kept)
   double nominal_separation_m = 0.0;    // D as configured
   double effective_separation_m = 0.0;  // D sqrt(k)
@@ -51,8 +51,8 @@ struct RigCalibrationResult {
   double swings_scatter_kg_m2 = NAN;    // sample std between the swings (n >= 2)
   std::string rig_inertia_source;       // "value", "table" or "tare"
   double rig_inertia_kg_m2 = NAN, rig_inertia_std_kg_m2 = NAN;  // as used
-  int iterations = 0;                   // fitting rounds
-  std::vector<std::string> logs;        // the reference swings as shown to the user
+  int iterations = 0;                                           // fitting rounds
+  std::vector<std::string> logs;  // the reference swings as shown to the user
   std::vector<std::string> warnings;
   std::vector<std::string> cache_keys;  // every fit of every round (the campaign keeps them)
 

@@ -590,7 +590,7 @@ void WriteCampaignOutputs(const CampaignConfig& config, const CampaignOptions& o
   }
   if (result.calibration) {  // every round's fits, so that a rerun finds them all in the cache
     for (const std::string& key : result.calibration->cache_keys) {
-      for (const char* suffix : {".json"}) keep.insert("cache/" + key + suffix);
+      keep.insert("cache/" + key + ".json");
       for (const char* suffix : {".svg", "_sweep.svg"}) keep.insert("figures/" + key + suffix);
     }
   }

@@ -4,19 +4,18 @@
 // then on a simulated mis-measured rig with the real fit (issue 16: true D 1.5 % wider than
 // configured: about 3 % off without calibration, within 0.3 % and 3 sigma with it), then the bad
 // input of the section.
-#include "pipeline/calibration.h"
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <tuple>
 #include <cstdlib>
-#include <sstream>
-
-#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <tuple>
 
 #include "pipeline/cache.h"
+#include "pipeline/calibration.h"
 #include "pipeline/campaign.h"
 #include "pipeline/results_json.h"
 #include "pipeline/simulate_spec.h"
@@ -33,18 +32,17 @@ using test_support::WriteFile;
 // ---- A fake fit: the log holds the true total inertia; the "fit" scales it like the D^2/L of
 // the configuration it is given against the true D^2/L (the classical formula: I ~ g D^2/L T^2).
 
-constexpr double kIx = 2.0, kIz = 3.0, kIxz = 0.1;   // aircraft truth (kg m^2)
-constexpr double kRig = 0.5, kReference = 1.2;       // rig, reference object (kg m^2)
-constexpr double kL = 2.0, kD = 1.0;                 // configured geometry (m)
-constexpr double kTrueD = 1.015 * kD;                // the rig's real separation: 1.5 % wider
-constexpr double kTrueFactor = 1.015 * 1.015;        // true D^2/L over configured D^2/L
-constexpr double kFitRelStd = 1e-4;                  // each fake fit's std, relative
+constexpr double kIx = 2.0, kIz = 3.0, kIxz = 0.1;  // aircraft truth (kg m^2)
+constexpr double kRig = 0.5, kReference = 1.2;      // rig, reference object (kg m^2)
+constexpr double kL = 2.0, kD = 1.0;                // configured geometry (m)
+constexpr double kTrueD = 1.015 * kD;               // the rig's real separation: 1.5 % wider
+constexpr double kTrueFactor = 1.015 * 1.015;       // true D^2/L over configured D^2/L
+constexpr double kFitRelStd = 1e-4;                 // each fake fit's std, relative
 const std::vector<double> kPitches = {-60, -30, 0, 30, 60, 90};
 
 double Truth(double pitch_deg) {
   const double t = pitch_deg * M_PI / 180.0;
-  return kIz * std::cos(t) * std::cos(t) + kIx * std::sin(t) * std::sin(t) +
-         kIxz * std::sin(2 * t);
+  return kIz * std::cos(t) * std::cos(t) + kIx * std::sin(t) * std::sin(t) + kIxz * std::sin(2 * t);
 }
 
 std::string Number(double v) {
@@ -72,10 +70,10 @@ struct FakeCampaign {
       WriteFile(dir.path + "/calib/ref_" + std::to_string(k) + ".csv",
                 "I=" + Number(kRig + kReference + sign * kSwingOffset) + "\n");
     }
-    WriteConfig("{tare: {logs: tare/*.csv}}",
-                "  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: " +
-                    Number(kReference) +
-                    ", reference_inertia_std_kg_m2: 0.0012, reference_mass_kg: 4}\n");
+    WriteConfig(
+        "{tare: {logs: tare/*.csv}}",
+        "  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: " + Number(kReference) +
+            ", reference_inertia_std_kg_m2: 0.0012, reference_mass_kg: 4}\n");
   }
   void WriteConfig(const std::string& rig_inertia, const std::string& calibration) {
     WriteFile(dir.path + "/campaign.yaml",
@@ -104,8 +102,8 @@ struct FakeCampaign {
         return r;
       }
       const RigGeometry g = GeometryForRole(config, options.role);
-      const double fitted_over_true = (g.filar_separation_m * g.filar_separation_m / g.filar_length_m) /
-                                      (kTrueD * kTrueD / kL);
+      const double fitted_over_true =
+          (g.filar_separation_m * g.filar_separation_m / g.filar_length_m) / (kTrueD * kTrueD / kL);
       r.status = TraceStatus::kOk;
       r.inertia_total_kg_m2 = std::stod(text.substr(2)) * fitted_over_true;
       r.inertia_total_std_kg_m2 = kFitRelStd * r.inertia_total_kg_m2;
@@ -135,8 +133,8 @@ TEST(Calibration, FakeFitRecoversTheTrueGeometryAndItsStd) {
   // and of the tare logs; each standard error is the larger of scatter/sqrt(3) and fit std/sqrt(3).
   const double s_err = std::max(FakeCampaign::kSwingOffset / std::sqrt(3.0),
                                 kFitRelStd * (kRig + kReference) / std::sqrt(3.0));
-  const double t_err = std::max(FakeCampaign::kTareOffset / std::sqrt(3.0),
-                                kFitRelStd * kRig / std::sqrt(3.0));
+  const double t_err =
+      std::max(FakeCampaign::kTareOffset / std::sqrt(3.0), kFitRelStd * kRig / std::sqrt(3.0));
   const double rel = std::sqrt(std::pow(0.0012 / kReference, 2) + std::pow(s_err / kReference, 2) +
                                std::pow(t_err / kReference, 2));
   EXPECT_NEAR(cal.factor_rel_std, rel, 1e-9);
@@ -261,9 +259,11 @@ TEST(Calibration, BadSectionsNameTheKey) {
   struct Case {
     std::string section, expected;
   } cases[] = {
-      {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 1.2, reference_mass_kg: 0" + tail,
+      {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 1.2, reference_mass_kg: 0" +
+           tail,
        "'rig.calibration.reference_mass_kg' must be > 0"},
-      {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: -1.2, reference_mass_kg: 4" + tail,
+      {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: -1.2, reference_mass_kg: 4" +
+           tail,
        "'rig.calibration.reference_inertia_kg_m2' must be > 0"},
       {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 0, reference_mass_kg: 4" + tail,
        "'rig.calibration.reference_inertia_kg_m2' must be > 0"},
@@ -271,7 +271,8 @@ TEST(Calibration, BadSectionsNameTheKey) {
        "rig.calibration.reference_inertia_std_kg_m2"},
       {"  calibration: {logs: [], reference_inertia_kg_m2: 1.2, reference_mass_kg: 4" + tail,
        "'rig.calibration.logs' lists no file"},
-      {"  calibration: {logs: calib/none_*.csv, reference_inertia_kg_m2: 1.2, reference_mass_kg: 4" +
+      {"  calibration: {logs: calib/none_*.csv, reference_inertia_kg_m2: 1.2, reference_mass_kg: "
+       "4" +
            tail,
        "rig.calibration.logs: no file matches"},
       {"  calibration: {logs: nowhere/*.csv, reference_inertia_kg_m2: 1.2, reference_mass_kg: 4" +
@@ -280,11 +281,13 @@ TEST(Calibration, BadSectionsNameTheKey) {
       {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 1.2, reference_mass_kg: 4, "
        "reference_inertia_std_kg_m2: 1.5}\n",
        "'rig.calibration.reference_inertia_std_kg_m2' must be below"},
-      {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 1.2, reference_mas_kg: 4" + tail,
+      {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 1.2, reference_mas_kg: 4" +
+           tail,
        "missing required key 'rig.calibration.reference_mass_kg'"},  // a typo
       // A reference inertia in the wrong unit (g cm^2 would be 1e7 times larger): no tape measure
       // is 10x off, so this is an error, not a factor.
-      {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 12, reference_mass_kg: 4" + tail,
+      {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 12, reference_mass_kg: 4" +
+           tail,
        "not a tape-measure error"},
   };
   for (const Case& k : cases) {
@@ -298,17 +301,20 @@ TEST(Calibration, BadSectionsNameTheKey) {
 TEST(Calibration, AFailedReferenceSwingStopsTheCampaignNamingTheLog) {
   FakeCampaign c;
   WriteFile(c.dir.path + "/calib/ref_2.csv", "not a log\n");
-  const std::string message = LoadError(
-      c, "  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 1.2, "
-         "reference_inertia_std_kg_m2: 0.001, reference_mass_kg: 4}\n");
+  const std::string message =
+      LoadError(c,
+                "  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 1.2, "
+                "reference_inertia_std_kg_m2: 0.001, reference_mass_kg: 4}\n");
   EXPECT_NE(message.find("rig.calibration: reference swing calib/ref_2.csv: error"),
-            std::string::npos) << message;
+            std::string::npos)
+      << message;
   EXPECT_NE(message.find("no oscillation found"), std::string::npos) << message;
   EXPECT_EQ(c.aircraft_fits, 0);  // no aircraft trace used an unknown geometry
   // A listed file that does not exist: named too.
   const std::string missing = LoadError(
-      c, "  calibration: {logs: [calib/ref_1.csv, calib/ref_9.csv], reference_inertia_kg_m2: 1.2, "
-         "reference_inertia_std_kg_m2: 0.001, reference_mass_kg: 4}\n");
+      c,
+      "  calibration: {logs: [calib/ref_1.csv, calib/ref_9.csv], reference_inertia_kg_m2: 1.2, "
+      "reference_inertia_std_kg_m2: 0.001, reference_mass_kg: 4}\n");
   EXPECT_NE(missing.find("calib/ref_9.csv"), std::string::npos) << missing;
   EXPECT_NE(missing.find("not found"), std::string::npos) << missing;
   EXPECT_EQ(c.aircraft_fits, 0);
@@ -325,7 +331,8 @@ TEST(Calibration, FitConfigNeedsTheRigInertia) {
     ADD_FAILURE() << "no error";
   } catch (const UserError& e) {
     EXPECT_NE(std::string(e.what()).find("'rig.calibration' needs 'rig.inertia'"),
-              std::string::npos) << e.what();
+              std::string::npos)
+        << e.what();
   }
 }
 
@@ -373,7 +380,8 @@ TEST(CalibrationRealFit, MisMeasuredRigIsCorrected) {
   options.out_dir = dir.path + "/out_plain";
   const CampaignResult plain = RunCampaign(LoadCampaignConfig(dir.path + "/plain.yaml"), options);
   ASSERT_TRUE(plain.ellipse_fit.has_value()) << plain.summary.ellipse_message;
-  const double off_x = plain.ellipse_fit->ix.value / ix - 1, off_z = plain.ellipse_fit->iz.value / iz - 1;
+  const double off_x = plain.ellipse_fit->ix.value / ix - 1,
+               off_z = plain.ellipse_fit->iz.value / iz - 1;
   EXPECT_NEAR(off_x, 1 / (1.015 * 1.015) - 1, 0.003) << "I_x " << plain.ellipse_fit->ix.value;
   EXPECT_NEAR(off_z, 1 / (1.015 * 1.015) - 1, 0.003) << "I_z " << plain.ellipse_fit->iz.value;
 
@@ -398,13 +406,16 @@ TEST(CalibrationRealFit, MisMeasuredRigIsCorrected) {
     const double sigma = std::hypot(stat_std, cal.systematic_relative_std * value);
     EXPECT_NEAR(value, true_value, 0.003 * true_value) << name;
     EXPECT_NEAR(value, true_value, 3 * sigma) << name << " sigma " << sigma;
-    std::printf("%s: truth %.6f, uncalibrated %+.3f %%, calibrated %.6f (%+.3f %%) +- %.6f "
-                "(%.3f %% incl. systematic %.3f %%)\n",
-                name, true_value,
-                100 * ((std::string(name) == "I_x" ? plain.ellipse_fit->ix.value
-                                                    : plain.ellipse_fit->iz.value) / true_value - 1),
-                value, 100 * (value / true_value - 1), sigma, 100 * sigma / value,
-                100 * cal.systematic_relative_std);
+    std::printf(
+        "%s: truth %.6f, uncalibrated %+.3f %%, calibrated %.6f (%+.3f %%) +- %.6f "
+        "(%.3f %% incl. systematic %.3f %%)\n",
+        name, true_value,
+        100 * ((std::string(name) == "I_x" ? plain.ellipse_fit->ix.value
+                                           : plain.ellipse_fit->iz.value) /
+                   true_value -
+               1),
+        value, 100 * (value / true_value - 1), sigma, 100 * sigma / value,
+        100 * cal.systematic_relative_std);
   }
   std::printf("%s\n  relative std parts: reference %.4f %%, swings %.4f %%, rig %.4f %%\n",
               c.BriefReport().c_str(), 100 * c.rel_std_reference, 100 * c.rel_std_swings,
@@ -438,9 +449,9 @@ TEST(CalibrationRealFit, MisMeasuredRigIsCorrected) {
       EXPECT_TRUE(t.name != "filar_length" && t.name != "filar_separation" && t.name != "gravity")
           << r.file << " " << t.name;
     }
-    EXPECT_TRUE(std::any_of(r.budget.begin(), r.budget.end(),
-                            [](const BudgetTerm& t) { return t.name == "calibration"; }))
-        << r.file;
+    EXPECT_TRUE(std::any_of(r.budget.begin(), r.budget.end(), [](const BudgetTerm& t) {
+      return t.name == "calibration";
+    })) << r.file;
   }
 }
 
