@@ -695,6 +695,31 @@ bool CampaignSpec::Check(std::string* why) const {
                          " must be greater than filar_separation_m (D) = " +
                          Num(filar_separation_m) + " (the wires would go slack); allowed L > D");
   }
+  if (!(TrueLengthM() > TrueSeparationM()) || !(true_filar_length_m >= 0.0) ||
+      !(true_filar_separation_m >= 0.0) || !std::isfinite(true_filar_length_m) ||
+      !std::isfinite(true_filar_separation_m)) {
+    return Fail(why, "true_filar_length_m = " + Num(TrueLengthM()) +
+                         " must be greater than true_filar_separation_m = " +
+                         Num(TrueSeparationM()) + " > 0 (the wires would go slack)");
+  }
+  if (calibration_logs > 0) {
+    if (!CheckValue(reference_inertia_kg_m2, "calibration.reference_inertia_kg_m2", 0.0, true,
+                    1e9, why) ||
+        !CheckValue(reference_mass_kg, "calibration.reference_mass_kg", 0.0, true, 1e6, why)) {
+      return false;
+    }
+    if (calibration_amplitude_deg.max > 0.0 &&
+        (!CheckRange(calibration_amplitude_deg, "calibration.amplitude_deg", 0.0, true, why) ||
+         !CheckValue(calibration_amplitude_deg.max, "calibration.amplitude_deg (max)", 0.0, true,
+                     75.0, why))) {
+      return false;
+    }
+    double unused;
+    if (!rig.InertiaAtPitch(tare_pitch_deg, &unused)) {
+      return Fail(why, "rig.inertia_by_pitch_kg_m2 has no entry for the tare pitch " +
+                           Num(tare_pitch_deg) + " deg (the reference swings' rig pitch)");
+    }
+  }
   if (pitch_deg.empty() && tare_logs == 0) return Fail(why, "pitch_deg: no pitch angles and no tare logs");
   for (size_t i = 0; i < pitch_deg.size(); ++i) {
     if (!CheckValue(pitch_deg[i], "pitch_deg", -90.0, false, 90.0, why)) return false;
@@ -714,6 +739,7 @@ bool CampaignSpec::Check(std::string* why) const {
   }
   return CheckValue(trials_per_pitch, "trials_per_pitch", 1.0, false, 1000.0, why) &&
          CheckValue(tare_logs, "tare_logs", 0.0, false, 1000.0, why) &&
+         CheckValue(calibration_logs, "calibration.logs", 0.0, false, 1000.0, why) &&
          CheckValue(tare_pitch_deg, "tare_pitch_deg", -90.0, false, 90.0, why) &&
          CheckValue(pitch_error_sigma_deg, "pitch_error_sigma_deg", 0.0, false, 10.0, why) &&
          CheckRange(amplitude_deg, "amplitude_deg", 0.0, true, why) &&
@@ -753,27 +779,37 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
                       std::vector<CampaignTrace>* out, std::string* why) {
   if (!spec.Check(why) || !options.Check(why)) return false;
   out->clear();
-  auto make = [&](const std::string& path, bool tare, int trial, double nominal_deg) -> bool {
+  enum Kind { kAircraftLog, kTareLog, kReferenceLog };
+  auto make = [&](const std::string& path, Kind kind, int trial, double nominal_deg) -> bool {
+    const bool tare = kind != kAircraftLog;  // rig without the aircraft
     CampaignTrace ct;
     ct.relative_path = path;
-    ct.is_tare = tare;
+    ct.is_tare = kind == kTareLog;
+    ct.is_calibration = kind == kReferenceLog;
     ct.trial = trial;
     ct.nominal_pitch_deg = nominal_deg;
     Rng rng(DeriveSeed(seed, path + "#setup"));
     ct.true_pitch_deg = std::clamp(nominal_deg + rng.Normal(spec.pitch_error_sigma_deg), -90.0, 90.0);
-    const double amplitude_deg = rng.Uniform(spec.amplitude_deg);
+    const double amplitude_deg =
+        rng.Uniform(kind == kReferenceLog && spec.calibration_amplitude_deg.max > 0.0
+                        ? spec.calibration_amplitude_deg
+                        : spec.amplitude_deg);
     const double sign = rng.Uniform() < options.negative_amplitude_probability ? -1.0 : 1.0;
     const double damping_scale = tare ? spec.tare_damping_scale : 1.0;
     const double drag = damping_scale * rng.Uniform(spec.drag_coeff_kg_m2);
     const double viscous = damping_scale * rng.Uniform(spec.viscous_coeff_kg_m2_per_s);
     spec.rig.InertiaAtPitch(nominal_deg, &ct.inertia_rig_kg_m2);
     ct.inertia_aircraft_kg_m2 = tare ? 0.0 : spec.aircraft.InertiaAtPitch(ct.true_pitch_deg * kDeg);
+    ct.inertia_reference_kg_m2 = kind == kReferenceLog ? spec.reference_inertia_kg_m2 : 0.0;
     TraceSetup& s = ct.setup;
-    s.geometry.filar_length_m = spec.filar_length_m;
-    s.geometry.filar_separation_m = spec.filar_separation_m;
+    s.geometry.filar_length_m = spec.TrueLengthM();
+    s.geometry.filar_separation_m = spec.TrueSeparationM();
     s.geometry.gravity_mps2 = spec.gravity_mps2;
-    s.geometry.mass_kg = spec.rig.mass_kg + spec.rig.imu_mass_kg + (tare ? 0.0 : spec.aircraft.mass_kg);
-    s.params.inertia_kg_m2 = ct.inertia_aircraft_kg_m2 + ct.inertia_rig_kg_m2;
+    s.geometry.mass_kg = spec.rig.mass_kg + spec.rig.imu_mass_kg +
+                         (kind == kAircraftLog ? spec.aircraft.mass_kg : 0.0) +
+                         (kind == kReferenceLog ? spec.reference_mass_kg : 0.0);
+    s.params.inertia_kg_m2 =
+        ct.inertia_aircraft_kg_m2 + ct.inertia_rig_kg_m2 + ct.inertia_reference_kg_m2;
     s.params.drag_coeff_kg_m2 = drag;
     s.params.viscous_coeff_kg_m2_per_s = viscous;
     s.pitch_rad = ct.true_pitch_deg * kDeg;
@@ -789,14 +825,20 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
   };
   for (double pitch : spec.pitch_deg) {
     for (int k = 1; k <= spec.trials_per_pitch; ++k) {
-      if (!make("pitch_" + FormatPitchDeg(pitch) + "/trial_" + std::to_string(k) + ".csv", false, k,
-                pitch)) {
+      if (!make("pitch_" + FormatPitchDeg(pitch) + "/trial_" + std::to_string(k) + ".csv",
+                kAircraftLog, k, pitch)) {
         return false;
       }
     }
   }
   for (int k = 1; k <= spec.tare_logs; ++k) {
-    if (!make("tare/tare_" + std::to_string(k) + ".csv", true, k, spec.tare_pitch_deg)) return false;
+    if (!make("tare/tare_" + std::to_string(k) + ".csv", kTareLog, k, spec.tare_pitch_deg)) return false;
+  }
+  for (int k = 1; k <= spec.calibration_logs; ++k) {
+    if (!make("calibration/reference_" + std::to_string(k) + ".csv", kReferenceLog, k,
+              spec.tare_pitch_deg)) {
+      return false;
+    }
   }
   return true;
 }

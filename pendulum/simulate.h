@@ -262,16 +262,37 @@ struct CampaignSpec {
   UniformRange drag_coeff_kg_m2 = {0.02, 0.08};            // K_D per log
   UniformRange viscous_coeff_kg_m2_per_s = {0.005, 0.02};  // C per log
   // Tare logs (rig alone, far less aerodynamic area) draw K_D and C from the ranges above times
-  // this factor; in [0, 1], default 0.25.
+  // this factor; in [0, 1], default 0.25. Reference swings (calibration) too.
   double tare_damping_scale = 0.25;
+  // A mis-measured rig: the geometry the logs are simulated with, when it differs from the one a
+  // user measured (filar_length_m, filar_separation_m, which truth.json reports as configured).
+  // 0 = as configured. With them, L_true > D_true > 0 is required.
+  double true_filar_length_m = 0.0;
+  double true_filar_separation_m = 0.0;
+  // Reference swings for rig.calibration: a reference object of known inertia (about the swing
+  // axis) and mass hung on the rig at tare_pitch_deg, swung calibration_logs times
+  // (calibration/reference_{k}.csv), each at an amplitude from calibration_amplitude_deg
+  // (default {0, 0}: amplitude_deg).
+  int calibration_logs = 0;                  // [0, 1000]
+  double reference_inertia_kg_m2 = 0.0;      // > 0 when calibration_logs > 0
+  double reference_mass_kg = 0.0;            // > 0 when calibration_logs > 0
+  UniformRange calibration_amplitude_deg = {0.0, 0.0};
+
+  double TrueLengthM() const { return true_filar_length_m > 0 ? true_filar_length_m : filar_length_m; }
+  double TrueSeparationM() const {
+    return true_filar_separation_m > 0 ? true_filar_separation_m : filar_separation_m;
+  }
 
   bool Check(std::string* why) const;
 };
 
 // One log of a campaign with its truth.
 struct CampaignTrace {
-  std::string relative_path;    // "pitch_-80/trial_1.csv", "tare/tare_1.csv"
+  std::string relative_path;    // "pitch_-80/trial_1.csv", "tare/tare_1.csv",
+                                // "calibration/reference_1.csv"
   bool is_tare = false;
+  bool is_calibration = false;  // a reference swing (rig + reference object)
+  double inertia_reference_kg_m2 = 0.0;  // the reference object's, for a reference swing
   int trial = 0;                // 1-based
   double nominal_pitch_deg = 0.0;
   double true_pitch_deg = 0.0;
@@ -281,7 +302,8 @@ struct CampaignTrace {
   SimulatedTrace trace;
 };
 
-// Simulates every log (pitch folders in the order given, then tare). Each log's random stream is
+// Simulates every log (pitch folders in the order given, then tare, then the reference swings),
+// with the true geometry (TrueLengthM, TrueSeparationM). Each log's random stream is
 // derived from (seed, its relative path), so a log does not change when others are added.
 bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options, uint64_t seed,
                       std::vector<CampaignTrace>* out, std::string* why);

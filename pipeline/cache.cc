@@ -64,8 +64,7 @@ void Put(std::ostringstream& out, const char* name, double value) {
 std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
                            const std::optional<std::array<double, 2>>& window_s) {
   std::ostringstream out;
-  const RigGeometry geometry =
-      role == TraceRole::kTare ? config.TareGeometry() : config.AircraftGeometry();
+  const RigGeometry geometry = GeometryForRole(config, role);  // D: the calibrated one, if any
   out << "version=" << ProgramVersion() << ';';
   out << "role=" << ToString(role) << ';';
   Put(out, "L", geometry.filar_length_m);
@@ -78,6 +77,12 @@ std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
   if (role == TraceRole::kAircraft) Put(out, "m_aircraft_std", config.aircraft_mass_std_kg);
   Put(out, "g_std", config.uncertainties.gravity_std_mps2);
   Put(out, "gyro_scale_std", config.imu.gyro_scale_std);
+  // A calibrated geometry (rig.calibration) changes D above, drops the L, D and g terms of the
+  // budget and adds its own; only then in the key, so uncalibrated keys stay those of 0.2.0.
+  if (config.geometry_calibration.applied) {
+    Put(out, "calibration_factor", config.geometry_calibration.factor);
+    Put(out, "calibration_rel_std", config.geometry_calibration.factor_rel_std);
+  }
   out << "model=" << ToString(config.fit.model) << ';';
   // Only a non-default integrator enters the key, so rk853 keys stay those of earlier versions.
   if (config.fit.integrator != IntegratorMethod::kRungeKutta) {

@@ -1,8 +1,8 @@
 // Per-trace fit results cached in OUT/cache/, so that a rerun redoes only what changed.
 //
 // A cache entry is keyed by CacheKey = hash(content hash of the log bytes, fingerprint of every
-// config value that affects that trace's fit): L, D, the suspended mass, g, their uncertainties
-// (the budget), the model, the window override, the amplitude band, the IMU format, swing axis
+// config value that affects that trace's fit): L, D (the calibrated D and the calibration's std
+// when rig.calibration is applied), the suspended mass, g, their uncertainties (the budget), the model, the window override, the amplitude band, the IMU format, swing axis
 // and mounting, the quality thresholds, the program version. Not in the key: the rig inertia
 // (tare logs/value/table), the pitch source, the ellipse options, the units — changing those
 // refits no trace. The fit figure is stored beside it in OUT/figures/<key>.svg.

@@ -144,17 +144,26 @@ void KeepDiscoveryFields(const TraceRecord& planned, bool from_cache, TraceRecor
   r->from_cache = from_cache;
 }
 
-// One record per run: an error row (discovery error, unreadable, duplicate content), a cache
-// hit, or a record to fit (listed in the plan). Counts reuse and refused cache entries.
+// One record per `wanted` run: an error row (discovery error, unreadable, duplicate content), a
+// cache hit, or a record to fit (listed in the plan). Counts reuse and refused cache entries.
+// Runs not wanted keep their records (the reference swings, fitted by the calibration), but
+// their content still counts for the duplicate test, so every pass finds the same duplicates.
 FitPlan PlanFits(const CampaignConfig& config, const CampaignOptions& options,
                  const CampaignInputs& in, const TraceCache& cache, const OutputFolder& out,
-                 CampaignResult* result) {
+                 const std::vector<bool>& wanted, CampaignResult* result) {
   FitPlan plan;
   result->traces.resize(in.size());
   std::map<std::string, std::string> first_with_hash;
   for (int i = 0; i < in.size(); ++i) {
     const RunFile& run = in.runs[i];
+    if (!wanted[i]) {
+      if (run.error.empty() && in.read_errors[i].empty()) {
+        first_with_hash.emplace(in.hashes[i], run.display);
+      }
+      continue;
+    }
     TraceRecord& record = result->traces[i];
+    record = TraceRecord();
     record.file = run.display;
     record.role = run.role;
     record.model = ToString(config.fit.model);
@@ -282,6 +291,48 @@ void FitTraces(const CampaignConfig& config, const CampaignOptions& options,
   });
 }
 
+// ---- Step 2a: calibrate (rig.calibration, pipeline/calibration.h) --------------------------
+
+// The reference swings (and the tare logs, when they give the rig inertia) fitted round by round
+// through the cache, each round at its own geometry; the result goes into `result->calibration`
+// and the reference swings' records into the trace list, each with the reference's share
+// (total - rig) as its `inertia_kg_m2`. Throws UserError (pipeline/calibration.h) before any
+// aircraft trace is fitted when the calibration cannot be made.
+GeometryCalibration CalibrateCampaign(const CampaignConfig& config, const CampaignOptions& options,
+                                      const CampaignInputs& in, const TraceCache& cache, int jobs,
+                                      OutputFolder* out, CampaignResult* result) {
+  const bool from_tare = config.rig_inertia.kind == RigInertiaSpec::Kind::kTare;
+  std::vector<bool> wanted(in.size());
+  for (int i = 0; i < in.size(); ++i) {
+    wanted[i] = in.runs[i].role == TraceRole::kCalibration ||
+                (from_tare && in.runs[i].role == TraceRole::kTare);
+  }
+  if (options.progress) *options.progress << "rig.calibration: fitting the reference swings\n";
+  const CalibrationFitFunction fit = [&](const CampaignConfig& round) {
+    const FitPlan plan = PlanFits(round, options, in, cache, *out, wanted, result);
+    FitTraces(round, options, in, plan, cache, jobs, out, &result->traces);
+    result->summary.n_fitted += static_cast<int>(plan.to_fit.size());
+    std::vector<TraceRecord> records;
+    for (int i = 0; i < in.size(); ++i) {
+      if (wanted[i]) records.push_back(result->traces[i]);
+    }
+    return records;
+  };
+  result->calibration = CalibrateRig(config, fit);
+  const RigCalibrationResult& c = *result->calibration;
+  for (TraceRecord& r : result->traces) {
+    if (r.role != TraceRole::kCalibration || !r.ok()) continue;
+    r.rig_inertia_kg_m2 = c.rig_inertia_kg_m2;
+    r.inertia_kg_m2 = r.inertia_total_kg_m2 - c.rig_inertia_kg_m2;
+    r.inertia_std_kg_m2 = std::hypot(r.inertia_total_std_kg_m2, c.rig_inertia_std_kg_m2);
+  }
+  if (options.progress) {
+    *options.progress << c.BriefReport() << "\n";
+    for (const std::string& w : c.warnings) *options.progress << "warning: " << w << "\n";
+  }
+  return c.Applied();
+}
+
 // ---- Step 3: tare -----------------------------------------------------------------------------
 
 // The tare logs' rig inertia: their mean, and the larger of the between-log standard error and
@@ -305,14 +356,7 @@ TareEstimate EstimateTare(std::vector<TraceRecord>* traces) {
   }
   TareEstimate tare;
   tare.n = static_cast<int>(values.size());
-  if (values.empty()) return tare;
-  tare.mean_kg_m2 = Mean(values);
-  double fit_var = 0.0;
-  for (double v : stds) fit_var += v * v / stds.size();
-  const double n = static_cast<double>(values.size());
-  const double fit_sem = std::sqrt(fit_var / n);
-  tare.std_kg_m2 =
-      values.size() >= 2 ? std::max(SampleStd(values) / std::sqrt(n), fit_sem) : fit_sem;
+  MeanAndStandardError(values, stds, &tare.mean_kg_m2, &tare.std_kg_m2);
   return tare;
 }
 
@@ -544,6 +588,12 @@ void WriteCampaignOutputs(const CampaignConfig& config, const CampaignOptions& o
     if (!r.figure.empty()) keep.insert("figures/" + r.figure);
     if (!r.sweep_figure.empty()) keep.insert("figures/" + r.sweep_figure);
   }
+  if (result.calibration) {  // every round's fits, so that a rerun finds them all in the cache
+    for (const std::string& key : result.calibration->cache_keys) {
+      keep.insert("cache/" + key + ".json");
+      for (const char* suffix : {".svg", "_sweep.svg"}) keep.insert("figures/" + key + suffix);
+    }
+  }
   if (!result.moments_figure.empty()) keep.insert("figures/" + result.moments_figure);
   if (!result.polar_figure.empty()) keep.insert("figures/" + result.polar_figure);
   out->manifest.Prune(keep);
@@ -608,7 +658,7 @@ bool RigInertiaAt(const CampaignConfig& config, double tare_mean_kg_m2, double t
   return false;
 }
 
-// discover -> fit traces -> tare -> group -> ellipse -> write.
+// discover -> calibrate (rig.calibration) -> fit traces -> tare -> group -> ellipse -> write.
 CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& options) {
   const Clock::time_point start = Clock::now();
   CheckCampaignInputs(config, options);
@@ -619,10 +669,20 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
 
   // 1. Discover: the logs, their windows and content hashes.
   const CampaignInputs inputs = DiscoverInputs(config, out.dir, jobs);
+  // 2a. Calibrate: the reference swings fix the geometry every other fit uses.
+  CampaignConfig fit_config = config;
+  if (config.calibration.enabled) {
+    fit_config.geometry_calibration =
+        CalibrateCampaign(config, options, inputs, cache, jobs, &out, &result);
+  }
   // 2. Fit traces: error rows and cache hits first, then the rest in parallel.
-  const FitPlan plan = PlanFits(config, options, inputs, cache, out, &result);
-  FitTraces(config, options, inputs, plan, cache, jobs, &out, &result.traces);
-  result.summary.n_fitted = static_cast<int>(plan.to_fit.size());
+  std::vector<bool> wanted(inputs.size());
+  for (int i = 0; i < inputs.size(); ++i) {
+    wanted[i] = inputs.runs[i].role != TraceRole::kCalibration;
+  }
+  const FitPlan plan = PlanFits(fit_config, options, inputs, cache, out, wanted, &result);
+  FitTraces(fit_config, options, inputs, plan, cache, jobs, &out, &result.traces);
+  result.summary.n_fitted += static_cast<int>(plan.to_fit.size());
   // 3. Tare: the rig inertia, subtracted from every aircraft trace.
   const TareEstimate tare = EstimateTare(&result.traces);
   SetRigInertia(config, tare, &result);

@@ -1,7 +1,8 @@
 // A test campaign: a folder of IMU logs (a few trials per pitch angle) plus the rig's tare logs
 // -> every trace fitted (in parallel, cached), the rig subtracted, per-angle statistics, the
 // ellipse of inertia, and results.json / traces.csv / angles.csv / report.html in OUT.
-// RunCampaign's steps: discover (pipeline/run_discovery.h) -> fit traces (in parallel,
+// RunCampaign's steps: discover (pipeline/run_discovery.h) -> calibrate the rig geometry when
+// rig.calibration is set (pipeline/calibration.h) -> fit traces (in parallel,
 // pipeline/parallel_runner.h, cached) -> tare -> group by angle -> ellipse -> write
 // (pipeline/output_set.h, atomically: pipeline/atomic_file.h).
 // Conventions: docs/physics.md §2 (tare: I_aircraft = I_total - I_rig), §3 (pitch, ellipse).
@@ -16,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fit/ellipse.h"
+#include "pipeline/calibration.h"
 #include "pipeline/config.h"
 #include "pipeline/run_discovery.h"  // RunFile, DiscoverRuns
 #include "pipeline/trace_process.h"
@@ -45,17 +47,20 @@ struct CampaignSummary {
 };
 
 struct CampaignResult {
-  std::vector<TraceRecord> traces;  // aircraft runs then tare logs, discovery order
+  std::vector<TraceRecord> traces;  // aircraft runs, tare logs, reference swings: discovery order
   double rig_inertia_kg_m2 = NAN;   // value / tare mean (table: NaN, see per-trace field)
   double rig_inertia_std_kg_m2 = NAN;
   int rig_tare_n = 0;               // ok tare logs used
+  // rig.calibration: the effective geometry every trace was fitted with (pipeline/calibration.h);
+  // absent without the section.
+  std::optional<RigCalibrationResult> calibration;
   std::vector<AngleStats> angles;   // sorted by pitch
   std::optional<EllipseResult> ellipse_fit;  // fit/ellipse.h, when >= min_angles angles remain
   nlohmann::json ellipse;           // pipeline/ellipse_json.h document, null when not fitted
   std::string moments_figure;       // Fig. 3 file name in OUT/figures/, "" when none
   std::string polar_figure;         // Fig. 4 file name in OUT/figures/, "" when none
   // Systematic relative uncertainty from the configured uncertainties (L, D, masses, g, gyro
-  // scale): the mean over ok
+  // scale; with rig.calibration: masses, gyro scale and the calibration): the mean over ok
   // aircraft traces of budget total / inertia total. It scales every moment alike, so it is not
   // in the ellipse's std; reported beside it. NaN when no budget.
   double systematic_relative_std = NAN;
@@ -85,7 +90,9 @@ struct CampaignOptions {
 
 // Runs the campaign and writes OUT/{results.json, traces.csv, angles.csv, report.html} (each
 // atomically), OUT/cache/ and OUT/figures/. Throws UserError for config/usage problems (the CLI
-// turns it into exit code 2); problems with single logs are error rows.
+// turns it into exit code 2), and when rig.calibration cannot be made (a reference swing that
+// does not fit, named; no aircraft trace is fitted then); problems with single logs are error
+// rows.
 CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& options);
 
 // Rig inertia subtracted at `pitch_deg` from the spec and the fitted tare mean/std. False with

@@ -38,8 +38,9 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     if (std::isfinite(result.systematic_relative_std) && result.systematic_relative_std > 0) {
       std::snprintf(
           line, sizeof(line),
-          "  (+- %.2f %% systematic, common to all moments, from the configured uncertainties)\n",
-          100.0 * result.systematic_relative_std);
+          "  (+- %.2f %% systematic, common to all moments, from the configured uncertainties%s)\n",
+          100.0 * result.systematic_relative_std,
+          result.calibration ? " and the calibration" : "");
       out << line;
     }
     std::snprintf(line, sizeof(line),
@@ -58,6 +59,15 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
       out << " (mean of " << result.rig_tare_n << " tare logs)";
     }
     out << "\n";
+  }
+  if (result.calibration) {  // rig.calibration: the geometry every fit used
+    const RigCalibrationResult& c = *result.calibration;
+    std::snprintf(line, sizeof(line),
+                  "Calibration: D^2/L x %.5f +- %.5f (+- %.2f %%, common to all moments): "
+                  "D %.5f m effective against %.5f m configured, L %.4f m; %d reference swing%s\n",
+                  c.factor, c.factor_std, 100.0 * c.factor_rel_std, c.effective_separation_m,
+                  c.nominal_separation_m, c.filar_length_m, c.n_swings, c.n_swings == 1 ? "" : "s");
+    out << line;
   }
   int shown = 0;
   for (const TraceRecord& r : result.traces) {

@@ -5,10 +5,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
 #include "fit/window.h"
+#include "pipeline/calibration.h"
 #include "pipeline/cli_commands.h"
 #include "pipeline/config.h"
 #include "pipeline/repeats.h"
@@ -157,6 +159,16 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
         throw UserError("--plot " + args->plot_dir + ": cannot create folder");
       }
     }
+    // rig.calibration: the reference swings fix the geometry first (pipeline/calibration.h).
+    std::optional<RigCalibrationResult> calibration;
+    if (config.calibration.enabled) {
+      calibration = CalibrateRigFromLogs(config);
+      config.geometry_calibration = calibration->Applied();
+      if (!args->json) {
+        std::cout << calibration->BriefReport() << std::endl;
+        for (const std::string& w : calibration->warnings) std::cout << "warning: " << w << std::endl;
+      }
+    }
     std::vector<TraceRecord> records;
     int failed = 0;
     for (const std::string& log : args->logs) {
@@ -181,7 +193,9 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       nlohmann::json traces = nlohmann::json::array();
       for (const TraceRecord& r : records) traces.push_back(TraceRecordToJson(r, false));
       nlohmann::json out = traces;
-      if (args->repeats) out = {{"traces", traces}, {"repeats", RepeatGroupsToJson(groups)}};
+      if (args->repeats || calibration) out = {{"traces", traces}};
+      if (args->repeats) out["repeats"] = RepeatGroupsToJson(groups);
+      if (calibration) out["calibration"] = CalibrationToJson(*calibration);
       // Invalid UTF-8 (a log's bytes in a message) is replaced, never a json exception.
       std::cout << out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
     } else if (args->repeats) {

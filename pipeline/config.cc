@@ -211,6 +211,44 @@ void ReadImu(YamlMap imu, ImuConfig* out) {
   imu.Finish();
 }
 
+// `logs` of a tare or calibration section: a pattern or a list of them, resolved against the
+// config folder; an empty list is an error naming the key.
+std::vector<std::string> ReadLogPatterns(YamlMap& map, const std::string& folder) {
+  std::vector<std::string> patterns;
+  YAML::Node logs = map.Required("logs");
+  if (logs.IsScalar()) {
+    patterns = {ResolvePath(folder, logs.Scalar())};
+  } else {
+    for (const std::string& p : map.OptionalStringList("logs", {})) {
+      patterns.push_back(ResolvePath(folder, p));
+    }
+  }
+  if (patterns.empty()) {
+    throw UserError(map.Where(logs) + ": '" + map.KeyPath("logs") + "' lists no file");
+  }
+  return patterns;
+}
+
+// `rig.calibration`: the reference swings and the reference's inertia, its std and its mass.
+void ReadRigCalibration(YamlMap cal, const std::string& folder, RigCalibrationSpec* out) {
+  out->enabled = true;
+  out->log_patterns = ReadLogPatterns(cal, folder);
+  out->reference_inertia_kg_m2 = Positive(cal, "reference_inertia_kg_m2");
+  const YAML::Node std_node = cal.Required("reference_inertia_std_kg_m2");
+  out->reference_inertia_std_kg_m2 = NonNegative(cal, "reference_inertia_std_kg_m2", 0.0);
+  if (!(out->reference_inertia_std_kg_m2 < out->reference_inertia_kg_m2)) {
+    throw UserError(cal.Where(std_node) + ": '" + cal.KeyPath("reference_inertia_std_kg_m2") +
+                    "' must be below reference_inertia_kg_m2 (the quantity it qualifies)");
+  }
+  out->reference_mass_kg = Positive(cal, "reference_mass_kg");
+  out->rig_pitch_deg = cal.OptionalDouble("rig_pitch_deg", 0.0);
+  if (!(std::abs(out->rig_pitch_deg) <= 180.0)) {
+    throw UserError(cal.Where(cal.Optional("rig_pitch_deg")) + ": '" +
+                    cal.KeyPath("rig_pitch_deg") + "' must be in [-180, 180] deg");
+  }
+  cal.Finish();
+}
+
 void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* out) {
   const int ways = inertia.Has("inertia_kg_m2") + inertia.Has("table") + inertia.Has("tare");
   if (ways != 1) {
@@ -244,17 +282,7 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
   } else {
     out->kind = RigInertiaSpec::Kind::kTare;
     YamlMap tare = Sub(inertia, "tare");
-    YAML::Node logs = tare.Required("logs");
-    if (logs.IsScalar()) {
-      out->tare_patterns = {ResolvePath(folder, logs.Scalar())};
-    } else {
-      for (const std::string& p : tare.OptionalStringList("logs", {})) {
-        out->tare_patterns.push_back(ResolvePath(folder, p));
-      }
-    }
-    if (out->tare_patterns.empty()) {
-      throw UserError(tare.Where(logs) + ": 'rig.inertia.tare.logs' lists no file");
-    }
+    out->tare_patterns = ReadLogPatterns(tare, folder);
     tare.Finish();
   }
   inertia.Finish();
@@ -282,10 +310,14 @@ std::string ResolvePath(const std::string& folder, const std::string& path) {
   return p.lexically_normal().string();
 }
 
+double CampaignConfig::EffectiveSeparationM() const {
+  return filar_separation_m * std::sqrt(geometry_calibration.factor);  // sqrt(1) = 1 exactly
+}
+
 RigGeometry CampaignConfig::AircraftGeometry() const {
   RigGeometry g;
   g.filar_length_m = filar_length_m;
-  g.filar_separation_m = filar_separation_m;
+  g.filar_separation_m = EffectiveSeparationM();
   g.mass_kg = rig_mass_kg + aircraft_mass_kg;
   g.gravity_mps2 = gravity_mps2;
   return g;
@@ -297,8 +329,35 @@ RigGeometry CampaignConfig::TareGeometry() const {
   return g;
 }
 
+RigGeometry CampaignConfig::CalibrationGeometry() const {
+  RigGeometry g = AircraftGeometry();
+  g.mass_kg = rig_mass_kg + calibration.reference_mass_kg;
+  return g;
+}
+
 bool CampaignConfig::Check(std::string* why) const {
   std::string reason;
+  if (calibration.enabled) {
+    const RigCalibrationSpec& c = calibration;
+    const char* bad = c.log_patterns.empty()               ? "'rig.calibration.logs' lists no file"
+                      : !(c.reference_inertia_kg_m2 > 0.0) ? "'rig.calibration.reference_inertia_kg_m2' must be > 0"
+                      : !(c.reference_mass_kg > 0.0)       ? "'rig.calibration.reference_mass_kg' must be > 0"
+                      : !(c.reference_inertia_std_kg_m2 >= 0.0 &&
+                          c.reference_inertia_std_kg_m2 < c.reference_inertia_kg_m2)
+                          ? "'rig.calibration.reference_inertia_std_kg_m2' must be >= 0 and below "
+                            "reference_inertia_kg_m2"
+                          : nullptr;
+    if (bad) {
+      *why = bad;
+      return false;
+    }
+  }
+  if (!(geometry_calibration.factor > 0.0 && std::isfinite(geometry_calibration.factor) &&
+        geometry_calibration.factor_rel_std >= 0.0 &&
+        std::isfinite(geometry_calibration.factor_rel_std))) {
+    *why = "rig.calibration: the calibration factor is not a finite number > 0";
+    return false;
+  }
   if (!AircraftGeometry().Check(&reason)) {
     *why = "rig/aircraft: " + reason;
     return false;
@@ -469,6 +528,14 @@ void ReadRig(YamlMap& root, const std::string& path, const ConfigLoadOptions& op
     ReadRigInertia(Sub(rig, "inertia"), config->folder, &config->rig_inertia);
   } else if (options.require_runs) {
     throw UserError(path + ": missing required key 'rig.inertia'");
+  }
+  if (rig.Has("calibration")) {
+    if (!rig.Has("inertia")) {
+      throw UserError(rig.Where(rig.Optional("calibration")) +
+                      ": 'rig.calibration' needs 'rig.inertia' (the reference swings measure rig "
+                      "+ reference: the rig's own inertia is needed to calibrate)");
+    }
+    ReadRigCalibration(Sub(rig, "calibration"), config->folder, &config->calibration);
   }
   YamlMap unc = Sub(rig, "uncertainties");
   RigUncertainties& u = config->uncertainties;

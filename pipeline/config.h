@@ -39,6 +39,31 @@ struct RigInertiaSpec {
   std::vector<std::string> tare_patterns;  // glob-like patterns relative to the config folder
 };
 
+// `rig.calibration`: a reference object of known inertia and mass swung on the rig, whose swings
+// fix the rig's effective geometry (docs/method.md §15, docs/physics.md §2.6). Absent: the
+// configured L and D are used as they are.
+struct RigCalibrationSpec {
+  bool enabled = false;                    // the section is present
+  // The reference swings (absolute patterns or files, as rig.inertia.tare.logs); each is fitted
+  // with the rig mass + reference_mass_kg and the suspended inertia rig + reference.
+  std::vector<std::string> log_patterns;
+  double reference_inertia_kg_m2 = 0.0;      // about the swing axis (kg m^2); > 0
+  double reference_inertia_std_kg_m2 = 0.0;  // its standard uncertainty (kg m^2); [0, inertia)
+  double reference_mass_kg = 0.0;            // (kg); > 0
+  // rig.inertia.table only: the rig pitch (deg) at which the reference was swung; default 0.
+  double rig_pitch_deg = 0.0;
+};
+
+// The effective geometry a calibration found, applied to every fit: the D^2/L of the pendulum is
+// `factor` times the configured one. It is realised as an effective separation
+// D_eff = D sqrt(factor) with L as configured (docs/physics.md §2.6: to leading order the
+// dynamics depend on D^2/L only). Not applied: factor 1, the configured geometry.
+struct GeometryCalibration {
+  bool applied = false;
+  double factor = 1.0;           // k = (D^2/L)_effective / (D^2/L)_configured; > 0
+  double factor_rel_std = 0.0;   // std(k) / k: common to every moment of the campaign; >= 0
+};
+
 struct RigUncertainties {
   double filar_length_std_m = 0.0;      // standard uncertainty of L (m); >= 0; default 0
   double filar_separation_std_m = 0.0;  // of D (m); >= 0; default 0
@@ -151,6 +176,11 @@ struct CampaignConfig {
   double filar_separation_m = 0.0;  // D (m)
   double rig_mass_kg = 0.0;         // rig (+ IMU) mass (kg)
   RigInertiaSpec rig_inertia;
+  RigCalibrationSpec calibration;   // rig.calibration (enabled = false when absent)
+  // The calibration in effect (set by the campaign or `bifilar fit` after the reference swings
+  // are fitted, never read from the file). Applied: the geometries below use D_eff, and the
+  // L, D and g terms of the budget are replaced by one `calibration` term.
+  GeometryCalibration geometry_calibration;
   RigUncertainties uncertainties;
   double aircraft_mass_kg = 0.0;      // aircraft mass (kg); 0 when only tare logs are fitted
   double aircraft_mass_std_kg = 0.0;  // its standard uncertainty (kg)
@@ -161,9 +191,12 @@ struct CampaignConfig {
   EllipseConfig ellipse;
   DisplayUnits units = DisplayUnits::kSi;
 
-  // Geometry of an aircraft trace (mass = aircraft + rig) and of a tare trace (rig alone).
+  // Geometry of an aircraft trace (mass = aircraft + rig), of a tare trace (rig alone) and of a
+  // reference swing (rig + reference), with the calibrated separation when one is applied.
   RigGeometry AircraftGeometry() const;
   RigGeometry TareGeometry() const;
+  RigGeometry CalibrationGeometry() const;
+  double EffectiveSeparationM() const;  // D sqrt(geometry_calibration.factor)
 
   bool Check(std::string* why) const;
 };

@@ -238,14 +238,46 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
   }
   h << "</table>\n";
   const double systematic = Num(p.results, "systematic_relative_std");
+  const bool calibrated = p.Part("calibration", json(nullptr)).is_object();
   h << "<p>Uncertainties above are statistical (scatter between trials and angles). "
-    << "The configured uncertainties of L, D, the masses, g and the gyro scale add a systematic &plusmn;"
+    << (calibrated ? "The rig calibration and the configured uncertainties of the masses and the "
+                     "gyro scale add a systematic &plusmn;"
+                   : "The configured uncertainties of L, D, the masses, g and the gyro scale add a "
+                     "systematic &plusmn;")
     << Fmt(100.0 * systematic, "%.2f")
     << " % that scales every moment alike and leaves &tau; unchanged (mean per-trace uncertainty budget).</p>\n";
   if (ellipse.contains("warnings")) {
     for (const auto& w : ellipse["warnings"]) {
       if (w.is_string()) h << "<p class=\"note\">" << Escape(w.get<std::string>()) << "</p>\n";
     }
+  }
+}
+
+// rig.calibration: effective against configured geometry, the factor with its std and parts.
+void WriteCalibration(const ReportPage& p, std::ostream& h) {
+  const json c = p.Part("calibration", json(nullptr));
+  if (!c.is_object()) return;
+  const json nominal = c.value("nominal", json::object()), effective = c.value("effective", json::object());
+  const json parts = c.value("relative_std_parts", json::object());
+  const json swings = c.value("swings", json::object()), reference = c.value("reference", json::object());
+  h << "<h2>Rig calibration (reference object)</h2>\n<table><tr><th class=\"l\">geometry</th>"
+       "<th>L (m)</th><th>D (m)</th><th>D<sup>2</sup>/L (m)</th></tr>\n";
+  for (const auto& [label, g] : {std::make_pair("configured", nominal), std::make_pair("effective", effective)}) {
+    h << "<tr><td class=\"l\">" << label << "</td><td>" << Fmt(Num(g, "filar_length_m"), "%.4f")
+      << "</td><td>" << Fmt(Num(g, "filar_separation_m"), "%.5f") << "</td><td>"
+      << Fmt(Num(g, "d2_over_l_m"), "%.6f") << "</td></tr>\n";
+  }
+  h << "</table>\n<p>Factor k = " << Fmt(Num(c, "factor"), "%.5f") << " &plusmn; "
+    << Fmt(Num(c, "factor_std"), "%.5f") << " (&plusmn;" << Fmt(100.0 * Num(c, "factor_relative_std"), "%.3f")
+    << " %, common to every moment: reference inertia " << Fmt(100.0 * Num(parts, "reference_inertia"), "%.3f")
+    << " %, reference swings " << Fmt(100.0 * Num(parts, "reference_swings"), "%.3f") << " %, rig inertia "
+    << Fmt(100.0 * Num(parts, "rig_inertia"), "%.3f") << " %), from " << swings.value("n", 0)
+    << " swing(s) of a reference of " << p.u.Inertia(Num(reference, "inertia_kg_m2"), "%.5g") << " "
+    << p.u.name << " and " << Fmt(Num(reference, "mass_kg"), "%.4g")
+    << " kg. Every trace, tare logs included, was fitted with the effective geometry; the "
+       "tape-measure uncertainties of L and D and that of g do not apply.</p>\n";
+  for (const auto& w : c.value("warnings", json::array())) {
+    if (w.is_string()) h << "<p class=\"note\">" << Escape(w.get<std::string>()) << "</p>\n";
   }
 }
 
@@ -271,6 +303,7 @@ void WriteTable1AndRig(const ReportPage& p, std::ostream& h) {
     << " &plusmn; " << u.Inertia(Num(rig, "inertia_std_kg_m2"), "%.2e") << " " << u.name;
   if (Str(rig, "inertia_source") == "tare") h << " from " << rig.value("tare_n", 0) << " tare log(s)";
   h << ".</p>\n";
+  WriteCalibration(p, h);
 }
 
 // Figures 3 and 4, and the NACA Report 467 comparison of I_xz.

@@ -289,7 +289,9 @@ TraceRecord TraceRecordFromJson(const json& j) {
       r.repeat_scatter_std_kg_m2 = GetNumber(*it, "repeat_scatter_kg_m2");
   }
   if (auto it = j.find("amplitude_sweep"); it != j.end() && it->is_object()) r.sweep = SweepFromJson(*it);
-  if (j.contains("role")) r.role = GetString(j, "role") == "tare" ? TraceRole::kTare : TraceRole::kAircraft;
+  if (j.contains("role") && !ParseTraceRole(GetString(j, "role"), &r.role)) {
+    throw UserError("trace record: bad 'role'");
+  }
   r.content_hash = GetString(j, "content_hash");
   r.cache_key = GetString(j, "cache_key");
   r.from_cache = j.value("from_cache", false);
@@ -300,6 +302,35 @@ TraceRecord TraceRecordFromJson(const json& j) {
   r.inertia_kg_m2 = GetNumber(j, "inertia_kg_m2");
   r.inertia_std_kg_m2 = GetNumber(j, "inertia_std_kg_m2");
   return r;
+}
+
+json CalibrationToJson(const RigCalibrationResult& c) {
+  return {{"applied", c.applied},
+          {"factor", Number(c.factor)},
+          {"factor_std", Number(c.factor_std)},
+          {"factor_relative_std", Number(c.factor_rel_std)},
+          {"relative_std_parts", {{"reference_inertia", Number(c.rel_std_reference)},
+                                  {"reference_swings", Number(c.rel_std_swings)},
+                                  {"rig_inertia", Number(c.rel_std_rig)}}},
+          {"nominal", {{"filar_length_m", Number(c.filar_length_m)},
+                       {"filar_separation_m", Number(c.nominal_separation_m)},
+                       {"d2_over_l_m", Number(c.nominal_d2_over_l_m)}}},
+          {"effective", {{"filar_length_m", Number(c.filar_length_m)},
+                         {"filar_separation_m", Number(c.effective_separation_m)},
+                         {"d2_over_l_m", Number(c.effective_d2_over_l_m)}}},
+          {"reference", {{"inertia_kg_m2", Number(c.reference_inertia_kg_m2)},
+                         {"inertia_std_kg_m2", Number(c.reference_inertia_std_kg_m2)},
+                         {"mass_kg", Number(c.reference_mass_kg)}}},
+          {"swings", {{"n", c.n_swings},
+                      {"logs", c.logs},
+                      {"total_mean_kg_m2", Number(c.swings_total_kg_m2)},
+                      {"total_standard_error_kg_m2", Number(c.swings_total_std_kg_m2)},
+                      {"scatter_kg_m2", Number(c.swings_scatter_kg_m2)}}},
+          {"rig_inertia", {{"source", c.rig_inertia_source},
+                           {"inertia_kg_m2", Number(c.rig_inertia_kg_m2)},
+                           {"inertia_std_kg_m2", Number(c.rig_inertia_std_kg_m2)}}},
+          {"iterations", c.iterations},
+          {"warnings", c.warnings}};
 }
 
 json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
@@ -358,6 +389,9 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   table1["regression_rmse_kg_m2"] = Number(result.regression_rmse_kg_m2);
   j["table1"] = table1;
   j["systematic_relative_std"] = Number(result.systematic_relative_std);
+  // rig.calibration: the effective geometry of every fit; its relative std is the `calibration`
+  // term of each trace's budget (and so inside systematic_relative_std). null without one.
+  j["calibration"] = result.calibration ? CalibrationToJson(*result.calibration) : json(nullptr);
   json traces = json::array();
   for (const TraceRecord& r : result.traces) traces.push_back(TraceRecordToJson(r));
   j["traces"] = traces;

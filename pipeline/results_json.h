@@ -19,6 +19,10 @@ nlohmann::json TraceRecordToJson(const TraceRecord& record, bool campaign_fields
 // Inverse of TraceRecordToJson; throws UserError when a required field is missing or mistyped.
 TraceRecord TraceRecordFromJson(const nlohmann::json& json);
 
+// The `calibration` section of results.json and of `bifilar fit --json` (rig.calibration):
+// effective against nominal geometry, the factor with its std and the std's three parts.
+nlohmann::json CalibrationToJson(const RigCalibrationResult& calibration);
+
 // The whole results.json document.
 nlohmann::json ResultsToJson(const CampaignConfig& config, const CampaignResult& result);
 

@@ -268,10 +268,17 @@ std::vector<RunFile> DiscoverPattern(const CampaignConfig& config) {
   return runs;
 }
 
-// rig.inertia.tare.logs: plain file names, or patterns whose leading literal folders must exist.
-std::vector<RunFile> DiscoverTare(const CampaignConfig& config) {
+}  // namespace
+
+// rig.inertia.tare.logs or rig.calibration.logs: plain file names, or patterns whose leading
+// literal folders must exist.
+std::vector<RunFile> DiscoverListedLogs(const CampaignConfig& config,
+                                        const std::vector<std::string>& patterns, TraceRole role) {
+  const std::string key =
+      role == TraceRole::kCalibration ? "rig.calibration.logs" : "rig.inertia.tare.logs";
+  const std::string what = role == TraceRole::kCalibration ? "calibration log" : "tare log";
   std::vector<RunFile> tare;
-  for (const std::string& pattern : config.rig_inertia.tare_patterns) {
+  for (const std::string& pattern : patterns) {
     const std::vector<std::string> parts = SplitPath(pattern);
     size_t fixed = 0;
     while (fixed < parts.size() && !HasWildcard(parts[fixed])) ++fixed;
@@ -279,9 +286,9 @@ std::vector<RunFile> DiscoverTare(const CampaignConfig& config) {
       RunFile run;
       run.path = pattern;
       run.display = Display(config, pattern);
-      run.role = TraceRole::kTare;
+      run.role = role;
       std::error_code ec;
-      if (!fs::exists(pattern, ec)) run.error = run.display + ": tare log not found";
+      if (!fs::exists(pattern, ec)) run.error = run.display + ": " + what + " not found";
       tare.push_back(run);
       continue;
     }
@@ -289,29 +296,31 @@ std::vector<RunFile> DiscoverTare(const CampaignConfig& config) {
     for (size_t i = 0; i < fixed; ++i) dir /= parts[i];
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) {
-      throw UserError("rig.inertia.tare.logs: folder '" + dir.string() + "' does not exist");
+      throw UserError(key + ": folder '" + dir.string() + "' does not exist");
     }
     const std::vector<std::string> rest(parts.begin() + fixed, parts.end());
     for (const std::string& part : rest) {
       if (part.find('{') != std::string::npos) {
-        throw UserError("rig.inertia.tare.logs: placeholders are not allowed in tare patterns");
+        throw UserError(key + ": placeholders are not allowed in these patterns");
       }
     }
     std::vector<PatternHit> hits;
     WalkPattern(dir, rest, 0, std::nullopt, &hits);
     if (hits.empty()) {
-      throw UserError("rig.inertia.tare.logs: no file matches '" + pattern + "'");
+      throw UserError(key + ": no file matches '" + pattern + "'");
     }
     for (const PatternHit& hit : hits) {
       RunFile run;
       run.path = fs::path(hit.path).lexically_normal().string();
       run.display = Display(config, run.path);
-      run.role = TraceRole::kTare;
+      run.role = role;
       tare.push_back(run);
     }
   }
   return tare;
 }
+
+namespace {
 
 // A file matched twice (two tare patterns, a table row repeated) is one log; matched as an
 // aircraft run and as a tare log it is an error row, not "the same content as" itself.
@@ -323,7 +332,9 @@ std::vector<RunFile> OncePerPath(std::vector<RunFile> runs) {
     if (inserted) {
       unique.push_back(std::move(run));
     } else if (it->second != run.role && run.error.empty()) {
-      run.error = run.display + ": listed both as an aircraft run and as a tare log";
+      run.error = run.display + ": listed both as " + (it->second == TraceRole::kAircraft ? "an " : "a ") +
+                  ToString(it->second) + " log and as " +
+                  (run.role == TraceRole::kAircraft ? "an " : "a ") + ToString(run.role) + " log";
       unique.push_back(std::move(run));
     }
   }
@@ -341,8 +352,14 @@ std::vector<RunFile> DiscoverRuns(const CampaignConfig& config) {
   std::vector<RunFile> runs =
       config.runs.table.empty() ? DiscoverPattern(config) : DiscoverTable(config);
   if (config.rig_inertia.kind == RigInertiaSpec::Kind::kTare) {
-    std::vector<RunFile> tare = DiscoverTare(config);
+    std::vector<RunFile> tare =
+        DiscoverListedLogs(config, config.rig_inertia.tare_patterns, TraceRole::kTare);
     runs.insert(runs.end(), tare.begin(), tare.end());
+  }
+  if (config.calibration.enabled) {
+    std::vector<RunFile> reference =
+        DiscoverListedLogs(config, config.calibration.log_patterns, TraceRole::kCalibration);
+    runs.insert(runs.end(), reference.begin(), reference.end());
   }
   return OncePerPath(std::move(runs));
 }

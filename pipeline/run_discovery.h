@@ -24,8 +24,16 @@ struct RunFile {
   std::string error;                        // non-empty: becomes an error row
 };
 
-// Aircraft runs (runs.pattern or runs.table) then tare logs, sorted by path within each.
-// Throws UserError when runs.root (or the table) does not exist or nothing at all is found.
+// Aircraft runs (runs.pattern or runs.table), then tare logs, then the reference swings of
+// rig.calibration, sorted by path within each. Throws UserError when runs.root (or the table)
+// does not exist or nothing at all is found.
 std::vector<RunFile> DiscoverRuns(const CampaignConfig& config);
+
+// The logs of rig.inertia.tare.logs (role kTare) or rig.calibration.logs (kCalibration): each
+// pattern's matches sorted by path; a plain file name that does not exist is a RunFile with an
+// error. Throws UserError naming the key when a pattern's folder does not exist or it matches
+// nothing.
+std::vector<RunFile> DiscoverListedLogs(const CampaignConfig& config,
+                                        const std::vector<std::string>& patterns, TraceRole role);
 
 }  // namespace bifilar

@@ -284,12 +284,16 @@ double ReadInertia(YamlMap& map, const std::string& stem, bool required, double 
 }
 
 void ReadGeometry(YamlMap map, std::optional<double>* length, std::optional<double>* separation,
-                  double* gravity) {
+                  double* gravity, std::optional<double>* true_length,
+                  std::optional<double>* true_separation) {
   const double inf = INFINITY;
   const YAML::Node length_node = map.Optional("filar_length_m");
   *length = ReadOptionalValue(map, "filar_length_m", 0, true, 1000);
   *separation = ReadOptionalValue(map, "filar_separation_m", 0, true, 1000);
   *gravity = ReadValue(map, "gravity_mps2", *gravity, 0, true, 100);
+  // A mis-measured rig (campaign only): the geometry the logs are simulated with.
+  *true_length = ReadOptionalValue(map, "true_filar_length_m", 0, true, 1000);
+  *true_separation = ReadOptionalValue(map, "true_filar_separation_m", 0, true, 1000);
   (void)inf;
   if (length->has_value() && separation->has_value() && !(**length > **separation)) {
     throw UserError(map.Where(length_node) + ": '" + map.KeyPath("filar_length_m") + "' = " +
@@ -333,9 +337,10 @@ SimulateSpec ParseSpec(YamlMap root) {
       }
     }
   }
-  std::optional<double> length, separation;
+  std::optional<double> length, separation, true_length, true_separation;
   double gravity = 9.80665;
-  ReadGeometry(Section(root, "geometry"), &length, &separation, &gravity);
+  ReadGeometry(Section(root, "geometry"), &length, &separation, &gravity, &true_length,
+               &true_separation);
   ReadFormat(Section(root, "format"), &spec);
   ReadTimeline(Section(root, "timeline"), &spec.options.timeline);
   ReadSensor(Section(root, "sensor"), &spec.options.sensor, &spec.time_jitter_given);
@@ -437,7 +442,23 @@ SimulateSpec ParseSpec(YamlMap root) {
     c.filar_length_m = *length;
     c.filar_separation_m = *separation;
     c.gravity_mps2 = gravity;
+    c.true_filar_length_m = true_length.value_or(0.0);
+    c.true_filar_separation_m = true_separation.value_or(0.0);
+    // `calibration`: reference swings for rig.calibration (a reference object on the rig).
+    YamlMap calibration = Section(root, "calibration");
+    if (root.Has("calibration")) {
+      c.calibration_logs = static_cast<int>(ReadValue(calibration, "logs", 3, 1, false, 1000));
+      c.reference_inertia_kg_m2 = ReadInertia(calibration, "reference_inertia", true, 0, true);
+      c.reference_mass_kg = calibration.RequiredDouble("reference_mass_kg");
+      c.reference_mass_kg = ReadValue(calibration, "reference_mass_kg", 0, 0, true, 1e6);
+      c.calibration_amplitude_deg =
+          ReadRange(calibration, "amplitude_deg", c.amplitude_deg, 0, true, 75);
+    }
+    calibration.Finish();
     if (!c.Check(&why)) throw UserError(spec.file + ": " + why);
+  } else if (true_length || true_separation || root.Has("calibration")) {
+    throw UserError(spec.file + ": 'geometry.true_filar_*' and 'calibration' describe a campaign's "
+                    "rig: they need the 'aircraft', 'rig' and 'campaign' sections");
   }
 
   spec.has_trace = root.Has("trace");
@@ -562,7 +583,8 @@ nlohmann::json TraceJson(const CampaignTrace& ct, const SimulateSpec& spec) {
   const SensorOptions& so = spec.options.sensor;
   nlohmann::json j;
   j["file"] = ct.relative_path;
-  j["kind"] = ct.is_tare ? "tare" : "aircraft";
+  j["kind"] = ct.is_calibration ? "calibration" : ct.is_tare ? "tare" : "aircraft";
+  if (ct.is_calibration) j["inertia_reference_kg_m2"] = ct.inertia_reference_kg_m2;
   j["trial"] = ct.trial;
   j["nominal_pitch_deg"] = ct.nominal_pitch_deg;
   j["true_pitch_deg"] = ct.true_pitch_deg;
@@ -759,6 +781,21 @@ std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<Campai
   j["geometry"] = {{"filar_length_m", c.filar_length_m},
                    {"filar_separation_m", c.filar_separation_m},
                    {"gravity_mps2", c.gravity_mps2}};
+  // A mis-measured rig: the logs follow the true geometry, a user measured the one above.
+  if (c.true_filar_length_m > 0 || c.true_filar_separation_m > 0) {
+    j["geometry"]["true_filar_length_m"] = c.TrueLengthM();
+    j["geometry"]["true_filar_separation_m"] = c.TrueSeparationM();
+    j["geometry"]["true_d2_over_l_factor"] =
+        (c.TrueSeparationM() * c.TrueSeparationM() / c.TrueLengthM()) /
+        (c.filar_separation_m * c.filar_separation_m / c.filar_length_m);
+  }
+  if (c.calibration_logs > 0) {
+    j["calibration"] = {{"logs", c.calibration_logs},
+                        {"reference_inertia_kg_m2", c.reference_inertia_kg_m2},
+                        {"reference_mass_kg", c.reference_mass_kg},
+                        {"rig_pitch_deg", c.tare_pitch_deg},
+                        {"amplitude_deg", Range(c.calibration_amplitude_deg)}};
+  }
   const double tau = c.aircraft.PrincipalInclinationRad();
   j["aircraft"] = {{"mass_kg", c.aircraft.mass_kg},
                    {"ix_kg_m2", c.aircraft.ix_kg_m2},

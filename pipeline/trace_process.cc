@@ -40,7 +40,31 @@ bool ParseTraceStatus(const std::string& name, TraceStatus* status) {
   return true;
 }
 
-const char* ToString(TraceRole role) { return role == TraceRole::kTare ? "tare" : "aircraft"; }
+const char* ToString(TraceRole role) {
+  switch (role) {
+    case TraceRole::kAircraft: return "aircraft";
+    case TraceRole::kTare: return "tare";
+    case TraceRole::kCalibration: return "calibration";
+  }
+  return "aircraft";
+}
+
+bool ParseTraceRole(const std::string& name, TraceRole* role) {
+  if (name == "aircraft") *role = TraceRole::kAircraft;
+  else if (name == "tare") *role = TraceRole::kTare;
+  else if (name == "calibration") *role = TraceRole::kCalibration;
+  else return false;
+  return true;
+}
+
+RigGeometry GeometryForRole(const CampaignConfig& config, TraceRole role) {
+  switch (role) {
+    case TraceRole::kTare: return config.TareGeometry();
+    case TraceRole::kCalibration: return config.CalibrationGeometry();
+    case TraceRole::kAircraft: break;
+  }
+  return config.AircraftGeometry();
+}
 
 std::optional<std::array<double, 2>> ConfigWindowFor(const CampaignConfig& config,
                                                      const std::string& path) {
@@ -310,8 +334,7 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   input.noise_rad_per_s = series.noise_rad_per_s;
   input.secondary_motion_ratio =
       SecondaryMotionRatio(data, axis.axis_in_imu, band.t0_s, band.t1_s);
-  input.geometry = options.role == TraceRole::kTare ? config.TareGeometry()
-                                                    : config.AircraftGeometry();
+  input.geometry = GeometryForRole(config, options.role);
   input.label = name;
   TraceFitOptions fit_options;
   fit_options.model = config.fit.model;
@@ -330,13 +353,17 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   fit_options.min_periods = q.min_periods;
   fit_options.max_amplitude_deg = band_options.max_amplitude_deg;
   fit_options.min_amplitude_deg = std::min(fit_options.min_amplitude_deg, band_options.min_amplitude_deg);
-  fit_options.filar_length_std_m = config.uncertainties.filar_length_std_m;
-  fit_options.filar_separation_std_m = config.uncertainties.filar_separation_std_m;
-  fit_options.mass_std_kg = options.role == TraceRole::kTare
-                                ? config.uncertainties.mass_std_kg
-                                : std::hypot(config.uncertainties.mass_std_kg,
-                                             config.aircraft_mass_std_kg);
-  fit_options.gravity_std_mps2 = config.uncertainties.gravity_std_mps2;
+  // A calibrated geometry absorbs L, D and g (docs/physics.md §2.6): their terms are replaced by
+  // the calibration's own (added below).
+  const bool calibrated = config.geometry_calibration.applied;
+  fit_options.filar_length_std_m = calibrated ? 0.0 : config.uncertainties.filar_length_std_m;
+  fit_options.filar_separation_std_m =
+      calibrated ? 0.0 : config.uncertainties.filar_separation_std_m;
+  fit_options.mass_std_kg = options.role == TraceRole::kAircraft
+                                ? std::hypot(config.uncertainties.mass_std_kg,
+                                             config.aircraft_mass_std_kg)
+                                : config.uncertainties.mass_std_kg;
+  fit_options.gravity_std_mps2 = calibrated ? 0.0 : config.uncertainties.gravity_std_mps2;
   fit_options.gyro_scale_std = config.imu.gyro_scale_std;
   // The residual series is kept for the second glitch pass below (and dropped after it when
   // neither a figure nor the caller wants it).
@@ -423,6 +450,11 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
       record.budget.push_back({c.name, c.contribution_kg_m2});
     }
     record.budget_total_std_kg_m2 = fit.inertia_budget_std_kg_m2;
+    if (calibrated) {  // k's std moves I (and every other moment) by the same fraction
+      const double term = config.geometry_calibration.factor_rel_std * fit.params.inertia_kg_m2;
+      record.budget.push_back({"calibration", term});
+      record.budget_total_std_kg_m2 = std::hypot(record.budget_total_std_kg_m2, term);
+    }
   }
   if (record.status == TraceStatus::kOk && !record.warnings.empty()) {
     record.message = name + ": " + record.warnings.front() +

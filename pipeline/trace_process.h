@@ -23,8 +23,11 @@ enum class TraceStatus { kOk, kRejected, kError };
 const char* ToString(TraceStatus status);  // "ok", "rejected", "error"
 bool ParseTraceStatus(const std::string& name, TraceStatus* status);
 
-enum class TraceRole { kAircraft, kTare };  // an aircraft run, or a tare log of the rig alone
-const char* ToString(TraceRole role);        // "aircraft", "tare"
+// An aircraft run, a tare log of the rig alone, or a reference swing of rig.calibration (rig +
+// reference object).
+enum class TraceRole { kAircraft, kTare, kCalibration };
+const char* ToString(TraceRole role);        // "aircraft", "tare", "calibration"
+bool ParseTraceRole(const std::string& name, TraceRole* role);
 
 // One term of the systematic uncertainty budget of I (issue 3 item 7).
 struct BudgetTerm {
@@ -100,7 +103,8 @@ struct TraceRecord {
 constexpr double kDefaultMaxAmplitudeDeg = 90.0;
 
 struct TraceProcessOptions {
-  TraceRole role = TraceRole::kAircraft;  // chooses the suspended mass (aircraft + rig, or rig)
+  // Chooses the suspended mass: aircraft + rig, rig alone, or rig + reference.
+  TraceRole role = TraceRole::kAircraft;
   std::string display_name;               // `file` of the record; default: the path
   // Window override [t0, t1] (s); takes precedence over the config's per-file windows.
   std::optional<std::array<double, 2>> window_s;
@@ -114,6 +118,9 @@ struct TraceProcessOptions {
   std::vector<std::string> sweep_figure_paths;
   int figure_width_px = 1100, figure_height_px = 700;  // page size of both figures (px)
 };
+
+// The geometry (L, D, suspended mass, g) a trace of `role` is fitted with.
+RigGeometry GeometryForRole(const CampaignConfig& config, TraceRole role);
 
 // Processes one log. Never throws: every failure is a record with status error naming the file.
 TraceRecord ProcessTrace(const CampaignConfig& config, const std::string& path,
