@@ -17,6 +17,7 @@
 #include "pipeline/cache.h"
 #include "pipeline/campaign_inputs.h"
 #include "pipeline/ellipse_json.h"
+#include "pipeline/interrupt.h"
 #include "pipeline/output_set.h"
 #include "pipeline/parallel_runner.h"
 #include "pipeline/report.h"
@@ -282,13 +283,19 @@ void FitTraces(const CampaignConfig& config, const CampaignOptions& options,
   CampaignConfig fit_config = config;
   fit_config.fit.windows_s.clear();
   const int n_fit = static_cast<int>(plan.to_fit.size());
-  ProgressReporter progress(options.progress, options.progress_bar, n_fit);
+  ProgressReporter progress(options.progress, options.progress_bar, n_fit, options.on_progress);
+  auto cancelled = [&] { return options.cancel != nullptr && options.cancel->load(); };
   ParallelFor(n_fit, jobs, [&](int k) {
+    if (cancelled()) return;  // Ctrl-C: hand out no further fit
     const int i = plan.to_fit[k];
     TraceRecord& record = (*traces)[i];
     record = FitOneTrace(fit, fit_config, options, in.runs[i], in.windows[i], record, cache, *out);
     progress.TaskDone(ProgressLine(record));
   });
+  if (cancelled()) {
+    throw CampaignInterrupted(progress.Stop(), n_fit,
+                              (std::filesystem::path(options.out_dir) / "cache").string());
+  }
 }
 
 // ---- Step 2a: calibrate (rig.calibration, pipeline/calibration.h) --------------------------

@@ -8,6 +8,7 @@
 // Conventions: docs/physics.md §2 (tare: I_aircraft = I_total - I_rig), §3 (pitch, ellipse).
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <iosfwd>
 #include <optional>
@@ -84,6 +85,12 @@ struct CampaignOptions {
   std::ostream* progress = nullptr;  // progress lines / bar; nullptr = quiet
   bool progress_bar = false;  // redraw one line ('\r') instead of one line per trace
   TraceFitFunction fit_function;  // empty = ProcessTrace
+  // Ctrl-C (pipeline/interrupt.h): when set, no further fit starts; fits running finish and are
+  // cached, and RunCampaign throws CampaignInterrupted before writing any result. nullptr: none.
+  const std::atomic<bool>* cancel = nullptr;
+  // Called after each fit (from worker threads, serialised): fits done, fits planned, the
+  // trace's progress line. Empty: none. Beside `progress`, for the Python module's callback.
+  std::function<void(int done, int total, const std::string& line)> on_progress;
 
   bool Check(std::string* why) const;
 };

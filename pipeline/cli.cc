@@ -44,6 +44,7 @@ int RunCommandLine(int argc, char** argv) {
   RegisterFitCommand(app, &exit_code);
   RegisterEllipseCommands(app, &exit_code);
   RegisterSimulateCommand(app, &exit_code);
+  RegisterInspectCommands(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -13,5 +13,6 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code);
 void RegisterFitCommand(CLI::App& app, int* exit_code);
 void RegisterEllipseCommands(CLI::App& app, int* exit_code);  // `ellipse` and `plan`
 void RegisterProcessCommands(CLI::App& app, int* exit_code);  // `process` and `report`
+void RegisterInspectCommands(CLI::App& app, int* exit_code);  // `inspect` and `init`
 
 }  // namespace bifilar

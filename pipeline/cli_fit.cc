@@ -13,6 +13,7 @@
 #include "pipeline/calibration.h"
 #include "pipeline/cli_commands.h"
 #include "pipeline/config.h"
+#include "pipeline/interrupt.h"
 #include "pipeline/repeats.h"
 #include "pipeline/results_json.h"
 #include "pipeline/trace_process.h"
@@ -171,7 +172,17 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     }
     std::vector<TraceRecord> records;
     int failed = 0;
+    InstallInterruptHandler();
     for (const std::string& log : args->logs) {
+      if (ProcessInterruptFlag().load()) {  // Ctrl-C: what was fitted, then exit 130
+        if (args->json || args->repeats) {
+          for (const TraceRecord& r : records) std::cout << HumanLine(r) << std::endl;
+        }
+        std::cerr << "bifilar: interrupted: " << records.size() << " of " << args->logs.size()
+                  << " logs fitted (above)\n";
+        *exit_code = kInterruptedExitCode;
+        return;
+      }
       TraceProcessOptions trace = options;
       trace.display_name = log;
       if (!args->plot_dir.empty()) {

@@ -7,6 +7,7 @@
 #include "pipeline/campaign.h"
 #include "pipeline/cli_commands.h"
 #include "pipeline/config.h"
+#include "pipeline/interrupt.h"
 #include "pipeline/report.h"
 
 namespace bifilar {
@@ -45,7 +46,16 @@ void RegisterProcessCommands(CLI::App& app, int* exit_code) {
     options.force = args->force;
     options.progress = &std::cerr;
     options.progress_bar = isatty(2) != 0;
-    const CampaignResult result = RunCampaign(config, options);
+    InstallInterruptHandler();
+    options.cancel = &ProcessInterruptFlag();
+    CampaignResult result;
+    try {
+      result = RunCampaign(config, options);
+    } catch (const CampaignInterrupted& e) {
+      std::cerr << "bifilar: " << e.what() << "\n";
+      *exit_code = kInterruptedExitCode;
+      return;
+    }
     PrintCampaignSummary(config, result, std::cout);
     std::cout << "Wrote " << options.out_dir << "/{results.json, traces.csv, angles.csv, report.html}\n";
     *exit_code = result.summary.exit_code;

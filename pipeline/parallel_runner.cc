@@ -35,11 +35,12 @@ void ParallelFor(int n, int jobs, const std::function<void(int)>& fn) {
 }
 
 void ProgressReporter::TaskDone(const std::string& line) {
-  if (out_ == nullptr) return;
   // Counted under the lock, so the lines (and the bar) show 1, 2, ... n in order and the bar's
   // final newline comes last.
   const std::lock_guard<std::mutex> lock(mutex_);
   const int done = ++done_;
+  if (callback_) callback_(done, total_, line);
+  if (out_ == nullptr) return;
   std::ostream& out = *out_;
   if (bar_) {
     const int width = 30;
@@ -50,6 +51,12 @@ void ProgressReporter::TaskDone(const std::string& line) {
   } else {
     out << "  fit " << done << "/" << total_ << " " << line << "\n" << std::flush;
   }
+}
+
+int ProgressReporter::Stop() {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (out_ != nullptr && bar_ && done_ < total_) *out_ << "\n" << std::flush;
+  return done_;
 }
 
 }  // namespace bifilar

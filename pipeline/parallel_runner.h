@@ -20,17 +20,23 @@ void ParallelFor(int n, int jobs, const std::function<void(int)>& fn);
 
 // Progress of `total` tasks finished by any thread, written to `out` (nullptr = quiet): one line
 // per task ("  fit 3/57 <line>"), or with `bar` one redrawn line ("\r  fitting [###   ] 3/57").
+// `callback` (optional) is called under the same lock with (done, total, line).
 class ProgressReporter {
  public:
-  ProgressReporter(std::ostream* out, bool bar, int total) : out_(out), bar_(bar), total_(total) {}
+  using Callback = std::function<void(int done, int total, const std::string& line)>;
+  ProgressReporter(std::ostream* out, bool bar, int total, Callback callback = Callback())
+      : out_(out), bar_(bar), total_(total), callback_(std::move(callback)) {}
 
   // Counts one finished task; `line` describes it (one line, no '\n'; unused by the bar).
   void TaskDone(const std::string& line);
+  // Ends a bar that stopped short of `total` (Ctrl-C) with its newline; the count so far.
+  int Stop();
 
  private:
   std::ostream* out_;
   bool bar_;
   int total_;
+  Callback callback_;
   int done_ = 0;  // guarded by mutex_
   std::mutex mutex_;
 };

@@ -256,12 +256,14 @@ def fit_ellipse(pitch_deg, inertia, std=None, *, bootstrap=2000, seed=1, confide
                                     str(covariance)))
 
 
-def process(config_path, out=None, jobs=None, *, force=False, figures=True, progress=False):
+def process(config_path, out=None, jobs=None, *, force=False, figures=True, progress=None):
     """Process a campaign as ``bifilar process CONFIG --out OUT --jobs JOBS``.
 
     Fits every log (in parallel, with the cache in OUT/cache), subtracts the rig, fits the
     ellipse and writes results.json, traces.csv, angles.csv, report.html and figures into OUT.
-    The GIL is released while it runs.
+    The GIL is released while the fits run. Ctrl-C raises ``KeyboardInterrupt`` as soon as the
+    fits running have finished (well within a second); the finished fits stay in the cache, no
+    result file is written, and the next call goes on from the cache.
 
     Parameters
     ----------
@@ -275,8 +277,10 @@ def process(config_path, out=None, jobs=None, *, force=False, figures=True, prog
         Ignore the cache and refit every log (``--force``).
     figures : bool, default True
         Draw the per-trace figures, Fig. 3/4 and report.html (False: results files only).
-    progress : bool, default False
-        Print a progress line per trace to stderr.
+    progress : None, True, "bar" or callable, default None
+        None or False: quiet. True or "bar": a text bar on stderr. A callable is called as
+        ``progress(done, total, line)`` after every fit (``line``: "pitch_10/trial_1.csv: ok
+        I_total = ..."); an exception it raises stops the run and is raised here.
 
     Returns
     -------
@@ -290,10 +294,17 @@ def process(config_path, out=None, jobs=None, *, force=False, figures=True, prog
     ValueError
         Config or usage problems (the command line's exit code 2, with its message). Problems
         with single logs are records with status ``error``, not exceptions.
+    KeyboardInterrupt
+        Ctrl-C.
     """
+    callback = progress if callable(progress) else None
+    bar = progress is True or progress == "bar"
+    if progress not in (None, False, True, "bar") and callback is None:
+        raise ValueError("process: progress must be None, True, 'bar' or a callable "
+                         "progress(done, total, line), got %r" % (progress,))
     return Record(_core.process(str(config_path), None if out is None else str(out),
                                 _number("process", "jobs", jobs, int), bool(force), bool(figures),
-                                bool(progress)))
+                                bar, callback))
 
 
 def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=None,

@@ -70,3 +70,36 @@ def test_process_gives_the_results_json_of_the_cli(cli, small_campaign, tmp_path
     again = bifilar.process(small_campaign, out=tmp_path / "py_out", figures=False)
     assert again.summary.n_reused == len(PITCHES) + 1
     assert [t.inertia_kg_m2 for t in again.traces] == [t.inertia_kg_m2 for t in results.traces]
+
+
+def test_progress_callback_sees_every_fit(small_campaign, tmp_path):
+    seen = []
+    bifilar.process(small_campaign, out=tmp_path / "out", jobs=2, figures=False,
+                    progress=lambda done, total, line: seen.append((done, total, line)))
+    total = len(PITCHES) + 1  # the aircraft logs and the tare log
+    assert [d for d, _, _ in seen] == list(range(1, total + 1))
+    assert all(t == total for _, t, _ in seen)
+    assert all(": ok" in line for _, _, line in seen)
+    with pytest.raises(ValueError, match="progress must be"):
+        bifilar.process(small_campaign, out=tmp_path / "out", progress="lines")
+
+
+def test_ctrl_c_raises_keyboard_interrupt_and_keeps_the_finished_fits(small_campaign, tmp_path):
+    import os
+    import signal
+
+    out = tmp_path / "out"
+
+    def interrupt_after_two(done, total, line):
+        if done == 2:
+            os.kill(os.getpid(), signal.SIGINT)  # what Ctrl-C sends
+
+    with pytest.raises(KeyboardInterrupt):
+        bifilar.process(small_campaign, out=out, jobs=1, figures=False,
+                        progress=interrupt_after_two)
+    assert not (out / "results.json").exists()  # no partial result
+    cached = list((out / "cache").glob("*.json"))
+    assert 2 <= len(cached) < len(PITCHES) + 1
+    # The next run goes on from the cache.
+    results = bifilar.process(small_campaign, out=out, jobs=1, figures=False)
+    assert results.summary["n_reused"] >= 2
