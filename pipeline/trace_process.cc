@@ -16,6 +16,7 @@
 #include "fit/trace_plot.h"
 #include "fit/window.h"
 #include "pipeline/imu_log.h"
+#include "pipeline/total_uncertainty.h"
 #include "fit/figure.h"
 #include "pipeline/user_error.h"
 #include <plplot.h>
@@ -330,13 +331,16 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   fit_options.min_periods = q.min_periods;
   fit_options.max_amplitude_deg = band_options.max_amplitude_deg;
   fit_options.min_amplitude_deg = std::min(fit_options.min_amplitude_deg, band_options.min_amplitude_deg);
-  fit_options.filar_length_std_m = config.uncertainties.filar_length_std_m;
-  fit_options.filar_separation_std_m = config.uncertainties.filar_separation_std_m;
+  // Without rig.uncertainties the budget counts the assumed +-1 mm on L and D
+  // (pipeline/total_uncertainty.h).
+  const RigUncertainties uncertainties = config.uncertainties.InEffect();
+  fit_options.filar_length_std_m = uncertainties.filar_length_std_m;
+  fit_options.filar_separation_std_m = uncertainties.filar_separation_std_m;
   fit_options.mass_std_kg = options.role == TraceRole::kTare
-                                ? config.uncertainties.mass_std_kg
-                                : std::hypot(config.uncertainties.mass_std_kg,
+                                ? uncertainties.mass_std_kg
+                                : std::hypot(uncertainties.mass_std_kg,
                                              config.aircraft_mass_std_kg);
-  fit_options.gravity_std_mps2 = config.uncertainties.gravity_std_mps2;
+  fit_options.gravity_std_mps2 = uncertainties.gravity_std_mps2;
   fit_options.gyro_scale_std = config.imu.gyro_scale_std;
   // The residual series is kept for the second glitch pass below (and dropped after it when
   // neither a figure nor the caller wants it).
@@ -423,6 +427,13 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
       record.budget.push_back({c.name, c.contribution_kg_m2});
     }
     record.budget_total_std_kg_m2 = fit.inertia_budget_std_kg_m2;
+    record.budget_assumed = config.uncertainties.Assumed();
+    UpdateTotalUncertainty(&record);
+    // Every record says what the assumption adds on this rig (the console says it once).
+    if (record.budget_assumed) {
+      record.flags.push_back(kAssumedInputsFlag);
+      record.warnings.push_back(AssumedInputsWarning(record));
+    }
   }
   if (record.status == TraceStatus::kOk && !record.warnings.empty()) {
     record.message = name + ": " + record.warnings.front() +
