@@ -197,9 +197,9 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       for (const TraceRecord& r : records) std::cout << HumanLine(r) << std::endl;
       for (const RepeatGroup& g : groups) std::cout << RepeatGroupLine(g) << std::endl;
     }
-    // Once for the run: what the assumed +-1 mm on L and D adds (stderr beside --json).
+    // Once for the run: what the assumed +-1 mm on L and D adds (--json records carry it).
     const std::string assumed = AssumedInputsSummary(records);
-    if (!assumed.empty()) (args->json ? std::cerr : std::cout) << assumed << std::endl;
+    if (!assumed.empty() && !args->json) std::cout << assumed << std::endl;
     *exit_code = failed > 0 ? 1 : 0;
   });
 }

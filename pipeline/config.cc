@@ -293,7 +293,7 @@ RigGeometry CampaignConfig::AircraftGeometry() const {
 }
 
 RigUncertainties RigUncertainties::InEffect() const {
-  if (configured) return *this;
+  if (!Assumed()) return *this;
   RigUncertainties assumed = *this;
   assumed.filar_length_std_m = kAssumedLengthStdM;
   assumed.filar_separation_std_m = kAssumedLengthStdM;
