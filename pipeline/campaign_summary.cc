@@ -42,10 +42,9 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     out << line;
     if (std::isfinite(rel)) {
       std::snprintf(line, sizeof(line),
-                    "  (total = stat and +- %.2f %% common to all moments, from the %s uncertainties "
-                    "of L, D, the masses, g and the gyro scale, in quadrature)\n",
-                    100.0 * rel, result.common_mode_assumed ? "assumed (+-1 mm on L and D)"
-                                                            : "configured");
+                    "  (total: stat and +- %.2f %% common to all moments in quadrature, from the "
+                    "uncertainties of L, D%s, the masses, g and the gyro scale)\n",
+                    100.0 * rel, result.common_mode_assumed ? " (assumed +-1 mm)" : "");
       out << line;
     }
     std::snprintf(line, sizeof(line),

@@ -247,9 +247,9 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
   h << "<p><b>std (stat)</b>: the scatter between trials and angles, the fits' own errors and the "
        "rig inertia's offset; the interval is its 95 % bootstrap interval. <b>std (total)</b> adds "
        "in quadrature the common-mode terms, one error shared by every moment: the "
-    << (assumed ? "<b>assumed</b> &plusmn;1 mm on L and D (no <code>rig.uncertainties</code>)"
-                : "configured uncertainties of L, D, the masses, g and the gyro scale")
-    << " and the rig calibration, &plusmn;" << Fmt(100.0 * common, "%.2f")
+    << "uncertainties of L, D"
+    << (assumed ? " (<b>assumed</b> &plusmn;1 mm: no <code>rig.uncertainties</code>)" : "")
+    << ", the masses, g and the gyro scale and the rig calibration, &plusmn;" << Fmt(100.0 * common, "%.2f")
     << " % of each moment. It scales every moment alike and leaves &tau; unchanged. Read the total "
        "when you use a number; compare trials or set-ups with the stat std.</p>\n";
   const std::string note = Str(total, "note");

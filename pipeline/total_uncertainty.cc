@@ -47,6 +47,7 @@ std::vector<UncertaintyTerm> PerLogTerms(const TraceRecord& r) {
 }
 
 std::string Percent(double fraction) {
+  if (!std::isfinite(fraction)) return "?";  // a budget line that could not be computed
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), fraction < 0.001 ? "%.3f" : "%.2g", 100.0 * fraction);
   return buffer;
