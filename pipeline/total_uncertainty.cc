@@ -66,10 +66,10 @@ TotalUncertainty ComposeTotalUncertainty(const TraceRecord& r) {
   TotalUncertainty u;
   u.terms = PerLogTerms(r);
   u.terms.push_back({kTermConfiguredInputs, ConfiguredInputsStd(r), true, r.budget_assumed});
-  u.terms.push_back({kTermCalibration,
-                     r.calibrated ? std::abs(r.calibration_relative_std * r.inertia_total_kg_m2)
-                                  : 0.0,
-                     true, false});
+  u.terms.push_back(
+      {kTermCalibration,
+       r.calibrated ? std::abs(r.calibration_relative_std * r.inertia_total_kg_m2) : 0.0, true,
+       false});
   Finish(&u);
   return u;
 }
@@ -79,7 +79,8 @@ TotalUncertainty ComposeAircraftUncertainty(const TraceRecord& r, double rig_std
   TotalUncertainty u;
   u.terms = PerLogTerms(r);
   const double share = rig_from_tare ? r.inertia_kg_m2 / r.inertia_total_kg_m2 : 1.0;
-  u.terms.push_back({kTermConfiguredInputs, share * ConfiguredInputsStd(r), true, r.budget_assumed});
+  u.terms.push_back(
+      {kTermConfiguredInputs, share * ConfiguredInputsStd(r), true, r.budget_assumed});
   u.terms.push_back({kTermCalibration,
                      r.calibrated ? std::abs(r.calibration_relative_std * r.inertia_kg_m2) : 0.0,
                      true, false});
@@ -145,11 +146,13 @@ std::string AssumedInputsSummary(const std::vector<TraceRecord>& records) {
     ++n;
   }
   if (n == 0) return "";
-  const std::string range =
-      Percent(lo) == Percent(hi) ? "+-" + Percent(lo) + " %" : "+-" + Percent(lo) + " to " + Percent(hi) + " %";
+  const std::string range = Percent(lo) == Percent(hi)
+                                ? "+-" + Percent(lo) + " %"
+                                : "+-" + Percent(lo) + " to " + Percent(hi) + " %";
   return "note: rig.uncertainties is not set, so every total counts an assumed tape-measure "
-         "+-1 mm on L and on D: " + range + " of I on this rig (" + std::to_string(n) +
-         " fit" + (n == 1 ? "" : "s") + "). Measure L and D and set rig.uncertainties "
+         "+-1 mm on L and on D: " +
+         range + " of I on this rig (" + std::to_string(n) + " fit" + (n == 1 ? "" : "s") +
+         "). Measure L and D and set rig.uncertainties "
          "(configs/README.md; zeros count nothing), or calibrate the rig with a reference object.";
 }
 

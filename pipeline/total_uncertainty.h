@@ -28,12 +28,12 @@ namespace bifilar {
 constexpr double kAssumedLengthStdM = 0.001;
 
 // Term names, in the order of TotalUncertainty::terms.
-constexpr const char* kTermStatistical = "statistical";        // HAC, Birge-scaled (per log)
-constexpr const char* kTermModelInadequacy = "model_inadequacy";  // amplitude trend (per log)
-constexpr const char* kTermBetweenRepeat = "between_repeat";   // tau of --repeats (per log)
+constexpr const char* kTermStatistical = "statistical";             // HAC, Birge-scaled (per log)
+constexpr const char* kTermModelInadequacy = "model_inadequacy";    // amplitude trend (per log)
+constexpr const char* kTermBetweenRepeat = "between_repeat";        // tau of --repeats (per log)
 constexpr const char* kTermConfiguredInputs = "configured_inputs";  // L, D, m, g, gyro scale
-constexpr const char* kTermCalibration = "calibration";        // rig.calibration (0: none)
-constexpr const char* kTermRigInertia = "rig_inertia";         // tare/value std (aircraft alone)
+constexpr const char* kTermCalibration = "calibration";             // rig.calibration (0: none)
+constexpr const char* kTermRigInertia = "rig_inertia";  // tare/value std (aircraft alone)
 
 struct UncertaintyTerm {
   std::string name;          // one of the kTerm* names

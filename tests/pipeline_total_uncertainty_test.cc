@@ -1,21 +1,20 @@
 // The total uncertainty (pipeline/total_uncertainty.h): named terms in quadrature, the assumed
 // +-1 mm on L and D without rig.uncertainties, the total in every output, and on the real
 // quadrotor logs (../shared/data/crazyflie, skipped when absent) the numbers issue 16 asks for.
-#include "pipeline/total_uncertainty.h"
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
 #include "pipeline/campaign.h"
 #include "pipeline/repeats.h"
+#include "pipeline/total_uncertainty.h"
 #include "pipeline/trace_process.h"
 #include "tests/test_support.h"
 
@@ -92,13 +91,15 @@ TEST(TotalUncertainty, AssumedTapeMeasureUnlessConfigured) {
                 BIFILAR_BINARY, dir.path.c_str(), inertia, mass, length, separation);
   ASSERT_EQ(std::system(command), 0);
   const std::string rig = "rig: {filar_length_m: 2.0, filar_separation_m: 1.8, mass_kg: 6.75";
-  const std::string imu = "imu:\n  time: {column: t, unit: s}\n"
-                          "  gyro: {columns: [gx, gy, gz], unit: rad/s}\n  accel: null\n";
+  const std::string imu =
+      "imu:\n  time: {column: t, unit: s}\n"
+      "  gyro: {columns: [gx, gy, gz], unit: rad/s}\n  accel: null\n";
   WriteFile(dir.path + "/none.yaml", rig + "}\n" + imu);
   WriteFile(dir.path + "/zeros.yaml", rig + ", uncertainties: {}}\n" + imu);
   WriteFile(dir.path + "/set.yaml", rig +
                                         ", uncertainties: {filar_length_std_m: 0.002, "
-                                        "filar_separation_std_m: 0.0005}}\n" + imu);
+                                        "filar_separation_std_m: 0.0005}}\n" +
+                                        imu);
   const std::string log = dir.path + "/swing.csv";
   const TraceRecord none = ProcessTrace(LoadFitConfig(dir.path + "/none.yaml"), log, {});
   const TraceRecord zeros = ProcessTrace(LoadFitConfig(dir.path + "/zeros.yaml"), log, {});
@@ -219,7 +220,8 @@ TEST(TotalUncertainty, CampaignTable2AndFilesCarryTheTotal) {
     UpdateTotalUncertainty(&r);
     return r;
   };
-  const CampaignResult result = RunCampaign(LoadCampaignConfig(dir.path + "/campaign.yaml"), options);
+  const CampaignResult result =
+      RunCampaign(LoadCampaignConfig(dir.path + "/campaign.yaml"), options);
   ASSERT_TRUE(result.ellipse_fit.has_value());
   // A rig value (not a tare): the 2 % of I_total carries whole to the aircraft alone.
   double expected_rel = 0.0;
@@ -241,8 +243,10 @@ TEST(TotalUncertainty, CampaignTable2AndFilesCarryTheTotal) {
               std::hypot(e.ix.std, expected_rel * e.ix.value), 1e-12);
   EXPECT_NEAR(json["total_uncertainty"]["tau_deg"].get<double>(), e.tau_deg.std, 1e-12);
   EXPECT_TRUE(json["total_uncertainty"]["configured_inputs_assumed"].get<bool>());
-  EXPECT_NE(ReadFile(dir.path + "/out/traces.csv").find("inertia_std_total_kg_m2"), std::string::npos);
-  EXPECT_NE(ReadFile(dir.path + "/out/angles.csv").find("inertia_std_total_kg_m2"), std::string::npos);
+  EXPECT_NE(ReadFile(dir.path + "/out/traces.csv").find("inertia_std_total_kg_m2"),
+            std::string::npos);
+  EXPECT_NE(ReadFile(dir.path + "/out/angles.csv").find("inertia_std_total_kg_m2"),
+            std::string::npos);
   EXPECT_NE(ReadFile(dir.path + "/out/report.html").find("std (total)"), std::string::npos);
   std::ostringstream console;
   PrintCampaignSummary(LoadCampaignConfig(dir.path + "/campaign.yaml"), result, console);
@@ -282,8 +286,8 @@ TEST(TotalUncertainty, QuadrotorLogsCountTheGeometry) {
         const TraceRecord assumed = ProcessTrace(plain, paths.back(), {});
         ASSERT_TRUE(assumed.ok()) << paths.back() << ": " << assumed.message;
         EXPECT_TRUE(assumed.budget_assumed);
-        smallest_assumed = std::min(smallest_assumed, assumed.inertia_total_std_total_kg_m2 /
-                                                          assumed.inertia_total_kg_m2);
+        smallest_assumed = std::min(
+            smallest_assumed, assumed.inertia_total_std_total_kg_m2 / assumed.inertia_total_kg_m2);
         records.push_back(ProcessTrace(configured, paths.back(), {}));
         ASSERT_TRUE(records.back().ok()) << paths.back() << ": " << records.back().message;
         EXPECT_FALSE(records.back().budget_assumed);
@@ -293,8 +297,8 @@ TEST(TotalUncertainty, QuadrotorLogsCountTheGeometry) {
       CombineRepeats(&groups, &records);
       ASSERT_EQ(groups.size(), 1u);
       for (const TraceRecord& r : records) {
-        const double z =
-            std::abs(r.inertia_total_kg_m2 - groups[0].plain_mean_kg_m2) / r.inertia_total_std_kg_m2;
+        const double z = std::abs(r.inertia_total_kg_m2 - groups[0].plain_mean_kg_m2) /
+                         r.inertia_total_std_kg_m2;
         largest_z = std::max(largest_z, z);
         EXPECT_LE(z, 2.5) << r.file;
         const double total = r.inertia_total_std_total_kg_m2 / r.inertia_total_kg_m2;
@@ -307,10 +311,11 @@ TEST(TotalUncertainty, QuadrotorLogsCountTheGeometry) {
       std::printf("  %s\n", RepeatGroupLine(groups[0]).c_str());
     }
   }
-  std::printf("  %d logs; assumed +-1 mm: smallest total %.2f %%; L +-1 mm, D +-0.5 mm: smallest "
-              "total %.2f %%; with --repeats stat %.3f-%.2f %%, the largest |z| %.2f\n",
-              logs, 100 * smallest_assumed, 100 * smallest_total, 100 * stat_range[0],
-              100 * stat_range[1], largest_z);
+  std::printf(
+      "  %d logs; assumed +-1 mm: smallest total %.2f %%; L +-1 mm, D +-0.5 mm: smallest "
+      "total %.2f %%; with --repeats stat %.3f-%.2f %%, the largest |z| %.2f\n",
+      logs, 100 * smallest_assumed, 100 * smallest_total, 100 * stat_range[0], 100 * stat_range[1],
+      largest_z);
   EXPECT_EQ(logs, 24);
   EXPECT_GE(smallest_assumed, 0.06);  // 2 x 1/30 = 6.7 % from D alone
 }
