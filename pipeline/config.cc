@@ -13,6 +13,7 @@
 
 #include "pipeline/ulog.h"
 #include "pipeline/user_error.h"
+#include "pipeline/total_uncertainty.h"
 #include "pipeline/yaml_reader.h"
 
 namespace bifilar {
@@ -323,6 +324,14 @@ RigGeometry CampaignConfig::AircraftGeometry() const {
   return g;
 }
 
+RigUncertainties RigUncertainties::InEffect() const {
+  if (!Assumed()) return *this;
+  RigUncertainties assumed = *this;
+  assumed.filar_length_std_m = kAssumedLengthStdM;
+  assumed.filar_separation_std_m = kAssumedLengthStdM;
+  return assumed;
+}
+
 RigGeometry CampaignConfig::TareGeometry() const {
   RigGeometry g = AircraftGeometry();
   g.mass_kg = rig_mass_kg;
@@ -539,6 +548,7 @@ void ReadRig(YamlMap& root, const std::string& path, const ConfigLoadOptions& op
   }
   YamlMap unc = Sub(rig, "uncertainties");
   RigUncertainties& u = config->uncertainties;
+  u.configured = rig.Has("uncertainties");
   u.filar_length_std_m = NonNegative(unc, "filar_length_std_m", 0.0);
   u.filar_separation_std_m = NonNegative(unc, "filar_separation_std_m", 0.0);
   u.mass_std_kg = NonNegative(unc, "mass_std_kg", 0.0);

@@ -37,6 +37,11 @@ struct RepeatGroup {
   // ideal model shows here even when each log is too short to show it.
   double amplitude_trend_percent_per_10deg = NAN;
   double amplitude_trend_z = NAN;
+  // Total uncertainty of the mean (pipeline/total_uncertainty.h): mean_std_kg_m2 and the
+  // members' common-mode terms (budget, calibration; their mean fraction of I times the mean) in
+  // quadrature: what the `--repeats` line and JSON give as the set-up's total.
+  double common_mode_std_kg_m2 = NAN;
+  double total_std_kg_m2 = NAN;
   std::string note;          // why nothing was combined (fewer than 2 usable members)
 };
 
@@ -46,7 +51,8 @@ std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths);
 
 // Combines each group's usable members (status ok, finite I, std > 0): fills the group's
 // statistics, and for every used member sets repeat_scatter_std_kg_m2 = tau, adds tau in
-// quadrature to inertia_total_std_kg_m2 and, when tau > 0, a warning saying so.
+// quadrature to inertia_total_std_kg_m2 (and updates its total) and, when tau > 0, a warning
+// saying so.
 void CombineRepeats(std::vector<RepeatGroup>* groups, std::vector<TraceRecord>* records);
 
 // One line per group for the console.

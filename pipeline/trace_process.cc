@@ -16,6 +16,7 @@
 #include "fit/trace_plot.h"
 #include "fit/window.h"
 #include "pipeline/imu_log.h"
+#include "pipeline/total_uncertainty.h"
 #include "fit/figure.h"
 #include "pipeline/user_error.h"
 #include <plplot.h>
@@ -354,16 +355,17 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   fit_options.max_amplitude_deg = band_options.max_amplitude_deg;
   fit_options.min_amplitude_deg = std::min(fit_options.min_amplitude_deg, band_options.min_amplitude_deg);
   // A calibrated geometry absorbs L, D and g (docs/physics.md §2.6): their terms are replaced by
-  // the calibration's own (added below).
+  // the calibration's own (added below). Without rig.uncertainties the budget counts the assumed
+  // +-1 mm on L and D (pipeline/total_uncertainty.h), unless the rig is calibrated.
   const bool calibrated = config.geometry_calibration.applied;
-  fit_options.filar_length_std_m = calibrated ? 0.0 : config.uncertainties.filar_length_std_m;
-  fit_options.filar_separation_std_m =
-      calibrated ? 0.0 : config.uncertainties.filar_separation_std_m;
+  const RigUncertainties uncertainties = config.uncertainties.InEffect();
+  fit_options.filar_length_std_m = calibrated ? 0.0 : uncertainties.filar_length_std_m;
+  fit_options.filar_separation_std_m = calibrated ? 0.0 : uncertainties.filar_separation_std_m;
   fit_options.mass_std_kg = options.role == TraceRole::kAircraft
-                                ? std::hypot(config.uncertainties.mass_std_kg,
+                                ? std::hypot(uncertainties.mass_std_kg,
                                              config.aircraft_mass_std_kg)
-                                : config.uncertainties.mass_std_kg;
-  fit_options.gravity_std_mps2 = calibrated ? 0.0 : config.uncertainties.gravity_std_mps2;
+                                : uncertainties.mass_std_kg;
+  fit_options.gravity_std_mps2 = calibrated ? 0.0 : uncertainties.gravity_std_mps2;
   fit_options.gyro_scale_std = config.imu.gyro_scale_std;
   // The residual series is kept for the second glitch pass below (and dropped after it when
   // neither a figure nor the caller wants it).
@@ -454,6 +456,15 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
       const double term = config.geometry_calibration.factor_rel_std * fit.params.inertia_kg_m2;
       record.budget.push_back({"calibration", term});
       record.budget_total_std_kg_m2 = std::hypot(record.budget_total_std_kg_m2, term);
+      record.calibrated = true;
+      record.calibration_relative_std = config.geometry_calibration.factor_rel_std;
+    }
+    record.budget_assumed = config.uncertainties.Assumed() && !calibrated;
+    UpdateTotalUncertainty(&record);
+    // Every record says what the assumption adds on this rig (the console says it once).
+    if (record.budget_assumed) {
+      record.flags.push_back(kAssumedInputsFlag);
+      record.warnings.push_back(AssumedInputsWarning(record));
     }
   }
   if (record.status == TraceStatus::kOk && !record.warnings.empty()) {
