@@ -244,8 +244,7 @@ bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
       //  - anything else (a scale, a column or a broken sensor: the fixed-wing logs' 0.27 g).
       const double g_read = f_mean.norm() / kStandardGravityMps2;  // in standard gravities
       const double tol = options.gravity_tolerance;
-      const bool gravity_ok =
-          f_mean.allFinite() && std::abs(g_read - 1.0) <= tol;
+      const bool gravity_ok = f_mean.allFinite() && std::abs(g_read - 1.0) <= tol;
       if (!gravity_ok) {
         bool gravity_removed = false;
         if (f_mean.allFinite() && g_read < options.gravity_removed_below_g && g_read > 0.0) {
@@ -256,8 +255,7 @@ bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
         const char* where = down_at_rest ? "at rest" : "over the swing";
         char buf[640];
         if (!f_mean.allFinite()) {
-          std::snprintf(buf, sizeof(buf), "the mean accelerometer reading %s is not finite",
-                        where);
+          std::snprintf(buf, sizeof(buf), "the mean accelerometer reading %s is not finite", where);
         } else if (gravity_removed) {
           std::snprintf(buf, sizeof(buf),
                         "the accelerometer reads %.3g g (%.3g m/s^2) %s instead of 1 g: gravity "

@@ -343,7 +343,8 @@ void SubtractRig(const CampaignConfig& config, const TareEstimate& tare,
           if (w.find(kAccelIgnoredSentence) != std::string::npos) why = w;
         }
         r.status = TraceStatus::kError;
-        r.message = r.file + ": runs.pitch_source: measured needs the accelerometer's pitch, but " + why;
+        r.message =
+            r.file + ": runs.pitch_source: measured needs the accelerometer's pitch, but " + why;
         continue;
       }
       r.pitch_used_deg = *r.pitch_measured_deg;

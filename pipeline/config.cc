@@ -521,9 +521,11 @@ void CheckRigInertiaPlausible(YamlMap inertia, const CampaignConfig& c) {
   const RigInertiaSpec& spec = c.rig_inertia;
   std::string why;
   if (spec.kind == RigInertiaSpec::Kind::kValue) {
-    why = ImplausibleRigInertia(inertia.KeyPath("inertia_kg_m2"), spec.inertia_kg_m2,
-                                c.rig_mass_kg, c.filar_separation_m);
-    if (!why.empty()) throw UserError(inertia.Where(inertia.Optional("inertia_kg_m2")) + ": " + why);
+    why = ImplausibleRigInertia(inertia.KeyPath("inertia_kg_m2"), spec.inertia_kg_m2, c.rig_mass_kg,
+                                c.filar_separation_m);
+    if (!why.empty()) {
+      throw UserError(inertia.Where(inertia.Optional("inertia_kg_m2")) + ": " + why);
+    }
   } else if (spec.kind == RigInertiaSpec::Kind::kTable) {
     for (const auto& [pitch_deg, value] : spec.table_kg_m2) {
       char key[96];
