@@ -396,8 +396,14 @@ void SubtractRig(const CampaignConfig& config, const TareEstimate& tare,
     if (r.role != TraceRole::kAircraft || !r.ok()) continue;
     if (config.runs.pitch_source == PitchSource::kMeasured) {
       if (!r.pitch_measured_deg) {
+        // The accelerometer's own warning says why (not gravity: fit/swing_axis.h).
+        std::string why = "the log gave no measured pitch";
+        for (const std::string& w : r.warnings) {
+          if (w.find(kAccelIgnoredSentence) != std::string::npos) why = w;
+        }
         r.status = TraceStatus::kError;
-        r.message = r.file + ": pitch_source is measured but the log gave no measured pitch";
+        r.message =
+            r.file + ": runs.pitch_source: measured needs the accelerometer's pitch, but " + why;
         continue;
       }
       r.pitch_used_deg = *r.pitch_measured_deg;

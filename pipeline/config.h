@@ -211,6 +211,9 @@ struct CampaignConfig {
   double EffectiveSeparationM() const;  // D sqrt(geometry_calibration.factor)
 
   bool Check(std::string* why) const;
+  // Values no lab rig can have (pipeline/plausibility.h): L, D, the masses, the rig inertia
+  // against the rig's mass and D. Part of Check; *why names the key and the likely unit.
+  bool CheckPlausible(std::string* why) const;
 };
 
 struct ConfigLoadOptions {

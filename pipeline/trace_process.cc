@@ -16,6 +16,7 @@
 #include "fit/trace_plot.h"
 #include "fit/window.h"
 #include "pipeline/imu_log.h"
+#include "pipeline/plausibility.h"
 #include "pipeline/total_uncertainty.h"
 #include "fit/figure.h"
 #include "pipeline/user_error.h"
@@ -294,8 +295,15 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                                        (*override_s)[1], window_options, name)
                  : FindFreeOscillationWindow(data.t_s, axis.rate_rad_per_s, window_options, name);
   if (!window.IsUsable()) {
+    // Time in s declared ms (or the reverse) puts every period 1000 times outside the range.
+    const std::string hint =
+        !override_s && config.imu.format.container != LogContainer::kUlog &&
+                window.message.find("no oscillation found") != std::string::npos
+            ? TimeUnitHint(data.t_s, axis.rate_rad_per_s, window_options,
+                           config.imu.format.time_unit)
+            : "";
     return fail(window.status == WindowStatus::kError ? TraceStatus::kError : TraceStatus::kRejected,
-                window.message);
+                window.message + hint);
   }
   // No rest seen: the accelerometer averaged over the window still gives the pitch.
   if (!axis.pitch_measured_deg && data.has_accel() && !axis.accel_ignored && !axis_window) {
@@ -317,10 +325,19 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   const AmplitudeBand band =
       TrimToAmplitudeBand(data.t_s, axis.rate_rad_per_s, window, band_options, name);
   record.window_s = {window.t0_s, window.t1_s};
+  // A swing beyond 180 deg (deg/s read as rad/s): a hint on a rejection, a warning on a fit.
+  double largest_deg = 0.0, smallest_deg = INFINITY;
+  for (const AngleExtreme& e : band.extremes) {
+    largest_deg = std::max(largest_deg, e.amplitude_deg);
+    smallest_deg = std::min(smallest_deg, e.amplitude_deg);
+  }
+  const std::string impossible =
+      ImpossibleAmplitude(largest_deg, smallest_deg, config.imu.format.gyro_unit);
   if (!band.IsUsable()) {
     return fail(band.status == WindowStatus::kError ? TraceStatus::kError : TraceStatus::kRejected,
-                band.message);
+                band.message + (impossible.empty() ? "" : "; " + impossible));
   }
+  if (!impossible.empty()) record.warnings.push_back(impossible);
   record.window_s = {band.t0_s, band.t1_s};
 
   // 5. Fit.
@@ -424,6 +441,13 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
     record.flags.push_back(flag);
   }
   for (const std::string& w : fit.warnings) record.warnings.push_back(w);
+  if (fit.HasFit()) {  // an amplitude or radius of gyration no real rig gives: units (issue 16)
+    for (const std::string& w : FitPlausibilityWarnings(
+             fit.params.inertia_kg_m2, input.geometry.mass_kg, input.geometry.filar_separation_m,
+             input.geometry.filar_length_m, fit.amplitude_start_deg, config.imu.format.gyro_unit)) {
+      record.warnings.push_back(w);
+    }
+  }
   record.model = ToString(fit.model);
   record.iterations = fit.iterations;
   record.secondary_motion_ratio = input.secondary_motion_ratio >= 0.0 ? input.secondary_motion_ratio : NAN;
