@@ -9,6 +9,10 @@
 //   nothing unrecorded. Clean-up removes only recorded files; a file in an owned place that is
 //   not recorded (the user's) makes the run refuse the folder before any work. A folder written
 //   before the manifest existed is adopted through its results.json: the files it names.
+//   Nothing outside OUT is ever removed (issue 15): a manifest entry that is not a name bifilar
+//   writes there, or that resolves to anything but a regular file inside OUT (a symbolic link,
+//   cache/ or figures/ being a link), makes the manifest damaged and the run stop; removal opens
+//   the folders below OUT without following links.
 // - Consistent set: results.json is written last and carries the FNV-1a 64 hashes of
 //   traces.csv and angles.csv; report.html carries the hash of the results.json it was built
 //   from. CheckOutputSet finds a mixed set (a run killed between two renames).
@@ -39,7 +43,10 @@ class OutputFolderLock {
 class OutputManifest {
  public:
   static constexpr const char* kFileName = ".bifilar-manifest.json";
-  // Reads OUT/.bifilar-manifest.json when present. Throws UserError when it is damaged.
+  // Reads OUT/.bifilar-manifest.json when present. Throws UserError when it is damaged: not
+  // JSON, or an entry that is not a name bifilar writes in OUT (a result file, cache/<n>.json,
+  // figures/<n>, or their temporary names: no "..", no absolute path), or one that is there but
+  // is not a regular file, or lies behind a symbolic link (each refused entry named).
   explicit OutputManifest(std::string out_dir);
 
   // Throws UserError naming the first foreign entries when OUT/cache/ or OUT/figures/ hold
@@ -52,8 +59,10 @@ class OutputManifest {
   bool Contains(const std::string& relative) const { return files_.count(relative) > 0; }
 
   // Removes every recorded file not in `keep` (relative paths), forgets recorded files that no
-  // longer exist, and saves. Never touches an unrecorded file.
-  void Prune(const std::set<std::string>& keep);
+  // longer exist, and saves. Never touches an unrecorded file, and removes only regular files
+  // reached without a symbolic link below OUT; returns one warning per recorded entry refused
+  // for that (left alone and forgotten).
+  std::vector<std::string> Prune(const std::set<std::string>& keep);
 
  private:
   void Save() const;
