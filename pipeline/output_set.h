@@ -2,7 +2,9 @@
 // mixed set, and from which bifilar removes only what it wrote itself.
 //
 // - Lock: OUT/.bifilar.lock is held with flock(2) for the whole run (and by `bifilar report`).
-//   A second run on the same OUT fails at once, naming the holder's pid and start time.
+//   A second run on the same OUT fails at once, naming the holder's pid and start time. It is
+//   opened without following a link and never truncated; anything but a regular file of its
+//   own (a link, a hard link to another file, a FIFO, a file holding other data) is refused.
 // - Manifest: OUT/.bifilar-manifest.json lists every file bifilar wrote in the places it owns
 //   (OUT/cache/, OUT/figures/ and the four result files). Names are recorded before the files
 //   are created (write-ahead, temporary names included), so a run killed at any point leaves
@@ -27,7 +29,9 @@
 namespace bifilar {
 
 // Holds OUT/.bifilar.lock (created) until destroyed. Throws UserError when another process
-// holds it ("OUT is in use by bifilar pid N, started T") or the folder cannot be written.
+// holds it ("OUT is in use by bifilar pid N, started T"), the folder cannot be written, or the
+// lock is not a regular file of bifilar's own (a symbolic link, even dangling; a hard link; a
+// FIFO, device or folder; a file holding anything but a holder line), named.
 class OutputFolderLock {
  public:
   explicit OutputFolderLock(const std::string& out_dir);

@@ -29,6 +29,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -620,7 +621,7 @@ std::string CrazyflieSeries(const std::string& text) {
 
 // ---- Runs aimed outside the output folder (issue 15 items 1, 2, 4) ----
 
-// A file under OUT/`folder` (sorted, the `pick`-th modulo their number), "" when none.
+// A regular file in `folder`, picked by `rng` from the sorted list, "" when none.
 std::string SomeFileIn(const std::string& folder, std::mt19937_64& rng) {
   std::vector<std::string> files;
   std::error_code ec;
@@ -671,7 +672,8 @@ void ManifestTraversalCase(const Args& args, const Workspace& w, int c, std::mt1
     fs::remove(entry);
     fs::create_symlink(w.thesis, entry);
     restore = [entry, text] {
-      fs::remove(entry);
+      std::error_code ignored;
+      fs::remove(entry, ignored);
       WriteFile(entry, text);
     };
   } else {
@@ -687,8 +689,9 @@ void ManifestTraversalCase(const Args& args, const Workspace& w, int c, std::mt1
     }
     fs::create_symlink(outside, w.out + "/" + folder);
     restore = [&w, folder, outside] {
-      fs::remove(w.out + "/" + folder);
-      fs::rename(outside, w.out + "/" + folder);
+      std::error_code ignored;
+      fs::remove(w.out + "/" + folder, ignored);
+      fs::rename(outside, w.out + "/" + folder, ignored);
     };
   }
   const Outcome o =
@@ -708,24 +711,30 @@ void ManifestTraversalCase(const Args& args, const Workspace& w, int c, std::mt1
 void LockCase(const Args& args, const Workspace& w, int c, std::mt19937_64& rng,
               Failures* failures) {
   const std::string lock = w.out + "/.bifilar.lock";
-  fs::remove(lock);
+  std::error_code ignored;
+  fs::remove(lock, ignored);
   std::string kind = "lock: ";
   const int variant = Uniform(rng, 0, 4);
+  std::error_code ec;
   if (variant == 0) {
     kind += "link to the thesis";
-    fs::create_symlink(w.thesis, lock);
+    fs::create_symlink(w.thesis, lock, ec);
   } else if (variant == 1) {
     kind += "dangling link";
-    fs::create_symlink(w.dir + "/precious/new_file.txt", lock);
+    fs::create_symlink(w.dir + "/precious/new_file.txt", lock, ec);
   } else if (variant == 2) {
     kind += "hard link to the thesis";
-    fs::create_hard_link(w.thesis, lock);
+    fs::create_hard_link(w.thesis, lock, ec);
   } else if (variant == 3) {
     kind += "FIFO";
-    mkfifo(lock.c_str(), 0644);
+    if (mkfifo(lock.c_str(), 0644) != 0) ec = std::error_code(errno, std::generic_category());
   } else {
     kind += "a file of the user's";
     WriteFile(lock, "my lock notes\n");
+  }
+  if (ec) {  // e.g. the thesis is gone: an earlier failure, already counted
+    failures->Add(c, kind, "cannot plant the lock: " + ec.message());
+    return;
   }
   const bool report = Uniform(rng, 0, 1) == 1;
   kind += report ? ", report" : ", process";
@@ -742,7 +751,7 @@ void LockCase(const Args& args, const Workspace& w, int c, std::mt19937_64& rng,
   if (variant == 4 && ReadFile(lock) != "my lock notes\n") {
     failures->Add(c, kind, "the user's file in place of the lock was changed");
   }
-  fs::remove(lock);
+  fs::remove(lock, ignored);
 }
 
 // `--out` inside the logs (a pitch folder, runs.root, the tare folder, the folder holding the
