@@ -1,5 +1,7 @@
 #include "fit/figure.h"
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <mutex>
 
@@ -33,6 +35,9 @@ bool WriteFigure(const std::string& path, const FigureOptions& options,
     return false;
   }
   const std::string temporary = path + ".tmp";
+  // PLplot opens the name as given: a stale temporary, or a link planted under its name, is
+  // removed first so the figure never writes through a link to a file elsewhere.
+  ::unlink(temporary.c_str());
   {
     std::lock_guard<std::mutex> lock(PlplotMutex());
     PLINT stream = 0;

@@ -34,6 +34,9 @@ void WriteFileAtomically(const std::string& path, const std::string& text) {
                     "bifilar writes only regular files: move it away or choose another path");
   }
   const std::string temp = AtomicTemporaryName(path);
+  // A stale temporary (or a link planted under its name) is removed first, so the write below
+  // creates a fresh file and never writes through a link to a file outside the folder.
+  ::unlink(temp.c_str());
   {
     std::ofstream file(temp, std::ios::binary | std::ios::trunc);
     if (!file) throw UserError(path + ": cannot write (temporary file " + temp + ")");

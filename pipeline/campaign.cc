@@ -12,6 +12,7 @@
 #include <ostream>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "fit/ellipse_plot.h"
 #include "pipeline/cache.h"
@@ -101,15 +102,22 @@ struct CampaignInputs {
   int size() const { return static_cast<int>(runs.size()); }
 };
 
-// Discovery (outputs are not inputs: pipeline/campaign_inputs.h), windows, then the content
-// hashes in parallel: reading is most of a rerun's time.
-CampaignInputs DiscoverInputs(const CampaignConfig& config, const fs::path& out, int jobs) {
-  CampaignInputs in;
-  in.runs = DiscoverRuns(config);
-  DropOutputFolder(out.string(), &in.runs);
-  if (in.runs.empty()) {
-    throw UserError("runs: every file found is inside the output folder " + out.string());
+// Discovery, before OUT is created or locked: the logs, none of them inside OUT (outputs are
+// not inputs, and a log inside OUT is an error: pipeline/campaign_inputs.h).
+std::vector<RunFile> DiscoverLogs(const CampaignConfig& config, const std::string& out_dir) {
+  std::vector<RunFile> runs = DiscoverRuns(config);
+  DropOutputFolder(out_dir, &runs);
+  if (runs.empty()) {
+    throw UserError("runs: every file found is inside the output folder " + out_dir);
   }
+  return runs;
+}
+
+// The discovered logs' windows, then their content hashes in parallel: reading is most of a
+// rerun's time.
+CampaignInputs DiscoverInputs(const CampaignConfig& config, std::vector<RunFile> runs, int jobs) {
+  CampaignInputs in;
+  in.runs = std::move(runs);
   in.windows = WindowsForRuns(config, in.runs);
   in.hashes.resize(in.runs.size());
   in.read_errors.resize(in.runs.size());
@@ -644,7 +652,9 @@ void WriteCampaignOutputs(const CampaignConfig& config, const CampaignOptions& o
   }
   if (!result.moments_figure.empty()) keep.insert("figures/" + result.moments_figure);
   if (!result.polar_figure.empty()) keep.insert("figures/" + result.polar_figure);
-  out->manifest.Prune(keep);
+  for (const std::string& refused : out->manifest.Prune(keep)) {
+    if (options.progress) *options.progress << "warning: " << refused << "\n";
+  }
 }
 
 }  // namespace
@@ -710,13 +720,14 @@ bool RigInertiaAt(const CampaignConfig& config, double tare_mean_kg_m2, double t
 CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& options) {
   const Clock::time_point start = Clock::now();
   CheckCampaignInputs(config, options);
+  std::vector<RunFile> logs = DiscoverLogs(config, options.out_dir);
   OutputFolder out(options);
   const int jobs = ResolveJobs(options.jobs);
   const TraceCache cache((out.dir / "cache").string());
   CampaignResult result;
 
-  // 1. Discover: the logs, their windows and content hashes.
-  const CampaignInputs inputs = DiscoverInputs(config, out.dir, jobs);
+  // 1. Discover: the logs (found above), their windows and content hashes.
+  const CampaignInputs inputs = DiscoverInputs(config, std::move(logs), jobs);
   // 2a. Calibrate: the reference swings fix the geometry every other fit uses.
   CampaignConfig fit_config = config;
   if (config.calibration.enabled) {

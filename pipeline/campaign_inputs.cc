@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <iterator>
 #include <map>
 
 #include "pipeline/user_error.h"
@@ -10,19 +11,61 @@ namespace bifilar {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// True when `relative` (to OUT) is in a place bifilar writes: cache/, figures/, a result file
+// (or its temporary name), or its lock and manifest.
+bool IsInOutputPlace(const fs::path& relative) {
+  const std::string first = relative.begin()->string();
+  if (first == "cache" || first == "figures") return std::next(relative.begin()) != relative.end();
+  if (std::next(relative.begin()) != relative.end()) return false;
+  if (first.rfind(".bifilar", 0) == 0) return true;
+  for (const char* name : {"results.json", "traces.csv", "angles.csv", "report.html"}) {
+    if (first.rfind(name, 0) == 0 &&
+        (first.size() == std::string(name).size() || first[std::string(name).size()] == '.')) {
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 int DropOutputFolder(const std::string& out_dir, std::vector<RunFile>* runs) {
   std::error_code ec;
   fs::path out = fs::weakly_canonical(fs::absolute(out_dir), ec);
   if (ec) out = fs::absolute(out_dir).lexically_normal();
+  // The path of a run relative to OUT, empty when it is not inside OUT.
   const auto inside = [&](const RunFile& run) {
     std::error_code ec2;
     fs::path path = fs::weakly_canonical(run.path, ec2);
     if (ec2) path = fs::path(run.path).lexically_normal();
-    const std::string rel = path.lexically_relative(out).string();
-    return !rel.empty() && rel != "." && rel.rfind("..", 0) != 0;
+    const fs::path rel = path.lexically_relative(out);
+    const std::string text = rel.string();
+    return text.empty() || text == "." || text.rfind("..", 0) == 0 ? fs::path() : rel;
   };
+  // Issue 15 item 4: a log of the user's inside OUT (`--out LOGS/pitch_0`) was dropped in
+  // silence. Only bifilar's own outputs are left out; any other log there stops the run.
+  std::vector<std::string> logs_inside;
+  for (const RunFile& run : *runs) {
+    const fs::path rel = inside(run);
+    if (!rel.empty() && !IsInOutputPlace(rel)) logs_inside.push_back(run.display);
+  }
+  if (!logs_inside.empty()) {
+    std::string list;
+    for (size_t i = 0; i < logs_inside.size() && i < 3; ++i) {
+      list += (i ? ", " : "") + logs_inside[i];
+    }
+    if (logs_inside.size() > 3) list += " and " + std::to_string(logs_inside.size() - 3) + " more";
+    throw UserError(out_dir + ": the output folder holds " + std::to_string(logs_inside.size()) +
+                    " log(s) of this campaign (" + list +
+                    "); bifilar never reads its output folder as input, so they would be left "
+                    "out: choose an --out that is not a log folder and holds no logs");
+  }
   const size_t before = runs->size();
-  runs->erase(std::remove_if(runs->begin(), runs->end(), inside), runs->end());
+  runs->erase(std::remove_if(runs->begin(), runs->end(),
+                             [&](const RunFile& run) { return !inside(run).empty(); }),
+              runs->end());
   return static_cast<int>(before - runs->size());
 }
 

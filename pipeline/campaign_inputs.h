@@ -12,9 +12,12 @@
 
 namespace bifilar {
 
-// Removes the logs found inside the output folder `out_dir` (its traces.csv, cache and figures
-// are outputs, never inputs: an output folder inside runs.root must not feed the rerun). Returns
-// how many were removed.
+// Removes the files found inside the output folder `out_dir` that are bifilar's own outputs
+// (its result files, cache/ and figures/ are outputs, never inputs: an output folder inside
+// runs.root must not feed the rerun). Returns how many were removed. Throws UserError naming
+// them when any other log of the campaign lies inside `out_dir` (`--out LOGS/pitch_0`, or an
+// --out that holds runs.root or a tare folder): those would be left out in silence. Called
+// before the output folder is created or locked, so a refused --out is left as it was.
 int DropOutputFolder(const std::string& out_dir, std::vector<RunFile>* runs);
 
 // The fit.windows override of each run (same order), looked up once per run in a map of the

@@ -2,13 +2,19 @@
 // mixed set, and from which bifilar removes only what it wrote itself.
 //
 // - Lock: OUT/.bifilar.lock is held with flock(2) for the whole run (and by `bifilar report`).
-//   A second run on the same OUT fails at once, naming the holder's pid and start time.
+//   A second run on the same OUT fails at once, naming the holder's pid and start time. It is
+//   opened without following a link and never truncated; anything but a regular file of its
+//   own (a link, a hard link to another file, a FIFO, a file holding other data) is refused.
 // - Manifest: OUT/.bifilar-manifest.json lists every file bifilar wrote in the places it owns
 //   (OUT/cache/, OUT/figures/ and the four result files). Names are recorded before the files
 //   are created (write-ahead, temporary names included), so a run killed at any point leaves
 //   nothing unrecorded. Clean-up removes only recorded files; a file in an owned place that is
 //   not recorded (the user's) makes the run refuse the folder before any work. A folder written
 //   before the manifest existed is adopted through its results.json: the files it names.
+//   Nothing outside OUT is ever removed (issue 15): a manifest entry that is not a name bifilar
+//   writes there, or that resolves to anything but a regular file inside OUT (a symbolic link,
+//   cache/ or figures/ being a link), makes the manifest damaged and the run stop; removal opens
+//   the folders below OUT without following links.
 // - Consistent set: results.json is written last and carries the FNV-1a 64 hashes of
 //   traces.csv and angles.csv; report.html carries the hash of the results.json it was built
 //   from. CheckOutputSet finds a mixed set (a run killed between two renames).
@@ -23,7 +29,9 @@
 namespace bifilar {
 
 // Holds OUT/.bifilar.lock (created) until destroyed. Throws UserError when another process
-// holds it ("OUT is in use by bifilar pid N, started T") or the folder cannot be written.
+// holds it ("OUT is in use by bifilar pid N, started T"), the folder cannot be written, or the
+// lock is not a regular file of bifilar's own (a symbolic link, even dangling; a hard link; a
+// FIFO, device or folder; a file holding anything but a holder line), named.
 class OutputFolderLock {
  public:
   explicit OutputFolderLock(const std::string& out_dir);
@@ -39,7 +47,10 @@ class OutputFolderLock {
 class OutputManifest {
  public:
   static constexpr const char* kFileName = ".bifilar-manifest.json";
-  // Reads OUT/.bifilar-manifest.json when present. Throws UserError when it is damaged.
+  // Reads OUT/.bifilar-manifest.json when present. Throws UserError when it is damaged: not
+  // JSON, or an entry that is not a name bifilar writes in OUT (a result file, cache/<n>.json,
+  // figures/<n>, or their temporary names: no "..", no absolute path), or one that is there but
+  // is not a regular file, or lies behind a symbolic link (each refused entry named).
   explicit OutputManifest(std::string out_dir);
 
   // Throws UserError naming the first foreign entries when OUT/cache/ or OUT/figures/ hold
@@ -52,8 +63,10 @@ class OutputManifest {
   bool Contains(const std::string& relative) const { return files_.count(relative) > 0; }
 
   // Removes every recorded file not in `keep` (relative paths), forgets recorded files that no
-  // longer exist, and saves. Never touches an unrecorded file.
-  void Prune(const std::set<std::string>& keep);
+  // longer exist, and saves. Never touches an unrecorded file, and removes only regular files
+  // reached without a symbolic link below OUT; returns one warning per recorded entry refused
+  // for that (left alone and forgotten).
+  std::vector<std::string> Prune(const std::set<std::string>& keep);
 
  private:
   void Save() const;

@@ -5,15 +5,19 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "pipeline/campaign.h"
 #include "pipeline/report.h"
@@ -231,6 +235,226 @@ TEST(OutputSet, OutputFolderInsideTheLogsIsNotReadAsLogs) {
   const CampaignResult again = c.Run();  // traces.csv and angles.csv now exist in it
   EXPECT_EQ(again.summary.n_traces, 12);
   EXPECT_EQ(again.summary.exit_code, 0);
+}
+
+// ---- Issue 15: nothing outside the output folder is ever touched ----------------------------
+
+// A user's file beside the campaign that no bifilar run may change ("thesis.txt").
+struct Precious {
+  std::string path, text = "four years of work\n";
+  explicit Precious(const Campaign& c) : path(c.dir + "/precious/thesis.txt") {
+    WriteFile(path, text);
+  }
+  bool Intact() const {
+    return fs::is_regular_file(fs::symlink_status(path)) && ReadFile(path) == text;
+  }
+};
+
+std::string ManifestPath(const Campaign& c) { return c.out + "/" + OutputManifest::kFileName; }
+
+// Appends `entry` to OUT's manifest "files".
+void AppendManifestEntry(const Campaign& c, const std::string& entry) {
+  nlohmann::json j = nlohmann::json::parse(ReadFile(ManifestPath(c)));
+  j["files"].push_back(entry);
+  WriteFile(ManifestPath(c), j.dump(1));
+}
+
+// The message of the UserError `f` throws ("" and a failure when it throws none).
+template <typename F>
+std::string UserErrorOf(F f) {
+  try {
+    f();
+  } catch (const UserError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no UserError";
+  return "";
+}
+
+// issue 15 item 1: "../precious/thesis.txt" or an absolute path appended to the manifest's
+// "files" was deleted by the next `process`, exit 0, no message.
+TEST(OutputSet, ManifestEntryOutsideTheFolderIsRefusedAndNothingIsRemoved) {
+  Campaign c;
+  Precious thesis(c);
+  c.Run();
+  const std::string manifest = ReadFile(ManifestPath(c));
+  const std::string log = c.dir + "/logs/pitch_0/trial_1.csv";
+  const std::string log_text = ReadFile(log);
+  for (const std::string& entry :
+       {std::string("../precious/thesis.txt"), thesis.path,
+        std::string("cache/../../precious/thesis.txt"),
+        std::string("figures/../../logs/pitch_0/trial_1.csv"), log, std::string("cache/sub/x.json"),
+        std::string("notes.txt"), std::string("cache/thesis.txt"), std::string("figures/.."),
+        std::string("")}) {
+    SCOPED_TRACE(entry);
+    AppendManifestEntry(c, entry);
+    // A stale entry among them, so a run that used the manifest would prune.
+    c.SetLog(60, 2, 0.02);
+    const std::string message = UserErrorOf([&] { c.Run(); });
+    EXPECT_NE(message.find("damaged manifest"), std::string::npos) << message;
+    EXPECT_NE(message.find(nlohmann::json(entry).dump() + " refused"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("nothing was removed"), std::string::npos) << message;
+    EXPECT_TRUE(thesis.Intact());
+    EXPECT_EQ(ReadFile(log), log_text);
+    c.SetLog(60, 2, 0.0);
+    WriteFile(ManifestPath(c), manifest);
+  }
+  EXPECT_EQ(c.Run().summary.n_ok, 12);  // the repaired manifest is used again
+}
+
+// Issue 15 item 1, symbolic links: a recorded name that is now a link to a file outside OUT,
+// or cache/ replaced by a link to another folder, is refused; the target is never removed.
+TEST(OutputSet, RecordedNameBehindASymbolicLinkIsRefused) {
+  Campaign c;
+  Precious thesis(c);
+  c.Run();
+  std::string entry;
+  for (const auto& e : fs::directory_iterator(c.out + "/cache")) entry = e.path().string();
+  ASSERT_FALSE(entry.empty());
+  const std::string entry_text = ReadFile(entry);
+  fs::remove(entry);
+  fs::create_symlink(thesis.path, entry);
+  c.SetLog(0, 1, 0.02);  // the linked entry, if it is trial 1 at 0 deg, would be stale
+  std::string message = UserErrorOf([&] { c.Run(); });
+  EXPECT_NE(message.find("damaged manifest"), std::string::npos) << message;
+  EXPECT_NE(message.find("is a symbolic link"), std::string::npos) << message;
+  EXPECT_TRUE(thesis.Intact());
+  fs::remove(entry);
+  WriteFile(entry, entry_text);
+
+  // cache/ itself a link to a folder outside OUT holding a file under a recorded name.
+  const std::string elsewhere = c.dir + "/precious/cache_copy";
+  fs::rename(c.out + "/cache", elsewhere);
+  fs::create_symlink(elsewhere, c.out + "/cache");
+  message = UserErrorOf([&] { c.Run(); });
+  EXPECT_NE(message.find("is a symbolic link"), std::string::npos) << message;
+  EXPECT_TRUE(fs::exists(elsewhere + "/" + fs::path(entry).filename().string()));
+  fs::remove(c.out + "/cache");
+  fs::rename(elsewhere, c.out + "/cache");
+  c.SetLog(0, 1, 0.0);
+  EXPECT_EQ(c.Run().summary.n_ok, 12);
+}
+
+// The last line of defence: a link planted under a recorded name after the manifest was read
+// (during the run) is left alone by Prune, with a warning, and forgotten.
+TEST(OutputSet, PruneNeverFollowsALinkPlantedDuringTheRun) {
+  Campaign c;
+  Precious thesis(c);
+  c.Run();
+  OutputManifest manifest(c.out);
+  std::string name;
+  for (const auto& e : fs::directory_iterator(c.out + "/cache")) {
+    name = "cache/" + e.path().filename().string();
+  }
+  ASSERT_TRUE(manifest.Contains(name));
+  fs::remove(c.out + "/" + name);
+  fs::create_symlink(thesis.path, c.out + "/" + name);
+  const std::vector<std::string> warnings = manifest.Prune({});
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find(name + ": not removed (is a symbolic link)"), std::string::npos)
+      << warnings[0];
+  EXPECT_TRUE(thesis.Intact());
+  EXPECT_TRUE(fs::is_symlink(c.out + "/" + name));
+  EXPECT_FALSE(manifest.Contains(name));
+  EXPECT_FALSE(fs::exists(c.out + "/results.json"));  // every regular recorded file was removed
+}
+
+// issue 15 item 2: `ln -s ~/thesis.txt OUT/.bifilar.lock` then `process` left thesis.txt empty.
+TEST(OutputSet, LockThatIsNotARegularFileOfItsOwnIsRefusedAndNeverWritten) {
+  Campaign c;
+  Precious thesis(c);
+  fs::create_directories(c.out);
+  const std::string lock = c.out + "/.bifilar.lock";
+  struct Case {
+    std::string what, expected;
+    std::function<void()> make;
+  };
+  const std::vector<Case> cases = {
+      {"symbolic link", "is a symbolic link", [&] { fs::create_symlink(thesis.path, lock); }},
+      {"dangling link", "is a symbolic link",
+       [&] { fs::create_symlink(c.dir + "/precious/new.txt", lock); }},
+      {"hard link", "has other names", [&] { fs::create_hard_link(thesis.path, lock); }},
+      {"FIFO", "not a regular file", [&] { ASSERT_EQ(::mkfifo(lock.c_str(), 0644), 0); }},
+      {"folder", "", [&] { fs::create_directories(lock); }},
+      {"user's file", "not bifilar's lock file", [&] { WriteFile(lock, "my own text\n"); }},
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.what);
+    k.make();
+    for (bool report : {false, true}) {
+      const std::string message = UserErrorOf([&] {
+        if (report) {
+          RunReport(c.out);
+        } else {
+          c.Run();
+        }
+      });
+      EXPECT_NE(message.find(lock), std::string::npos) << message;
+      EXPECT_NE(message.find(k.expected), std::string::npos) << message;
+    }
+    EXPECT_TRUE(thesis.Intact());
+    EXPECT_FALSE(fs::exists(c.dir + "/precious/new.txt"));
+    if (k.what == "user's file") EXPECT_EQ(ReadFile(lock), "my own text\n");
+    EXPECT_FALSE(fs::exists(c.out + "/results.json"));
+    fs::remove_all(lock);
+  }
+  // A lock of bifilar's own, even a long holder line left by a killed run, is used and
+  // overwritten in place (never truncated, never grown).
+  WriteFile(lock, "pid 4242, started 2026-01-01 00:00:00 UTC\n");
+  EXPECT_EQ(c.Run().summary.n_ok, 12);
+  EXPECT_EQ(fs::file_size(lock), 64u);
+  EXPECT_EQ(ReadFile(lock).rfind("pid ", 0), 0u);
+  EXPECT_EQ(c.Run().summary.n_ok, 12);
+  EXPECT_EQ(fs::file_size(lock), 64u);
+}
+
+// Everything under `dir` with its content: what a refused run must leave as it was.
+std::map<std::string, std::string> TreeOf(const std::string& dir) {
+  std::map<std::string, std::string> tree;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    tree[e.path().string()] = e.is_regular_file() ? ReadFile(e.path().string()) : "(folder)";
+  }
+  return tree;
+}
+
+// issue 15 item 4: `process cfg --out LOGS/pitch_0` dropped that folder's logs, exit 0.
+TEST(OutputSet, OutputFolderHoldingLogsIsRefusedBeforeAnythingIsWritten) {
+  Campaign c;
+  const std::map<std::string, std::string> before = TreeOf(c.dir);
+  for (const std::string& out : {c.dir + "/logs/pitch_0", c.dir + "/logs/pitch_0/", c.dir + "/logs",
+                                 c.dir, c.dir + "/logs/../logs/pitch_30"}) {
+    SCOPED_TRACE(out);
+    c.out = out;
+    const std::string message = UserErrorOf([&] { c.Run(); });
+    EXPECT_NE(message.find("the output folder holds"), std::string::npos) << message;
+    EXPECT_NE(message.find("log(s) of this campaign"), std::string::npos) << message;
+    EXPECT_NE(message.find("trial_1.csv"), std::string::npos) << message;
+    EXPECT_EQ(TreeOf(c.dir), before);  // no lock, manifest, cache/ or figures/ created
+  }
+  EXPECT_EQ(c.calls, 0);
+  // A link to a log folder is the log folder.
+  fs::create_symlink(c.dir + "/logs/pitch_90", c.dir + "/link_out");
+  c.out = c.dir + "/link_out";
+  const std::string linked = UserErrorOf([&] { c.Run(); });
+  EXPECT_NE(linked.find("2 log(s) of this campaign (pitch_90/trial_1.csv, "
+                        "pitch_90/trial_2.csv)"),
+            std::string::npos)
+      << linked;
+  // The tare folder too.
+  fs::remove(c.dir + "/link_out");
+  WriteFile(c.dir + "/tare/tare_1.csv", "I=0.5\n");
+  WriteFile(c.dir + "/campaign.yaml",
+            "rig: {filar_length_m: 2.0, filar_separation_m: 1.0, mass_kg: 2.0,\n"
+            "      inertia: {tare: {logs: tare/*.csv}}}\n"
+            "aircraft: {mass_kg: 10}\n"
+            "runs: {root: logs, pattern: \"pitch_{pitch_deg}/*.csv\"}\n");
+  c.out = c.dir + "/tare";
+  const std::string message = UserErrorOf([&] { c.Run(); });
+  EXPECT_NE(message.find("1 log(s) of this campaign (tare/tare_1.csv)"), std::string::npos)
+      << message;
+  c.out = c.dir + "/out";
+  EXPECT_EQ(c.Run().summary.n_traces, 13);
 }
 
 // issue 9 item 11: a fit.windows entry for a file that does not exist was ignored silently.

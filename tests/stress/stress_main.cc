@@ -7,11 +7,15 @@
 // byte flips, truncation); cache tampering; kill -9 at a random time of `process` followed by a
 // rerun; two concurrent runs on one output folder; a user's file in a folder bifilar owns; and,
 // when ../shared/data/crazyflie is beside the repository, mutations of real logs through
-// `bifilar fit`.
+// `bifilar fit`. Every tenth case (issue 15 item 11) aims a run outside the output folder: a
+// manifest entry with "../", an absolute path or a symbolic link out of OUT; the lock replaced
+// by a link, hard link or FIFO; `--out` inside the logs.
 //
 // Asserted for every run: no crash (signal), no hang (each run is bounded by --run-timeout-s,
 // default 60 s, far above the ~0.3 s a run takes), exit code 0, 1 or 2, no NaN or inf written
-// (results.json, traces.csv, angles.csv, `fit --json`), the user's files untouched, a consistent
+// (results.json, traces.csv, angles.csv, `fit --json`), no file outside OUT changed, added or
+// removed (the workspace beside OUT, with the logs, the config and a fake thesis, hashed
+// before and after every run), the user's files untouched, a consistent
 // output set (pipeline/output_set.h CheckOutputSet) after every run that finished; after cache
 // tampering, a kill or concurrent runs on the pristine campaign, the ellipse equals the baseline.
 //
@@ -25,6 +29,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -32,6 +37,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <random>
@@ -42,6 +48,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pipeline/cache.h"
 #include "pipeline/gzip.h"
 #include "pipeline/output_set.h"
 
@@ -71,12 +78,72 @@ void WriteFile(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
 }
 
+// ---- The files outside OUT (issue 15 item 11) ----
+
+// The workspace outside the output folder: every entry under `root` except the `skip` folders
+// (OUT, and the harness's own folder of run outputs).
+struct Sentinel {
+  std::string root;
+  std::vector<std::string> skip;
+};
+const Sentinel* g_sentinel = nullptr;  // set once the workspace exists
+
+// path -> what it is: a file's size and FNV-1a 64, a link's target, "folder", another type.
+using TreeState = std::map<std::string, std::string>;
+
+TreeState SnapshotOutside(const Sentinel& sentinel) {
+  TreeState state;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(sentinel.root, ec), end; !ec && it != end;
+       it.increment(ec)) {
+    const std::string path = it->path().string();
+    if (std::find(sentinel.skip.begin(), sentinel.skip.end(), path) != sentinel.skip.end()) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    const fs::file_status status = it->symlink_status(ec);
+    if (fs::is_symlink(status)) {
+      state[path] = "link -> " + fs::read_symlink(it->path(), ec).string();
+    } else if (fs::is_regular_file(status)) {
+      const std::string bytes = ReadFile(path);
+      state[path] = "file " + std::to_string(bytes.size()) + " " +
+                    bifilar::HashToHex(bifilar::Fnv1a64(bytes));
+    } else if (fs::is_directory(status)) {
+      state[path] = "folder";
+    } else {
+      state[path] = "type " + std::to_string(static_cast<int>(status.type()));
+    }
+  }
+  return state;
+}
+
+// The first few differences between two states, "" when equal.
+std::string DescribeChanges(const TreeState& before, const TreeState& after) {
+  std::vector<std::string> changes;
+  for (const auto& [path, what] : before) {
+    const auto it = after.find(path);
+    if (it == after.end()) {
+      changes.push_back(path + " removed");
+    } else if (it->second != what) {
+      changes.push_back(path + " changed (" + what + " -> " + it->second + ")");
+    }
+  }
+  for (const auto& [path, what] : after) {
+    if (!before.count(path)) changes.push_back(path + " added (" + what + ")");
+  }
+  std::string text;
+  for (size_t i = 0; i < changes.size() && i < 5; ++i) text += (i ? "; " : "") + changes[i];
+  if (changes.size() > 5) text += "; and " + std::to_string(changes.size() - 5) + " more";
+  return text;
+}
+
 // ---- Running bifilar ----
 
 struct Process {
   pid_t pid = -1;
   std::string out_path, err_path;
   Clock::time_point start;
+  TreeState outside_before;  // the workspace outside OUT when the run started
 };
 
 struct Outcome {
@@ -86,12 +153,14 @@ struct Outcome {
   int exit_code = -1;
   std::string out, err;
   double seconds = 0.0;
+  std::string outside_changed;  // what changed outside OUT during the run, "" when nothing
 };
 
 Process Start(const std::vector<std::string>& argv, const std::string& log_prefix) {
   Process p;
   p.out_path = log_prefix + ".stdout";
   p.err_path = log_prefix + ".stderr";
+  if (g_sentinel) p.outside_before = SnapshotOutside(*g_sentinel);
   p.start = Clock::now();
   p.pid = fork();
   if (p.pid == 0) {
@@ -131,6 +200,8 @@ Outcome Wait(const Process& p, double timeout_s, double kill_after_s = -1.0) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
   o.seconds = std::chrono::duration<double>(Clock::now() - p.start).count();
+  if (g_sentinel)
+    o.outside_changed = DescribeChanges(p.outside_before, SnapshotOutside(*g_sentinel));
   if (!o.killed && !o.timed_out) {
     if (WIFSIGNALED(status)) o.signal = WTERMSIG(status);
     if (WIFEXITED(status)) o.exit_code = WEXITSTATUS(status);
@@ -193,6 +264,13 @@ struct Failures {
     std::cerr << "FAIL case " << case_no << " (" << kind << "): " << what << "\n";
   }
 };
+
+// Issue 15: a run of bifilar never touches a file outside its output folder.
+void CheckOutside(const Outcome& o, int case_no, const std::string& kind, Failures* failures) {
+  if (!o.outside_changed.empty()) {
+    failures->Add(case_no, kind, "a file outside the output folder changed: " + o.outside_changed);
+  }
+}
 
 // ---- Mutations ----
 
@@ -349,6 +427,8 @@ std::string MutateConfig(const std::string& text, std::mt19937_64& rng, std::str
 
 struct Workspace {
   std::string dir, logs, out, config_path, config_text;
+  std::string harness;  // the runs' stdout and stderr (outside the sentinel tree)
+  std::string thesis;   // a user's file beside the campaign: never to be touched
   std::map<std::string, std::string> pristine;  // path -> content of every log
   std::map<std::string, std::string> user_files;  // path -> content, must never change
   double ixz_kg_m2 = NAN, ix_kg_m2 = NAN;        // baseline ellipse
@@ -378,6 +458,9 @@ Workspace MakeWorkspace(const Args& args) {
   w.dir = mkdtemp(tmpl);
   w.logs = w.dir + "/logs";
   w.out = w.dir + "/out";
+  w.harness = w.dir + "/harness";
+  w.thesis = w.dir + "/precious/thesis.txt";
+  fs::create_directories(w.harness);
   w.config_path = w.dir + "/campaign.yaml";
   const std::string sample = args.source + "/sample_runs/prandtl_d/logs";
   std::vector<std::string> names;
@@ -406,7 +489,9 @@ Workspace MakeWorkspace(const Args& args) {
   // The user's own files beside and above the outputs: never to be touched.
   w.user_files[w.out + "/my_notes.txt"] = "my notes\n";
   w.user_files[w.dir + "/results_backup.json"] = "{}\n";
+  w.user_files[w.thesis] = "four years of work\n";
   for (const auto& [path, text] : w.user_files) WriteFile(path, text);
+  fs::create_symlink(w.thesis, w.dir + "/precious/thesis_link.txt");
   return w;
 }
 
@@ -434,6 +519,7 @@ void CheckRun(const Outcome& o, const Workspace& w, int case_no, const std::stri
               Failures* failures) {
   if (o.timed_out) failures->Add(case_no, kind, "no answer within the bound: a hang");
   if (o.signal) failures->Add(case_no, kind, "crashed with signal " + std::to_string(o.signal) + "\n" + o.err);
+  CheckOutside(o, case_no, kind, failures);
   if (!o.killed && !o.timed_out && !o.signal && (o.exit_code < 0 || o.exit_code > 2)) {
     failures->Add(case_no, kind, "exit code " + std::to_string(o.exit_code) + "\n" + o.err);
   }
@@ -533,6 +619,176 @@ std::string CrazyflieSeries(const std::string& text) {
   return Join(kept);
 }
 
+// ---- Runs aimed outside the output folder (issue 15 items 1, 2, 4) ----
+
+// A regular file in `folder`, picked by `rng` from the sorted list, "" when none.
+std::string SomeFileIn(const std::string& folder, std::mt19937_64& rng) {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->is_regular_file(ec) && !it->is_symlink(ec)) files.push_back(it->path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files.empty() ? "" : Pick(files, rng);
+}
+
+// A manifest entry reaching outside OUT: "../", an absolute path, a recorded name that is now a
+// symbolic link out of OUT, or cache/ or figures/ replaced by a link to a folder outside.
+// `process` must refuse the manifest (exit 2, naming the entry) and remove nothing.
+void ManifestTraversalCase(const Args& args, const Workspace& w, int c, std::mt19937_64& rng,
+                           Failures* failures) {
+  const std::string manifest_path = w.out + "/" + bifilar::OutputManifest::kFileName;
+  const std::string manifest = ReadFile(manifest_path);
+  const std::string log = w.logs + "/pitch_0/trial_1.csv";
+  std::string kind = "manifest traversal", expected = "damaged manifest";
+  std::function<void()> restore = [] {};
+  const int variant = Uniform(rng, 0, 6);
+  if (variant <= 4) {
+    static const char* kWhat[] = {"relative ../", "absolute thesis", "cache/../../ to a log",
+                                  "absolute log", "figures/../../ to the config"};
+    const std::vector<std::string> entries = {"../precious/thesis.txt", w.thesis,
+                                              "cache/../../logs/pitch_0/trial_1.csv", log,
+                                              "figures/../../campaign.yaml"};
+    kind += std::string(" (") + kWhat[variant] + ")";
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(manifest);
+    } catch (const std::exception&) {
+      failures->Add(c, kind, "no readable manifest in OUT before the case");
+      return;
+    }
+    j["files"].push_back(entries[variant]);
+    WriteFile(manifest_path, j.dump(1));
+    restore = [&] { WriteFile(manifest_path, manifest); };
+  } else if (variant == 5) {
+    kind += " (recorded cache entry is a link to the thesis)";
+    expected = "is a symbolic link";
+    const std::string entry = SomeFileIn(w.out + "/cache", rng);
+    if (entry.empty()) {
+      failures->Add(c, kind, "no cache entry in OUT before the case");
+      return;
+    }
+    const std::string text = ReadFile(entry);
+    fs::remove(entry);
+    fs::create_symlink(w.thesis, entry);
+    restore = [entry, text] {
+      std::error_code ignored;
+      fs::remove(entry, ignored);
+      WriteFile(entry, text);
+    };
+  } else {
+    const std::string folder = Uniform(rng, 0, 1) ? "cache" : "figures";
+    kind += " (" + folder + "/ is a link to a folder outside OUT)";
+    expected = "symbolic link";
+    const std::string outside = w.dir + "/precious/" + folder;
+    std::error_code ec;
+    fs::rename(w.out + "/" + folder, outside, ec);
+    if (ec) {
+      failures->Add(c, kind, "no " + folder + "/ in OUT before the case: " + ec.message());
+      return;
+    }
+    fs::create_symlink(outside, w.out + "/" + folder);
+    restore = [&w, folder, outside] {
+      std::error_code ignored;
+      fs::remove(w.out + "/" + folder, ignored);
+      fs::rename(outside, w.out + "/" + folder, ignored);
+    };
+  }
+  const Outcome o =
+      Wait(Start(ProcessArgv(args, w, Uniform(rng, 0, 1)), w.harness + "/run"), args.run_timeout_s);
+  CheckRun(o, w, c, kind, failures);
+  if (o.exit_code != 2 || o.err.find(expected) == std::string::npos) {
+    failures->Add(
+        c, kind,
+        "not refused with '" + expected + "': exit " + std::to_string(o.exit_code) + "\n" + o.err);
+  }
+  restore();
+}
+
+// OUT/.bifilar.lock replaced by a link to the thesis, a dangling link, a hard link to the thesis,
+// a FIFO or a file of the user's: `process` and `report` refuse it (exit 2, naming it) and
+// write nothing through it.
+void LockCase(const Args& args, const Workspace& w, int c, std::mt19937_64& rng,
+              Failures* failures) {
+  const std::string lock = w.out + "/.bifilar.lock";
+  std::error_code ignored;
+  fs::remove(lock, ignored);
+  std::string kind = "lock: ";
+  const int variant = Uniform(rng, 0, 4);
+  std::error_code ec;
+  if (variant == 0) {
+    kind += "link to the thesis";
+    fs::create_symlink(w.thesis, lock, ec);
+  } else if (variant == 1) {
+    kind += "dangling link";
+    fs::create_symlink(w.dir + "/precious/new_file.txt", lock, ec);
+  } else if (variant == 2) {
+    kind += "hard link to the thesis";
+    fs::create_hard_link(w.thesis, lock, ec);
+  } else if (variant == 3) {
+    kind += "FIFO";
+    if (mkfifo(lock.c_str(), 0644) != 0) ec = std::error_code(errno, std::generic_category());
+  } else {
+    kind += "a file of the user's";
+    WriteFile(lock, "my lock notes\n");
+  }
+  if (ec) {  // e.g. the thesis is gone: an earlier failure, already counted
+    failures->Add(c, kind, "cannot plant the lock: " + ec.message());
+    return;
+  }
+  const bool report = Uniform(rng, 0, 1) == 1;
+  kind += report ? ", report" : ", process";
+  const Outcome o = Wait(Start(report ? std::vector<std::string>{args.binary, "report", w.out}
+                                      : ProcessArgv(args, w, false),
+                               w.harness + "/run"),
+                         args.run_timeout_s);
+  CheckRun(o, w, c, kind, failures);
+  if (o.exit_code != 2 || o.err.find(".bifilar.lock") == std::string::npos) {
+    failures->Add(c, kind,
+                  "a lock that is not bifilar's own file was used: exit " +
+                      std::to_string(o.exit_code) + "\n" + o.err);
+  }
+  if (variant == 4 && ReadFile(lock) != "my lock notes\n") {
+    failures->Add(c, kind, "the user's file in place of the lock was changed");
+  }
+  fs::remove(lock, ignored);
+}
+
+// `--out` inside the logs (a pitch folder, runs.root, the tare folder, the folder holding the
+// logs): refused before anything is written (exit 2, naming the logs), never a silent drop.
+void OutInsideLogsCase(const Args& args, const Workspace& w, int c, std::mt19937_64& rng,
+                       Failures* failures) {
+  const std::vector<std::string> outs = {w.logs + "/pitch_0", w.logs + "/pitch_30/", w.logs,
+                                         w.logs + "/tare", w.dir};
+  const std::string out = Pick(outs, rng);
+  const std::string kind = "--out inside the logs (" + out + ")";
+  std::vector<std::string> argv = ProcessArgv(args, w, Uniform(rng, 0, 1));
+  argv[4] = out;  // process CONFIG --out OUT
+  const Outcome o = Wait(Start(argv, w.harness + "/run"), args.run_timeout_s);
+  CheckRun(o, w, c, kind, failures);
+  if (o.exit_code != 2 || o.err.find("log(s) of this campaign") == std::string::npos) {
+    failures->Add(c, kind,
+                  "an output folder holding logs was used: exit " + std::to_string(o.exit_code) +
+                      "\n" + o.err);
+  }
+}
+
+// One of the three, chosen by `rng`; returns the kind for the counts.
+std::string OutsideOutCase(const Args& args, const Workspace& w, int c, std::mt19937_64& rng,
+                           Failures* failures) {
+  switch (Uniform(rng, 0, 2)) {
+    case 0:
+      ManifestTraversalCase(args, w, c, rng, failures);
+      return "manifest traversal";
+    case 1:
+      LockCase(args, w, c, rng, failures);
+      return "lock not a file of its own";
+    default:
+      OutInsideLogsCase(args, w, c, rng, failures);
+      return "--out inside the logs";
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -564,11 +820,15 @@ int main(int argc, char** argv) {
   }
   const Clock::time_point start = Clock::now();
   Workspace w = MakeWorkspace(args);
+  const Sentinel sentinel{w.dir, {w.out, w.harness}};
+  g_sentinel = &sentinel;
   Failures failures;
   std::mt19937_64 rng(args.seed);
+  std::mt19937_64 rng_outside(args.seed + 15);  // the cases aimed outside OUT: their own stream
 
   // Baseline: the pristine campaign, fitted from scratch; its duration times the kills.
-  Outcome base = Wait(Start(ProcessArgv(args, w, true), w.dir + "/baseline"), args.run_timeout_s);
+  Outcome base =
+      Wait(Start(ProcessArgv(args, w, true), w.harness + "/baseline"), args.run_timeout_s);
   CheckRun(base, w, 0, "baseline", &failures);
   ReadEllipse(w.out, &w.ix_kg_m2, &w.ixz_kg_m2);
   if (base.exit_code != 0 || !std::isfinite(w.ixz_kg_m2)) {
@@ -595,9 +855,13 @@ int main(int argc, char** argv) {
 
   std::map<std::string, int> kinds_run;
   for (int c = 1; c <= args.cases; ++c) {
+    if (c % 10 == 5) {  // every tenth case aims outside OUT (issue 15 item 11)
+      ++kinds_run[OutsideOutCase(args, w, c, rng_outside, &failures)];
+      continue;
+    }
     const int roll = Uniform(rng, 0, 99);
     std::string kind, what;
-    const std::string prefix = w.dir + "/run";
+    const std::string prefix = w.harness + "/run";
     if (roll < 25) {
       kind = "log mutation";
       const int k = Uniform(rng, 1, 3);
@@ -643,6 +907,7 @@ int main(int argc, char** argv) {
       // `report` on what the kill left: a page from a consistent set, or a refusal naming it.
       const bool mixed = !bifilar::CheckOutputSet(w.out, false).empty();
       const Outcome report = Wait(Start({args.binary, "report", w.out}, prefix), args.run_timeout_s);
+      CheckOutside(report, c, kind + " then report (" + what + ")", &failures);
       if (report.signal || report.timed_out || (report.exit_code != 0 && report.exit_code != 2) ||
           (mixed && report.exit_code != 2) ||
           (report.exit_code == 2 && report.err.find("error") == std::string::npos)) {
@@ -700,6 +965,7 @@ int main(int argc, char** argv) {
       const std::string label = kind + " (" + fs::path(source).filename().string() + ": " + what + ")";
       if (o.timed_out) failures.Add(c, label, "no answer within the bound: a hang");
       if (o.signal) failures.Add(c, label, "crashed with signal " + std::to_string(o.signal) + "\n" + o.err);
+      CheckOutside(o, c, label, &failures);
       if (!o.timed_out && !o.signal && (o.exit_code < 0 || o.exit_code > 2)) {
         failures.Add(c, label, "exit code " + std::to_string(o.exit_code));
       }
