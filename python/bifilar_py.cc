@@ -31,6 +31,7 @@
 #include "fit/swing_axis.h"
 #include "fit/trace_fit.h"
 #include "fit/window.h"
+#include "pipeline/bounded_read.h"
 #include "pipeline/campaign.h"
 #include "pipeline/config.h"
 #include "pipeline/ellipse_json.h"
@@ -260,7 +261,7 @@ py::dict ReadLogCore(const std::string& path, const std::string& config_path) {
   std::optional<std::array<double, 2>> window;
   {
     py::gil_scoped_release release;
-    data = ReadImuLog(path, config.imu.format);
+    data = ReadImuLog(path, config.imu.format, config.limits.LogOptions());
     // Step 2 of ProcessTrace (pipeline/trace_process.cc): the swing axis with the config's
     // settings, over the config's window for this file when it has one (matched as
     // `bifilar fit` matches it, on the path as given).
@@ -347,9 +348,7 @@ py::object ProcessCore(const std::string& config_path, const std::optional<std::
     RunCampaign(config, options);
     // The file just written, so that the two can never differ.
     const std::string path = (std::filesystem::path(options.out_dir) / "results.json").string();
-    std::ifstream in(path);
-    if (!in) throw UserError(path + ": cannot read the results just written");
-    results = nlohmann::json::parse(in);
+    results = nlohmann::json::parse(ReadRegularFileOrThrow(path, OutputFileCap()));
   }
   return ToPython(results);
 }
@@ -364,11 +363,9 @@ struct SimulateArgs {
   bool no_accel = false;
 };
 
+// A file simulate just wrote (truth.json), read back within the result-file cap.
 std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  return ReadRegularFileOrThrow(path, OutputFileCap());
 }
 
 // The same checks and merging as `bifilar simulate` (pipeline/cli_simulate.cc), with the

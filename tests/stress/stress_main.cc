@@ -389,7 +389,8 @@ Workspace MakeWorkspace(const Args& args) {
   for (int k = 1; k <= 3; ++k) names.push_back("tare/tare_" + std::to_string(k));
   for (const std::string& name : names) {
     std::string text, why;
-    if (!bifilar::GzipDecompress(ReadFile(sample + "/" + name + ".csv.gz"), &text, &why)) {
+    if (!bifilar::GzipDecompress(ReadFile(sample + "/" + name + ".csv.gz"), &text, &why,
+                                 bifilar::LogCap(1'000'000'000))) {
       throw std::runtime_error(sample + "/" + name + ".csv.gz: " + why);
     }
     w.pristine[w.logs + "/" + name + ".csv"] = text;
