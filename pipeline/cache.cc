@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "pipeline/bounded_read.h"
 #include "pipeline/json_error.h"
 #include "pipeline/results_json.h"
 #include "pipeline/user_error.h"
@@ -30,27 +31,6 @@ std::string HashToHex(uint64_t hash) {
   char buffer[17];
   std::snprintf(buffer, sizeof(buffer), "%016" PRIx64, hash);
   return buffer;
-}
-
-bool ReadFileBytes(const std::string& path, std::string* bytes, std::string* why) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    *why = path + ": is a folder, not a log file";
-    return false;
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    *why = path + ": cannot open file for reading";
-    return false;
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) {
-    *why = path + ": read error";
-    return false;
-  }
-  *bytes = text.str();
-  return true;
 }
 
 namespace {
@@ -168,7 +148,7 @@ bool TraceCache::Load(const std::string& key, const std::string& content_hash,
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return false;
   std::string bytes, why;
-  if (!ReadFileBytes(path, &bytes, &why)) {
+  if (!ReadRegularFile(path, CacheEntryCap(), &bytes, &why)) {
     *problem = why;
     return false;
   }

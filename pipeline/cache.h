@@ -25,9 +25,6 @@ uint64_t Fnv1a64(const void* data, size_t size, uint64_t hash = kFnvOffsetBasis)
 uint64_t Fnv1a64(const std::string& text, uint64_t hash = kFnvOffsetBasis);
 std::string HashToHex(uint64_t hash);  // 16 lowercase hex digits
 
-// Reads the whole file into *bytes. False with *why naming the file when it cannot be read.
-bool ReadFileBytes(const std::string& path, std::string* bytes, std::string* why);
-
 // The text of every config value that affects the fit of one trace of `role` (see above),
 // including the window override that applies to this file.
 std::string FitFingerprint(const CampaignConfig& config, TraceRole role,

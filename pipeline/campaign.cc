@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "fit/ellipse_plot.h"
+#include "pipeline/bounded_read.h"
 #include "pipeline/cache.h"
 #include "pipeline/campaign_inputs.h"
 #include "pipeline/ellipse_json.h"
@@ -73,6 +74,7 @@ struct OutputFolder {
   explicit OutputFolder(const CampaignOptions& options)
       : dir(CreateOutputFolder(options.out_dir)), lock(dir.string()), manifest(dir.string()) {
     manifest.CheckOwnedPlaces();
+    RefuseNonRegularOutputs(dir.string());
     if (options.progress) {
       for (const std::string& problem : CheckOutputSet(dir.string(), true)) {
         *options.progress << "warning: previous outputs are a mixed set (" << problem
@@ -126,7 +128,8 @@ CampaignInputs DiscoverInputs(const CampaignConfig& config, std::vector<RunFile>
     if (!run.error.empty()) return;
     std::string bytes;
     std::string& error = in.read_errors[i];
-    if (ReadFileBytes(run.path, &bytes, &error)) {
+    if (ReadRegularFile(run.path, LogCap(config.limits.LogOptions().max_file_bytes), &bytes,
+                        &error)) {
       in.hashes[i] = HashToHex(Fnv1a64(bytes));
     } else {
       error = run.display + ": " +

@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 
+#include "pipeline/bounded_read.h"
 #include "pipeline/plausibility.h"
 #include "pipeline/ulog.h"
 #include "pipeline/user_error.h"
@@ -30,13 +31,7 @@ YamlMap Sub(YamlMap& map, const std::string& key) {
   return YamlMap(YAML::Node(YAML::NodeType::Null), map.file(), map.KeyPath(key));
 }
 
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw UserError(path + ": cannot open config file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+std::string ReadText(const std::string& path) { return ReadRegularFileOrThrow(path, ConfigCap()); }
 
 // Positive finite number, or throw naming the key.
 double Positive(YamlMap& map, const std::string& key) {
@@ -849,7 +844,32 @@ DisplayUnits ReadUnits(YamlMap& root) {
                   units + "'");
 }
 
+// `limits`: the size caps of the logs, MB in [1, kMaxLimitMb].
+InputLimits ReadLimits(YamlMap limits) {
+  InputLimits l;
+  for (auto [key, value] : {std::pair<const char*, double*>{"max_log_mb", &l.max_log_mb},
+                            {"max_decompressed_log_mb", &l.max_decompressed_log_mb}}) {
+    YAML::Node node = limits.Optional(key);
+    if (!node.IsDefined()) continue;
+    const double mb = limits.AsDouble(node, key);
+    if (!(mb >= 1 && mb <= kMaxLimitMb)) {
+      throw UserError(limits.Where(node) + ": '" + limits.KeyPath(key) + "' must be in [1, " +
+                      std::to_string(static_cast<long long>(kMaxLimitMb)) + "] (MB)");
+    }
+    *value = mb;
+  }
+  limits.Finish();
+  return l;
+}
+
 }  // namespace
+
+ImuLogOptions InputLimits::LogOptions() const {
+  ImuLogOptions options;
+  options.max_file_bytes = static_cast<uint64_t>(max_log_mb * 1e6);
+  options.max_decompressed_bytes = static_cast<uint64_t>(max_decompressed_log_mb * 1e6);
+  return options;
+}
 
 // read the file -> rig -> aircraft, gravity -> imu -> runs -> fit -> ellipse -> units -> no
 // unknown key -> the ranges that involve several keys (CampaignConfig::Check).
@@ -864,6 +884,7 @@ CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptio
   ReadFit(Sub(root, "fit"), &config.fit);
   ReadEllipse(Sub(root, "ellipse"), &config.ellipse);
   config.units = ReadUnits(root);
+  config.limits = ReadLimits(Sub(root, "limits"));
   root.Finish();
   std::string why;
   if (!config.Check(&why)) throw UserError(path + ": " + why);

@@ -18,6 +18,7 @@
 #include "pendulum/integrator.h"
 #include "pendulum/model.h"
 #include "pipeline/imu_format.h"
+#include "pipeline/imu_log.h"
 
 namespace bifilar {
 
@@ -179,6 +180,17 @@ struct EllipseConfig {
   bool Check(std::string* why) const;  // the ranges above; *why names the key
 };
 
+// `limits`: size caps of the logs (MB = 1e6 bytes), README "Input size limits". The other
+// inputs have fixed caps (pipeline/bounded_read.h).
+struct InputLimits {
+  double max_log_mb = kDefaultMaxLogMb;  // a log file as stored; [1, kMaxLimitMb]; default 1000
+  // its text once a .csv.gz is decompressed; [1, kMaxLimitMb]; default 1000
+  double max_decompressed_log_mb = kDefaultMaxDecompressedLogMb;
+
+  ImuLogOptions LogOptions() const;  // the reader's options with these caps (bytes)
+};
+constexpr double kMaxLimitMb = 1e6;  // 1 TB: the largest limits.* accepted
+
 struct CampaignConfig {
   std::string file;          // absolute path of the config file
   std::string folder;        // its folder: relative paths are resolved against it
@@ -202,6 +214,7 @@ struct CampaignConfig {
   FitConfig fit;
   EllipseConfig ellipse;
   DisplayUnits units = DisplayUnits::kSi;
+  InputLimits limits;
 
   // Geometry of an aircraft trace (mass = aircraft + rig), of a tare trace (rig alone) and of a
   // reference swing (rig + reference), with the calibrated separation when one is applied.

@@ -6,6 +6,7 @@
 
 #include <fast_float/fast_float.h>
 
+#include "pipeline/bounded_read.h"
 #include "pipeline/gzip.h"
 #include "pipeline/user_error.h"
 
@@ -145,15 +146,10 @@ std::vector<EllipsePoint> ParseEllipseTable(const std::string& text, const std::
 }
 
 std::vector<EllipsePoint> ReadEllipseTable(const std::string& path, InertiaUnits units) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw UserError(path + ": cannot open the moments table");
-  std::ostringstream text;
-  text << file.rdbuf();
-  if (file.bad()) throw UserError(path + ": read error");
-  std::string bytes = text.str();
+  std::string bytes = ReadRegularFileOrThrow(path, TableCap("moments table"));
   if (LooksGzipped(bytes)) {  // a .csv.gz table is read like a .csv.gz log
     std::string inflated, why;
-    if (!GzipDecompress(bytes, &inflated, &why)) {
+    if (!GzipDecompress(bytes, &inflated, &why, TableCap("moments table once decompressed"))) {
       throw UserError(path + ": gzip-compressed but cannot be inflated: " + why);
     }
     bytes = std::move(inflated);

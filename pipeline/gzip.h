@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "pipeline/bounded_read.h"
+
 namespace bifilar {
 
 // True when `bytes` begin with the gzip magic number (1f 8b).
@@ -13,7 +15,12 @@ bool LooksGzipped(const std::string& bytes);
 // gives the same bytes.
 std::string GzipCompress(const std::string& text);
 
-// Inflates a whole gzip stream; false with *why set when the data are corrupt or truncated.
-bool GzipDecompress(const std::string& bytes, std::string* text, std::string* why);
+// Inflates a whole gzip file: every member of it, as zcat does (`cat a.gz b.gz > log.csv.gz` is
+// one file whose text is a's then b's); zero bytes after the last member (padding) are ignored.
+// False with *why set when the data are corrupt or truncated, when other bytes follow a member,
+// or when the text would exceed cap.max_bytes (a gzip bomb: inflation stops at the cap, so the
+// memory used is bounded by it).
+bool GzipDecompress(const std::string& bytes, std::string* text, std::string* why,
+                    const InputCap& cap);
 
 }  // namespace bifilar

@@ -456,25 +456,17 @@ ImuData FinishImuLog(const std::string& name, const ImuLogOptions& options,
 
 namespace {
 
-std::string ReadWholeFile(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) Fail(path + ": is a directory, not a log file");
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) Fail(path + ": cannot open the log: " + std::strerror(errno));
-  std::string text;
-  // Reserved at the file's size: a long log is read without the doubling copies.
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (!ec && size < (std::uintmax_t{1} << 40)) text.reserve(static_cast<size_t>(size));
-  char buffer[1 << 16];
-  size_t n;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), f)) > 0) text.append(buffer, n);
-  const bool failed = std::ferror(f);
-  const int err = errno;
-  std::fclose(f);
-  if (failed) Fail(path + ": cannot read the log: " + std::strerror(err));
+// The log's text: the file (bounded_read.h: a regular file within the cap), decompressed when
+// it is a .csv.gz (within the decompressed cap).
+std::string ReadWholeFile(const std::string& path, const ImuLogOptions& options) {
+  std::string text, why;
+  if (!ReadRegularFile(path, LogCap(options.max_file_bytes), &text, &why)) Fail(why);
   if (LooksGzipped(text)) {  // a .csv.gz log: inflate it in memory
-    std::string inflated, why;
-    if (!GzipDecompress(text, &inflated, &why)) Fail(path + ": " + why);
+    std::string inflated;
+    if (!GzipDecompress(text, &inflated, &why,
+                        DecompressedLogCap(options.max_decompressed_bytes))) {
+      Fail(path + ": " + why);
+    }
     return inflated;
   }
   return text;
@@ -491,6 +483,10 @@ bool ImuLogOptions::Check(std::string* why) const {
     *why = "min_rows must be at least 1";
     return false;
   }
+  if (max_file_bytes < 1 || max_decompressed_bytes < 1) {
+    *why = "max_file_bytes and max_decompressed_bytes must be at least 1";
+    return false;
+  }
   return true;
 }
 
@@ -502,7 +498,7 @@ ImuData ReadImuLogFromString(const std::string& text, const std::string& name,
 
 ImuData ReadImuLog(const std::string& path, const ImuFormat& format,
                    const ImuLogOptions& options) {
-  std::string text = ReadWholeFile(path);
+  std::string text = ReadWholeFile(path, options);
   if (UseUlogReader(text, format)) return ReadUlogImu(text, path, format, options);
   return Parse(text, path, format, options, &text);
 }

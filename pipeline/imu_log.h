@@ -27,9 +27,11 @@
 // The whole file is read at once and numbers are parsed with fast_float (no streams per field).
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "pendulum/imu_data.h"
+#include "pipeline/bounded_read.h"
 #include "pipeline/imu_format.h"
 
 namespace bifilar {
@@ -53,6 +55,12 @@ struct ImuLogOptions {
   bool require_accel = false;
   // Fewest data rows accepted (after repairs). Default 2.
   int min_rows = 2;
+  // Size caps (bytes): the file as stored, and its text once a .csv.gz is decompressed. Defaults
+  // kDefaultMaxLogMb and kDefaultMaxDecompressedLogMb MB (pipeline/bounded_read.h); the config's
+  // limits.max_log_mb and limits.max_decompressed_log_mb set them. A FIFO, device or folder is
+  // refused whatever the caps.
+  uint64_t max_file_bytes = static_cast<uint64_t>(kDefaultMaxLogMb * 1e6);
+  uint64_t max_decompressed_bytes = static_cast<uint64_t>(kDefaultMaxDecompressedLogMb * 1e6);
 
   bool Check(std::string* why) const;
 };

@@ -10,7 +10,7 @@
 #include "fit/swing_axis.h"
 #include "fit/window.h"
 #include "pendulum/model.h"
-#include "pipeline/cache.h"
+#include "pipeline/bounded_read.h"
 #include "pipeline/gzip.h"
 #include "pipeline/imu_log.h"
 #include "pipeline/trace_process.h"
@@ -505,8 +505,11 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config) 
     report.error = path + ": is a folder; give the log files inside it";
     return report;
   }
+  // The caps of the config's limits, or their defaults.
+  const InputLimits limits = config != nullptr ? config->limits : InputLimits();
+  const ImuLogOptions log_options = limits.LogOptions();
   std::string bytes, why;
-  if (!ReadFileBytes(path, &bytes, &why)) {
+  if (!ReadRegularFile(path, LogCap(log_options.max_file_bytes), &bytes, &why)) {
     report.kind = "unreadable";
     report.error = why;
     return report;
@@ -518,7 +521,7 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config) 
   }
   if (LooksGzipped(bytes)) {
     std::string text;
-    if (!GzipDecompress(bytes, &text, &why)) {
+    if (!GzipDecompress(bytes, &text, &why, DecompressedLogCap(log_options.max_decompressed_bytes))) {
       report.kind = "binary";
       report.error = path + ": gzip data that cannot be read: " + why;
       return report;
@@ -542,7 +545,7 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config) 
                        "; name the topic and fields in imu.ulog (configs/README.md)";
         return report;
       }
-      data = ReadUlogImu(bytes, path, report.format);
+      data = ReadUlogImu(bytes, path, report.format, log_options);
     } else {
       const std::string kind = ClassifyText(bytes);
       const FormatGuess guess = GuessCsvFormat(bytes);
@@ -568,7 +571,7 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config) 
         report.format = guess.format;
         report.guesses = guess.guesses;
       }
-      data = ReadImuLogFromString(bytes, path, report.format);
+      data = ReadImuLogFromString(bytes, path, report.format, log_options);
       if (!report.format_from_config && !guess.gyro_unit_from_names) {
         RefineGyroUnitGuess(&data, &report);
       }

@@ -11,6 +11,7 @@
 #include <ctime>
 #include <filesystem>
 
+#include "pipeline/bounded_read.h"
 #include "pipeline/cache.h"
 #include "pipeline/atomic_file.h"
 #include "pipeline/json_error.h"
@@ -26,9 +27,11 @@ constexpr const char* kOwnedFolders[] = {"cache", "figures"};
 constexpr const char* kResultFiles[] = {"results.json", "traces.csv", "angles.csv", "report.html"};
 constexpr const char* kReportStamp = "<!-- bifilar results.json fnv1a64: ";
 
-std::string ReadAll(const std::string& path) {
+// The file's bytes, "" when it cannot be read (pipeline/bounded_read.h: not a regular file, or
+// larger than the cap).
+std::string ReadAll(const std::string& path, const InputCap& cap = OutputFileCap()) {
   std::string bytes, why;
-  return ReadFileBytes(path, &bytes, &why) ? bytes : std::string();
+  return ReadRegularFile(path, cap, &bytes, &why) ? bytes : std::string();
 }
 
 // The temporary names bifilar's writers use: WriteFileAtomically (".tmp.<pid>") and
@@ -257,7 +260,7 @@ OutputManifest::OutputManifest(std::string out_dir) : out_dir_(std::move(out_dir
   const std::string damaged = path + ": damaged manifest of the files bifilar wrote (";
   const std::string advice = "); move the output folder away or choose another --out";
   try {
-    const nlohmann::json j = nlohmann::json::parse(ReadAll(path));
+    const nlohmann::json j = nlohmann::json::parse(ReadAll(path, ManifestCap()));
     if (!j.is_object() || !j.contains("files") || !j["files"].is_array()) {
       throw UserError("no list 'files'");
     }
@@ -388,7 +391,7 @@ void OutputManifest::Save() const {
 
 std::string FileHash(const std::string& path) {
   std::string bytes, why;
-  if (!ReadFileBytes(path, &bytes, &why)) return "";
+  if (!ReadRegularFile(path, OutputFileCap(), &bytes, &why)) return "";
   return HashToHex(Fnv1a64(bytes));
 }
 
@@ -468,6 +471,29 @@ std::vector<std::string> CheckOutputSet(const std::string& out_dir, bool check_r
     for (const auto& [kind, name] : results["figures"].items()) check_figure(name);
   }
   return problems;
+}
+
+void RefuseNonRegularOutputs(const std::string& out_dir) {
+  const fs::path out(out_dir);
+  std::vector<fs::path> paths = {out / OutputManifest::kFileName};
+  for (const char* name : kResultFiles) paths.push_back(out / name);
+  std::error_code ec;
+  for (const char* folder : kOwnedFolders) {
+    for (fs::directory_iterator it(out / folder, ec), end; !ec && it != end; it.increment(ec)) {
+      paths.push_back(it->path());
+    }
+  }
+  for (const fs::path& path : paths) {
+    const fs::file_status status = fs::status(path, ec);  // follows symlinks
+    if (!fs::exists(status) || fs::is_regular_file(status)) continue;
+    const char* kind = fs::is_directory(status) ? "a folder"
+                       : fs::is_fifo(status)    ? "a FIFO (named pipe)"
+                       : fs::is_socket(status)  ? "a socket"
+                                                : "a device";
+    throw UserError(path.string() + ": is " + kind +
+                    ", not a regular file; bifilar reads and writes only regular files in its "
+                    "output folder: move it away or choose another --out");
+  }
 }
 
 }  // namespace bifilar

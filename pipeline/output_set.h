@@ -94,4 +94,10 @@ std::string StampReport(const std::string& html, const std::string& results_hash
 // results.json. Empty when consistent (or when results.json predates the hashes).
 std::vector<std::string> CheckOutputSet(const std::string& out_dir, bool check_report);
 
+// Throws UserError naming the first of the result files, the manifest and the entries of cache/
+// and figures/ that exists and is not a regular file (a FIFO, device, socket or folder, also
+// behind a symlink): bifilar reads and writes only regular files there, and a FIFO would block
+// a reader. Called before any fit, so such a folder stops the run at once.
+void RefuseNonRegularOutputs(const std::string& out_dir);
+
 }  // namespace bifilar

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "pipeline/bounded_read.h"
 #include "pipeline/cache.h"
 #include "pipeline/json_error.h"
 #include "pipeline/output_set.h"
@@ -97,7 +98,7 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
   if (name.empty()) return "<p class=\"note\">(no figure)</p>";
   std::string bytes, why;
   const std::string path = (fs::path(out_dir) / "figures" / name).string();
-  if (!ReadFileBytes(path, &bytes, &why)) {
+  if (!ReadRegularFile(path, FigureCap(), &bytes, &why)) {
     return "<p class=\"note\">(figure " + Escape(name) + " missing)</p>";
   }
   const std::string ext = fs::path(name).extension().string();
@@ -489,7 +490,7 @@ void RunReport(const std::string& out_dir) {
   const OutputFolderLock lock(out_dir);
   const std::string path = (fs::path(out_dir) / "results.json").string();
   std::string bytes, why;
-  if (!ReadFileBytes(path, &bytes, &why)) throw UserError(why);
+  if (!ReadRegularFile(path, OutputFileCap(), &bytes, &why)) throw UserError(why);
   json results;
   try {
     results = json::parse(bytes);

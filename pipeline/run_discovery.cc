@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 
+#include "pipeline/bounded_read.h"
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -191,8 +193,8 @@ std::vector<std::string> SplitCsvLine(const std::string& line) {
 
 // runs.table: one row per log, its pitch in a column.
 std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
-  std::ifstream in(config.runs.table);
-  if (!in) throw UserError(config.runs.table + ": cannot open runs table (runs.table)");
+  std::istringstream in(
+      ReadRegularFileOrThrow(config.runs.table, TableCap("runs table (runs.table)")));
   std::vector<RunFile> runs;
   std::string line;
   int line_no = 0;

@@ -756,13 +756,7 @@ SimulateSpec ReadSimulateSpec(const std::string& file) {
 }
 
 SimulateSpec ParseSimulateSpec(const std::string& yaml_text, const std::string& name) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw UserError(name + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
-  }
-  return ParseSpec(YamlMap(root, name, ""));
+  return ParseSpec(YamlMap::LoadText(yaml_text, name));
 }
 
 std::string SimulateRunSummary::BriefReport() const {

@@ -3,6 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <sstream>
+
+#include <yaml-cpp/anchor.h>
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
+
+#include "pipeline/bounded_read.h"
 
 namespace bifilar {
 namespace {
@@ -42,6 +49,42 @@ void RejectDuplicateKeys(const YAML::Node& node, const std::string& file, const 
   }
 }
 
+// Refuses YAML aliases (`*name`, and the merge key `<< : *name` built on them) before the
+// document is built: yaml-cpp shares an aliased node, so a 1 kB "billion laughs" document
+// (aliases of aliases) is a tree of 9^10 nodes to any code that walks it. A config spells its
+// values out; an alias is an error naming its line.
+class AliasRefuser : public YAML::EventHandler {
+ public:
+  AliasRefuser(const std::string& text, const std::string& file) : text_(text), file_(file) {}
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
+    // The alias as written ("*base"), from its position in the text.
+    std::string alias = "*name";
+    if (mark.pos >= 0 && static_cast<size_t>(mark.pos) < text_.size() && text_[mark.pos] == '*') {
+      const size_t end = text_.find_first_of(" \t\r\n,]}", mark.pos);
+      alias = text_.substr(mark.pos, std::min<size_t>(end, mark.pos + 40) - mark.pos);
+    }
+    throw UserError(file_ + ":" + std::to_string(mark.line + 1) + ":" +
+                    std::to_string(mark.column + 1) + ": YAML alias '" + alias +
+                    "'; bifilar reads no aliases or merge keys ('<<') in its YAML files: write "
+                    "the values out where they are used");
+  }
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+
+ private:
+  const std::string& text_;
+  const std::string& file_;
+};
+
 }  // namespace
 
 YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
@@ -53,11 +96,18 @@ YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
 }
 
 YamlMap YamlMap::LoadFile(const std::string& file) {
+  return LoadText(ReadRegularFileOrThrow(file, ConfigCap()), file);
+}
+
+YamlMap YamlMap::LoadText(const std::string& text, const std::string& file) {
   std::vector<YAML::Node> documents;
   try {
-    documents = YAML::LoadAllFromFile(file);
-  } catch (const YAML::BadFile&) {
-    throw UserError(file + ": cannot open file");
+    std::istringstream stream(text);
+    YAML::Parser parser(stream);
+    AliasRefuser refuser(text, file);
+    while (parser.HandleNextDocument(refuser)) {
+    }
+    documents = YAML::LoadAll(text);
   } catch (const YAML::Exception& e) {
     throw UserError(file + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
   }

@@ -19,8 +19,12 @@ class YamlMap {
   // Throws UserError when `node` is not a mapping (a null node counts as an empty mapping).
   YamlMap(const YAML::Node& node, std::string file, std::string path);
 
-  // Loads `file` (throws UserError naming the file when it is missing or not valid YAML).
+  // Loads `file` (throws UserError naming the file when it is missing, not a regular file,
+  // larger than kMaxConfigBytes (pipeline/bounded_read.h), not valid YAML, holds more than one
+  // document, a repeated key or an alias ('*name': refused, see yaml_reader.cc)).
   static YamlMap LoadFile(const std::string& file);
+  // The same checks on YAML text already in memory; `file` names it in messages.
+  static YamlMap LoadText(const std::string& text, const std::string& file);
 
   bool Has(const std::string& key) const;
   // The value node; Required throws "file:line: missing required key 'a.b'".

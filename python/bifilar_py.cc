@@ -34,6 +34,7 @@
 #include "fit/swing_axis.h"
 #include "fit/trace_fit.h"
 #include "fit/window.h"
+#include "pipeline/bounded_read.h"
 #include "pipeline/campaign.h"
 #include "pipeline/config.h"
 #include "pipeline/ellipse_json.h"
@@ -265,7 +266,7 @@ py::dict ReadLogCore(const std::string& path, const std::string& config_path) {
   std::optional<std::array<double, 2>> window;
   {
     py::gil_scoped_release release;
-    data = ReadImuLog(path, config.imu.format);
+    data = ReadImuLog(path, config.imu.format, config.limits.LogOptions());
     // Step 2 of ProcessTrace (pipeline/trace_process.cc): the swing axis with the config's
     // settings, over the config's window for this file when it has one (matched as
     // `bifilar fit` matches it, on the path as given).
@@ -299,20 +300,55 @@ py::dict ReadLogCore(const std::string& path, const std::string& config_path) {
 
 // ---- fit_ellipse ----
 
+// The residuals of the ellipse fit as one numpy array per field of EllipseResidual (the keys of
+// a residual in `bifilar ellipse --json`).
+py::dict ResidualColumns(const std::vector<EllipseResidual>& residuals) {
+  const auto n = static_cast<py::ssize_t>(residuals.size());
+  py::array_t<std::int64_t> index(n);
+  py::array_t<bool> outlier(n);
+  py::array_t<double> pitch(n), inertia(n), fitted(n), residual(n), studentized(n);
+  std::int64_t* index_data = index.mutable_data();
+  bool* outlier_data = outlier.mutable_data();
+  double* data[] = {pitch.mutable_data(), inertia.mutable_data(), fitted.mutable_data(),
+                    residual.mutable_data(), studentized.mutable_data()};
+  for (size_t i = 0; i < residuals.size(); ++i) {
+    const EllipseResidual& e = residuals[i];
+    index_data[i] = e.index;
+    outlier_data[i] = e.outlier;
+    data[0][i] = e.pitch_deg;
+    data[1][i] = e.inertia_kg_m2;
+    data[2][i] = e.fitted_kg_m2;
+    data[3][i] = e.residual_kg_m2;
+    data[4][i] = e.studentized;
+  }
+  py::dict columns;
+  columns["index"] = index;
+  columns["pitch_deg"] = pitch;
+  columns["inertia_kg_m2"] = inertia;
+  columns["fitted_kg_m2"] = fitted;
+  columns["residual_kg_m2"] = residual;
+  columns["studentized"] = studentized;
+  columns["outlier"] = outlier;
+  return columns;
+}
+
 py::object FitEllipseCore(const Array& pitch_array, const Array& inertia_array,
                           const std::optional<Array>& std_array, int bootstrap,
                           std::uint64_t seed, double confidence, const std::string& covariance) {
   const char* fn = "fit_ellipse";
-  const std::vector<double> pitch = Series(pitch_array, fn, "pitch_deg");
-  const std::vector<double> inertia = Series(inertia_array, fn, "inertia");
-  SameLength(pitch, inertia, fn, "pitch_deg", "inertia");
-  std::vector<double> stds(pitch.size(), 0.0);
-  if (std_array) {
-    stds = Series(*std_array, fn, "std");
-    SameLength(pitch, stds, fn, "pitch_deg", "std");
+  std::vector<EllipsePoint> points;
+  {  // the checked copies of the arrays live only until the points are built
+    const std::vector<double> pitch = Series(pitch_array, fn, "pitch_deg");
+    const std::vector<double> inertia = Series(inertia_array, fn, "inertia");
+    SameLength(pitch, inertia, fn, "pitch_deg", "inertia");
+    std::vector<double> stds(pitch.size(), 0.0);
+    if (std_array) {
+      stds = Series(*std_array, fn, "std");
+      SameLength(pitch, stds, fn, "pitch_deg", "std");
+    }
+    points.resize(pitch.size());
+    for (size_t i = 0; i < points.size(); ++i) points[i] = {pitch[i], inertia[i], stds[i]};
   }
-  std::vector<EllipsePoint> points(pitch.size());
-  for (size_t i = 0; i < points.size(); ++i) points[i] = {pitch[i], inertia[i], stds[i]};
   EllipseOptions options;
   options.bootstrap_replicates = bootstrap;
   options.seed = seed;
@@ -330,7 +366,12 @@ py::object FitEllipseCore(const Array& pitch_array, const Array& inertia_array,
     ok = FitEllipse(points, options, &result, &why);
   }
   if (!ok) throw UserError(why);
-  return ToPython(EllipseResultToJson(result));
+  // The document without the per-point residuals, which come as numpy columns (~49 bytes a point)
+  // instead: as JSON objects, then dicts, then Records they took ~2.7 kB a point (1e6 points:
+  // 2.8 GB), where `bifilar ellipse` streams them. bifilar/__init__.py wraps the columns.
+  py::dict document = ToPython(EllipseResultToJson(result, /*with_residuals=*/false));
+  document["residuals"] = ResidualColumns(result.residuals);
+  return std::move(document);
 }
 
 // ---- process ----
@@ -375,9 +416,7 @@ py::object ProcessCore(const std::string& config_path, const std::optional<std::
       RunCampaign(config, options);
       // The file just written, so that the two can never differ.
       const std::string path = (std::filesystem::path(options.out_dir) / "results.json").string();
-      std::ifstream in(path);
-      if (!in) throw UserError(path + ": cannot read the results just written");
-      results = nlohmann::json::parse(in);
+      results = nlohmann::json::parse(ReadRegularFileOrThrow(path, OutputFileCap()));
     } catch (...) {
       error = std::current_exception();
     }
@@ -429,11 +468,9 @@ struct SimulateArgs {
   bool no_accel = false;
 };
 
+// A file simulate just wrote (truth.json), read back within the result-file cap.
 std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  return ReadRegularFileOrThrow(path, OutputFileCap());
 }
 
 // The same checks and merging as `bifilar simulate` (pipeline/cli_simulate.cc), with the

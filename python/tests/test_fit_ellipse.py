@@ -41,4 +41,34 @@ def test_gives_the_cli_numbers(cli, tmp_path):
     result = bifilar.fit_ellipse(PITCH, inertia, std, bootstrap=300, seed=5)
     expected = json.loads(done.stdout)
     del expected["table"], expected["figures"]  # the CLI's file names
-    assert without_timings(dict(result)) == without_timings(expected)
+    plain = dict(result)
+    plain["residuals"] = [dict(row) for row in result.residuals]  # Columns -> the CLI's rows
+    assert without_timings(plain) == without_timings(expected)
+
+
+def test_residuals_are_columns_with_rows_on_demand():
+    inertia = moments(0.004)
+    result = bifilar.fit_ellipse(PITCH, inertia, bootstrap=0)
+    residuals = result.residuals
+    assert isinstance(residuals, bifilar.Columns)
+    assert len(residuals) == PITCH.size
+    assert residuals.keys() == ["index", "pitch_deg", "inertia_kg_m2", "fitted_kg_m2",
+                                "residual_kg_m2", "studentized", "outlier"]
+    # Columns are numpy arrays holding the inputs, in input order, with measured - fitted.
+    assert isinstance(residuals.studentized, np.ndarray)
+    np.testing.assert_array_equal(residuals.index, np.arange(PITCH.size))
+    np.testing.assert_array_equal(residuals.pitch_deg, PITCH)
+    np.testing.assert_array_equal(residuals["inertia_kg_m2"], inertia)
+    np.testing.assert_allclose(residuals.residual_kg_m2,
+                               residuals.inertia_kg_m2 - residuals.fitted_kg_m2, atol=1e-15)
+    assert residuals.outlier.dtype == bool
+    # A row is a Record of plain Python values, as a row of the CLI's JSON; negative index too.
+    last = residuals[-1]
+    assert isinstance(last, bifilar.Record) and isinstance(last.index, int)
+    assert last.index == PITCH.size - 1 and last.pitch_deg == PITCH[-1]
+    assert isinstance(last.outlier, bool)
+    assert [row.index for row in residuals[:3]] == [0, 1, 2]
+    with pytest.raises(IndexError):
+        residuals[PITCH.size]
+    with pytest.raises(AttributeError):
+        residuals.no_such_column

@@ -10,6 +10,10 @@
 // `bifilar fit`. Every tenth case (issue 15 item 11) aims a run outside the output folder: a
 // manifest entry with "../", an absolute path or a symbolic link out of OUT; the lock replaced
 // by a link, hard link or FIFO; `--out` inside the logs.
+// Then, once each, hostile inputs that must stop quickly with a clear message
+// (issue 15): a FIFO and a symlink to /dev/urandom among the logs, /dev/zero as the config, a
+// multi-member gzip log (the baseline's ellipse), a gzip bomb, a FIFO as results.json and as a
+// cache entry (process and report), a YAML alias bomb.
 //
 // Asserted for every run: no crash (signal), no hang (each run is bounded by --run-timeout-s,
 // default 60 s, far above the ~0.3 s a run takes), exit code 0, 1 or 2, no NaN or inf written
@@ -472,7 +476,8 @@ Workspace MakeWorkspace(const Args& args) {
   for (int k = 1; k <= 3; ++k) names.push_back("tare/tare_" + std::to_string(k));
   for (const std::string& name : names) {
     std::string text, why;
-    if (!bifilar::GzipDecompress(ReadFile(sample + "/" + name + ".csv.gz"), &text, &why)) {
+    if (!bifilar::GzipDecompress(ReadFile(sample + "/" + name + ".csv.gz"), &text, &why,
+                                 bifilar::LogCap(1'000'000'000))) {
       throw std::runtime_error(sample + "/" + name + ".csv.gz: " + why);
     }
     w.pristine[w.logs + "/" + name + ".csv"] = text;
@@ -789,6 +794,178 @@ std::string OutsideOutCase(const Args& args, const Workspace& w, int c, std::mt1
   }
 }
 
+// ---- Hostile inputs that must stop quickly (issue 15, items 5 and 6) ----------------------------
+//
+// Each case runs once, after the random ones, bounded like every run by --run-timeout-s, and
+// restores the workspace. Asserted: no hang, no signal, the expected exit codes, and the clear
+// message (on stderr, or in the error row of results.json for a bad log in a campaign).
+
+// Checks a run that must end with one of `codes` and show `message` in `where`. A hang or a
+// crash is reported here unless CheckRun, which reports them too, has seen the run.
+void ExpectStop(const Outcome& o, int case_no, const std::string& kind,
+                const std::vector<int>& codes, const std::string& where, const std::string& message,
+                Failures* failures, bool after_check_run = false) {
+  if (o.timed_out || o.signal) {
+    if (after_check_run) return;
+    failures->Add(case_no, kind,
+                  o.timed_out ? "no answer within the bound: a hang"
+                              : "crashed with signal " + std::to_string(o.signal));
+    return;
+  }
+  if (std::find(codes.begin(), codes.end(), o.exit_code) == codes.end()) {
+    failures->Add(case_no, kind, "exit code " + std::to_string(o.exit_code) + "\n" + o.err);
+  }
+  if (where.find(message) == std::string::npos) {
+    failures->Add(case_no, kind, "no message '" + message + "' in:\n" + where.substr(0, 2000));
+  }
+}
+
+// The results.json text of OUT ("" when it is not a regular file: never read a FIFO).
+std::string ResultsText(const Workspace& w) {
+  const std::string path = w.out + "/results.json";
+  return fs::is_regular_file(fs::symlink_status(path)) ? ReadFile(path) : "";
+}
+
+// A log that is not a regular file among the logs: a FIFO, or a symlink to /dev/urandom. An error
+// row naming it; the campaign goes on.
+void CaseSpecialFileAmongLogs(const Args& args, const Workspace& w, int case_no, bool fifo,
+                              Failures* failures) {
+  const std::string kind = fifo ? "FIFO among the logs" : "log symlinked to /dev/urandom";
+  const std::string path = w.logs + "/pitch_30/trial_9.csv";
+  std::error_code ec;
+  if (fifo && mkfifo(path.c_str(), 0644) != 0) ec = std::error_code(errno, std::generic_category());
+  if (!fifo) fs::create_symlink("/dev/urandom", path, ec);
+  if (ec) {
+    failures->Add(case_no, kind, "cannot create " + path + ": " + ec.message());
+    return;
+  }
+  const Outcome o =
+      Wait(Start(ProcessArgv(args, w, false), w.dir + "/hostile"), args.run_timeout_s);
+  CheckRun(o, w, case_no, kind, failures);
+  ExpectStop(o, case_no, kind, {0, 1}, ResultsText(w),
+             fifo ? "trial_9.csv: is a FIFO (named pipe), not a regular file"
+                  : "trial_9.csv: is a character device, not a regular file",
+             failures, /*after_check_run=*/true);
+  fs::remove(path);
+}
+
+// `fit` and `process` with /dev/zero as the config: refused before reading.
+void CaseDevZeroConfig(const Args& args, const Workspace& w, int case_no, Failures* failures) {
+  const std::string log = w.logs + "/pitch_0/trial_1.csv";
+  for (const std::vector<std::string>& argv :
+       {std::vector<std::string>{args.binary, "fit", "/dev/zero", log},
+        std::vector<std::string>{args.binary, "process", "/dev/zero", "--out", w.out}}) {
+    const Outcome o = Wait(Start(argv, w.dir + "/hostile"), args.run_timeout_s);
+    ExpectStop(o, case_no, "/dev/zero as the config (" + argv[1] + ")", {2}, o.err,
+               "/dev/zero: is a character device, not a regular file", failures);
+  }
+}
+
+// `cat a.gz b.gz > log`: one log in two gzip members gives the baseline's ellipse.
+void CaseMultiMemberGzip(const Args& args, Workspace& w, int case_no, Failures* failures) {
+  const std::string kind = "multi-member gzip log";
+  const std::string path = w.logs + "/pitch_0/trial_1.csv";
+  const std::string& text = w.pristine.at(path);
+  const size_t half = text.find('\n', text.size() / 2) + 1;
+  WriteFile(path,
+            bifilar::GzipCompress(text.substr(0, half)) + bifilar::GzipCompress(text.substr(half)));
+  const Outcome o =
+      Wait(Start(ProcessArgv(args, w, false), w.dir + "/hostile"), args.run_timeout_s);
+  CheckRun(o, w, case_no, kind, failures);
+  ExpectStop(o, case_no, kind, {0}, o.out + o.err, "Traces:", failures, /*after_check_run=*/true);
+  if (o.exit_code == 0) CheckBaseline(w, case_no, kind, failures);
+  w.RestoreLogs();
+}
+
+// A gzip bomb: 110 members of 10 MB of zeros each (~1 MB on disk, 1.1 GB inflated), above the
+// default decompressed-log cap (1000 MB): an error row, inflation stopped at the cap.
+void CaseGzipBomb(const Args& args, const Workspace& w, int case_no, Failures* failures) {
+  const std::string kind = "gzip bomb";
+  const std::string path = w.logs + "/pitch_60/trial_9.csv";
+  const std::string member = bifilar::GzipCompress(std::string(10'000'000, '0'));
+  std::string bomb;
+  for (int i = 0; i < 110; ++i) bomb += member;
+  WriteFile(path, bomb);
+  const Outcome o =
+      Wait(Start(ProcessArgv(args, w, false), w.dir + "/hostile"), args.run_timeout_s);
+  CheckRun(o, w, case_no, kind + " (" + std::to_string(bomb.size()) + " bytes)", failures);
+  ExpectStop(o, case_no, kind, {0, 1}, ResultsText(w),
+             "too large for a log once decompressed: more than the cap of 1000000000 bytes; "
+             "raise limits.max_decompressed_log_mb",
+             failures, /*after_check_run=*/true);
+  fs::remove(path);
+}
+
+// A FIFO in place of OUT/results.json or of a cache entry: `process` refuses before any fit and
+// `report` refuses to read it; both name it.
+void CaseFifoInOutput(const Args& args, const Workspace& w, int case_no, bool cache_entry,
+                      Failures* failures) {
+  const std::string kind = cache_entry ? "FIFO as a cache entry" : "FIFO as results.json";
+  std::string path = w.out + "/results.json";
+  if (cache_entry) {
+    std::vector<std::string> entries;
+    for (const auto& e : fs::directory_iterator(w.out + "/cache"))
+      entries.push_back(e.path().string());
+    std::sort(entries.begin(), entries.end());
+    if (entries.empty()) {
+      failures->Add(case_no, kind, "no cache entry to replace");
+      return;
+    }
+    path = entries.front();
+  }
+  const std::string saved = ReadFile(path);
+  fs::remove(path);
+  if (mkfifo(path.c_str(), 0644) != 0) {
+    failures->Add(case_no, kind, "cannot create " + path);
+    WriteFile(path, saved);
+    return;
+  }
+  const std::string message = path + ": is a FIFO (named pipe), not a regular file";
+  const Outcome o =
+      Wait(Start(ProcessArgv(args, w, false), w.dir + "/hostile"), args.run_timeout_s);
+  ExpectStop(o, case_no, kind + " (process)", {2}, o.err, message, failures);
+  const Outcome r =
+      Wait(Start({args.binary, "report", w.out}, w.dir + "/hostile"), args.run_timeout_s);
+  if (cache_entry) {  // report reads no cache entry: it only has to end
+    ExpectStop(r, case_no, kind + " (report)", {0, 2}, "", "", failures);
+  } else {
+    ExpectStop(r, case_no, kind + " (report)", {2}, r.err, message, failures);
+  }
+  fs::remove(path);
+  WriteFile(path, saved);
+}
+
+// "Billion laughs" in the config: 10 levels of 9 aliases (~0.5 kB). Refused at the first alias.
+void CaseAliasBomb(const Args& args, const Workspace& w, int case_no, Failures* failures) {
+  const std::string kind = "YAML alias bomb in the config";
+  std::string bomb = "laughs:\n  a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]\n";
+  for (int level = 1; level <= 10; ++level) {
+    bomb += "  a" + std::to_string(level) + ": &a" + std::to_string(level) + " [";
+    for (int k = 0; k < 9; ++k) bomb += (k ? ", *a" : "*a") + std::to_string(level - 1);
+    bomb += "]\n";
+  }
+  WriteFile(w.config_path, w.config_text + bomb);
+  const Outcome o =
+      Wait(Start(ProcessArgv(args, w, false), w.dir + "/hostile"), args.run_timeout_s);
+  CheckRun(o, w, case_no, kind, failures);
+  ExpectStop(o, case_no, kind, {2}, o.err, "YAML alias '*a0'", failures, /*after_check_run=*/true);
+  w.RestoreConfig();
+}
+
+// Runs the cases above once each; returns how many ran.
+int RunHostileInputCases(const Args& args, Workspace& w, int first_case_no, Failures* failures) {
+  int c = first_case_no;
+  CaseSpecialFileAmongLogs(args, w, c++, /*fifo=*/true, failures);
+  CaseSpecialFileAmongLogs(args, w, c++, /*fifo=*/false, failures);
+  CaseDevZeroConfig(args, w, c++, failures);
+  CaseMultiMemberGzip(args, w, c++, failures);
+  CaseGzipBomb(args, w, c++, failures);
+  CaseFifoInOutput(args, w, c++, /*cache_entry=*/false, failures);
+  CaseFifoInOutput(args, w, c++, /*cache_entry=*/true, failures);
+  CaseAliasBomb(args, w, c++, failures);
+  return c - first_case_no;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -980,6 +1157,8 @@ int main(int argc, char** argv) {
     }
     ++kinds_run[kind];
   }
+  kinds_run["hostile input (bounded reads)"] =
+      RunHostileInputCases(args, w, args.cases + 1, &failures);
   const double total_s = std::chrono::duration<double>(Clock::now() - start).count();
   std::cout << "bifilar_stress: seed " << args.seed << ", " << args.cases << " cases in "
             << total_s << " s (one forced run " << forced_s << " s):";
