@@ -49,6 +49,9 @@ struct CampaignResult {
   double rig_inertia_kg_m2 = NAN;   // value / tare mean (table: NaN, see per-trace field)
   double rig_inertia_std_kg_m2 = NAN;
   int rig_tare_n = 0;               // ok tare logs used
+  // Why the rig inertia is unknown (tare: no usable tare log, with the first tare log's own
+  // message), "" when known; the console says it once, before the traces it affects.
+  std::string rig_problem;
   std::vector<AngleStats> angles;   // sorted by pitch
   std::optional<EllipseResult> ellipse_fit;  // fit/ellipse.h, when >= min_angles angles remain
   nlohmann::json ellipse;           // pipeline/ellipse_json.h document, null when not fitted
@@ -88,8 +91,11 @@ struct CampaignOptions {
 // turns it into exit code 2); problems with single logs are error rows.
 CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& options);
 
+// The start of a trace's message when a tare campaign has no usable tare log.
+inline constexpr char kNoUsableTareLog[] = "no usable tare log";
+
 // Rig inertia subtracted at `pitch_deg` from the spec and the fitted tare mean/std. False with
-// *why when it cannot be found (table: pitch outside it; tare: no usable tare log).
+// *why when it cannot be found (table: pitch outside it; tare: kNoUsableTareLog ...).
 bool RigInertiaAt(const CampaignConfig& config, double tare_mean_kg_m2, double tare_std_kg_m2,
                   double pitch_deg, double* inertia_kg_m2, double* std_kg_m2, std::string* why);
 

@@ -13,6 +13,8 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
   auto inertia = [&](double kg_m2) { return InertiaToDisplay(kg_m2, units); };
   char line[256];
   const CampaignSummary& s = result.summary;
+  // The one cause that fails every aircraft trace comes first, once.
+  if (!result.rig_problem.empty()) out << "Error: " << result.rig_problem << "\n";
   if (result.ellipse_fit) {
     const EllipseResult& e = *result.ellipse_fit;
     out << "Table 2 (" << unit << ", +- 1 std):\n";
@@ -42,6 +44,9 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
           100.0 * result.systematic_relative_std);
       out << line;
     }
+    for (const std::string& w : e.warnings) {
+      if (!e.physical && w.rfind("non-physical", 0) == 0) out << "Warning: " << w << "\n";
+    }
     std::snprintf(line, sizeof(line),
                   "Table 1: raw sigma %#.5g %s, CV %.4f %%, regression RMSE %#.5g %s\n",
                   inertia(result.raw_sigma_kg_m2), unit, result.cv_percent,
@@ -59,14 +64,24 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     }
     out << "\n";
   }
-  int shown = 0;
+  int shown = 0, rig_unknown = 0;
   for (const TraceRecord& r : result.traces) {
     if (r.ok()) continue;
+    // Traces failed only by the unknown rig inertia: counted in one line, the cause is above.
+    if (!result.rig_problem.empty() && r.role == TraceRole::kAircraft &&
+        r.message.find(kNoUsableTareLog) != std::string::npos) {
+      ++rig_unknown;
+      continue;
+    }
     if (shown++ == 10) {
       out << "  ...\n";
       break;
     }
     out << "  " << ToString(r.status) << ": " << r.message << "\n";
+  }
+  if (rig_unknown > 0) {
+    out << "  error: " << rig_unknown << " aircraft trace" << (rig_unknown == 1 ? "" : "s")
+        << ": rig inertia unknown (no usable tare log, see the first line)\n";
   }
   std::snprintf(line, sizeof(line),
                 "Traces: %d ok, %d rejected, %d error (of %d); fits run %d, reused from cache %d; "
