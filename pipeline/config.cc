@@ -227,7 +227,11 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
   out->inertia_std_kg_m2 = NonNegative(inertia, "inertia_std_kg_m2", 0.0);
   if (inertia.Has("inertia_kg_m2")) {
     out->kind = RigInertiaSpec::Kind::kValue;
-    out->inertia_kg_m2 = NonNegative(inertia, "inertia_kg_m2", 0.0);
+    YAML::Node value = inertia.Required("inertia_kg_m2");  // blank or ~: an error, never 0
+    out->inertia_kg_m2 = inertia.AsDouble(value, "inertia_kg_m2");
+    if (out->inertia_kg_m2 < 0.0) {
+      throw UserError(inertia.Where(value) + ": 'rig.inertia.inertia_kg_m2' must be >= 0");
+    }
   } else if (inertia.Has("table")) {
     out->kind = RigInertiaSpec::Kind::kTable;
     YAML::Node table = inertia.Optional("table");
