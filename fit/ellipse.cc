@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <sstream>
 
@@ -177,6 +178,31 @@ std::vector<AngleGroup> GroupByAngle(const std::vector<EllipsePoint>& points,
   return groups;
 }
 
+// Groups that hold different pitches (within the tolerance) are one "angle" for Table 1, the
+// per-angle statistics and the covariance: their spread then includes the curve's change across
+// the group, not only the trials' scatter. Said in one warning naming the merged pitches.
+void WarnMergedAngles(const std::vector<EllipsePoint>& points,
+                      const std::vector<AngleGroup>& groups, double tol_deg,
+                      std::vector<std::string>* warnings) {
+  std::string listed;
+  int merged = 0;
+  for (const AngleGroup& g : groups) {
+    double lo = points[g.members.front()].pitch_deg, hi = lo;
+    for (int i : g.members) {
+      lo = std::min(lo, points[i].pitch_deg);
+      hi = std::max(hi, points[i].pitch_deg);
+    }
+    if (lo == hi) continue;
+    if (++merged <= 5) listed += (merged > 1 ? "; " : "") + Num(lo) + " to " + Num(hi) + " deg";
+  }
+  if (merged == 0) return;
+  if (merged > 5) listed += "; ...";
+  warnings->push_back(std::to_string(merged) + " angle group" + (merged == 1 ? "" : "s") +
+                      " merge different pitches within " + Num(tol_deg) + " deg (" + listed +
+                      "): Table 1's per-angle std and CoV then include the curve's change "
+                      "across each group, not only the trials' scatter");
+}
+
 // kAuto made concrete, then checked against the counts it needs.
 bool ResolveCovariance(EllipseCovariance requested, int n_points, int n_groups,
                        EllipseCovariance* mode, std::string* why) {
@@ -237,6 +263,7 @@ bool PrepareData(const std::vector<EllipsePoint>& points, const EllipseOptions& 
   d.sqrt_w = d.w.cwiseSqrt();
   d.xw = d.sqrt_w.asDiagonal() * d.x;
   d.groups = GroupByAngle(points, d.w, options.angle_group_tol_deg);
+  WarnMergedAngles(points, d.groups, options.angle_group_tol_deg, &d.warnings);
   return ResolveCovariance(options.covariance, n, static_cast<int>(d.groups.size()),
                            &d.covariance, why);
 }
@@ -392,6 +419,38 @@ EllipseResult AssembleResult(PreparedData data, const ClosedFormFit& closed,
   return r;
 }
 
+// A moment of inertia is > 0 and the x-z tensor [[I_x, -I_xz], [-I_xz, I_z]] positive
+// definite (both principal moments > 0). A fit that breaks this (an outlier, mixed units) is a
+// number no body has: said in a warning that names the moments and the worst point.
+void CheckPhysical(EllipseResult* r) {
+  const double ix = r->ix.value, iz = r->iz.value, ixz = r->ixz.value;
+  const double det = ix * iz - ixz * ixz;
+  r->physical = ix > 0.0 && iz > 0.0 && det > 0.0;
+  if (r->physical) return;
+  const double mean = 0.5 * (ix + iz), half = std::sqrt(0.25 * (ix - iz) * (ix - iz) + ixz * ixz);
+  char buffer[400];
+  std::snprintf(buffer, sizeof(buffer),
+                "non-physical result: I_x = %.6g, I_z = %.6g, I_xz = %.6g kg m^2 give principal "
+                "moments %.6g and %.6g; a body's moments are > 0 with I_x I_z > I_xz^2",
+                ix, iz, ixz, mean + half, mean - half);
+  std::string text = buffer;
+  const EllipseResidual* worst = nullptr;
+  for (const EllipseResidual& e : r->residuals) {
+    if (std::isfinite(e.studentized) &&
+        (worst == nullptr || std::abs(e.studentized) > std::abs(worst->studentized))) {
+      worst = &e;
+    }
+  }
+  if (worst != nullptr) {
+    std::snprintf(buffer, sizeof(buffer),
+                  ". Check the table for outliers (point %d at pitch %g deg: %.6g kg m^2, "
+                  "studentized residual %.2f) and units",
+                  worst->index + 1, worst->pitch_deg, worst->inertia_kg_m2, worst->studentized);
+    text += buffer;
+  }
+  r->warnings.push_back(text);
+}
+
 }  // namespace
 
 bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& options,
@@ -415,6 +474,7 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
 
   *result = AssembleResult(std::move(data), closed, nelder_mead, ceres, cov, intervals,
                            std::move(diagnostics));
+  CheckPhysical(result);
   result->time_s = SecondsSince(start);
   return true;
 }

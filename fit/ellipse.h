@@ -204,6 +204,9 @@ struct EllipseResult {
   int n_outliers = 0;
   std::vector<EllipseNacaEstimate> naca;
   std::vector<std::string> warnings;  // human-readable, e.g. tau ill-defined, fits disagree
+  // false when the fitted tensor is not one of a body: I_x or I_z <= 0, or I_x I_z <= I_xz^2
+  // (a principal moment <= 0); a warning then says so, and the commands exit 1.
+  bool physical = true;
 
   double time_s = 0.0;
 

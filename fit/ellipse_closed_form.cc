@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <vector>
 
 namespace bifilar {
 namespace ellipse {
@@ -73,6 +75,26 @@ bool FitClosedForm(const PreparedData& data, ClosedFormFit* fit, std::string* wh
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(data.xw);
   if (qr.rank() < 3) {
     *why = "the pitch angles do not determine the ellipse (rank-deficient design)";
+    // Weights 1/std^2 that far apart leave the other points no say: name the std, not the design.
+    if (data.weighted) {
+      std::vector<double> stds;
+      int smallest = 0;
+      for (int i = 0; i < data.n; ++i) {
+        stds.push_back(data.points[i].std_kg_m2);
+        if (data.points[i].std_kg_m2 < data.points[smallest].std_kg_m2) smallest = i;
+      }
+      std::nth_element(stds.begin(), stds.begin() + stds.size() / 2, stds.end());
+      const double median = stds[stds.size() / 2], least = data.points[smallest].std_kg_m2;
+      if (least < 1e-6 * median) {
+        char buffer[400];
+        std::snprintf(buffer, sizeof(buffer),
+                      ": point %d (pitch %g deg) has std %g kg m^2, %.3g times below the median "
+                      "std %g, so its weight 1/std^2 swamps every other point; check that std "
+                      "(its units, or a typo), or drop the std column",
+                      smallest + 1, data.points[smallest].pitch_deg, least, median / least, median);
+        *why += buffer;
+      }
+    }
     return false;
   }
   ClosedFormFit& f = *fit;

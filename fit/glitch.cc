@@ -18,15 +18,15 @@ double MedianInPlace(std::vector<double>* v) {
   return m;
 }
 
-// The four samples nearest to k in index (two on each side inside the series, else the next
-// ones on the other side), for n >= 5.
-void Neighbours(size_t k, size_t n, size_t idx[4]) {
-  size_t first = k >= 2 ? k - 2 : 0;
-  if (first + 4 >= n) first = n - 5;
+// The four samples nearest to the span [k, k + m) outside it: two on each side inside the
+// series, else more on the other side; for n >= m + 4. With m = 1, the neighbours of sample k.
+void Neighbours(size_t k, size_t m, size_t n, size_t idx[4]) {
+  size_t before = std::min<size_t>(k, 2), after = std::min<size_t>(n - k - m, 2);
+  if (before < 2) after = 4 - before;
+  else if (after < 2) before = 4 - after;
   int j = 0;
-  for (size_t i = first; i <= first + 4; ++i) {
-    if (i != k) idx[j++] = i;
-  }
+  for (size_t i = k - before; i < k; ++i) idx[j++] = i;
+  for (size_t i = k + m; i < k + m + after; ++i) idx[j++] = i;
 }
 
 }  // namespace
@@ -57,7 +57,7 @@ std::vector<size_t> FindGlitches(const std::vector<double>& t, const std::vector
   std::vector<double> e(n, 0.0);
   size_t idx[4];
   for (size_t k = 0; k < n; ++k) {
-    Neighbours(k, n, idx);
+    Neighbours(k, 1, n, idx);
     e[k] = NeighbourCubicResidual(t, x, k, idx);
   }
   // Robust scale with its floors.
@@ -78,18 +78,46 @@ std::vector<size_t> FindGlitches(const std::vector<double>& t, const std::vector
   const double excursion = work[q99];
   scale = std::max({scale, 1e-3 * excursion, quantum});
   const double threshold = options.threshold_sigmas * scale;
-  for (size_t k = 0; k < n; ++k) {
-    if (!(std::abs(e[k]) > threshold)) continue;
-    Neighbours(k, n, idx);
+  // Sample j against the cubic through idx: far outside the noise, and beyond the neighbours'
+  // range by more than range_factor times that range and excursion_fraction of the swing.
+  auto stands_out = [&](size_t j, const size_t idx[4], double residual) {
+    if (!(std::abs(residual) > threshold)) return false;
     double lo = x[idx[0]], hi = x[idx[0]];
     for (int i = 1; i < 4; ++i) {
       lo = std::min(lo, x[idx[i]]);
       hi = std::max(hi, x[idx[i]]);
     }
-    const double outside = std::max(x[k] - hi, lo - x[k]);  // beyond the neighbours' range
-    if (outside > options.range_factor * (hi - lo) && outside > options.excursion_fraction * excursion) {
-      out.push_back(k);
+    const double outside = std::max(x[j] - hi, lo - x[j]);  // beyond the neighbours' range
+    return outside > options.range_factor * (hi - lo) &&
+           outside > options.excursion_fraction * excursion;
+  };
+  std::vector<char> flagged(n, 0);
+  for (size_t k = 0; k < n; ++k) {
+    Neighbours(k, 1, n, idx);
+    if (stands_out(k, idx, e[k])) flagged[k] = 1;
+  }
+  // Short runs: two glitches adjacent (m = 2) or one sample apart (m = 3) widen each other's
+  // neighbour range, so neither stands out alone. The span [k, k + m) is tested against the four
+  // samples around it; its first and last samples must both stand out (a smooth swing's peak
+  // cannot, as for one sample), and a middle sample is dropped only when it stands out too.
+  for (size_t m = 2; m <= 3 && n >= m + 4; ++m) {
+    for (size_t k = 0; k + m <= n; ++k) {
+      const size_t last = k + m - 1;
+      if (flagged[k] || flagged[last]) continue;
+      Neighbours(k, m, n, idx);
+      if (!stands_out(k, idx, NeighbourCubicResidual(t, x, k, idx)) ||
+          !stands_out(last, idx, NeighbourCubicResidual(t, x, last, idx))) {
+        continue;
+      }
+      for (size_t j = k; j <= last; ++j) {
+        if (j == k || j == last || stands_out(j, idx, NeighbourCubicResidual(t, x, j, idx))) {
+          flagged[j] = 1;
+        }
+      }
     }
+  }
+  for (size_t k = 0; k < n; ++k) {
+    if (flagged[k]) out.push_back(k);
   }
   if (static_cast<double>(out.size()) > options.max_fraction * static_cast<double>(n)) out.clear();
   return out;
@@ -134,8 +162,8 @@ std::string DescribeGlitches(const ImuData& data, const std::vector<size_t>& ind
   double largest = 0.0;
   for (size_t k : indices) largest = std::max(largest, data.gyro_in_imu[k].cwiseAbs().maxCoeff());
   char buf[128];
-  std::snprintf(buf, sizeof(buf), "%zu glitch sample%s ignored (single gyro readings far outside "
-                "the swing, up to %.3g rad/s) at t =", indices.size(),
+  std::snprintf(buf, sizeof(buf), "%zu glitch sample%s ignored (gyro readings far outside the "
+                "swing, alone or in runs of 2-3, up to %.3g rad/s) at t =", indices.size(),
                 indices.size() == 1 ? "" : "s", largest);
   std::string text = buf;
   const size_t shown = std::min<size_t>(indices.size(), 5);

@@ -1,6 +1,7 @@
-// Isolated single-sample glitches in a gyro log (a radio or bus error that writes one absurd
-// reading), found before the swing axis, the window, the guess and the fit see the data, so that
-// one bad sample neither rejects a trace nor moves its window (issue 8, "a reader for real files").
+// Gyro glitches, single samples or short runs of 2-3 (a radio or bus error that writes absurd
+// readings), found before the swing axis, the window, the guess and the fit see the data, so that
+// a few bad samples neither reject a trace nor move its window (issue 8, "a reader for real
+// files"; issue 15 item 9).
 //
 // Detector (per gyro axis, a Hampel-type test at the log's real timestamps): each sample x_k is
 // predicted by the cubic through its four nearest neighbours (two on each side inside the log),
@@ -19,7 +20,12 @@
 // On the 24 real Crazyflie logs (30 Hz, steps of 8-160 ms) and simulated logs of that rig, no
 // clean sample beyond 10 sigma passes both range tests (the closest: 1.55x the range at 0.34x
 // the excursion, 0.98x at 1.3x); 5 and 50 rad/s glitches reach 11-90x and 4-12x.
-// Only isolated samples are found: two adjacent glitches widen each other's neighbour range.
+// Short runs (issue 15 item 9): two glitches adjacent, or one sample apart, widen each other's
+// neighbour range, so neither passes the test alone (two 50 rad/s samples rejected the trace; a
+// pair of 2 rad/s ones moved the window start by 15 s). Each span of 2 or 3 consecutive samples
+// is therefore also tested against the cubic through the two samples on each side of it: when its
+// first and last samples both pass the three tests above, they are glitches, and so is its middle
+// sample (span of 3) only if it passes them too. Longer runs are the signal, not glitches.
 #pragma once
 
 #include <string>
@@ -44,8 +50,8 @@ struct GlitchOptions {
   bool Check(std::string* why) const;
 };
 
-// Indices (increasing) of the isolated glitches of x at times t (same size, t increasing). Fewer
-// than 6 samples: none.
+// Indices (increasing) of the glitches of x at times t (same size, t increasing): isolated
+// samples and runs of 2-3. Fewer than 6 samples: none.
 std::vector<size_t> FindGlitches(const std::vector<double>& t_s, const std::vector<double>& x,
                                  const GlitchOptions& options);
 

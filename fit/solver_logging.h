@@ -6,8 +6,9 @@
 
 namespace bifilar {
 
-// Initialises glog once per process (to stderr only, never log files) and keeps only errors.
-// Thread-safe and idempotent; called by the command line and by FitEllipse.
+// Initialises glog once per process (to stderr only, never log files) and keeps only fatal
+// messages (the solvers' errors name no file; their outcome is in the summaries). Thread-safe
+// and idempotent; called by the command line, FitEllipse and the trace fit's solver.
 void QuietSolverLogging();
 
 }  // namespace bifilar

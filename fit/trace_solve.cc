@@ -8,6 +8,7 @@
 #include <nlopt.hpp>
 #include <Eigen/Dense>
 
+#include "fit/solver_logging.h"
 #include "fit/trace_fit_steps.h"
 
 namespace bifilar {
@@ -132,6 +133,7 @@ double Cost(const TraceRateCost& cost, const double* p, std::vector<double>* r) 
 
 SolveOutcome SolveLm(const TraceRateCost& cost, int max_iterations, const bool fixed[2],
                      bool stop_at_bound, double* p) {
+  QuietSolverLogging();  // also from the Python module and tests, not only the command line
   ceres::Problem problem;
   AddTraceResidual(cost, fixed, p, &problem);
   ceres::Solver::Options options;

@@ -392,6 +392,17 @@ void SetRigInertia(const CampaignConfig& config, const TareEstimate& tare, Campa
   if (config.rig_inertia.kind == RigInertiaSpec::Kind::kTare) {
     result->rig_inertia_kg_m2 = tare.mean_kg_m2;
     result->rig_inertia_std_kg_m2 = tare.std_kg_m2;
+    if (tare.n == 0) {  // the cause, from the tare logs' own rows, said once
+      int failed = 0;
+      std::string first;
+      for (const TraceRecord& r : result->traces) {
+        if (r.role != TraceRole::kTare) continue;
+        if (failed++ == 0) first = r.message.empty() ? r.file + ": " + ToString(r.status) : r.message;
+      }
+      result->rig_problem = "no usable tare log, so the rig inertia is unknown: " +
+                            (failed == 0 ? std::string("no tare log found") : first) +
+                            (failed > 1 ? " (and " + std::to_string(failed - 1) + " more)" : "");
+    }
   } else if (config.rig_inertia.kind == RigInertiaSpec::Kind::kValue) {
     result->rig_inertia_kg_m2 = config.rig_inertia.inertia_kg_m2;
     result->rig_inertia_std_kg_m2 = config.rig_inertia.inertia_std_kg_m2;
@@ -685,7 +696,7 @@ bool RigInertiaAt(const CampaignConfig& config, double tare_mean_kg_m2, double t
       return true;
     case RigInertiaSpec::Kind::kTare:
       if (!std::isfinite(tare_mean_kg_m2)) {
-        *why = "no usable tare log: the rig inertia is unknown";
+        *why = std::string(kNoUsableTareLog) + ": the rig inertia is unknown";
         return false;
       }
       *inertia_kg_m2 = tare_mean_kg_m2;
@@ -758,7 +769,8 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   result.assumed_inputs_note = AssumedInputsSummary(result.traces);
   // 5. Ellipse of inertia, Table 1, Fig. 3/4.
   FitCampaignEllipse(config, options, &out, &result);
-  if (result.summary.n_rejected + result.summary.n_error > 0 || !result.summary.ellipse_fitted) {
+  if (result.summary.n_rejected + result.summary.n_error > 0 || !result.summary.ellipse_fitted ||
+      (result.ellipse_fit && !result.ellipse_fit->physical)) {
     result.summary.exit_code = 1;
   }
   result.summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();

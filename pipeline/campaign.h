@@ -60,6 +60,9 @@ struct CampaignResult {
   // rig.calibration: the effective geometry every trace was fitted with (pipeline/calibration.h);
   // absent without the section.
   std::optional<RigCalibrationResult> calibration;
+  // Why the rig inertia is unknown (tare: no usable tare log, with the first tare log's own
+  // message), "" when known; the console says it once, before the traces it affects.
+  std::string rig_problem;
   std::vector<AngleStats> angles;   // sorted by pitch
   std::optional<EllipseResult> ellipse_fit;  // fit/ellipse.h, when >= min_angles angles remain
   nlohmann::json ellipse;           // pipeline/ellipse_json.h document, null when not fitted
@@ -113,8 +116,11 @@ struct CampaignOptions {
 // rows.
 CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& options);
 
+// The start of a trace's message when a tare campaign has no usable tare log.
+inline constexpr char kNoUsableTareLog[] = "no usable tare log";
+
 // Rig inertia subtracted at `pitch_deg` from the spec and the fitted tare mean/std. False with
-// *why when it cannot be found (table: pitch outside it; tare: no usable tare log).
+// *why when it cannot be found (table: pitch outside it; tare: kNoUsableTareLog ...).
 bool RigInertiaAt(const CampaignConfig& config, double tare_mean_kg_m2, double tare_std_kg_m2,
                   double pitch_deg, double* inertia_kg_m2, double* std_kg_m2, std::string* why);
 

@@ -14,6 +14,8 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
   auto inertia = [&](double kg_m2) { return InertiaToDisplay(kg_m2, units); };
   char line[256];
   const CampaignSummary& s = result.summary;
+  // The one cause that fails every aircraft trace comes first, once.
+  if (!result.rig_problem.empty()) out << "Error: " << result.rig_problem << "\n";
   if (result.ellipse_fit) {
     const EllipseResult& e = *result.ellipse_fit;
     // Each moment: its std (stat: the trials' scatter, the rig offset) and the total, which adds
@@ -49,6 +51,9 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
                     : result.common_mode_assumed ? "L, D (assumed +-1 mm), g" : "L, D, g");
       out << line;
     }
+    for (const std::string& w : e.warnings) {
+      if (!e.physical && w.rfind("non-physical", 0) == 0) out << "Warning: " << w << "\n";
+    }
     std::snprintf(line, sizeof(line),
                   "Table 1: raw sigma %#.5g %s, CV %.4f %%, regression RMSE %#.5g %s\n",
                   inertia(result.raw_sigma_kg_m2), unit, result.cv_percent,
@@ -75,9 +80,15 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
                   c.nominal_separation_m, c.filar_length_m, c.n_swings, c.n_swings == 1 ? "" : "s");
     out << line;
   }
-  int shown = 0;
+  int shown = 0, rig_unknown = 0;
   for (const TraceRecord& r : result.traces) {
     if (r.ok()) continue;
+    // Traces failed only by the unknown rig inertia: counted in one line, the cause is above.
+    if (!result.rig_problem.empty() && r.role == TraceRole::kAircraft &&
+        r.message.find(kNoUsableTareLog) != std::string::npos) {
+      ++rig_unknown;
+      continue;
+    }
     if (shown++ == 10) {
       out << "  ...\n";
       break;
@@ -85,6 +96,10 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     out << "  " << ToString(r.status) << ": " << r.message << "\n";
   }
   if (!result.assumed_inputs_note.empty()) out << result.assumed_inputs_note << "\n";
+  if (rig_unknown > 0) {
+    out << "  error: " << rig_unknown << " aircraft trace" << (rig_unknown == 1 ? "" : "s")
+        << ": rig inertia unknown (no usable tare log, see the first line)\n";
+  }
   std::snprintf(line, sizeof(line),
                 "Traces: %d ok, %d rejected, %d error (of %d); fits run %d, reused from cache %d; "
                 "wall time %.2f s\n",

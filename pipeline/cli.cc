@@ -1,5 +1,8 @@
 #include "pipeline/cli.h"
 
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <new>
@@ -33,6 +36,40 @@ std::string CommandAndInputs(int argc, char** argv) {
 }
 
 }  // namespace
+
+CLI::Validator FiniteNumber() {
+  return CLI::Validator(
+      [](std::string& input) {
+        double value = 0.0;
+        size_t used = 0;
+        try {
+          value = std::stod(input, &used);
+        } catch (const std::exception&) {
+          return "'" + input + "' is not a number";
+        }
+        if (used != input.size()) return "'" + input + "' is not a number";
+        if (!std::isfinite(value)) return "'" + input + "' is not a finite number";
+        return std::string();
+      },
+      "NUMBER", "finite number");
+}
+
+uint64_t ParseSeed(const std::string& text, const std::string& flag, uint64_t max) {
+  const std::string range = "[0, " + std::to_string(max) + "]";
+  bool digits = !text.empty() && text.size() <= 20;
+  for (char c : text) digits = digits && c >= '0' && c <= '9';
+  uint64_t value = 0;
+  if (digits) {
+    errno = 0;
+    const unsigned long long parsed = std::strtoull(text.c_str(), nullptr, 10);
+    digits = errno == 0 && parsed <= max;
+    value = parsed;
+  }
+  if (!digits) {
+    throw UserError(flag + " '" + text.substr(0, 40) + "': a seed is an integer in " + range);
+  }
+  return value;
+}
 
 int RunCommandLine(int argc, char** argv) {
   QuietSolverLogging();  // fit/solver_logging.h: no glog preamble or solver chatter

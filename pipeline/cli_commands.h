@@ -3,11 +3,22 @@
 // bifilar::UserError, which the dispatcher prints as one line and turns into exit code 2.
 #pragma once
 
+#include <cstdint>
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 #include "pipeline/user_error.h"
 
 namespace bifilar {
+
+// A check for every numeric flag: the text must be a finite number (CLI11 reads "nan" and "inf"
+// as doubles, and CLI::Range lets NaN through).
+CLI::Validator FiniteNumber();
+
+// A seed flag, read strictly: a decimal integer in [0, max]; anything else (-1, 2^64, 1e23, 1.5)
+// is a UserError naming the flag and the range, never a saturated or wrapped seed.
+uint64_t ParseSeed(const std::string& text, const std::string& flag, uint64_t max);
 
 void RegisterSimulateCommand(CLI::App& app, int* exit_code);
 void RegisterFitCommand(CLI::App& app, int* exit_code);

@@ -2,6 +2,7 @@
 // RunPlanCommand (pipeline/ellipse_command.h).
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include <fast_float/fast_float.h>
@@ -79,7 +80,8 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
   ellipse->add_flag("--json", opts->json, "print the result as JSON (SI)");
   ellipse->add_option("--plot", opts->plot_dir,
                       "write ellipse_moments and ellipse_polar figures (.png, .svg) here");
-  ellipse->add_option("--seed", opts->fit.seed, "bootstrap seed (default 1)");
+  auto seed = std::make_shared<std::string>();
+  ellipse->add_option("--seed", *seed, "bootstrap seed, an integer in [0, 2^64 - 1] (default 1)");
   ellipse->add_option("--bootstrap", opts->fit.bootstrap_replicates,
                       "parametric bootstrap replicates for the 95% intervals; 0 = t intervals "
                       "(default 2000)")
@@ -87,9 +89,13 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
   ellipse->add_option("--covariance", *covariance,
                       "auto (default), points, angle_means or absolute (trust the std column)");
   ellipse->add_option("--outlier-threshold", opts->fit.outlier_threshold,
-                      "flag trials with |studentized residual| above this (default 3)");
-  ellipse->callback([opts, units, covariance, exit_code] {
+                      "flag trials with |studentized residual| above this (default 3)")
+      ->check(FiniteNumber());
+  ellipse->callback([opts, units, covariance, seed, exit_code] {
     opts->units = Units(*units);
+    if (!seed->empty()) {
+      opts->fit.seed = ParseSeed(*seed, "--seed", std::numeric_limits<uint64_t>::max());
+    }
     if (!ParseEllipseCovariance(*covariance, &opts->fit.covariance)) {
       throw UserError("--covariance must be auto, points, angle_means or absolute, got '" +
                       *covariance + "'");
@@ -114,11 +120,15 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
   plan->add_option("--trials", plan_opts->trials_per_angle, "trials per angle (default 3)")
       ->check(CLI::Range(1, 1000000));
   plan->add_option("--sigma", plan_opts->sigma, "per-trial standard deviation of a moment, in --units")
-      ->required();
-  plan->add_option("--ix", *ix, "guess of I_x in --units (default: the paper's PRANDTL-D)");
-  plan->add_option("--iz", *iz, "guess of I_z in --units (default: the paper's PRANDTL-D)");
+      ->required()
+      ->check(FiniteNumber());
+  plan->add_option("--ix", *ix, "guess of I_x in --units (default: the paper's PRANDTL-D)")
+      ->check(FiniteNumber());
+  plan->add_option("--iz", *iz, "guess of I_z in --units (default: the paper's PRANDTL-D)")
+      ->check(FiniteNumber());
   auto* ixz_option =
-      plan->add_option("--ixz", *ixz, "guess of I_xz in --units (default 0 when --ix/--iz given)");
+      plan->add_option("--ixz", *ixz, "guess of I_xz in --units (default 0 when --ix/--iz given)")
+          ->check(FiniteNumber());
   plan->add_option("--units", *plan_units, "si (kg m^2, default) or imperial (slug ft^2)");
   plan->add_flag("--json", plan_opts->json, "print JSON (SI)");
   plan->callback([plan_opts, angles, plan_units, ix, iz, ixz, ixz_option, exit_code] {

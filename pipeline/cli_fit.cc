@@ -136,6 +136,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
   sub->add_option("--window", args->window, "fit only T0:T1 (s, the log's own time)");
   sub->add_option("--max-amplitude", args->max_amplitude_deg,
                   "upper end of the amplitude band (deg)")
+      ->check(FiniteNumber())
       ->check(CLI::Range(kMinMaxAmplitudeDeg, kMaxMaxAmplitudeDeg));  // as fit.max_amplitude_deg
   sub->add_option("--plot", args->plot_dir,
                   "write fit figures DIR/<log>.svg and .png, and the amplitude sweep (I against "

@@ -4,6 +4,7 @@
 //                 [--amplitude-deg A] [--pitch-deg P] [--duration-s T] [--model M] [--seed N]
 //                 [SPEC.yaml for sensor/timeline/format settings and defaults]
 #include <iostream>
+#include <limits>
 #include <optional>
 
 #include "pipeline/cli_commands.h"
@@ -22,7 +23,7 @@ struct SimulateArgs {
 
 // CLI11 2.1 binds plain values; an option given on the command line fills the std::optional.
 struct RawArgs {
-  uint64_t seed = 1;
+  std::string seed;
   double inertia = 0, mass = 0, length = 0, separation = 0, gravity = 0, amplitude = 0, pitch = 0,
          duration = 0, sample_rate = 0;
   CLI::Option *o_seed = nullptr, *o_inertia = nullptr, *o_mass = nullptr, *o_length = nullptr,
@@ -113,7 +114,9 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
   sub->add_option("--out", args->out_dir, "campaign output folder (pitch_*/trial_*.csv, tare/, truth.json)");
   sub->add_option("--trace", args->trace_csv, "simulate one trace into this CSV file");
   sub->add_option("--truth", args->truth_json, "truth JSON of --trace (default OUT.truth.json)");
-  raw->o_seed = sub->add_option("--seed", raw->seed, "random seed (overrides the spec's `seed`; default 1)");
+  raw->o_seed = sub->add_option("--seed", raw->seed,
+                                "random seed, an integer in [0, 2^64 - 1] (overrides the spec's "
+                                "`seed`; default 1)");
   raw->o_inertia = sub->add_option("--inertia-kg-m2", raw->inertia, "--trace: whole suspended inertia I (kg m^2)");
   raw->o_mass = sub->add_option("--mass-kg", raw->mass, "--trace: whole suspended mass m (kg)");
   raw->o_length = sub->add_option("-L,--filar-length-m", raw->length, "filar (wire) length L (m), > D");
@@ -123,11 +126,18 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
   raw->o_pitch = sub->add_option("--pitch-deg", raw->pitch, "--trace: true pitch of the body (deg), default 0");
   raw->o_duration = sub->add_option("--duration-s", raw->duration, "free-oscillation duration (s)");
   raw->o_sample_rate = sub->add_option("--sample-rate-hz", raw->sample_rate, "IMU sample rate (Hz), default 100");
+  for (CLI::Option* option : {raw->o_inertia, raw->o_mass, raw->o_length, raw->o_separation,
+                              raw->o_gravity, raw->o_amplitude, raw->o_pitch, raw->o_duration,
+                              raw->o_sample_rate}) {
+    option->check(FiniteNumber());
+  }
   sub->add_option("--model", args->model, "truth model: full (default), jardin, linear");
   sub->add_flag("--no-accel", args->no_accel, "write no accelerometer columns");
   sub->callback([args, raw, exit_code] {
     SimulateArgs& a = *args;
-    a.seed = Given(raw->o_seed, raw->seed);
+    if (raw->o_seed->count() > 0) {
+      a.seed = ParseSeed(raw->seed, "--seed", std::numeric_limits<uint64_t>::max());
+    }
     a.inertia = Given(raw->o_inertia, raw->inertia);
     a.mass = Given(raw->o_mass, raw->mass);
     a.length = Given(raw->o_length, raw->length);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -43,7 +44,7 @@ double Positive(YamlMap& map, const std::string& key) {
 
 double NonNegative(YamlMap& map, const std::string& key, double fallback) {
   YAML::Node node = map.Optional(key);
-  if (!node.IsDefined() || node.IsNull()) return fallback;
+  if (!map.Given(node, key, "a number >= 0")) return fallback;
   const double value = map.AsDouble(node, key);
   if (value < 0.0) throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be >= 0");
   return value;
@@ -161,8 +162,14 @@ void ReadImuMounting(YamlMap& imu, ImuConfig* out) {
     out->swing_axis_auto = true;
   } else {
     const Eigen::Vector3d v = ThreeVector(imu, axis, "swing_axis");
-    if (!(v.norm() > 1e-9)) {
-      throw UserError(imu.Where(axis) + ": 'imu.swing_axis' must be auto or a non-zero vector");
+    // A direction, normalised here: its length must be neither 0 nor overflow the norm (1e300
+    // gave an infinite norm and a zero axis, so every trace failed instead of the config).
+    const double length = v.cwiseAbs().maxCoeff() > kMaxSwingAxisLength ? HUGE_VAL : v.norm();
+    if (!(length >= kMinSwingAxisLength && length <= kMaxSwingAxisLength)) {
+      char range[96];
+      std::snprintf(range, sizeof(range), "[%g, %g]", kMinSwingAxisLength, kMaxSwingAxisLength);
+      throw UserError(imu.Where(axis) + ": 'imu.swing_axis' must be auto or a direction in IMU "
+                      "axes of length in " + range + ", e.g. [0, 0, 1] (it is normalised)");
     }
     out->swing_axis_auto = false;
     out->swing_axis_in_imu = v.normalized();
@@ -255,7 +262,11 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
   out->inertia_std_kg_m2 = NonNegative(inertia, "inertia_std_kg_m2", 0.0);
   if (inertia.Has("inertia_kg_m2")) {
     out->kind = RigInertiaSpec::Kind::kValue;
-    out->inertia_kg_m2 = NonNegative(inertia, "inertia_kg_m2", 0.0);
+    YAML::Node value = inertia.Required("inertia_kg_m2");  // blank or ~: an error, never 0
+    out->inertia_kg_m2 = inertia.AsDouble(value, "inertia_kg_m2");
+    if (out->inertia_kg_m2 < 0.0) {
+      throw UserError(inertia.Where(value) + ": 'rig.inertia.inertia_kg_m2' must be >= 0");
+    }
   } else if (inertia.Has("table")) {
     out->kind = RigInertiaSpec::Kind::kTable;
     YAML::Node table = inertia.Optional("table");
@@ -340,6 +351,25 @@ RigGeometry CampaignConfig::CalibrationGeometry() const {
   return g;
 }
 
+bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why) {
+  char buffer[320];
+  if (off_earth) {
+    if (gravity_mps2 > 0.0 && gravity_mps2 <= kMaxOffEarthGravityMps2) return true;
+    std::snprintf(buffer, sizeof(buffer),
+                  "'gravity_mps2' must be in (0, %g] m/s^2 (gravity_off_earth: true), got %g",
+                  kMaxOffEarthGravityMps2, gravity_mps2);
+  } else {
+    if (gravity_mps2 >= kMinEarthGravityMps2 && gravity_mps2 <= kMaxEarthGravityMps2) return true;
+    std::snprintf(buffer, sizeof(buffer),
+                  "'gravity_mps2' = %g m/s^2 is not a gravity found on Earth ([%g, %g] m/s^2, "
+                  "from the equator's mountains to the poles); check for a typo (9.80665 is "
+                  "standard gravity), or set 'gravity_off_earth: true' for a rig elsewhere",
+                  gravity_mps2, kMinEarthGravityMps2, kMaxEarthGravityMps2);
+  }
+  *why = buffer;
+  return false;
+}
+
 bool CampaignConfig::Check(std::string* why) const {
   std::string reason;
   if (calibration.enabled) {
@@ -363,6 +393,7 @@ bool CampaignConfig::Check(std::string* why) const {
     *why = "rig.calibration: the calibration factor is not a finite number > 0";
     return false;
   }
+  if (!CheckGravity(gravity_mps2, gravity_off_earth, why)) return false;
   if (!AircraftGeometry().Check(&reason)) {
     *why = "rig/aircraft: " + reason;
     return false;
@@ -648,12 +679,16 @@ void ReadAircraftAndGravity(YamlMap& root, const std::string& path,
     throw UserError(path + ": missing required key 'aircraft'");
   }
   aircraft.Finish();
+  // g is bounded to what is found on Earth (a typo such as 98.0665 would scale every moment);
+  // `gravity_off_earth: true` allows (0, 100] for a rig elsewhere.
+  config->gravity_off_earth = root.OptionalBool("gravity_off_earth", false);
   YAML::Node g = root.Optional("gravity_mps2");
-  if (g.IsDefined() && !g.IsNull()) {
+  if (root.Given(g, "gravity_mps2", "a number (m/s^2)")) {
     config->gravity_mps2 = root.AsDouble(g, "gravity_mps2");
-    if (!(config->gravity_mps2 > 0.0)) {
-      throw UserError(root.Where(g) + ": 'gravity_mps2' must be > 0");
-    }
+  }
+  std::string why;
+  if (!CheckGravity(config->gravity_mps2, config->gravity_off_earth, &why)) {
+    throw UserError((g.IsDefined() ? root.Where(g) : path) + ": " + why);
   }
 }
 
@@ -820,7 +855,8 @@ void ReadFit(YamlMap fit, FitConfig* out) {
 // `ellipse`: bootstrap, seed, confidence, covariance, min_angles; then EllipseConfig::Check.
 void ReadEllipse(YamlMap ellipse, EllipseConfig* e) {
   e->bootstrap = ellipse.OptionalInt("bootstrap", e->bootstrap);
-  e->seed = static_cast<unsigned>(ellipse.OptionalInt("seed", static_cast<int>(e->seed)));
+  e->seed = static_cast<unsigned>(
+      ellipse.OptionalIntIn("seed", e->seed, 0, std::numeric_limits<unsigned>::max()));
   e->confidence = ellipse.OptionalDouble("confidence", e->confidence);
   e->covariance = ellipse.OptionalString("covariance", e->covariance);
   e->min_angles = ellipse.OptionalInt("min_angles", e->min_angles);

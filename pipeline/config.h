@@ -166,6 +166,8 @@ constexpr int kMaxWhitenessLags = 1000;    // fit.quality.whiteness_lags in [1, 
 constexpr double kMaxMinPeriods = 10000;   // fit.quality.min_periods in [2, 10000]
 constexpr double kMinMaxAmplitudeDeg = 1;  // fit.max_amplitude_deg in [1, 90]: the trace fit's
 constexpr double kMaxMaxAmplitudeDeg = 90; //   model holds to 90 deg; below 1 deg is noise
+constexpr double kMinSwingAxisLength = 1e-3;  // imu.swing_axis: a direction whose length lies
+constexpr double kMaxSwingAxisLength = 1e3;   //   in [1e-3, 1e3] (typos and overflow refused)
 constexpr double kMaxRigInertiaStdKgM2 = 1e3;  // rig.inertia.inertia_std_kg_m2 below this
 // The other std keys (rig.uncertainties.*, aircraft.mass_std_kg, imu.gyro.scale_std) must be
 // below the quantity they qualify (L, D, the masses, g; 1 for the scale factor).
@@ -208,7 +210,8 @@ struct CampaignConfig {
   RigUncertainties uncertainties;
   double aircraft_mass_kg = 0.0;      // aircraft mass (kg); 0 when only tare logs are fitted
   double aircraft_mass_std_kg = 0.0;  // its standard uncertainty (kg)
-  double gravity_mps2 = 9.80665;      // local gravity (m/s^2)
+  double gravity_mps2 = 9.80665;      // local gravity (m/s^2); in [9.76, 9.84] (Earth) unless
+  bool gravity_off_earth = false;     // `gravity_off_earth: true`: then in (0, 100]
   ImuConfig imu;
   RunsConfig runs;       // absent (root empty) for a `fit`-only config
   FitConfig fit;
@@ -228,6 +231,13 @@ struct CampaignConfig {
   // against the rig's mass and D. Part of Check; *why names the key and the likely unit.
   bool CheckPlausible(std::string* why) const;
 };
+
+// Gravity on Earth's surface spans 9.7639 (Huascaran, 6.8 km at the equator) to 9.8337 m/s^2
+// (the poles); a config's gravity_mps2 must lie in [9.76, 9.84] unless gravity_off_earth is set,
+// which allows (0, 100] (the Moon 1.62, Mars 3.71, Jupiter 24.8). *why names the key and range.
+constexpr double kMinEarthGravityMps2 = 9.76, kMaxEarthGravityMps2 = 9.84;
+constexpr double kMaxOffEarthGravityMps2 = 100.0;
+bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why);
 
 struct ConfigLoadOptions {
   bool require_runs = true;      // `process` needs runs/aircraft; `fit` only geometry + IMU

@@ -186,7 +186,7 @@ int RunEllipseCommand(const EllipseCommandOptions& options, std::ostream& out) {
     PrintEllipseReport(result, options.units, out);
     for (const auto& p : plots) out << "wrote " << p << "\n";
   }
-  return 0;
+  return result.physical ? 0 : 1;  // a non-physical tensor is printed with its warning, exit 1
 }
 
 int RunPlanCommand(const PlanCommandOptions& options, std::ostream& out) {

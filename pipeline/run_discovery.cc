@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -196,11 +197,14 @@ std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
   std::istringstream in(
       ReadRegularFileOrThrow(config.runs.table, TableCap("runs table (runs.table)")));
   std::vector<RunFile> runs;
+  std::map<std::string, std::pair<size_t, int>> first_row;  // path -> (index in runs, line)
   std::string line;
   int line_no = 0;
   int path_col = -1, pitch_col = -1;
   while (std::getline(in, line)) {
     ++line_no;
+    // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
+    if (line_no == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
     if (line.find_first_not_of(" \r\t") == std::string::npos) continue;
     const std::vector<std::string> cells = SplitCsvLine(line);
     if (path_col < 0) {
@@ -233,8 +237,30 @@ std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
         run.error = run.display + ": listed in " + config.runs.table + ":" +
                     std::to_string(line_no) + " but not found";
       }
+      // A log listed twice: the same pitch is one run; two pitches cannot both be right, so the
+      // log becomes an error row naming both lines (its fit would be grouped at a guess).
+      auto [it, inserted] = first_row.emplace(run.path, std::make_pair(runs.size(), line_no));
+      if (!inserted) {
+        RunFile& first = runs[it->second.first];
+        if (first.pitch_nominal_deg && *first.pitch_nominal_deg != pitch) {
+          char buffer[160];
+          std::snprintf(buffer, sizeof(buffer), "lines %d and %d give pitch %g and %g deg",
+                        it->second.second, line_no, *first.pitch_nominal_deg, pitch);
+          first.error = first.display + ": listed twice in " + config.runs.table + " with " +
+                        "different pitches (" + buffer + "); give each log once";
+        }
+        continue;
+      }
     }
     runs.push_back(run);
+  }
+  if (path_col < 0) {
+    throw UserError(config.runs.table + ": runs table is empty (runs.table): expected a header "
+                    "'path,pitch_deg' and one row per log");
+  }
+  if (runs.empty()) {
+    throw UserError(config.runs.table + ": runs table has a header but no rows (runs.table): "
+                    "add one row 'path,pitch_deg' per log");
   }
   return runs;
 }

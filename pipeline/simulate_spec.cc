@@ -1,6 +1,7 @@
 #include "pipeline/simulate_spec.h"
 
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -42,7 +43,7 @@ std::string Num(double value) {
 double ReadValue(YamlMap& map, const std::string& key, double fallback, double lower,
                  bool lower_open, double upper) {
   const YAML::Node node = map.Optional(key);
-  if (!node.IsDefined() || node.IsNull()) return fallback;
+  if (!map.Given(node, key, "a number")) return fallback;
   const double value = map.AsDouble(node, key);
   const bool ok = (lower_open ? value > lower : value >= lower) && value <= upper;
   if (!ok) {
@@ -66,7 +67,7 @@ std::optional<double> ReadOptionalValue(YamlMap& map, const std::string& key, do
 UniformRange ReadRange(YamlMap& map, const std::string& key, UniformRange fallback, double lower,
                        bool lower_open, double upper) {
   const YAML::Node node = map.Optional(key);
-  if (!node.IsDefined() || node.IsNull()) return fallback;
+  if (!map.Given(node, key, "a number or a list [min, max]")) return fallback;
   UniformRange r;
   if (node.IsSequence()) {
     if (node.size() != 2) {
@@ -90,7 +91,7 @@ UniformRange ReadRange(YamlMap& map, const std::string& key, UniformRange fallba
 
 Eigen::Vector3d ReadVector3(YamlMap& map, const std::string& key, Eigen::Vector3d fallback) {
   const YAML::Node node = map.Optional(key);
-  if (!node.IsDefined() || node.IsNull()) return fallback;
+  if (!map.Given(node, key, "a list of 3 numbers")) return fallback;
   if (!node.IsSequence() || node.size() != 3) {
     throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be a list of 3 numbers");
   }
@@ -309,10 +310,12 @@ SimulateSpec ParseSpec(YamlMap root) {
   const double inf = INFINITY;
   {
     const YAML::Node seed = root.Optional("seed");
-    if (seed.IsDefined() && !seed.IsNull()) {
+    if (root.Given(seed, "seed", "an integer")) {
       unsigned long long value = 0;
-      if (!seed.IsScalar() || !YAML::convert<unsigned long long>::decode(seed, value)) {
-        throw UserError(root.Where(seed) + ": 'seed' must be a non-negative integer");
+      if (!seed.IsScalar() || (!seed.Scalar().empty() && seed.Scalar()[0] == '-') ||
+          !YAML::convert<unsigned long long>::decode(seed, value)) {
+        throw UserError(root.Where(seed) + ": 'seed' must be an integer in [0, " +
+                        std::to_string(std::numeric_limits<uint64_t>::max()) + "]");
       }
       spec.seed = value;
     }

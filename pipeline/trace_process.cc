@@ -197,37 +197,72 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                         const TraceProcessOptions& options, TraceRecord record,
                         TraceFitResult* fit_out);
 
-// A user window that does not lie inside the log, said in the log's own terms (its span in
-// seconds, and the window read as ms or us when that would fit), before the swing axis or the
-// window code look inside it. Empty when the window is inside the log (up to half a mean sample
-// step, as ApplyWindowOverride allows).
-std::string WindowOutsideLog(const ImuData& data, const std::array<double, 2>& window_s,
-                             bool from_cli, TimeUnit time_unit) {
+// A user window checked against the log, said in the log's own terms (its span in seconds, and
+// the window read as ms or us when that would fit), before the swing axis or the window code look
+// inside it. A window that overlaps the log has its open or too-large end(s) clamped to the log,
+// with *note saying so; one that misses the log is an error naming the wrong end (returned).
+// Inside means up to half a mean sample step beyond the ends, as ApplyWindowOverride allows.
+std::string WindowOutsideLog(const ImuData& data, std::array<double, 2>* window_s, bool from_cli,
+                             TimeUnit time_unit, std::string* note) {
   const std::vector<double>& t = data.t_s;
   if (t.size() < 2) return "";
   const double half_dt = 0.5 * (t.back() - t.front()) / static_cast<double>(t.size() - 1);
   auto inside = [&](double t0, double t1) {
     return t0 >= t.front() - half_dt && t1 <= t.back() + half_dt;
   };
-  if (inside(window_s[0], window_s[1])) return "";
+  const double t0 = (*window_s)[0], t1 = (*window_s)[1];
+  if (inside(t0, t1)) return "";
   const char* key = from_cli ? "--window" : "fit.windows";
   char buf[512];
+  // The window read as ms or us, when that lies inside the log: a unit mistake, never clamped.
+  std::string unit_hint;
+  for (const auto& [factor, unit] : {std::make_pair(1e-3, "ms"), std::make_pair(1e-6, "us")}) {
+    const double s0 = t0 * factor, s1 = t1 * factor;
+    if (inside(s0, s1)) {
+      std::snprintf(buf, sizeof(buf), "; if these are %s, give %g:%g", unit, s0, s1);
+      unit_hint = buf;
+      break;
+    }
+  }
+  if (unit_hint.empty() && t0 < t.back() && t1 > t.front()) {  // overlaps: clamp what is beyond
+    std::string clamped;
+    if (t0 < t.front() - half_dt) {
+      std::snprintf(buf, sizeof(buf), "start %g s is before the log's start %g s", t0, t.front());
+      clamped = buf;
+      (*window_s)[0] = t.front();
+    }
+    if (t1 > t.back() + half_dt) {
+      std::snprintf(buf, sizeof(buf), "%send %g s is after the log's end %g s",
+                    clamped.empty() ? "" : " and its ", t1, t.back());
+      clamped += buf;
+      (*window_s)[1] = t.back();
+    }
+    std::snprintf(buf, sizeof(buf), "%s %g-%g s: its %s; clamped to %g-%g s", key, t0, t1,
+                  clamped.c_str(), (*window_s)[0], (*window_s)[1]);
+    *note = buf;
+    return "";
+  }
   std::snprintf(buf, sizeof(buf), "window %g-%g s is outside the log (%g-%g s); %s takes seconds",
-                window_s[0], window_s[1], t.front(), t.back(), key);
+                t0, t1, t.front(), t.back(), key);
   std::string message = buf;
   if (time_unit != TimeUnit::kSeconds) {
     message += std::string(" (the file's time column is in ") + ToString(time_unit) +
                ", converted to seconds)";
   }
-  for (const auto& [factor, unit] : {std::make_pair(1e-3, "ms"), std::make_pair(1e-6, "us")}) {
-    const double t0 = window_s[0] * factor, t1 = window_s[1] * factor;
-    if (inside(t0, t1)) {
-      std::snprintf(buf, sizeof(buf), "; if these are %s, give %g:%g", unit, t0, t1);
-      message += buf;
-      break;
-    }
+  // Which end is wrong: the start after the log's end, the end before its start, or both ends
+  // beyond the log (read in another unit).
+  if (t0 >= t.back()) {
+    std::snprintf(buf, sizeof(buf), "; its start %g s is after the log's end", t0);
+  } else if (t1 <= t.front()) {
+    std::snprintf(buf, sizeof(buf), "; its end %g s is before the log's start", t1);
+  } else {
+    std::snprintf(buf, sizeof(buf), "; %s", t0 < t.front() - half_dt && t1 > t.back() + half_dt
+                                                ? "both ends are beyond the log"
+                                                : t0 < t.front() - half_dt
+                                                    ? "its start is before the log's start"
+                                                    : "its end is after the log's end");
   }
-  return message;
+  return message + buf + unit_hint;
 }
 
 TraceRecord Process(const CampaignConfig& config, const std::string& path,
@@ -271,12 +306,14 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   const ImuData& data = glitches.empty() ? raw : cleaned;
 
   // 2. Swing axis (and the pitch, from the accelerometer at rest).
-  const std::optional<std::array<double, 2>> override_s =
+  std::optional<std::array<double, 2>> override_s =
       options.window_s ? options.window_s : ConfigWindowFor(config, path);
   if (override_s) {
-    const std::string outside = WindowOutsideLog(data, *override_s, options.window_s.has_value(),
-                                                 config.imu.format.time_unit);
+    std::string clamped;
+    const std::string outside = WindowOutsideLog(data, &*override_s, options.window_s.has_value(),
+                                                 config.imu.format.time_unit, &clamped);
     if (!outside.empty()) return fail(TraceStatus::kError, name + ": " + outside);
+    if (!clamped.empty()) record.warnings.push_back(clamped);
   }
   const SwingAxisOptions axis_options = SwingAxisOptionsFor(config.imu);
   std::optional<std::pair<double, double>> axis_window;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -145,10 +146,33 @@ YAML::Node YamlMap::Optional(const std::string& key) {
 
 YAML::Node YamlMap::Required(const std::string& key) {
   YAML::Node value = Optional(key);
-  if (!value.IsDefined() || value.IsNull()) {
+  if (!value.IsDefined()) {
     throw UserError(Where(node_) + ": missing required key '" + KeyPath(key) + "'");
   }
+  if (value.IsNull()) {
+    throw UserError(WhereKey(key) + ": '" + KeyPath(key) +
+                    "' is blank (or ~ / null): give its value; a blank is not read as 0");
+  }
   return value;
+}
+
+std::string YamlMap::WhereKey(const std::string& key) const {
+  // A blank value's mark is the next token (often the next line): name the key's own place.
+  if (node_.IsMap()) {
+    for (const auto& item : node_) {
+      if (item.first.IsScalar() && item.first.Scalar() == key) return Where(item.first);
+    }
+  }
+  return Where(node_);
+}
+
+bool YamlMap::Given(const YAML::Node& node, const std::string& key, const char* expected) const {
+  if (!node.IsDefined()) return false;
+  if (node.IsNull()) {
+    throw UserError(WhereKey(key) + ": '" + KeyPath(key) + "' is blank (or ~ / null): give " +
+                    expected + ", or remove the key to use its default");
+  }
+  return true;
 }
 
 double YamlMap::AsDouble(const YAML::Node& node, const std::string& key) const {
@@ -170,22 +194,32 @@ double YamlMap::RequiredDouble(const std::string& key) { return AsDouble(Require
 
 double YamlMap::OptionalDouble(const std::string& key, double fallback) {
   YAML::Node value = Optional(key);
-  return value.IsDefined() && !value.IsNull() ? AsDouble(value, key) : fallback;
+  return Given(value, key, "a number") ? AsDouble(value, key) : fallback;
 }
 
 int YamlMap::OptionalInt(const std::string& key, int fallback) {
+  return static_cast<int>(OptionalIntIn(key, fallback, std::numeric_limits<int>::min(),
+                                        std::numeric_limits<int>::max()));
+}
+
+long long YamlMap::OptionalIntIn(const std::string& key, long long fallback, long long lo,
+                                 long long hi) {
   YAML::Node value = Optional(key);
-  if (!value.IsDefined() || value.IsNull()) return fallback;
-  int result = 0;
-  if (!value.IsScalar() || !YAML::convert<int>::decode(value, result)) {
-    throw UserError(Where(value) + ": '" + KeyPath(key) + "' must be an integer");
+  if (!Given(value, key, "an integer")) return fallback;
+  long long result = 0;
+  if (!value.IsScalar() || !YAML::convert<long long>::decode(value, result) || result < lo ||
+      result > hi) {
+    const std::string got = value.IsScalar() ? value.Scalar() : std::string("a list or mapping");
+    throw UserError(Where(value) + ": '" + KeyPath(key) + "' must be an integer in [" +
+                    std::to_string(lo) + ", " + std::to_string(hi) + "], got '" +
+                    got.substr(0, 40) + (got.size() > 40 ? "...'" : "'"));
   }
   return result;
 }
 
 bool YamlMap::OptionalBool(const std::string& key, bool fallback) {
   YAML::Node value = Optional(key);
-  if (!value.IsDefined() || value.IsNull()) return fallback;
+  if (!Given(value, key, "true or false")) return fallback;
   bool result = false;
   if (!value.IsScalar() || !YAML::convert<bool>::decode(value, result)) {
     throw UserError(Where(value) + ": '" + KeyPath(key) + "' must be true or false");
@@ -203,7 +237,7 @@ std::string YamlMap::OptionalString(const std::string& key, const std::string& f
 std::vector<double> YamlMap::OptionalDoubleList(const std::string& key,
                                                 std::vector<double> fallback) {
   YAML::Node value = Optional(key);
-  if (!value.IsDefined() || value.IsNull()) return fallback;
+  if (!Given(value, key, "a list of numbers")) return fallback;
   if (!value.IsSequence()) {
     throw UserError(Where(value) + ": '" + KeyPath(key) + "' must be a list of numbers");
   }

@@ -34,6 +34,8 @@ class YamlMap {
   double RequiredDouble(const std::string& key);
   double OptionalDouble(const std::string& key, double fallback);
   int OptionalInt(const std::string& key, int fallback);
+  // An integer in [lo, hi]; the message gives the range (also for values beyond 64 bits).
+  long long OptionalIntIn(const std::string& key, long long fallback, long long lo, long long hi);
   bool OptionalBool(const std::string& key, bool fallback);
   std::string RequiredString(const std::string& key);
   std::string OptionalString(const std::string& key, const std::string& fallback);
@@ -49,7 +51,15 @@ class YamlMap {
   // "file:line:column" of a node of this document, for messages; "file" when unknown.
   std::string Where(const YAML::Node& node) const;
   std::string KeyPath(const std::string& key) const;
+  // "file:line:column" of `key` itself in this mapping (of the mapping when absent).
+  std::string WhereKey(const std::string& key) const;
   const std::string& file() const { return file_; }
+
+  // Whether a value was given for `key`: false when the key is absent, true for a value, and a
+  // UserError naming the key and line when it is present but blank (`key:`, `key: ~`, `null`):
+  // a blank where `expected` ("a number", "true or false") is wanted is never read as a default
+  // or as zero.
+  bool Given(const YAML::Node& node, const std::string& key, const char* expected) const;
 
   // Scalar conversions that name the key and line on failure.
   double AsDouble(const YAML::Node& node, const std::string& key) const;

@@ -101,5 +101,35 @@ TEST(Glitch, GyroGlitchesAreDroppedFromEveryColumn) {
   EXPECT_NE(text.find("up to 50 rad/s"), std::string::npos) << text;
 }
 
+// Short runs (issue 15 item 9): two glitches adjacent or one sample apart widen each other's
+// neighbour range, so the one-sample test keeps both; the run test drops exactly them (the clean
+// sample between a pair one apart is kept), at the series' ends too. Three sets of at most 6, so
+// that the glitches stay below the 1 % that the swing's excursion (99th percentile) is blind to.
+TEST(Glitch, ShortRunsOfTwoOrThreeAreFound) {
+  for (const bool irregular : {false, true}) {
+    const TraceFitInput clean = Window(irregular, 0.25, 0.5, 6);
+    const size_t n = clean.t_s.size();
+    const std::vector<std::vector<std::pair<size_t, double>>> sets = {
+        {{0, 50.0}, {1, 50.0},                         // adjacent, at the start
+         {n / 6, 50.0}, {n / 6 + 1, 50.0},             // adjacent, same sign
+         {n / 4, -50.0}, {n / 4 + 2, -50.0}},          // one apart
+        {{n / 3, 5.0}, {n / 3 + 1, 5.0}, {n / 3 + 2, 5.0},  // three in a row
+         {n / 2, 50.0}, {n / 2 + 1, -50.0}},           // adjacent, both signs
+        {{2 * n / 3, 2.0}, {2 * n / 3 + 1, 2.0},       // 2 rad/s on a 1.1 rad/s swing
+         {5 * n / 6, -2.0}, {5 * n / 6 + 2, -2.0},     // ... one apart
+         {n - 2, -5.0}, {n - 1, -5.0}}};               // adjacent, at the end
+    for (const auto& spikes : sets) {
+      TraceFitInput in = clean;
+      std::vector<size_t> expected;
+      for (const auto& [k, v] : spikes) {
+        in.rate_rad_per_s[k] = v;
+        expected.push_back(k);
+      }
+      EXPECT_EQ(FindGlitches(in.t_s, in.rate_rad_per_s, GlitchOptions()), expected)
+          << "irregular " << irregular << ", first glitch at " << spikes[0].first;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace bifilar

@@ -249,8 +249,15 @@ TEST(BadLogs, WindowOutsideTheLogInItsOwnTerms) {
                             "--window takes seconds")) << out;
   EXPECT_TRUE(Contains(out, "if these are ms, give 5:60")) << out;
   EXPECT_FALSE(Contains(out, "constant")) << out;
-  EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 100:200", &out), 1) << out;
-  EXPECT_TRUE(Contains(out, "window 100-200 s is outside the log (0-130 s)")) << out;
+  EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 200:300", &out), 1) << out;
+  EXPECT_TRUE(Contains(out, "window 200-300 s is outside the log (0-130 s); --window takes "
+                            "seconds")) << out;
+  EXPECT_TRUE(Contains(out, "; its start 200 s is after the log's end")) << out;
+  // Past the log's end only (an end of 1e9 meaning "to the end"): clamped, with a warning naming
+  // the end (issue 15 item 8; it was "outside the log").
+  EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 5:1e9", &out), 0) << out;
+  EXPECT_TRUE(Contains(out, "--window 5-1e+09 s: its end 1e+09 s is after the log's "
+                            "end 130 s; clamped to 5-130 s")) << out;
   // Inside the log, in seconds: fitted.
   EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 5:60", &out), 0) << out;
 }

@@ -21,6 +21,9 @@ whose keys are also attributes (``r.inertia_total_kg_m2 == r["inertia_total_kg_m
 Conventions and the equations: docs/physics.md.
 """
 
+import math as _math
+import operator as _operator
+
 from . import _core
 
 try:  # needed by every function; `import bifilar` itself works without it
@@ -132,14 +135,50 @@ def _series(values, name):
         raise ValueError(f"{name} must be an array of numbers: {error}") from None
 
 
+def _path(function, name, value):
+    """None, or the path as a str; ValueError when it holds a NUL (the C library would read
+    only the part before it: another file, silently)."""
+    if value is None:
+        return None
+    text = str(value)
+    if "\0" in text:
+        raise ValueError(f"{function}: {name} contains a NUL character: {text!r}")
+    return text
+
+
+def _seed(function, value):
+    """A seed: a whole number in [0, 2**64 - 1]; anything else (-1, 2**64, 1e23, 1.5) is a
+    ValueError giving the range, never a wrapped or saturated seed."""
+    message = f"{function}: seed must be a whole number in [0, 2**64 - 1], got {value!r}"
+    try:
+        if isinstance(value, bool):
+            raise TypeError
+        if isinstance(value, float):
+            if not (value.is_integer() and abs(value) < 2.0**53):  # 1e23 is not exact
+                raise ValueError
+            seed = int(value)
+        elif isinstance(value, str):
+            seed = int(value)
+        else:
+            seed = _operator.index(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(message) from None
+    if not 0 <= seed <= 2**64 - 1:
+        raise ValueError(message)
+    return seed
+
+
 def _number(function, name, value, kind=float):
-    """None, or the value as a float (or int); ValueError naming the argument otherwise."""
+    """None, or the value as a float (or int); ValueError naming the argument otherwise (NaN
+    and infinities too: a number the computation cannot use is never passed on)."""
     if value is None:
         return None
     try:
         number = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ValueError(f"{function}: {name} must be a number, got {value!r}") from None
+    if not _math.isfinite(number):
+        raise ValueError(f"{function}: {name} must be a finite number, got {value!r}")
     if kind is int:
         if not number.is_integer():
             raise ValueError(f"{function}: {name} must be a whole number, got {value!r}")
@@ -170,7 +209,8 @@ def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None
     mass_kg : float
         Whole suspended mass: aircraft + rig + IMU (kg).
     g : float, default 9.80665
-        Local gravity (m/s^2).
+        Local gravity (m/s^2), in [9.76, 9.84] (Earth) unless the config sets
+        ``gravity_off_earth: true`` (then (0, 100]).
     model : {'full', 'jardin', 'linear'}, default 'full'
         Equation of motion fitted (docs/physics.md).
     window : None, (t0, t1) or 'T0:T1'
@@ -220,9 +260,10 @@ def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None
         if key not in ("model", "window", "config", "name"):
             settings[key] = _number("fit_trace", key, value,
                                     int if key == "whiteness_lags" else float)
-    for key in ("model", "config", "name"):
+    for key in ("model", "name"):
         if settings[key] is not None:
             settings[key] = str(settings[key])
+    settings["config"] = _path("fit_trace", "config", settings["config"])
     record, t_s, measured, fitted, residual = _core.fit_trace(
         _series(t, "t"), _series(rate, "rate"), **settings)
     result = Record(record)
@@ -260,7 +301,8 @@ def read_log(path, config):
         The file or config cannot be read or is malformed (the command line's message, naming
         the file, line and column or key).
     """
-    return Record(_core.read_log(str(path), str(config)))
+    return Record(_core.read_log(_path("read_log", "path", path),
+                                 _path("read_log", "config", config)))
 
 
 def fit_ellipse(pitch_deg, inertia, std=None, *, bootstrap=2000, seed=1, confidence=0.95,
@@ -305,9 +347,9 @@ def fit_ellipse(pitch_deg, inertia, std=None, *, bootstrap=2000, seed=1, confide
     """
     std_array = None if std is None else _series(std, "std")
     bootstrap = _number("fit_ellipse", "bootstrap", bootstrap, int)
-    seed = _number("fit_ellipse", "seed", seed, int)
-    if bootstrap < 0 or seed < 0:
-        raise ValueError("fit_ellipse: bootstrap and seed must be >= 0")
+    seed = _seed("fit_ellipse", seed)
+    if bootstrap < 0:
+        raise ValueError("fit_ellipse: bootstrap must be >= 0")
     result = Record(_core.fit_ellipse(_series(pitch_deg, "pitch_deg"), _series(inertia, "inertia"),
                                       std_array, bootstrap, seed,
                                       _number("fit_ellipse", "confidence", confidence),
@@ -362,7 +404,8 @@ def process(config_path, out=None, jobs=None, *, force=False, figures=True, prog
     if progress not in (None, False, True, "bar") and callback is None:
         raise ValueError("process: progress must be None, True, 'bar' or a callable "
                          "progress(done, total, line), got %r" % (progress,))
-    return Record(_core.process(str(config_path), None if out is None else str(out),
+    return Record(_core.process(_path("process", "config_path", config_path),
+                                _path("process", "out", out),
                                 _number("process", "jobs", jobs, int), bool(force), bool(figures),
                                 bar, callback))
 
@@ -418,13 +461,12 @@ def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=No
                     separation_m=separation_m, g=g, amplitude_deg=amplitude_deg,
                     pitch_deg=pitch_deg, duration_s=duration_s, sample_rate_hz=sample_rate_hz,
                     no_accel=bool(no_accel))
-    for key in ("spec", "out", "trace", "truth", "model"):
-        if settings[key] is not None:
-            settings[key] = str(settings[key])
+    for key in ("spec", "out", "trace", "truth"):
+        settings[key] = _path("simulate", key, settings[key])
+    if settings["model"] is not None:
+        settings["model"] = str(settings["model"])
     for key in ("inertia_kg_m2", "mass_kg", "length_m", "separation_m", "g", "amplitude_deg",
                 "pitch_deg", "duration_s", "sample_rate_hz"):
         settings[key] = _number("simulate", key, settings[key])
-    settings["seed"] = _number("simulate", "seed", seed, int)
-    if settings["seed"] is not None and settings["seed"] < 0:
-        raise ValueError("simulate: seed must be >= 0")
+    settings["seed"] = None if seed is None else _seed("simulate", seed)
     return Record(_core.simulate(**settings))

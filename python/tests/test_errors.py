@@ -129,7 +129,35 @@ def test_settings_of_the_wrong_type_name_the_argument():
         bifilar.fit_trace(t, np.zeros(100), length_m="abc", separation_m=0.9, mass_kg=6.0)
     with pytest.raises(ValueError, match="whiteness_lags must be a whole number"):
         bifilar.fit_trace(t, np.zeros(100), whiteness_lags=2.5, **GEOMETRY)
-    with pytest.raises(ValueError, match="seed must be >= 0"):
+    with pytest.raises(ValueError, match=r"seed must be a whole number in \[0, 2\*\*64 - 1\]"):
         bifilar.fit_ellipse([0, 30, 60], [1.0, 1.1, 1.2], seed=-1)
     with pytest.raises(ValueError, match="simulate: mass_kg must be a number"):
         bifilar.simulate(inertia_kg_m2=1.0, mass_kg=[1, 2], length_m=2.0, separation_m=0.9)
+
+
+@pytest.mark.parametrize("call", [
+    lambda: bifilar.read_log(str(sample_log(0)) + "\0ignored", SAMPLE_CONFIG),
+    lambda: bifilar.read_log(sample_log(0), str(SAMPLE_CONFIG) + "\0.yaml"),
+    lambda: bifilar.fit_trace(np.arange(10.0), np.zeros(10), config="c.yaml\0x"),
+    lambda: bifilar.process("c\0.yaml"),
+    lambda: bifilar.simulate(trace="a\0.csv", inertia_kg_m2=1, mass_kg=1, length_m=2,
+                             separation_m=1),
+])
+def test_path_with_nul_raises_value_error(call):
+    # A NUL ended the path in the C library: the part before it was read, silently.
+    with pytest.raises(ValueError, match="contains a NUL character"):
+        call()
+
+
+@pytest.mark.parametrize("seed", [-1, 2**64, 1e23, 1.5, "x", True])
+def test_seed_out_of_range_is_refused_with_the_range(seed):
+    with pytest.raises(ValueError, match=r"seed must be a whole number in \[0, 2\*\*64 - 1\]"):
+        bifilar.fit_ellipse([0, 30, 60, 90], [3.0, 2.75, 2.25, 2.0], seed=seed)
+    with pytest.raises(ValueError, match=r"\[0, 2\*\*64 - 1\]"):
+        bifilar.simulate(seed=seed, inertia_kg_m2=1, mass_kg=1, length_m=2, separation_m=1)
+
+
+def test_nan_setting_is_refused():
+    with pytest.raises(ValueError, match="fit_trace: max_amplitude_deg must be a finite number"):
+        bifilar.fit_trace(np.arange(10.0), np.zeros(10), max_amplitude_deg=float("nan"),
+                          **GEOMETRY)
