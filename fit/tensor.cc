@@ -30,6 +30,55 @@ std::string Num(double v) {
 
 Eigen::Vector3d ToVector(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
+// Continued fraction of the regularized incomplete beta function (modified Lentz).
+double BetaContinuedFraction(double a, double b, double x) {
+  constexpr double kTiny = 1e-300;
+  double c = 1.0, d = 1.0 - (a + b) * x / (a + 1.0);
+  if (std::fabs(d) < kTiny) d = kTiny;
+  d = 1.0 / d;
+  double h = d;
+  for (int m = 1; m <= 300; ++m) {
+    const double m2 = 2.0 * m;
+    double aa = m * (b - m) * x / ((a + m2 - 1) * (a + m2));
+    d = 1.0 + aa * d;
+    c = 1.0 + aa / c;
+    if (std::fabs(d) < kTiny) d = kTiny;
+    if (std::fabs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    h *= d * c;
+    aa = -(a + m) * (a + b + m) * x / ((a + m2) * (a + m2 + 1));
+    d = 1.0 + aa * d;
+    c = 1.0 + aa / c;
+    if (std::fabs(d) < kTiny) d = kTiny;
+    if (std::fabs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    const double delta = d * c;
+    h *= delta;
+    if (std::fabs(delta - 1.0) < 1e-14) break;
+  }
+  return h;
+}
+
+// I_x(a, b), the regularized incomplete beta function.
+double IncompleteBeta(double a, double b, double x) {
+  if (x <= 0.0) return 0.0;
+  if (x >= 1.0) return 1.0;
+  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) +
+                                a * std::log(x) + b * std::log1p(-x));
+  return x < (a + 1.0) / (a + b + 2.0) ? front * BetaContinuedFraction(a, b, x) / a
+                                       : 1.0 - front * BetaContinuedFraction(b, a, 1.0 - x) / b;
+}
+
+}  // namespace
+
+// P(F > f) for F with (d1, d2) degrees of freedom.
+double FDistributionUpperTail(double f, double d1, double d2) {
+  if (!(f > 0.0)) return 1.0;
+  return IncompleteBeta(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
+}
+
+namespace {
+
 }  // namespace
 
 Eigen::Matrix<double, 1, 6> DesignRow(const Eigen::Vector3d& n) {
@@ -94,6 +143,7 @@ bool PrepareTensorData(const std::vector<TensorPoint>& points, const TensorOptio
   d.w.resize(d.n);
   for (int i = 0; i < d.n; ++i) {
     d.x.row(i) = DesignRow(used[i]);
+    d.axes.push_back(used[i]);
     d.x_nominal.row(i) = DesignRow(nominal[i]);
     d.y(i) = points[i].inertia_kg_m2;
     d.w(i) = d.weighted ? 1.0 / (points[i].std_kg_m2 * points[i].std_kg_m2) : 1.0;
@@ -373,6 +423,85 @@ void DiagnoseTensor(const Prepared& data, const Design& design, const Solution& 
   }
 }
 
+// d I(n) / d(axis): the moment's sensitivity to tilting the axis, |2 (J n - (n^T J n) n)| per
+// rad (the gradient of n^T J n on the unit sphere), at the fitted tensor.
+Eigen::VectorXd AttitudeSensitivity(const Prepared& data, const Vec6& beta) {
+  const Eigen::Matrix3d j = TensorMatrix(beta);
+  Eigen::VectorXd g(data.n);
+  for (int i = 0; i < data.n; ++i) {
+    // The used direction from its design row: (nx^2, ny^2, nz^2, -2 nx ny, ...) is not
+    // invertible in sign, so keep the unit axes in Prepared.
+    const Eigen::Vector3d& n = data.axes[i];
+    const Eigen::Vector3d jn = j * n;
+    g(i) = 2.0 * (jn - n.dot(jn) * n).norm();
+  }
+  return g;
+}
+
+// A swing axis is known only to within the attitude the aircraft hung at (set by hand, or
+// measured by an accelerometer with a bias): an error of sigma_a rad about a horizontal axis moves
+// the moment by g_i sigma_a, far above a trace fit's own std (1e-4 of I against ~1e-3 for 0.5
+// deg). With a full design the fit weighs each point by 1/(s_i^2 + sigma_a^2 g_i^2), sigma_a
+// solved from the residuals (sum r_i^2 / (s_i^2 + sigma_a^2 g_i^2) = n - rank, the Paule-Mandel
+// equation), refitting with the new weights until they settle. Returns sigma_a (rad; 0 when the
+// stated stds explain the scatter or the design is not full or unweighted), NaN when a refit fails.
+double ReweighForAttitudeScatter(const Design& design, const TensorOptions& options,
+                                 Prepared* data, Solution* fit) {
+  if (!options.attitude_scatter || design.rank < 6 || !data->weighted || data->n <= design.rank) {
+    return 0.0;
+  }
+  const Eigen::VectorXd s2 = data->w.cwiseInverse();  // the stated variances
+  double sigma2 = 0.0;
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    const Eigen::VectorXd g2 = AttitudeSensitivity(*data, fit->beta).array().square();
+    const Eigen::VectorXd r2 = fit->resid.array().square();
+    auto excess = [&](double v) {
+      return (r2.array() / (s2.array() + v * g2.array())).sum() - (data->n - design.rank);
+    };
+    double next = 0.0;
+    if (excess(0.0) > 0.0) {
+      double lo = 0.0, hi = 1e-6;
+      while (excess(hi) > 0.0 && hi < 1.0) hi *= 4.0;  // 1 rad^2: beyond any attitude error
+      for (int k = 0; k < 100; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (excess(mid) > 0.0 ? lo : hi) = mid;
+      }
+      next = 0.5 * (lo + hi);
+    }
+    const bool settled = std::fabs(next - sigma2) <= 1e-4 * std::max(next, 1e-300);
+    sigma2 = next;
+    data->w = (s2.array() + sigma2 * g2.array()).inverse().matrix();
+    data->sqrt_w = data->w.cwiseSqrt();
+    std::string why;
+    if (!FitTensorClosedForm(*data, design, fit, &why)) return NAN;
+    if (settled) break;
+  }
+  return std::sqrt(sigma2);
+}
+
+// Lack-of-fit F test at 5 %: do the orientations' means scatter about the fit more than their
+// trials scatter about the means? Needs repeats and more orientations than components.
+bool OrientationsScatterBeyondTrials(const Prepared& data, const Design& design,
+                                     const Solution& fit) {
+  const int n = data.n, m = static_cast<int>(data.groups.size()), r = design.rank;
+  if (m >= n || m <= r) return false;
+  double pure = 0.0, lack = 0.0;
+  for (const std::vector<int>& g : data.groups) {
+    double sw = 0, sy = 0, sf = 0;
+    for (int i : g) {
+      sw += data.w(i);
+      sy += data.w(i) * data.y(i);
+      sf += data.w(i) * fit.fitted(i);
+    }
+    const double mean = sy / sw, fitted = sf / sw;
+    for (int i : g) pure += data.w(i) * (data.y(i) - mean) * (data.y(i) - mean);
+    lack += sw * (mean - fitted) * (mean - fitted);
+  }
+  if (!(pure > 0.0)) return lack > 0.0;
+  const double f = (lack / (m - r)) / (pure / (n - m));
+  return FDistributionUpperTail(f, m - r, n - m) < 0.05;
+}
+
 }  // namespace
 
 bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& options,
@@ -384,15 +513,23 @@ bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& opti
   if (!PrepareTensorData(points, options, &data, why)) return false;
   Design design;
   if (!AnalyseDesign(data, options, &design, why)) return false;
-  // The covariance mode (kAuto: orientation means with repeats and >= rank + 3 orientations).
+  Solution closed;
+  if (!FitTensorClosedForm(data, design, &closed, why)) return false;
+  // Each axis is known to within an attitude error: weights 1/(s_i^2 + sigma_a^2 g_i^2).
+  const double attitude_scatter_rad = ReweighForAttitudeScatter(design, options, &data, &closed);
+  if (!std::isfinite(attitude_scatter_rad)) {
+    *why = "the refit with the attitude scatter failed (singular fit)";
+    return false;
+  }
+  // The covariance mode (kAuto: orientation means when the orientations scatter beyond their
+  // trials, points otherwise).
   const int m = static_cast<int>(data.groups.size());
   data.covariance = options.covariance;
   if (data.covariance == EllipseCovariance::kAuto) {
-    data.covariance = (m < data.n && m >= design.rank + 3) ? EllipseCovariance::kAngleMeans
-                                                          : EllipseCovariance::kPointResiduals;
+    data.covariance = OrientationsScatterBeyondTrials(data, design, closed)
+                          ? EllipseCovariance::kAngleMeans
+                          : EllipseCovariance::kPointResiduals;
   }
-  Solution closed;
-  if (!FitTensorClosedForm(data, design, &closed, why)) return false;
   TensorResult r;
   const Solution solved = FitTensorCeres(data, design, closed, &r.ceres);
   Covariance cov;
@@ -402,6 +539,7 @@ bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& opti
   r.n_orientations = m;
   r.rank = design.rank;
   r.weighted = data.weighted;
+  r.attitude_scatter_deg = attitude_scatter_rad * 180.0 / kPi;
   r.full = design.rank == 6;
   r.condition_number = design.condition_number;
   for (int k = 0; k < 6; ++k) r.design_singular_values[k] = design.singular_values(k);

@@ -58,8 +58,9 @@ struct TensorOptions {
   int bootstrap_replicates = 2000;
   std::uint64_t seed = 1;    // bootstrap seed. Default 1.
   double confidence = 0.95;  // interval level, (0, 1). Default 0.95.
-  // kAuto: orientation means (kAngleMeans) when some orientation has repeats and there are at
-  // least rank + 3 orientations, else points. Default kAuto.
+  // kAuto: orientation means (kAngleMeans) when the orientations' means scatter about the fit
+  // beyond what their trials scatter (lack-of-fit F test at 5 %: an error shared by the trials
+  // of an orientation), else points (more degrees of freedom). Default kAuto.
   EllipseCovariance covariance = EllipseCovariance::kAuto;
   // Points whose nominal axes lie within this angle (deg, sign-free) are one orientation when
   // no group is given; [0, 45). Default 0.5.
@@ -70,6 +71,11 @@ struct TensorOptions {
   // A singular value of the unit-direction design below this fraction of the largest is a
   // direction the data do not determine. (0, 1). Default 1e-6.
   double rank_tolerance = 1e-6;
+  // Weigh each point by 1/(s_i^2 + sigma_a^2 g_i^2), g_i the moment's sensitivity to tilting its
+  // axis and sigma_a the attitude scatter solved from the residuals (full designs with stds).
+  // Default true: a trace fit's std (1e-4 of I) is far below what a 0.5 deg attitude error
+  // moves the moment (~1e-3), so the stated stds alone would weigh points almost at random.
+  bool attitude_scatter = true;
   // |studentized residual| above this flags an outlier. Default 3.
   double outlier_threshold = 3.0;
 
@@ -113,6 +119,9 @@ struct TensorResult {
   int n_orientations = 0;
   int rank = 0;                    // of the design (6: full 3-D)
   bool weighted = false;           // every point had a std
+  // The attitude scatter found in the residuals (deg, TensorOptions::attitude_scatter), 0 when
+  // the stated stds explain the scatter or the design is not full.
+  double attitude_scatter_deg = 0.0;
   bool full = false;               // rank == 6: principal moments and axes below are defined
   double condition_number = 0.0;   // largest / smallest non-zero singular value of the design
   std::array<double, kTensorComponents> design_singular_values = {};  // descending

@@ -36,6 +36,7 @@ Eigen::Matrix3d TensorMatrix(const Vec6& components);
 struct Prepared {
   int n = 0;
   bool weighted = false;
+  std::vector<Eigen::Vector3d> axes;  // the fitted (used) unit directions
   Eigen::MatrixXd x;          // n x 6 design of the fitted (used) directions
   Eigen::MatrixXd x_nominal;  // n x 6 design of the nominal directions
   Eigen::VectorXd y, w, sqrt_w;
@@ -87,6 +88,9 @@ struct Covariance {
 
 bool EstimateTensorCovariance(const Prepared& data, const Design& design, const Solution& s,
                               const TensorOptions& options, Covariance* cov, std::string* why);
+
+// P(F > f) of the F distribution with (d1, d2) degrees of freedom (regularized incomplete beta).
+double FDistributionUpperTail(double f, double d1, double d2);
 
 // Principal moments (ascending) and axes, Euler angles of the matched frame, their std.
 struct Principal {

@@ -118,14 +118,15 @@ TEST(Tensor, EulerAnglesOfARotatedTensor) {
 }
 
 TEST(Tensor, NoisyCampaignsAreWithinTheirStd) {
-  // 200 seeded campaigns of 12 attitudes x 2 trials, trial sigma 0.1 % of the largest moment.
-  // Each component's (value - truth) / std is Student-t with 12 - 6 = 6 dof (orientation means,
-  // the auto choice here): within 1 std 64 %, within 3 std 97.6 % of the time. Over 1200
-  // component fits the binomial std of those fractions is 1.4 % and 0.44 %; the bounds below are
-  // ~4 of those.
+  // 200 seeded campaigns of 12 attitudes x 2 trials, trial sigma 0.1 % of the largest moment,
+  // independent trials: auto picks the points' scatter (the orientations show no error of their
+  // own, F test), so each component's (value - truth) / std is Student-t with 24 - 6 = 18 dof:
+  // within 1 std 67.0 %, within 3 std 99.2 % of the time. Over 1200 component fits the binomial
+  // std of those fractions is 1.4 % and 0.26 %; the bounds are ~4 of those (the six components
+  // of one campaign share their variance factor, which widens the spread a little).
   constexpr double kSigma = 0.00045;
   std::mt19937_64 rng(7);
-  int within1 = 0, within3 = 0, total = 0, principal_within = 0;
+  int within1 = 0, within3 = 0, total = 0, principal_within = 0, points_mode = 0;
   const Eigen::Vector3d true_principal =
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Matrix(kTruth)).eigenvalues();
   for (int c = 0; c < 200; ++c) {
@@ -134,7 +135,7 @@ TEST(Tensor, NoisyCampaignsAreWithinTheirStd) {
     TensorResult r;
     std::string why;
     ASSERT_TRUE(FitTensor(Campaign(kTruth, 2, kSigma, &rng), options, &r, &why)) << why;
-    EXPECT_EQ(r.covariance_used, EllipseCovariance::kAngleMeans);
+    points_mode += r.covariance_used == EllipseCovariance::kPointResiduals;
     for (int k = 0; k < 6; ++k) {
       const double z = std::fabs(r.components[k].value - kTruth[k]) / r.components[k].std;
       within1 += z < 1;
@@ -146,10 +147,77 @@ TEST(Tensor, NoisyCampaignsAreWithinTheirStd) {
                           3 * r.principal_moments[k].std;
     }
   }
-  EXPECT_GT(within1, 0.58 * total);
-  EXPECT_LT(within1, 0.70 * total);
-  EXPECT_GT(within3, 0.955 * total);
-  EXPECT_GT(principal_within, 0.955 * 600);
+  EXPECT_GT(points_mode, 180);  // the F test at 5 % picks orientation means ~5 % of the time
+  EXPECT_GT(within1, 0.60 * total);
+  EXPECT_LT(within1, 0.74 * total);
+  EXPECT_GT(within3, 0.975 * total);
+  EXPECT_GT(principal_within, 0.975 * 600);
+}
+
+TEST(Tensor, AnErrorSharedByTheTrialsOfAnOrientationWidensTheStd) {
+  // Each orientation carries an error of 0.3 % shared by its 3 trials (trial noise 0.05 %): the
+  // F test picks orientation means (12 - 6 = 6 dof), and the truth stays within 3 std in at
+  // least 95 % of 600 component fits (t with 6 dof: 97.6 %).
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  int means_mode = 0, within3 = 0;
+  for (int c = 0; c < 100; ++c) {
+    std::vector<TensorPoint> points = Campaign(kTruth, 3, 0.0001, &rng, 0.0001);
+    for (size_t i = 0; i < points.size(); i += 3) {
+      const double shared = 0.0013 * normal(rng);
+      for (size_t k = i; k < i + 3; ++k) points[k].inertia_kg_m2 += shared;
+    }
+    TensorOptions options;
+    options.bootstrap_replicates = 0;
+    options.attitude_scatter = false;  // the shared error here is not an attitude's
+    TensorResult r;
+    std::string why;
+    ASSERT_TRUE(FitTensor(points, options, &r, &why)) << why;
+    means_mode += r.covariance_used == EllipseCovariance::kAngleMeans;
+    for (int k = 0; k < 6; ++k) {
+      within3 += std::fabs(r.components[k].value - kTruth[k]) < 3 * r.components[k].std;
+    }
+  }
+  EXPECT_GT(means_mode, 95);
+  EXPECT_GT(within3, 0.95 * 600);
+}
+
+TEST(Tensor, AttitudeScatterIsFoundAndWeighed) {
+  // Every trial hung with its own 0.5 deg attitude error (roll and pitch), trace stds of 1e-4 of
+  // I (what a trace fit reports): the stated stds explain nothing, the fit finds the attitude
+  // scatter (~0.5 deg: 0.5 deg in each of two angles tilts the axis by 0.5 deg about the one
+  // horizontal direction that matters) and the truth stays within 3 std in >= 97 % of the
+  // component fits (t with 18 dof: 99.2 %; the scatter estimate adds a little).
+  std::mt19937_64 rng(33);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  int within3 = 0;
+  double scatter_sum = 0.0;
+  for (int c = 0; c < 100; ++c) {
+    std::vector<TensorPoint> points;
+    for (const auto& a : kAttitudes) {
+      for (int k = 0; k < 2; ++k) {
+        TensorPoint p;
+        p.nominal_in_body = DownInBodyFromAttitude(a[0], a[1]);
+        p.direction_in_body = p.nominal_in_body;
+        const auto truth_axis =
+            DownInBodyFromAttitude(a[0] + 0.5 * normal(rng), a[1] + 0.5 * normal(rng));
+        p.inertia_kg_m2 = TensorMoment(kTruth, truth_axis) * (1 + 1e-4 * normal(rng));
+        p.std_kg_m2 = 1e-4 * p.inertia_kg_m2;
+        points.push_back(p);
+      }
+    }
+    TensorOptions options;
+    options.bootstrap_replicates = 0;
+    TensorResult r;
+    std::string why;
+    ASSERT_TRUE(FitTensor(points, options, &r, &why)) << why;
+    scatter_sum += r.attitude_scatter_deg;
+    for (int k = 0; k < 6; ++k) {
+      within3 += std::fabs(r.components[k].value - kTruth[k]) < 3 * r.components[k].std;
+    }
+  }
+  EXPECT_NEAR(scatter_sum / 100, 0.5, 0.15);
+  EXPECT_GT(within3, 0.97 * 600);
 }
 
 TEST(Tensor, BootstrapIntervalsCoverTheTruth) {
@@ -290,6 +358,7 @@ TEST(Tensor, PlanarDesignAgreesWithTheEllipse) {
   }
   TensorOptions options;
   options.bootstrap_replicates = 0;
+  options.covariance = EllipseCovariance::kAngleMeans;  // the ellipse's auto choice here
   TensorResult t;
   std::string why;
   ASSERT_TRUE(FitTensor(tp, options, &t, &why)) << why;
