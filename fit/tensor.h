@@ -72,7 +72,8 @@ struct TensorOptions {
   // direction the data do not determine. (0, 1). Default 1e-6.
   double rank_tolerance = 1e-6;
   // Weigh each point by 1/(s_i^2 + sigma_a^2 g_i^2), g_i the moment's sensitivity to tilting its
-  // axis and sigma_a the attitude scatter solved from the residuals (full designs with stds).
+  // axis and sigma_a the attitude scatter solved from the residuals (full designs with stds;
+  // designs that are not full: 1/(s_i^2 + (sigma_r I_i)^2), a relative scatter).
   // Default true: a trace fit's std (1e-4 of I) is far below what a 0.5 deg attitude error
   // moves the moment (~1e-3), so the stated stds alone would weigh points almost at random.
   bool attitude_scatter = true;
@@ -122,6 +123,9 @@ struct TensorResult {
   // The attitude scatter found in the residuals (deg, TensorOptions::attitude_scatter), 0 when
   // the stated stds explain the scatter or the design is not full.
   double attitude_scatter_deg = 0.0;
+  // A design that is not full: the relative scatter of the moments beyond their stds instead
+  // (fraction, e.g. 0.002), 0 when the stds explain it.
+  double relative_scatter = 0.0;
   bool full = false;               // rank == 6: principal moments and axes below are defined
   double condition_number = 0.0;   // largest / smallest non-zero singular value of the design
   std::array<double, kTensorComponents> design_singular_values = {};  // descending

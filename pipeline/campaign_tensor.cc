@@ -180,6 +180,12 @@ void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& resu
                   "docs/method.md)\n", t.attitude_scatter_deg);
     out << line;
   }
+  if (t.relative_scatter > 0) {
+    std::snprintf(line, sizeof(line),
+                  "  (the moments scatter by %.2f %% beyond their logs' stds: weighed by that, "
+                  "docs/method.md)\n", 100.0 * t.relative_scatter);
+    out << line;
+  }
   if (t.full) {
     out << "Principal moments (ascending) and axes in body axes (x, y, z):\n";
     for (int k = 0; k < 3; ++k) {

@@ -219,7 +219,8 @@ std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
   int path_col = -1, pitch_col = -1, roll_col = -1;  // roll_deg is optional (0 when absent)
   while (std::getline(in, line)) {
     ++line_no;
-    if (line.find_first_not_of(" \r\t") == std::string::npos) continue;
+    const size_t first = line.find_first_not_of(" \r\t");
+    if (first == std::string::npos || line[first] == '#') continue;  // blank or a comment
     const std::vector<std::string> cells = SplitCsvLine(line);
     if (path_col < 0) {
       for (size_t i = 0; i < cells.size(); ++i) {

@@ -115,6 +115,7 @@ json TensorResultToJson(const TensorResult& r, const TensorJsonContext& c) {
   j["n_orientations"] = r.n_orientations;
   j["weighted"] = r.weighted;
   j["attitude_scatter_deg"] = Num(r.attitude_scatter_deg);
+  j["relative_scatter"] = Num(r.relative_scatter);
   j["covariance"] = EllipseCovarianceName(r.covariance_used);
   j["variance_factor"] = Num(r.variance_factor);
   j["dof"] = Num(r.dof);
