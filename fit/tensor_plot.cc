@@ -147,19 +147,20 @@ bool WriteTensorFigure(const TensorResult& r, const std::string& path,
   auto draw = [&] {
     plschr(0, 0.85);
     pladv(0);
-    panel(kViews[0], 0.07, 0.47, 0.56, 0.94);
-    panel(kViews[1], 0.57, 0.97, 0.56, 0.94);
-    panel(kViews[2], 0.07, 0.47, 0.08, 0.46);
-    residual_panel(0.57, 0.97, 0.12, 0.42);
+    panel(kViews[0], 0.07, 0.47, 0.54, 0.86);
+    panel(kViews[1], 0.57, 0.97, 0.54, 0.86);
+    panel(kViews[2], 0.07, 0.47, 0.09, 0.41);
+    residual_panel(0.57, 0.97, 0.11, 0.38);
     plcol0(kFigureBlack);
     plvpor(0.0, 1.0, 0.0, 1.0);
     plwind(0, 1, 0, 1);
-    std::string caption = "ellipsoid of inertia (blue), principal axes 1-3 (red, moments " +
-                          Fmt("%.4g", r.principal_moments[0].value * scale) + ", " +
-                          Fmt("%.4g", r.principal_moments[1].value * scale) + ", " +
-                          Fmt("%.4g", r.principal_moments[2].value * scale) + " " +
-                          options.unit_label + "), measured moments near each plane (o)";
-    plptex(0.5, 0.985, 1, 0, 0.5, caption.c_str());
+    const std::string caption = "ellipsoid of inertia (blue), principal axes 1-3 (red: " +
+                                Fmt("%.4g", r.principal_moments[0].value * scale) + ", " +
+                                Fmt("%.4g", r.principal_moments[1].value * scale) + ", " +
+                                Fmt("%.4g", r.principal_moments[2].value * scale) + " " +
+                                options.unit_label + ")";
+    plptex(0.5, 0.98, 1, 0, 0.5, caption.c_str());
+    plptex(0.5, 0.955, 1, 0, 0.5, "o: measured moments whose axes lie near that plane");
   };
   return WriteFigure(path, options.figure, draw, why);
 }

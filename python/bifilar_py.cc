@@ -288,6 +288,9 @@ py::dict ReadLogCore(const std::string& path, const std::string& config_path) {
   out["axis_source"] = ToString(axis.source);
   out["pitch_measured_deg"] =
       axis.pitch_measured_deg ? py::object(py::float_(*axis.pitch_measured_deg)) : py::none();
+  out["roll_measured_deg"] = axis.pitch_measured_deg && axis.roll_measured_deg
+                                 ? py::object(py::float_(*axis.roll_measured_deg))
+                                 : py::none();
   out["window_s"] = window ? py::object(py::make_tuple((*window)[0], (*window)[1])) : py::none();
   out["warnings"] = data.warnings;
   out["notes"] = axis.notes;

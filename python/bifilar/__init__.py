@@ -199,7 +199,7 @@ def read_log(path, config):
         ``t_s`` (N,), ``rate_rad_per_s`` (N,) the swing rate gyro . n, ``gyro_rad_per_s``
         (N, 3), ``accel_mps2`` (N, 3) or None, all in SI and IMU axes; ``axis_in_imu``,
         ``axis_in_body``, ``axis_source`` (the swing axis n and how it was found),
-        ``pitch_measured_deg`` (from the accelerometer at rest, or None), ``window_s`` (the
+        ``pitch_measured_deg`` and ``roll_measured_deg`` (from the accelerometer at rest, or None), ``window_s`` (the
         config's window for this file, or None), ``warnings`` (repairs made while reading) and
         ``notes``. ``fit_trace(r.t_s, r.rate_rad_per_s, config=config, name=path)`` then gives
         the numbers of ``bifilar fit config path``.
