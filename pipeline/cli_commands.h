@@ -3,8 +3,11 @@
 // bifilar::UserError, which the dispatcher prints as one line and turns into exit code 2.
 #pragma once
 
+#include <memory>
+
 #include <CLI/CLI.hpp>
 
+#include "pipeline/ellipse_table.h"  // InertiaUnits
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -14,5 +17,15 @@ void RegisterFitCommand(CLI::App& app, int* exit_code);
 void RegisterEllipseCommands(CLI::App& app, int* exit_code);  // `ellipse` and `plan`
 void RegisterProcessCommands(CLI::App& app, int* exit_code);  // `process` and `report`
 void RegisterInspectCommands(CLI::App& app, int* exit_code);  // `inspect` and `init`
+void RegisterExportCommand(CLI::App& app, int* exit_code);    // `export`
+
+// `plan --tensor` (pipeline/cli_plan_tensor.cc): its options on the `plan` subcommand, whether
+// it was asked for (throws UserError when a tensor-only option comes without --tensor), and the
+// run, given the options it shares with the pitch-plane plan.
+struct TensorPlanCli;
+std::shared_ptr<TensorPlanCli> AddTensorPlanOptions(CLI::App* plan);
+bool TensorPlanRequested(const TensorPlanCli& tensor_plan);
+int RunTensorPlanFromCli(const TensorPlanCli& tensor_plan, const CLI::App& plan, int trials,
+                         double sigma, double ixz, bool ixz_given, InertiaUnits units, bool json);
 
 }  // namespace bifilar
