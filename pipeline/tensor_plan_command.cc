@@ -109,6 +109,11 @@ int RunTensorPlanCommand(const TensorPlanCommandOptions& options, std::ostream& 
     throw UserError("plan --tensor: --target and --target-rel must be > 0");
   }
   o.target_std_kg_m2 = options.target * to_si;
+  if ((o.sigma_relative > 0 || o.attitude_std_deg > 0) && !options.guess_given) {
+    throw UserError(
+        "plan --tensor: --sigma-rel and --attitude-std need a guess of the tensor: "
+        "give --ixx, --iyy, --izz (and --ixy, --ixz, --iyz when known)");
+  }
   std::string why;
   if (!o.Check(&why)) throw UserError("plan --tensor: " + why);
   if (options.target_relative > 0) {
