@@ -33,9 +33,13 @@ std::string Num(double v) {
 // A number, or "" when it is not known (CSV).
 std::string CsvNum(double v) { return std::isfinite(v) ? Num(v) : std::string(); }
 
-// Text for an XML comment: "--" is not allowed inside one.
+// Text for an XML comment: "--" is not allowed inside one (nor a final "-"): "--set" becomes
+// "- -set".
 std::string CommentSafe(std::string s) {
-  for (size_t at = s.find("--"); at != std::string::npos; at = s.find("--", at)) s[at + 1] = ' ';
+  for (size_t at = s.find("--"); at != std::string::npos; at = s.find("--", at)) {
+    s.insert(at + 1, " ");
+  }
+  if (!s.empty() && s.back() == '-') s += ' ';
   return s;
 }
 
@@ -99,8 +103,7 @@ void RequireComplete(const ExportInertia& in, const char* format) {
 // The comment every XML file starts with: source, frame and sign, what is not measured.
 std::string XmlHeader(const ExportInertia& in, const std::string& frame_text,
                       const std::string& sign_text, const char* cg_text) {
-  std::string s = "<!-- bifilar export of " + CommentSafe(in.results_name) + " (section '" +
-                  in.section + "').\n";
+  std::string s = "bifilar export of " + in.results_name + " (section '" + in.section + "').\n";
   s += "     Frame: " + frame_text + "\n     Signs: " + sign_text + "\n";
   s += "     Inertia about the CG in body axes (x forward, y right, z down; products positive, "
        "I_xy = integral x y dm), kg m^2, value +- std:\n";
@@ -111,14 +114,15 @@ std::string XmlHeader(const ExportInertia& in, const std::string& frame_text,
            (std::isfinite(in.std_kg_m2[k]) ? Num(in.std_kg_m2[k]) : std::string("unknown")) + "\n";
     } else {
       s += Num(in.value_kg_m2[k]) + " (not measured: " +
-           (in.source[k] == "set" ? "given with set" : "assumed 0, aircraft symmetric about x-z") +
+           (in.source[k] == "set" ? "given by the user"
+                                  : "assumed 0, aircraft symmetric about x-z") +
            ")\n";
     }
   }
   s += "     NOT MEASURED by the bifilar: the mass (" + Num(in.mass_kg) + " kg, from " +
-       in.mass_source + ") and the CG: " + cg_text +
-       " Move it to the measured CG; the inertia is about the CG. -->\n";
-  return s;
+       (in.mass_source == "--mass-kg" ? std::string("the command line") : in.mass_source) +
+       ") and the CG: " + cg_text + " Move it to the measured CG; the inertia is about the CG.";
+  return "<!-- " + CommentSafe(s) + " -->\n";
 }
 
 }  // namespace

@@ -354,6 +354,15 @@ TEST(ExportCli, WritesEachFormatAndRefusesBadInputNamingTheFile) {
   r = Bifilar(dir, "export " + no_mass + " --format urdf --mass-kg 0.9");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("<mass value=\"0.9\"/>"), std::string::npos) << r.out;
+  // An XML comment holds no "--" (not even from a path): the file stays well-formed.
+  const std::string dashes = WriteFile(dir.path + "/a--b/results.json", ReadFile(no_mass));
+  r = Bifilar(dir, "export " + dashes + " --format sdf --mass-kg 0.9 --set Ixy=0.01 --symmetric");
+  ASSERT_EQ(r.exit_code, 2) << r.err;  // Ixy is measured: cannot be set
+  r = Bifilar(dir, "export " + dashes + " --format sdf --mass-kg 0.9");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string comment = r.out.substr(4, r.out.find("-->") - 4);
+  EXPECT_EQ(comment.find("--"), std::string::npos) << comment;
+  EXPECT_EQ(r.out.find("-->"), r.out.rfind("-->"));
   r = Bifilar(dir, "export " + no_mass + " --format csv");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find(",,,missing,2,"), std::string::npos) << r.out;
