@@ -8,6 +8,13 @@
 // to every repeat's std, so that each log's std covers what a repeat of it would give. The
 // combined value is the random-effects mean, weights 1 / (sigma_i^2 + tau^2).
 //
+// Before that, the release amplitude is taken out: on a rig that departs from the ideal model, I
+// grows with the amplitude, and repeats released at different amplitudes scatter for that
+// reason. One relative coefficient c of I_0 (1 + c A^2), pooled over every set-up of the run
+// (each with its own I_0), moves each log's I from the amplitude of its result to zero amplitude,
+// with the std of c propagated (common to all logs of a set-up: it enters each log's std and the
+// set-up mean's std, not the scatter between repeats). The scatter is reported before and after.
+//
 // `bifilar fit --repeats` groups the logs whose paths differ only in the last number of the
 // file name (`BaseModel_Ixx_Log-1.csv` ... `-4.csv`; `pitch_10/trial_1.csv` ... `trial_5.csv`).
 // docs/method.md, "Repeats".
@@ -37,6 +44,16 @@ struct RepeatGroup {
   // ideal model shows here even when each log is too short to show it.
   double amplitude_trend_percent_per_10deg = NAN;
   double amplitude_trend_z = NAN;
+  // The scatter of the used members before and after the amplitude correction: sample standard
+  // deviation of I over their plain mean (%), and Cochran's Q on the per-log stds; the largest
+  // |I_i - plain mean| / std_i before (per-log std alone). q, tau, max_abs_z above are after the
+  // correction (the same as before when none was applied).
+  double spread_before_percent = NAN;
+  double spread_after_percent = NAN;
+  double q_before = NAN;
+  double max_abs_z_before = NAN;
+  // The correction's std for the set-up mean (common to its members), included in mean_std_kg_m2.
+  double correction_std_kg_m2 = NAN;
   std::string note;          // why nothing was combined (fewer than 2 usable members)
 };
 
@@ -44,13 +61,35 @@ struct RepeatGroup {
 // number is a group of its own.
 std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths);
 
-// Combines each group's usable members (status ok, finite I, std > 0): fills the group's
-// statistics, and for every used member sets repeat_scatter_std_kg_m2 = tau, adds tau in
-// quadrature to inertia_total_std_kg_m2 and, when tau > 0, a warning saying so.
-void CombineRepeats(std::vector<RepeatGroup>* groups, std::vector<TraceRecord>* records);
+// The amplitude correction pooled over the groups (fit/amplitude_trend.h,
+// FitPooledAmplitudeTrend on each usable log's I, std and result amplitude: the lowest band's
+// when the result comes from it, else the RMS of the fitted start and end amplitudes).
+struct RepeatsAmplitudeCorrection {
+  bool applied = false;
+  double coeff_per_deg2 = NAN;      // c of I_0 (1 + c A^2), relative
+  double coeff_std_per_deg2 = NAN;  // with the between-log scatter in the weights
+  double z = NAN;
+  double birge = NAN;               // scatter about the pooled fit over the stds, sqrt(chi^2/dof)
+  double scatter_percent = NAN;     // between-log relative std in the pooled fit's weights (%)
+  int dof = 0;
+  int n_logs = 0, n_groups = 0;     // used by the pooled fit
+  double amplitude_min_deg = NAN, amplitude_max_deg = NAN;
+  std::string note;                 // why it was not applied
+};
+
+// Combines each group's usable members (status ok, finite I, std > 0). First the amplitude
+// correction: c pooled over the groups with >= 2 usable members; every usable record gets
+// amplitude_correction_* set, the correction subtracted from inertia_total_kg_m2. Then per group:
+// the statistics, and for every used member repeat_scatter_std_kg_m2 = tau, tau and the
+// correction's std added in quadrature to inertia_total_std_kg_m2 and, when tau > 0, a warning.
+RepeatsAmplitudeCorrection CombineRepeats(std::vector<RepeatGroup>* groups,
+                                          std::vector<TraceRecord>* records);
 
 // One line per group for the console.
 std::string RepeatGroupLine(const RepeatGroup& group);
+
+// One line for the console: the pooled coefficient, or why no correction was applied.
+std::string AmplitudeCorrectionLine(const RepeatsAmplitudeCorrection& correction);
 
 }  // namespace bifilar
 
