@@ -82,7 +82,7 @@ void BM_TraceFitWithBudget(benchmark::State& state) {
 BENCHMARK(BM_TraceFitWithBudget)->Unit(benchmark::kMillisecond);
 
 // A large release (issue 16): the same 60 s window released at 75 deg, where the full model's
-// nonlinearity is strongest; the amplitude sweep (6 bands, the trend chosen among A, A^2, A^4)
+// nonlinearity is strongest; the amplitude sweep (6 bands, the trend chosen between A and A^2)
 // is included, as in every case above.
 void BM_TraceFitLargeRelease(benchmark::State& state) {
   RunFit(state, Window(75.0), TraceFitOptions());

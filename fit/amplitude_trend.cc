@@ -47,7 +47,7 @@ bool FitAmplitudePower(const std::vector<AmplitudePoint>& points, double ref, do
 }
 
 const std::vector<double>& AmplitudeTrendExponents() {
-  static const std::vector<double> kExponents = {1.0, 2.0, 4.0};
+  static const std::vector<double> kExponents = {1.0, 2.0};
   return kExponents;
 }
 
@@ -56,7 +56,7 @@ bool FitAmplitudeShape(const std::vector<AmplitudePoint>& points, double ref,
   AmplitudePowerFit best;
   bool any = false;
   // p = 2 first: on a tie (2 points, or curves that fit equally well) the analytic term stays.
-  for (double p : {2.0, 1.0, 4.0}) {
+  for (double p : {2.0, 1.0}) {
     AmplitudePowerFit fit;
     if (!FitAmplitudePower(points, ref, p, &fit)) continue;
     // A relative margin, so that rounding does not decide between curves through 2 points.

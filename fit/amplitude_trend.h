@@ -3,9 +3,8 @@
 // through points (A_j, I_j +- s_j), the relative coefficient c with its std scaled by the Birge
 // ratio when the points scatter about the fitted curve more than their stds (chi^2 > dof, the
 // PDG rule). Deviations of a real rig from the ideal model are even in the angle; an analytic one
-// starts as A^2 (p = 2), a sway coupling as A^4, and a rig whose I rises linearly with the
-// amplitude (hooks, wire bending, slack: |psi| terms) as A (p = 1). FitAmplitudeShape lets the
-// data choose p among these. Used by the amplitude sweep within one log (fit/trace_sweep.cc) and
+// starts as A^2 (p = 2), and a rig whose I rises linearly with the amplitude (hooks, wire bending,
+// slack: |psi| terms) as A (p = 1). FitAmplitudeShape lets the data choose p among these. Used by the amplitude sweep within one log (fit/trace_sweep.cc) and
 // across repeats of one set-up (pipeline/repeats.cc). docs/method.md §4 and §8.
 #ifndef BIFILAR_FIT_AMPLITUDE_TREND_H_
 #define BIFILAR_FIT_AMPLITUDE_TREND_H_
@@ -47,7 +46,8 @@ struct AmplitudePowerFit {
 bool FitAmplitudePower(const std::vector<AmplitudePoint>& points, double reference_kg_m2,
                        double exponent, AmplitudePowerFit* out);
 
-// The exponents FitAmplitudeShape chooses among: 1, 2, 4.
+// The exponents FitAmplitudeShape chooses among: 1, 2. (A^4 as a third choice flagged 1 of 160
+// ideal simulated quadrotor logs, none without it; a quartic rig shows as A^2 as well.)
 const std::vector<double>& AmplitudeTrendExponents();
 
 // The data's choice of p among AmplitudeTrendExponents(): the curve with the lowest chi^2 (each

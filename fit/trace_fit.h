@@ -58,7 +58,7 @@ struct TraceFitOptions {
   // successive bands of the window, each holding the same number of cycles (at least
   // sweep_min_cycles_per_band, at most sweep_max_bands bands), with K_D and C held at the window
   // fit. A trend of I with amplitude beyond its statistical error (|z| > sweep_trend_z for the
-  // coefficient of I_0 (1 + c A^p), p in {1, 2, 4} chosen by the data) means the rig departs
+  // coefficient of I_0 (1 + c A^p), p in {1, 2} chosen by the data) means the rig departs
   // from the model: a warning, the result taken from the lowest-amplitude band with its std
   // scaled by the bands' scatter about the trend, and a model-inadequacy term (the trend's
   // change from that band's amplitude to zero) added to its uncertainty.
@@ -139,7 +139,7 @@ struct AmplitudeSweep {
   std::string note;
   std::vector<AmplitudeSweepBand> bands;  // in time order (amplitude decreasing)
   // The trend over the bands (fit/amplitude_trend.h, FitAmplitudeShape): the weighted curve
-  // I_j = I_0 (1 + c A_j^p) with p in {1, 2, 4} chosen by the data (lowest chi^2); c (per deg^p)
+  // I_j = I_0 (1 + c A_j^p) with p in {1, 2} chosen by the data (lowest chi^2); c (per deg^p)
   // with its std scaled by the Birge ratio of the bands about that curve, z = c / std.
   double trend_exponent = 2.0;  // p
   double trend_coeff = 0.0;     // c (per deg^p), relative to I_0

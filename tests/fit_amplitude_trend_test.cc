@@ -42,7 +42,7 @@ TEST(AmplitudeTrend, ChoosesTheExponentOfTheData) {
       EXPECT_NEAR(shape.percent_per_10deg, 1.0, 0.1) << seed;
     }
   }
-  // The 0.1 % noise cannot confuse 1 % per 10 deg with A^2 or A^4 on these amplitudes.
+  // The 0.1 % noise cannot confuse 1 % per 10 deg with A^2 on these amplitudes.
   EXPECT_EQ(chosen_linear, 20);
   // And an A^2 rig is taken as A^2.
   AmplitudePowerFit shape;
