@@ -89,7 +89,7 @@ void AddCorrectionStd(TraceRecord* r) {
 }
 
 void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
-  std::vector<const TraceRecord*> used;
+  std::vector<TraceRecord*> used;
   for (int i : group->members) {
     if (Usable((*records)[i])) used.push_back(&(*records)[i]);
   }
@@ -97,20 +97,35 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
   if (used.size() < 2) {
     group->note = std::to_string(used.size()) + " usable repeat(s) of " +
                   std::to_string(group->members.size()) + ": nothing to combine";
-    for (int i : group->members) {
-      if (Usable((*records)[i])) AddCorrectionStd(&(*records)[i]);
-    }
+    for (TraceRecord* r : used) AddCorrectionStd(r);
     return;
   }
-  // The scatter before and after the amplitude correction, on the per-log stds.
+  // The error of the correction's c moves a log by I A_i^2 dc: its part I Abar^2 dc moves every
+  // repeat of the set-up together (the set-up mean's std gets it), the rest I (A_i^2 - Abar^2) dc
+  // moves the repeats against each other and counts in their scatter (s below).
+  double a2bar = 0.0;
+  int corrected = 0;
+  for (const TraceRecord* r : used) {
+    if (!std::isfinite(r->amplitude_correction_kg_m2)) continue;
+    a2bar += r->amplitude_correction_from_deg * r->amplitude_correction_from_deg;
+    ++corrected;
+  }
+  if (corrected > 0) a2bar /= corrected;
+  std::vector<double> s, before, after;
+  for (const TraceRecord* r : used) {
+    double differential = 0.0;
+    const double a2 = r->amplitude_correction_from_deg * r->amplitude_correction_from_deg;
+    if (std::isfinite(r->amplitude_correction_kg_m2) && a2 > 0.0)
+      differential = r->amplitude_correction_std_kg_m2 * std::abs(a2 - a2bar) / a2;
+    s.push_back(std::hypot(r->inertia_total_std_kg_m2, differential));
+    before.push_back(Uncorrected(*r));
+    after.push_back(r->inertia_total_kg_m2);
+  }
+  // The scatter before (per-log stds) and after the amplitude correction.
   {
-    std::vector<double> before, after, s;
-    for (const TraceRecord* r : used) {
-      before.push_back(Uncorrected(*r));
-      after.push_back(r->inertia_total_kg_m2);
-      s.push_back(r->inertia_total_std_kg_m2);
-    }
-    Scatter(before, s, &group->spread_before_percent, &group->q_before);
+    std::vector<double> s_before;
+    for (const TraceRecord* r : used) s_before.push_back(r->inertia_total_std_kg_m2);
+    Scatter(before, s_before, &group->spread_before_percent, &group->q_before);
     double q_after = 0.0;
     Scatter(after, s, &group->spread_after_percent, &q_after);
     double plain_before = 0.0;
@@ -118,25 +133,23 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
     group->max_abs_z_before = 0.0;
     for (size_t i = 0; i < before.size(); ++i) {
       group->max_abs_z_before =
-          std::max(group->max_abs_z_before, std::abs(before[i] - plain_before) / s[i]);
+          std::max(group->max_abs_z_before, std::abs(before[i] - plain_before) / s_before[i]);
     }
   }
   // DerSimonian-Laird: Q about the fixed-effect mean, tau^2 = max(0, (Q - (k - 1)) / c).
   double sw = 0.0, sw2 = 0.0, swy = 0.0, plain = 0.0;
-  for (const TraceRecord* r : used) {
-    const double w = 1.0 / (r->inertia_total_std_kg_m2 * r->inertia_total_std_kg_m2);
+  for (size_t i = 0; i < used.size(); ++i) {
+    const double w = 1.0 / (s[i] * s[i]);
     sw += w;
     sw2 += w * w;
-    swy += w * r->inertia_total_kg_m2;
-    plain += r->inertia_total_kg_m2;
+    swy += w * after[i];
+    plain += after[i];
   }
   const double k = static_cast<double>(used.size());
   const double fixed_mean = swy / sw;
   group->plain_mean_kg_m2 = plain / k;
   double q = 0.0;
-  for (const TraceRecord* r : used) {
-    q += std::pow((r->inertia_total_kg_m2 - fixed_mean) / r->inertia_total_std_kg_m2, 2);
-  }
+  for (size_t i = 0; i < used.size(); ++i) q += std::pow((after[i] - fixed_mean) / s[i], 2);
   group->q = q;
   const double tau2 = std::max(0.0, (q - (k - 1.0)) / (sw - sw2 / sw));
   group->tau_kg_m2 = std::sqrt(tau2);
@@ -154,19 +167,20 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
   }
   double sw_re = 0.0, swy_re = 0.0, swc = 0.0;
   group->max_abs_z = 0.0;
-  for (int i : group->members) {
-    TraceRecord& r = (*records)[i];
-    if (!Usable(r)) continue;
+  for (size_t i = 0; i < used.size(); ++i) {
+    TraceRecord& r = *used[i];
+    const double s_re = std::hypot(s[i], group->tau_kg_m2);
+    const double w = 1.0 / (s_re * s_re);
+    sw_re += w;
+    swy_re += w * after[i];
+    // The common part of the correction's std: I Abar^2 std(c) for the set-up mean.
+    const double a2 = r.amplitude_correction_from_deg * r.amplitude_correction_from_deg;
+    if (std::isfinite(r.amplitude_correction_kg_m2) && a2 > 0.0)
+      swc += w * r.amplitude_correction_std_kg_m2 * a2bar / a2;
+    group->max_abs_z = std::max(group->max_abs_z, std::abs(after[i] - group->plain_mean_kg_m2) / s_re);
+    // The log's own std: its per-log std, tau and the whole std of its correction.
     r.repeat_scatter_std_kg_m2 = group->tau_kg_m2;
     r.inertia_total_std_kg_m2 = std::hypot(r.inertia_total_std_kg_m2, group->tau_kg_m2);
-    const double w = 1.0 / (r.inertia_total_std_kg_m2 * r.inertia_total_std_kg_m2);
-    sw_re += w;
-    swy_re += w * r.inertia_total_kg_m2;
-    if (std::isfinite(r.amplitude_correction_std_kg_m2)) swc += w * r.amplitude_correction_std_kg_m2;
-    // Against the set-up mean, the correction's std (common to the members) does not count.
-    group->max_abs_z = std::max(
-        group->max_abs_z,
-        std::abs(r.inertia_total_kg_m2 - group->plain_mean_kg_m2) / r.inertia_total_std_kg_m2);
     AddCorrectionStd(&r);
     if (tau2 > 0.0) {
       char text[320];
@@ -180,8 +194,6 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
     }
   }
   group->mean_kg_m2 = swy_re / sw_re;
-  // The correction's error moves every member together: its weighted mean std adds to the
-  // random-effects std in quadrature.
   group->correction_std_kg_m2 = swc / sw_re;
   group->mean_std_kg_m2 = std::hypot(1.0 / std::sqrt(sw_re), group->correction_std_kg_m2);
 }
@@ -305,7 +317,7 @@ std::string AmplitudeCorrectionLine(const RepeatsAmplitudeCorrection& c) {
   char buffer[640];
   std::snprintf(buffer, sizeof(buffer),
                 "amplitude correction: I = I_0 (1 + c A^2), c = %.3g +- %.2g per deg^2 (z = %.1f; "
-                "pooled over %d logs in %d set-ups, %.1f-%.1f deg, weighted with a between-log "
+                "pooled over %d logs in %d set-up(s), %.1f-%.1f deg, weighted with a between-log "
                 "scatter of %.2g %%): "
                 "every log's I is moved from the amplitude of its result to zero amplitude "
                 "(%+.2f %% at 10 deg, %+.2f %% at 20 deg) with the std of c propagated",

@@ -35,9 +35,12 @@ struct RepeatGroup {
   double mean_kg_m2 = NAN;   // random-effects mean
   double mean_std_kg_m2 = NAN;
   double plain_mean_kg_m2 = NAN;  // unweighted mean of the used members
-  double q = NAN;            // Cochran's Q about the fixed-effect mean, n_used - 1 dof
-  double tau_kg_m2 = NAN;    // between-repeat std beyond the per-log stds (0: none)
-  // Largest |I_i - plain mean| / std_i over the used members, std_i with tau added.
+  // Cochran's Q about the fixed-effect mean, n_used - 1 dof, on the per-log stds with the part
+  // of the amplitude correction's std that differs between the repeats,
+  // I_i (A_i^2 - mean A^2) std(c); the part common to the set-up does not scatter them.
+  double q = NAN;
+  double tau_kg_m2 = NAN;    // between-repeat std beyond those stds (0: none)
+  // Largest |I_i - plain mean| / std_i over the used members, std_i those stds with tau added.
   double max_abs_z = NAN;
   // Across the repeats, I against the mean squared amplitude of each log's fit (weighted line):
   // the slope in % per 10 deg at the repeats' amplitudes and its z. A rig that departs from the
@@ -45,8 +48,8 @@ struct RepeatGroup {
   double amplitude_trend_percent_per_10deg = NAN;
   double amplitude_trend_z = NAN;
   // The scatter of the used members before and after the amplitude correction: sample standard
-  // deviation of I over their plain mean (%), and Cochran's Q on the per-log stds; the largest
-  // |I_i - plain mean| / std_i before (per-log std alone). q, tau, max_abs_z above are after the
+  // deviation of I over their plain mean (%), and Cochran's Q; the largest |I_i - plain mean| /
+  // std_i before (per-log std alone). q, tau, max_abs_z above are after the
   // correction (the same as before when none was applied).
   double spread_before_percent = NAN;
   double spread_after_percent = NAN;
