@@ -128,6 +128,8 @@ nlohmann::json AmplitudeCorrectionToJson(const RepeatsAmplitudeCorrection& c) {
           {"dof", c.dof},
           {"n_logs", c.n_logs},
           {"n_groups", c.n_groups},
+          {"n_corrected", c.n_corrected},
+          {"n_low_band_kept", c.n_low_band_kept},
           {"amplitude_range_deg", {number(c.amplitude_min_deg), number(c.amplitude_max_deg)}},
           {"note", c.note}};
 }

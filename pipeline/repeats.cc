@@ -166,18 +166,24 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
     AmplitudeTrendAcrossRepeats(pointers, group->plain_mean_kg_m2, group);
   }
   double sw_re = 0.0, swy_re = 0.0, swc = 0.0;
+  for (size_t i = 0; i < used.size(); ++i) {
+    const double s_re = std::hypot(s[i], group->tau_kg_m2);
+    sw_re += 1.0 / (s_re * s_re);
+    swy_re += after[i] / (s_re * s_re);
+  }
+  group->mean_kg_m2 = swy_re / sw_re;
   group->max_abs_z = 0.0;
   for (size_t i = 0; i < used.size(); ++i) {
     TraceRecord& r = *used[i];
     const double s_re = std::hypot(s[i], group->tau_kg_m2);
     const double w = 1.0 / (s_re * s_re);
-    sw_re += w;
-    swy_re += w * after[i];
     // The common part of the correction's std: I Abar^2 std(c) for the set-up mean.
     const double a2 = r.amplitude_correction_from_deg * r.amplitude_correction_from_deg;
     if (std::isfinite(r.amplitude_correction_kg_m2) && a2 > 0.0)
       swc += w * r.amplitude_correction_std_kg_m2 * a2bar / a2;
-    group->max_abs_z = std::max(group->max_abs_z, std::abs(after[i] - group->plain_mean_kg_m2) / s_re);
+    // Against the set-up's value, the random-effects mean (a plain mean would be pulled by an
+    // imprecise log, a lowest-band result with its large std).
+    group->max_abs_z = std::max(group->max_abs_z, std::abs(after[i] - group->mean_kg_m2) / s_re);
     // The log's own std: its per-log std, tau and the whole std of its correction.
     r.repeat_scatter_std_kg_m2 = group->tau_kg_m2;
     r.inertia_total_std_kg_m2 = std::hypot(r.inertia_total_std_kg_m2, group->tau_kg_m2);
@@ -193,7 +199,6 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
       r.flags.push_back("repeat_scatter");
     }
   }
-  group->mean_kg_m2 = swy_re / sw_re;
   group->correction_std_kg_m2 = swc / sw_re;
   group->mean_std_kg_m2 = std::hypot(1.0 / std::sqrt(sw_re), group->correction_std_kg_m2);
 }
@@ -221,7 +226,6 @@ RepeatsAmplitudeCorrection CorrectAmplitude(const std::vector<RepeatGroup>& grou
                "freedom beyond the fit)";
     return out;
   }
-  out.applied = true;
   out.coeff_per_deg2 = pooled.coeff_per_deg2;
   out.coeff_std_per_deg2 = pooled.coeff_std_per_deg2;
   out.z = pooled.z;
@@ -235,6 +239,13 @@ RepeatsAmplitudeCorrection CorrectAmplitude(const std::vector<RepeatGroup>& grou
   for (TraceRecord& r : *records) {
     const double a2 = ResultAmplitudeSquared(r);
     if (!Usable(r) || !std::isfinite(a2)) continue;
+    // A result from the lowest band of a log whose own sweep found the trend already carries
+    // the change to zero amplitude in its model-inadequacy std: it is a point of the pooled fit
+    // (at that band's amplitude), but is not corrected a second time.
+    if (r.inertia_source == "low_amplitude_band") {
+      ++out.n_low_band_kept;
+      continue;
+    }
     const double factor = 1.0 + out.coeff_per_deg2 * a2;
     if (!(factor > 0.5)) continue;  // far outside what the fit measured: leave it
     const double corrected = r.inertia_total_kg_m2 / factor;
@@ -242,6 +253,12 @@ RepeatsAmplitudeCorrection CorrectAmplitude(const std::vector<RepeatGroup>& grou
     r.amplitude_correction_std_kg_m2 = corrected * a2 * out.coeff_std_per_deg2 / factor;
     r.amplitude_correction_from_deg = std::sqrt(a2);
     r.inertia_total_kg_m2 = corrected;
+    ++out.n_corrected;
+  }
+  out.applied = out.n_corrected > 0;
+  if (!out.applied) {
+    out.note = "every usable log's result comes from the lowest-amplitude band of its own sweep, "
+               "whose std already covers the change to zero amplitude";
   }
   return out;
 }
@@ -314,18 +331,24 @@ std::string RepeatGroupLine(const RepeatGroup& g) {
 
 std::string AmplitudeCorrectionLine(const RepeatsAmplitudeCorrection& c) {
   if (!c.applied) return "amplitude correction: none (" + c.note + ")";
+  std::string kept;
+  if (c.n_low_band_kept > 0) {
+    kept = "; " + std::to_string(c.n_low_band_kept) +
+           " log(s) whose result comes from their own lowest band keep it (their std covers the "
+           "change to zero amplitude)";
+  }
   char buffer[640];
   std::snprintf(buffer, sizeof(buffer),
                 "amplitude correction: I = I_0 (1 + c A^2), c = %.3g +- %.2g per deg^2 (z = %.1f; "
                 "pooled over %d logs in %d set-up(s), %.1f-%.1f deg, weighted with a between-log "
                 "scatter of %.2g %%): "
-                "every log's I is moved from the amplitude of its result to zero amplitude "
+                "each log's I is moved from the amplitude of its result to zero amplitude "
                 "(%+.2f %% at 10 deg, %+.2f %% at 20 deg) with the std of c propagated",
                 c.coeff_per_deg2, c.coeff_std_per_deg2, c.z, c.n_logs, c.n_groups,
                 c.amplitude_min_deg, c.amplitude_max_deg, c.scatter_percent,
                 -100.0 * (1.0 - 1.0 / (1.0 + c.coeff_per_deg2 * 100.0)),
                 -100.0 * (1.0 - 1.0 / (1.0 + c.coeff_per_deg2 * 400.0)));
-  return buffer;
+  return buffer + kept;
 }
 
 }  // namespace bifilar

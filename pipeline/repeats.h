@@ -40,7 +40,7 @@ struct RepeatGroup {
   // I_i (A_i^2 - mean A^2) std(c); the part common to the set-up does not scatter them.
   double q = NAN;
   double tau_kg_m2 = NAN;    // between-repeat std beyond those stds (0: none)
-  // Largest |I_i - plain mean| / std_i over the used members, std_i those stds with tau added.
+  // Largest |I_i - mean_kg_m2| / std_i over the used members, std_i those stds with tau added.
   double max_abs_z = NAN;
   // Across the repeats, I against the mean squared amplitude of each log's fit (weighted line):
   // the slope in % per 10 deg at the repeats' amplitudes and its z. A rig that departs from the
@@ -76,13 +76,19 @@ struct RepeatsAmplitudeCorrection {
   double scatter_percent = NAN;     // between-log relative std in the pooled fit's weights (%)
   int dof = 0;
   int n_logs = 0, n_groups = 0;     // used by the pooled fit
+  int n_corrected = 0;              // logs moved to zero amplitude
+  // Logs whose result is the lowest band of their own sweep's trend (inertia_source
+  // "low_amplitude_band"): points of the fit, but not corrected (their model-inadequacy std
+  // already covers the change to zero amplitude).
+  int n_low_band_kept = 0;
   double amplitude_min_deg = NAN, amplitude_max_deg = NAN;
-  std::string note;                 // why it was not applied
+  std::string note;                 // why it was not applied (the fields above may be set)
 };
 
 // Combines each group's usable members (status ok, finite I, std > 0). First the amplitude
-// correction: c pooled over the groups with >= 2 usable members; every usable record gets
-// amplitude_correction_* set, the correction subtracted from inertia_total_kg_m2. Then per group:
+// correction: c pooled over the groups with >= 2 usable members; every usable record whose result
+// is not already a low-amplitude band gets amplitude_correction_* set, the correction subtracted
+// from inertia_total_kg_m2. Then per group:
 // the statistics, and for every used member repeat_scatter_std_kg_m2 = tau, tau and the
 // correction's std added in quadrature to inertia_total_std_kg_m2 and, when tau > 0, a warning.
 RepeatsAmplitudeCorrection CombineRepeats(std::vector<RepeatGroup>* groups,
