@@ -231,40 +231,64 @@ bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
     if (count > 0) {
       const Eigen::Vector3d f_mean = f_sum / count;
       axis->rest_accel_mps2 = f_mean.norm();
-      // Gravity removed by the logger (f + g n_est): the residual g (n_est - n) of its tilt
-      // estimate is small and nearly perpendicular to the down vertical n (|n| = |n_est| = 1),
-      // which is the swing axis, while gravity in a wrong unit (g read as m/s^2, also ~0.1 g)
-      // lies along it. So: below gravity_removed_below_g and more than 60 deg from the gyro's
-      // principal direction -> continue gyro-only with a warning.
+      // An accelerometer that does not read gravity is ignored with a warning: a yaw, pitch or
+      // roll swing needs only the gyro (the axis from its principal direction), and only a caller
+      // that needs the down vector (options.accel_required, or a campaign's measured pitch)
+      // turns it into an error. The warning says what the reading looks like:
+      //  - gravity removed by the logger (f + g n_est): the residual g (n_est - n) of its tilt
+      //    estimate is small and nearly perpendicular to the down vertical n, which is the swing
+      //    axis: below gravity_removed_below_g and more than 60 deg from the gyro's principal
+      //    direction;
+      //  - a unit mix-up: 1 g logged in g and read as m/s^2 (0.102 g), or in m/s^2 read as g
+      //    (9.81 g), within gravity_tolerance;
+      //  - anything else (a scale, a column or a broken sensor: the fixed-wing logs' 0.27 g).
       const double g_read = f_mean.norm() / kStandardGravityMps2;  // in standard gravities
-      bool gravity_removed = false;
-      if (f_mean.allFinite() && g_read < options.gravity_removed_below_g && g_read > 0.0) {
-        const std::optional<Eigen::Vector3d> principal =
-            GyroPrincipalDirection(data, range.first, range.second);
-        gravity_removed = principal && std::abs(principal->dot(f_mean.normalized())) < 0.5;
-      }
-      if (gravity_removed) {
-        char buf[512];
-        std::snprintf(buf, sizeof(buf),
-                      "the accelerometer reads %.3g g (%.3g m/s^2) %s instead of 1 g: gravity "
-                      "removed by the logger? The accelerometer is ignored (swing axis from the "
-                      "gyro, no measured pitch); set imu.accel: null to say so",
-                      g_read, f_mean.norm(), down_at_rest ? "at rest" : "over the swing");
-        axis->warnings.push_back(buf);
+      const double tol = options.gravity_tolerance;
+      const bool gravity_ok = f_mean.allFinite() && std::abs(g_read - 1.0) <= tol;
+      if (!gravity_ok) {
+        bool gravity_removed = false;
+        if (f_mean.allFinite() && g_read < options.gravity_removed_below_g && g_read > 0.0) {
+          const std::optional<Eigen::Vector3d> principal =
+              GyroPrincipalDirection(data, range.first, range.second);
+          gravity_removed = principal && std::abs(principal->dot(f_mean.normalized())) < 0.5;
+        }
+        const char* where = down_at_rest ? "at rest" : "over the swing";
+        char buf[640];
+        if (!f_mean.allFinite()) {
+          std::snprintf(buf, sizeof(buf), "the mean accelerometer reading %s is not finite", where);
+        } else if (gravity_removed) {
+          std::snprintf(buf, sizeof(buf),
+                        "the accelerometer reads %.3g g (%.3g m/s^2) %s instead of 1 g: gravity "
+                        "removed by the logger?",
+                        g_read, f_mean.norm(), where);
+        } else if (std::abs(g_read * kStandardGravityMps2 - 1.0) <= tol) {
+          std::snprintf(buf, sizeof(buf),
+                        "the accelerometer reads %.3g m/s^2 %s, 1/9.81 of gravity: a log in g "
+                        "declared m/s^2? (set imu.accel.unit: g)",
+                        f_mean.norm(), where);
+        } else if (std::abs(g_read / kStandardGravityMps2 - 1.0) <= tol) {
+          std::snprintf(buf, sizeof(buf),
+                        "the accelerometer reads %.3g g %s, 9.81 times gravity: a log in m/s^2 "
+                        "declared g? (set imu.accel.unit: m/s^2)",
+                        g_read, where);
+        } else {
+          std::snprintf(buf, sizeof(buf),
+                        "the accelerometer reads %.3g g (%.3g m/s^2) %s: neither gravity (1 g "
+                        "+- %.0f %%) nor removed gravity; check imu.accel.columns and "
+                        "imu.accel.unit",
+                        g_read, f_mean.norm(), where, 100.0 * tol);
+        }
+        const std::string text = buf;
+        const std::string message =
+            text + (text.back() == '?' ? " " : ". ") + kAccelIgnoredSentence;
+        if (options.accel_required) {
+          *why = "swing axis: " + message;
+          return false;
+        }
+        axis->warnings.push_back(message);
         axis->accel_ignored = true;
         axis->rest_samples = 0;
         count = 0;
-      } else if (!f_mean.allFinite() ||
-          std::abs(f_mean.norm() - kStandardGravityMps2) > options.gravity_tolerance * kStandardGravityMps2) {
-        char buf[512];
-        std::snprintf(buf, sizeof(buf),
-                      "swing axis: the mean accelerometer reading %s is %.4g m/s^2, not gravity "
-                      "(9.81 +- %.0f %%): check the accelerometer unit (m/s^2 or g) and columns, "
-                      "or set imu.accel: null to fit gyro-only",
-                      down_at_rest ? "at rest" : "over the window", f_mean.norm(),
-                      100.0 * options.gravity_tolerance);
-        *why = buf;
-        return false;
       }
       if (!axis->accel_ignored) down_in_imu = Eigen::Vector3d(-f_mean / f_mean.norm());
     }

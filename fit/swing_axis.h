@@ -54,17 +54,27 @@ struct SwingAxisOptions {
   // |f| at rest must be within this fraction of standard gravity for the accelerometer to be
   // trusted (units or a broken sensor). Default 0.1.
   double gravity_tolerance = 0.1;
-  // A mean reading below this many standard gravities, pointing more than 60 deg away from the
-  // gyro's principal direction (the swing axis), is an accelerometer with gravity removed by the
-  // logger's firmware: what is left is the residual g (n_est - n) of its tilt estimate (real
-  // logs read 0.07-0.27 g), nearly perpendicular to the down vertical n. The accelerometer is
-  // then ignored (gyro-only, as with imu.accel: null) with a warning in SwingAxis::warnings. A
-  // small reading along the swing axis is gravity in a wrong unit (g read as m/s^2) and stays an
-  // error. In [0, 1 - gravity_tolerance); 0 turns the detection off. Default 0.5.
+  // An accelerometer whose mean reading is not gravity (outside gravity_tolerance) is ignored:
+  // gyro-only, as with imu.accel: null, with a warning in SwingAxis::warnings that says what the
+  // reading looks like. A mean reading below this many standard gravities, pointing more than
+  // 60 deg away from the gyro's principal direction (the swing axis), is called an
+  // accelerometer with gravity removed by the logger's firmware: what is left is the residual
+  // g (n_est - n) of its tilt estimate (real logs read 0.07-0.27 g), nearly perpendicular to the
+  // down vertical n. In [0, 1 - gravity_tolerance); 0 turns that diagnosis off. Default 0.5.
   double gravity_removed_below_g = 0.5;
+  // True: an accelerometer that does not read gravity is an error (the caller needs the down
+  // vector). Default false: ignored with a warning (a swing about the vertical needs only the
+  // gyro; a campaign with runs.pitch_source: measured makes such a trace an error row).
+  bool accel_required = false;
 
   bool Check(std::string* why) const;
 };
+
+// Ends every warning about an ignored accelerometer (SwingAxis::warnings), so that a caller that
+// needed the accelerometer can find and quote it.
+inline constexpr char kAccelIgnoredSentence[] =
+    "The accelerometer is ignored (swing axis from the gyro, no measured pitch); set "
+    "imu.accel: null to say so";
 
 struct SwingAxis {
   Eigen::Vector3d axis_in_imu = Eigen::Vector3d::UnitZ();  // unit n, IMU axes
@@ -78,8 +88,8 @@ struct SwingAxis {
   int rest_samples = 0;          // samples used for the accelerometer down vector (0: none)
   double rest_accel_mps2 = 0.0;  // |mean f| over them (should be ~9.8)
   std::vector<std::string> notes;  // fallbacks taken (no rest -> window, ...)
-  // The accelerometer read far below 1 g (gravity removed) and was ignored: no pitch, the axis
-  // from the gyro. The sentence for the user is in `warnings`.
+  // The accelerometer did not read gravity (removed, a wrong unit, a broken sensor) and was
+  // ignored: no pitch, the axis from the gyro. The sentence for the user is in `warnings`.
   bool accel_ignored = false;
   std::vector<std::string> warnings;  // for the trace's record
 };
@@ -87,8 +97,8 @@ struct SwingAxis {
 // Estimates the swing axis and the swing rate. The optional window [t0, t1] (s) is used by kAuto
 // when the log shows no rest (accelerometer averaged over the window) and for the gyro principal
 // direction (default: the whole log). Returns false with *why on invalid options, an empty log, a
-// zero fixed axis or an accelerometer whose magnitude is neither gravity nor near zero (a
-// reading below gravity_removed_below_g is ignored with a warning, see SwingAxisOptions).
+// zero fixed axis, or (only with accel_required) an accelerometer that does not read gravity;
+// without accel_required such an accelerometer is ignored with a warning (SwingAxisOptions).
 bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
                        std::optional<std::pair<double, double>> window_s, SwingAxis* axis,
                        std::string* why);

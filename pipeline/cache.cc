@@ -71,11 +71,15 @@ std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
   Put(out, "D", geometry.filar_separation_m);
   Put(out, "m", geometry.mass_kg);
   Put(out, "g", geometry.gravity_mps2);
-  Put(out, "L_std", config.uncertainties.filar_length_std_m);
-  Put(out, "D_std", config.uncertainties.filar_separation_std_m);
-  Put(out, "m_rig_std", config.uncertainties.mass_std_kg);
+  // The stds in effect (the assumed 1 mm on L and D without rig.uncertainties, marked: the
+  // record then carries the assumption's warning).
+  const RigUncertainties uncertainties = config.uncertainties.InEffect();
+  if (config.uncertainties.Assumed()) out << "unc=assumed;";
+  Put(out, "L_std", uncertainties.filar_length_std_m);
+  Put(out, "D_std", uncertainties.filar_separation_std_m);
+  Put(out, "m_rig_std", uncertainties.mass_std_kg);
   if (role == TraceRole::kAircraft) Put(out, "m_aircraft_std", config.aircraft_mass_std_kg);
-  Put(out, "g_std", config.uncertainties.gravity_std_mps2);
+  Put(out, "g_std", uncertainties.gravity_std_mps2);
   Put(out, "gyro_scale_std", config.imu.gyro_scale_std);
   // A calibrated geometry (rig.calibration) changes D above, drops the L, D and g terms of the
   // budget and adds its own; only then in the key, so uncalibrated keys stay those of 0.2.0.

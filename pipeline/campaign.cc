@@ -22,6 +22,7 @@
 #include "pipeline/parallel_runner.h"
 #include "pipeline/report.h"
 #include "pipeline/results_json.h"
+#include "pipeline/total_uncertainty.h"
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -256,8 +257,11 @@ TraceRecord FitOneTrace(const TraceFitFunction& fit, const CampaignConfig& fit_c
 std::string ProgressLine(const TraceRecord& record) {
   std::string line = record.file + ": " + ToString(record.status);
   if (record.ok()) {
-    char buffer[64];
-    std::snprintf(buffer, sizeof(buffer), " I_total = %#.5g kg m^2", record.inertia_total_kg_m2);
+    char buffer[160];
+    std::snprintf(buffer, sizeof(buffer), " I_total = %#.5g kg m^2 +- %.2g %% (stat) +- %.2g %% (total)",
+                  record.inertia_total_kg_m2,
+                  100.0 * record.inertia_total_std_kg_m2 / record.inertia_total_kg_m2,
+                  100.0 * record.inertia_total_std_total_kg_m2 / record.inertia_total_kg_m2);
     line += buffer;
   } else {
     line += " (" + record.message + ")";
@@ -360,6 +364,10 @@ TareEstimate EstimateTare(std::vector<TraceRecord>* traces) {
     stds.push_back(r.inertia_total_std_kg_m2);
     r.inertia_kg_m2 = r.inertia_total_kg_m2;
     r.inertia_std_kg_m2 = r.inertia_total_std_kg_m2;
+    r.inertia_std_total_kg_m2 = r.inertia_total_std_total_kg_m2;
+    const TotalUncertainty total = ComposeTotalUncertainty(r);
+    r.aircraft_scale_std_kg_m2 =
+        std::hypot(total.Term(kTermConfiguredInputs), total.Term(kTermCalibration));
   }
   TareEstimate tare;
   tare.n = static_cast<int>(values.size());
@@ -388,8 +396,14 @@ void SubtractRig(const CampaignConfig& config, const TareEstimate& tare,
     if (r.role != TraceRole::kAircraft || !r.ok()) continue;
     if (config.runs.pitch_source == PitchSource::kMeasured) {
       if (!r.pitch_measured_deg) {
+        // The accelerometer's own warning says why (not gravity: fit/swing_axis.h).
+        std::string why = "the log gave no measured pitch";
+        for (const std::string& w : r.warnings) {
+          if (w.find(kAccelIgnoredSentence) != std::string::npos) why = w;
+        }
         r.status = TraceStatus::kError;
-        r.message = r.file + ": pitch_source is measured but the log gave no measured pitch";
+        r.message =
+            r.file + ": runs.pitch_source: measured needs the accelerometer's pitch, but " + why;
         continue;
       }
       r.pitch_used_deg = *r.pitch_measured_deg;
@@ -417,6 +431,11 @@ void SubtractRig(const CampaignConfig& config, const TareEstimate& tare,
     }
     r.inertia_kg_m2 = r.inertia_total_kg_m2 - rig;
     r.inertia_std_kg_m2 = std::hypot(r.inertia_total_std_kg_m2, rig_std);
+    const TotalUncertainty total = ComposeAircraftUncertainty(
+        r, rig_std, config.rig_inertia.kind == RigInertiaSpec::Kind::kTare);
+    r.inertia_std_total_kg_m2 = total.total_std_kg_m2;
+    r.aircraft_scale_std_kg_m2 =
+        std::hypot(total.Term(kTermConfiguredInputs), total.Term(kTermCalibration));
   }
 }
 
@@ -444,11 +463,14 @@ std::vector<AngleStats> GroupByAngle(const std::vector<TraceRecord>& traces) {
   std::vector<AngleStats> angles;
   for (const auto& [key, members] : groups) {
     AngleStats a;
-    std::vector<double> values, pitches, fit_stds;
+    std::vector<double> values, pitches, fit_stds, common_mode;
     for (const TraceRecord* r : members) {
       values.push_back(r->inertia_kg_m2);
       pitches.push_back(r->pitch_used_deg);
       fit_stds.push_back(r->inertia_std_kg_m2);
+      // The trace's common-mode terms (rig inertia, configured inputs, calibration).
+      const double total = r->inertia_std_total_kg_m2, stat = r->inertia_total_std_kg_m2;
+      common_mode.push_back(std::sqrt(std::max(0.0, total * total - stat * stat)));
     }
     a.pitch_deg = Mean(pitches);
     a.n = static_cast<int>(values.size());
@@ -457,6 +479,10 @@ std::vector<AngleStats> GroupByAngle(const std::vector<TraceRecord>& traces) {
     a.fit_std_mean_kg_m2 = Mean(fit_stds);
     a.inertia_sem_kg_m2 = a.n >= 2 ? a.inertia_std_kg_m2 / std::sqrt(a.n) : fit_stds[0];
     a.cv_percent = 100.0 * a.inertia_std_kg_m2 / a.inertia_mean_kg_m2;
+    // The mean's total: its standard error and the common-mode terms (one trial: its own total).
+    a.common_mode_std_kg_m2 = Mean(common_mode);
+    a.inertia_std_total_kg_m2 = a.n >= 2 ? std::hypot(a.inertia_sem_kg_m2, a.common_mode_std_kg_m2)
+                                         : members[0]->inertia_std_total_kg_m2;
     angles.push_back(a);
   }
   return angles;
@@ -471,6 +497,21 @@ double SystematicRelativeStd(const std::vector<TraceRecord>& traces) {
     }
   }
   return Mean(relative_budget);
+}
+
+// Mean over ok aircraft traces of the scale terms (configured inputs, calibration) over the
+// aircraft's inertia: the common-mode fraction Table 2's total adds (CampaignResult).
+double CommonModeRelativeStd(const std::vector<TraceRecord>& traces, bool* assumed) {
+  std::vector<double> relative;
+  *assumed = false;
+  for (const TraceRecord& r : traces) {
+    if (r.role == TraceRole::kAircraft && r.ok() && std::isfinite(r.aircraft_scale_std_kg_m2) &&
+        r.inertia_kg_m2 > 0.0) {
+      relative.push_back(r.aircraft_scale_std_kg_m2 / r.inertia_kg_m2);
+      *assumed = *assumed || r.budget_assumed;
+    }
+  }
+  return Mean(relative);
 }
 
 // ---- Step 5: ellipse --------------------------------------------------------------------------
@@ -698,6 +739,9 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   CountStatuses(result.traces, &result.summary);
   result.angles = GroupByAngle(result.traces);
   result.systematic_relative_std = SystematicRelativeStd(result.traces);
+  result.common_mode_relative_std =
+      CommonModeRelativeStd(result.traces, &result.common_mode_assumed);
+  result.assumed_inputs_note = AssumedInputsSummary(result.traces);
   // 5. Ellipse of inertia, Table 1, Fig. 3/4.
   FitCampaignEllipse(config, options, &out, &result);
   if (result.summary.n_rejected + result.summary.n_error > 0 || !result.summary.ellipse_fitted) {

@@ -35,6 +35,11 @@ struct AngleStats {
                                    // when n >= 2, else the fit's own std
   double cv_percent = NAN;         // 100 std / mean
   double fit_std_mean_kg_m2 = NAN; // mean of the traces' own fit std
+  // Total uncertainty of the mean (pipeline/total_uncertainty.h): the standard error and the
+  // common-mode terms (rig inertia, configured inputs, calibration; their mean over the trials)
+  // in quadrature; with one trial, its own total.
+  double common_mode_std_kg_m2 = NAN;
+  double inertia_std_total_kg_m2 = NAN;
 };
 
 struct CampaignSummary {
@@ -65,6 +70,12 @@ struct CampaignResult {
   // aircraft traces of budget total / inertia total. It scales every moment alike, so it is not
   // in the ellipse's std; reported beside it. NaN when no budget.
   double systematic_relative_std = NAN;
+  // The scale terms of the total (configured inputs, calibration; pipeline/total_uncertainty.h)
+  // as a fraction of the aircraft's inertia, mean over ok aircraft traces: Table 2's total std of
+  // a moment is hypot(its std, this x |moment|); tau has none. NaN when no trace.
+  double common_mode_relative_std = NAN;
+  bool common_mode_assumed = false;  // it holds the assumed +-1 mm on L and D
+  std::string assumed_inputs_note;   // AssumedInputsSummary of the traces ("" when none)
   // Table 1 of the paper (kg m^2): mean of per-angle std, mean CV (%), regression RMSE.
   double raw_sigma_kg_m2 = NAN, cv_percent = NAN, regression_rmse_kg_m2 = NAN;
   CampaignSummary summary;

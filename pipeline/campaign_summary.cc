@@ -3,6 +3,7 @@
 #include <ostream>
 
 #include "pipeline/campaign.h"
+#include "pipeline/total_uncertainty.h"
 
 namespace bifilar {
 
@@ -15,13 +16,17 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
   const CampaignSummary& s = result.summary;
   if (result.ellipse_fit) {
     const EllipseResult& e = *result.ellipse_fit;
-    out << "Table 2 (" << unit << ", +- 1 std):\n";
+    // Each moment: its std (stat: the trials' scatter, the rig offset) and the total, which adds
+    // the common-mode scale terms (pipeline/total_uncertainty.h).
+    const double rel = result.common_mode_relative_std;
+    out << "Table 2 (" << unit << ", +- 1 std: stat, then total with the common-mode terms):\n";
     auto row = [&](const char* name, const EllipseEstimate& est) {
       if (!est.defined) {
         std::snprintf(line, sizeof(line), "  %-5s  ill-defined (I_x ~ I_z)\n", name);
       } else {
-        std::snprintf(line, sizeof(line), "  %-5s  %#10.5g +- %.2g\n", name, inertia(est.value),
-                      inertia(est.std));
+        std::snprintf(line, sizeof(line), "  %-5s  %#10.5g +- %#.2g (stat) +- %#.2g (total)\n", name,
+                      inertia(est.value), inertia(est.std),
+                      inertia(WithCommonModeScale(est.value, est.std, rel)));
       }
       out << line;
     };
@@ -29,18 +34,19 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     row("I_z", e.iz);
     row("I_xz", e.ixz);
     if (e.tau_deg.defined) {
-      std::snprintf(line, sizeof(line), "  %-5s  %10.4f +- %.4f deg\n", "tau", e.tau_deg.value,
-                    e.tau_deg.std);
+      std::snprintf(line, sizeof(line), "  %-5s  %10.4f +- %.4f deg (stat = total: a scale leaves tau)\n",
+                    "tau", e.tau_deg.value, e.tau_deg.std);
     } else {
       std::snprintf(line, sizeof(line), "  %-5s  ill-defined (I_x ~ I_z)\n", "tau");
     }
     out << line;
-    if (std::isfinite(result.systematic_relative_std) && result.systematic_relative_std > 0) {
-      std::snprintf(
-          line, sizeof(line),
-          "  (+- %.2f %% systematic, common to all moments, from the configured uncertainties%s)\n",
-          100.0 * result.systematic_relative_std,
-          result.calibration ? " and the calibration" : "");
+    if (std::isfinite(rel)) {
+      std::snprintf(line, sizeof(line),
+                    "  (total: stat and +- %.2f %% common to all moments in quadrature, from the "
+                    "uncertainties of %s, the masses and the gyro scale)\n",
+                    100.0 * rel,
+                    result.calibration ? "the rig calibration"
+                    : result.common_mode_assumed ? "L, D (assumed +-1 mm), g" : "L, D, g");
       out << line;
     }
     std::snprintf(line, sizeof(line),
@@ -78,6 +84,7 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     }
     out << "  " << ToString(r.status) << ": " << r.message << "\n";
   }
+  if (!result.assumed_inputs_note.empty()) out << result.assumed_inputs_note << "\n";
   std::snprintf(line, sizeof(line),
                 "Traces: %d ok, %d rejected, %d error (of %d); fits run %d, reused from cache %d; "
                 "wall time %.2f s\n",

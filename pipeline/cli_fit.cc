@@ -16,6 +16,7 @@
 #include "pipeline/interrupt.h"
 #include "pipeline/repeats.h"
 #include "pipeline/results_json.h"
+#include "pipeline/total_uncertainty.h"
 #include "pipeline/trace_process.h"
 
 namespace bifilar {
@@ -32,20 +33,25 @@ std::string FigureStem(const std::string& log) {
 }
 
 std::string HumanLine(const TraceRecord& r) {
-  char buffer[512];
+  char buffer[1024];
   // Messages name the file already; say it once at the start of the line.
   const std::string prefix = r.file + ": ";
-  const std::string message =
+  std::string message =
       r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message;
+  // The assumed +-1 mm on L and D is said once for the run (AssumedInputsSummary), not per log.
+  if (IsAssumedInputsWarning(message)) message.clear();
   // No fit to show (an error, or rejected before fitting): status and reason only, never NaN.
   if (r.status == TraceStatus::kError || !std::isfinite(r.inertia_total_kg_m2)) {
     return prefix + ToString(r.status) + ": " + message;
   }
   std::snprintf(buffer, sizeof(buffer),
-                "%s: %s  I = %#.5g +- %.2g kg m^2 (budget +- %.2g)  K_D %.3g  C %.3g  "
+                "%s: %s  I = %s  K_D %.3g  C %.3g  "
                 "window [%.2f, %.2f] s  amplitude %.1f -> %.1f deg  rms/noise %.2f  %d it  %.0f ms",
-                r.file.c_str(), ToString(r.status), r.inertia_total_kg_m2,
-                r.inertia_total_std_kg_m2, r.budget_total_std_kg_m2, r.drag_coeff_kg_m2,
+                r.file.c_str(), ToString(r.status),
+                StatAndTotal(r.inertia_total_kg_m2, r.inertia_total_std_kg_m2,
+                             r.inertia_total_std_total_kg_m2, "kg m^2")
+                    .c_str(),
+                r.drag_coeff_kg_m2,
                 r.viscous_coeff_kg_m2_per_s, r.window_s[0], r.window_s[1], r.amplitude_deg[0],
                 r.amplitude_deg[1], r.residual_rms_rad_per_s / r.noise_rms_rad_per_s, r.iterations,
                 1e3 * r.fit_seconds);
@@ -85,7 +91,8 @@ std::string HumanLine(const TraceRecord& r) {
     }
   }
   for (const std::string& w : r.warnings) {
-    if (message.find(w) == std::string::npos) line += "\n    warning: " + w;
+    if (message.find(w) == std::string::npos && !IsAssumedInputsWarning(w))
+      line += "\n    warning: " + w;
   }
   return line;
 }
@@ -110,6 +117,8 @@ nlohmann::json RepeatGroupsToJson(const std::vector<RepeatGroup>& groups) {
                    {"q_before", number(g.q_before)},
                    {"max_abs_z_before", number(g.max_abs_z_before)},
                    {"correction_std_kg_m2", number(g.correction_std_kg_m2)},
+                   {"common_mode_std_kg_m2", number(g.common_mode_std_kg_m2)},
+                   {"total_std_kg_m2", number(g.total_std_kg_m2)},
                    {"note", g.note}});
   }
   return out;
@@ -252,6 +261,9 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       std::cout << AmplitudeCorrectionLine(correction) << std::endl;
       for (const RepeatGroup& g : groups) std::cout << RepeatGroupLine(g) << std::endl;
     }
+    // Once for the run: what the assumed +-1 mm on L and D adds (--json records carry it).
+    const std::string assumed = AssumedInputsSummary(records);
+    if (!assumed.empty() && !args->json) std::cout << assumed << std::endl;
     *exit_code = failed > 0 ? 1 : 0;
   });
 }

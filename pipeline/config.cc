@@ -11,8 +11,10 @@
 
 #include <Eigen/Geometry>
 
+#include "pipeline/plausibility.h"
 #include "pipeline/ulog.h"
 #include "pipeline/user_error.h"
+#include "pipeline/total_uncertainty.h"
 #include "pipeline/yaml_reader.h"
 
 namespace bifilar {
@@ -323,6 +325,14 @@ RigGeometry CampaignConfig::AircraftGeometry() const {
   return g;
 }
 
+RigUncertainties RigUncertainties::InEffect() const {
+  if (!Assumed()) return *this;
+  RigUncertainties assumed = *this;
+  assumed.filar_length_std_m = kAssumedLengthStdM;
+  assumed.filar_separation_std_m = kAssumedLengthStdM;
+  return assumed;
+}
+
 RigGeometry CampaignConfig::TareGeometry() const {
   RigGeometry g = AircraftGeometry();
   g.mass_kg = rig_mass_kg;
@@ -366,6 +376,10 @@ bool CampaignConfig::Check(std::string* why) const {
     *why = "imu: " + reason;
     return false;
   }
+  if (!CheckPlausible(&reason)) {
+    *why = reason;
+    return false;
+  }
   // A standard uncertainty is below the quantity it qualifies (a 100 % uncertainty says nothing;
   // 1e308 overflowed the budget into a "non-finite value" naming no key).
   const struct {
@@ -392,6 +406,39 @@ bool CampaignConfig::Check(std::string* why) const {
     }
   }
   return fit.Check(why) && ellipse.Check(why);
+}
+
+bool CampaignConfig::CheckPlausible(std::string* why) const {
+  const struct {
+    const char* key;
+    const char* quantity;
+    double value, min, max;
+  } values[] = {
+      {"rig.filar_length_m", "length", filar_length_m, kMinFilarLengthM, kMaxFilarLengthM},
+      {"rig.filar_separation_m", "length", filar_separation_m, kMinFilarSeparationM,
+       kMaxFilarSeparationM},
+      {"rig.mass_kg", "mass", rig_mass_kg, 0.0, kMaxMassKg},
+      {"aircraft.mass_kg", "mass", aircraft_mass_kg, 0.0, kMaxMassKg},
+      {"rig.mass_kg + aircraft.mass_kg", "mass", rig_mass_kg + aircraft_mass_kg,
+       kMinSuspendedMassKg, 2 * kMaxMassKg},
+  };
+  for (const auto& v : values) {
+    *why = ImplausibleValue(v.key, v.quantity, v.value, v.min, v.max);
+    if (!why->empty()) return false;
+  }
+  *why = SeparationNotBelowLength(filar_length_m, filar_separation_m);
+  if (!why->empty()) return false;
+  if (rig_inertia.kind == RigInertiaSpec::Kind::kValue) {
+    *why = ImplausibleRigInertia("rig.inertia.inertia_kg_m2", rig_inertia.inertia_kg_m2,
+                                 rig_mass_kg, filar_separation_m);
+  }
+  for (const auto& [pitch_deg, value] : rig_inertia.table_kg_m2) {
+    if (!why->empty()) break;
+    char key[96];
+    std::snprintf(key, sizeof(key), "rig.inertia.table (pitch %g deg)", pitch_deg);
+    *why = ImplausibleRigInertia(key, value, rig_mass_kg, filar_separation_m);
+  }
+  return why->empty();
 }
 
 GlitchOptions GlitchConfig::Options() const {
@@ -516,6 +563,48 @@ void ReadConfigFile(const std::string& path, CampaignConfig* config) {
   config->text = ReadText(path);
 }
 
+// `rig` values no lab rig can have (pipeline/plausibility.h): an error at the key's line that
+// names the unit the value was probably written in.
+void CheckRigPlausible(YamlMap& rig, const CampaignConfig& c) {
+  const struct {
+    const char* key;
+    const char* quantity;
+    double value, min, max;
+  } values[] = {
+      {"filar_length_m", "length", c.filar_length_m, kMinFilarLengthM, kMaxFilarLengthM},
+      {"filar_separation_m", "length", c.filar_separation_m, kMinFilarSeparationM,
+       kMaxFilarSeparationM},
+      {"mass_kg", "mass", c.rig_mass_kg, 0.0, kMaxMassKg},
+  };
+  for (const auto& v : values) {
+    const std::string why = ImplausibleValue(rig.KeyPath(v.key), v.quantity, v.value, v.min, v.max);
+    if (!why.empty()) throw UserError(rig.Where(rig.Optional(v.key)) + ": " + why);
+  }
+  const std::string why = SeparationNotBelowLength(c.filar_length_m, c.filar_separation_m);
+  if (!why.empty()) throw UserError(rig.Where(rig.Optional("filar_separation_m")) + ": " + why);
+}
+
+// `rig.inertia.inertia_kg_m2` or a `table` value that would make the rig far wider than its wires.
+void CheckRigInertiaPlausible(YamlMap inertia, const CampaignConfig& c) {
+  const RigInertiaSpec& spec = c.rig_inertia;
+  std::string why;
+  if (spec.kind == RigInertiaSpec::Kind::kValue) {
+    why = ImplausibleRigInertia(inertia.KeyPath("inertia_kg_m2"), spec.inertia_kg_m2, c.rig_mass_kg,
+                                c.filar_separation_m);
+    if (!why.empty()) {
+      throw UserError(inertia.Where(inertia.Optional("inertia_kg_m2")) + ": " + why);
+    }
+  } else if (spec.kind == RigInertiaSpec::Kind::kTable) {
+    for (const auto& [pitch_deg, value] : spec.table_kg_m2) {
+      char key[96];
+      std::snprintf(key, sizeof(key), "%s (pitch %g deg)", inertia.KeyPath("table").c_str(),
+                    pitch_deg);
+      why = ImplausibleRigInertia(key, value, c.rig_mass_kg, c.filar_separation_m);
+      if (!why.empty()) throw UserError(inertia.Where(inertia.Optional("table")) + ": " + why);
+    }
+  }
+}
+
 // `rig`: geometry and mass, how its inertia is known (rig.inertia), its uncertainties.
 void ReadRig(YamlMap& root, const std::string& path, const ConfigLoadOptions& options,
              CampaignConfig* config) {
@@ -524,8 +613,10 @@ void ReadRig(YamlMap& root, const std::string& path, const ConfigLoadOptions& op
   config->filar_length_m = Positive(rig, "filar_length_m");
   config->filar_separation_m = Positive(rig, "filar_separation_m");
   config->rig_mass_kg = Positive(rig, "mass_kg");
+  CheckRigPlausible(rig, *config);
   if (rig.Has("inertia")) {
     ReadRigInertia(Sub(rig, "inertia"), config->folder, &config->rig_inertia);
+    CheckRigInertiaPlausible(Sub(rig, "inertia"), *config);
   } else if (options.require_runs) {
     throw UserError(path + ": missing required key 'rig.inertia'");
   }
@@ -539,6 +630,7 @@ void ReadRig(YamlMap& root, const std::string& path, const ConfigLoadOptions& op
   }
   YamlMap unc = Sub(rig, "uncertainties");
   RigUncertainties& u = config->uncertainties;
+  u.configured = rig.Has("uncertainties");
   u.filar_length_std_m = NonNegative(unc, "filar_length_std_m", 0.0);
   u.filar_separation_std_m = NonNegative(unc, "filar_separation_std_m", 0.0);
   u.mass_std_kg = NonNegative(unc, "mass_std_kg", 0.0);
@@ -553,6 +645,9 @@ void ReadAircraftAndGravity(YamlMap& root, const std::string& path,
   YamlMap aircraft = Sub(root, "aircraft");
   if (root.Has("aircraft")) {
     config->aircraft_mass_kg = Positive(aircraft, "mass_kg");
+    const std::string why = ImplausibleValue("aircraft.mass_kg", "mass", config->aircraft_mass_kg,
+                                             0.0, kMaxMassKg);
+    if (!why.empty()) throw UserError(aircraft.Where(aircraft.Optional("mass_kg")) + ": " + why);
     config->aircraft_mass_std_kg = NonNegative(aircraft, "mass_std_kg", 0.0);
   } else if (options.require_runs) {
     throw UserError(path + ": missing required key 'aircraft'");

@@ -69,6 +69,18 @@ struct RigUncertainties {
   double filar_separation_std_m = 0.0;  // of D (m); >= 0; default 0
   double mass_std_kg = 0.0;             // of the rig mass (kg); >= 0; default 0
   double gravity_std_mps2 = 0.0;        // of g (m/s^2); >= 0; default 0
+  // The config has a `rig.uncertainties` section (zeros included). Without one (Assumed()),
+  // InEffect() assumes a tape-measure 1 mm on L and D (pipeline/total_uncertainty.h), labelled.
+  bool configured = false;
+
+  // The stds the budget uses: these when configured, else the assumed ones (1 mm on L and D).
+  RigUncertainties InEffect() const;
+  // Not configured: no section, and no std set in memory either (a config built in code that
+  // sets a std has configured it).
+  bool Assumed() const {
+    return !configured && filar_length_std_m == 0.0 && filar_separation_std_m == 0.0 &&
+           mass_std_kg == 0.0 && gravity_std_mps2 == 0.0;
+  }
 };
 
 // The CSV layout of the logs and how the IMU sits on the aircraft.
@@ -199,6 +211,9 @@ struct CampaignConfig {
   double EffectiveSeparationM() const;  // D sqrt(geometry_calibration.factor)
 
   bool Check(std::string* why) const;
+  // Values no lab rig can have (pipeline/plausibility.h): L, D, the masses, the rig inertia
+  // against the rig's mass and D. Part of Check; *why names the key and the likely unit.
+  bool CheckPlausible(std::string* why) const;
 };
 
 struct ConfigLoadOptions {

@@ -7,6 +7,8 @@
 #include <map>
 
 #include "fit/amplitude_trend.h"
+#include "pipeline/total_uncertainty.h"
+
 namespace bifilar {
 namespace {
 
@@ -83,9 +85,11 @@ void Scatter(const std::vector<double>& v, const std::vector<double>& s, double*
 }
 
 // Adds the amplitude correction's std (common to the set-up) to a used member's total std.
+// Its total (pipeline/total_uncertainty.h) is updated: the correction is a term of its own.
 void AddCorrectionStd(TraceRecord* r) {
   if (std::isfinite(r->amplitude_correction_std_kg_m2))
     r->inertia_total_std_kg_m2 = std::hypot(r->inertia_total_std_kg_m2, r->amplitude_correction_std_kg_m2);
+  UpdateTotalUncertainty(r);
 }
 
 void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
@@ -187,7 +191,7 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
     // The log's own std: its per-log std, tau and the whole std of its correction.
     r.repeat_scatter_std_kg_m2 = group->tau_kg_m2;
     r.inertia_total_std_kg_m2 = std::hypot(r.inertia_total_std_kg_m2, group->tau_kg_m2);
-    AddCorrectionStd(&r);
+    AddCorrectionStd(&r);  // the between-repeat and correction terms enter the total too
     if (tau2 > 0.0) {
       char text[320];
       std::snprintf(text, sizeof(text),
@@ -201,6 +205,14 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
   }
   group->correction_std_kg_m2 = swc / sw_re;
   group->mean_std_kg_m2 = std::hypot(1.0 / std::sqrt(sw_re), group->correction_std_kg_m2);
+  // The common-mode terms do not average out over repeats: their mean fraction of I.
+  double common_fraction = 0.0;
+  for (const TraceRecord* r : used) {
+    const TotalUncertainty total = ComposeTotalUncertainty(*r);
+    common_fraction += total.common_mode_std_kg_m2 / r->inertia_total_kg_m2 / k;
+  }
+  group->common_mode_std_kg_m2 = common_fraction * group->mean_kg_m2;
+  group->total_std_kg_m2 = std::hypot(group->mean_std_kg_m2, group->common_mode_std_kg_m2);
 }
 
 // The pooled amplitude coefficient over the groups' usable members, applied to every usable
@@ -294,10 +306,14 @@ std::string RepeatGroupLine(const RepeatGroup& g) {
     return buffer;
   }
   std::snprintf(buffer, sizeof(buffer),
-                "repeats %s: I = %#.5g +- %.2g kg m^2 (random-effects mean of %d; Q = %.1f on %d "
+                "repeats %s: I = %s (random-effects mean of %d; Q = %.1f on %d "
                 "dof; between-repeat std %.2g kg m^2 = %.2f %% added to each log; every log within "
-                "%.1f sigma of the mean)",
-                g.name.c_str(), g.mean_kg_m2, g.mean_std_kg_m2, g.n_used, g.q, g.n_used - 1,
+                "%.1f sigma (stat) of the mean)",
+                g.name.c_str(),
+                StatAndTotal(g.mean_kg_m2, g.mean_std_kg_m2,
+                             std::isfinite(g.total_std_kg_m2) ? g.total_std_kg_m2 : NAN, "kg m^2")
+                    .c_str(),
+                g.n_used, g.q, g.n_used - 1,
                 g.tau_kg_m2, 100.0 * g.tau_kg_m2 / g.plain_mean_kg_m2, g.max_abs_z);
   std::string line = buffer;
   if (std::isfinite(g.amplitude_trend_z)) {

@@ -57,6 +57,11 @@ struct RepeatGroup {
   double max_abs_z_before = NAN;
   // The correction's std for the set-up mean (common to its members), included in mean_std_kg_m2.
   double correction_std_kg_m2 = NAN;
+  // Total uncertainty of the mean (pipeline/total_uncertainty.h): mean_std_kg_m2 and the
+  // members' common-mode terms (budget, calibration; their mean fraction of I times the mean) in
+  // quadrature: what the `--repeats` line and JSON give as the set-up's total.
+  double common_mode_std_kg_m2 = NAN;
+  double total_std_kg_m2 = NAN;
   std::string note;          // why nothing was combined (fewer than 2 usable members)
 };
 
@@ -90,7 +95,8 @@ struct RepeatsAmplitudeCorrection {
 // is not already a low-amplitude band gets amplitude_correction_* set, the correction subtracted
 // from inertia_total_kg_m2. Then per group:
 // the statistics, and for every used member repeat_scatter_std_kg_m2 = tau, tau and the
-// correction's std added in quadrature to inertia_total_std_kg_m2 and, when tau > 0, a warning.
+// correction's std added in quadrature to inertia_total_std_kg_m2 (and its total updated) and,
+// when tau > 0, a warning.
 RepeatsAmplitudeCorrection CombineRepeats(std::vector<RepeatGroup>* groups,
                                           std::vector<TraceRecord>* records);
 

@@ -217,8 +217,11 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
       << Escape(p.summary.value("ellipse_message", std::string("ellipse not fitted"))) << "</p>\n";
     return;
   }
-  h << "<table><tr><th class=\"l\">quantity</th><th>value</th><th>std</th><th>interval</th>"
-       "<th class=\"l\">unit</th></tr>\n";
+  // The total column (results.json total_uncertainty, pipeline/total_uncertainty.h): the std and
+  // the common-mode scale terms in quadrature.
+  const json total = p.Part("total_uncertainty", json::object());
+  h << "<table><tr><th class=\"l\">quantity</th><th>value</th><th>std (stat)</th>"
+       "<th>std (total)</th><th>interval (stat)</th><th class=\"l\">unit</th></tr>\n";
   struct Row { const char* key; const char* label; bool angle; };
   for (const Row& row : {Row{"Ix_kg_m2", "I<sub>x</sub>", false}, Row{"Iz_kg_m2", "I<sub>z</sub>", false},
                          Row{"Ixz_kg_m2", "I<sub>xz</sub>", false}, Row{"tau_deg", "&tau; (principal inclination)", true},
@@ -227,27 +230,36 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
     const Estimate e = GetEstimate(ellipse, row.key);
     if (!e.present) continue;
     h << "<tr><td class=\"l\">" << row.label << "</td>";
+    const double e_total = Num(total, row.key);
     if (!e.defined) {
-      h << "<td colspan=\"3\">ill-defined (I<sub>x</sub> &asymp; I<sub>z</sub>)</td>";
+      h << "<td colspan=\"4\">ill-defined (I<sub>x</sub> &asymp; I<sub>z</sub>)</td>";
     } else if (row.angle) {
-      h << "<td>" << Fmt(e.value) << "</td><td>" << Fmt(e.std) << "</td><td>[" << Fmt(e.lo)
-        << ", " << Fmt(e.hi) << "]</td>";
+      h << "<td>" << Fmt(e.value) << "</td><td>" << Fmt(e.std) << "</td><td>" << Fmt(e_total)
+        << "</td><td>[" << Fmt(e.lo) << ", " << Fmt(e.hi) << "]</td>";
     } else {
-      h << "<td>" << u.Inertia(e.value) << "</td><td>" << u.Inertia(e.std) << "</td><td>["
-        << u.Inertia(e.lo) << ", " << u.Inertia(e.hi) << "]</td>";
+      h << "<td>" << u.Inertia(e.value) << "</td><td>" << u.Inertia(e.std) << "</td><td>"
+        << u.Inertia(e_total) << "</td><td>[" << u.Inertia(e.lo) << ", " << u.Inertia(e.hi)
+        << "]</td>";
     }
     h << "<td class=\"l\">" << (row.angle ? "deg" : u.name) << "</td></tr>\n";
   }
   h << "</table>\n";
-  const double systematic = Num(p.results, "systematic_relative_std");
   const bool calibrated = p.Part("calibration", json(nullptr)).is_object();
-  h << "<p>Uncertainties above are statistical (scatter between trials and angles). "
-    << (calibrated ? "The rig calibration and the configured uncertainties of the masses and the "
-                     "gyro scale add a systematic &plusmn;"
-                   : "The configured uncertainties of L, D, the masses, g and the gyro scale add a "
-                     "systematic &plusmn;")
-    << Fmt(100.0 * systematic, "%.2f")
-    << " % that scales every moment alike and leaves &tau; unchanged (mean per-trace uncertainty budget).</p>\n";
+  const double common = Num(total, "common_mode_relative_std");
+  const bool assumed = total.is_object() && total.value("configured_inputs_assumed", false);
+  h << "<p><b>std (stat)</b>: the scatter between trials and angles, the fits' own errors and the "
+       "rig inertia's offset; the interval is its 95 % bootstrap interval. <b>std (total)</b> adds "
+       "in quadrature the common-mode terms, one error shared by every moment: the "
+    << (calibrated ? "rig calibration (it replaces the uncertainties of L, D and g)"
+                   : std::string("uncertainties of L, D") +
+                         (assumed ? " (<b>assumed</b> &plusmn;1 mm: no <code>rig.uncertainties</code>)"
+                                  : "") +
+                         ", g")
+    << ", the masses and the gyro scale, &plusmn;" << Fmt(100.0 * common, "%.2f")
+    << " % of each moment. It scales every moment alike and leaves &tau; unchanged. Read the total "
+       "when you use a number; compare trials or set-ups with the stat std.</p>\n";
+  const std::string note = Str(total, "note");
+  if (!note.empty()) h << "<p class=\"bad\">" << Escape(note) << "</p>\n";
   if (ellipse.contains("warnings")) {
     for (const auto& w : ellipse["warnings"]) {
       if (w.is_string()) h << "<p class=\"note\">" << Escape(w.get<std::string>()) << "</p>\n";
@@ -338,12 +350,13 @@ void WriteEllipseSection(ReportPage& p, std::ostream& h) {
 void WriteAngleTable(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
   h << "<h2>Per-angle statistics</h2>\n<table><tr><th>pitch (deg)</th><th>n</th><th>mean ("
-    << u.name << ")</th><th>std</th><th>sem</th><th>CV (%)</th></tr>\n";
+    << u.name << ")</th><th>std</th><th>sem</th><th>total of the mean</th><th>CV (%)</th></tr>\n";
   for (const auto& a : p.angles) {
     h << "<tr><td>" << Fmt(Num(a, "pitch_deg"), "%.2f") << "</td><td>" << a.value("n", 0)
       << "</td><td>" << u.Inertia(Num(a, "inertia_mean_kg_m2")) << "</td><td>"
       << u.Inertia(Num(a, "inertia_std_kg_m2"), "%.5f") << "</td><td>"
       << u.Inertia(Num(a, "inertia_sem_kg_m2"), "%.5f") << "</td><td>"
+      << u.Inertia(Num(a, "inertia_std_total_kg_m2"), "%.5f") << "</td><td>"
       << Fmt(Num(a, "cv_percent"), "%.3f") << "</td></tr>\n";
   }
   h << "</table>\n";
@@ -375,7 +388,8 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
   h << "<h2>Traces</h2>\n<table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"
        "<th class=\"l\">status</th><th>pitch (deg)</th><th>I total (" << u.name
-    << ")</th><th>std</th><th>I aircraft</th><th>std</th><th>window (s)</th>"
+    << ")</th><th>std (stat)</th><th>std (total)</th><th>I aircraft</th><th>std (stat)</th>"
+       "<th>std (total)</th><th>window (s)</th>"
        "<th>amplitude (deg)</th><th>rms/noise</th></tr>\n";
   for (const auto& t : p.traces) {
     const std::string status = Str(t, "status");
@@ -393,8 +407,10 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
       << Escape(status) << "</td><td>" << Fmt(Num(t, "pitch_used_deg"), "%.2f") << "</td><td>"
       << u.Inertia(Num(t, "inertia_total_kg_m2"), "%.5f") << "</td><td>"
       << u.Inertia(Num(t, "inertia_total_std_kg_m2"), "%.2e") << "</td><td>"
+      << u.Inertia(Num(t, "inertia_total_std_total_kg_m2"), "%.2e") << "</td><td>"
       << u.Inertia(Num(t, "inertia_kg_m2"), "%.5f") << "</td><td>"
-      << u.Inertia(Num(t, "inertia_std_kg_m2"), "%.2e") << "</td><td>" << window << "</td><td>"
+      << u.Inertia(Num(t, "inertia_std_kg_m2"), "%.2e") << "</td><td>"
+      << u.Inertia(Num(t, "inertia_std_total_kg_m2"), "%.2e") << "</td><td>" << window << "</td><td>"
       << amplitude << "</td><td>"
       << Fmt(Num(t, "residual_rms_rad_per_s") / Num(t, "noise_rms_rad_per_s"), "%.2f")
       << "</td></tr>\n";

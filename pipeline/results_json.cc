@@ -7,6 +7,7 @@
 #include <sstream>
 #include <thread>
 
+#include "pipeline/total_uncertainty.h"
 #include "pipeline/user_error.h"
 
 #ifndef BIFILAR_VERSION
@@ -165,6 +166,59 @@ std::string Join(const std::vector<std::string>& parts, const char* separator) {
   return out;
 }
 
+// The headline total as a percentage of the headline I: the aircraft's after a tare, else the
+// whole suspended I's.
+double TotalPercent(const TraceRecord& r) {
+  if (std::isfinite(r.inertia_std_total_kg_m2) && r.inertia_kg_m2 > 0.0)
+    return 100.0 * r.inertia_std_total_kg_m2 / r.inertia_kg_m2;
+  if (r.inertia_total_kg_m2 > 0.0) return 100.0 * r.inertia_total_std_total_kg_m2 / r.inertia_total_kg_m2;
+  return NAN;
+}
+
+// The terms of I_total's total in one cell: "statistical:2.1e-09 model_inadequacy:0 ...", the
+// assumed one marked "(assumed)"; "" without a fit.
+std::string TermsCell(const TraceRecord& r) {
+  if (!std::isfinite(r.inertia_total_kg_m2)) return "";
+  std::string out;
+  char buffer[96];
+  for (const UncertaintyTerm& t : ComposeTotalUncertainty(r).terms) {
+    std::snprintf(buffer, sizeof(buffer), "%s%s:%.3g%s", out.empty() ? "" : " ", t.name.c_str(),
+                  t.std_kg_m2, t.assumed ? "(assumed)" : "");
+    out += buffer;
+  }
+  return out;
+}
+
+// The total uncertainty of I_total into the record's "uncertainty" object: every named term
+// (pipeline/total_uncertainty.h), the stat, common-mode and total stds, and what was assumed.
+void AddTotalUncertainty(const TraceRecord& r, json* u) {
+  const TotalUncertainty total = ComposeTotalUncertainty(r);
+  const bool fitted = std::isfinite(r.inertia_total_kg_m2);
+  json terms = json::array();
+  for (const UncertaintyTerm& t : total.terms) {
+    json term = {{"name", t.name},
+                 {"std_kg_m2", fitted ? Number(t.std_kg_m2) : json(nullptr)},
+                 {"kind", t.common_mode ? "common_mode" : "per_log"}};
+    if (t.assumed) term["assumed"] = true;
+    terms.push_back(term);
+  }
+  (*u)["terms"] = terms;
+  (*u)["stat_kg_m2"] = fitted ? Number(total.stat_std_kg_m2) : json(nullptr);
+  (*u)["common_mode_kg_m2"] = fitted ? Number(total.common_mode_std_kg_m2) : json(nullptr);
+  (*u)["total_kg_m2"] = Number(r.inertia_total_std_total_kg_m2);
+  (*u)["total_percent"] =
+      fitted && r.inertia_total_kg_m2 > 0.0
+          ? Number(100.0 * r.inertia_total_std_total_kg_m2 / r.inertia_total_kg_m2)
+          : json(nullptr);
+  (*u)["configured_inputs_assumed"] = r.budget_assumed;
+  (*u)["assumed_inputs"] = r.budget_assumed
+                               ? json({{"filar_length_std_m", kAssumedLengthStdM},
+                                       {"filar_separation_std_m", kAssumedLengthStdM}})
+                               : json(nullptr);
+  (*u)["calibrated"] = r.calibrated;
+  (*u)["calibration_relative_std"] = r.calibration_relative_std;
+}
+
 }  // namespace
 
 std::string SweepSummary(const AmplitudeSweep& sweep) {
@@ -233,6 +287,8 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
                                  {"from_amplitude_deg", Number(r.amplitude_correction_from_deg)},
                                  {"to_amplitude_deg", 0.0}};
   }
+  j["inertia_total_std_total_kg_m2"] = Number(r.inertia_total_std_total_kg_m2);
+  AddTotalUncertainty(r, &j["uncertainty"]);
   j["amplitude_sweep"] = SweepToJson(r.sweep);
   if (campaign_fields) {
     j["role"] = ToString(r.role);
@@ -244,6 +300,8 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
     j["rig_inertia_kg_m2"] = Number(r.rig_inertia_kg_m2);
     j["inertia_kg_m2"] = Number(r.inertia_kg_m2);
     j["inertia_std_kg_m2"] = Number(r.inertia_std_kg_m2);
+    j["inertia_std_total_kg_m2"] = Number(r.inertia_std_total_kg_m2);
+    j["aircraft_scale_std_kg_m2"] = Number(r.aircraft_scale_std_kg_m2);
   }
   return j;
 }
@@ -310,6 +368,9 @@ TraceRecord TraceRecordFromJson(const json& j) {
     r.model_inadequacy_std_kg_m2 = GetNumber(*it, "model_inadequacy_kg_m2");
     if (it->contains("repeat_scatter_kg_m2"))
       r.repeat_scatter_std_kg_m2 = GetNumber(*it, "repeat_scatter_kg_m2");
+    r.budget_assumed = it->value("configured_inputs_assumed", false);
+    r.calibrated = it->value("calibrated", false);
+    r.calibration_relative_std = NumberOr0(*it, "calibration_relative_std");
   }
   if (auto it = j.find("amplitude_correction"); it != j.end() && it->is_object()) {
     r.amplitude_correction_kg_m2 = GetNumber(*it, "correction_kg_m2");
@@ -329,6 +390,9 @@ TraceRecord TraceRecordFromJson(const json& j) {
   r.rig_inertia_kg_m2 = GetNumber(j, "rig_inertia_kg_m2");
   r.inertia_kg_m2 = GetNumber(j, "inertia_kg_m2");
   r.inertia_std_kg_m2 = GetNumber(j, "inertia_std_kg_m2");
+  r.inertia_std_total_kg_m2 = GetNumber(j, "inertia_std_total_kg_m2");
+  r.aircraft_scale_std_kg_m2 = GetNumber(j, "aircraft_scale_std_kg_m2");
+  UpdateTotalUncertainty(&r);  // composed from the fields just read (pipeline/total_uncertainty.h)
   return r;
 }
 
@@ -420,6 +484,25 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   // rig.calibration: the effective geometry of every fit; its relative std is the `calibration`
   // term of each trace's budget (and so inside systematic_relative_std). null without one.
   j["calibration"] = result.calibration ? CalibrationToJson(*result.calibration) : json(nullptr);
+  // Table 2's total (pipeline/total_uncertainty.h): each moment's std and the common-mode scale
+  // fraction in quadrature; tau has no scale term.
+  json total = {{"common_mode_relative_std", Number(result.common_mode_relative_std)},
+                {"configured_inputs_assumed", result.common_mode_assumed},
+                {"note", result.assumed_inputs_note}};
+  if (result.ellipse_fit) {
+    const EllipseResult& e = *result.ellipse_fit;
+    const double rel = result.common_mode_relative_std;
+    auto moment = [&](const EllipseEstimate& est) {
+      return est.defined ? Number(WithCommonModeScale(est.value, est.std, rel)) : json(nullptr);
+    };
+    total["Ix_kg_m2"] = moment(e.ix);
+    total["Iz_kg_m2"] = moment(e.iz);
+    total["Ixz_kg_m2"] = moment(e.ixz);
+    total["Ixp_kg_m2"] = moment(e.ixp);
+    total["Izp_kg_m2"] = moment(e.izp);
+    total["tau_deg"] = e.tau_deg.defined ? Number(e.tau_deg.std) : json(nullptr);
+  }
+  j["total_uncertainty"] = total;
   json traces = json::array();
   for (const TraceRecord& r : result.traces) traces.push_back(TraceRecordToJson(r));
   j["traces"] = traces;
@@ -431,7 +514,9 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
                       {"inertia_std_kg_m2", Number(a.inertia_std_kg_m2)},
                       {"inertia_sem_kg_m2", Number(a.inertia_sem_kg_m2)},
                       {"cv_percent", Number(a.cv_percent)},
-                      {"fit_std_mean_kg_m2", Number(a.fit_std_mean_kg_m2)}});
+                      {"fit_std_mean_kg_m2", Number(a.fit_std_mean_kg_m2)},
+                      {"common_mode_std_kg_m2", Number(a.common_mode_std_kg_m2)},
+                      {"inertia_std_total_kg_m2", Number(a.inertia_std_total_kg_m2)}});
   }
   j["angles"] = angles;
   j["ellipse"] = result.ellipse;
@@ -443,7 +528,9 @@ std::string TracesCsv(const CampaignResult& result) {
   std::ostringstream out;
   out << "file,role,status,pitch_nominal_deg,pitch_measured_deg,pitch_used_deg,"
          "inertia_total_kg_m2,inertia_total_std_kg_m2,rig_inertia_kg_m2,inertia_kg_m2,"
-         "inertia_std_kg_m2,budget_total_std_kg_m2,drag_coeff_kg_m2,viscous_coeff_kg_m2_per_s,"
+         "inertia_std_kg_m2,inertia_total_std_total_kg_m2,inertia_std_total_kg_m2,"
+         "std_total_percent,uncertainty_terms,budget_assumed,"
+         "budget_total_std_kg_m2,drag_coeff_kg_m2,viscous_coeff_kg_m2_per_s,"
          "window_t0_s,window_t1_s,amplitude_start_deg,amplitude_end_deg,bias_rad_per_s,"
          "residual_rms_rad_per_s,model,iterations,fit_seconds,from_cache,inertia_source,"
          "inertia_window_kg_m2,model_inadequacy_std_kg_m2,secondary_motion_ratio,rms_over_noise,"
@@ -456,7 +543,9 @@ std::string TracesCsv(const CampaignResult& result) {
         << Cell(r.pitch_used_deg) << ',' << Cell(r.inertia_total_kg_m2) << ','
         << Cell(r.inertia_total_std_kg_m2) << ',' << Cell(r.rig_inertia_kg_m2) << ','
         << Cell(r.inertia_kg_m2) << ',' << Cell(r.inertia_std_kg_m2) << ','
-        << Cell(r.budget_total_std_kg_m2) << ',' << Cell(r.drag_coeff_kg_m2) << ','
+        << Cell(r.inertia_total_std_total_kg_m2) << ',' << Cell(r.inertia_std_total_kg_m2) << ','
+        << Cell(TotalPercent(r)) << ',' << Cell(TermsCell(r)) << ','
+        << (r.budget_assumed ? "true" : "false") << ',' << Cell(r.budget_total_std_kg_m2) << ',' << Cell(r.drag_coeff_kg_m2) << ','
         << Cell(r.viscous_coeff_kg_m2_per_s) << ',' << Cell(r.window_s[0]) << ','
         << Cell(r.window_s[1]) << ',' << Cell(r.amplitude_deg[0]) << ','
         << Cell(r.amplitude_deg[1]) << ',' << Cell(r.bias_rad_per_s) << ','
@@ -478,11 +567,12 @@ std::string TracesCsv(const CampaignResult& result) {
 std::string AnglesCsv(const CampaignResult& result) {
   std::ostringstream out;
   out << "pitch_deg,n,inertia_mean_kg_m2,inertia_std_kg_m2,inertia_sem_kg_m2,cv_percent,"
-         "fit_std_mean_kg_m2\n";
+         "fit_std_mean_kg_m2,common_mode_std_kg_m2,inertia_std_total_kg_m2\n";
   for (const AngleStats& a : result.angles) {
     out << Cell(a.pitch_deg) << ',' << a.n << ',' << Cell(a.inertia_mean_kg_m2) << ','
         << Cell(a.inertia_std_kg_m2) << ',' << Cell(a.inertia_sem_kg_m2) << ','
-        << Cell(a.cv_percent) << ',' << Cell(a.fit_std_mean_kg_m2) << '\n';
+        << Cell(a.cv_percent) << ',' << Cell(a.fit_std_mean_kg_m2) << ','
+        << Cell(a.common_mode_std_kg_m2) << ',' << Cell(a.inertia_std_total_kg_m2) << '\n';
   }
   return out.str();
 }

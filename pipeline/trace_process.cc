@@ -16,6 +16,8 @@
 #include "fit/trace_plot.h"
 #include "fit/window.h"
 #include "pipeline/imu_log.h"
+#include "pipeline/plausibility.h"
+#include "pipeline/total_uncertainty.h"
 #include "fit/figure.h"
 #include "pipeline/user_error.h"
 #include <plplot.h>
@@ -293,8 +295,15 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                                        (*override_s)[1], window_options, name)
                  : FindFreeOscillationWindow(data.t_s, axis.rate_rad_per_s, window_options, name);
   if (!window.IsUsable()) {
+    // Time in s declared ms (or the reverse) puts every period 1000 times outside the range.
+    const std::string hint =
+        !override_s && config.imu.format.container != LogContainer::kUlog &&
+                window.message.find("no oscillation found") != std::string::npos
+            ? TimeUnitHint(data.t_s, axis.rate_rad_per_s, window_options,
+                           config.imu.format.time_unit)
+            : "";
     return fail(window.status == WindowStatus::kError ? TraceStatus::kError : TraceStatus::kRejected,
-                window.message);
+                window.message + hint);
   }
   // No rest seen: the accelerometer averaged over the window still gives the pitch.
   if (!axis.pitch_measured_deg && data.has_accel() && !axis.accel_ignored && !axis_window) {
@@ -316,10 +325,19 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   const AmplitudeBand band =
       TrimToAmplitudeBand(data.t_s, axis.rate_rad_per_s, window, band_options, name);
   record.window_s = {window.t0_s, window.t1_s};
+  // A swing beyond 180 deg (deg/s read as rad/s): a hint on a rejection, a warning on a fit.
+  double largest_deg = 0.0, smallest_deg = INFINITY;
+  for (const AngleExtreme& e : band.extremes) {
+    largest_deg = std::max(largest_deg, e.amplitude_deg);
+    smallest_deg = std::min(smallest_deg, e.amplitude_deg);
+  }
+  const std::string impossible =
+      ImpossibleAmplitude(largest_deg, smallest_deg, config.imu.format.gyro_unit);
   if (!band.IsUsable()) {
     return fail(band.status == WindowStatus::kError ? TraceStatus::kError : TraceStatus::kRejected,
-                band.message);
+                band.message + (impossible.empty() ? "" : "; " + impossible));
   }
+  if (!impossible.empty()) record.warnings.push_back(impossible);
   record.window_s = {band.t0_s, band.t1_s};
 
   // 5. Fit.
@@ -354,16 +372,17 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   fit_options.max_amplitude_deg = band_options.max_amplitude_deg;
   fit_options.min_amplitude_deg = std::min(fit_options.min_amplitude_deg, band_options.min_amplitude_deg);
   // A calibrated geometry absorbs L, D and g (docs/physics.md §2.6): their terms are replaced by
-  // the calibration's own (added below).
+  // the calibration's own (added below). Without rig.uncertainties the budget counts the assumed
+  // +-1 mm on L and D (pipeline/total_uncertainty.h), unless the rig is calibrated.
   const bool calibrated = config.geometry_calibration.applied;
-  fit_options.filar_length_std_m = calibrated ? 0.0 : config.uncertainties.filar_length_std_m;
-  fit_options.filar_separation_std_m =
-      calibrated ? 0.0 : config.uncertainties.filar_separation_std_m;
+  const RigUncertainties uncertainties = config.uncertainties.InEffect();
+  fit_options.filar_length_std_m = calibrated ? 0.0 : uncertainties.filar_length_std_m;
+  fit_options.filar_separation_std_m = calibrated ? 0.0 : uncertainties.filar_separation_std_m;
   fit_options.mass_std_kg = options.role == TraceRole::kAircraft
-                                ? std::hypot(config.uncertainties.mass_std_kg,
+                                ? std::hypot(uncertainties.mass_std_kg,
                                              config.aircraft_mass_std_kg)
-                                : config.uncertainties.mass_std_kg;
-  fit_options.gravity_std_mps2 = calibrated ? 0.0 : config.uncertainties.gravity_std_mps2;
+                                : uncertainties.mass_std_kg;
+  fit_options.gravity_std_mps2 = calibrated ? 0.0 : uncertainties.gravity_std_mps2;
   fit_options.gyro_scale_std = config.imu.gyro_scale_std;
   // The residual series is kept for the second glitch pass below (and dropped after it when
   // neither a figure nor the caller wants it).
@@ -422,6 +441,13 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
     record.flags.push_back(flag);
   }
   for (const std::string& w : fit.warnings) record.warnings.push_back(w);
+  if (fit.HasFit()) {  // an amplitude or radius of gyration no real rig gives: units (issue 16)
+    for (const std::string& w : FitPlausibilityWarnings(
+             fit.params.inertia_kg_m2, input.geometry.mass_kg, input.geometry.filar_separation_m,
+             input.geometry.filar_length_m, fit.amplitude_start_deg, config.imu.format.gyro_unit)) {
+      record.warnings.push_back(w);
+    }
+  }
   record.model = ToString(fit.model);
   record.iterations = fit.iterations;
   record.secondary_motion_ratio = input.secondary_motion_ratio >= 0.0 ? input.secondary_motion_ratio : NAN;
@@ -454,6 +480,15 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
       const double term = config.geometry_calibration.factor_rel_std * fit.params.inertia_kg_m2;
       record.budget.push_back({"calibration", term});
       record.budget_total_std_kg_m2 = std::hypot(record.budget_total_std_kg_m2, term);
+      record.calibrated = true;
+      record.calibration_relative_std = config.geometry_calibration.factor_rel_std;
+    }
+    record.budget_assumed = config.uncertainties.Assumed() && !calibrated;
+    UpdateTotalUncertainty(&record);
+    // Every record says what the assumption adds on this rig (the console says it once).
+    if (record.budget_assumed) {
+      record.flags.push_back(kAssumedInputsFlag);
+      record.warnings.push_back(AssumedInputsWarning(record));
     }
   }
   if (record.status == TraceStatus::kOk && !record.warnings.empty()) {

@@ -43,8 +43,9 @@ struct TraceRecord {
   TraceStatus status = TraceStatus::kError;
   std::string message;                   // why rejected/error; warnings for ok
   double inertia_total_kg_m2 = NAN;      // fitted I of everything suspended (kg m^2)
-  // Its per-trace std (kg m^2): statistical (HAC) and model-inadequacy terms in quadrature; the
-  // systematic budget (L, D, m, g, gyro scale) is separate (budget_total_std_kg_m2).
+  // Its per-trace ("stat") std (kg m^2): statistical (HAC) and model-inadequacy terms in
+  // quadrature (and the between-repeat std with --repeats); the ellipse's weights. The budget
+  // (L, D, m, g, gyro scale) is common-mode: in inertia_total_std_total_kg_m2, not here.
   double inertia_total_std_kg_m2 = NAN;
   double drag_coeff_kg_m2 = NAN;         // K_D
   double viscous_coeff_kg_m2_per_s = NAN;  // C
@@ -87,6 +88,15 @@ struct TraceRecord {
   double amplitude_correction_kg_m2 = NAN;
   double amplitude_correction_std_kg_m2 = NAN;
   double amplitude_correction_from_deg = NAN;
+  // Total uncertainty of inertia_total_kg_m2 (pipeline/total_uncertainty.h): the per-log terms
+  // above and the common-mode ones (budget, calibration) in quadrature; NaN without a fit.
+  double inertia_total_std_total_kg_m2 = NAN;
+  // The budget's L and D lines hold the assumed +-1 mm (the config has no rig.uncertainties).
+  bool budget_assumed = false;
+  // rig.calibration (a reference object fixed the rig's effective geometry): its relative std is
+  // a common-mode term and the budget's L, D and g lines drop out. false: not calibrated.
+  bool calibrated = false;
+  double calibration_relative_std = 0.0;  // (fraction) >= 0
   int hac_bandwidth = 0;
   AmplitudeSweep sweep;                  // I against amplitude
 
@@ -100,6 +110,10 @@ struct TraceRecord {
   double rig_inertia_kg_m2 = NAN;        // subtracted tare at this pitch
   double inertia_kg_m2 = NAN;            // aircraft alone = total - rig (kg m^2)
   double inertia_std_kg_m2 = NAN;        // sqrt(fit std^2 + rig std^2)
+  // Total uncertainty of inertia_kg_m2 (ComposeAircraftUncertainty): per-log terms, rig inertia,
+  // and the scale terms (configured inputs, calibration); the last alone in aircraft_scale_std.
+  double inertia_std_total_kg_m2 = NAN;
+  double aircraft_scale_std_kg_m2 = NAN;
 
   bool ok() const { return status == TraceStatus::kOk; }
 };

@@ -185,6 +185,8 @@ CampaignConfig FitTraceConfig(const FitTraceArgs& a) {
   if (a.separation_std_m) u.filar_separation_std_m = *a.separation_std_m;
   if (a.mass_std_kg) u.mass_std_kg = *a.mass_std_kg;
   if (a.g_std) u.gravity_std_mps2 = *a.g_std;
+  // Any std given replaces the assumed +-1 mm on L and D, as a rig.uncertainties section does.
+  if (a.length_std_m || a.separation_std_m || a.mass_std_kg || a.g_std) u.configured = true;
   if (a.gyro_scale_std) config.imu.gyro_scale_std = *a.gyro_scale_std;
   QualityThresholds& q = config.fit.quality;
   if (a.max_rms_over_noise) q.max_rms_over_noise = *a.max_rms_over_noise;

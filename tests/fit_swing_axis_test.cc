@@ -153,11 +153,14 @@ TEST(SwingAxis, Rejects) {
   Synthetic s = MakeSynthetic(0.0, Eigen::Matrix3d::Identity(), true, 15);
   SwingAxis axis;
   std::string why;
-  // Accelerometer in g read as m/s^2: |f| = 1, not gravity.
+  // Accelerometer in g read as m/s^2: |f| = 1, not gravity. An error when the caller needs the
+  // accelerometer, naming the unit key.
   ImuData wrong_unit = s.data;
   for (auto& f : wrong_unit.accel_in_imu) f /= kG;
-  EXPECT_FALSE(EstimateSwingAxis(wrong_unit, SwingAxisOptions(), std::nullopt, &axis, &why));
-  EXPECT_NE(why.find("unit"), std::string::npos) << why;
+  SwingAxisOptions required;
+  required.accel_required = true;
+  EXPECT_FALSE(EstimateSwingAxis(wrong_unit, required, std::nullopt, &axis, &why));
+  EXPECT_NE(why.find("set imu.accel.unit: g"), std::string::npos) << why;
   // Constant gyro, no accelerometer: no axis to find.
   ImuData flat = s.data;
   flat.accel_in_imu.clear();
@@ -197,15 +200,55 @@ TEST(SwingAxis, GravityRemovedAccelerometerIsIgnoredWithAWarning) {
     // The axis is the swing's, within the rocking's pull on the principal direction (~0.5 deg).
     EXPECT_LT(std::min(AngleDeg(axis.axis_in_imu, s.down_in_imu), AngleDeg(-axis.axis_in_imu, s.down_in_imu)), 1.0);
   }
-  // With detection off (0), the old error.
+  // With the diagnosis off (0), still ignored, but not called "gravity removed".
   SwingAxisOptions off;
   off.gravity_removed_below_g = 0.0;
   ImuData removed = s.data;
   for (auto& f : removed.accel_in_imu) f += kG * (s.down_in_imu + 0.2 * s.down_in_imu.unitOrthogonal()).normalized();
   SwingAxis axis;
   std::string why;
-  EXPECT_FALSE(EstimateSwingAxis(removed, off, std::nullopt, &axis, &why));
-  EXPECT_NE(why.find("imu.accel: null"), std::string::npos) << why;
+  ASSERT_TRUE(EstimateSwingAxis(removed, off, std::nullopt, &axis, &why)) << why;
+  EXPECT_TRUE(axis.accel_ignored);
+  ASSERT_EQ(axis.warnings.size(), 1u);
+  EXPECT_EQ(axis.warnings[0].find("gravity removed"), std::string::npos) << axis.warnings[0];
+  EXPECT_NE(axis.warnings[0].find("neither gravity"), std::string::npos) << axis.warnings[0];
+}
+
+// issue 16 item 4: an accelerometer that reads neither gravity nor zero (the fixed-wing rig's
+// 0.27 g, along the vertical), or gravity in a wrong unit, is ignored with a warning that says
+// what the reading looks like; the axis comes from the gyro. Only accel_required makes it an
+// error.
+TEST(SwingAxis, AccelerometerThatDoesNotReadGravityIsIgnored) {
+  const Eigen::Matrix3d mount = MountingFromRollPitchYawDeg(0, 10, 30);
+  Synthetic s = MakeSynthetic(15.0, mount, true, 33);
+  const struct {
+    double scale;
+    const char* says;
+  } cases[] = {{0.27, "neither gravity"},
+               {1.0 / kG, "set imu.accel.unit: g"},
+               {kG, "set imu.accel.unit: m/s^2"}};
+  for (const auto& c : cases) {
+    ImuData odd = s.data;
+    for (auto& f : odd.accel_in_imu) f *= c.scale;
+    SwingAxis axis;
+    std::string why;
+    ASSERT_TRUE(EstimateSwingAxis(odd, SwingAxisOptions(), std::nullopt, &axis, &why)) << why;
+    EXPECT_TRUE(axis.accel_ignored) << c.says;
+    EXPECT_EQ(axis.source, SwingAxisSource::kGyroPrincipal) << c.says;
+    EXPECT_FALSE(axis.pitch_measured_deg.has_value()) << c.says;
+    ASSERT_EQ(axis.warnings.size(), 1u) << c.says;
+    EXPECT_NE(axis.warnings[0].find(c.says), std::string::npos) << axis.warnings[0];
+    EXPECT_NE(axis.warnings[0].find(kAccelIgnoredSentence), std::string::npos) << axis.warnings[0];
+    // The gyro's axis is the swing's, within the rocking's pull on the principal direction.
+    EXPECT_LT(std::min(AngleDeg(axis.axis_in_imu, s.down_in_imu),
+                       AngleDeg(-axis.axis_in_imu, s.down_in_imu)),
+              1.0)
+        << c.says;
+    SwingAxisOptions required;
+    required.accel_required = true;
+    EXPECT_FALSE(EstimateSwingAxis(odd, required, std::nullopt, &axis, &why)) << c.says;
+    EXPECT_NE(why.find(c.says), std::string::npos) << why;
+  }
 }
 
 TEST(SwingAxis, SecondaryMotionRatio) {

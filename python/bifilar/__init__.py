@@ -129,7 +129,8 @@ def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None
         Amplitude band of the fitted part (deg); default as the config's ``fit`` section.
     length_std_m, separation_std_m, mass_std_kg, g_std, gyro_scale_std : float, optional
         1-sigma uncertainties of L, D, m, g and the gyro scale factor (fraction) for the
-        uncertainty budget; default 0 (or the config's).
+        uncertainty budget; default the config's, or without one an assumed 1 mm on L and D
+        (labelled in ``uncertainty``); any of the first four given (0 too) replaces it.
     max_rms_over_noise, max_residual_autocorr, whiteness_lags, max_secondary_motion_ratio,
     min_periods : optional
         Quality thresholds (``fit.quality`` of the config); default the library's.

@@ -60,7 +60,18 @@ def test_keywords_alone_match_the_config():
                                       separation_m=1.8, mass_kg=5.5 + 1.25, max_amplitude_deg=30)
     assert from_keywords.inertia_total_kg_m2 == from_config.inertia_total_kg_m2
     assert from_keywords.inertia_total_std_kg_m2 == from_config.inertia_total_std_kg_m2
-    assert from_keywords.budget.total_kg_m2 == 0.0  # no uncertainties given
+    # No uncertainties given: the total counts the assumed +-1 mm on L and D, and says so.
+    assert from_keywords.uncertainty["configured_inputs_assumed"]
+    assert set(from_keywords.budget.keys()) == {"filar_length_kg_m2", "filar_separation_kg_m2",
+                                                "total_kg_m2"}
+    assert from_keywords.inertia_total_std_total_kg_m2 > from_keywords.inertia_total_std_kg_m2
+    # Explicit zeros replace the assumption.
+    zeros = bifilar.fit_trace(series.t_s, series.rate_rad_per_s, length_m=2.0, separation_m=1.8,
+                              mass_kg=5.5 + 1.25, max_amplitude_deg=30, length_std_m=0.0,
+                              separation_std_m=0.0)
+    assert zeros.budget.total_kg_m2 == 0.0
+    assert zeros.inertia_total_std_total_kg_m2 == pytest.approx(zeros.inertia_total_std_kg_m2,
+                                                                rel=1e-12)
 
 
 def test_series_are_the_fitted_window():
