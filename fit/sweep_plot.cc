@@ -87,14 +87,13 @@ bool WriteAmplitudeSweepFigure(const AmplitudeSweep& sweep, double inertia_kg_m2
   x_hi += x_pad;
   if (x_lo < 0.25 * x_hi) x_lo = 0.0;
 
-  // The trend I_0 (1 + c A^2) over the axis.
+  // The trend I_0 (1 + c A^p) over the axis.
   std::vector<double> tx, ty;
   if (trend) {
     for (int j = 0; j <= 60; ++j) {
       const double a = x_lo + (x_hi - x_lo) * j / 60.0;
       tx.push_back(a);
-      const double relative = 1.0 + sweep.trend_coeff_per_deg2 * a * a;
-      ty.push_back(sweep.inertia_zero_amplitude_kg_m2 * relative * k);
+      ty.push_back(sweep.TrendAt(a) * k);
     }
   }
   const double y_ref = inertia_kg_m2 * k, y_ref_std = inertia_std_kg_m2 * k;
@@ -222,7 +221,12 @@ bool WriteAmplitudeSweepFigure(const AmplitudeSweep& sweep, double inertia_kg_m2
     }
     if (trend) {
       sample_line(col[1], row[0], kRed, 2.0);
-      text(col[1], row[0], "trend I#d0#u (1 + c A#u2#d)");
+      const std::string legend = "trend I#d0#u (1 + c A" +
+                                 (sweep.trend_exponent == 1.0
+                                      ? std::string()
+                                      : "#u" + Fmt("%g", sweep.trend_exponent) + "#d") +
+                                 ")";
+      text(col[1], row[0], legend.c_str());
     }
     if (marked) {
       const double mx = col[1] + 0.5 * w, my = row[1];

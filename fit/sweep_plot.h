@@ -1,7 +1,7 @@
 // Figure of a trace's amplitude sweep (issue 8 item 3): I against amplitude, where the ideal model
 // is flat. One point per fitted band at the band's mean amplitude, with its +-1 sigma statistical
 // (HAC) error bar and a horizontal bar over the band's amplitude range; the reported I as a flat
-// line with its +-1 sigma band; when the sweep found a trend, the fitted I_0 (1 + c A^2) and a
+// line with its +-1 sigma band; when the sweep found a trend, the fitted I_0 (1 + c A^p) and a
 // marker on the band the result was taken from. A right-hand axis gives the deviation from the
 // reported I in %. PNG or SVG by extension, via fit/figure.h. Method: docs/method.md,
 // "Amplitude sweep".

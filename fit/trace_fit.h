@@ -12,6 +12,7 @@
 // fit/: nothing here exposes a Ceres or NLopt type.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -57,8 +58,10 @@ struct TraceFitOptions {
   // successive bands of the window, each holding the same number of cycles (at least
   // sweep_min_cycles_per_band, at most sweep_max_bands bands), with K_D and C held at the window
   // fit. A trend of I with amplitude beyond its statistical error (|z| > sweep_trend_z for the
-  // slope of I against A^2) means the rig departs from the model: a warning, the result taken
-  // from the lowest-amplitude band, and a model-inadequacy term added to its uncertainty.
+  // coefficient of I_0 (1 + c A^p), p in {1, 2} chosen by the data) means the rig departs
+  // from the model: a warning, the result taken from the lowest-amplitude band with its std
+  // scaled by the bands' scatter about the trend, and a model-inadequacy term (the trend's
+  // change from that band's amplitude to zero) added to its uncertainty.
   bool amplitude_sweep = true;
   double sweep_min_cycles_per_band = 2.0;  // (cycles) >= 1
   int sweep_max_bands = 6;                 // (count) >= 2
@@ -135,22 +138,36 @@ struct AmplitudeSweep {
   bool evaluated = false;    // false: too few cycles for two bands (note says why)
   std::string note;
   std::vector<AmplitudeSweepBand> bands;  // in time order (amplitude decreasing)
-  // Weighted fit I_j = I_0 (1 + c A_j^2) over the bands: c (1/deg^2) with its std (scaled by the
-  // Birge ratio when the bands scatter more than their stds), z = c / std.
-  double trend_coeff_per_deg2 = 0.0;
-  double trend_coeff_std_per_deg2 = 0.0;
+  // The trend over the bands (fit/amplitude_trend.h, FitAmplitudeShape): the weighted curve
+  // I_j = I_0 (1 + c A_j^p) with p in {1, 2} chosen by the data (lowest chi^2); c (per deg^p)
+  // with its std scaled by the Birge ratio of the bands about that curve, z = c / std.
+  double trend_exponent = 2.0;  // p
+  double trend_coeff = 0.0;     // c (per deg^p), relative to I_0
+  double trend_coeff_std = 0.0;
   double trend_z = 0.0;
+  double trend_chi2 = 0.0;     // chi^2 of the bands about the curve, their own stds
+  int trend_dof = 0;           // bands - 2
+  double trend_scale = 1.0;    // Birge ratio about the curve: sqrt(chi2/dof) when > 1, else 1
   // Mean relative slope of I over the swept amplitudes (% per 10 deg).
   double trend_percent_per_10deg = 0.0;
   double inertia_zero_amplitude_kg_m2 = 0.0;  // I_0, the trend extrapolated to zero amplitude
   bool trend_detected = false;                // |z| > sweep_trend_z
+  // The trend curve at amplitude a (deg); 0 when the sweep was not evaluated.
+  double TrendAt(double a_deg) const {
+    return inertia_zero_amplitude_kg_m2 *
+           (1.0 + trend_coeff * std::pow(std::abs(a_deg), trend_exponent));
+  }
   int low_band = -1;  // index in `bands` of the fitted band with the lowest amplitude (-1: none)
   // Consistency of the bands with one constant I: chi^2 about their weighted mean, its degrees of
   // freedom, and the scale applied to the statistical std (sqrt(chi^2/dof) when chi^2 exceeds
   // its degrees of freedom, else 1: the Birge ratio as the Particle Data Group applies it): segments of the same swing that disagree beyond their stds show
-  // the real error of the fit (unmodelled motion, coloured disturbances).
+  // the real error of the fit (unmodelled motion, coloured disturbances). With a trend the
+  // scale is the trend's (trend_scale): the bands' scatter about the curve, not about a constant,
+  // which would count the trend a second time.
   double chi2_constant = 0.0;
-  bool bands_disagree = false;  // chi2_constant above its 95 % quantile
+  // The bands scatter beyond their stds at 5 %: about the constant, or about the trend curve
+  // when a trend was detected.
+  bool bands_disagree = false;
   int chi2_dof = 0;
   double std_scale = 1.0;
 };

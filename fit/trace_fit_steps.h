@@ -14,7 +14,7 @@
 //   EstimateStatisticalStd  HAC sandwich covariance over the free parameters (trace_uncertainty.cc)
 //   ComputeInputBudget      geometry and gyro-scale uncertainties to I by the implicit-function
 //                           derivative                                     (trace_uncertainty.cc)
-//   RunAmplitudeSweep       I refitted in equal-cycle bands, trend of I against A^2 (trace_sweep.cc)
+//   RunAmplitudeSweep       I refitted in equal-cycle bands, trend of I against A^p (trace_sweep.cc)
 //   ApplySweepRule          trend -> low-amplitude band + model inadequacy; Birge scale
 //                                                                               (trace_sweep.cc)
 //   ComputeWhiteness        residual whiteness against their own AR(1) noise (residual_stats.cc)
@@ -184,7 +184,7 @@ InputBudget ComputeInputBudget(const TraceFitInput& input, const TraceFitOptions
 // --- Step 8: the amplitude sweep and its rule (trace_sweep.cc).
 
 // I refitted in successive equal-cycle bands of the window, from the window fit's state at each
-// band's first sample, K_D and C held at the window fit; then the trend of I against A^2.
+// band's first sample, K_D and C held at the window fit; then the trend of I against A^p.
 AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptions& options,
                                  const double* p, double scale, const Trajectory& traj,
                                  double period_s);

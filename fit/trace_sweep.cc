@@ -1,7 +1,8 @@
 // Step 8 of FitTrace (fit/trace_fit_steps.h): the amplitude sweep (I refitted in equal-cycle
-// bands of the window, and the trend of I against A^2) and its rule: a trend gives the
-// lowest-amplitude band's I with a model-inadequacy term; bands that scatter beyond their stds
-// scale the statistical std by the Birge ratio (docs/method.md §4).
+// bands of the window, and the trend of I against A^p, p chosen by the data) and its rule: a trend
+// gives the lowest-amplitude band's I, its std scaled by the bands' scatter about the trend, with
+// a model-inadequacy term; without one, bands that scatter beyond their stds scale the
+// statistical std by the Birge ratio about a constant (docs/method.md §4).
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -81,9 +82,11 @@ void TestConstant(const std::vector<const AmplitudeSweepBand*>& good, AmplitudeS
   sweep->bands_disagree = sweep->chi2_constant > ChiSquare95(sweep->chi2_dof);
 }
 
-// The trend over the fitted bands: weighted line I_j / I_ref = I_0 (1 + c A_j^2) / I_ref, its
-// std scaled by the Birge ratio of the line; the lowest-amplitude band; the constancy test.
-// Leaves sweep->evaluated false (with a note) when the bands cannot support a line.
+// The trend over the fitted bands: the weighted curve I_j = I_0 (1 + c A_j^p), p chosen by the
+// data (FitAmplitudeShape), its std scaled by the Birge ratio about the curve; the
+// lowest-amplitude band; the constancy test. With a trend, the bands' scatter is judged about the
+// curve: its Birge ratio becomes the std scale (about a constant it would count the trend twice).
+// Leaves sweep->evaluated false (with a note) when the bands cannot support a curve.
 void FitTrend(const TraceFitOptions& options, double ref, AmplitudeSweep* sweep) {
   std::vector<const AmplitudeSweepBand*> good;
   for (size_t j = 0; j < sweep->bands.size(); ++j) {
@@ -101,19 +104,27 @@ void FitTrend(const TraceFitOptions& options, double ref, AmplitudeSweep* sweep)
   std::vector<AmplitudePoint> points;
   for (const AmplitudeSweepBand* b : good)
     points.push_back({b->amplitude_mean_deg, b->inertia_kg_m2, b->inertia_std_kg_m2});
-  AmplitudeTrend trend;
-  if (!FitAmplitudeTrend(points, ref, &trend)) {
+  AmplitudePowerFit trend;
+  if (!FitAmplitudeShape(points, ref, &trend)) {
     sweep->note = "the bands do not span a range of amplitudes";
     return;
   }
   sweep->evaluated = true;
   TestConstant(good, sweep);
-  sweep->trend_coeff_per_deg2 = trend.coeff_per_deg2;
-  sweep->trend_coeff_std_per_deg2 = trend.coeff_std_per_deg2;
+  sweep->trend_exponent = trend.exponent;
+  sweep->trend_coeff = trend.coeff;
+  sweep->trend_coeff_std = trend.coeff_std;
   sweep->trend_z = trend.z;
+  sweep->trend_chi2 = trend.chi2;
+  sweep->trend_dof = trend.dof;
+  sweep->trend_scale = trend.birge;
   sweep->trend_percent_per_10deg = trend.percent_per_10deg;
   sweep->inertia_zero_amplitude_kg_m2 = trend.inertia_zero_amplitude_kg_m2;
   sweep->trend_detected = std::abs(sweep->trend_z) > options.sweep_trend_z;
+  if (sweep->trend_detected) {
+    sweep->std_scale = trend.birge;
+    sweep->bands_disagree = trend.dof > 0 && trend.chi2 > ChiSquare95(trend.dof);
+  }
 }
 
 }  // namespace
@@ -155,25 +166,32 @@ SweepRule ApplySweepRule(const AmplitudeSweep& sweep, const Solution& solution,
   if (sweep.evaluated && sweep.std_scale > 1.0) rule.inertia_stat_std_kg_m2 *= sweep.std_scale;
   if (sweep.bands_disagree) rule.findings.flags.push_back("bands_disagree");
   if (!sweep.trend_detected) return rule;
-  // The result comes from the lowest-amplitude band; the trend's bias left at that band's
-  // amplitude, |c| A_low^2 I, is the model-inadequacy term (docs/method.md).
+  // The result comes from the lowest-amplitude band, its std scaled by the bands' scatter about
+  // the trend (std_scale is the trend's Birge ratio here); the change the trend predicts from
+  // that band's amplitude to zero, |I(A_low) - I(0)|, is the model-inadequacy term
+  // (docs/method.md §4).
   const AmplitudeSweepBand* low = &sweep.bands[sweep.low_band];
   rule.inertia_kg_m2 = low->inertia_kg_m2;
   rule.inertia_stat_std_kg_m2 = low->inertia_std_kg_m2 * sweep.std_scale;
   rule.inertia_source = "low_amplitude_band";
-  rule.model_inadequacy_std_kg_m2 = std::abs(sweep.trend_coeff_per_deg2) *
-                                    low->amplitude_mean_deg * low->amplitude_mean_deg *
-                                    low->inertia_kg_m2;
+  rule.model_inadequacy_std_kg_m2 =
+      std::abs(sweep.TrendAt(low->amplitude_mean_deg) - sweep.TrendAt(0.0));
   rule.findings.Warn(
       "amplitude_trend",
       "I depends on the amplitude beyond its statistical error (" +
           Fmt("%+.3g", sweep.trend_percent_per_10deg) + " % per 10 deg between " +
           Fmt("%.1f", sweep.bands.back().amplitude_mean_deg) + " and " +
           Fmt("%.1f", sweep.bands.front().amplitude_mean_deg) + " deg, z = " +
-          Fmt("%.1f", sweep.trend_z) + "): the rig departs from the ideal model; I is taken from "
-          "the lowest-amplitude band (" + Fmt("%.1f", low->amplitude_mean_deg) +
-          " deg) with a model-inadequacy std of " + Fmt("%.2g", rule.model_inadequacy_std_kg_m2) +
-          " kg m^2. Swing at smaller amplitude, or set fit.max_amplitude_deg");
+          Fmt("%.1f", sweep.trend_z) + ", I_0 (1 + c A^" + Fmt("%g", sweep.trend_exponent) +
+          ") fits best): the rig departs from the ideal model; I is taken from the "
+          "lowest-amplitude band (" + Fmt("%.1f", low->amplitude_mean_deg) + " deg)" +
+          (sweep.std_scale > 1.0
+               ? ", its std scaled by " + Fmt("%.2g", sweep.std_scale) +
+                     " for the bands' scatter about the trend,"
+               : std::string()) +
+          " with a model-inadequacy std of " + Fmt("%.2g", rule.model_inadequacy_std_kg_m2) +
+          " kg m^2 (the trend's change from that amplitude to zero). Swing at smaller amplitude, "
+          "or set fit.max_amplitude_deg");
   return rule;
 }
 

@@ -272,9 +272,9 @@ bool TraceSetup::Check(std::string* why) const {
   if (!std::isfinite(roll_rad) || std::abs(roll_rad) > kPi + 1e-9) {
     return Fail(why, "roll = " + Num(roll_rad / kDeg) + " deg is out of range; allowed [-180, 180]");
   }
-  if (!std::isfinite(amplitude_rad) || amplitude_rad == 0.0 || std::abs(amplitude_rad) >= 80 * kDeg) {
+  if (!std::isfinite(amplitude_rad) || amplitude_rad == 0.0 || std::abs(amplitude_rad) >= 89 * kDeg) {
     return Fail(why, "amplitude = " + Num(amplitude_rad / kDeg) +
-                         " deg is out of range; allowed 0 < |amplitude| < 80 deg");
+                         " deg is out of range; allowed 0 < |amplitude| < 89 deg");
   }
   if (!body_from_imu.allFinite() ||
       (body_from_imu.transpose() * body_from_imu - Eigen::Matrix3d::Identity()).norm() > 1e-6 ||
@@ -818,7 +818,7 @@ bool CampaignSpec::Check(std::string* why) const {
          CheckValue(tare_pitch_deg, "tare_pitch_deg", -90.0, false, 90.0, why) &&
          CheckValue(pitch_error_sigma_deg, "pitch_error_sigma_deg", 0.0, false, 10.0, why) &&
          CheckRange(amplitude_deg, "amplitude_deg", 0.0, true, why) &&
-         CheckValue(amplitude_deg.max, "amplitude_deg (max)", 0.0, true, 75.0, why) &&
+         CheckValue(amplitude_deg.max, "amplitude_deg (max)", 0.0, true, 85.0, why) &&
          CheckRange(drag_coeff_kg_m2, "drag_coeff_kg_m2", 0.0, false, why) &&
          CheckRange(viscous_coeff_kg_m2_per_s, "viscous_coeff_kg_m2_per_s", 0.0, false, why) &&
          CheckValue(tare_damping_scale, "rig.tare_damping_scale", 0.0, false, 1.0, why);

@@ -168,7 +168,7 @@ struct TraceSetup {
   // TRUE roll (right wing down +, rad), |roll| <= pi: the swing axis in body axes is then
   // (-sin theta, sin phi cos theta, cos phi cos theta) (docs/physics.md §3.5). Default 0.
   double roll_rad = 0.0;
-  double amplitude_rad = 0.3;            // psi at release (sign = twist direction); 0 < |A| < 80 deg
+  double amplitude_rad = 0.3;            // psi at release (sign = twist direction); 0 < |A| < 89 deg
   Eigen::Matrix3d body_from_imu = Eigen::Matrix3d::Identity();  // IMU mounting (rotation)
   Eigen::Vector3d imu_offset_in_body_m = Eigen::Vector3d::Zero();  // IMU position from the CG
 
@@ -277,7 +277,7 @@ struct CampaignSpec {
   int tare_logs = 0;                 // logs of the rig alone; >= 0
   double tare_pitch_deg = 0.0;       // rig pitch for the tare logs (nominal)
   double pitch_error_sigma_deg = 0.5;       // true pitch = nominal + N(0, sigma), per log; >= 0
-  UniformRange amplitude_deg = {5.0, 30.0}; // |psi(t_release)| (deg); 0 < min, max < 80
+  UniformRange amplitude_deg = {5.0, 30.0}; // |psi(t_release)| (deg); 0 < min, max <= 85
   UniformRange drag_coeff_kg_m2 = {0.02, 0.08};            // K_D per log
   UniformRange viscous_coeff_kg_m2_per_s = {0.005, 0.02};  // C per log
   // Tare logs (rig alone, far less aerodynamic area) draw K_D and C from the ranges above times

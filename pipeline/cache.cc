@@ -104,6 +104,9 @@ std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
   Put(out, "sweep_cycles", sw.min_cycles_per_band);
   Put(out, "sweep_bands", sw.max_bands);
   Put(out, "sweep_z", sw.trend_z);
+  // The sweep's trend rule (I_0 (1 + c A^p), p in {1, 2}; Birge scale about the trend): a
+  // record fitted under the earlier A^2-only rule is not replayed.
+  out << "sweep_rule=power12;";
   // Only non-default glitch settings enter the key, so default keys stay those of 0.2.0.
   const GlitchConfig& gl = config.fit.glitch;
   if (!gl.IsDefault()) {

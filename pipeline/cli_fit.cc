@@ -65,13 +65,23 @@ std::string HumanLine(const TraceRecord& r) {
   if (!r.sweep.bands.empty()) {
     line += "\n    I(A): " + SweepSummary(r.sweep);
     if (r.sweep.evaluated) {
-      std::snprintf(buffer, sizeof(buffer), "  trend %+.3g %% per 10 deg (z = %.1f)%s",
-                    r.sweep.trend_percent_per_10deg, r.sweep.trend_z,
+      std::snprintf(buffer, sizeof(buffer), "  trend %+.3g %% per 10 deg (as A^%g, z = %.1f)%s",
+                    r.sweep.trend_percent_per_10deg, r.sweep.trend_exponent, r.sweep.trend_z,
                     r.sweep.trend_detected ? ": the rig departs from the model" : "");
       line += buffer;
     }
   } else if (!r.sweep.note.empty()) {
     line += "\n    I(A): no sweep (" + r.sweep.note + ")";
+  }
+  if (std::isfinite(r.amplitude_correction_kg_m2)) {
+    const double before = r.inertia_total_kg_m2 + r.amplitude_correction_kg_m2;
+    std::snprintf(buffer, sizeof(buffer),
+                  "\n    amplitude correction (--repeats): %#.5g -> %#.5g kg m^2 (%+.2f %% +- %.2f "
+                  "%%) from %.1f deg to zero amplitude",
+                  before, r.inertia_total_kg_m2, -100.0 * r.amplitude_correction_kg_m2 / before,
+                  100.0 * r.amplitude_correction_std_kg_m2 / before,
+                  r.amplitude_correction_from_deg);
+    line += buffer;
   }
   for (const std::string& flag : r.flags) {
     if (flag.rfind("block_means_of_", 0) == 0) {
@@ -102,11 +112,35 @@ nlohmann::json RepeatGroupsToJson(const std::vector<RepeatGroup>& groups) {
                    {"max_abs_z", number(g.max_abs_z)},
                    {"amplitude_trend_percent_per_10deg", number(g.amplitude_trend_percent_per_10deg)},
                    {"amplitude_trend_z", number(g.amplitude_trend_z)},
+                   {"spread_before_percent", number(g.spread_before_percent)},
+                   {"spread_after_percent", number(g.spread_after_percent)},
+                   {"q_before", number(g.q_before)},
+                   {"max_abs_z_before", number(g.max_abs_z_before)},
+                   {"correction_std_kg_m2", number(g.correction_std_kg_m2)},
                    {"common_mode_std_kg_m2", number(g.common_mode_std_kg_m2)},
                    {"total_std_kg_m2", number(g.total_std_kg_m2)},
                    {"note", g.note}});
   }
   return out;
+}
+
+nlohmann::json AmplitudeCorrectionToJson(const RepeatsAmplitudeCorrection& c) {
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  return {{"applied", c.applied},
+          {"model", "I_0 (1 + c A^2)"},
+          {"to_amplitude_deg", 0.0},
+          {"coeff_per_deg2", number(c.coeff_per_deg2)},
+          {"coeff_std_per_deg2", number(c.coeff_std_per_deg2)},
+          {"z", number(c.z)},
+          {"birge", number(c.birge)},
+          {"scatter_percent", number(c.scatter_percent)},
+          {"dof", c.dof},
+          {"n_logs", c.n_logs},
+          {"n_groups", c.n_groups},
+          {"n_corrected", c.n_corrected},
+          {"n_low_band_kept", c.n_low_band_kept},
+          {"amplitude_range_deg", {number(c.amplitude_min_deg), number(c.amplitude_max_deg)}},
+          {"note", c.note}};
 }
 
 }  // namespace
@@ -206,21 +240,26 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       if (!args->json && !args->repeats) std::cout << HumanLine(records.back()) << std::endl;
     }
     std::vector<RepeatGroup> groups;
+    RepeatsAmplitudeCorrection correction;
     if (args->repeats) {
       groups = GroupRepeats(args->logs);
-      CombineRepeats(&groups, &records);
+      correction = CombineRepeats(&groups, &records);
     }
     if (args->json) {
       nlohmann::json traces = nlohmann::json::array();
       for (const TraceRecord& r : records) traces.push_back(TraceRecordToJson(r, false));
       nlohmann::json out = traces;
       if (args->repeats || calibration) out = {{"traces", traces}};
-      if (args->repeats) out["repeats"] = RepeatGroupsToJson(groups);
+      if (args->repeats) {
+        out["repeats"] = RepeatGroupsToJson(groups);
+        out["amplitude_correction"] = AmplitudeCorrectionToJson(correction);
+      }
       if (calibration) out["calibration"] = CalibrationToJson(*calibration);
       // Invalid UTF-8 (a log's bytes in a message) is replaced, never a json exception.
       std::cout << out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
     } else if (args->repeats) {
       for (const TraceRecord& r : records) std::cout << HumanLine(r) << std::endl;
+      std::cout << AmplitudeCorrectionLine(correction) << std::endl;
       for (const RepeatGroup& g : groups) std::cout << RepeatGroupLine(g) << std::endl;
     }
     // Once for the run: what the assumed +-1 mm on L and D adds (--json records carry it).

@@ -133,7 +133,9 @@ std::string SweepFigure(const json& t, const std::string& out_dir, int* counter)
   return "<figure>" + Figure(out_dir, name, alt, "sweep", counter) + "<figcaption>" + file +
          " &middot; I against amplitude, flat for the ideal model: each band &plusmn; 1&sigma; "
          "over its amplitude range; blue, the result &plusmn; 1&sigma;" +
-         (trend ? "; red, the trend I<sub>0</sub>(1 + c A<sup>2</sup>) and a ring on the band the "
+         (trend ? "; red, the trend I<sub>0</sub>(1 + c A<sup>" +
+                      Fmt(sweep.value("trend_exponent", 2.0), "%g") +
+                      "</sup>) and a ring on the band the "
                   "result is taken from"
                 : "") +
          "</figcaption></figure>\n";

@@ -75,11 +75,16 @@ json SweepToJson(const AmplitudeSweep& s) {
                      {"inertia_std_kg_m2", b.ok ? Number(b.inertia_std_kg_m2) : json(nullptr)},
                      {"ok", b.ok}});
   }
-  json j = {{"evaluated", s.evaluated}, {"note", s.note}, {"bands", bands}};
+  json j = {{"evaluated", s.evaluated}, {"note", s.note}, {"bands", bands}, {"low_band", s.low_band}};
   if (s.evaluated) {
-    j["trend_coeff_per_deg2"] = Number(s.trend_coeff_per_deg2);
-    j["trend_coeff_std_per_deg2"] = Number(s.trend_coeff_std_per_deg2);
+    j["trend_exponent"] = Number(s.trend_exponent);
+    j["trend_coeff_per_deg_p"] = Number(s.trend_coeff);
+    j["trend_coeff_std_per_deg_p"] = Number(s.trend_coeff_std);
     j["trend_z"] = Number(s.trend_z);
+    j["trend_chi2"] = Number(s.trend_chi2);
+    j["trend_dof"] = s.trend_dof;
+    j["trend_scale"] = Number(s.trend_scale);
+    j["std_scale"] = Number(s.std_scale);
     j["trend_percent_per_10deg"] = Number(s.trend_percent_per_10deg);
     j["inertia_zero_amplitude_kg_m2"] = Number(s.inertia_zero_amplitude_kg_m2);
     j["trend_detected"] = s.trend_detected;
@@ -115,10 +120,22 @@ AmplitudeSweep SweepFromJson(const json& j) {
       s.bands.push_back(band);
     }
   }
+  if (auto it = j.find("low_band"); it != j.end() && it->is_number_integer() && *it >= 0 &&
+                                      *it < static_cast<int>(s.bands.size())) {
+    s.low_band = it->get<int>();
+  }
   if (s.evaluated) {
-    s.trend_coeff_per_deg2 = NumberOr0(j, "trend_coeff_per_deg2");
-    s.trend_coeff_std_per_deg2 = NumberOr0(j, "trend_coeff_std_per_deg2");
+    // Records of earlier versions carry the A^2 line only (trend_coeff_per_deg2).
+    const bool power = j.contains("trend_exponent");
+    s.trend_exponent = power ? NumberOr0(j, "trend_exponent") : 2.0;
+    s.trend_coeff = NumberOr0(j, power ? "trend_coeff_per_deg_p" : "trend_coeff_per_deg2");
+    s.trend_coeff_std =
+        NumberOr0(j, power ? "trend_coeff_std_per_deg_p" : "trend_coeff_std_per_deg2");
     s.trend_z = NumberOr0(j, "trend_z");
+    s.trend_chi2 = NumberOr0(j, "trend_chi2");
+    s.trend_dof = static_cast<int>(NumberOr0(j, "trend_dof"));
+    s.trend_scale = j.contains("trend_scale") ? NumberOr0(j, "trend_scale") : 1.0;
+    s.std_scale = j.contains("std_scale") ? NumberOr0(j, "std_scale") : 1.0;
     s.trend_percent_per_10deg = NumberOr0(j, "trend_percent_per_10deg");
     s.inertia_zero_amplitude_kg_m2 = NumberOr0(j, "inertia_zero_amplitude_kg_m2");
     s.trend_detected = j.value("trend_detected", false);
@@ -265,6 +282,12 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
                       {"model_inadequacy_kg_m2", Number(r.model_inadequacy_std_kg_m2)}};
   if (std::isfinite(r.repeat_scatter_std_kg_m2))
     j["uncertainty"]["repeat_scatter_kg_m2"] = r.repeat_scatter_std_kg_m2;
+  if (std::isfinite(r.amplitude_correction_kg_m2)) {
+    j["amplitude_correction"] = {{"correction_kg_m2", Number(r.amplitude_correction_kg_m2)},
+                                 {"std_kg_m2", Number(r.amplitude_correction_std_kg_m2)},
+                                 {"from_amplitude_deg", Number(r.amplitude_correction_from_deg)},
+                                 {"to_amplitude_deg", 0.0}};
+  }
   j["inertia_total_std_total_kg_m2"] = Number(r.inertia_total_std_total_kg_m2);
   AddTotalUncertainty(r, &j["uncertainty"]);
   j["amplitude_sweep"] = SweepToJson(r.sweep);
@@ -353,6 +376,11 @@ TraceRecord TraceRecordFromJson(const json& j) {
     r.budget_assumed = it->value("configured_inputs_assumed", false);
     r.calibrated = it->value("calibrated", false);
     r.calibration_relative_std = NumberOr0(*it, "calibration_relative_std");
+  }
+  if (auto it = j.find("amplitude_correction"); it != j.end() && it->is_object()) {
+    r.amplitude_correction_kg_m2 = GetNumber(*it, "correction_kg_m2");
+    r.amplitude_correction_std_kg_m2 = GetNumber(*it, "std_kg_m2");
+    r.amplitude_correction_from_deg = GetNumber(*it, "from_amplitude_deg");
   }
   if (auto it = j.find("amplitude_sweep"); it != j.end() && it->is_object()) r.sweep = SweepFromJson(*it);
   if (j.contains("role") && !ParseTraceRole(GetString(j, "role"), &r.role)) {

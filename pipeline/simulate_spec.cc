@@ -353,7 +353,7 @@ SimulateSpec ParseSpec(YamlMap root) {
   CampaignSpec& c = spec.campaign;
   {
     YamlMap swing = Section(root, "swing");
-    c.amplitude_deg = ReadRange(swing, "amplitude_deg", c.amplitude_deg, 0, true, 75);
+    c.amplitude_deg = ReadRange(swing, "amplitude_deg", c.amplitude_deg, 0, true, 85);
     spec.options.negative_amplitude_probability =
         ReadValue(swing, "negative_amplitude_probability",
                   spec.options.negative_amplitude_probability, 0, false, 1);
@@ -506,10 +506,10 @@ SimulateSpec ParseSpec(YamlMap root) {
     t.mass_kg = ReadOptionalValue(trace, "mass_kg", 0, true, 1e6);
     t.pitch_deg = ReadValue(trace, "pitch_deg", t.pitch_deg, -90, false, 90);
     const YAML::Node amp = trace.Optional("amplitude_deg");
-    t.amplitude_deg = ReadValue(trace, "amplitude_deg", t.amplitude_deg, -75, false, 75);
+    t.amplitude_deg = ReadValue(trace, "amplitude_deg", t.amplitude_deg, -85, false, 85);
     if (t.amplitude_deg == 0) {
       throw UserError(trace.Where(amp) + ": 'trace.amplitude_deg' must not be 0; allowed "
-                      "0 < |amplitude| <= 75");
+                      "0 < |amplitude| <= 85");
     }
     t.drag_coeff_kg_m2 = ReadValue(trace, "drag_coeff_kg_m2", t.drag_coeff_kg_m2, 0, false, inf);
     t.viscous_coeff_kg_m2_per_s =

@@ -44,7 +44,8 @@ void Finish(TotalUncertainty* u) {
 std::vector<UncertaintyTerm> PerLogTerms(const TraceRecord& r) {
   return {{kTermStatistical, r.inertia_stat_std_kg_m2, false, false},
           {kTermModelInadequacy, OrZero(r.model_inadequacy_std_kg_m2), false, false},
-          {kTermBetweenRepeat, OrZero(r.repeat_scatter_std_kg_m2), false, false}};
+          {kTermBetweenRepeat, OrZero(r.repeat_scatter_std_kg_m2), false, false},
+          {kTermAmplitudeCorrection, OrZero(r.amplitude_correction_std_kg_m2), false, false}};
 }
 
 std::string Percent(double fraction) {

@@ -5,7 +5,8 @@
 //
 // Two kinds of term:
 //   per-log      statistical (HAC, Birge-scaled), model inadequacy (the sweep's trend), between-
-//                repeat (tau of `--repeats`): what differs from one log to the next. Their sum in
+//                repeat (tau of `--repeats`), amplitude correction (its std, `--repeats`): what
+//                differs from one log to the next. Their sum in
 //                quadrature is the "stat" std, the record's inertia_total_std_kg_m2, which weights
 //                the points of the ellipse fit exactly as before.
 //   common-mode  configured inputs (the implicit-function budget of L, D, m, g, gyro scale),
@@ -31,6 +32,8 @@ constexpr double kAssumedLengthStdM = 0.001;
 constexpr const char* kTermStatistical = "statistical";             // HAC, Birge-scaled (per log)
 constexpr const char* kTermModelInadequacy = "model_inadequacy";    // amplitude trend (per log)
 constexpr const char* kTermBetweenRepeat = "between_repeat";        // tau of --repeats (per log)
+// The std of the amplitude correction of --repeats (pooled c moved to zero amplitude; per log).
+constexpr const char* kTermAmplitudeCorrection = "amplitude_correction";
 constexpr const char* kTermConfiguredInputs = "configured_inputs";  // L, D, m, g, gyro scale
 constexpr const char* kTermCalibration = "calibration";             // rig.calibration (0: none)
 constexpr const char* kTermRigInertia = "rig_inertia";  // tare/value std (aircraft alone)

@@ -82,6 +82,13 @@ struct TraceRecord {
   double model_inadequacy_std_kg_m2 = NAN;  // from the amplitude sweep's trend (0: none)
   // Between-repeat std added by `bifilar fit --repeats` (pipeline/repeats.h); NaN: not combined.
   double repeat_scatter_std_kg_m2 = NAN;
+  // Amplitude correction applied by `bifilar fit --repeats` (pipeline/repeats.h): the pooled
+  // coefficient c moves I from the amplitude of its result to zero amplitude, I_0 = I / (1 + c
+  // A^2). The correction I - I_0 (subtracted from inertia_total_kg_m2), its std (added in
+  // quadrature to inertia_total_std_kg_m2) and A (deg); NaN: not corrected.
+  double amplitude_correction_kg_m2 = NAN;
+  double amplitude_correction_std_kg_m2 = NAN;
+  double amplitude_correction_from_deg = NAN;
   // Total uncertainty of inertia_total_kg_m2 (pipeline/total_uncertainty.h): the per-log terms
   // above and the common-mode ones (budget, calibration) in quadrature; NaN without a fit.
   double inertia_total_std_total_kg_m2 = NAN;
