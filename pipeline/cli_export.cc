@@ -29,7 +29,8 @@ void RegisterExportCommand(CLI::App& app, int* exit_code) {
       "urdf/sdf: flu (x forward, y left, z up: ROS REP 103, Gazebo; default) or frd (the body "
       "axes as measured, x forward, y right, z down)");
   cmd->add_option("--mass-kg", opts->mass_kg,
-                  "mass to write (default: aircraft.mass_kg of the config stored in the result)");
+                  "mass to write (default: aircraft.mass_kg of the config stored in the result)")
+      ->check(FiniteNumber());
   cmd->add_option("--set", *sets,
                   "NAME=VALUE: a component the result does not hold, in kg m^2, body axes, "
                   "products positive (I_xy = integral x y dm), e.g. --set Iyy=0.42; repeatable");
