@@ -47,6 +47,10 @@ struct RepeatGroup {
 
 // Groups `paths` by the path with its last number in the file name removed; a path without a
 // number is a group of its own.
+// True for the warning CombineRepeats puts on each member of a group whose repeats scatter
+// beyond their stds (the same text on every member: `fit --repeats` prints it once).
+bool IsRepeatScatterWarning(const std::string& warning);
+
 std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths);
 
 // Combines each group's usable members (status ok, finite I, std > 0): fills the group's
