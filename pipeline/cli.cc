@@ -86,8 +86,19 @@ int RunCommandLine(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    // --help and --version print as CLI11 does; a usage error gets the prefix every other
+    // error has, so scripts and users can grep one form.
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::string what = e.what();
+    if (argc > 1 && argv[1][0] != '-' && app.get_subcommands().empty()) {
+      std::string names;  // CLI11 says only "A subcommand is required" for `bifilar fitt`
+      for (const CLI::App* sub : app.get_subcommands({})) {
+        names += (names.empty() ? "" : ", ") + sub->get_name();
+      }
+      what = std::string("unknown command '") + argv[1] + "'; the commands are " + names;
+    }
+    std::cerr << "bifilar: error: " << what << "\nRun with --help for more information.\n";
+    return 2;
   } catch (const std::bad_alloc&) {
     std::cerr << "bifilar: error: out of memory in `" << CommandAndInputs(argc, argv)
               << "`: one of these inputs (a file, or a count in the config or options) is far "

@@ -1,6 +1,7 @@
 // `bifilar fit CONFIG LOG... [--json] [--model M] [--window T0:T1] [--max-amplitude DEG]
 // [--plot DIR]`: fits single logs with the campaign's trace processing (pipeline/trace_process.h).
 // The config needs only the rig geometry, the masses and the IMU format (configs/README.md).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -160,7 +161,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
   sub->add_option("config", args->config,
                   "config (YAML): rig geometry, masses, IMU format (configs/README.md)")
       ->required();
-  sub->add_option("logs", args->logs, "IMU CSV logs")->required();
+  sub->add_option("logs", args->logs, "IMU logs: CSV (optionally .gz) or PX4 ULog (.ulg)")->required();
   sub->add_flag("--json", args->json, "print a JSON array of trace records instead of lines");
   sub->add_option("--model", args->model, "full (default), jardin or linear")
       ->check(CLI::IsMember({"full", "jardin", "linear"}));
@@ -258,9 +259,36 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       // Invalid UTF-8 (a log's bytes in a message) is replaced, never a json exception.
       std::cout << out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
     } else if (args->repeats) {
-      for (const TraceRecord& r : records) std::cout << HumanLine(r) << std::endl;
+      // The between-repeat (Q) warning is the same on every member: said once, under its group.
+      std::vector<std::string> scatter_warnings;
+      for (const TraceRecord& r : records) {
+        TraceRecord shown = r;
+        shown.warnings.clear();
+        for (const std::string& w : r.warnings) {
+          if (IsRepeatScatterWarning(w)) {
+            if (std::find(scatter_warnings.begin(), scatter_warnings.end(), w) ==
+                scatter_warnings.end()) {
+              scatter_warnings.push_back(w);
+            }
+          } else {
+            shown.warnings.push_back(w);
+          }
+        }
+        std::cout << HumanLine(shown) << std::endl;
+      }
       std::cout << AmplitudeCorrectionLine(correction) << std::endl;
-      for (const RepeatGroup& g : groups) std::cout << RepeatGroupLine(g) << std::endl;
+      for (const RepeatGroup& g : groups) {
+        std::cout << RepeatGroupLine(g) << std::endl;
+        const std::string of = " repeats of " + g.name + " scatter beyond";
+        for (const std::string& w : scatter_warnings) {
+          if (w.find(of) == std::string::npos) continue;
+          std::string text = w;
+          const std::string per_log = "this log's std";
+          const size_t at = text.find(per_log);
+          if (at != std::string::npos) text.replace(at, per_log.size(), "each log's std");
+          std::cout << "    warning: " << text << std::endl;
+        }
+      }
     }
     // Once for the run: what the assumed +-1 mm on L and D adds (--json records carry it).
     const std::string assumed = AssumedInputsSummary(records);

@@ -107,12 +107,13 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
   auto raw = std::make_shared<RawArgs>();
   auto* sub = app.add_subcommand(
       "simulate",
-      "Write realistic IMU CSV logs plus a JSON truth file: a campaign from a spec "
-      "(SPEC.yaml --out DIR) or one trace (--trace OUT.csv --inertia-kg-m2 --mass-kg -L -D)");
+      "Write realistic IMU logs (CSV, or PX4 ULog with `ulog: true` in the spec or a --trace "
+      "name ending in .ulg) plus a JSON truth file: a campaign from a spec (SPEC.yaml --out DIR) "
+      "or one trace (--trace OUT.csv|OUT.ulg --inertia-kg-m2 --mass-kg -L -D)");
   sub->add_option("spec", args->spec_file, "simulation spec (YAML); see configs/simulate_prandtl_d.yaml")
       ->check(CLI::ExistingFile);
   sub->add_option("--out", args->out_dir, "campaign output folder (pitch_*/trial_*.csv, tare/, truth.json)");
-  sub->add_option("--trace", args->trace_csv, "simulate one trace into this CSV file");
+  sub->add_option("--trace", args->trace_csv, "simulate one trace into this file: CSV, or PX4 ULog when it ends in .ulg");
   sub->add_option("--truth", args->truth_json, "truth JSON of --trace (default OUT.truth.json)");
   raw->o_seed = sub->add_option("--seed", raw->seed,
                                 "random seed, an integer in [0, 2^64 - 1] (overrides the spec's "

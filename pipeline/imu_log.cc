@@ -1,6 +1,7 @@
 #include "pipeline/imu_log.h"
 
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -129,6 +130,33 @@ std::string FormatNumber(double v) {
 }
 
 [[noreturn]] void Fail(const std::string& message) { throw UserError(message); }
+
+// True when the file name ends in .ulg or .ulg.gz (any case).
+bool NamedLikeUlog(const std::string& path) {
+  std::string lower = path;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  auto ends_with = [&](const std::string& suffix) {
+    return lower.size() >= suffix.size() &&
+           lower.compare(lower.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  return ends_with(".ulg") || ends_with(".ulg.gz");
+}
+
+// The first bytes of `text` for a message: printable ASCII quoted, anything else as hex.
+std::string DescribeStart(std::string_view text) {
+  if (text.empty()) return "nothing: the file is empty";
+  std::string out;
+  const size_t n = std::min<size_t>(text.size(), 8);
+  bool printable = true;
+  for (size_t i = 0; i < n; ++i) printable = printable && text[i] >= 32 && text[i] < 127;
+  if (printable) return "\"" + std::string(text.substr(0, n)) + "\"";
+  char hex[4];
+  for (size_t i = 0; i < n; ++i) {
+    std::snprintf(hex, sizeof(hex), "%s%02x", i ? " " : "", static_cast<unsigned char>(text[i]));
+    out += hex;
+  }
+  return "the bytes " + out;
+}
 
 // `owner`, when given, holds the bytes `text` views; it is released once the rows are parsed, so a
 // long log's text and its samples are not both held while the samples are finished.
@@ -500,6 +528,17 @@ ImuData ReadImuLog(const std::string& path, const ImuFormat& format,
                    const ImuLogOptions& options) {
   std::string text = ReadWholeFile(path, options);
   if (UseUlogReader(text, format)) return ReadUlogImu(text, path, format, options);
+  // A .ulg without the ULog magic is read as CSV (a CSV named .ulg still works); when that fails
+  // too, say so rather than "missing column 't'", which points at the wrong problem.
+  if (NamedLikeUlog(path)) {
+    try {
+      return Parse(text, path, format, options, &text);
+    } catch (const UserError& e) {
+      Fail(path + ": not a valid ULog file (a .ulg starts with the bytes \"ULog\" 01 12 35; " +
+           "this one starts with " + DescribeStart(text) + ") and not a CSV log either (" +
+           e.what() + ")");
+    }
+  }
   return Parse(text, path, format, options, &text);
 }
 

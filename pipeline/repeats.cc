@@ -277,6 +277,11 @@ RepeatsAmplitudeCorrection CorrectAmplitude(const std::vector<RepeatGroup>& grou
 
 }  // namespace
 
+bool IsRepeatScatterWarning(const std::string& warning) {
+  return warning.rfind("the ", 0) == 0 &&
+         warning.find(" scatter beyond their own stds (Q = ") != std::string::npos;
+}
+
 std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths) {
   std::vector<RepeatGroup> groups;
   std::map<std::string, size_t> index;

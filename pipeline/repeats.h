@@ -67,6 +67,10 @@ struct RepeatGroup {
 
 // Groups `paths` by the path with its last number in the file name removed; a path without a
 // number is a group of its own.
+// True for the warning CombineRepeats puts on each member of a group whose repeats scatter
+// beyond their stds (the same text on every member: `fit --repeats` prints it once).
+bool IsRepeatScatterWarning(const std::string& warning);
+
 std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths);
 
 // The amplitude correction pooled over the groups (fit/amplitude_trend.h,
