@@ -142,7 +142,7 @@ _SUMMARY_CHARS = 500  # about six lines of a terminal
 
 
 def _short(value):
-    """A value in a few characters: numbers to 6 digits, strings cut at 60 characters, arrays as
+    """A value in a few characters: numbers to 6 digits, strings cut to 60 characters, arrays as
     <array shape>, records and long or nested lists as their size."""
     if isinstance(value, bool) or value is None:
         return repr(value)
@@ -150,8 +150,8 @@ def _short(value):
         return "%.6g" % value
     if isinstance(value, int):
         return repr(value)
-    if isinstance(value, str):
-        return repr(value if len(value) <= 60 else value[:57] + "...")
+    if isinstance(value, str):  # long ones keep their end too (a path's file name)
+        return repr(value if len(value) <= 60 else value[:20] + "..." + value[-37:])
     if _np is not None and isinstance(value, _np.ndarray):
         return "<array %s>" % ("x".join(map(str, value.shape)) or "scalar")
     if isinstance(value, dict):
@@ -196,6 +196,10 @@ class _FileNotFoundError(FileNotFoundError, ValueError):
 
     def __str__(self):
         return self.message
+
+
+# Tracebacks say "bifilar.FileNotFoundError: <the command line's message>".
+_FileNotFoundError.__name__ = _FileNotFoundError.__qualname__ = "FileNotFoundError"
 
 
 def _calling(inputs, call, *args, **kwargs):
