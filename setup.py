@@ -44,12 +44,18 @@ def _cached_python(build_dir):
     return None
 
 
+# The CMake build folder; setuptools' own scratch files go into it too (under setuptools/), so
+# nothing is written beside the sources and two builds with different folders do not meet.
+BUILD_DIR = os.path.abspath(
+    os.environ.get("BIFILAR_CMAKE_BUILD_DIR") or os.path.join(HERE, "build", "pip"))
+SCRATCH = os.path.join(BUILD_DIR, "setuptools")
+
+
 class CMakeBuild(build_ext):
     """Configures (once) and builds the CMake target bifilar_python, then copies _core*.so."""
 
     def build_extension(self, ext):
-        build_dir = os.path.abspath(
-            os.environ.get("BIFILAR_CMAKE_BUILD_DIR") or os.path.join(HERE, "build", "pip"))
+        build_dir = BUILD_DIR
         python = os.path.realpath(sys.executable)
         cached = _cached_python(build_dir)
         if cached is not None and os.path.realpath(cached) != python:
@@ -76,7 +82,7 @@ class CMakeBuild(build_ext):
         shutil.copyfile(built[0], target)
 
 
-os.makedirs(os.path.join(HERE, "build", "pip-setuptools"), exist_ok=True)
+os.makedirs(SCRATCH, exist_ok=True)
 setup(
     version=_version(),
     packages=["bifilar"],
@@ -84,7 +90,5 @@ setup(
     ext_modules=[Extension("bifilar._core", sources=[])],
     cmdclass={"build_ext": CMakeBuild},
     zip_safe=False,
-    # setuptools' own scratch files go under build/ (ignored by git), not beside the sources.
-    options={"build": {"build_base": os.path.join("build", "pip-setuptools")},
-             "egg_info": {"egg_base": os.path.join("build", "pip-setuptools")}},
+    options={"build": {"build_base": SCRATCH}, "egg_info": {"egg_base": SCRATCH}},
 )
