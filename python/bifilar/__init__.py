@@ -210,7 +210,7 @@ def _calling(inputs, call, *args, **kwargs):
         return call(*args, **kwargs)
     except ValueError as error:
         for path in inputs:
-            if path is not None and not _os.path.lexists(path):
+            if path is not None and not _os.path.exists(path):
                 message = str(error)
                 if path not in message:
                     message = "%s: no such file" % path
