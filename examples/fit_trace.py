@@ -49,7 +49,7 @@ else:
     top.set_title(f"I = {result.inertia_total_kg_m2:.6g} kg m$^2$ ({result.model} model)")
     top.legend(loc="upper right")
     bottom.plot(result.t_s, result.residual_rad_per_s, color="C3", lw=0.5)
-    bottom.set_ylabel("fit - measured (rad/s)")
+    bottom.set_ylabel("meas. - fit (rad/s)")
     bottom.set_xlabel("t (s)")
     fig.tight_layout()
     if args.save:

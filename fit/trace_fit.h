@@ -242,7 +242,8 @@ struct TraceFitResult {
   TraceInitialGuess guess;
 
   // Series for plotting (empty unless options.keep_series): the window's times, the measured
-  // rate, the fitted rate psi'(t_k) + b and the residual fitted - measured.
+  // rate, the fitted rate psi'(t_k) + b and the residual fitted - measured (the fit's own sign;
+  // the figures and Python's residual_rad_per_s show its negative, measured - fitted).
   std::vector<double> t_s;
   std::vector<double> measured_rate_rad_per_s;
   std::vector<double> fitted_rate_rad_per_s;

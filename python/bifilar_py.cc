@@ -40,6 +40,7 @@
 #include "pipeline/config.h"
 #include "pipeline/ellipse_json.h"
 #include "pipeline/imu_log.h"
+#include "pipeline/log_inspect.h"
 #include "pipeline/results_json.h"
 #include "pipeline/simulate_spec.h"
 #include "pipeline/tensor_json.h"
@@ -261,8 +262,27 @@ py::tuple FitTraceCore(const Array& t_array, const Array& rate_array, const FitT
 
 // ---- read_log ----
 
-py::dict ReadLogCore(const std::string& path, const std::string& config_path) {
-  const CampaignConfig config = LoadFitConfig(config_path);
+// Without a config the format is the one `bifilar inspect` guesses (pipeline/log_inspect.h), and
+// the swing axis, window search and reading limits are the defaults of a config that gives only
+// the format (as the config `bifilar init --log` writes).
+py::dict ReadLogCore(const std::string& path, const std::optional<std::string>& config_path) {
+  CampaignConfig config;
+  std::optional<nlohmann::json> guessed_format;
+  if (config_path) {
+    config = LoadFitConfig(*config_path);
+  } else {
+    InspectReport report;
+    {
+      py::gil_scoped_release release;
+      report = InspectLog(path, nullptr);
+    }
+    if (!report.is_log()) {
+      throw UserError(report.error.empty() ? path + ": not a log bifilar recognises"
+                                           : report.error);
+    }
+    config.imu.format = report.format;
+    guessed_format = InspectReportToJson(report)["format"];
+  }
   ImuData data;
   SwingAxis axis;
   std::optional<std::array<double, 2>> window;
@@ -300,6 +320,9 @@ py::dict ReadLogCore(const std::string& path, const std::string& config_path) {
   out["window_s"] = window ? py::object(py::make_tuple((*window)[0], (*window)[1])) : py::none();
   out["warnings"] = data.warnings;
   out["notes"] = axis.notes;
+  // The format used: the guess (its "guesses" say what was guessed from what), or None when the
+  // config gave it.
+  out["format_guessed"] = guessed_format ? ToPython(*guessed_format) : py::object(py::none());
   return out;
 }
 
@@ -785,7 +808,7 @@ PYBIND11_MODULE(_core, m) {
       "fit_trace does (processing + JSON record), repeated in C++ (benchmark reference).");
   m.def("read_log", &ReadLogCore, py::arg("path"), py::arg("config"),
         "read_log(path, config) -> dict: the log in SI units and its swing rate, as `bifilar fit` "
-        "reads it with the YAML config.");
+        "reads it with the YAML config (None: the format `bifilar inspect` guesses).");
   m.def("fit_ellipse", &FitEllipseCore, py::arg("pitch_deg"), py::arg("inertia"),
         py::arg("std"), py::arg("bootstrap"), py::arg("seed"), py::arg("confidence"),
         py::arg("covariance"),

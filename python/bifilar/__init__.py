@@ -5,8 +5,9 @@ Functions
 fit_trace(t, rate, *, length_m, separation_m, mass_kg, ...)
     Fit one swing-rate series; the record of ``bifilar fit --json`` plus the fitted and
     residual series as numpy arrays.
-read_log(path, config)
-    Read an IMU log the way ``bifilar fit`` does: the time series a fit uses.
+read_log(path, config=None)
+    Read an IMU log the way ``bifilar fit`` does: the time series a fit uses. Without a
+    config, the format ``bifilar inspect`` guesses.
 fit_ellipse(pitch_deg, inertia, std=None)
     I_x, I_z, I_xz and tau with their uncertainties (``bifilar ellipse --json``); the
     per-point residuals as :class:`Columns` (numpy arrays; rows on demand).
@@ -20,13 +21,17 @@ simulate(...)
     Realistic logs with known truth (``bifilar simulate``), in memory or on disk.
 
 Units are SI throughout (s, rad/s, m, kg, kg m^2), pitch and amplitudes in degrees. Bad input
-raises ValueError with the command line's message. Results are :class:`Record` objects: dicts
+raises ValueError with the command line's message; a file given that does not exist raises
+FileNotFoundError (a subclass of ValueError too, so older ``except ValueError`` code still
+catches it). Results are :class:`Record` objects: dicts
 whose keys are also attributes (``r.inertia_total_kg_m2 == r["inertia_total_kg_m2"]``).
 Conventions and the equations: docs/physics.md.
 """
 
+import errno as _errno
 import math as _math
 import operator as _operator
+import os as _os
 
 from . import _core
 
@@ -65,6 +70,17 @@ class Record(dict):
     def __dir__(self):
         """The keys too, for tab completion in notebooks."""
         return list(self.keys()) + list(super().__dir__())
+
+    def __repr__(self):
+        """A summary, not the whole record: the headline numbers first (status, inertia and
+        its uncertainty, period, ...), then other short values until about 500 characters;
+        arrays as their shape, nested records and long lists as their size; the rest counted.
+        ``dict(r)`` (or ``r.keys()``) shows everything."""
+        return _summary(self)
+
+    def _repr_pretty_(self, printer, cycle):
+        """IPython/Jupyter show the same summary (not the dict pretty-printer's full dump)."""
+        printer.text("Record(...)" if cycle else _summary(self))
 
 
 class Columns:
@@ -118,6 +134,93 @@ class Columns:
 
     def __repr__(self):
         return "Columns(%d rows: %s)" % (self._length, ", ".join(self._columns))
+
+
+# Keys shown first in a Record's summary, when present (trace records, ellipse fits, campaigns).
+_HEADLINE = ("file", "status", "message", "warnings", "inertia_total_kg_m2",
+             "inertia_total_std_total_kg_m2", "inertia_total_std_kg_m2", "inertia_kg_m2",
+             "inertia_std_total_kg_m2", "inertia_std_kg_m2", "period_s", "frequency_hz",
+             "small_angle_inertia_kg_m2", "Ix_kg_m2", "Ix_kg_m2_std", "Iz_kg_m2", "Iz_kg_m2_std",
+             "Ixz_kg_m2", "Ixz_kg_m2_std", "tau_deg", "tau_deg_std", "window_s", "axis_source",
+             "summary")
+_SUMMARY_CHARS = 500  # about six lines of a terminal
+
+
+def _short(value):
+    """A value in a few characters: numbers to 6 digits, strings cut to 60 characters, arrays as
+    <array shape>, records and long or nested lists as their size."""
+    if isinstance(value, bool) or value is None:
+        return repr(value)
+    if isinstance(value, float):
+        return "%.6g" % value
+    if isinstance(value, int):
+        return repr(value)
+    if isinstance(value, str):  # long ones keep their end too (a path's file name)
+        return repr(value if len(value) <= 60 else value[:20] + "..." + value[-37:])
+    if _np is not None and isinstance(value, _np.ndarray):
+        return "<array %s>" % ("x".join(map(str, value.shape)) or "scalar")
+    if isinstance(value, dict):
+        return "{%d keys}" % len(value)
+    if isinstance(value, Columns):
+        return "<%d rows x %d columns>" % (len(value), len(value.keys()))
+    if isinstance(value, (list, tuple)):
+        simple = all(isinstance(v, (int, float, str, bool)) or v is None for v in value)
+        if simple and len(value) <= 4:
+            text = ", ".join(_short(v) for v in value)
+            return ("[%s]" if isinstance(value, list) else "(%s)") % text
+        return "[%d items]" % len(value)
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _summary(record):
+    """Record(key=value, ..., +N more keys: a, b, ...) within about _SUMMARY_CHARS."""
+    keys = [k for k in _HEADLINE if k in record]
+    keys += [k for k in record if k not in keys]
+    parts, length = [], 0
+    for key in keys:
+        part = "%s=%s" % (key, _short(record[key]))
+        if parts and length + len(part) > _SUMMARY_CHARS:
+            break
+        parts.append(part)
+        length += len(part) + 2
+    rest = keys[len(parts):]
+    if rest:
+        names = ", ".join(rest[:6]) + (", ..." if len(rest) > 6 else "")
+        parts.append("+%d more keys: %s" % (len(rest), names))
+    return "Record(%s)" % ", ".join(parts)
+
+
+class _FileNotFoundError(FileNotFoundError, ValueError):
+    """FileNotFoundError for a path given that does not exist; str() is the command line's
+    message. Also a ValueError, as bifilar raised before."""
+
+    def __init__(self, message, filename):
+        super().__init__(_errno.ENOENT, message, filename)
+        self.message = message
+
+    def __str__(self):
+        return self.message
+
+
+# Tracebacks say "bifilar.FileNotFoundError: <the command line's message>".
+_FileNotFoundError.__name__ = _FileNotFoundError.__qualname__ = "FileNotFoundError"
+
+
+def _calling(inputs, call, *args, **kwargs):
+    """call(*args, **kwargs); a ValueError raised while one of `inputs` (paths the call reads,
+    None skipped) does not exist becomes FileNotFoundError, with the command line's message
+    when it names that file."""
+    try:
+        return call(*args, **kwargs)
+    except ValueError as error:
+        for path in inputs:
+            if path is not None and not _os.path.exists(path):
+                message = str(error)
+                if path not in message:
+                    message = "%s: no such file" % path
+                raise _FileNotFoundError(message, path) from None
+        raise
 
 
 def _wrap(value):
@@ -242,8 +345,8 @@ def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None
         The fields of ``bifilar fit --json`` (``status``, ``message``, ``inertia_total_kg_m2``,
         ``inertia_total_std_kg_m2``, ``window_s``, ``budget``, ...; numbers that do not apply
         are None), plus numpy arrays of the fitted window: ``t_s``, ``measured_rad_per_s``,
-        ``fitted_rad_per_s`` (model rate + bias) and ``residual_rad_per_s`` (fitted -
-        measured); empty when no fit ran. A trace the data cannot support has status
+        ``fitted_rad_per_s`` (model rate + bias) and ``residual_rad_per_s`` (measured -
+        fitted, the sign of the figures' "meas. - fit" panel); empty when no fit ran. A trace the data cannot support has status
         ``'rejected'`` with the reason in ``message``.
 
     Raises
@@ -251,6 +354,8 @@ def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None
     ValueError
         t and rate of different lengths, not finite or t not increasing (naming the argument);
         bad settings; any trace the command line would report as ``error`` (its message).
+    FileNotFoundError
+        ``config`` does not exist.
     """
     settings = dict(length_m=length_m, separation_m=separation_m, mass_kg=mass_kg, g=g,
                     model=model, window=window, config=config,
@@ -269,25 +374,29 @@ def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None
         if settings[key] is not None:
             settings[key] = str(settings[key])
     settings["config"] = _path("fit_trace", "config", settings["config"])
-    record, t_s, measured, fitted, residual = _core.fit_trace(
-        _series(t, "t"), _series(rate, "rate"), **settings)
+    record, t_s, measured, fitted, residual = _calling(
+        [settings["config"]], _core.fit_trace, _series(t, "t"), _series(rate, "rate"), **settings)
     result = Record(record)
     result["t_s"] = t_s
     result["measured_rad_per_s"] = measured
     result["fitted_rad_per_s"] = fitted
-    result["residual_rad_per_s"] = residual
+    # measured - fitted, as the figures' "meas. - fit" axis (the core computes fitted - measured)
+    result["residual_rad_per_s"] = -residual
     return result
 
 
-def read_log(path, config):
+def read_log(path, config=None):
     """Read an IMU log as ``bifilar fit`` does: the time series its fit uses.
 
     Parameters
     ----------
     path : str
-        The log (CSV, optionally .gz), as given to ``bifilar fit``.
-    config : str
+        The log (CSV or ULog, optionally .gz), as given to ``bifilar fit``.
+    config : str, optional
         The YAML config naming the columns and units (``imu`` section, configs/README.md).
+        Without it, the format is guessed from the file as ``bifilar inspect`` guesses it
+        (column names and data; ULog topics), with the default swing-axis settings; the
+        guess is in ``format_guessed`` (its ``guesses`` say what was guessed from what).
 
     Returns
     -------
@@ -295,19 +404,24 @@ def read_log(path, config):
         ``t_s`` (N,), ``rate_rad_per_s`` (N,) the swing rate gyro . n, ``gyro_rad_per_s``
         (N, 3), ``accel_mps2`` (N, 3) or None, all in SI and IMU axes; ``axis_in_imu``,
         ``axis_in_body``, ``axis_source`` (the swing axis n and how it was found),
-        ``pitch_measured_deg`` and ``roll_measured_deg`` (from the accelerometer at rest, or None), ``window_s`` (the
-        config's window for this file, or None), ``warnings`` (repairs made while reading) and
-        ``notes``. ``fit_trace(r.t_s, r.rate_rad_per_s, config=config, name=path)`` then gives
-        the numbers of ``bifilar fit config path``.
+        ``pitch_measured_deg`` and ``roll_measured_deg`` (from the accelerometer at rest, or None),
+        ``window_s`` (the config's window for this file, or None), ``warnings`` (repairs made
+        while reading), ``notes`` and ``format_guessed`` (None when the config gave the format).
+        ``fit_trace(r.t_s, r.rate_rad_per_s, config=config, name=path)`` then gives the
+        numbers of ``bifilar fit config path``.
 
     Raises
     ------
+    FileNotFoundError
+        ``path`` or ``config`` does not exist.
     ValueError
         The file or config cannot be read or is malformed (the command line's message, naming
-        the file, line and column or key).
+        the file, line and column or key); without a config, a file that is not a log
+        bifilar recognises (what it looks like instead, as ``bifilar inspect`` says).
     """
-    return Record(_core.read_log(_path("read_log", "path", path),
-                                 _path("read_log", "config", config)))
+    path = _path("read_log", "path", path)
+    config = _path("read_log", "config", config)
+    return Record(_calling([config, path], _core.read_log, path, config))
 
 
 def fit_ellipse(pitch_deg, inertia, std=None, *, bootstrap=2000, seed=1, confidence=0.95,
@@ -473,6 +587,8 @@ def process(config_path, out=None, jobs=None, *, force=False, figures=True, prog
     ValueError
         Config or usage problems (the command line's exit code 2, with its message). Problems
         with single logs are records with status ``error``, not exceptions.
+    FileNotFoundError
+        ``config_path`` does not exist.
     KeyboardInterrupt
         Ctrl-C.
     """
@@ -481,10 +597,10 @@ def process(config_path, out=None, jobs=None, *, force=False, figures=True, prog
     if progress not in (None, False, True, "bar") and callback is None:
         raise ValueError("process: progress must be None, True, 'bar' or a callable "
                          "progress(done, total, line), got %r" % (progress,))
-    return Record(_core.process(_path("process", "config_path", config_path),
-                                _path("process", "out", out),
-                                _number("process", "jobs", jobs, int), bool(force), bool(figures),
-                                bar, callback))
+    config_path = _path("process", "config_path", config_path)
+    return Record(_calling([config_path], _core.process, config_path,
+                           _path("process", "out", out), _number("process", "jobs", jobs, int),
+                           bool(force), bool(figures), bar, callback))
 
 
 def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=None,
@@ -532,6 +648,8 @@ def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=No
     ------
     ValueError
         Missing or out-of-range parameters, bad spec (naming the key), both out and trace.
+    FileNotFoundError
+        ``spec`` does not exist.
     """
     settings = dict(spec=spec, out=out, trace=trace, truth=truth, seed=seed, model=model,
                     inertia_kg_m2=inertia_kg_m2, mass_kg=mass_kg, length_m=length_m,
@@ -546,4 +664,4 @@ def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=No
                 "pitch_deg", "duration_s", "sample_rate_hz"):
         settings[key] = _number("simulate", key, settings[key])
     settings["seed"] = None if seed is None else _seed("simulate", seed)
-    return Record(_core.simulate(**settings))
+    return Record(_calling([settings["spec"]], _core.simulate, **settings))

@@ -83,9 +83,9 @@ def test_series_are_the_fitted_window():
     inside = (series.t_s >= t0) & (series.t_s <= t1)
     np.testing.assert_array_equal(result.t_s, series.t_s[inside])
     np.testing.assert_array_equal(result.measured_rad_per_s, series.rate_rad_per_s[inside])
-    # residual = fitted - measured; its RMS is the record's.
+    # residual = measured - fitted (the figures' "meas. - fit"); its RMS is the record's.
     np.testing.assert_allclose(result.residual_rad_per_s,
-                               result.fitted_rad_per_s - result.measured_rad_per_s, atol=1e-15)
+                               result.measured_rad_per_s - result.fitted_rad_per_s, atol=1e-15)
     rms = np.sqrt(np.mean(result.residual_rad_per_s ** 2))
     assert rms == pytest.approx(result.residual_rms_rad_per_s, rel=1e-9)
 
