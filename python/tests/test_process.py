@@ -84,10 +84,17 @@ def test_progress_callback_sees_every_fit(small_campaign, tmp_path):
         bifilar.process(small_campaign, out=tmp_path / "out", progress="lines")
 
 
-def test_ctrl_c_raises_keyboard_interrupt_and_keeps_the_finished_fits(small_campaign, tmp_path):
+def test_ctrl_c_raises_keyboard_interrupt_and_keeps_the_finished_fits(tmp_path):
+    """SIGINT during process() on the whole sample campaign (57 logs, one worker): the run stops
+    long before its end however loaded the machine is (the signal lands within one 50 ms poll,
+    the remaining fits take seconds)."""
     import os
     import signal
 
+    from conftest import SAMPLE_CONFIG
+
+    if not SAMPLE_LOGS.exists():
+        pytest.skip("sample logs absent")
     out = tmp_path / "out"
 
     def interrupt_after_two(done, total, line):
@@ -95,11 +102,11 @@ def test_ctrl_c_raises_keyboard_interrupt_and_keeps_the_finished_fits(small_camp
             os.kill(os.getpid(), signal.SIGINT)  # what Ctrl-C sends
 
     with pytest.raises(KeyboardInterrupt):
-        bifilar.process(small_campaign, out=out, jobs=1, figures=False,
+        bifilar.process(SAMPLE_CONFIG, out=out, jobs=1, figures=False,
                         progress=interrupt_after_two)
     assert not (out / "results.json").exists()  # no partial result
     cached = list((out / "cache").glob("*.json"))
-    assert 2 <= len(cached) < len(PITCHES) + 1
+    assert 2 <= len(cached) < 57
     # The next run goes on from the cache.
-    results = bifilar.process(small_campaign, out=out, jobs=1, figures=False)
+    results = bifilar.process(SAMPLE_CONFIG, out=out, jobs=2, figures=False)
     assert results.summary["n_reused"] >= 2
