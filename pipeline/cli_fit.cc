@@ -32,7 +32,8 @@ std::string FigureStem(const std::string& log) {
   return stem.empty() ? "trace" : stem;
 }
 
-std::string HumanLine(const TraceRecord& r) {
+// The record's console line, inertias (I, K_D, C and the small-angle I) in the config's units.
+std::string HumanLine(const TraceRecord& r, DisplayUnits units) {
   char buffer[1024];
   // Messages name the file already; say it once at the start of the line.
   const std::string prefix = r.file + ": ";
@@ -44,15 +45,17 @@ std::string HumanLine(const TraceRecord& r) {
   if (r.status == TraceStatus::kError || !std::isfinite(r.inertia_total_kg_m2)) {
     return prefix + ToString(r.status) + ": " + message;
   }
+  const double scale = InertiaToDisplay(1.0, units);
+  const char* unit = InertiaUnitName(units);
   std::snprintf(buffer, sizeof(buffer),
                 "%s: %s  I = %s  K_D %.3g  C %.3g  "
                 "window [%.2f, %.2f] s  amplitude %.1f -> %.1f deg  rms/noise %.2f  %d it  %.0f ms",
                 r.file.c_str(), ToString(r.status),
-                StatAndTotal(r.inertia_total_kg_m2, r.inertia_total_std_kg_m2,
-                             r.inertia_total_std_total_kg_m2, "kg m^2")
+                StatAndTotal(scale * r.inertia_total_kg_m2, scale * r.inertia_total_std_kg_m2,
+                             scale * r.inertia_total_std_total_kg_m2, unit)
                     .c_str(),
-                r.drag_coeff_kg_m2,
-                r.viscous_coeff_kg_m2_per_s, r.window_s[0], r.window_s[1], r.amplitude_deg[0],
+                scale * r.drag_coeff_kg_m2,
+                scale * r.viscous_coeff_kg_m2_per_s, r.window_s[0], r.window_s[1], r.amplitude_deg[0],
                 r.amplitude_deg[1], r.residual_rms_rad_per_s / r.noise_rms_rad_per_s, r.iterations,
                 1e3 * r.fit_seconds);
   std::string line = buffer;
@@ -61,6 +64,13 @@ std::string HumanLine(const TraceRecord& r) {
     line += buffer;
   }
   if (!message.empty()) line += "  (" + message + ")";
+  // The measured period and the hand calculation beside the nonlinear fit.
+  if (std::isfinite(r.period_s)) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "\n    period %.4f s (%.4f Hz), small-angle I = m g D^2 T^2 / (16 pi^2 L) = %.5g %s",
+                  r.period_s, r.frequency_hz, scale * r.small_angle_inertia_total_kg_m2, unit);
+    line += buffer;
+  }
   // I against amplitude (the ideal model is flat), and every warning on its own line.
   if (!r.sweep.bands.empty()) {
     line += "\n    I(A): " + SweepSummary(r.sweep);
@@ -186,7 +196,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     for (const std::string& log : args->logs) {
       if (ProcessInterruptFlag().load()) {  // Ctrl-C: what was fitted, then exit 130
         if (args->json || args->repeats) {
-          for (const TraceRecord& r : records) std::cout << HumanLine(r) << std::endl;
+          for (const TraceRecord& r : records) std::cout << HumanLine(r, config.units) << std::endl;
         }
         std::cerr << "bifilar: interrupted: " << records.size() << " of " << args->logs.size()
                   << " logs fitted (above)\n";
@@ -203,7 +213,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       records.push_back(ProcessTrace(config, log, trace));
       if (!records.back().ok()) ++failed;
       // Without --repeats each line is printed as soon as its log is fitted.
-      if (!args->json && !args->repeats) std::cout << HumanLine(records.back()) << std::endl;
+      if (!args->json && !args->repeats) std::cout << HumanLine(records.back(), config.units) << std::endl;
     }
     std::vector<RepeatGroup> groups;
     if (args->repeats) {
@@ -220,7 +230,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       // Invalid UTF-8 (a log's bytes in a message) is replaced, never a json exception.
       std::cout << out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
     } else if (args->repeats) {
-      for (const TraceRecord& r : records) std::cout << HumanLine(r) << std::endl;
+      for (const TraceRecord& r : records) std::cout << HumanLine(r, config.units) << std::endl;
       for (const RepeatGroup& g : groups) std::cout << RepeatGroupLine(g) << std::endl;
     }
     // Once for the run: what the assumed +-1 mm on L and D adds (--json records carry it).
