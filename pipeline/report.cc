@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cctype>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -158,6 +159,120 @@ std::string SimplifySvgNumbers(const std::string& svg) {
   return out;
 }
 
+// A number as short as SVG allows at 0.1 px: "12.3", "-4", ".5".
+std::string ShortNumber(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.1f", value);
+  std::string text = buffer;
+  if (text == "-0.0") text = "0.0";
+  if (text.size() > 2 && text.compare(text.size() - 2, 2, ".0") == 0) text.resize(text.size() - 2);
+  if (text.rfind("0.", 0) == 0) text.erase(0, 1);
+  if (text.rfind("-0.", 0) == 0) text.erase(1, 1);
+  return text;
+}
+
+// A cairo polyline `<path ... d="M x y L x y ..." transform="matrix(1,0,0,-1,0,H)"/>` rewritten
+// with the flip applied and relative line-tos ("M x y l dx dy dx dy ..."), every point rounded
+// to 0.1 px first so the sums do not drift; other paths come back unchanged. About half the
+// bytes of a long line.
+std::string CompactPolyline(const std::string& tag) {
+  const size_t d_at = tag.find(" d=\"");
+  if (d_at == std::string::npos) return tag;
+  const size_t d_end = tag.find('"', d_at + 4);
+  if (d_end == std::string::npos) return tag;
+  double flip_height = NAN;
+  size_t tr_at = tag.find(" transform=\"matrix(1,0,0,-1,0,");
+  size_t tr_end = std::string::npos;
+  if (tr_at != std::string::npos) {
+    const size_t num = tr_at + std::string(" transform=\"matrix(1,0,0,-1,0,").size();
+    char* stop = nullptr;
+    flip_height = std::strtod(tag.c_str() + num, &stop);
+    if (stop == nullptr || std::string(stop, std::min<size_t>(2, std::strlen(stop))) != ")\"") return tag;
+    tr_end = static_cast<size_t>(stop - tag.c_str()) + 2;
+  } else if (tag.find(" transform=") != std::string::npos) {
+    return tag;
+  }
+  std::istringstream in(tag.substr(d_at + 4, d_end - d_at - 4));
+  std::string token, d;
+  long px = 0, py = 0;
+  bool first = true;
+  while (in >> token) {
+    if (token != (first ? "M" : "L")) return tag;  // curves, several sub-paths: leave as is
+    double x = NAN, y = NAN;
+    if (!(in >> x >> y) || !std::isfinite(x) || !std::isfinite(y)) return tag;
+    if (std::isfinite(flip_height)) y = flip_height - y;
+    const long qx = std::lround(10.0 * x), qy = std::lround(10.0 * y);
+    if (first) {
+      d = "M" + ShortNumber(qx / 10.0) + " " + ShortNumber(qy / 10.0) + "l";
+    } else {
+      const std::string dx = ShortNumber((qx - px) / 10.0), dy = ShortNumber((qy - py) / 10.0);
+      if (d.back() != 'l' && dx[0] != '-') d += ' ';
+      d += dx;
+      if (dy[0] != '-') d += ' ';
+      d += dy;
+    }
+    px = qx;
+    py = qy;
+    first = false;
+  }
+  if (first) return tag;
+  if (d.back() == 'l') d.pop_back();
+  std::string out = tag;
+  if (tr_end != std::string::npos) out.erase(tr_at, tr_end - tr_at);
+  return out.replace(d_at + 4, d_end - d_at - 4, d);
+}
+
+// Every <path .../> of `svg` through CompactPolyline.
+std::string CompactSvgPaths(const std::string& svg) {
+  std::string out;
+  out.reserve(svg.size());
+  size_t at = 0;
+  for (size_t start = svg.find("<path ", at); start != std::string::npos; start = svg.find("<path ", at)) {
+    const size_t end = svg.find('>', start);
+    if (end == std::string::npos) break;
+    out.append(svg, at, start - at);
+    out += CompactPolyline(svg.substr(start, end + 1 - start));
+    at = end + 1;
+  }
+  out.append(svg, at, std::string::npos);
+  return out;
+}
+
+// Every style="..." attribute of the page (cairo repeats the same few on each element) becomes
+// class="sN" with one CSS rule per distinct style; tags that have a class already keep theirs.
+std::string ShareStyles(const std::string& html) {
+  std::map<std::string, std::string> classes;
+  std::string out, css;
+  out.reserve(html.size());
+  const std::string attr = " style=\"";
+  size_t at = 0;
+  for (size_t hit = html.find(attr); hit != std::string::npos; hit = html.find(attr, at)) {
+    const size_t value = hit + attr.size(), value_end = html.find('"', value);
+    if (value_end == std::string::npos) break;
+    const size_t tag_start = html.rfind('<', hit), tag_end = html.find('>', hit);
+    const std::string tag = html.substr(tag_start, tag_end - tag_start);
+    if (tag_start == std::string::npos || tag.find(" class=\"") != std::string::npos) {
+      out.append(html, at, value_end + 1 - at);
+      at = value_end + 1;
+      continue;
+    }
+    const std::string style = html.substr(value, value_end - value);
+    auto it = classes.find(style);
+    if (it == classes.end()) {
+      it = classes.emplace(style, "s" + std::to_string(classes.size())).first;
+      css += "." + it->second + "{" + style + "}\n";
+    }
+    out.append(html, at, hit - at);
+    out += " class=\"" + it->second + "\"";
+    at = value_end + 1;
+  }
+  out.append(html, at, std::string::npos);
+  if (classes.empty()) return html;
+  const size_t head = out.find("</head>");
+  out.insert(head == std::string::npos ? 0 : head, "<style>\n" + css + "</style>\n");
+  return out;
+}
+
 // Every inline SVG of the page defines its own outline of each glyph (cairo writes text as
 // paths): the same digit and letter over a hundred times. This keeps one <symbol> per distinct
 // outline, in a hidden SVG at the end of the page, and points every figure's <use> at it (ids
@@ -232,7 +347,7 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
     const size_t start = bytes.find("<svg");
     if (start == std::string::npos) return "<p class=\"note\">(figure " + Escape(name) + " unreadable)</p>";
     const std::string prefix = "f" + std::to_string((*counter)++) + "-";
-    std::string svg = SimplifySvgNumbers(bytes.substr(start));
+    std::string svg = SimplifySvgNumbers(CompactSvgPaths(bytes.substr(start)));
     svg = ReplaceAll(svg, "id=\"", "id=\"" + prefix);
     svg = ReplaceAll(svg, "href=\"#", "href=\"#" + prefix);
     svg = ReplaceAll(svg, "url(#", "url(#" + prefix);
@@ -550,7 +665,7 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
   h << "<h2>Traces</h2>\n<table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"
        "<th class=\"l\">status</th><th>pitch (deg)</th><th>I total (" << u.name
-    << ")</th><th>std (stat)</th><th>std (total)</th><th>period (s)</th><th>I small-angle</th><th>I aircraft</th><th>std (stat)</th>"
+    << ")</th><th>std (stat)</th><th>std (total)</th><th>period (s)</th><th>I aircraft</th><th>std (stat)</th>"
        "<th>std (total)</th><th>window (s)</th>"
        "<th>amplitude (deg)</th><th>rms/noise</th></tr>\n";
   for (const auto& t : p.traces) {
@@ -572,7 +687,6 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
       << u.Inertia(Num(t, "inertia_total_std_kg_m2"), "%.2e") << "</td><td>"
       << u.Inertia(Num(t, "inertia_total_std_total_kg_m2"), "%.2e") << "</td><td>"
       << Fmt(Num(t, "period_s"), "%.4f") << "</td><td>"
-      << u.Inertia(Num(t, "small_angle_inertia_total_kg_m2"), "%.5f") << "</td><td>"
       << u.Inertia(Num(t, "inertia_kg_m2"), "%.5f") << "</td><td>"
       << u.Inertia(Num(t, "inertia_std_kg_m2"), "%.2e") << "</td><td>"
       << u.Inertia(Num(t, "inertia_std_total_kg_m2"), "%.2e") << "</td><td>" << window << "</td><td>"
@@ -597,7 +711,12 @@ std::string TraceCaptionFacts(const ReportPage& p, const json& t) {
 
 // The per-trace section: every trace's figures (fit and residual) with its caption.
 void WriteTraceFigures(ReportPage& p, std::ostream& h) {
-  h << "<h2>Fit and residual of every trace</h2>\n<div class=\"traces\">\n";
+  h << "<h2>Fit and residual of every trace</h2>\n<p>Left, each trace: the measured swing rate "
+       "(black) over the fit (light blue), and beneath them the residual (grey) with the "
+       "&plusmn;1&sigma; noise estimate (red). Its caption gives the measured period T "
+       "and the small-angle inertia m g D<sup>2</sup> T<sup>2</sup> / (16 &pi;<sup>2</sup> L) of "
+       "everything suspended, the hand check of the fitted I<sub>total</sub>. Right: I against "
+       "amplitude.</p>\n<div class=\"traces\">\n";
   for (const auto& t : p.traces) {
     const std::string fig = Str(t, "figure");
     if (fig.empty()) continue;
@@ -660,7 +779,7 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
   WriteTraceTable(page, h);
   WriteTraceFigures(page, h);
   WriteFooter(page, h);
-  return ShareSvgGlyphs(h.str());
+  return ShareSvgGlyphs(ShareStyles(h.str()));
 }
 
 void RunReport(const std::string& out_dir) {

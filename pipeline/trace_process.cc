@@ -175,11 +175,11 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
     pllab("", "deg/s", top_title.c_str());
     // The fit first (wide, light blue), the measured rate on top of it (thin, dark): where the
     // two agree the measured line shows inside the fit's band (issue 18).
-    plscol0(9, 120, 160, 225);
+    plscol0(9, 150, 185, 235);
     plcol0(9);
-    plwidth(3.5);
+    plwidth(4.0);
     plline(static_cast<PLINT>(tf.size()), tf.data(), yf.data());
-    plscol0(15, 60, 60, 60);
+    plscol0(15, 0, 0, 0);
     plcol0(15);
     plwidth(1.0);
     plline(static_cast<PLINT>(tm.size()), tm.data(), ym.data());
