@@ -84,6 +84,33 @@ struct Units {
   }
 };
 
+// A message or warning as the page shows it: under units: imperial every "<number> kg m^2" of
+// the text (the fit writes its messages in SI) becomes "<number> slug ft^2", so the page keeps one
+// unit system throughout.
+std::string InDisplayUnits(const Units& u, const std::string& text) {
+  if (!u.imperial) return text;
+  const std::string si = " kg m^2";
+  std::string out;
+  size_t at = 0;
+  for (size_t hit = text.find(si); hit != std::string::npos; hit = text.find(si, hit + 1)) {
+    size_t start = hit;
+    while (start > at && (std::isdigit(static_cast<unsigned char>(text[start - 1])) ||
+                          std::strchr(".eE+-", text[start - 1]) != nullptr)) {
+      --start;
+    }
+    char* stop = nullptr;
+    const double value = start < hit ? std::strtod(text.c_str() + start, &stop) : NAN;
+    if (stop != text.c_str() + hit || !std::isfinite(value)) continue;  // not "<number> kg m^2"
+    char buffer[64];
+    std::snprintf(buffer, sizeof(buffer), "%.3g slug ft^2", value * u.scale);
+    out.append(text, at, start - at);
+    out += buffer;
+    at = hit + si.size();
+  }
+  out.append(text, at, std::string::npos);
+  return out;
+}
+
 // An estimate of the ellipse JSON (pipeline/ellipse_json.h): KEY, KEY_std, KEY_ci95 [lo, hi];
 // null when undefined (tau, I_xp, I_zp when I_x ~ I_z).
 struct Estimate {
@@ -613,7 +640,7 @@ void WriteRejectedTraces(const ReportPage& p, std::ostream& h) {
     ++bad;
     rows << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
          << "</td><td class=\"l\">" << Escape(status) << "</td><td class=\"l\">"
-         << Escape(Str(t, "message")) << "</td></tr>\n";
+         << Escape(InDisplayUnits(p.u, Str(t, "message"))) << "</td></tr>\n";
   }
   if (bad == 0) {
     h << "<p class=\"ok\">None: every trace was fitted (warnings, if any, are listed below).</p>\n";
@@ -636,7 +663,7 @@ void WriteWarnings(const ReportPage& p, std::ostream& h) {
     ++warned;
     rows << "<tr class=\"warned\"><td class=\"l\">" << Escape(Str(t, "file")) << "</td><td class=\"l\">";
     for (size_t i = 0; i < warnings.size(); ++i) {
-      rows << (i ? "<br>" : "") << Escape(warnings[i]);
+      rows << (i ? "<br>" : "") << Escape(InDisplayUnits(p.u, warnings[i]));
     }
     rows << "</td></tr>\n";
   }
@@ -652,11 +679,11 @@ void WriteWarnings(const ReportPage& p, std::ostream& h) {
 
 // The traces table's status cell: "ok (warned)" links to the Warnings section and carries the
 // warnings' text as its tooltip.
-std::string StatusCell(const json& t) {
+std::string StatusCell(const Units& u, const json& t) {
   const std::string shown = DisplayStatus(t);
   if (shown != "ok (warned)") return Escape(shown);
   std::string tip;
-  for (const std::string& w : TraceWarnings(t)) tip += (tip.empty() ? "" : "\n") + w;
+  for (const std::string& w : TraceWarnings(t)) tip += (tip.empty() ? "" : "\n") + InDisplayUnits(u, w);
   return "<a href=\"#warnings\" title=\"" + Escape(tip) + "\">" + Escape(shown) + "</a>";
 }
 
@@ -682,7 +709,7 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
     const std::string row_class = DisplayStatus(t) == "ok (warned)" ? "warned" : status;
     h << "<tr class=\"" << Escape(row_class) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
       << "</td><td class=\"l\">" << Escape(Str(t, "role")) << "</td><td class=\"l\">"
-      << StatusCell(t) << "</td><td>" << Fmt(Num(t, "pitch_used_deg"), "%.2f") << "</td><td>"
+      << StatusCell(u, t) << "</td><td>" << Fmt(Num(t, "pitch_used_deg"), "%.2f") << "</td><td>"
       << u.Inertia(Num(t, "inertia_total_kg_m2"), "%.5f") << "</td><td>"
       << u.Inertia(Num(t, "inertia_total_std_kg_m2"), "%.2e") << "</td><td>"
       << u.Inertia(Num(t, "inertia_total_std_total_kg_m2"), "%.2e") << "</td><td>"
@@ -705,7 +732,9 @@ std::string TraceCaptionFacts(const ReportPage& p, const json& t) {
     out += " &middot; T = " + Fmt(period, "%.4f") + " s, small-angle I = " +
            p.u.Inertia(Num(t, "small_angle_inertia_total_kg_m2"), "%.5f") + " " + p.u.name;
   }
-  for (const std::string& w : TraceWarnings(t)) out += "<br><span class=\"bad\">warning: " + Escape(w) + "</span>";
+  for (const std::string& w : TraceWarnings(t)) {
+    out += "<br><span class=\"bad\">warning: " + Escape(InDisplayUnits(p.u, w)) + "</span>";
+  }
   return out;
 }
 
