@@ -9,7 +9,6 @@
 
 namespace bifilar {
 namespace ellipse {
-namespace {
 
 // Standard normal quantile (Acklam's rational approximation refined by one Halley step; the
 // refinement makes it accurate to ~1e-15).
@@ -58,6 +57,8 @@ double StudentQuantile(double p, double dof) {
   const double g4 = ((((79 * z2 + 776) * z2 + 1482) * z2 - 1920) * z2 - 945) * z / 92160;
   return z + g1 / n + g2 / (n * n) + g3 / (n * n * n) + g4 / (n * n * n * n);
 }
+
+namespace {
 
 // The two quantiles p_lo < p_hi of a stream of `count` values, interpolated linearly between the
 // order statistics around p (count - 1) as for a sorted list, keeping only the tails they need:

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <random>
 #include <sstream>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 namespace bifilar {
@@ -267,6 +269,9 @@ bool TraceSetup::Check(std::string* why) const {
   if (!std::isfinite(pitch_rad) || std::abs(pitch_rad) > kPi / 2 + 1e-9) {
     return Fail(why, "pitch = " + Num(pitch_rad / kDeg) + " deg is out of range; allowed [-90, 90]");
   }
+  if (!std::isfinite(roll_rad) || std::abs(roll_rad) > kPi + 1e-9) {
+    return Fail(why, "roll = " + Num(roll_rad / kDeg) + " deg is out of range; allowed [-180, 180]");
+  }
   if (!std::isfinite(amplitude_rad) || amplitude_rad == 0.0 || std::abs(amplitude_rad) >= 80 * kDeg) {
     return Fail(why, "amplitude = " + Num(amplitude_rad / kDeg) +
                          " deg is out of range; allowed 0 < |amplitude| < 80 deg");
@@ -482,11 +487,19 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
 
   // IMU synthesis.
   const double st = std::sin(setup.pitch_rad), ct = std::cos(setup.pitch_rad);
-  const Eigen::Vector3d n_body(-st, 0.0, ct);
-  const Eigen::Vector3d horizontal(ct, 0.0, st);  // in the x-z plane, perpendicular to n
+  Eigen::Vector3d n_body(-st, 0.0, ct);
+  Eigen::Vector3d horizontal(ct, 0.0, st);  // in the x-z plane, perpendicular to n
+  Eigen::Vector3d lateral = Eigen::Vector3d::UnitY();  // the other horizontal direction
+  if (setup.roll_rad != 0.0) {
+    // Rolled by phi: n = Rx(-phi) (-sin theta, 0, cos theta) = (-st, sf ct, cf ct), and the two
+    // horizontal directions turn with it (docs/physics.md §3.5).
+    const double sf = std::sin(setup.roll_rad), cf = std::cos(setup.roll_rad);
+    n_body = Eigen::Vector3d(-st, sf * ct, cf * ct);
+    horizontal = Eigen::Vector3d(ct, sf * st, cf * st);
+    lateral = Eigen::Vector3d(0.0, cf, -sf);
+  }
   const Eigen::Vector3d rock_axis =
-      (std::cos(rocking_beta) * Eigen::Vector3d::UnitY() + std::sin(rocking_beta) * horizontal)
-          .normalized();
+      (std::cos(rocking_beta) * lateral + std::sin(rocking_beta) * horizontal).normalized();
   const Eigen::Matrix3d imu_from_body = setup.body_from_imu.transpose();
   const Eigen::Vector3d& r = setup.imu_offset_in_body_m;
   const Eigen::Vector3d r_perp = r - n_body * n_body.dot(r);
@@ -509,7 +522,7 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
     truth.gravity_removal_error_rad = accel_rng.Uniform(so.gravity_removal_error_deg) * kDeg;
     const double beta = 2.0 * kPi * accel_rng.Uniform();
     const Eigen::Vector3d tilt_axis =
-        (std::cos(beta) * Eigen::Vector3d::UnitY() + std::sin(beta) * horizontal).normalized();
+        (std::cos(beta) * lateral + std::sin(beta) * horizontal).normalized();
     down_estimate_in_imu =
         imu_from_body * (Eigen::AngleAxisd(truth.gravity_removal_error_rad, tilt_axis) * n_body);
   }
@@ -627,6 +640,20 @@ double AircraftTruth::InertiaAtPitch(double pitch_rad) const {
   return iz_kg_m2 * c * c + ix_kg_m2 * s * s + ixz_kg_m2 * std::sin(2 * pitch_rad);
 }
 
+double AircraftTruth::InertiaAtAttitude(double roll_rad, double pitch_rad) const {
+  if (roll_rad == 0.0 && !HasTensor()) return InertiaAtPitch(pitch_rad);
+  const Eigen::Vector3d n(-std::sin(pitch_rad), std::sin(roll_rad) * std::cos(pitch_rad),
+                          std::cos(roll_rad) * std::cos(pitch_rad));
+  return n.dot(Tensor() * n);
+}
+
+Eigen::Matrix3d AircraftTruth::Tensor() const {
+  Eigen::Matrix3d j;
+  j << ix_kg_m2, -ixy_kg_m2, -ixz_kg_m2, -ixy_kg_m2, iy_kg_m2, -iyz_kg_m2, -ixz_kg_m2,
+      -iyz_kg_m2, iz_kg_m2;
+  return j;
+}
+
 double AircraftTruth::PrincipalInclinationRad() const {
   double tau = 0.5 * std::atan2(2 * ixz_kg_m2, iz_kg_m2 - ix_kg_m2);
   if (tau <= -kPi / 4) tau += kPi / 2;
@@ -640,6 +667,25 @@ bool AircraftTruth::Check(std::string* why) const {
       !CheckValue(iz_kg_m2, "aircraft I_z", 0.0, true, 1e9, why) ||
       !CheckValue(ixz_kg_m2, "aircraft I_xz", -1e9, false, 1e9, why)) {
     return false;
+  }
+  if (HasTensor()) {
+    if (!CheckValue(iy_kg_m2, "aircraft I_y", 0.0, true, 1e9, why) ||
+        !CheckValue(ixy_kg_m2, "aircraft I_xy", -1e9, false, 1e9, why) ||
+        !CheckValue(iyz_kg_m2, "aircraft I_yz", -1e9, false, 1e9, why)) {
+      return false;
+    }
+    const Eigen::Vector3d m = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Tensor()).eigenvalues();
+    if (!(m(0) > 0)) {
+      return Fail(why, "aircraft products of inertia are too large: the tensor is not positive "
+                       "definite (smallest principal moment " + Num(m(0)) + " kg m^2)");
+    }
+    if (!(m(2) <= m(0) + m(1))) {
+      return Fail(why, "aircraft tensor breaks the triangle inequality of principal moments (" +
+                           Num(m(2)) + " > " + Num(m(0)) + " + " + Num(m(1)) +
+                           "): no rigid body has it");
+    }
+  } else if (ixy_kg_m2 != 0.0 || iyz_kg_m2 != 0.0) {
+    return Fail(why, "aircraft I_xy or I_yz given without I_y (iy_kg_m2)");
   }
   // Smallest value of I(theta) = A - sqrt(B^2 + C^2) must be positive.
   const double a = 0.5 * (ix_kg_m2 + iz_kg_m2), b = 0.5 * (iz_kg_m2 - ix_kg_m2);
@@ -720,7 +766,36 @@ bool CampaignSpec::Check(std::string* why) const {
                            Num(tare_pitch_deg) + " deg (the reference swings' rig pitch)");
     }
   }
-  if (pitch_deg.empty() && tare_logs == 0) return Fail(why, "pitch_deg: no pitch angles and no tare logs");
+  if (!attitudes_deg.empty()) {
+    if (!pitch_deg.empty()) return Fail(why, "give either pitch_deg or attitudes_deg, not both");
+    if (!aircraft.HasTensor()) {
+      return Fail(why, "attitudes_deg (a campaign that rolls) needs the whole tensor: aircraft "
+                       "iy_kg_m2 (and ixy_kg_m2, iyz_kg_m2 when not 0)");
+    }
+    for (size_t i = 0; i < attitudes_deg.size(); ++i) {
+      const std::array<double, 2>& a = attitudes_deg[i];
+      if (!CheckValue(a[0], "attitudes_deg roll", -180.0, false, 180.0, why) ||
+          !CheckValue(a[1], "attitudes_deg pitch", -90.0, false, 90.0, why)) {
+        return false;
+      }
+      for (size_t j = 0; j < i; ++j) {
+        if (AttitudeFolder(attitudes_deg[j]) == AttitudeFolder(a)) {
+          return Fail(why, "attitudes_deg: roll " + Num(a[0]) + ", pitch " + Num(a[1]) +
+                               " appears twice");
+        }
+      }
+      double unused;
+      if (!rig.InertiaAtPitch(a[1], &unused)) {
+        return Fail(why, "rig.inertia_by_pitch_kg_m2 has no entry for pitch " + Num(a[1]) + " deg");
+      }
+    }
+    if (!CheckValue(roll_error_sigma_deg, "roll_error_sigma_deg", 0.0, false, 10.0, why)) {
+      return false;
+    }
+  }
+  if (pitch_deg.empty() && attitudes_deg.empty() && tare_logs == 0) {
+    return Fail(why, "pitch_deg: no pitch angles and no tare logs");
+  }
   for (size_t i = 0; i < pitch_deg.size(); ++i) {
     if (!CheckValue(pitch_deg[i], "pitch_deg", -90.0, false, 90.0, why)) return false;
     for (size_t j = 0; j < i; ++j) {
@@ -747,6 +822,10 @@ bool CampaignSpec::Check(std::string* why) const {
          CheckRange(drag_coeff_kg_m2, "drag_coeff_kg_m2", 0.0, false, why) &&
          CheckRange(viscous_coeff_kg_m2_per_s, "viscous_coeff_kg_m2_per_s", 0.0, false, why) &&
          CheckValue(tare_damping_scale, "rig.tare_damping_scale", 0.0, false, 1.0, why);
+}
+
+std::string AttitudeFolder(const std::array<double, 2>& roll_pitch_deg) {
+  return "roll_" + FormatPitchDeg(roll_pitch_deg[0]) + "_pitch_" + FormatPitchDeg(roll_pitch_deg[1]);
 }
 
 std::string FormatPitchDeg(double pitch_deg) {
@@ -780,7 +859,8 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
   if (!spec.Check(why) || !options.Check(why)) return false;
   out->clear();
   enum Kind { kAircraftLog, kTareLog, kReferenceLog };
-  auto make = [&](const std::string& path, Kind kind, int trial, double nominal_deg) -> bool {
+  auto make = [&](const std::string& path, Kind kind, int trial, double nominal_deg,
+                  std::optional<double> nominal_roll_deg = std::nullopt) -> bool {
     const bool tare = kind != kAircraftLog;  // rig without the aircraft
     CampaignTrace ct;
     ct.relative_path = path;
@@ -789,7 +869,23 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
     ct.trial = trial;
     ct.nominal_pitch_deg = nominal_deg;
     Rng rng(DeriveSeed(seed, path + "#setup"));
-    ct.true_pitch_deg = std::clamp(nominal_deg + rng.Normal(spec.pitch_error_sigma_deg), -90.0, 90.0);
+    if (!nominal_roll_deg) {
+      ct.true_pitch_deg =
+          std::clamp(nominal_deg + rng.Normal(spec.pitch_error_sigma_deg), -90.0, 90.0);
+    } else {
+      // An attitude campaign: the roll's error from a stream of its own; a pitch set beyond
+      // +-90 deg is the same attitude as 180 - pitch with the roll turned by 180 deg.
+      ct.nominal_roll_deg = *nominal_roll_deg;
+      double pitch = nominal_deg + rng.Normal(spec.pitch_error_sigma_deg);
+      Rng roll_rng(DeriveSeed(seed, path + "#roll"));
+      double roll = *nominal_roll_deg + roll_rng.Normal(spec.roll_error_sigma_deg);
+      if (std::abs(pitch) > 90.0) {
+        pitch = std::copysign(180.0, pitch) - pitch;
+        roll += 180.0;
+      }
+      ct.true_pitch_deg = pitch;
+      ct.true_roll_deg = std::remainder(roll, 360.0);
+    }
     const double amplitude_deg =
         rng.Uniform(kind == kReferenceLog && spec.calibration_amplitude_deg.max > 0.0
                         ? spec.calibration_amplitude_deg
@@ -799,7 +895,9 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
     const double drag = damping_scale * rng.Uniform(spec.drag_coeff_kg_m2);
     const double viscous = damping_scale * rng.Uniform(spec.viscous_coeff_kg_m2_per_s);
     spec.rig.InertiaAtPitch(nominal_deg, &ct.inertia_rig_kg_m2);
-    ct.inertia_aircraft_kg_m2 = tare ? 0.0 : spec.aircraft.InertiaAtPitch(ct.true_pitch_deg * kDeg);
+    ct.inertia_aircraft_kg_m2 =
+        tare ? 0.0
+             : spec.aircraft.InertiaAtAttitude(ct.true_roll_deg * kDeg, ct.true_pitch_deg * kDeg);
     ct.inertia_reference_kg_m2 = kind == kReferenceLog ? spec.reference_inertia_kg_m2 : 0.0;
     TraceSetup& s = ct.setup;
     s.geometry.filar_length_m = spec.TrueLengthM();
@@ -813,6 +911,7 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
     s.params.drag_coeff_kg_m2 = drag;
     s.params.viscous_coeff_kg_m2_per_s = viscous;
     s.pitch_rad = ct.true_pitch_deg * kDeg;
+    s.roll_rad = ct.true_roll_deg * kDeg;
     s.amplitude_rad = sign * amplitude_deg * kDeg;
     s.body_from_imu = spec.rig.body_from_imu;
     s.imu_offset_in_body_m = spec.rig.imu_offset_in_body_m;
@@ -827,6 +926,14 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
     for (int k = 1; k <= spec.trials_per_pitch; ++k) {
       if (!make("pitch_" + FormatPitchDeg(pitch) + "/trial_" + std::to_string(k) + ".csv",
                 kAircraftLog, k, pitch)) {
+        return false;
+      }
+    }
+  }
+  for (const std::array<double, 2>& attitude : spec.attitudes_deg) {
+    for (int k = 1; k <= spec.trials_per_pitch; ++k) {
+      if (!make(AttitudeFolder(attitude) + "/trial_" + std::to_string(k) + ".csv", kAircraftLog, k,
+                attitude[1], attitude[0])) {
         return false;
       }
     }

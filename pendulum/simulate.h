@@ -25,6 +25,7 @@
 // models: the timestamps for the steps, the swing for the softening, one channel for the others.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -164,6 +165,9 @@ struct TraceSetup {
   RigGeometry geometry;                  // L, D, whole suspended mass, g
   PendulumParams params;                 // I, K_D, C of the whole suspended body
   double pitch_rad = 0.0;                // TRUE pitch of the body axes (nose-up +)
+  // TRUE roll (right wing down +, rad), |roll| <= pi: the swing axis in body axes is then
+  // (-sin theta, sin phi cos theta, cos phi cos theta) (docs/physics.md §3.5). Default 0.
+  double roll_rad = 0.0;
   double amplitude_rad = 0.3;            // psi at release (sign = twist direction); 0 < |A| < 80 deg
   Eigen::Matrix3d body_from_imu = Eigen::Matrix3d::Identity();  // IMU mounting (rotation)
   Eigen::Vector3d imu_offset_in_body_m = Eigen::Vector3d::Zero();  // IMU position from the CG
@@ -224,6 +228,17 @@ struct AircraftTruth {
   double ix_kg_m2 = 0.0;      // I_x, body axes about the CG; > 0
   double iz_kg_m2 = 0.0;      // I_z; > 0
   double ixz_kg_m2 = 0.0;     // I_xz = integral x z dm (docs/physics.md §3)
+  // The rest of the tensor (docs/physics.md §3.5), for campaigns that roll: I_y > 0 turns it on
+  // (0: a pitch-only aircraft, as before); products positive, I_xy = integral x y dm.
+  double iy_kg_m2 = 0.0;
+  double ixy_kg_m2 = 0.0;
+  double iyz_kg_m2 = 0.0;
+  bool HasTensor() const { return iy_kg_m2 > 0.0; }
+  // [[Ix, -Ixy, -Ixz], [-Ixy, Iy, -Iyz], [-Ixz, -Iyz, Iz]].
+  Eigen::Matrix3d Tensor() const;
+  // n^T J n about n = (-sin theta, sin phi cos theta, cos phi cos theta); InertiaAtPitch when the
+  // roll is 0 and there is no tensor (bit for bit as before).
+  double InertiaAtAttitude(double roll_rad, double pitch_rad) const;
 
   // I(theta) = I_z cos^2 + I_x sin^2 + I_xz sin 2theta (docs/physics.md §3, paper Eq. 4).
   double InertiaAtPitch(double pitch_rad) const;
@@ -254,6 +269,10 @@ struct CampaignSpec {
   double filar_separation_m = 0.0;   // D; > 0
   double gravity_mps2 = 9.80665;     // > 0
   std::vector<double> pitch_deg;     // nominal pitch angles (deg), distinct, in [-90, 90]
+  // Attitudes (roll, pitch) in deg instead of pitch_deg (a tensor campaign): folders
+  // roll_{R}_pitch_{P}; roll in [-180, 180], pitch in [-90, 90]; needs aircraft.iy_kg_m2.
+  std::vector<std::array<double, 2>> attitudes_deg;
+  double roll_error_sigma_deg = 0.5;        // true roll = nominal + N(0, sigma), per log; >= 0
   int trials_per_pitch = 3;          // >= 1
   int tare_logs = 0;                 // logs of the rig alone; >= 0
   double tare_pitch_deg = 0.0;       // rig pitch for the tare logs (nominal)
@@ -296,6 +315,8 @@ struct CampaignTrace {
   int trial = 0;                // 1-based
   double nominal_pitch_deg = 0.0;
   double true_pitch_deg = 0.0;
+  double nominal_roll_deg = 0.0;   // attitude campaigns (0 otherwise)
+  double true_roll_deg = 0.0;
   double inertia_aircraft_kg_m2 = 0.0;  // 0 for tare logs
   double inertia_rig_kg_m2 = 0.0;
   TraceSetup setup;             // setup.params.inertia_kg_m2 = I_total, geometry.mass_kg = m
@@ -307,6 +328,9 @@ struct CampaignTrace {
 // derived from (seed, its relative path), so a log does not change when others are added.
 bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options, uint64_t seed,
                       std::vector<CampaignTrace>* out, std::string* why);
+
+// "roll_-45_pitch_30": the folder of an attitude (roll, pitch in deg) of a tensor campaign.
+std::string AttitudeFolder(const std::array<double, 2>& roll_pitch_deg);
 
 // "-80", "0", "10", "12.5": the folder name part of a nominal pitch.
 std::string FormatPitchDeg(double pitch_deg);

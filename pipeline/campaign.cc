@@ -15,9 +15,11 @@
 #include <utility>
 
 #include "fit/ellipse_plot.h"
+#include "fit/tensor.h"
 #include "pipeline/bounded_read.h"
 #include "pipeline/cache.h"
 #include "pipeline/campaign_inputs.h"
+#include "pipeline/campaign_tensor.h"
 #include "pipeline/ellipse_json.h"
 #include "pipeline/interrupt.h"
 #include "pipeline/output_set.h"
@@ -152,6 +154,7 @@ void KeepDiscoveryFields(const TraceRecord& planned, bool from_cache, TraceRecor
   r->file = planned.file;
   r->role = planned.role;
   r->pitch_nominal_deg = planned.pitch_nominal_deg;
+  r->roll_nominal_deg = planned.roll_nominal_deg;
   r->content_hash = planned.content_hash;
   r->cache_key = planned.cache_key;
   r->from_cache = from_cache;
@@ -181,6 +184,7 @@ FitPlan PlanFits(const CampaignConfig& config, const CampaignOptions& options,
     record.role = run.role;
     record.model = ToString(config.fit.model);
     record.pitch_nominal_deg = run.pitch_nominal_deg;
+    record.roll_nominal_deg = run.roll_nominal_deg;
     record.content_hash = in.hashes[i];
     if (!run.error.empty() || !in.read_errors[i].empty()) {
       record.status = TraceStatus::kError;
@@ -205,7 +209,8 @@ FitPlan PlanFits(const CampaignConfig& config, const CampaignOptions& options,
     std::error_code ec;
     // Reused only with its figures: a record with a sweep and no sweep figure (an older run's)
     // is refitted, so the report shows I against amplitude for every trace that has a sweep.
-    if (loaded &&
+    // Likewise a measured pitch without its roll (written before the roll was recorded).
+    if (loaded && (!cached.pitch_measured_deg || cached.roll_measured_deg) &&
         (!options.figures ||
          ((cached.figure.empty() || fs::exists(out.figures() / cached.figure, ec)) &&
           (cached.sweep_figure.empty() ? !cached.sweep.evaluated
@@ -410,6 +415,30 @@ void SetRigInertia(const CampaignConfig& config, const TareEstimate& tare, Campa
   }
 }
 
+// The measured down vector against the nominal one (docs/physics.md §3.5): farther apart than
+// runs.attitude_tolerance_deg is a warning naming the log (a wrong folder, a rig set wrongly, or
+// an IMU mounting that imu.imu_to_body does not describe).
+void WarnIfAttitudesDisagree(const CampaignConfig& config, TraceRecord* r) {
+  if (!r->pitch_measured_deg || !r->pitch_nominal_deg) return;
+  const std::array<double, 3> nominal =
+      DownInBodyFromAttitude(r->roll_nominal_deg.value_or(0.0), *r->pitch_nominal_deg);
+  const std::array<double, 3> measured =
+      DownInBodyFromAttitude(r->roll_measured_deg.value_or(0.0), *r->pitch_measured_deg);
+  double dot = 0.0;
+  for (int k = 0; k < 3; ++k) dot += nominal[k] * measured[k];
+  const double angle_deg = std::acos(std::clamp(dot, -1.0, 1.0)) * 180.0 / M_PI;
+  if (angle_deg <= config.runs.attitude_tolerance_deg) return;
+  char buffer[320];
+  std::snprintf(buffer, sizeof(buffer),
+                ": the measured down vector (roll %.1f, pitch %.1f deg) is %.1f deg from the "
+                "nominal one (roll %.1f, pitch %.1f deg), more than runs.attitude_tolerance_deg "
+                "%.3g: check the log's attitude, the rig and imu.imu_to_body",
+                r->roll_measured_deg.value_or(0.0), *r->pitch_measured_deg, angle_deg,
+                r->roll_nominal_deg.value_or(0.0), *r->pitch_nominal_deg,
+                config.runs.attitude_tolerance_deg);
+  r->warnings.push_back(r->file + buffer);
+}
+
 // Every ok aircraft trace: the pitch used (nominal or measured), then I_aircraft = I_total - I_rig
 // with the stds in quadrature. A trace whose pitch or rig inertia is unknown, or whose total is
 // not above the rig, becomes an error row.
@@ -430,9 +459,12 @@ void SubtractRig(const CampaignConfig& config, const TareEstimate& tare,
         continue;
       }
       r.pitch_used_deg = *r.pitch_measured_deg;
+      r.roll_used_deg = r.roll_measured_deg.value_or(0.0);
     } else {
       r.pitch_used_deg = r.pitch_nominal_deg ? *r.pitch_nominal_deg : NAN;
+      r.roll_used_deg = r.roll_nominal_deg.value_or(0.0);
     }
+    WarnIfAttitudesDisagree(config, &r);
     double rig = 0.0, rig_std = 0.0;
     std::string reason;
     if (!RigInertiaAt(config, tare.mean_kg_m2, tare.std_kg_m2, r.pitch_used_deg, &rig, &rig_std,
@@ -473,29 +505,34 @@ void CountStatuses(const std::vector<TraceRecord>& traces, CampaignSummary* summ
   }
 }
 
-// Per-angle statistics of the ok aircraft traces, sorted by pitch. Groups: the nominal pitch
-// when known, else the measured pitch to 0.5 deg.
+// Per-angle statistics of the ok aircraft traces, sorted by roll then pitch (roll 0 when the
+// campaign has no rolls). Groups: the nominal attitude when known, else the measured one to
+// 0.5 deg.
 std::vector<AngleStats> GroupByAngle(const std::vector<TraceRecord>& traces) {
-  std::map<double, std::vector<const TraceRecord*>> groups;
+  std::map<std::pair<double, double>, std::vector<const TraceRecord*>> groups;
   for (const TraceRecord& r : traces) {
     if (r.role != TraceRole::kAircraft || !r.ok()) continue;
-    const double key =
+    const double pitch =
         r.pitch_nominal_deg ? *r.pitch_nominal_deg : std::round(r.pitch_used_deg * 2.0) / 2.0;
-    groups[key].push_back(&r);
+    const double roll = r.pitch_nominal_deg ? r.roll_nominal_deg.value_or(0.0)
+                                            : std::round(r.roll_used_deg * 2.0) / 2.0;
+    groups[{roll, pitch}].push_back(&r);
   }
   std::vector<AngleStats> angles;
   for (const auto& [key, members] : groups) {
     AngleStats a;
-    std::vector<double> values, pitches, fit_stds, common_mode;
+    std::vector<double> values, pitches, rolls, fit_stds, common_mode;
     for (const TraceRecord* r : members) {
       values.push_back(r->inertia_kg_m2);
       pitches.push_back(r->pitch_used_deg);
+      rolls.push_back(r->roll_used_deg);
       fit_stds.push_back(r->inertia_std_kg_m2);
       // The trace's common-mode terms (rig inertia, configured inputs, calibration).
       const double total = r->inertia_std_total_kg_m2, stat = r->inertia_total_std_kg_m2;
       common_mode.push_back(std::sqrt(std::max(0.0, total * total - stat * stat)));
     }
     a.pitch_deg = Mean(pitches);
+    a.roll_deg = Mean(rolls);
     a.n = static_cast<int>(values.size());
     a.inertia_mean_kg_m2 = Mean(values);
     a.inertia_std_kg_m2 = SampleStd(values);
@@ -615,6 +652,13 @@ void FitCampaignEllipse(const CampaignConfig& config, const CampaignOptions& opt
   result->raw_sigma_kg_m2 = Mean(stds);
   result->cv_percent = Mean(cvs);
   CampaignSummary& summary = result->summary;
+  if (!IsPlanarCampaign(result->traces)) {
+    summary.ellipse_fitted = false;
+    summary.ellipse_message =
+        "ellipse not fitted: the campaign swings about axes outside the x-z plane (roll_deg); "
+        "see the inertia tensor";
+    return;
+  }
   if (static_cast<int>(result->angles.size()) < config.ellipse.min_angles) {
     summary.ellipse_fitted = false;
     summary.ellipse_message = "ellipse not fitted: " + std::to_string(result->angles.size()) +
@@ -667,6 +711,7 @@ void WriteCampaignOutputs(const CampaignConfig& config, const CampaignOptions& o
   }
   if (!result.moments_figure.empty()) keep.insert("figures/" + result.moments_figure);
   if (!result.polar_figure.empty()) keep.insert("figures/" + result.polar_figure);
+  if (!result.tensor_figure.empty()) keep.insert("figures/" + result.tensor_figure);
   for (const std::string& refused : out->manifest.Prune(keep)) {
     if (options.progress) *options.progress << "warning: " << refused << "\n";
   }
@@ -768,9 +813,13 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   result.common_mode_relative_std =
       CommonModeRelativeStd(result.traces, &result.common_mode_assumed);
   result.assumed_inputs_note = AssumedInputsSummary(result.traces);
-  // 5. Ellipse of inertia, Table 1, Fig. 3/4.
+  // 5. Ellipse of inertia, Table 1, Fig. 3/4; the inertia tensor (pipeline/campaign_tensor.h).
   FitCampaignEllipse(config, options, &out, &result);
-  if (result.summary.n_rejected + result.summary.n_error > 0 || !result.summary.ellipse_fitted ||
+  FitCampaignTensor(config, options.figures ? out.figures().string() : "",
+                    [&out](const std::string& name) { out.manifest.Record({"figures/" + name}); },
+                    &result);
+  if (result.summary.n_rejected + result.summary.n_error > 0 ||
+      (!result.summary.ellipse_fitted && !result.summary.tensor_fitted) ||
       (result.ellipse_fit && !result.ellipse_fit->physical)) {
     result.summary.exit_code = 1;
   }

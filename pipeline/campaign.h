@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fit/ellipse.h"
+#include "fit/tensor.h"
 #include "pipeline/calibration.h"
 #include "pipeline/config.h"
 #include "pipeline/run_discovery.h"  // RunFile, DiscoverRuns
@@ -28,6 +29,7 @@ namespace bifilar {
 // Per-angle statistics of the usable (ok) traces of one pitch group.
 struct AngleStats {
   double pitch_deg = NAN;          // group pitch: the nominal pitch, or mean measured pitch
+  double roll_deg = NAN;           // group roll, likewise (0 in a campaign without rolls)
   int n = 0;                       // ok traces
   double inertia_mean_kg_m2 = NAN; // mean aircraft inertia
   double inertia_std_kg_m2 = NAN;  // sample standard deviation between trials (n >= 2), else NaN
@@ -49,6 +51,8 @@ struct CampaignSummary {
   double wall_s = 0.0;             // whole run
   bool ellipse_fitted = false;
   std::string ellipse_message;     // why not fitted, if so
+  bool tensor_fitted = false;      // the inertia tensor (or the components it can observe)
+  std::string tensor_message;      // why not fitted, if so
   int exit_code = 0;               // 0 all well, 1 some traces failed or rejected (or no ellipse)
 };
 
@@ -68,6 +72,12 @@ struct CampaignResult {
   nlohmann::json ellipse;           // pipeline/ellipse_json.h document, null when not fitted
   std::string moments_figure;       // Fig. 3 file name in OUT/figures/, "" when none
   std::string polar_figure;         // Fig. 4 file name in OUT/figures/, "" when none
+  // The inertia tensor (pipeline/campaign_tensor.h): the `tensor` section of results.json
+  // (null when nothing was fitted), its fit when it ran as a tensor fit, and the principal-axes
+  // figure ("" when none).
+  nlohmann::json tensor;
+  std::optional<TensorResult> tensor_fit;
+  std::string tensor_figure;
   // Systematic relative uncertainty from the configured uncertainties (L, D, masses, g, gyro
   // scale; with rig.calibration: masses, gyro scale and the calibration): the mean over ok
   // aircraft traces of budget total / inertia total. It scales every moment alike, so it is not

@@ -4,6 +4,7 @@
 
 #include "pipeline/campaign.h"
 #include "pipeline/total_uncertainty.h"
+#include "pipeline/campaign_tensor.h"
 
 namespace bifilar {
 
@@ -59,8 +60,14 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
                   inertia(result.raw_sigma_kg_m2), unit, result.cv_percent,
                   inertia(result.regression_rmse_kg_m2), unit);
     out << line;
-  } else {
+  } else if (IsPlanarCampaign(result.traces)) {
     out << s.ellipse_message << "\n";
+  }
+  // The inertia tensor when it was fitted as one (rolls, or too few pitch angles for the ellipse).
+  if (result.tensor_fit) {
+    PrintTensorSummary(config, result, out);
+  } else if (!IsPlanarCampaign(result.traces)) {
+    out << s.tensor_message << "\n";
   }
   if (std::isfinite(result.rig_inertia_kg_m2)) {
     std::snprintf(line, sizeof(line), "Rig inertia %#.5g +- %.2g %s",

@@ -82,6 +82,7 @@ int RunCommandLine(int argc, char** argv) {
   RegisterEllipseCommands(app, &exit_code);
   RegisterSimulateCommand(app, &exit_code);
   RegisterInspectCommands(app, &exit_code);
+  RegisterExportCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -4,10 +4,12 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "pipeline/ellipse_table.h"  // InertiaUnits
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -25,5 +27,15 @@ void RegisterFitCommand(CLI::App& app, int* exit_code);
 void RegisterEllipseCommands(CLI::App& app, int* exit_code);  // `ellipse` and `plan`
 void RegisterProcessCommands(CLI::App& app, int* exit_code);  // `process` and `report`
 void RegisterInspectCommands(CLI::App& app, int* exit_code);  // `inspect` and `init`
+void RegisterExportCommand(CLI::App& app, int* exit_code);    // `export`
+
+// `plan --tensor` (pipeline/cli_plan_tensor.cc): its options on the `plan` subcommand, whether
+// it was asked for (throws UserError when a tensor-only option comes without --tensor), and the
+// run, given the options it shares with the pitch-plane plan.
+struct TensorPlanCli;
+std::shared_ptr<TensorPlanCli> AddTensorPlanOptions(CLI::App* plan);
+bool TensorPlanRequested(const TensorPlanCli& tensor_plan);
+int RunTensorPlanFromCli(const TensorPlanCli& tensor_plan, const CLI::App& plan, int trials,
+                         double sigma, double ixz, bool ixz_given, InertiaUnits units, bool json);
 
 }  // namespace bifilar

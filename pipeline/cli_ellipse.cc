@@ -107,7 +107,7 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
   auto* plan = app.add_subcommand(
       "plan",
       "Predict the standard errors of I_xz and tau for a proposed set of pitch angles, before "
-      "building a rig");
+      "building a rig; with --tensor, choose the attitudes for the full inertia tensor");
   auto plan_opts = std::make_shared<PlanCommandOptions>();
   auto angles = std::make_shared<std::string>();
   auto plan_units = std::make_shared<std::string>("si");
@@ -115,12 +115,13 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
        ixz = std::make_shared<double>(0.0);
   plan->add_option("--angles", *angles,
                    "pitch angles in deg: a list and/or ranges first:last:step, e.g. "
-                   "--angles=-80:90:10 (use '=' when the list starts with '-')")
-      ->required();
+                   "--angles=-80:90:10 (use '=' when the list starts with '-'); required "
+                   "without --tensor");
   plan->add_option("--trials", plan_opts->trials_per_angle, "trials per angle (default 3)")
       ->check(CLI::Range(1, 1000000));
-  plan->add_option("--sigma", plan_opts->sigma, "per-trial standard deviation of a moment, in --units")
-      ->required()
+  plan->add_option("--sigma", plan_opts->sigma,
+                   "per-trial standard deviation of a moment, in --units (required without "
+                   "--tensor)")
       ->check(FiniteNumber());
   plan->add_option("--ix", *ix, "guess of I_x in --units (default: the paper's PRANDTL-D)")
       ->check(FiniteNumber());
@@ -131,8 +132,18 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
           ->check(FiniteNumber());
   plan->add_option("--units", *plan_units, "si (kg m^2, default) or imperial (slug ft^2)");
   plan->add_flag("--json", plan_opts->json, "print JSON (SI)");
-  plan->callback([plan_opts, angles, plan_units, ix, iz, ixz, ixz_option, exit_code] {
+  auto tensor_plan = AddTensorPlanOptions(plan);  // `plan --tensor`: pipeline/cli_plan_tensor.cc
+  plan->callback([plan, plan_opts, angles, plan_units, ix, iz, ixz, ixz_option, tensor_plan,
+                  exit_code] {
     plan_opts->units = Units(*plan_units);
+    if (TensorPlanRequested(*tensor_plan)) {
+      *exit_code = RunTensorPlanFromCli(*tensor_plan, *plan, plan_opts->trials_per_angle,
+                                        plan_opts->sigma, *ixz, ixz_option->count() > 0,
+                                        plan_opts->units, plan_opts->json);
+      return;
+    }
+    if (angles->empty()) throw UserError("plan: --angles is required (or --tensor)");
+    if (plan->count("--sigma") == 0) throw UserError("plan: --sigma is required");
     plan_opts->pitch_deg = ParseAngleList(*angles);
     if (std::isnan(*ix) != std::isnan(*iz)) {
       throw UserError("plan: give both --ix and --iz, or neither (the paper's aircraft)");

@@ -19,6 +19,7 @@ void RegisterProcessCommands(CLI::App& app, int* exit_code) {
     int jobs = 0;
     bool force = false;
     std::string integrator;
+    std::string runs_root;
     std::string report_dir;
   };
   auto args = std::make_shared<Args>();
@@ -35,8 +36,12 @@ void RegisterProcessCommands(CLI::App& app, int* exit_code) {
   process->add_option("--integrator", args->integrator,
                       "ODE solver of the fits: rk853 or cvodes; overrides fit.integrator")
       ->check(CLI::IsMember({"rk853", "cvodes"}));
+  process->add_option("--runs-root", args->runs_root,
+                      "folder of the aircraft logs, instead of the config's runs.root");
   process->callback([args, exit_code] {
-    CampaignConfig config = LoadCampaignConfig(args->config);
+    ConfigLoadOptions load;
+    load.runs_root = args->runs_root;
+    CampaignConfig config = LoadCampaignConfig(args->config, load);
     if (!args->integrator.empty()) ParseIntegratorMethod(args->integrator, &config.fit.integrator);
     CampaignOptions options;
     options.out_dir = args->out.empty()

@@ -643,8 +643,11 @@ void ReadRig(YamlMap& root, const std::string& path, const ConfigLoadOptions& op
   if (rig.Has("inertia")) {
     ReadRigInertia(Sub(rig, "inertia"), config->folder, &config->rig_inertia);
     CheckRigInertiaPlausible(Sub(rig, "inertia"), *config);
-  } else if (options.require_runs) {
-    throw UserError(path + ": missing required key 'rig.inertia'");
+  } else if (options.require_runs && root.Has("aircraft")) {
+    throw UserError(path + ": missing required key 'rig.inertia' (or leave out 'aircraft' too: "
+                    "then rig.mass_kg is everything that hangs and no rig inertia is subtracted)");
+  } else {
+    config->rig_inertia_given = false;  // nothing subtracted: the moments of all that hangs
   }
   if (rig.Has("calibration")) {
     if (!rig.Has("inertia")) {
@@ -675,8 +678,9 @@ void ReadAircraftAndGravity(YamlMap& root, const std::string& path,
                                              0.0, kMaxMassKg);
     if (!why.empty()) throw UserError(aircraft.Where(aircraft.Optional("mass_kg")) + ": " + why);
     config->aircraft_mass_std_kg = NonNegative(aircraft, "mass_std_kg", 0.0);
-  } else if (options.require_runs) {
-    throw UserError(path + ": missing required key 'aircraft'");
+  } else if (options.require_runs && config->rig_inertia_given) {
+    throw UserError(path + ": missing required key 'aircraft' (or leave out 'rig.inertia' too: "
+                    "then rig.mass_kg is everything that hangs and no rig inertia is subtracted)");
   }
   aircraft.Finish();
   // g is bounded to what is found on Earth (a typo such as 98.0665 would scale every moment);
@@ -702,7 +706,12 @@ void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& o
   }
   YamlMap runs = Sub(root, "runs");
   RunsConfig& r = config->runs;
-  r.root = ResolvePath(config->folder, runs.RequiredString("root"));
+  if (!options.runs_root.empty()) {
+    runs.Optional("root");  // read (not an unknown key), replaced by --runs-root
+    r.root = fs::absolute(options.runs_root).lexically_normal().string();
+  } else {
+    r.root = ResolvePath(config->folder, runs.RequiredString("root"));
+  }
   const bool has_pattern = runs.Has("pattern"), has_table = runs.Has("table");
   if (has_pattern == has_table) {
     throw UserError(runs.Where(root.Optional("runs")) +
@@ -714,10 +723,12 @@ void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& o
       throw UserError(runs.Where(runs.Optional("pattern")) +
                       ": 'runs.pattern' must be relative to runs.root");
     }
-    const size_t first = r.pattern.find("{pitch_deg}");
-    if (first != std::string::npos && r.pattern.find("{pitch_deg}", first + 1) != std::string::npos) {
-      throw UserError(runs.Where(runs.Optional("pattern")) +
-                      ": 'runs.pattern' may hold {pitch_deg} only once, not in two components");
+    for (const char* placeholder : {"{pitch_deg}", "{roll_deg}"}) {
+      const size_t first = r.pattern.find(placeholder);
+      if (first != std::string::npos && r.pattern.find(placeholder, first + 1) != std::string::npos) {
+        throw UserError(runs.Where(runs.Optional("pattern")) + ": 'runs.pattern' may hold " +
+                        placeholder + " only once, not in two components");
+      }
     }
     for (const auto& part : fs::path(r.pattern)) {
       if (part == "..") {
@@ -737,6 +748,14 @@ void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& o
   } else {
     throw UserError(runs.Where(runs.Optional("pitch_source")) +
                     ": 'runs.pitch_source' must be nominal or measured, not '" + source + "'");
+  }
+  const YAML::Node tolerance = runs.Optional("attitude_tolerance_deg");
+  if (tolerance.IsDefined() && !tolerance.IsNull()) {
+    r.attitude_tolerance_deg = runs.AsDouble(tolerance, "attitude_tolerance_deg");
+    if (!(r.attitude_tolerance_deg > 0.0 && r.attitude_tolerance_deg <= 180.0)) {
+      throw UserError(runs.Where(tolerance) +
+                      ": 'runs.attitude_tolerance_deg' must be in (0, 180] deg");
+    }
   }
   if (r.pitch_source == PitchSource::kMeasured && !config->imu.format.has_accel()) {
     throw UserError(path + ": 'runs.pitch_source: measured' needs accelerometer columns (imu.accel)");

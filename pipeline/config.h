@@ -102,6 +102,9 @@ struct RunsConfig {
   std::string pattern;
   std::string table;     // absolute path of a CSV table "path,pitch_deg" (paths relative to root)
   PitchSource pitch_source = PitchSource::kNominal;
+  // A log whose measured down vector lies farther than this from its nominal one (pitch and
+  // roll of the path or table) gets a warning naming it (deg); (0, 180]. Default 3.
+  double attitude_tolerance_deg = 3.0;
 };
 
 // Quality thresholds of the trace fit (fit/trace_fit.h TraceFitOptions, same names and
@@ -207,6 +210,9 @@ struct CampaignConfig {
   // are fitted, never read from the file). Applied: the geometries below use D_eff, and the
   // L, D and g terms of the budget are replaced by one `calibration` term.
   GeometryCalibration geometry_calibration;
+  // false when `process` runs without `rig.inertia` and `aircraft` (a rig of thread only, like
+  // the Crazyflie's): rig.mass_kg is everything that hangs and the rig inertia is 0.
+  bool rig_inertia_given = true;
   RigUncertainties uncertainties;
   double aircraft_mass_kg = 0.0;      // aircraft mass (kg); 0 when only tare logs are fitted
   double aircraft_mass_std_kg = 0.0;  // its standard uncertainty (kg)
@@ -241,6 +247,9 @@ bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why);
 
 struct ConfigLoadOptions {
   bool require_runs = true;      // `process` needs runs/aircraft; `fit` only geometry + IMU
+  // `process --runs-root DIR`: the folder of the aircraft logs, replacing runs.root (which may
+  // then be absent). Empty: runs.root as written.
+  std::string runs_root;
 };
 
 // Reads and validates `path`. Throws UserError naming the file, line and key on any problem.

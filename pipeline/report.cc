@@ -562,6 +562,97 @@ void WriteCalibration(const ReportPage& p, std::ostream& h) {
   }
 }
 
+// The inertia tensor of a campaign that rolls (or has too few pitch angles for the ellipse):
+// the six components with std and interval (unobservable ones named), the principal moments,
+// axes and Euler angles, the principal-axes figure, the per-orientation residuals. Nothing for a
+// planar campaign (its tensor section repeats Table 2).
+void WriteTensorSection(ReportPage& p, std::ostream& h) {
+  const Units& u = p.u;
+  const json tensor = p.Part("tensor", json(nullptr));
+  if (!tensor.is_object() || Str(tensor, "mode") == "planar_xz") return;
+  h << "<h2>Inertia tensor</h2>\n<p>" << tensor.value("n_points", 0) << " moments about "
+    << tensor.value("n_orientations", 0) << " axes; design rank " << tensor.value("rank", 0)
+    << " of 6, condition number " << Fmt(Num(tensor, "condition_number"), "%.3g")
+    << "; covariance " << Escape(Str(tensor, "covariance"));
+  const double scatter = Num(tensor, "attitude_scatter_deg");
+  if (scatter > 0) h << "; attitude scatter " << Fmt(scatter, "%.2f") << " deg";
+  h << ". Products are positive (I<sub>xy</sub> = &int; x y dm); the tensor holds their negatives "
+       "(docs/physics.md &sect;3.5).</p>\n";
+  h << "<table><tr><th class=\"l\">component</th><th>value</th><th>std</th><th>interval</th>"
+       "<th class=\"l\">unit</th></tr>\n";
+  for (const char* name : {"Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"}) {
+    const Estimate e = GetEstimate(tensor, std::string(name) + "_kg_m2");
+    h << "<tr><td class=\"l\">I<sub>" << (name + 1) << "</sub></td>";
+    if (!e.defined) {
+      h << "<td colspan=\"3\">not observable from these swing axes</td>";
+    } else {
+      h << "<td>" << u.Inertia(e.value, "%.5g") << "</td><td>" << u.Inertia(e.std, "%.2g")
+        << "</td><td>[" << u.Inertia(e.lo, "%.5g") << ", " << u.Inertia(e.hi, "%.5g") << "]</td>";
+    }
+    h << "<td class=\"l\">" << u.name << "</td></tr>\n";
+  }
+  h << "</table>\n";
+  const json moments = tensor.value("principal_moments_kg_m2", json(nullptr));
+  if (moments.is_array() && moments.size() == 3) {
+    const json stds = tensor.value("principal_moments_kg_m2_std", json::array());
+    const json axes = tensor.value("principal_axes", json::array());
+    const json axes_std = tensor.value("principal_axes_std_deg", json::array());
+    h << "<table><tr><th>principal</th><th>moment</th><th>std</th><th>axis x</th><th>axis y</th>"
+         "<th>axis z</th><th>axis std (deg)</th></tr>\n";
+    for (int k = 0; k < 3; ++k) {
+      auto at = [](const json& a, int i) {
+        return a.is_array() && i < static_cast<int>(a.size()) && a[i].is_number() ? a[i].get<double>()
+                                                                                : NAN;
+      };
+      const json axis = k < static_cast<int>(axes.size()) ? axes[k] : json::array();
+      h << "<tr><td>" << k + 1 << "</td><td>" << u.Inertia(at(moments, k), "%.5g") << "</td><td>"
+        << u.Inertia(at(stds, k), "%.2g") << "</td><td>" << Fmt(at(axis, 0)) << "</td><td>"
+        << Fmt(at(axis, 1)) << "</td><td>" << Fmt(at(axis, 2)) << "</td><td>"
+        << Fmt(at(axes_std, k), "%.2f") << "</td></tr>\n";
+    }
+    h << "</table>\n";
+    const json euler = tensor.value("principal_euler_deg", json::object());
+    h << "<p>Principal axes from body axes (Z-Y-X Euler angles, each principal axis matched to the "
+         "nearest body axis): roll "
+      << Fmt(Num(euler, "roll"), "%.3f") << " &plusmn; " << Fmt(Num(euler, "roll_std"), "%.3f")
+      << ", pitch " << Fmt(Num(euler, "pitch"), "%.3f") << " &plusmn; "
+      << Fmt(Num(euler, "pitch_std"), "%.3f") << ", yaw " << Fmt(Num(euler, "yaw"), "%.3f")
+      << " &plusmn; " << Fmt(Num(euler, "yaw_std"), "%.3f") << " deg.</p>\n";
+  }
+  h << "<p>Uncertainties are statistical; the configured uncertainties add a systematic &plusmn;"
+    << Fmt(100.0 * Num(tensor, "systematic_relative_std"), "%.2f")
+    << " % that scales every component alike.</p>\n";
+  for (const auto& w : tensor.value("warnings", json::array())) {
+    if (w.is_string()) h << "<p class=\"note\">" << Escape(w.get<std::string>()) << "</p>\n";
+  }
+  if (!Str(p.figures, "tensor").empty()) {
+    h << "<h2>Principal axes and per-orientation residuals</h2>\n"
+      << Figure(p.out_dir, Str(p.figures, "tensor"),
+                "ellipsoid of inertia in three plane views and residuals", "fig", &p.figures_drawn)
+      << "\n";
+  }
+  h << "<h2>Per-orientation residuals</h2>\n<table><tr><th>#</th><th>roll (deg)</th>"
+       "<th>pitch (deg)</th><th>axis in body</th><th>logs</th><th>mean</th><th>fitted</th>"
+       "<th>residual</th><th>residual / expected</th></tr>\n";
+  int index = 0;
+  for (const auto& o : tensor.value("orientations", json::array())) {
+    const json axis = o.value("axis_in_body", json::array());
+    std::string axis_text = "&ndash;";
+    if (axis.is_array() && axis.size() == 3 && axis[0].is_number()) {
+      axis_text = "(" + Fmt(axis[0].get<double>(), "%.3f") + ", " + Fmt(axis[1].get<double>(), "%.3f") +
+                  ", " + Fmt(axis[2].get<double>(), "%.3f") + ")";
+    }
+    const double z = Num(o, "z");
+    h << "<tr><td>" << ++index << "</td><td>" << Fmt(Num(o, "roll_deg"), "%.1f") << "</td><td>"
+      << Fmt(Num(o, "pitch_deg"), "%.1f") << "</td><td>" << axis_text << "</td><td>"
+      << o.value("n", 0) << "</td><td>" << u.Inertia(Num(o, "mean_kg_m2"), "%.5g") << "</td><td>"
+      << u.Inertia(Num(o, "fitted_kg_m2"), "%.5g") << "</td><td>"
+      << u.Inertia(Num(o, "residual_kg_m2"), "%.2g") << "</td><td"
+      << (std::fabs(z) > 3 ? " class=\"bad\"" : "") << ">" << Fmt(z, "%+.2f") << "</td></tr>\n";
+  }
+  h << "</table>\n";
+}
+
 // Table 1 (data quality) and the rig line.
 void WriteTable1AndRig(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
@@ -793,13 +884,14 @@ std::string Base64(const std::string& bytes) {
   return out;
 }
 
-// header -> Table 2 -> Table 1 and rig -> ellipse figures and NACA 467 -> per-angle table ->
+// header -> Table 2 -> inertia tensor (campaigns that roll) -> Table 1 and rig -> ellipse figures and NACA 467 -> per-angle table ->
 // rejected traces -> warnings -> trace table -> per-trace figures -> footer.
 std::string BuildReportHtml(const json& results, const std::string& out_dir) {
   ReportPage page(results, out_dir);
   std::ostringstream h;
   WriteHeader(page, h);
   WriteTable2(page, h);
+  WriteTensorSection(page, h);
   WriteTable1AndRig(page, h);
   WriteEllipseSection(page, h);
   WriteAngleTable(page, h);

@@ -238,6 +238,7 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
   j["residual_rms_rad_per_s"] = Number(r.residual_rms_rad_per_s);
   j["noise_rms_rad_per_s"] = Number(r.noise_rms_rad_per_s);
   j["pitch_measured_deg"] = r.pitch_measured_deg ? Number(*r.pitch_measured_deg) : json(nullptr);
+  j["roll_measured_deg"] = r.roll_measured_deg ? Number(*r.roll_measured_deg) : json(nullptr);
   j["model"] = r.model;
   j["iterations"] = r.iterations;
   j["fit_seconds"] = r.fit_seconds;
@@ -277,6 +278,8 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
     j["from_cache"] = r.from_cache;
     j["pitch_nominal_deg"] = r.pitch_nominal_deg ? Number(*r.pitch_nominal_deg) : json(nullptr);
     j["pitch_used_deg"] = Number(r.pitch_used_deg);
+    j["roll_nominal_deg"] = r.roll_nominal_deg ? Number(*r.roll_nominal_deg) : json(nullptr);
+    j["roll_used_deg"] = Number(r.roll_used_deg);
     j["rig_inertia_kg_m2"] = Number(r.rig_inertia_kg_m2);
     j["inertia_kg_m2"] = Number(r.inertia_kg_m2);
     j["inertia_std_kg_m2"] = Number(r.inertia_std_kg_m2);
@@ -306,6 +309,8 @@ TraceRecord TraceRecordFromJson(const json& j) {
   r.noise_rms_rad_per_s = GetNumber(j, "noise_rms_rad_per_s");
   const double pitch = GetNumber(j, "pitch_measured_deg");
   if (std::isfinite(pitch)) r.pitch_measured_deg = pitch;
+  const double roll = GetNumber(j, "roll_measured_deg");
+  if (std::isfinite(roll)) r.roll_measured_deg = roll;
   r.model = GetString(j, "model");
   r.iterations = j.value("iterations", 0);
   r.fit_seconds = GetNumber(j, "fit_seconds");
@@ -365,6 +370,9 @@ TraceRecord TraceRecordFromJson(const json& j) {
   const double nominal = GetNumber(j, "pitch_nominal_deg");
   if (std::isfinite(nominal)) r.pitch_nominal_deg = nominal;
   r.pitch_used_deg = GetNumber(j, "pitch_used_deg");
+  const double roll_nominal = GetNumber(j, "roll_nominal_deg");
+  if (std::isfinite(roll_nominal)) r.roll_nominal_deg = roll_nominal;
+  r.roll_used_deg = GetNumber(j, "roll_used_deg");
   r.rig_inertia_kg_m2 = GetNumber(j, "rig_inertia_kg_m2");
   r.inertia_kg_m2 = GetNumber(j, "inertia_kg_m2");
   r.inertia_std_kg_m2 = GetNumber(j, "inertia_std_kg_m2");
@@ -438,6 +446,8 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   summary["wall_s"] = s.wall_s;
   summary["ellipse_fitted"] = s.ellipse_fitted;
   summary["ellipse_message"] = s.ellipse_message;
+  summary["tensor_fitted"] = s.tensor_fitted;
+  summary["tensor_message"] = s.tensor_message;
   summary["exit_code"] = s.exit_code;
   j["summary"] = summary;
   json rig;
@@ -446,7 +456,8 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   rig["mass_kg"] = config.rig_mass_kg;
   rig["aircraft_mass_kg"] = config.aircraft_mass_kg;
   rig["gravity_mps2"] = config.gravity_mps2;
-  rig["inertia_source"] = config.rig_inertia.kind == RigInertiaSpec::Kind::kValue   ? "value"
+  rig["inertia_source"] = !config.rig_inertia_given ? "none"
+                          : config.rig_inertia.kind == RigInertiaSpec::Kind::kValue   ? "value"
                           : config.rig_inertia.kind == RigInertiaSpec::Kind::kTable ? "table"
                                                                                     : "tare";
   rig["inertia_kg_m2"] = Number(result.rig_inertia_kg_m2);
@@ -494,11 +505,14 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
                       {"cv_percent", Number(a.cv_percent)},
                       {"fit_std_mean_kg_m2", Number(a.fit_std_mean_kg_m2)},
                       {"common_mode_std_kg_m2", Number(a.common_mode_std_kg_m2)},
-                      {"inertia_std_total_kg_m2", Number(a.inertia_std_total_kg_m2)}});
+                      {"inertia_std_total_kg_m2", Number(a.inertia_std_total_kg_m2)},
+                      {"roll_deg", Number(a.roll_deg)}});
   }
   j["angles"] = angles;
   j["ellipse"] = result.ellipse;
-  j["figures"] = {{"moments", result.moments_figure}, {"polar", result.polar_figure}};
+  j["tensor"] = result.tensor;
+  j["figures"] = {{"moments", result.moments_figure}, {"polar", result.polar_figure},
+                  {"tensor", result.tensor_figure}};
   return j;
 }
 
@@ -514,7 +528,8 @@ std::string TracesCsv(const CampaignResult& result) {
          "residual_rms_rad_per_s,model,iterations,fit_seconds,from_cache,inertia_source,"
          "inertia_window_kg_m2,model_inadequacy_std_kg_m2,secondary_motion_ratio,rms_over_noise,"
          "residual_ar1_phi,sweep_bands,sweep_trend_percent_per_10deg,sweep_trend_z,"
-         "sweep_trend_detected,sweep_inertia_by_amplitude,warnings,message\n";
+         "sweep_trend_detected,sweep_inertia_by_amplitude,warnings,message,roll_nominal_deg,"
+         "roll_measured_deg,roll_used_deg\n";
   for (const TraceRecord& r : result.traces) {
     out << Cell(r.file) << ',' << ToString(r.role) << ',' << ToString(r.status) << ','
         << Cell(r.pitch_nominal_deg ? *r.pitch_nominal_deg : NAN) << ','
@@ -540,7 +555,9 @@ std::string TracesCsv(const CampaignResult& result) {
         << (r.sweep.evaluated ? Cell(r.sweep.trend_z) : "") << ','
         << (r.sweep.evaluated ? (r.sweep.trend_detected ? "true" : "false") : "") << ','
         << Cell(SweepSummary(r.sweep)) << ',' << Cell(Join(r.warnings, " | ")) << ','
-        << Cell(r.message) << '\n';
+        << Cell(r.message) << ',' << Cell(r.roll_nominal_deg ? *r.roll_nominal_deg : NAN) << ','
+        << Cell(r.roll_measured_deg ? *r.roll_measured_deg : NAN) << ',' << Cell(r.roll_used_deg)
+        << '\n';
   }
   return out.str();
 }
@@ -548,12 +565,13 @@ std::string TracesCsv(const CampaignResult& result) {
 std::string AnglesCsv(const CampaignResult& result) {
   std::ostringstream out;
   out << "pitch_deg,n,inertia_mean_kg_m2,inertia_std_kg_m2,inertia_sem_kg_m2,cv_percent,"
-         "fit_std_mean_kg_m2,common_mode_std_kg_m2,inertia_std_total_kg_m2\n";
+         "fit_std_mean_kg_m2,common_mode_std_kg_m2,inertia_std_total_kg_m2,roll_deg\n";
   for (const AngleStats& a : result.angles) {
     out << Cell(a.pitch_deg) << ',' << a.n << ',' << Cell(a.inertia_mean_kg_m2) << ','
         << Cell(a.inertia_std_kg_m2) << ',' << Cell(a.inertia_sem_kg_m2) << ','
         << Cell(a.cv_percent) << ',' << Cell(a.fit_std_mean_kg_m2) << ','
-        << Cell(a.common_mode_std_kg_m2) << ',' << Cell(a.inertia_std_total_kg_m2) << '\n';
+        << Cell(a.common_mode_std_kg_m2) << ',' << Cell(a.inertia_std_total_kg_m2) << ','
+        << Cell(a.roll_deg) << '\n';
   }
   return out.str();
 }

@@ -45,36 +45,41 @@ std::vector<std::string> SplitPath(const std::string& pattern) {
 }
 
 // One wildcard component as fnmatch(3) patterns. '[' and '\' are literal in our rules, so they
-// are escaped; {pitch_deg} splits the component into the parts before and after the capture.
+// are escaped; {pitch_deg} and {roll_deg} split the component into the literal parts around the
+// captures.
 struct ComponentPattern {
-  std::string whole;          // the component, {pitch_deg} as '*'
-  bool captures = false;      // holds {pitch_deg}
-  std::string before, after;  // around {pitch_deg} (when `captures`)
+  std::string whole;               // the component, each placeholder as '*'
+  std::vector<std::string> names;  // placeholders in order ("pitch_deg", "roll_deg")
+  std::vector<std::string> parts;  // literal parts around them: names.size() + 1 (when any)
+  bool captures() const { return !names.empty(); }
 };
 
 ComponentPattern ParseComponent(const std::string& component) {
   ComponentPattern p;
-  std::string* side = &p.before;
+  p.parts.emplace_back();
   for (size_t i = 0; i < component.size(); ++i) {
     const char c = component[i];
     if (c == '{') {
       const size_t end = component.find('}', i);
       const std::string name = end == std::string::npos ? "" : component.substr(i + 1, end - i - 1);
-      if (name != "pitch_deg") {
+      if (name != "pitch_deg" && name != "roll_deg") {
         throw UserError("runs.pattern: unknown placeholder in '" + component +
-                        "' (only {pitch_deg} is known)");
+                        "' (only {pitch_deg} and {roll_deg} are known)");
       }
-      if (p.captures) throw UserError("runs.pattern: {pitch_deg} may appear only once");
-      p.captures = true;
+      for (const std::string& seen : p.names) {
+        if (seen == name) throw UserError("runs.pattern: {" + name + "} may appear only once");
+      }
+      p.names.push_back(name);
+      p.parts.emplace_back();
       p.whole += '*';
-      side = &p.after;
       i = end;
       continue;
     }
     const std::string literal = c == '[' || c == '\\' ? std::string("\\") + c : std::string(1, c);
     p.whole += literal;
-    *side += literal;
+    p.parts.back() += literal;
   }
+  if (!p.captures()) p.parts.clear();
   return p;
 }
 
@@ -82,42 +87,57 @@ bool FnMatch(const std::string& pattern, const std::string& name) {
   return ::fnmatch(pattern.c_str(), name.c_str(), 0) == 0;
 }
 
-// Whether `name` matches; with {pitch_deg}, *pitch_text is the shortest text after the longest
-// prefix that matches the part before it.
-bool MatchComponent(const ComponentPattern& p, const std::string& name,
-                    std::optional<std::string>* pitch_text) {
-  if (!FnMatch(p.whole, name)) return false;
-  if (!p.captures) return true;
+// Captures of `name` from literal part `k` on: the longest text matching part k, then the
+// shortest capture after which the rest matches (with one placeholder: the shortest text after
+// the longest prefix that matches the part before it).
+bool MatchFrom(const ComponentPattern& p, size_t k, const std::string& name,
+               std::vector<std::string>* captured) {
+  if (k + 1 == p.parts.size()) return FnMatch(p.parts[k], name);
   for (size_t i = name.size() + 1; i-- > 0;) {
-    if (!FnMatch(p.before, name.substr(0, i))) continue;
+    if (!FnMatch(p.parts[k], name.substr(0, i))) continue;
     for (size_t j = i; j <= name.size(); ++j) {
-      if (FnMatch(p.after, name.substr(j))) {
-        *pitch_text = name.substr(i, j - i);
-        return true;
-      }
+      (*captured)[k] = name.substr(i, j - i);
+      if (MatchFrom(p, k + 1, name.substr(j), captured)) return true;
     }
   }
-  return false;  // unreachable: `whole` matched
+  return false;
+}
+
+// What the placeholders stood for in a path: {pitch_deg} and {roll_deg}.
+struct CapturedText {
+  std::optional<std::string> pitch, roll;
+};
+
+// Whether `name` matches; its captures go into *text.
+bool MatchComponent(const ComponentPattern& p, const std::string& name, CapturedText* text) {
+  if (!FnMatch(p.whole, name)) return false;
+  if (!p.captures()) return true;
+  std::vector<std::string> captured(p.names.size());
+  if (!MatchFrom(p, 0, name, &captured)) return false;  // unreachable: `whole` matched
+  for (size_t k = 0; k < p.names.size(); ++k) {
+    (p.names[k] == "pitch_deg" ? text->pitch : text->roll) = captured[k];
+  }
+  return true;
 }
 
 struct PatternHit {
   std::string path;
-  std::optional<std::string> pitch_text;  // what {pitch_deg} stood for
+  CapturedText text;  // what {pitch_deg} and {roll_deg} stood for
 };
 
 // Depth-first from `dir`, entries in name order: files (not folders) matching the last
 // component, through folders matching the others. A literal component is looked up directly.
 void WalkPattern(const fs::path& dir, const std::vector<std::string>& parts, size_t index,
-                 const std::optional<std::string>& pitch_text, std::vector<PatternHit>* hits) {
+                 const CapturedText& captured, std::vector<PatternHit>* hits) {
   const bool last = index + 1 == parts.size();
   const std::string& part = parts[index];
   std::error_code ec;
   if (!HasWildcard(part)) {
     const fs::path next = dir / part;
     if (last) {
-      if (fs::exists(next, ec)) hits->push_back({next.string(), pitch_text});
+      if (fs::exists(next, ec)) hits->push_back({next.string(), captured});
     } else if (fs::is_directory(next, ec)) {
-      WalkPattern(next, parts, index + 1, pitch_text, hits);
+      WalkPattern(next, parts, index + 1, captured, hits);
     }
     return;
   }
@@ -128,7 +148,7 @@ void WalkPattern(const fs::path& dir, const std::vector<std::string>& parts, siz
   }
   std::sort(entries.begin(), entries.end());
   for (const fs::path& entry : entries) {
-    std::optional<std::string> text = pitch_text;
+    CapturedText text = captured;
     if (!MatchComponent(pattern, entry.filename().string(), &text)) continue;
     if (last) {
       if (!fs::is_directory(entry, ec)) hits->push_back({entry.string(), text});
@@ -200,17 +220,19 @@ std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
   std::map<std::string, std::pair<size_t, int>> first_row;  // path -> (index in runs, line)
   std::string line;
   int line_no = 0;
-  int path_col = -1, pitch_col = -1;
+  int path_col = -1, pitch_col = -1, roll_col = -1;  // roll_deg is optional (0 when absent)
   while (std::getline(in, line)) {
     ++line_no;
     // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
     if (line_no == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
-    if (line.find_first_not_of(" \r\t") == std::string::npos) continue;
+    const size_t first = line.find_first_not_of(" \r\t");
+    if (first == std::string::npos || line[first] == '#') continue;  // blank or a comment
     const std::vector<std::string> cells = SplitCsvLine(line);
     if (path_col < 0) {
       for (size_t i = 0; i < cells.size(); ++i) {
         if (cells[i] == "path" || cells[i] == "file") path_col = static_cast<int>(i);
         if (cells[i] == "pitch_deg") pitch_col = static_cast<int>(i);
+        if (cells[i] == "roll_deg") roll_col = static_cast<int>(i);
       }
       if (path_col < 0 || pitch_col < 0) {
         throw UserError(config.runs.table + ":" + std::to_string(line_no) +
@@ -222,16 +244,21 @@ std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
     const std::string rel = static_cast<int>(cells.size()) > path_col ? cells[path_col] : "";
     run.path = ResolvePath(config.runs.root, rel);
     run.display = Display(config, run.path);
-    double pitch = 0.0;
+    double pitch = 0.0, roll = 0.0;
     if (rel.empty()) {
       run.display = config.runs.table + ":" + std::to_string(line_no);
       run.error = run.display + ": empty path in runs table";
+    } else if (roll_col >= 0 && (static_cast<int>(cells.size()) <= roll_col ||
+                                 !ParsePitchText(cells[roll_col], &roll))) {
+      run.error = config.runs.table + ":" + std::to_string(line_no) + ": roll of '" + rel +
+                  "' is not a number in [-180, 180] (column roll_deg)";
     } else if (static_cast<int>(cells.size()) <= pitch_col ||
                !ParsePitchText(cells[pitch_col], &pitch)) {
       run.error = config.runs.table + ":" + std::to_string(line_no) + ": pitch of '" + rel +
                   "' is not a number in [-180, 180]";
     } else {
       run.pitch_nominal_deg = pitch;
+      if (roll_col >= 0) run.roll_nominal_deg = roll;
       std::error_code ec;
       if (!fs::exists(run.path, ec)) {
         run.error = run.display + ": listed in " + config.runs.table + ":" +
@@ -270,18 +297,28 @@ std::vector<RunFile> DiscoverPattern(const CampaignConfig& config) {
   const std::vector<std::string> parts = SplitPath(config.runs.pattern);
   if (parts.empty()) throw UserError("runs.pattern is empty");
   std::vector<PatternHit> hits;
-  WalkPattern(config.runs.root, parts, 0, std::nullopt, &hits);
+  WalkPattern(config.runs.root, parts, 0, CapturedText(), &hits);
   std::vector<RunFile> runs;
   for (const PatternHit& hit : hits) {
     RunFile run;
     run.path = fs::path(hit.path).lexically_normal().string();
     run.display = Display(config, run.path);
-    double pitch = 0.0;
-    if (hit.pitch_text) {
-      if (ParsePitchText(*hit.pitch_text, &pitch)) {
+    double pitch = 0.0, roll = 0.0;
+    if (hit.text.roll) {
+      if (ParsePitchText(*hit.text.roll, &roll)) {
+        run.roll_nominal_deg = roll;
+      } else {
+        run.error = run.display + ": cannot read the roll from the path ('" + *hit.text.roll +
+                    "' in pattern " + config.runs.pattern + " is not a number in [-180, 180])";
+      }
+    }
+    if (!run.error.empty()) {
+      // the roll already failed
+    } else if (hit.text.pitch) {
+      if (ParsePitchText(*hit.text.pitch, &pitch)) {
         run.pitch_nominal_deg = pitch;
       } else {
-        run.error = run.display + ": cannot read the pitch from the path ('" + *hit.pitch_text +
+        run.error = run.display + ": cannot read the pitch from the path ('" + *hit.text.pitch +
                     "' in pattern " + config.runs.pattern + " is not a number in [-180, 180])";
       }
     } else if (config.runs.pitch_source == PitchSource::kNominal) {
@@ -333,7 +370,7 @@ std::vector<RunFile> DiscoverListedLogs(const CampaignConfig& config,
       }
     }
     std::vector<PatternHit> hits;
-    WalkPattern(dir, rest, 0, std::nullopt, &hits);
+    WalkPattern(dir, rest, 0, CapturedText(), &hits);
     if (hits.empty()) {
       throw UserError(key + ": no file matches '" + pattern + "'");
     }

@@ -21,6 +21,7 @@ struct RunFile {
   std::string display;  // relative to the config folder
   TraceRole role = TraceRole::kAircraft;
   std::optional<double> pitch_nominal_deg;  // from the path pattern or the table
+  std::optional<double> roll_nominal_deg;   // {roll_deg} in the pattern, roll_deg in the table
   std::string error;                        // non-empty: becomes an error row
 };
 

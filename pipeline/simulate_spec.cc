@@ -1,5 +1,7 @@
 #include "pipeline/simulate_spec.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
 #include <limits>
 #include <cstdio>
@@ -378,6 +380,10 @@ SimulateSpec ParseSpec(YamlMap root) {
     c.aircraft.ix_kg_m2 = ReadInertia(aircraft, "ix", true, 0, true);
     c.aircraft.iz_kg_m2 = ReadInertia(aircraft, "iz", true, 0, true);
     c.aircraft.ixz_kg_m2 = ReadInertia(aircraft, "ixz", true, -1e9, false);
+    // The rest of the tensor (campaigns that roll): optional, 0 when absent.
+    c.aircraft.iy_kg_m2 = ReadInertia(aircraft, "iy", false, 0, false);
+    c.aircraft.ixy_kg_m2 = ReadInertia(aircraft, "ixy", false, -1e9, false);
+    c.aircraft.iyz_kg_m2 = ReadInertia(aircraft, "iyz", false, -1e9, false);
     aircraft.Finish();
     std::string why;
     if (!c.aircraft.Check(&why)) throw UserError(spec.file + ": aircraft: " + why);
@@ -425,7 +431,30 @@ SimulateSpec ParseSpec(YamlMap root) {
 
     YamlMap campaign = Section(root, "campaign");
     if (!has_campaign) root.Required("campaign");
-    const YAML::Node pitch_node = campaign.Required("pitch_deg");
+    // attitudes_deg: [[roll, pitch], ...] (a tensor campaign) instead of pitch_deg.
+    const YAML::Node attitudes = campaign.Optional("attitudes_deg");
+    if (attitudes.IsDefined() && !attitudes.IsNull()) {
+      if (!attitudes.IsSequence() || attitudes.size() == 0) {
+        throw UserError(campaign.Where(attitudes) + ": '" + campaign.KeyPath("attitudes_deg") +
+                        "' must be a list of [roll_deg, pitch_deg] pairs");
+      }
+      for (const auto& item : attitudes) {
+        if (!item.IsSequence() || item.size() != 2) {
+          throw UserError(campaign.Where(item) + ": '" + campaign.KeyPath("attitudes_deg") +
+                          "' entries are [roll_deg, pitch_deg] pairs");
+        }
+        const double roll = campaign.AsDouble(item[0], "attitudes_deg");
+        const double pitch = campaign.AsDouble(item[1], "attitudes_deg");
+        if (roll < -180 || roll > 180 || pitch < -90 || pitch > 90) {
+          throw UserError(campaign.Where(item) + ": '" + campaign.KeyPath("attitudes_deg") +
+                          "' has roll " + Num(roll) + ", pitch " + Num(pitch) +
+                          "; allowed roll [-180, 180], pitch [-90, 90]");
+        }
+        c.attitudes_deg.push_back({roll, pitch});
+      }
+    }
+    const YAML::Node pitch_node =
+        c.attitudes_deg.empty() ? campaign.Required("pitch_deg") : campaign.Optional("pitch_deg");
     c.pitch_deg = campaign.OptionalDoubleList("pitch_deg", {});
     for (double p : c.pitch_deg) {
       if (p < -90 || p > 90) {
@@ -436,6 +465,8 @@ SimulateSpec ParseSpec(YamlMap root) {
     c.trials_per_pitch = static_cast<int>(ReadValue(campaign, "trials_per_pitch", 3, 1, false, 1000));
     c.pitch_error_sigma_deg =
         ReadValue(campaign, "pitch_error_sigma_deg", c.pitch_error_sigma_deg, 0, false, 10);
+    c.roll_error_sigma_deg =
+        ReadValue(campaign, "roll_error_sigma_deg", c.pitch_error_sigma_deg, 0, false, 10);
     campaign.Finish();
 
     if (!length || !separation) {
@@ -591,6 +622,13 @@ nlohmann::json TraceJson(const CampaignTrace& ct, const SimulateSpec& spec) {
   j["trial"] = ct.trial;
   j["nominal_pitch_deg"] = ct.nominal_pitch_deg;
   j["true_pitch_deg"] = ct.true_pitch_deg;
+  if (!spec.campaign.attitudes_deg.empty()) {
+    j["nominal_roll_deg"] = ct.nominal_roll_deg;
+    j["true_roll_deg"] = ct.true_roll_deg;
+    const double p = ct.true_pitch_deg * kDeg, r = ct.true_roll_deg * kDeg;
+    j["swing_axis_in_body"] = Vec(Eigen::Vector3d(-std::sin(p), std::sin(r) * std::cos(p),
+                                                  std::cos(r) * std::cos(p)));
+  }
   j["mass_kg"] = s.geometry.mass_kg;
   j["inertia_total_kg_m2"] = s.params.inertia_kg_m2;
   j["inertia_aircraft_kg_m2"] = ct.inertia_aircraft_kg_m2;
@@ -824,12 +862,42 @@ std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<Campai
   }
   rig["body_from_imu"] = mounting;
   j["rig"] = rig;
+  if (c.aircraft.HasTensor()) {
+    // The whole tensor (docs/physics.md §3.5; products positive, the tensor holds -Ixy ...).
+    const Eigen::Matrix3d tensor = c.aircraft.Tensor();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(tensor);
+    nlohmann::json axes = nlohmann::json::array();
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector3d axis = eig.eigenvectors().col(k);
+      int largest = 0;
+      axis.cwiseAbs().maxCoeff(&largest);
+      if (axis(largest) < 0) axis = -axis;
+      axes.push_back(Vec(axis));
+    }
+    j["aircraft"]["iy_kg_m2"] = c.aircraft.iy_kg_m2;
+    j["aircraft"]["ixy_kg_m2"] = c.aircraft.ixy_kg_m2;
+    j["aircraft"]["iyz_kg_m2"] = c.aircraft.iyz_kg_m2;
+    j["aircraft"]["tensor"] = {
+        {"Ixx_kg_m2", c.aircraft.ix_kg_m2}, {"Iyy_kg_m2", c.aircraft.iy_kg_m2},
+        {"Izz_kg_m2", c.aircraft.iz_kg_m2}, {"Ixy_kg_m2", c.aircraft.ixy_kg_m2},
+        {"Ixz_kg_m2", c.aircraft.ixz_kg_m2}, {"Iyz_kg_m2", c.aircraft.iyz_kg_m2},
+        {"tensor_kg_m2", {Vec(tensor.row(0).transpose()), Vec(tensor.row(1).transpose()),
+                          Vec(tensor.row(2).transpose())}},
+        {"principal_moments_kg_m2", Vec(eig.eigenvalues())},
+        {"principal_axes", axes}};
+  }
   j["campaign"] = {{"pitch_deg", c.pitch_deg},
                    {"trials_per_pitch", c.trials_per_pitch},
                    {"pitch_error_sigma_deg", c.pitch_error_sigma_deg},
                    {"amplitude_deg", Range(c.amplitude_deg)},
                    {"drag_coeff_kg_m2", Range(c.drag_coeff_kg_m2)},
                    {"viscous_coeff_kg_m2_per_s", Range(c.viscous_coeff_kg_m2_per_s)}};
+  if (!c.attitudes_deg.empty()) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& a : c.attitudes_deg) list.push_back({a[0], a[1]});
+    j["campaign"]["attitudes_deg"] = list;
+    j["campaign"]["roll_error_sigma_deg"] = c.roll_error_sigma_deg;
+  }
   j["options"] = OptionsJson(spec);
   nlohmann::json list = nlohmann::json::array();
   for (const auto& ct : traces) list.push_back(TraceJson(ct, spec));

@@ -355,9 +355,11 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
     if (EstimateSwingAxis(data, axis_options, std::make_pair(window.t0_s, window.t1_s), &again,
                           &why)) {
       axis.pitch_measured_deg = again.pitch_measured_deg;
+      axis.roll_measured_deg = again.roll_measured_deg;
     }
   }
   record.pitch_measured_deg = axis.pitch_measured_deg;
+  if (axis.pitch_measured_deg) record.roll_measured_deg = axis.roll_measured_deg;
   for (int k = 0; k < 3; ++k) record.swing_axis_in_imu[k] = axis.axis_in_imu[k];
   // The measured period and the small-angle inertia (the hand calculation `inspect` prints).
   if (window.period_s > 0.0) {

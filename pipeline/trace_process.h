@@ -64,6 +64,7 @@ struct TraceRecord {
   double residual_rms_rad_per_s = NAN;
   double noise_rms_rad_per_s = NAN;      // gyro noise estimated from the rest segment
   std::optional<double> pitch_measured_deg;  // from the accelerometer; none without one
+  std::optional<double> roll_measured_deg;   // ... and its roll (docs/physics.md §3.5)
   std::string model;                     // "full", "jardin", "linear"
   int iterations = 0;
   double fit_seconds = 0.0;              // wall time of this file's processing (s)
@@ -108,6 +109,8 @@ struct TraceRecord {
   bool from_cache = false;
   std::optional<double> pitch_nominal_deg;  // from the path or table
   double pitch_used_deg = NAN;           // nominal or measured, per runs.pitch_source
+  std::optional<double> roll_nominal_deg;   // from the path or table ({roll_deg}, roll_deg)
+  double roll_used_deg = NAN;            // nominal (0 when none) or measured, like the pitch
   double rig_inertia_kg_m2 = NAN;        // subtracted tare at this pitch
   double inertia_kg_m2 = NAN;            // aircraft alone = total - rig (kg m^2)
   double inertia_std_kg_m2 = NAN;        // sqrt(fit std^2 + rig std^2)

@@ -10,6 +10,10 @@ read_log(path, config)
 fit_ellipse(pitch_deg, inertia, std=None)
     I_x, I_z, I_xz and tau with their uncertainties (``bifilar ellipse --json``); the
     per-point residuals as :class:`Columns` (numpy arrays; rows on demand).
+fit_tensor(directions, inertias, stds=None)
+    The full inertia tensor from moments about any body axes (results.json's ``tensor``).
+down_in_body(roll_deg, pitch_deg)
+    The swing axis (down vertical) in body axes of an aircraft hung at that attitude.
 process(config_path, out=None, jobs=None)
     Run a campaign (``bifilar process``); the parsed results.json.
 simulate(...)
@@ -31,7 +35,8 @@ try:  # needed by every function; `import bifilar` itself works without it
 except ImportError:  # pragma: no cover - depends on the interpreter
     _np = None
 
-__all__ = ["Record", "Columns", "fit_trace", "read_log", "fit_ellipse", "process", "simulate"]
+__all__ = ["Record", "Columns", "fit_trace", "read_log", "fit_ellipse", "fit_tensor",
+           "down_in_body", "process", "simulate"]
 __version__ = _core.version
 
 
@@ -290,7 +295,7 @@ def read_log(path, config):
         ``t_s`` (N,), ``rate_rad_per_s`` (N,) the swing rate gyro . n, ``gyro_rad_per_s``
         (N, 3), ``accel_mps2`` (N, 3) or None, all in SI and IMU axes; ``axis_in_imu``,
         ``axis_in_body``, ``axis_source`` (the swing axis n and how it was found),
-        ``pitch_measured_deg`` (from the accelerometer at rest, or None), ``window_s`` (the
+        ``pitch_measured_deg`` and ``roll_measured_deg`` (from the accelerometer at rest, or None), ``window_s`` (the
         config's window for this file, or None), ``warnings`` (repairs made while reading) and
         ``notes``. ``fit_trace(r.t_s, r.rate_rad_per_s, config=config, name=path)`` then gives
         the numbers of ``bifilar fit config path``.
@@ -356,6 +361,78 @@ def fit_ellipse(pitch_deg, inertia, std=None, *, bootstrap=2000, seed=1, confide
                                       str(covariance)))
     dict.__setitem__(result, "residuals", Columns(result["residuals"]))
     return result
+
+
+def down_in_body(roll_deg, pitch_deg):
+    """The down vertical in body axes of an aircraft hung at roll and pitch (deg), a numpy array.
+
+    n = (-sin pitch, sin roll cos pitch, cos roll cos pitch) (docs/physics.md 3.5); scalars give
+    shape (3,), arrays of N attitudes shape (N, 3).
+    """
+    roll = _np.radians(_series(roll_deg, "roll_deg"))
+    pitch = _np.radians(_series(pitch_deg, "pitch_deg"))
+    return _np.stack([-_np.sin(pitch), _np.sin(roll) * _np.cos(pitch),
+                      _np.cos(roll) * _np.cos(pitch)], axis=-1)
+
+
+def fit_tensor(directions, inertias, stds=None, *, nominal=None, groups=None, bootstrap=2000,
+               seed=1, confidence=0.95, covariance="auto", common_offset_std=0.0,
+               attitude_scatter=True):
+    """Fit the full inertia tensor to moments measured about swing axes in any body direction.
+
+    I(n) = n^T J n with J = [[Ixx, -Ixy, -Ixz], [-Ixy, Iyy, -Iyz], [-Ixz, -Iyz, Izz]]
+    (products positive: Ixy = integral x y dm; docs/physics.md 3.5), by weighted least squares
+    (Ceres) over what the axes determine; components they do not determine are None and named
+    in ``unobservable``. As ``bifilar process`` fits a campaign that rolls; the GIL is released.
+
+    Parameters
+    ----------
+    directions : array-like, shape (N, 3)
+        Swing axis of each moment in body axes (x forward, y right wing, z down); any length.
+        ``down_in_body(roll_deg, pitch_deg)`` gives them from attitudes.
+    inertias : array-like, shape (N,)
+        Moment about that axis (kg m^2), > 0.
+    stds : array-like, shape (N,), optional
+        Standard errors of ``inertias`` (kg m^2).
+    nominal : array-like, shape (N, 3), optional
+        The planned axes (when ``directions`` are measured ones): they decide what the design
+        observes. Default: ``directions``.
+    groups : sequence of int, optional
+        Orientation of each moment (trials of one attitude share it). Default: by axis.
+    bootstrap, seed, confidence, covariance
+        As ``fit_ellipse`` (covariance 'angle_means' uses the orientations' means).
+    common_offset_std : float, default 0
+        Std of an offset shared by every moment (the rig inertia): enters Ixx, Iyy, Izz.
+    attitude_scatter : bool, default True
+        Weigh by the scatter an attitude error explains (docs/method.md 16).
+
+    Returns
+    -------
+    Record
+        ``Ixx_kg_m2`` ... ``Iyz_kg_m2`` each with ``_std`` and ``_ci95``, ``covariance_kg2_m4``,
+        ``principal_moments_kg_m2`` (ascending), ``principal_axes``, ``principal_euler_deg``,
+        ``condition_number``, ``unobservable``, ``residuals``, ``orientations``, ``warnings``.
+
+    Raises
+    ------
+    ValueError
+        Arrays of different lengths, not finite or of the wrong shape (naming the argument),
+        non-positive inertia, nothing observable (naming the components), bad options.
+    """
+    directions = _series(directions, "directions")
+    nominal_array = None if nominal is None else _series(nominal, "nominal")
+    std_array = None if stds is None else _series(stds, "stds")
+    bootstrap = _number("fit_tensor", "bootstrap", bootstrap, int)
+    seed = _seed("fit_tensor", seed)
+    if bootstrap < 0:
+        raise ValueError("fit_tensor: bootstrap must be >= 0")
+    group_list = None if groups is None else [int(g) for g in groups]
+    return Record(_core.fit_tensor(directions, _series(inertias, "inertias"), std_array,
+                                   nominal_array, group_list, bootstrap, seed,
+                                   _number("fit_tensor", "confidence", confidence),
+                                   str(covariance),
+                                   _number("fit_tensor", "common_offset_std", common_offset_std),
+                                   bool(attitude_scatter)))
 
 
 def process(config_path, out=None, jobs=None, *, force=False, figures=True, progress=None):

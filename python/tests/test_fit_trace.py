@@ -12,7 +12,8 @@ from conftest import SAMPLE_CONFIG, sample_log, without_timings
 SERIES = ("t_s", "measured_rad_per_s", "fitted_rad_per_s", "residual_rad_per_s")
 # Record fields that need the whole 3-axis log (accelerometer, other gyro axes), which a swing
 # rate alone does not carry: read_log gives the pitch and the axis instead.
-LOG_ONLY = ("pitch_measured_deg", "swing_axis_in_imu", "secondary_motion_ratio")
+LOG_ONLY = ("pitch_measured_deg", "roll_measured_deg", "swing_axis_in_imu",
+            "secondary_motion_ratio")
 
 
 def python_fit(log, **settings):
@@ -30,6 +31,7 @@ def test_fit_trace_gives_the_cli_numbers_exactly(pitch, cli_fit_json):
     python_record = {k: v for k, v in result.items() if k not in SERIES}
     assert set(python_record) == set(cli_record)  # same fields as `bifilar fit --json`
     assert series.pitch_measured_deg == cli_record["pitch_measured_deg"]
+    assert series.roll_measured_deg == cli_record["roll_measured_deg"]
     assert python_record["pitch_measured_deg"] is None
     if "swing_axis_in_imu" in cli_record:
         assert series.axis_in_imu == cli_record["swing_axis_in_imu"]

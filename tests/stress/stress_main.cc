@@ -840,7 +840,7 @@ void CaseSpecialFileAmongLogs(const Args& args, const Workspace& w, int case_no,
     return;
   }
   const Outcome o =
-      Wait(Start(ProcessArgv(args, w, false), w.dir + "/hostile"), args.run_timeout_s);
+      Wait(Start(ProcessArgv(args, w, false), w.harness + "/hostile"), args.run_timeout_s);
   CheckRun(o, w, case_no, kind, failures);
   ExpectStop(o, case_no, kind, {0, 1}, ResultsText(w),
              fifo ? "trial_9.csv: is a FIFO (named pipe), not a regular file"
@@ -855,7 +855,7 @@ void CaseDevZeroConfig(const Args& args, const Workspace& w, int case_no, Failur
   for (const std::vector<std::string>& argv :
        {std::vector<std::string>{args.binary, "fit", "/dev/zero", log},
         std::vector<std::string>{args.binary, "process", "/dev/zero", "--out", w.out}}) {
-    const Outcome o = Wait(Start(argv, w.dir + "/hostile"), args.run_timeout_s);
+    const Outcome o = Wait(Start(argv, w.harness + "/hostile"), args.run_timeout_s);
     ExpectStop(o, case_no, "/dev/zero as the config (" + argv[1] + ")", {2}, o.err,
                "/dev/zero: is a character device, not a regular file", failures);
   }
@@ -870,7 +870,7 @@ void CaseMultiMemberGzip(const Args& args, Workspace& w, int case_no, Failures* 
   WriteFile(path,
             bifilar::GzipCompress(text.substr(0, half)) + bifilar::GzipCompress(text.substr(half)));
   const Outcome o =
-      Wait(Start(ProcessArgv(args, w, false), w.dir + "/hostile"), args.run_timeout_s);
+      Wait(Start(ProcessArgv(args, w, false), w.harness + "/hostile"), args.run_timeout_s);
   CheckRun(o, w, case_no, kind, failures);
   ExpectStop(o, case_no, kind, {0}, o.out + o.err, "Traces:", failures, /*after_check_run=*/true);
   if (o.exit_code == 0) CheckBaseline(w, case_no, kind, failures);
@@ -887,7 +887,7 @@ void CaseGzipBomb(const Args& args, const Workspace& w, int case_no, Failures* f
   for (int i = 0; i < 110; ++i) bomb += member;
   WriteFile(path, bomb);
   const Outcome o =
-      Wait(Start(ProcessArgv(args, w, false), w.dir + "/hostile"), args.run_timeout_s);
+      Wait(Start(ProcessArgv(args, w, false), w.harness + "/hostile"), args.run_timeout_s);
   CheckRun(o, w, case_no, kind + " (" + std::to_string(bomb.size()) + " bytes)", failures);
   ExpectStop(o, case_no, kind, {0, 1}, ResultsText(w),
              "too large for a log once decompressed: more than the cap of 1000000000 bytes; "
@@ -922,10 +922,15 @@ void CaseFifoInOutput(const Args& args, const Workspace& w, int case_no, bool ca
   }
   const std::string message = path + ": is a FIFO (named pipe), not a regular file";
   const Outcome o =
-      Wait(Start(ProcessArgv(args, w, false), w.dir + "/hostile"), args.run_timeout_s);
-  ExpectStop(o, case_no, kind + " (process)", {2}, o.err, message, failures);
+      Wait(Start(ProcessArgv(args, w, false), w.harness + "/hostile"), args.run_timeout_s);
+  // `process` checks the manifest first: a recorded file that is no longer a regular file makes
+  // it refuse the manifest, naming the entry (pipeline/output_set.h); either refusal will do.
+  const std::string entry = path.substr(w.out.size() + 1);
+  const std::string refused = "entry \"" + entry + "\" refused: is not a regular file";
+  ExpectStop(o, case_no, kind + " (process)", {2}, o.err,
+             o.err.find(refused) != std::string::npos ? refused : message, failures);
   const Outcome r =
-      Wait(Start({args.binary, "report", w.out}, w.dir + "/hostile"), args.run_timeout_s);
+      Wait(Start({args.binary, "report", w.out}, w.harness + "/hostile"), args.run_timeout_s);
   if (cache_entry) {  // report reads no cache entry: it only has to end
     ExpectStop(r, case_no, kind + " (report)", {0, 2}, "", "", failures);
   } else {
@@ -946,7 +951,7 @@ void CaseAliasBomb(const Args& args, const Workspace& w, int case_no, Failures* 
   }
   WriteFile(w.config_path, w.config_text + bomb);
   const Outcome o =
-      Wait(Start(ProcessArgv(args, w, false), w.dir + "/hostile"), args.run_timeout_s);
+      Wait(Start(ProcessArgv(args, w, false), w.harness + "/hostile"), args.run_timeout_s);
   CheckRun(o, w, case_no, kind, failures);
   ExpectStop(o, case_no, kind, {2}, o.err, "YAML alias '*a0'", failures, /*after_check_run=*/true);
   w.RestoreConfig();

@@ -1,0 +1,640 @@
+// The tensor fit as a procedure (FitTensor), its public names, and the linear steps: preparing
+// the data, the design's rank and row space, the closed form, the covariance and the residuals.
+// Ceres lives in tensor_solve.cc, the principal axes and intervals in tensor_principal.cc;
+// tensor_steps.h lists the steps. Conventions: fit/tensor.h, docs/physics.md §3.5.
+#include "fit/tensor.h"
+
+#include "fit/ellipse_steps.h"
+#include "fit/solver_logging.h"
+#include "fit/tensor_steps.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace bifilar {
+namespace tensor {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+
+Eigen::Vector3d ToVector(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+
+// Continued fraction of the regularized incomplete beta function (modified Lentz).
+double BetaContinuedFraction(double a, double b, double x) {
+  constexpr double kTiny = 1e-300;
+  double c = 1.0, d = 1.0 - (a + b) * x / (a + 1.0);
+  if (std::fabs(d) < kTiny) d = kTiny;
+  d = 1.0 / d;
+  double h = d;
+  for (int m = 1; m <= 300; ++m) {
+    const double m2 = 2.0 * m;
+    double aa = m * (b - m) * x / ((a + m2 - 1) * (a + m2));
+    d = 1.0 + aa * d;
+    c = 1.0 + aa / c;
+    if (std::fabs(d) < kTiny) d = kTiny;
+    if (std::fabs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    h *= d * c;
+    aa = -(a + m) * (a + b + m) * x / ((a + m2) * (a + m2 + 1));
+    d = 1.0 + aa * d;
+    c = 1.0 + aa / c;
+    if (std::fabs(d) < kTiny) d = kTiny;
+    if (std::fabs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    const double delta = d * c;
+    h *= delta;
+    if (std::fabs(delta - 1.0) < 1e-14) break;
+  }
+  return h;
+}
+
+// I_x(a, b), the regularized incomplete beta function.
+double IncompleteBeta(double a, double b, double x) {
+  if (x <= 0.0) return 0.0;
+  if (x >= 1.0) return 1.0;
+  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) +
+                                a * std::log(x) + b * std::log1p(-x));
+  return x < (a + 1.0) / (a + b + 2.0) ? front * BetaContinuedFraction(a, b, x) / a
+                                       : 1.0 - front * BetaContinuedFraction(b, a, 1.0 - x) / b;
+}
+
+}  // namespace
+
+// P(F > f) for F with (d1, d2) degrees of freedom.
+double FDistributionUpperTail(double f, double d1, double d2) {
+  if (!(f > 0.0)) return 1.0;
+  return IncompleteBeta(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
+}
+
+namespace {
+
+}  // namespace
+
+Eigen::Matrix<double, 1, 6> DesignRow(const Eigen::Vector3d& n) {
+  Eigen::Matrix<double, 1, 6> row;
+  row << n.x() * n.x(), n.y() * n.y(), n.z() * n.z(), -2 * n.x() * n.y(), -2 * n.x() * n.z(),
+      -2 * n.y() * n.z();
+  return row;
+}
+
+Eigen::Matrix3d TensorMatrix(const Vec6& c) {
+  Eigen::Matrix3d j;
+  j << c(kIxx), -c(kIxy), -c(kIxz), -c(kIxy), c(kIyy), -c(kIyz), -c(kIxz), -c(kIyz), c(kIzz);
+  return j;
+}
+
+bool PrepareTensorData(const std::vector<TensorPoint>& points, const TensorOptions& options,
+                       Prepared* data, std::string* why) {
+  Prepared& d = *data;
+  d.n = static_cast<int>(points.size());
+  if (d.n == 0) {
+    *why = "no moments to fit";
+    return false;
+  }
+  int n_std = 0, n_grouped = 0;
+  std::vector<Eigen::Vector3d> used(d.n), nominal(d.n);
+  for (int i = 0; i < d.n; ++i) {
+    const TensorPoint& p = points[i];
+    const std::string where = "point " + std::to_string(i + 1) + ": ";
+    used[i] = ToVector(p.direction_in_body);
+    nominal[i] = ToVector(p.nominal_in_body);
+    if (!used[i].allFinite() || !(used[i].norm() > 1e-12) || !nominal[i].allFinite()) {
+      *why = where + "the swing axis must be a finite, non-zero vector";
+      return false;
+    }
+    used[i].normalize();
+    nominal[i] = nominal[i].norm() > 1e-12 ? nominal[i].normalized() : used[i];
+    if (!std::isfinite(p.inertia_kg_m2) || !(p.inertia_kg_m2 > 0.0) || p.inertia_kg_m2 > 1e100 ||
+        p.inertia_kg_m2 < 1e-100) {
+      *why = where + "inertia must be finite and in [1e-100, 1e100] kg m^2, got " +
+             Num(p.inertia_kg_m2);
+      return false;
+    }
+    if (p.std_kg_m2 < 0.0 || std::isinf(p.std_kg_m2) || (p.std_kg_m2 > 0 && p.std_kg_m2 < 1e-100)) {
+      *why = where + "std must be >= 0 and finite (0 or NaN = unknown), got " + Num(p.std_kg_m2);
+      return false;
+    }
+    if (p.std_kg_m2 > 0.0) ++n_std;
+    if (p.group >= 0) ++n_grouped;
+  }
+  d.weighted = n_std == d.n;
+  if (n_std > 0 && !d.weighted) {
+    d.warnings.push_back("std given for only " + std::to_string(n_std) + " of " +
+                         std::to_string(d.n) + " points: fitted unweighted");
+  }
+  if (options.covariance == EllipseCovariance::kAbsolute && !d.weighted) {
+    *why = "covariance 'absolute' needs a std for every point";
+    return false;
+  }
+  d.x.resize(d.n, 6);
+  d.x_nominal.resize(d.n, 6);
+  d.y.resize(d.n);
+  d.w.resize(d.n);
+  for (int i = 0; i < d.n; ++i) {
+    d.x.row(i) = DesignRow(used[i]);
+    d.axes.push_back(used[i]);
+    d.x_nominal.row(i) = DesignRow(nominal[i]);
+    d.y(i) = points[i].inertia_kg_m2;
+    d.w(i) = d.weighted ? 1.0 / (points[i].std_kg_m2 * points[i].std_kg_m2) : 1.0;
+  }
+  d.sqrt_w = d.w.cwiseSqrt();
+  // Orientation groups: the given ids when every point has one, else nominal axes within the
+  // tolerance of a group's first axis (sign-free: n and -n are one axis).
+  const double cos_tol = std::cos(options.group_tol_deg * kPi / 180.0);
+  std::vector<int> ids;
+  for (int i = 0; i < d.n; ++i) {
+    int g = -1;
+    if (n_grouped == d.n) {
+      for (size_t k = 0; k < ids.size(); ++k) {
+        if (ids[k] == points[i].group) g = static_cast<int>(k);
+      }
+    } else {
+      for (size_t k = 0; k < d.group_axis.size(); ++k) {
+        if (std::fabs(d.group_axis[k].dot(nominal[i])) >= cos_tol) {
+          g = static_cast<int>(k);
+          break;
+        }
+      }
+    }
+    if (g < 0) {
+      g = static_cast<int>(d.groups.size());
+      d.groups.emplace_back();
+      d.group_axis.push_back(nominal[i]);
+      ids.push_back(points[i].group);
+    }
+    d.groups[g].push_back(i);
+  }
+  return true;
+}
+
+bool AnalyseDesign(const Prepared& data, const TensorOptions& options, Design* design,
+                   std::string* why) {
+  Design& g = *design;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(data.x_nominal, Eigen::ComputeFullV);
+  const Eigen::VectorXd s = svd.singularValues();
+  g.singular_values.setZero();
+  for (int k = 0; k < s.size() && k < 6; ++k) g.singular_values(k) = s(k);
+  const double s_max = s.size() > 0 ? s(0) : 0.0;
+  g.rank = 0;
+  for (int k = 0; k < s.size(); ++k) {
+    if (s(k) > options.rank_tolerance * s_max) ++g.rank;
+  }
+  const Eigen::MatrixXd v = svd.matrixV();
+  g.basis = v.leftCols(g.rank);
+  g.condition_number = g.rank > 0 ? s_max / s(g.rank - 1) : kInf;
+  // A component is observable when its unit vector lies in the row space: no null-space part.
+  const Eigen::MatrixXd null_space = v.rightCols(6 - g.rank);
+  for (int c = 0; c < 6; ++c) {
+    g.observable[c] = g.rank == 6 || null_space.row(c).norm() < 1e-6;
+    if (!g.observable[c]) g.unobservable.push_back(TensorComponentName(c));
+  }
+  // Row-space directions not spanned by the observable components: combinations the data
+  // determine without determining their parts. Project the observable unit vectors out.
+  Eigen::MatrixXd rest = g.basis;
+  for (int c = 0; c < 6; ++c) {
+    if (g.observable[c]) rest.row(c).setZero();
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> rest_svd(rest, Eigen::ComputeThinU);
+  for (int k = 0; k < rest_svd.singularValues().size(); ++k) {
+    if (rest_svd.singularValues()(k) < 1e-6) continue;
+    Eigen::VectorXd u = rest_svd.matrixU().col(k);
+    int largest = 0;
+    u.cwiseAbs().maxCoeff(&largest);
+    u /= u(largest);
+    std::string text;
+    for (int c = 0; c < 6; ++c) {
+      if (std::fabs(u(c)) < 1e-6) continue;
+      char buffer[48];
+      std::snprintf(buffer, sizeof(buffer), "%s%.3g %s", text.empty() ? (u(c) < 0 ? "-" : "")
+                                                                      : (u(c) < 0 ? " - " : " + "),
+                    std::fabs(u(c)), TensorComponentName(c));
+      text += buffer;
+    }
+    g.combinations.push_back(text);
+  }
+  if (g.rank == 0 || g.unobservable.size() == 6) {
+    *why = "the swing axes determine none of the six components (Ixx, Iyy, Izz, Ixy, Ixz, Iyz are "
+           "all unobservable";
+    if (!g.combinations.empty()) *why += "; only " + g.combinations.front() + " is";
+    *why += "): swing about more axes";
+    return false;
+  }
+  // Resolve the covariance mode now that the number of parameters is known.
+  return true;
+}
+
+bool FitTensorClosedForm(const Prepared& data, const Design& design, Solution* s,
+                         std::string* why) {
+  const Eigen::MatrixXd z = data.x * design.basis;
+  const Eigen::MatrixXd zw = data.sqrt_w.asDiagonal() * z;
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(zw);
+  if (qr.rank() < design.rank) {
+    *why = "the measured swing axes do not determine the components the design should (singular "
+           "fit)";
+    return false;
+  }
+  s->gamma = qr.solve(data.sqrt_w.cwiseProduct(data.y));
+  s->beta = design.basis * s->gamma;
+  s->normal_inv = (zw.transpose() * zw).inverse();
+  s->fitted = data.x * s->beta;
+  s->resid = data.y - s->fitted;
+  s->chi2 = s->resid.cwiseProduct(s->resid).dot(data.w);
+  return true;
+}
+
+bool EstimateTensorCovariance(const Prepared& data, const Design& design, const Solution& s,
+                              const TensorOptions& options, Covariance* c, std::string* why) {
+  const int n = data.n, m = static_cast<int>(data.groups.size()), r = design.rank;
+  switch (data.covariance) {
+    case EllipseCovariance::kPointResiduals:
+      if (n <= r) {
+        *why = std::to_string(n) + " moments for " + std::to_string(r) +
+               " fitted components leave nothing to estimate the scatter: swing more trials or "
+               "give every moment a std with covariance 'absolute'";
+        return false;
+      }
+      c->variance_factor = s.chi2 / (n - r);
+      c->dof = n - r;
+      break;
+    case EllipseCovariance::kAngleMeans: {
+      if (m <= r) {
+        *why = "covariance 'angle_means' needs more orientations (" + std::to_string(m) +
+               ") than fitted components (" + std::to_string(r) + ")";
+        return false;
+      }
+      double ss = 0.0;
+      for (const std::vector<int>& g : data.groups) {
+        double sw = 0, sy = 0, sf = 0;
+        for (int i : g) {
+          sw += data.w(i);
+          sy += data.w(i) * data.y(i);
+          sf += data.w(i) * s.fitted(i);
+        }
+        const double d = (sy - sf) / sw;
+        ss += sw * d * d;
+      }
+      c->variance_factor = ss / (m - r);
+      c->dof = m - r;
+      break;
+    }
+    default:
+      c->variance_factor = 1.0;
+      c->dof = kInf;
+      break;
+  }
+  c->cov_gamma = s.normal_inv * c->variance_factor;
+  c->cov = design.basis * c->cov_gamma * design.basis.transpose();
+  // A common offset c adds c to every moment: the components answer with S 1, S the solution
+  // operator (for a full design exactly (1, 1, 1, 0, 0, 0)).
+  const Eigen::MatrixXd z = data.x * design.basis;
+  const Eigen::VectorXd response =
+      s.normal_inv * (z.transpose() * data.w);  // S 1 in row-space coordinates
+  c->offset_direction = design.basis * response;
+  const double off = options.common_offset_std_kg_m2;
+  c->cov += off * off * c->offset_direction * c->offset_direction.transpose();
+  return true;
+}
+
+}  // namespace tensor
+
+using namespace tensor;
+
+const char* TensorComponentName(int component) {
+  static const char* const kNames[] = {"Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"};
+  return component >= 0 && component < 6 ? kNames[component] : "?";
+}
+
+std::array<double, 3> DownInBodyFromAttitude(double roll_deg, double pitch_deg) {
+  const double t = pitch_deg * kPi / 180.0, f = roll_deg * kPi / 180.0;
+  return {-std::sin(t), std::sin(f) * std::cos(t), std::cos(f) * std::cos(t)};
+}
+
+double TensorMoment(const std::array<double, kTensorComponents>& c, const std::array<double, 3>& n) {
+  Vec6 beta;
+  for (int k = 0; k < 6; ++k) beta(k) = c[k];
+  const Eigen::Vector3d u = Eigen::Vector3d(n[0], n[1], n[2]).normalized();
+  return DesignRow(u) * beta;
+}
+
+bool TensorOptions::Check(std::string* why) const {
+  EllipseOptions e;
+  e.bootstrap_replicates = bootstrap_replicates;
+  e.confidence = confidence;
+  e.outlier_threshold = outlier_threshold;
+  e.common_offset_std_kg_m2 = common_offset_std_kg_m2;
+  if (!e.Check(why)) return false;
+  if (!(group_tol_deg >= 0.0 && group_tol_deg < 45.0)) {
+    *why = "group_tol_deg must be in [0, 45), got " + Num(group_tol_deg);
+    return false;
+  }
+  if (!(rank_tolerance > 0.0 && rank_tolerance < 1.0)) {
+    *why = "rank_tolerance must be in (0, 1), got " + Num(rank_tolerance);
+    return false;
+  }
+  return true;
+}
+
+bool TensorResult::IsUsable() const {
+  for (const TensorEstimate& e : components) {
+    if (e.observable && std::isfinite(e.value) && std::isfinite(e.std)) return true;
+  }
+  return false;
+}
+
+std::string TensorResult::BriefReport() const {
+  std::ostringstream s;
+  s.precision(6);
+  s << "tensor fit: " << n_points << " moments about " << n_orientations << " axes, rank " << rank
+    << ", condition " << condition_number << ", covariance "
+    << EllipseCovarianceName(covariance_used) << "\n";
+  for (int k = 0; k < 6; ++k) {
+    s << "  " << TensorComponentName(k) << " = ";
+    if (components[k].observable) {
+      s << components[k].value << " +- " << components[k].std << " kg m^2\n";
+    } else {
+      s << "not observable\n";
+    }
+  }
+  if (full) {
+    s << "  principal moments: ";
+    for (int k = 0; k < 3; ++k) {
+      s << (k ? ", " : "") << principal_moments[k].value << " +- " << principal_moments[k].std;
+    }
+    s << " kg m^2\n";
+  }
+  for (const std::string& w : warnings) s << "  warning: " << w << "\n";
+  return s.str();
+}
+
+namespace {
+
+// Point and orientation residuals (studentized with the hat matrix of the reduced fit).
+void DiagnoseTensor(const Prepared& data, const Design& design, const Solution& s,
+                    const Covariance& cov, const TensorOptions& options, TensorResult* r) {
+  const Eigen::MatrixXd z = data.x * design.basis;
+  r->orientations.resize(data.groups.size());
+  std::vector<int> orientation_of(data.n, 0);
+  for (size_t g = 0; g < data.groups.size(); ++g) {
+    TensorOrientation& o = r->orientations[g];
+    o.members = data.groups[g];
+    for (int k = 0; k < 3; ++k) o.nominal_in_body[k] = data.group_axis[g](k);
+    double sw = 0, sy = 0, sf = 0, sum = 0, sum2 = 0;
+    for (int i : o.members) {
+      orientation_of[i] = static_cast<int>(g);
+      sw += data.w(i);
+      sy += data.w(i) * data.y(i);
+      sf += data.w(i) * s.fitted(i);
+      sum += data.y(i);
+      sum2 += data.y(i) * data.y(i);
+    }
+    const double count = static_cast<double>(o.members.size());
+    o.mean_kg_m2 = sy / sw;
+    o.fitted_kg_m2 = sf / sw;
+    o.residual_kg_m2 = o.mean_kg_m2 - o.fitted_kg_m2;
+    o.residual_std_kg_m2 = std::sqrt(cov.variance_factor / sw);
+    o.z = o.residual_std_kg_m2 > 0 ? o.residual_kg_m2 / o.residual_std_kg_m2 : 0.0;
+    o.scatter_kg_m2 =
+        count > 1 ? std::sqrt(std::max(0.0, (sum2 - sum * sum / count) / (count - 1))) : 0.0;
+  }
+  for (int i = 0; i < data.n; ++i) {
+    TensorPointResidual p;
+    p.index = i;
+    p.orientation = orientation_of[i];
+    p.inertia_kg_m2 = data.y(i);
+    p.fitted_kg_m2 = s.fitted(i);
+    p.residual_kg_m2 = s.resid(i);
+    const double h = data.w(i) * z.row(i) * s.normal_inv * z.row(i).transpose();
+    const double denominator = cov.variance_factor * (1.0 - h) / data.w(i);
+    p.studentized = denominator > 0 ? s.resid(i) / std::sqrt(denominator) : 0.0;
+    p.outlier = std::fabs(p.studentized) > options.outlier_threshold;
+    r->n_outliers += p.outlier;
+    r->residuals.push_back(p);
+  }
+}
+
+// d I(n) / d(axis): the moment's sensitivity to tilting the axis, |2 (J n - (n^T J n) n)| per
+// rad (the gradient of n^T J n on the unit sphere), at the fitted tensor.
+Eigen::VectorXd AttitudeSensitivity(const Prepared& data, const Vec6& beta) {
+  const Eigen::Matrix3d j = TensorMatrix(beta);
+  Eigen::VectorXd g(data.n);
+  for (int i = 0; i < data.n; ++i) {
+    // The used direction from its design row: (nx^2, ny^2, nz^2, -2 nx ny, ...) is not
+    // invertible in sign, so keep the unit axes in Prepared.
+    const Eigen::Vector3d& n = data.axes[i];
+    const Eigen::Vector3d jn = j * n;
+    g(i) = 2.0 * (jn - n.dot(jn) * n).norm();
+  }
+  return g;
+}
+
+// A swing axis is known only to within the attitude the aircraft hung at (set by hand, or
+// measured by an accelerometer with a bias): an error of sigma_a rad about a horizontal axis moves
+// the moment by g_i sigma_a, far above a trace fit's own std (1e-4 of I against ~1e-3 for 0.5
+// deg). With a full design the fit weighs each point by 1/(s_i^2 + sigma_a^2 g_i^2), sigma_a
+// solved from the residuals (sum r_i^2 / (s_i^2 + sigma_a^2 g_i^2) = n - rank, the Paule-Mandel
+// equation), refitting with the new weights until they settle. Returns sigma_a (rad; 0 when the
+// stated stds explain the scatter or the design is not full or unweighted), NaN when a refit fails.
+// With a design that is not full (three axes, say, often principal ones, where g_i ~ 0) the
+// same equation is solved for a relative scatter instead, s_i^2 + (sigma_r I_i)^2: repeats of a
+// real rig scatter by 0.2-0.3 % (release amplitude, hanging) where each log's std says 0.02-0.15 %.
+// *relative receives sigma_r (0 when not used).
+double ReweighForAttitudeScatter(const Design& design, const TensorOptions& options,
+                                 Prepared* data, Solution* fit, double* relative) {
+  *relative = 0.0;
+  if (!options.attitude_scatter || !data->weighted || data->n <= design.rank) return 0.0;
+  const bool full = design.rank == 6;
+  const Eigen::VectorXd s2 = data->w.cwiseInverse();  // the stated variances
+  double sigma2 = 0.0;
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    const Eigen::VectorXd g2 = full ? Eigen::VectorXd(AttitudeSensitivity(*data, fit->beta).array().square())
+                                    : Eigen::VectorXd(fit->fitted.array().square());
+    const Eigen::VectorXd r2 = fit->resid.array().square();
+    auto excess = [&](double v) {
+      return (r2.array() / (s2.array() + v * g2.array())).sum() - (data->n - design.rank);
+    };
+    double next = 0.0;
+    if (excess(0.0) > 0.0) {
+      double lo = 0.0, hi = 1e-6;
+      while (excess(hi) > 0.0 && hi < 1.0) hi *= 4.0;  // 1 rad^2: beyond any attitude error
+      for (int k = 0; k < 100; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (excess(mid) > 0.0 ? lo : hi) = mid;
+      }
+      next = 0.5 * (lo + hi);
+    }
+    const bool settled = std::fabs(next - sigma2) <= 1e-4 * std::max(next, 1e-300);
+    sigma2 = next;
+    data->w = (s2.array() + sigma2 * g2.array()).inverse().matrix();
+    data->sqrt_w = data->w.cwiseSqrt();
+    std::string why;
+    if (!FitTensorClosedForm(*data, design, fit, &why)) return NAN;
+    if (settled) break;
+  }
+  if (!full) {
+    *relative = std::sqrt(sigma2);
+    return 0.0;
+  }
+  return std::sqrt(sigma2);
+}
+
+// Lack-of-fit F test at 5 %: do the orientations' means scatter about the fit more than their
+// trials scatter about the means? Needs repeats and more orientations than components.
+bool OrientationsScatterBeyondTrials(const Prepared& data, const Design& design,
+                                     const Solution& fit) {
+  const int n = data.n, m = static_cast<int>(data.groups.size()), r = design.rank;
+  if (m >= n || m <= r) return false;
+  double pure = 0.0, lack = 0.0;
+  for (const std::vector<int>& g : data.groups) {
+    double sw = 0, sy = 0, sf = 0;
+    for (int i : g) {
+      sw += data.w(i);
+      sy += data.w(i) * data.y(i);
+      sf += data.w(i) * fit.fitted(i);
+    }
+    const double mean = sy / sw, fitted = sf / sw;
+    for (int i : g) pure += data.w(i) * (data.y(i) - mean) * (data.y(i) - mean);
+    lack += sw * (mean - fitted) * (mean - fitted);
+  }
+  if (!(pure > 0.0)) return lack > 0.0;
+  const double f = (lack / (m - r)) / (pure / (n - m));
+  return FDistributionUpperTail(f, m - r, n - m) < 0.05;
+}
+
+}  // namespace
+
+bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& options,
+               TensorResult* result, std::string* why) {
+  const auto start = std::chrono::steady_clock::now();
+  QuietSolverLogging();
+  if (!options.Check(why)) return false;
+  Prepared data;
+  if (!PrepareTensorData(points, options, &data, why)) return false;
+  Design design;
+  if (!AnalyseDesign(data, options, &design, why)) return false;
+  Solution closed;
+  if (!FitTensorClosedForm(data, design, &closed, why)) return false;
+  // Each axis is known to within an attitude error: weights 1/(s_i^2 + sigma_a^2 g_i^2).
+  double relative_scatter = 0.0;
+  const double attitude_scatter_rad =
+      ReweighForAttitudeScatter(design, options, &data, &closed, &relative_scatter);
+  if (!std::isfinite(attitude_scatter_rad)) {
+    *why = "the refit with the attitude scatter failed (singular fit)";
+    return false;
+  }
+  // The covariance mode (kAuto: orientation means when the orientations scatter beyond their
+  // trials, points otherwise).
+  const int m = static_cast<int>(data.groups.size());
+  data.covariance = options.covariance;
+  if (data.covariance == EllipseCovariance::kAuto) {
+    data.covariance = OrientationsScatterBeyondTrials(data, design, closed)
+                          ? EllipseCovariance::kAngleMeans
+                          : EllipseCovariance::kPointResiduals;
+  }
+  TensorResult r;
+  const Solution solved = FitTensorCeres(data, design, closed, &r.ceres);
+  Covariance cov;
+  if (!EstimateTensorCovariance(data, design, solved, options, &cov, why)) return false;
+
+  r.n_points = data.n;
+  r.n_orientations = m;
+  r.rank = design.rank;
+  r.weighted = data.weighted;
+  r.attitude_scatter_deg = attitude_scatter_rad * 180.0 / kPi;
+  r.relative_scatter = relative_scatter;
+  r.full = design.rank == 6;
+  r.condition_number = design.condition_number;
+  for (int k = 0; k < 6; ++k) r.design_singular_values[k] = design.singular_values(k);
+  r.covariance_used = data.covariance;
+  r.variance_factor = cov.variance_factor;
+  r.dof = cov.dof;
+  r.reduced_chi2 = data.n > design.rank ? solved.chi2 / (data.n - design.rank) : 0.0;
+  r.rmse_kg_m2 = std::sqrt(solved.resid.squaredNorm() / data.n);
+  r.unobservable = design.unobservable;
+  r.observable_combinations = design.combinations;
+  double scale = 0.0;
+  for (int k = 0; k < 3; ++k) scale = std::max(scale, std::fabs(closed.beta(k)));
+  for (int k = 0; k < 6; ++k) {
+    r.closed_form_max_relative_difference =
+        std::max(r.closed_form_max_relative_difference,
+                 std::fabs(solved.beta(k) - closed.beta(k)) / std::max(scale, 1e-300));
+  }
+  if (r.closed_form_max_relative_difference > 1e-6) {
+    r.warnings.push_back("Ceres and the closed form disagree by " +
+                         Num(r.closed_form_max_relative_difference) + " of the largest moment");
+  }
+
+  const TensorIntervalSet intervals =
+      TensorIntervals(data, design, solved, cov, options, r.full);
+  r.bootstrap_replicates = intervals.replicates;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  for (int k = 0; k < 6; ++k) {
+    TensorEstimate& e = r.components[k];
+    e.observable = design.observable[k];
+    e.value = e.observable ? solved.beta(k) : kNaN;
+    e.std = e.observable ? std::sqrt(std::max(0.0, cov.cov(k, k))) : kNaN;
+    e.ci_lo = e.observable ? intervals.lo(k) : kNaN;
+    e.ci_hi = e.observable ? intervals.hi(k) : kNaN;
+    for (int l = 0; l < 6; ++l) {
+      r.covariance[k][l] = design.observable[k] && design.observable[l] ? cov.cov(k, l) : kNaN;
+    }
+  }
+  if (!r.unobservable.empty()) {
+    std::string names;
+    for (const std::string& u : r.unobservable) names += (names.empty() ? "" : ", ") + u;
+    std::string text = "not observable from these swing axes: " + names;
+    if (!r.observable_combinations.empty()) {
+      text += " (the data determine only";
+      for (size_t k = 0; k < r.observable_combinations.size(); ++k) {
+        text += (k ? "; " : " ") + r.observable_combinations[k];
+      }
+      text += ")";
+    }
+    r.warnings.push_back(text + "; swing about axes that mix them to measure them");
+  }
+  if (r.full) {
+    const Principal p = ComputePrincipal(solved.beta, cov.cov);
+    for (int k = 0; k < 3; ++k) {
+      r.principal_moments[k] = {p.moments(k), p.moments_std(k), intervals.principal_lo(k),
+                                intervals.principal_hi(k), true};
+      for (int c = 0; c < 3; ++c) r.principal_axes[k][c] = p.axes(c, k);
+      r.principal_axes_std_deg[k] = p.axes_std_deg(k);
+      // Euler intervals: normal, value -+ z std (first order; the angles are not bootstrapped).
+      const double z = ellipse::NormalQuantile(0.5 + 0.5 * options.confidence);
+      r.euler_deg[k] = {p.euler_deg(k), p.euler_std_deg(k), p.euler_deg(k) - z * p.euler_std_deg(k),
+                        p.euler_deg(k) + z * p.euler_std_deg(k), true};
+      r.principal_moments_matched_kg_m2[k] = p.matched_moments(k);
+    }
+    r.warnings.insert(r.warnings.end(), p.warnings.begin(), p.warnings.end());
+    if (r.condition_number > 100) {
+      r.warnings.push_back("the swing axes are nearly degenerate (design condition number " +
+                           Num(r.condition_number) + "): some components are poorly determined");
+    }
+  } else {
+    for (int k = 0; k < 3; ++k) {
+      r.principal_moments[k] = {kNaN, kNaN, kNaN, kNaN, false};
+      r.euler_deg[k] = {kNaN, kNaN, kNaN, kNaN, false};
+      r.principal_axes_std_deg[k] = kNaN;
+      r.principal_moments_matched_kg_m2[k] = kNaN;
+      for (int c = 0; c < 3; ++c) r.principal_axes[k][c] = kNaN;
+    }
+  }
+  DiagnoseTensor(data, design, solved, cov, options, &r);
+  r.warnings.insert(r.warnings.begin(), data.warnings.begin(), data.warnings.end());
+  r.warnings.insert(r.warnings.end(), cov.warnings.begin(), cov.warnings.end());
+  r.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  *result = std::move(r);
+  return true;
+}
+
+}  // namespace bifilar

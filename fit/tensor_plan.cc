@@ -1,0 +1,423 @@
+// D-optimal choice of attitudes for a tensor campaign (fit/tensor_plan.h).
+#include "fit/tensor_plan.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <tuple>
+
+namespace bifilar {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegToRad = kPi / 180.0;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+using Row = std::array<double, kTensorPlanComponents>;
+
+// One reachable attitude: its axis, its design row and its weight.
+struct Candidate {
+  double roll_deg = 0.0;
+  double pitch_deg = 0.0;
+  std::array<double, 3> n = {0, 0, 1};
+  Row row = {};
+  double inertia_kg_m2 = kNaN;  // guessed moment about n
+  double swing_var = 0.0;       // per-swing variance (absolute and relative parts)
+  double tilt_var = 0.0;        // variance of the moment from the attitude error
+};
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// lo, lo + step, ... and hi itself; {lo} when the range has no width.
+std::vector<double> GridValues(double lo, double hi, double step) {
+  std::vector<double> v;
+  for (int i = 0; lo + i * step < hi - 1e-9 * step; ++i) v.push_back(lo + i * step);
+  v.push_back(hi);
+  return v;
+}
+
+Eigen::Matrix3d TensorMatrix(const Row& c) {
+  Eigen::Matrix3d j;
+  j << c[0], -c[3], -c[4], -c[3], c[1], -c[5], -c[4], -c[5], c[2];
+  return j;
+}
+
+// n and -n are one swing axis: a key equal for both, to 1e-9.
+std::tuple<long long, long long, long long> AxisKey(const std::array<double, 3>& n) {
+  double s = 1.0;
+  for (double c : n) {
+    if (std::fabs(c) > 1e-12) {
+      s = c > 0 ? 1.0 : -1.0;
+      break;
+    }
+  }
+  return {std::llround(s * n[0] * 1e9), std::llround(s * n[1] * 1e9), std::llround(s * n[2] * 1e9)};
+}
+
+// The orientation means' weights 1 / (swing_var / trials + tilt_var), as a vector.
+Eigen::VectorXd Weights(const std::vector<Candidate>& c, const std::vector<int>& chosen,
+                        double trials) {
+  Eigen::VectorXd w(chosen.size());
+  for (size_t i = 0; i < chosen.size(); ++i) {
+    const Candidate& k = c[chosen[i]];
+    w[i] = 1.0 / (k.swing_var / trials + k.tilt_var);
+  }
+  return w;
+}
+
+// Covariance (6 x 6, NaN rows/columns for unobservable components) of the chosen design with
+// weights w, on the observable subspace spanned by the columns of basis.
+Eigen::MatrixXd Covariance6(const Eigen::MatrixXd& reduced_rows, const std::vector<int>& chosen,
+                            const Eigen::VectorXd& w, const Eigen::MatrixXd& basis,
+                            const std::array<bool, kTensorPlanComponents>& observable,
+                            double* log_det) {
+  const int r = static_cast<int>(basis.cols());
+  Eigen::MatrixXd info = Eigen::MatrixXd::Zero(r, r);
+  for (size_t i = 0; i < chosen.size(); ++i) {
+    const Eigen::VectorXd b = reduced_rows.row(chosen[i]).transpose();
+    info += w[i] * b * b.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(info);
+  if (log_det != nullptr) {
+    *log_det = 0.0;
+    for (int k = 0; k < r; ++k) *log_det += std::log(eig.eigenvalues()[k]);
+  }
+  const Eigen::MatrixXd inv = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() *
+                              eig.eigenvectors().transpose();
+  Eigen::MatrixXd cov = basis * inv * basis.transpose();
+  for (int k = 0; k < kTensorPlanComponents; ++k) {
+    if (observable[k]) continue;
+    cov.row(k).setConstant(kNaN);
+    cov.col(k).setConstant(kNaN);
+  }
+  return cov;
+}
+
+}  // namespace
+
+const char* TensorPlanComponentName(int component) {
+  static const char* const kNames[kTensorPlanComponents] = {"Ixx", "Iyy", "Izz",
+                                                            "Ixy", "Ixz", "Iyz"};
+  return component >= 0 && component < kTensorPlanComponents ? kNames[component] : "?";
+}
+
+std::array<double, 3> PlanDownInBody(double roll_deg, double pitch_deg) {
+  const double phi = roll_deg * kDegToRad, theta = pitch_deg * kDegToRad;
+  return {-std::sin(theta), std::sin(phi) * std::cos(theta), std::cos(phi) * std::cos(theta)};
+}
+
+Row TensorDesignRow(const std::array<double, 3>& axis) {
+  const double len = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+  const double x = axis[0] / len, y = axis[1] / len, z = axis[2] / len;
+  return {x * x, y * y, z * z, -2 * x * y, -2 * x * z, -2 * y * z};
+}
+
+bool TensorPlanOptions::Check(std::string* why) const {
+  const auto fail = [why](const std::string& m) {
+    if (why != nullptr) *why = m;
+    return false;
+  };
+  const auto finite = [](double v) { return std::isfinite(v); };
+  if (!finite(roll_min_deg) || !finite(roll_max_deg) || roll_min_deg < -180 || roll_max_deg > 180 ||
+      roll_min_deg > roll_max_deg) {
+    return fail("the roll range must lie in [-180, 180] deg with min <= max");
+  }
+  if (!finite(pitch_min_deg) || !finite(pitch_max_deg) || pitch_min_deg < -90 ||
+      pitch_max_deg > 90 || pitch_min_deg > pitch_max_deg) {
+    return fail("the pitch range must lie in [-90, 90] deg with min <= max");
+  }
+  if (!(grid_step_deg >= 0.5 && grid_step_deg <= 90)) {
+    return fail("the grid step must lie in [0.5, 90] deg");
+  }
+  if (n_orientations < 1 || n_orientations > 100) {
+    return fail("the number of orientations must lie in [1, 100]");
+  }
+  if (trials_per_orientation < 1 || trials_per_orientation > 1000000) {
+    return fail("the trials per orientation must lie in [1, 1000000]");
+  }
+  if (!finite(sigma_kg_m2) || sigma_kg_m2 < 0 || !finite(sigma_relative) || sigma_relative < 0 ||
+      sigma_relative >= 1) {
+    return fail("the per-swing std must be >= 0 (absolute) and in [0, 1) (relative)");
+  }
+  if (sigma_kg_m2 == 0 && sigma_relative == 0) {
+    return fail("give a per-swing std (absolute or relative), > 0");
+  }
+  if (!finite(attitude_std_deg) || attitude_std_deg < 0 || attitude_std_deg > 10) {
+    return fail("the attitude std must lie in [0, 10] deg");
+  }
+  if ((sigma_relative > 0 || attitude_std_deg > 0) && !guess_given) {
+    return fail(
+        "a relative swing std or an attitude error needs a guess of the tensor (at least "
+        "Ixx, Iyy, Izz)");
+  }
+  for (double g : guess_kg_m2) {
+    if (!finite(g)) return fail("the guessed tensor has a value that is not a finite number");
+  }
+  if (!finite(target_std_kg_m2) || target_std_kg_m2 < 0) {
+    return fail("the target std must be > 0 (or 0 for none)");
+  }
+  if (!(rank_tolerance > 0 && rank_tolerance < 1)) return fail("rank_tolerance must be in (0, 1)");
+  return true;
+}
+
+bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string* why) {
+  if (!options.Check(why)) return false;
+  *plan = TensorPlan();
+  const auto fail = [why](const std::string& m) {
+    if (why != nullptr) *why = m;
+    return false;
+  };
+  const Row& guess = options.guess_kg_m2;
+  const Eigen::Matrix3d j_guess = TensorMatrix(guess);
+  if (options.guess_given) {
+    const Eigen::Vector3d eig =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(j_guess).eigenvalues();
+    if (!(eig[0] > 0)) {
+      return fail("the guessed tensor is not positive definite (smallest principal moment " +
+                  Num(eig[0]) + " kg m^2): check the products' signs and sizes");
+    }
+  }
+
+  // 1. Candidates: the grid, one per distinct axis, the easiest attitude (smallest |roll| +
+  // |pitch|) kept for each.
+  std::vector<Candidate> all;
+  for (double roll :
+       GridValues(options.roll_min_deg, options.roll_max_deg, options.grid_step_deg)) {
+    for (double pitch :
+         GridValues(options.pitch_min_deg, options.pitch_max_deg, options.grid_step_deg)) {
+      Candidate c;
+      c.roll_deg = roll;
+      c.pitch_deg = pitch;
+      c.n = PlanDownInBody(roll, pitch);
+      all.push_back(c);
+    }
+  }
+  std::stable_sort(all.begin(), all.end(), [](const Candidate& a, const Candidate& b) {
+    const double ea = std::fabs(a.roll_deg) + std::fabs(a.pitch_deg);
+    const double eb = std::fabs(b.roll_deg) + std::fabs(b.pitch_deg);
+    if (ea != eb) return ea < eb;
+    return std::fabs(a.roll_deg) < std::fabs(b.roll_deg);
+  });
+  std::vector<Candidate> cand;
+  std::map<std::tuple<long long, long long, long long>, int> seen;
+  const double tilt_std_rad = options.attitude_std_deg * kDegToRad;
+  const double trials = options.trials_per_orientation;
+  for (Candidate& c : all) {
+    if (!seen.emplace(AxisKey(c.n), static_cast<int>(cand.size())).second) continue;
+    c.row = TensorDesignRow(c.n);
+    double swing_var = options.sigma_kg_m2 * options.sigma_kg_m2;
+    if (options.guess_given) {
+      const Eigen::Vector3d n(c.n[0], c.n[1], c.n[2]);
+      const Eigen::Vector3d jn = j_guess * n;
+      c.inertia_kg_m2 = n.dot(jn);
+      swing_var += std::pow(options.sigma_relative * c.inertia_kg_m2, 2);
+      // dI/d(tilt) = 2 (1 - n n^T) J n: the moment's rate of change per radian of tilt; an
+      // isotropic tilt error of std s per axis moves I by s |that| (first order).
+      const double g = 2.0 * (jn - n * n.dot(jn)).norm();
+      c.tilt_var = std::pow(tilt_std_rad * g, 2);
+    }
+    c.swing_var = swing_var;
+    cand.push_back(c);
+  }
+  const int n_cand = static_cast<int>(cand.size());
+  plan->n_candidates = n_cand;
+
+  // 2. What the reachable axes can observe: the row space of their design.
+  Eigen::MatrixXd a(n_cand, kTensorPlanComponents);
+  for (int i = 0; i < n_cand; ++i) {
+    for (int k = 0; k < kTensorPlanComponents; ++k) a(i, k) = cand[i].row[k];
+  }
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeThinV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  int rank = 0;
+  while (rank < sv.size() && sv[rank] > options.rank_tolerance * sv[0]) ++rank;
+  plan->rank = rank;
+  const Eigen::MatrixXd basis = svd.matrixV().leftCols(rank);  // 6 x r
+  int n_observable = 0;
+  for (int k = 0; k < kTensorPlanComponents; ++k) {
+    // e_k lies in the row space when its projection keeps its length.
+    const double in_space = basis.row(k).squaredNorm();
+    plan->observable[k] = 1.0 - in_space < 1e-12;
+    if (plan->observable[k]) {
+      ++n_observable;
+    } else {
+      plan->unobservable.push_back(TensorPlanComponentName(k));
+    }
+  }
+  plan->n_combinations = rank - n_observable;
+  const Eigen::MatrixXd reduced = a * basis;  // candidates' rows in row-space coordinates
+  if (!plan->unobservable.empty()) {
+    std::string names;
+    for (const std::string& u : plan->unobservable) names += (names.empty() ? "" : ", ") + u;
+    plan->warnings.push_back(
+        "the reachable attitudes (roll " + Num(options.roll_min_deg) + ".." +
+        Num(options.roll_max_deg) + " deg, pitch " + Num(options.pitch_min_deg) + ".." +
+        Num(options.pitch_max_deg) + " deg) cannot observe " + names +
+        ": no reachable swing axis separates them from the rest; widen the roll or pitch range "
+        "(a rig that holds roll at 0 keeps every axis in the body x-z plane: Iyy, Ixy, Iyz)");
+  }
+  if (n_observable == 0) {
+    return fail(
+        "the reachable attitudes determine no single component, only combinations of them; "
+        "widen the roll or pitch range");
+  }
+
+  int n = options.n_orientations;
+  if (n > n_cand) {
+    plan->warnings.push_back("the grid holds only " + std::to_string(n_cand) +
+                             " distinct swing axes, so " + std::to_string(n_cand) +
+                             " orientations are planned instead of " + std::to_string(n));
+    n = n_cand;
+  }
+  if (n < rank) {
+    return fail(std::to_string(n) + " orientation(s) cannot determine the " + std::to_string(rank) +
+                " components (or combinations) the rig can observe; plan "
+                "at least " +
+                std::to_string(rank));
+  }
+
+  // 3. D-optimal choice. Weights of the orientation means at the planned trials.
+  Eigen::VectorXd w_all(n_cand);
+  for (int i = 0; i < n_cand; ++i) w_all[i] = 1.0 / (cand[i].swing_var / trials + cand[i].tilt_var);
+  double scale = 0.0;
+  for (int i = 0; i < n_cand; ++i) scale = std::max(scale, w_all[i] * reduced.row(i).squaredNorm());
+  // A ridge of 1e-10 of the largest single contribution keeps the information matrix invertible
+  // while fewer than `rank` orientations are chosen; it only breaks ties among them.
+  const Eigen::MatrixXd ridge = 1e-10 * scale * Eigen::MatrixXd::Identity(rank, rank);
+  std::vector<int> chosen;
+  std::vector<char> in_design(n_cand, 0);
+  Eigen::MatrixXd info = ridge;
+  // The variance function d(c) = w_c b_c^T M^-1 b_c: adding c multiplies det M by 1 + d(c).
+  const auto best_addition = [&](const Eigen::MatrixXd& m, double* best_d) {
+    const Eigen::MatrixXd m_inv = m.ldlt().solve(Eigen::MatrixXd::Identity(rank, rank));
+    int best = -1;
+    *best_d = -1.0;
+    for (int c = 0; c < n_cand; ++c) {
+      if (in_design[c]) continue;
+      const Eigen::VectorXd b = reduced.row(c).transpose();
+      const double d = w_all[c] * b.dot(m_inv * b);
+      if (d > *best_d * (1 + 1e-12) + 1e-300) {
+        *best_d = d;
+        best = c;
+      }
+    }
+    return best;
+  };
+  for (int k = 0; k < n; ++k) {
+    double d = 0.0;
+    const int c = best_addition(info, &d);
+    chosen.push_back(c);
+    in_design[c] = 1;
+    const Eigen::VectorXd b = reduced.row(c).transpose();
+    info += w_all[c] * b * b.transpose();
+  }
+  // Fedorov exchange: swap a chosen orientation for a candidate while det M grows. Removing j
+  // leaves M_j; det(M_j + w_c b_c b_c^T) / det(M) = (1 + d_j(c)) / (1 + d_j(j)).
+  for (int sweep = 0; sweep < 100; ++sweep) {
+    bool improved = false;
+    for (int p = 0; p < n; ++p) {
+      const int j = chosen[p];
+      const Eigen::VectorXd bj = reduced.row(j).transpose();
+      const Eigen::MatrixXd m_j = info - w_all[j] * bj * bj.transpose();
+      in_design[j] = 0;
+      double d_best = 0.0;
+      const int c = best_addition(m_j, &d_best);
+      const Eigen::MatrixXd m_j_inv = m_j.ldlt().solve(Eigen::MatrixXd::Identity(rank, rank));
+      const double d_j = w_all[j] * bj.dot(m_j_inv * bj);
+      if (c >= 0 && c != j && (1 + d_best) > (1 + d_j) * (1 + 1e-9)) {
+        chosen[p] = c;
+        in_design[c] = 1;
+        const Eigen::VectorXd bc = reduced.row(c).transpose();
+        info = m_j + w_all[c] * bc * bc.transpose();
+        improved = true;
+      } else {
+        in_design[j] = 1;
+      }
+    }
+    plan->exchange_sweeps = sweep + 1;
+    if (!improved) break;
+  }
+
+  // 4. The chosen design's covariance, condition and trials needed.
+  Eigen::MatrixXd chosen_rows(n, kTensorPlanComponents);
+  for (int i = 0; i < n; ++i) chosen_rows.row(i) = a.row(chosen[i]);
+  const Eigen::VectorXd chosen_sv = Eigen::JacobiSVD<Eigen::MatrixXd>(chosen_rows).singularValues();
+  if (!(chosen_sv[rank - 1] > options.rank_tolerance * chosen_sv[0])) {
+    return fail("internal: the chosen orientations do not span what the rig can observe");
+  }
+  plan->condition_number = chosen_sv[0] / chosen_sv[rank - 1];
+  const Eigen::VectorXd w = Weights(cand, chosen, trials);
+  const Eigen::MatrixXd cov =
+      Covariance6(reduced, chosen, w, basis, plan->observable, &plan->log_det_information);
+  for (int k = 0; k < kTensorPlanComponents; ++k) {
+    plan->std_kg_m2[k] = plan->observable[k] ? std::sqrt(cov(k, k)) : kNaN;
+    for (int l = 0; l < kTensorPlanComponents; ++l) plan->covariance[k][l] = cov(k, l);
+  }
+  const auto std_at = [&](double t, int k) {
+    const Eigen::MatrixXd c =
+        Covariance6(reduced, chosen, Weights(cand, chosen, t), basis, plan->observable, nullptr);
+    return std::sqrt(c(k, k));
+  };
+  for (int k = 0; k < kTensorPlanComponents; ++k) {
+    // The floor: the attitude error alone, as the trials grow without bound (1e12 stands for
+    // infinity; an axis along a principal axis of the guess does not feel a tilt at first order
+    // and keeps a finite weight there).
+    plan->floor_std_kg_m2[k] = !plan->observable[k]           ? kNaN
+                               : options.attitude_std_deg > 0 ? std_at(1e12, k)
+                                                              : 0.0;
+  }
+  if (options.target_std_kg_m2 > 0) {
+    const double target = options.target_std_kg_m2;
+    plan->trials_needed_all = 1;
+    for (int k = 0; k < kTensorPlanComponents; ++k) {
+      if (!plan->observable[k]) continue;
+      constexpr int kMaxTrials = 1000000;
+      int needed = -1;
+      if (plan->floor_std_kg_m2[k] < target && std_at(kMaxTrials, k) <= target) {
+        int lo = 1, hi = kMaxTrials;  // std_at decreases with t: the smallest t reaching target
+        while (lo < hi) {
+          const int mid = lo + (hi - lo) / 2;
+          if (std_at(mid, k) <= target) {
+            hi = mid;
+          } else {
+            lo = mid + 1;
+          }
+        }
+        needed = lo;
+      }
+      plan->trials_needed[k] = needed;
+      if (needed < 0 || plan->trials_needed_all < 0) {
+        plan->trials_needed_all = -1;
+      } else {
+        plan->trials_needed_all = std::max(plan->trials_needed_all, needed);
+      }
+    }
+  }
+
+  plan->n_points = n * options.trials_per_orientation;
+  // Listed by roll, then pitch: the order a crew re-rigs in.
+  std::sort(chosen.begin(), chosen.end(), [&cand](int x, int y) {
+    if (cand[x].roll_deg != cand[y].roll_deg) return cand[x].roll_deg < cand[y].roll_deg;
+    return cand[x].pitch_deg < cand[y].pitch_deg;
+  });
+  for (int i : chosen) {
+    const Candidate& c = cand[i];
+    TensorPlanOrientation o;
+    o.roll_deg = c.roll_deg;
+    o.pitch_deg = c.pitch_deg;
+    o.axis_in_body = c.n;
+    o.inertia_kg_m2 = c.inertia_kg_m2;
+    o.swing_std_kg_m2 = std::sqrt(c.swing_var);
+    o.mean_std_kg_m2 = std::sqrt(c.swing_var / trials + c.tilt_var);
+    plan->orientations.push_back(o);
+  }
+  return true;
+}
+
+}  // namespace bifilar

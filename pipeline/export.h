@@ -1,0 +1,104 @@
+// `bifilar export`: the inertia of a results.json in a form a simulator loads. URDF and SDF
+// <inertial>, a JSBSim <mass_balance> and a flat CSV.
+//
+// What results.json holds (docs/physics.md §3): body axes x forward, y right wing, z down (FRD),
+// origin at the CG; products positive, I_xy = integral x y dm (likewise I_xz, I_yz), so the
+// tensor is J = [[Ixx, -Ixy, -Ixz], [-Ixy, Iyy, -Iyz], [-Ixz, -Iyz, Izz]]. Each format has its own
+// frame and sign, taken from its own documentation:
+//
+//  format   frame                                  written ixx iyy izz | ixy    ixz    iyz
+//  urdf     FLU (x fwd, y left, z up; ROS REP 103)    Ixx Iyy Izz       | +Ixy   +Ixz   -Iyz
+//  sdf      FLU, as urdf (SDFormat <inertia>)         Ixx Iyy Izz       | +Ixy   +Ixz   -Iyz
+//  urdf/sdf with --frame frd (body axes as measured)  Ixx Iyy Izz       | -Ixy   -Ixz   -Iyz
+//  jsbsim   structural (x aft, y right, z up), with   Ixx Iyy Izz       | +Ixy   -Ixz   +Iyz
+//           negated_crossproduct_inertia="true"
+//  csv      body FRD, results.json's own convention   Ixx Iyy Izz       | Ixy    Ixz    Iyz
+//
+// - URDF <inertia ixx ixy ixz iyy iyz izz> and SDFormat <inertia><ixx>... are the elements of the
+//   3x3 rotational inertia matrix above its diagonal ("the product of inertia convention -m x y
+//   (not +m x y) is used", SDFormat spec), about the CG, in the link frame, which ROS REP 103 and
+//   Gazebo take as FLU. FRD -> FLU is a half turn about x, (x, y, z) -> (x, -y, -z): the products
+//   with one of y, z flip (I_xy, I_xz) and I_yz does not; then the element is minus the product.
+// - JSBSim (FGMassBalance) reads the tensor in its structural frame, x aft, y right, z up (a half
+//   turn about y from its FRD body frame). With negated_crossproduct_inertia="true" (its default,
+//   and what every version reads) <ixy> etc. are the matrix elements, -integral x y dm in that
+//   frame: ixy = +I_xy, ixz = -I_xz, iyz = +I_yz of the body products. The attribute is written
+//   explicitly so the file reads the same in versions before and after it existed.
+// - Mass: aircraft.mass_kg from the config stored in results.json (or --mass-kg); CG: the origin
+//   of the link (URDF/SDF) or of the structural frame (JSBSim). The bifilar measures neither the
+//   mass nor the CG: the files say so, and the CG must be moved to where it was measured.
+#pragma once
+
+#include <array>
+#include <limits>
+#include <map>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace bifilar {
+
+enum class ExportFormat { kUrdf, kSdf, kJsbsim, kCsv };
+bool ParseExportFormat(const std::string& name, ExportFormat* format);  // urdf|sdf|jsbsim|csv
+const char* ExportFormatName(ExportFormat format);
+
+// The frame of a URDF/SDF <inertial>: FLU (REP 103, the default) or the body FRD as measured.
+enum class ExportFrame { kFlu, kFrd };
+bool ParseExportFrame(const std::string& name, ExportFrame* frame);  // flu|frd
+
+struct ExportOptions {
+  std::string results_path;  // results.json written by `bifilar process`
+  ExportFormat format = ExportFormat::kCsv;
+  std::string out_path;                   // write here (atomically); empty: to the output stream
+  ExportFrame frame = ExportFrame::kFlu;  // urdf and sdf only
+  bool frame_given = false;               // --frame was given (an error for jsbsim and csv)
+  // Mass (kg) to write instead of the config's aircraft.mass_kg; NaN: use the config. > 0.
+  double mass_kg = std::numeric_limits<double>::quiet_NaN();
+  // Values (kg m^2, body FRD, products positive) for components the result does not hold, by
+  // name ("Iyy", "Ixy", ...). A component the result measured cannot be set.
+  std::map<std::string, double> set_kg_m2;
+  // Take Ixy = Iyz = 0 when the result does not hold them: an aircraft symmetric about its x-z
+  // plane (the paper's assumption for a pitch-only campaign).
+  bool symmetric = false;
+
+  bool Check(std::string* why) const;
+};
+
+// The inertia to export: six components (kg m^2, body FRD, products positive, order Ixx, Iyy,
+// Izz, Ixy, Ixz, Iyz), each with its std and where it came from.
+struct ExportInertia {
+  std::array<double, 6> value_kg_m2 = {};  // NaN when missing
+  std::array<double, 6> std_kg_m2 = {};    // NaN when unknown
+  // "measured", "set" (--set), "symmetric" (--symmetric) or "missing".
+  std::array<std::string, 6> source;
+  std::string section;  // "tensor" or "ellipse": the results.json section read
+  double mass_kg = std::numeric_limits<double>::quiet_NaN();
+  double mass_std_kg = std::numeric_limits<double>::quiet_NaN();
+  std::string mass_source;   // "config aircraft.mass_kg", "--mass-kg" or "" (none)
+  std::string results_name;  // the file, for comments
+  std::vector<std::string> warnings;
+
+  std::vector<std::string> Missing() const;  // names of the missing components
+};
+
+const char* ExportComponentName(int component);  // "Ixx", ..., "Iyz"
+
+// Reads the inertia from results.json text (`name` prefixes every message) and fills missing
+// components from the options. Throws UserError naming the file on: text that is not JSON, a
+// document bifilar did not write, no `tensor` or `ellipse` section with a number, a --set of a
+// measured or unknown component.
+ExportInertia ReadExportInertia(const std::string& text, const std::string& name,
+                                const ExportOptions& options);
+
+// The text of each format (see the table above). URDF, SDF and JSBSim throw UserError when a
+// component or the mass is missing, naming them and how to supply them; the CSV leaves them empty.
+std::string FormatUrdfInertial(const ExportInertia& inertia, ExportFrame frame);
+std::string FormatSdfInertial(const ExportInertia& inertia, ExportFrame frame);
+std::string FormatJsbsimMassBalance(const ExportInertia& inertia);
+std::string FormatInertiaCsv(const ExportInertia& inertia);
+
+// Reads options.results_path, formats, writes options.out_path atomically (or the text to `out`),
+// and prints warnings and the CG/mass note to `err`. Returns 0; throws UserError.
+int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err);
+
+}  // namespace bifilar

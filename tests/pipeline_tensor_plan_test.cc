@@ -1,0 +1,120 @@
+// `bifilar plan --tensor` end to end (the real binary): the JSON plan against the library's, the
+// human table, a rig that cannot observe some components, units, and bad options. The planning
+// itself is tested against a Monte-Carlo in tests/fit_tensor_plan_test.cc.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "fit/tensor_plan.h"
+#include "test_support.h"
+
+namespace bifilar {
+namespace {
+
+using nlohmann::json;
+using test_support::ReadFile;
+using test_support::TempDir;
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+CliRun Bifilar(const TempDir& dir, const std::string& args) {
+  const std::string out = dir.path + "/stdout.txt", err = dir.path + "/stderr.txt";
+  const int status =
+      std::system((std::string(BIFILAR_BINARY) + " " + args + " >" + out + " 2>" + err).c_str());
+  CliRun r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = ReadFile(out);
+  r.err = ReadFile(err);
+  return r;
+}
+
+TEST(TensorPlanCli, JsonMatchesTheLibraryAndUnitsConvert) {
+  TempDir dir("bifilar_tensor_plan");
+  const CliRun r = Bifilar(dir,
+                           "plan --tensor --roll=-45:45 --pitch=-90:90 --trials 2 "
+                           "--sigma 0.005 --target 0.002 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json j = json::parse(r.out);
+  TensorPlanOptions o;
+  o.roll_min_deg = -45;
+  o.roll_max_deg = 45;
+  o.trials_per_orientation = 2;
+  o.sigma_kg_m2 = 0.005;
+  o.target_std_kg_m2 = 0.002;
+  TensorPlan plan;
+  std::string why;
+  ASSERT_TRUE(PlanTensor(o, &plan, &why)) << why;
+  EXPECT_EQ(j["rank"], 6);
+  EXPECT_TRUE(j["unobservable"].empty());
+  ASSERT_EQ(j["orientations"].size(), 12u);
+  for (size_t i = 0; i < 12; ++i) {
+    EXPECT_EQ(j["orientations"][i]["roll_deg"].get<double>(), plan.orientations[i].roll_deg);
+    EXPECT_EQ(j["orientations"][i]["pitch_deg"].get<double>(), plan.orientations[i].pitch_deg);
+  }
+  for (int k = 0; k < kTensorPlanComponents; ++k) {
+    const json& c = j["components"][TensorPlanComponentName(k)];
+    EXPECT_EQ(c["std_kg_m2"].get<double>(), plan.std_kg_m2[k]);
+    EXPECT_EQ(c["trials_needed"].get<int>(), plan.trials_needed[k]);
+  }
+  EXPECT_EQ(j["trials_needed_all"].get<int>(), plan.trials_needed_all);
+
+  // The same plan in slug ft^2: the printed stds are the SI ones divided by 1.35581795.
+  char sigma[64];
+  std::snprintf(sigma, sizeof sigma, "%.17g", 0.005 / 1.35581795);
+  const CliRun imperial = Bifilar(dir, "plan --tensor --roll=-45:45 --trials 2 --sigma " +
+                                           std::string(sigma) + " --units imperial");
+  ASSERT_EQ(imperial.exit_code, 0) << imperial.err;
+  char izz[64];
+  std::snprintf(izz, sizeof izz, "Izz  %-11.4g", plan.std_kg_m2[2] / 1.35581795);
+  EXPECT_NE(imperial.out.find(izz), std::string::npos) << izz << "\n" << imperial.out;
+  EXPECT_NE(imperial.out.find("slug ft^2"), std::string::npos);
+}
+
+TEST(TensorPlanCli, RollHeldAtZeroNamesTheUnobservableComponents) {
+  TempDir dir("bifilar_tensor_plan");
+  const CliRun r = Bifilar(dir, "plan --tensor --roll 0 --sigma 0.005");
+  ASSERT_EQ(r.exit_code, 0) << r.err;  // not an error: Ixx, Izz, Ixz are still planned
+  EXPECT_NE(r.out.find("Iyy  not observable"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Ixy  not observable"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Iyz  not observable"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("cannot observe Iyy, Ixy, Iyz"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("rank 3 of 6"), std::string::npos) << r.out;
+}
+
+TEST(TensorPlanCli, BadOptionsAreOneLineErrors) {
+  TempDir dir("bifilar_tensor_plan");
+  const struct {
+    std::string args, expect;
+  } cases[] = {
+      {"plan --roll 0 --sigma 0.1", "--roll belongs to the tensor plan: add --tensor"},
+      {"plan --tensor --angles 0,30 --sigma 0.1", "--angles belongs to the pitch-plane plan"},
+      {"plan --tensor --roll=200 --sigma 0.1", "roll range must lie in [-180, 180]"},
+      {"plan --tensor --roll=30:-30 --sigma 0.1", "MIN must not exceed MAX"},
+      {"plan --tensor --roll=a:3 --sigma 0.1", "--roll 'a:3': 'a' is not a number"},
+      {"plan --tensor --pitch=-95:0 --sigma 0.1", "pitch range must lie in [-90, 90]"},
+      {"plan --tensor --roll 0", "give a per-swing std"},
+      {"plan --tensor --sigma-rel 0.01", "--sigma-rel and --attitude-std need a guess"},
+      {"plan --tensor --sigma 0.1 --ixx 1 --iyy 1", "give all of --ixx, --iyy, --izz"},
+      {"plan --tensor --sigma 0.1 --ixz 0.1", "needs --ixx, --iyy, --izz"},
+      {"plan --tensor --sigma 0.1 --target-rel 0.01", "--target-rel is a fraction"},
+      {"plan --tensor --sigma 0.1 --ixx 1 --iyy 1 --izz 1 --ixy 2", "not positive definite"},
+      {"plan --angles 0,30,60", "--sigma is required"},
+      {"plan --sigma 0.1", "--angles is required"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.args);
+    const CliRun r = Bifilar(dir, c.args);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
+}  // namespace
+}  // namespace bifilar
