@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/atomic_file.h"
-#include "pipeline/cache.h"  // ReadFileBytes
+#include "pipeline/bounded_read.h"
 #include "pipeline/json_error.h"
 #include "pipeline/user_error.h"
 
@@ -422,7 +422,7 @@ int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err
     path = (std::filesystem::path(path) / "results.json").string();
   }
   std::string text;
-  if (!ReadFileBytes(path, &text, &why)) throw UserError(why);
+  if (!ReadRegularFile(path, OutputFileCap(), &text, &why)) throw UserError(why);
   const ExportInertia in = ReadExportInertia(text, path, options);
   std::string body;
   switch (options.format) {
