@@ -37,8 +37,8 @@ std::string HumanLine(const TraceRecord& r, DisplayUnits units) {
   char buffer[1024];
   // Messages name the file already; say it once at the start of the line.
   const std::string prefix = r.file + ": ";
-  std::string message =
-      r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message;
+  std::string message = SiTextInDisplayUnits(
+      r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message, units);
   // The assumed +-1 mm on L and D is said once for the run (AssumedInputsSummary), not per log.
   if (IsAssumedInputsWarning(message)) message.clear();
   // No fit to show (an error, or rejected before fitting): status and reason only, never NaN.
@@ -73,7 +73,12 @@ std::string HumanLine(const TraceRecord& r, DisplayUnits units) {
   }
   // I against amplitude (the ideal model is flat), and every warning on its own line.
   if (!r.sweep.bands.empty()) {
-    line += "\n    I(A): " + SweepSummary(r.sweep);
+    AmplitudeSweep shown = r.sweep;  // the bands' I in the display units
+    for (AmplitudeSweepBand& b : shown.bands) {
+      b.inertia_kg_m2 *= scale;
+      b.inertia_std_kg_m2 *= scale;
+    }
+    line += "\n    I(A): " + SweepSummary(shown);
     if (r.sweep.evaluated) {
       std::snprintf(buffer, sizeof(buffer), "  trend %+.3g %% per 10 deg (z = %.1f)%s",
                     r.sweep.trend_percent_per_10deg, r.sweep.trend_z,
@@ -91,8 +96,9 @@ std::string HumanLine(const TraceRecord& r, DisplayUnits units) {
     }
   }
   for (const std::string& w : r.warnings) {
-    if (message.find(w) == std::string::npos && !IsAssumedInputsWarning(w))
-      line += "\n    warning: " + w;
+    const std::string shown = SiTextInDisplayUnits(w, units);
+    if (message.find(shown) == std::string::npos && !IsAssumedInputsWarning(w))
+      line += "\n    warning: " + shown;
   }
   return line;
 }

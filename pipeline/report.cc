@@ -84,31 +84,9 @@ struct Units {
   }
 };
 
-// A message or warning as the page shows it: under units: imperial every "<number> kg m^2" of
-// the text (the fit writes its messages in SI) becomes "<number> slug ft^2", so the page keeps one
-// unit system throughout.
+// A message or warning as the page shows it: in the page's units (the fit writes them in SI).
 std::string InDisplayUnits(const Units& u, const std::string& text) {
-  if (!u.imperial) return text;
-  const std::string si = " kg m^2";
-  std::string out;
-  size_t at = 0;
-  for (size_t hit = text.find(si); hit != std::string::npos; hit = text.find(si, hit + 1)) {
-    size_t start = hit;
-    while (start > at && (std::isdigit(static_cast<unsigned char>(text[start - 1])) ||
-                          std::strchr(".eE+-", text[start - 1]) != nullptr)) {
-      --start;
-    }
-    char* stop = nullptr;
-    const double value = start < hit ? std::strtod(text.c_str() + start, &stop) : NAN;
-    if (stop != text.c_str() + hit || !std::isfinite(value)) continue;  // not "<number> kg m^2"
-    char buffer[64];
-    std::snprintf(buffer, sizeof(buffer), "%.3g slug ft^2", value * u.scale);
-    out.append(text, at, start - at);
-    out += buffer;
-    at = hit + si.size();
-  }
-  out.append(text, at, std::string::npos);
-  return out;
+  return SiTextInDisplayUnits(text, u.imperial ? DisplayUnits::kImperial : DisplayUnits::kSi);
 }
 
 // An estimate of the ellipse JSON (pipeline/ellipse_json.h): KEY, KEY_std, KEY_ci95 [lo, hi];
