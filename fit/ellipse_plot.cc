@@ -166,6 +166,20 @@ bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
   return WriteFigure(path, options.figure, draw, why);
 }
 
+
+// "(U)^-1/2" of a display unit "A B#u2#d" (PLplot text) as "A#u-1/2#d B#u-1#d"; other labels as
+// "1/#(2267)(U)".
+static std::string InverseSqrtUnit(const std::string& unit) {
+  const std::string squared = "#u2#d";
+  const size_t space = unit.find(' ');
+  if (space != std::string::npos && unit.size() > squared.size() &&
+      unit.compare(unit.size() - squared.size(), squared.size(), squared) == 0) {
+    return "(" + unit.substr(0, space) + "#u-1/2#d " +
+           unit.substr(space + 1, unit.size() - squared.size() - space - 1) + "#u-1#d)";
+  }
+  return "1/#(2267)(" + unit + ")";
+}
+
 bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
                              const EllipsePlotOptions& options, std::string* why) {
   const double k = options.unit_scale;
@@ -207,12 +221,14 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
       py.push_back(-rr * dy);
       r_max = std::max(r_max, rr);
     }
-    const double lim = 1.25 * r_max;
+    // Room between the data and the frame for the axis labels (x_p, x_body were cut or covered).
+    const double lim = 1.6 * r_max;
     plcol0(kBlack);
     plvpas(vx0, vx1, 0.2, 0.86, 1.0);
     plwind(-lim, lim, -lim, lim);
     plbox("bcnst", 0, 0, "bcnstv", 0, 0);
-    const std::string unit = inverse_sqrt ? "(" + options.unit_label + ")#u-1/2#d"
+    // (slug ft^2)^-1/2 written slug^-1/2 ft^-1: a superscript inside a superscript is garbled.
+    const std::string unit = inverse_sqrt ? InverseSqrtUnit(options.unit_label)
                                           : "(" + options.unit_label + ")";
     pllab(("forward, x#dbody#u  " + unit).c_str(), ("up, -z#dbody#u  " + unit).c_str(),
           inverse_sqrt ? "Ellipse of inertia, radius 1/#(2267)I(#gh)"

@@ -126,7 +126,17 @@ bool WriteAmplitudeSweepFigure(const AmplitudeSweep& sweep, double inertia_kg_m2
   // Page layout (normalised page coordinates), top down: title, subtitle and two legend rows
   // (not when compact), the axis labels (horizontal: rotated text is a second set of glyphs), the
   // plot.
-  constexpr double kLeft = 0.11, kRight = 0.91, kBottom = 0.13;
+  // The left margin holds the longest y tick label: a tare of 0.18442 slug ft^2 needs 7
+  // characters where 2.992 needs 5 (issue 18: the labels were clipped). Decimals as PLplot's
+  // tick step (3 to 8 ticks) needs them; about 11 px a character at this size.
+  const double y_range = std::max(y_hi - y_lo, 1e-300);
+  const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(y_range / 8.0))));
+  const double y_abs = std::max(std::fabs(y_lo), std::fabs(y_hi));
+  const int int_digits = std::max(1, static_cast<int>(std::floor(std::log10(std::max(y_abs, 1.0)))) + 1);
+  const int label_chars = int_digits + (decimals > 0 ? 1 + decimals : 0) + (y_lo < 0.0 ? 1 : 0);
+  const double kLeft = std::min(0.3, (22.0 + 11.0 * label_chars) /
+                                         std::max(1, options.figure.width_px));
+  constexpr double kRight = 0.91, kBottom = 0.13;
   const double kTop = options.compact ? 0.83 : 0.655;
   const double px_w = options.figure.width_px * (kRight - kLeft);
   const double px_h = options.figure.height_px * (kTop - kBottom);

@@ -80,13 +80,15 @@ bool WriteTraceFitFigure(const TraceFitResult& r, const std::string& path,
   if (!(r_abs > 0.0)) r_abs = 1.0;
 
   const std::string name = options.title.empty() ? std::string("trace") : options.title;
+  const double k = options.unit_scale;
+  const std::string& unit = options.unit_label;
   std::string title = name + " [" + ToString(r.model) + "]: I = " +
-                      Fmt("%.6g", r.params.inertia_kg_m2) + " ± " +
-                      Fmt("%.2g", r.inertia_std_kg_m2) + " kg m#u2#d";
+                      Fmt("%.6g", k * r.params.inertia_kg_m2) + " ± " +
+                      Fmt("%.2g", k * r.inertia_std_kg_m2) + " " + unit;
   if (r.status != TraceFitStatus::kOk) title += "  (" + std::string(ToString(r.status)) + ")";
   const std::string subtitle =
-      "K#dD#u = " + Fmt("%.3g", r.params.drag_coeff_kg_m2) + " kg m#u2#d,  C = " +
-      Fmt("%.3g", r.params.viscous_coeff_kg_m2_per_s) + " kg m#u2#d/s,  bias = " +
+      "K#dD#u = " + Fmt("%.3g", k * r.params.drag_coeff_kg_m2) + " " + unit + ",  C = " +
+      Fmt("%.3g", k * r.params.viscous_coeff_kg_m2_per_s) + " " + unit + "/s,  bias = " +
       Fmt("%.3f", r.bias_rad_per_s * kDegPerRad) + " deg/s,  amplitude " +
       Fmt("%.1f", r.amplitude_start_deg) + " → " + Fmt("%.1f", r.amplitude_end_deg) + " deg";
   const std::string residual_label =
@@ -128,17 +130,20 @@ bool WriteTraceFitFigure(const TraceFitResult& r, const std::string& path,
     plschr(0, 0.85);
     plmtex("t", 1.0, 0.5, 0.5, subtitle.c_str());
     plschr(0, 0.95);
-    plcol0(kGrey);
-    plssym(0, 0.35);
-    dots(t, meas, env_t, env_meas);  // measured: small dots (dense: their envelope)
+    // The fitted line first, the measured samples on top of it: where they agree the samples
+    // still show (issue 18); the envelope of a dense log is a thin band, so the line under it is
+    // drawn wide enough to show on both sides.
     plcol0(kBlue);
-    plwidth(1.2);
+    plwidth(dense ? 3.0 : 1.2);
     if (dense) {
       plline(static_cast<PLINT>(fit_t.size()), fit_t.data(), fit_v.data());
     } else {
       plline(static_cast<PLINT>(n), t.data(), fit.data());
     }
     plwidth(1.0);
+    plcol0(kGrey);
+    plssym(0, 0.35);
+    dots(t, meas, env_t, env_meas);  // measured: small dots (dense: their envelope)
     // Legend (top right, inside).
     {
       const double lx = 0.62 * t_hi, ly = 1.22 * y_abs, dx = 0.035 * t_hi;

@@ -13,6 +13,10 @@ struct TracePlotOptions {
   std::string title;     // usually the log's file name; empty: "trace"
   int width_px = 1100;   // page width (px); > 0
   int height_px = 700;   // page height (px); > 0
+  // Inertias (I, K_D, C) in the title are multiplied by unit_scale and labelled unit_label
+  // (PLplot text): the config's display units (slug ft^2 under units: imperial).
+  double unit_scale = 1.0;
+  std::string unit_label = "kg m#u2#d";
 };
 
 // Needs the series (TraceFitOptions::keep_series, the default); works for ok and rejected fits.

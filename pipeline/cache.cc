@@ -185,6 +185,9 @@ bool TraceCache::Load(const std::string& key, const std::string& content_hash,
   } catch (const std::exception& e) {
     return refuse(DescribeJsonError(e));
   }
+  // Entries written before records carried the measured period are refitted, not shown with a
+  // blank period.
+  if (!fields.contains("period_s")) return refuse("written before records carried the period");
   for (const char* field : {"inertia_total_kg_m2", "inertia_total_std_kg_m2"}) {
     if (!FiniteOrNull(fields, field)) return refuse(std::string(field) + " is not a finite number");
   }

@@ -270,12 +270,13 @@ TraceRecord FitOneTrace(const TraceFitFunction& fit, const CampaignConfig& fit_c
 }
 
 // "pitch_10/trial_1.csv: ok I_total = 4.0999 kg m^2": the progress line of a fitted trace.
-std::string ProgressLine(const TraceRecord& record) {
+std::string ProgressLine(const TraceRecord& record, DisplayUnits units) {
   std::string line = record.file + ": " + ToString(record.status);
   if (record.ok()) {
     char buffer[160];
-    std::snprintf(buffer, sizeof(buffer), " I_total = %#.5g kg m^2 +- %.2g %% (stat) +- %.2g %% (total)",
-                  record.inertia_total_kg_m2,
+    std::snprintf(buffer, sizeof(buffer), " I_total = %#.5g %s +- %.2g %% (stat) +- %.2g %% (total)",
+                  InertiaToDisplay(record.inertia_total_kg_m2, units),
+                  InertiaUnitName(units),
                   100.0 * record.inertia_total_std_kg_m2 / record.inertia_total_kg_m2,
                   100.0 * record.inertia_total_std_total_kg_m2 / record.inertia_total_kg_m2);
     line += buffer;
@@ -310,7 +311,7 @@ void FitTraces(const CampaignConfig& config, const CampaignOptions& options,
     const int i = plan.to_fit[k];
     TraceRecord& record = (*traces)[i];
     record = FitOneTrace(fit, fit_config, options, in.runs[i], in.windows[i], record, cache, *out);
-    progress.TaskDone(ProgressLine(record));
+    progress.TaskDone(ProgressLine(record, config.units));
   });
   if (cancelled()) {
     throw CampaignInterrupted(progress.Stop(), n_fit,

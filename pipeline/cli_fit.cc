@@ -33,27 +33,30 @@ std::string FigureStem(const std::string& log) {
   return stem.empty() ? "trace" : stem;
 }
 
-std::string HumanLine(const TraceRecord& r) {
+// The record's console line, inertias (I, K_D, C and the small-angle I) in the config's units.
+std::string HumanLine(const TraceRecord& r, DisplayUnits units) {
   char buffer[1024];
   // Messages name the file already; say it once at the start of the line.
   const std::string prefix = r.file + ": ";
-  std::string message =
-      r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message;
+  std::string message = SiTextInDisplayUnits(
+      r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message, units);
   // The assumed +-1 mm on L and D is said once for the run (AssumedInputsSummary), not per log.
   if (IsAssumedInputsWarning(message)) message.clear();
   // No fit to show (an error, or rejected before fitting): status and reason only, never NaN.
   if (r.status == TraceStatus::kError || !std::isfinite(r.inertia_total_kg_m2)) {
     return prefix + ToString(r.status) + ": " + message;
   }
+  const double scale = InertiaToDisplay(1.0, units);
+  const char* unit = InertiaUnitName(units);
   std::snprintf(buffer, sizeof(buffer),
                 "%s: %s  I = %s  K_D %.3g  C %.3g  "
                 "window [%.2f, %.2f] s  amplitude %.1f -> %.1f deg  rms/noise %.2f  %d it  %.0f ms",
                 r.file.c_str(), ToString(r.status),
-                StatAndTotal(r.inertia_total_kg_m2, r.inertia_total_std_kg_m2,
-                             r.inertia_total_std_total_kg_m2, "kg m^2")
+                StatAndTotal(scale * r.inertia_total_kg_m2, scale * r.inertia_total_std_kg_m2,
+                             scale * r.inertia_total_std_total_kg_m2, unit)
                     .c_str(),
-                r.drag_coeff_kg_m2,
-                r.viscous_coeff_kg_m2_per_s, r.window_s[0], r.window_s[1], r.amplitude_deg[0],
+                scale * r.drag_coeff_kg_m2,
+                scale * r.viscous_coeff_kg_m2_per_s, r.window_s[0], r.window_s[1], r.amplitude_deg[0],
                 r.amplitude_deg[1], r.residual_rms_rad_per_s / r.noise_rms_rad_per_s, r.iterations,
                 1e3 * r.fit_seconds);
   std::string line = buffer;
@@ -62,9 +65,21 @@ std::string HumanLine(const TraceRecord& r) {
     line += buffer;
   }
   if (!message.empty()) line += "  (" + message + ")";
+  // The measured period and the hand calculation beside the nonlinear fit.
+  if (std::isfinite(r.period_s)) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "\n    period %.4f s (%.4f Hz), small-angle I = m g D^2 T^2 / (16 pi^2 L) = %.5g %s",
+                  r.period_s, r.frequency_hz, scale * r.small_angle_inertia_total_kg_m2, unit);
+    line += buffer;
+  }
   // I against amplitude (the ideal model is flat), and every warning on its own line.
   if (!r.sweep.bands.empty()) {
-    line += "\n    I(A): " + SweepSummary(r.sweep);
+    AmplitudeSweep shown = r.sweep;  // the bands' I in the display units
+    for (AmplitudeSweepBand& b : shown.bands) {
+      b.inertia_kg_m2 *= scale;
+      b.inertia_std_kg_m2 *= scale;
+    }
+    line += "\n    I(A): " + SweepSummary(shown);
     if (r.sweep.evaluated) {
       std::snprintf(buffer, sizeof(buffer), "  trend %+.3g %% per 10 deg (as A^%g, z = %.1f)%s",
                     r.sweep.trend_percent_per_10deg, r.sweep.trend_exponent, r.sweep.trend_z,
@@ -92,8 +107,9 @@ std::string HumanLine(const TraceRecord& r) {
     }
   }
   for (const std::string& w : r.warnings) {
-    if (message.find(w) == std::string::npos && !IsAssumedInputsWarning(w))
-      line += "\n    warning: " + w;
+    const std::string shown = SiTextInDisplayUnits(w, units);
+    if (message.find(shown) == std::string::npos && !IsAssumedInputsWarning(w))
+      line += "\n    warning: " + shown;
   }
   return line;
 }
@@ -221,7 +237,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     for (const std::string& log : args->logs) {
       if (ProcessInterruptFlag().load()) {  // Ctrl-C: what was fitted, then exit 130
         if (args->json || args->repeats) {
-          for (const TraceRecord& r : records) std::cout << HumanLine(r) << std::endl;
+          for (const TraceRecord& r : records) std::cout << HumanLine(r, config.units) << std::endl;
         }
         std::cerr << "bifilar: interrupted: " << records.size() << " of " << args->logs.size()
                   << " logs fitted (above)\n";
@@ -238,7 +254,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       records.push_back(ProcessTrace(config, log, trace));
       if (!records.back().ok()) ++failed;
       // Without --repeats each line is printed as soon as its log is fitted.
-      if (!args->json && !args->repeats) std::cout << HumanLine(records.back()) << std::endl;
+      if (!args->json && !args->repeats) std::cout << HumanLine(records.back(), config.units) << std::endl;
     }
     std::vector<RepeatGroup> groups;
     RepeatsAmplitudeCorrection correction;
@@ -274,7 +290,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
             shown.warnings.push_back(w);
           }
         }
-        std::cout << HumanLine(shown) << std::endl;
+        std::cout << HumanLine(shown, config.units) << std::endl;
       }
       std::cout << AmplitudeCorrectionLine(correction) << std::endl;
       for (const RepeatGroup& g : groups) {

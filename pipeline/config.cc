@@ -2,8 +2,11 @@
 
 #include "fit/ellipse.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -310,6 +313,30 @@ double InertiaToDisplay(double inertia_kg_m2, DisplayUnits units) {
 }
 const char* InertiaUnitName(DisplayUnits units) {
   return units == DisplayUnits::kSi ? "kg m^2" : "slug ft^2";
+}
+
+std::string SiTextInDisplayUnits(const std::string& text, DisplayUnits units) {
+  if (units != DisplayUnits::kImperial) return text;
+  const std::string si = " kg m^2";
+  std::string out;
+  size_t at = 0;
+  for (size_t hit = text.find(si); hit != std::string::npos; hit = text.find(si, hit + 1)) {
+    size_t start = hit;
+    while (start > at && (std::isdigit(static_cast<unsigned char>(text[start - 1])) ||
+                          std::strchr(".eE+-", text[start - 1]) != nullptr)) {
+      --start;
+    }
+    char* stop = nullptr;
+    const double value = start < hit ? std::strtod(text.c_str() + start, &stop) : NAN;
+    if (stop != text.c_str() + hit || !std::isfinite(value)) continue;  // not "<number> kg m^2"
+    char buffer[64];
+    std::snprintf(buffer, sizeof(buffer), "%.3g slug ft^2", InertiaToDisplay(value, units));
+    out.append(text, at, start - at);
+    out += buffer;
+    at = hit + si.size();
+  }
+  out.append(text, at, std::string::npos);
+  return out;
 }
 
 std::string ResolvePath(const std::string& folder, const std::string& path) {

@@ -262,6 +262,9 @@ const char* ToString(PitchSource source);
 // Inertia in the display units, and their name ("kg m^2" or "slug ft^2").
 double InertiaToDisplay(double inertia_kg_m2, DisplayUnits units);
 const char* InertiaUnitName(DisplayUnits units);
+// A message written in SI (the fit's warnings) in the display units: under kImperial every
+// "<number> kg m^2" of `text` becomes "<number> slug ft^2" (3 significant digits); kSi: as is.
+std::string SiTextInDisplayUnits(const std::string& text, DisplayUnits units);
 
 // `path` resolved against `folder` unless absolute; lexically normalised.
 std::string ResolvePath(const std::string& folder, const std::string& path);

@@ -2,14 +2,20 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cctype>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <map>
 #include <sstream>
+#include <vector>
 
 #include "pipeline/bounded_read.h"
 #include "pipeline/cache.h"
 #include "pipeline/json_error.h"
 #include "pipeline/output_set.h"
 #include "pipeline/results_json.h"
+#include "pipeline/total_uncertainty.h"
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -45,6 +51,23 @@ std::string Str(const json& j, const char* key) {
   return it != j.end() && it->is_string() ? it->get<std::string>() : "";
 }
 
+// Trace `t`'s warnings as the report shows them: every warning of the record except the assumed
+// +-1 mm on L and D, which Table 2 states once for the campaign.
+std::vector<std::string> TraceWarnings(const json& t) {
+  std::vector<std::string> out;
+  if (!t.is_object() || !t.contains("warnings") || !t["warnings"].is_array()) return out;
+  for (const auto& w : t["warnings"]) {
+    if (w.is_string() && !IsAssumedInputsWarning(w.get<std::string>())) out.push_back(w.get<std::string>());
+  }
+  return out;
+}
+
+// The status a reader sees: "ok (warned)" for an ok trace with warnings, else the record's.
+std::string DisplayStatus(const json& t) {
+  const std::string status = Str(t, "status");
+  return status == "ok" && !TraceWarnings(t).empty() ? "ok (warned)" : status;
+}
+
 std::string Fmt(double value, const char* format = "%.4f") {
   if (!std::isfinite(value)) return "&ndash;";
   char buffer[64];
@@ -60,6 +83,11 @@ struct Units {
     return Fmt(kg_m2 * scale, format);
   }
 };
+
+// A message or warning as the page shows it: in the page's units (the fit writes them in SI).
+std::string InDisplayUnits(const Units& u, const std::string& text) {
+  return SiTextInDisplayUnits(text, u.imperial ? DisplayUnits::kImperial : DisplayUnits::kSi);
+}
 
 // An estimate of the ellipse JSON (pipeline/ellipse_json.h): KEY, KEY_std, KEY_ci95 [lo, hi];
 // null when undefined (tau, I_xp, I_zp when I_x ~ I_z).
@@ -90,6 +118,224 @@ std::string ReplaceAll(std::string text, const std::string& from, const std::str
   return text;
 }
 
+// Shortens every number with three or more decimals in `svg` to one decimal (0.1 px on a 640 px
+// page, finer than a screen pixel of the 540 px thumbnails; glyph outlines are in px too) and
+// drops the style properties that only restate SVG defaults. Cairo writes 6 decimals.
+std::string SimplifySvgNumbers(const std::string& svg) {
+  std::string out;
+  out.reserve(svg.size());
+  const size_t n = svg.size();
+  auto digit = [&](size_t i) { return i < n && svg[i] >= '0' && svg[i] <= '9'; };
+  for (size_t i = 0; i < n;) {
+    const bool starts = digit(i) && (i == 0 || !(std::isalnum(static_cast<unsigned char>(svg[i - 1])) ||
+                                                 svg[i - 1] == '.' || svg[i - 1] == '_'));
+    if (!starts) {
+      out += svg[i++];
+      continue;
+    }
+    size_t j = i;
+    while (digit(j)) ++j;
+    size_t decimals = 0;
+    if (j < n && svg[j] == '.') {
+      size_t k = j + 1;
+      while (digit(k)) ++k;
+      decimals = k - j - 1;
+      if (decimals >= 3) {
+        const bool negative = !out.empty() && out.back() == '-';
+        double value = std::strtod(svg.substr(i, k - i).c_str(), nullptr);
+        char buffer[64];
+        std::snprintf(buffer, sizeof(buffer), "%.1f", value);
+        std::string text = buffer;
+        if (text.size() > 2 && text.compare(text.size() - 2, 2, ".0") == 0) text.resize(text.size() - 2);
+        if (negative && text == "0") out.pop_back();  // "-0.04" -> "0", not "-0"
+        out += text;
+        i = k;
+        continue;
+      }
+      j = k;
+    }
+    out.append(svg, i, j - i);
+    i = j;
+  }
+  for (const char* redundant : {"stroke-opacity:1;", "fill-opacity:1;", "stroke-miterlimit:10;",
+                                "fill-rule:nonzero;"}) {
+    out = ReplaceAll(out, redundant, "");
+  }
+  return out;
+}
+
+// A number as short as SVG allows at 0.1 px: "12.3", "-4", ".5".
+std::string ShortNumber(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.1f", value);
+  std::string text = buffer;
+  if (text == "-0.0") text = "0.0";
+  if (text.size() > 2 && text.compare(text.size() - 2, 2, ".0") == 0) text.resize(text.size() - 2);
+  if (text.rfind("0.", 0) == 0) text.erase(0, 1);
+  if (text.rfind("-0.", 0) == 0) text.erase(1, 1);
+  return text;
+}
+
+// A cairo polyline `<path ... d="M x y L x y ..." transform="matrix(1,0,0,-1,0,H)"/>` rewritten
+// with the flip applied and relative line-tos ("M x y l dx dy dx dy ..."), every point rounded
+// to 0.1 px first so the sums do not drift; other paths come back unchanged. About half the
+// bytes of a long line.
+std::string CompactPolyline(const std::string& tag) {
+  const size_t d_at = tag.find(" d=\"");
+  if (d_at == std::string::npos) return tag;
+  const size_t d_end = tag.find('"', d_at + 4);
+  if (d_end == std::string::npos) return tag;
+  double flip_height = NAN;
+  size_t tr_at = tag.find(" transform=\"matrix(1,0,0,-1,0,");
+  size_t tr_end = std::string::npos;
+  if (tr_at != std::string::npos) {
+    const size_t num = tr_at + std::string(" transform=\"matrix(1,0,0,-1,0,").size();
+    char* stop = nullptr;
+    flip_height = std::strtod(tag.c_str() + num, &stop);
+    if (stop == nullptr || std::string(stop, std::min<size_t>(2, std::strlen(stop))) != ")\"") return tag;
+    tr_end = static_cast<size_t>(stop - tag.c_str()) + 2;
+  } else if (tag.find(" transform=") != std::string::npos) {
+    return tag;
+  }
+  std::istringstream in(tag.substr(d_at + 4, d_end - d_at - 4));
+  std::string token, d;
+  long px = 0, py = 0;
+  bool first = true;
+  while (in >> token) {
+    if (token != (first ? "M" : "L")) return tag;  // curves, several sub-paths: leave as is
+    double x = NAN, y = NAN;
+    if (!(in >> x >> y) || !std::isfinite(x) || !std::isfinite(y)) return tag;
+    if (std::isfinite(flip_height)) y = flip_height - y;
+    const long qx = std::lround(10.0 * x), qy = std::lround(10.0 * y);
+    if (first) {
+      d = "M" + ShortNumber(qx / 10.0) + " " + ShortNumber(qy / 10.0) + "l";
+    } else {
+      const std::string dx = ShortNumber((qx - px) / 10.0), dy = ShortNumber((qy - py) / 10.0);
+      if (d.back() != 'l' && dx[0] != '-') d += ' ';
+      d += dx;
+      if (dy[0] != '-') d += ' ';
+      d += dy;
+    }
+    px = qx;
+    py = qy;
+    first = false;
+  }
+  if (first) return tag;
+  if (d.back() == 'l') d.pop_back();
+  std::string out = tag;
+  if (tr_end != std::string::npos) out.erase(tr_at, tr_end - tr_at);
+  return out.replace(d_at + 4, d_end - d_at - 4, d);
+}
+
+// Every <path .../> of `svg` through CompactPolyline.
+std::string CompactSvgPaths(const std::string& svg) {
+  std::string out;
+  out.reserve(svg.size());
+  size_t at = 0;
+  for (size_t start = svg.find("<path ", at); start != std::string::npos; start = svg.find("<path ", at)) {
+    const size_t end = svg.find('>', start);
+    if (end == std::string::npos) break;
+    out.append(svg, at, start - at);
+    out += CompactPolyline(svg.substr(start, end + 1 - start));
+    at = end + 1;
+  }
+  out.append(svg, at, std::string::npos);
+  return out;
+}
+
+// Every style="..." attribute of the page (cairo repeats the same few on each element) becomes
+// class="sN" with one CSS rule per distinct style; tags that have a class already keep theirs.
+std::string ShareStyles(const std::string& html) {
+  std::map<std::string, std::string> classes;
+  std::string out, css;
+  out.reserve(html.size());
+  const std::string attr = " style=\"";
+  size_t at = 0;
+  for (size_t hit = html.find(attr); hit != std::string::npos; hit = html.find(attr, at)) {
+    const size_t value = hit + attr.size(), value_end = html.find('"', value);
+    if (value_end == std::string::npos) break;
+    const size_t tag_start = html.rfind('<', hit), tag_end = html.find('>', hit);
+    const std::string tag = html.substr(tag_start, tag_end - tag_start);
+    if (tag_start == std::string::npos || tag.find(" class=\"") != std::string::npos) {
+      out.append(html, at, value_end + 1 - at);
+      at = value_end + 1;
+      continue;
+    }
+    const std::string style = html.substr(value, value_end - value);
+    auto it = classes.find(style);
+    if (it == classes.end()) {
+      it = classes.emplace(style, "s" + std::to_string(classes.size())).first;
+      css += "." + it->second + "{" + style + "}\n";
+    }
+    out.append(html, at, hit - at);
+    out += " class=\"" + it->second + "\"";
+    at = value_end + 1;
+  }
+  out.append(html, at, std::string::npos);
+  if (classes.empty()) return html;
+  const size_t head = out.find("</head>");
+  out.insert(head == std::string::npos ? 0 : head, "<style>\n" + css + "</style>\n");
+  return out;
+}
+
+// Every inline SVG of the page defines its own outline of each glyph (cairo writes text as
+// paths): the same digit and letter over a hundred times. This keeps one <symbol> per distinct
+// outline, in a hidden SVG at the end of the page, and points every figure's <use> at it (ids
+// are document-wide in HTML). The figures' own ids were made unique by Figure()'s prefixes.
+std::string ShareSvgGlyphs(const std::string& html) {
+  std::map<std::string, std::string> by_content;  // symbol text without its id -> shared id
+  std::map<std::string, std::string> renamed;     // a figure's glyph id -> shared id
+  std::string shared, body;
+  body.reserve(html.size());
+  size_t at = 0;
+  while (true) {
+    const size_t start = html.find("<symbol", at);
+    const size_t end = start == std::string::npos ? start : html.find("</symbol>", start);
+    if (start == std::string::npos || end == std::string::npos) break;
+    const size_t stop = end + std::string("</symbol>").size();
+    std::string symbol = html.substr(start, stop - start);
+    const size_t id_at = symbol.find(" id=\"");
+    const size_t id_end = id_at == std::string::npos ? id_at : symbol.find('"', id_at + 5);
+    if (id_end == std::string::npos) {  // not a cairo glyph: leave it where it is
+      body.append(html, at, stop - at);
+      at = stop;
+      continue;
+    }
+    const std::string id = symbol.substr(id_at + 5, id_end - id_at - 5);
+    std::string key = symbol;
+    key.erase(id_at, id_end + 1 - id_at);
+    auto found = by_content.find(key);
+    if (found == by_content.end()) {
+      const std::string shared_id = "sg" + std::to_string(by_content.size());
+      found = by_content.emplace(key, shared_id).first;
+      shared += symbol.substr(0, id_at) + " id=\"" + shared_id + "\"" + symbol.substr(id_end + 1) + "\n";
+    }
+    renamed[id] = found->second;
+    body.append(html, at, start - at);
+    at = stop;
+  }
+  body.append(html, at, std::string::npos);
+  if (renamed.empty()) return html;
+  std::string out;
+  out.reserve(body.size() + shared.size());
+  const std::string href = "href=\"#";
+  at = 0;
+  for (size_t hit = body.find(href); hit != std::string::npos; hit = body.find(href, at)) {
+    const size_t id_start = hit + href.size(), id_end = body.find('"', id_start);
+    if (id_end == std::string::npos) break;
+    out.append(body, at, id_start - at);
+    const auto it = renamed.find(body.substr(id_start, id_end - id_start));
+    out += it != renamed.end() ? it->second : body.substr(id_start, id_end - id_start);
+    at = id_end;
+  }
+  out.append(body, at, std::string::npos);
+  const std::string defs = "<svg width=\"0\" height=\"0\" style=\"position:absolute\" aria-hidden=\"true\"><defs>\n" +
+                           shared + "</defs></svg>\n";
+  const size_t close = out.rfind("</body>");
+  out.insert(close == std::string::npos ? out.size() : close, defs);
+  return out;
+}
+
 // A figure file as page content: an SVG inline (its ids prefixed, so the glyph and clip ids that
 // every cairo SVG names alike do not collide; a third smaller than base64), a PNG as a base64
 // data URI.
@@ -106,7 +352,7 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
     const size_t start = bytes.find("<svg");
     if (start == std::string::npos) return "<p class=\"note\">(figure " + Escape(name) + " unreadable)</p>";
     const std::string prefix = "f" + std::to_string((*counter)++) + "-";
-    std::string svg = bytes.substr(start);
+    std::string svg = SimplifySvgNumbers(CompactSvgPaths(bytes.substr(start)));
     svg = ReplaceAll(svg, "id=\"", "id=\"" + prefix);
     svg = ReplaceAll(svg, "href=\"#", "href=\"#" + prefix);
     svg = ReplaceAll(svg, "url(#", "url(#" + prefix);
@@ -147,7 +393,7 @@ h1 { font-size: 1.6em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: .2e
 table { border-collapse: collapse; margin: .5em 0 1em; font-size: .9em; }
 th, td { border: 1px solid #ccc; padding: .25em .6em; text-align: right; }
 th { background: #f2f2f2; } td.l, th.l { text-align: left; }
-tr.rejected td { background: #fff4e0; } tr.error td { background: #fde8e8; }
+tr.rejected td { background: #fff4e0; } tr.warned td { background: #fffbe0; } tr.error td { background: #fde8e8; }
 .note { color: #666; font-style: italic; }
 img.fig, svg.fig { max-width: 100%; height: auto; border: 1px solid #ddd; }
 .traces { display: flex; flex-wrap: wrap; gap: 10px; }
@@ -465,14 +711,51 @@ void WriteRejectedTraces(const ReportPage& p, std::ostream& h) {
     ++bad;
     rows << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
          << "</td><td class=\"l\">" << Escape(status) << "</td><td class=\"l\">"
-         << Escape(Str(t, "message")) << "</td></tr>\n";
+         << Escape(InDisplayUnits(p.u, Str(t, "message"))) << "</td></tr>\n";
   }
   if (bad == 0) {
-    h << "<p class=\"ok\">None: every trace passed the quality checks.</p>\n";
+    h << "<p class=\"ok\">None: every trace was fitted (warnings, if any, are listed below).</p>\n";
   } else {
     h << "<table><tr><th class=\"l\">file</th><th class=\"l\">status</th><th class=\"l\">reason</th></tr>\n"
       << rows.str() << "</table>\n";
   }
+}
+
+// Every fitted trace that raised a warning, with the warnings' text: its number is used, so the
+// reader must see why to doubt it (the traces table says "ok (warned)").
+void WriteWarnings(const ReportPage& p, std::ostream& h) {
+  h << "<h2 id=\"warnings\">Warnings</h2>\n";
+  std::ostringstream rows;
+  int warned = 0;
+  for (const auto& t : p.traces) {
+    if (Str(t, "status") != "ok") continue;  // rejected and failed: the section above
+    const std::vector<std::string> warnings = TraceWarnings(t);
+    if (warnings.empty()) continue;
+    ++warned;
+    rows << "<tr class=\"warned\"><td class=\"l\">" << Escape(Str(t, "file")) << "</td><td class=\"l\">";
+    for (size_t i = 0; i < warnings.size(); ++i) {
+      rows << (i ? "<br>" : "") << Escape(InDisplayUnits(p.u, warnings[i]));
+    }
+    rows << "</td></tr>\n";
+  }
+  if (warned == 0) {
+    h << "<p class=\"ok\">None: no fitted trace raised a warning.</p>\n";
+    return;
+  }
+  h << "<p class=\"bad\">" << warned << " fitted trace" << (warned == 1 ? "" : "s")
+    << " raised warnings. Their numbers are in every table above; read why before you trust "
+       "them.</p>\n<table class=\"warnings\"><tr><th class=\"l\">file</th><th class=\"l\">warnings</th></tr>\n"
+    << rows.str() << "</table>\n";
+}
+
+// The traces table's status cell: "ok (warned)" links to the Warnings section and carries the
+// warnings' text as its tooltip.
+std::string StatusCell(const Units& u, const json& t) {
+  const std::string shown = DisplayStatus(t);
+  if (shown != "ok (warned)") return Escape(shown);
+  std::string tip;
+  for (const std::string& w : TraceWarnings(t)) tip += (tip.empty() ? "" : "\n") + InDisplayUnits(u, w);
+  return "<a href=\"#warnings\" title=\"" + Escape(tip) + "\">" + Escape(shown) + "</a>";
 }
 
 // One row per trace: role, status, pitch, total and aircraft inertia, window, amplitude.
@@ -480,7 +763,7 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
   h << "<h2>Traces</h2>\n<table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"
        "<th class=\"l\">status</th><th>pitch (deg)</th><th>I total (" << u.name
-    << ")</th><th>std (stat)</th><th>std (total)</th><th>I aircraft</th><th>std (stat)</th>"
+    << ")</th><th>std (stat)</th><th>std (total)</th><th>period (s)</th><th>I aircraft</th><th>std (stat)</th>"
        "<th>std (total)</th><th>window (s)</th>"
        "<th>amplitude (deg)</th><th>rms/noise</th></tr>\n";
   for (const auto& t : p.traces) {
@@ -494,12 +777,14 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
       amplitude = Fmt(t["amplitude_deg"][0].get<double>(), "%.1f") + "&rarr;" +
                   Fmt(t["amplitude_deg"][1].get<double>(), "%.1f");
     }
-    h << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
+    const std::string row_class = DisplayStatus(t) == "ok (warned)" ? "warned" : status;
+    h << "<tr class=\"" << Escape(row_class) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
       << "</td><td class=\"l\">" << Escape(Str(t, "role")) << "</td><td class=\"l\">"
-      << Escape(status) << "</td><td>" << Fmt(Num(t, "pitch_used_deg"), "%.2f") << "</td><td>"
+      << StatusCell(u, t) << "</td><td>" << Fmt(Num(t, "pitch_used_deg"), "%.2f") << "</td><td>"
       << u.Inertia(Num(t, "inertia_total_kg_m2"), "%.5f") << "</td><td>"
       << u.Inertia(Num(t, "inertia_total_std_kg_m2"), "%.2e") << "</td><td>"
       << u.Inertia(Num(t, "inertia_total_std_total_kg_m2"), "%.2e") << "</td><td>"
+      << Fmt(Num(t, "period_s"), "%.4f") << "</td><td>"
       << u.Inertia(Num(t, "inertia_kg_m2"), "%.5f") << "</td><td>"
       << u.Inertia(Num(t, "inertia_std_kg_m2"), "%.2e") << "</td><td>"
       << u.Inertia(Num(t, "inertia_std_total_kg_m2"), "%.2e") << "</td><td>" << window << "</td><td>"
@@ -510,15 +795,34 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
   h << "</table>\n";
 }
 
+// A trace figure's caption after the status: period, small-angle I, and each warning in red.
+std::string TraceCaptionFacts(const ReportPage& p, const json& t) {
+  std::string out;
+  const double period = Num(t, "period_s");
+  if (std::isfinite(period)) {
+    out += " &middot; T = " + Fmt(period, "%.4f") + " s, small-angle I = " +
+           p.u.Inertia(Num(t, "small_angle_inertia_total_kg_m2"), "%.5f") + " " + p.u.name;
+  }
+  for (const std::string& w : TraceWarnings(t)) {
+    out += "<br><span class=\"bad\">warning: " + Escape(InDisplayUnits(p.u, w)) + "</span>";
+  }
+  return out;
+}
+
 // The per-trace section: every trace's figures (fit and residual) with its caption.
 void WriteTraceFigures(ReportPage& p, std::ostream& h) {
-  h << "<h2>Fit and residual of every trace</h2>\n<div class=\"traces\">\n";
+  h << "<h2>Fit and residual of every trace</h2>\n<p>Left, each trace: the measured swing rate "
+       "(black) over the fit (light blue), and beneath them the residual (grey) with the "
+       "&plusmn;1&sigma; noise estimate (red). Its caption gives the measured period T "
+       "and the small-angle inertia m g D<sup>2</sup> T<sup>2</sup> / (16 &pi;<sup>2</sup> L) of "
+       "everything suspended, the hand check of the fitted I<sub>total</sub>. Right: I against "
+       "amplitude.</p>\n<div class=\"traces\">\n";
   for (const auto& t : p.traces) {
     const std::string fig = Str(t, "figure");
     if (fig.empty()) continue;
     h << "<figure>" << Figure(p.out_dir, fig, "fit of " + Str(t, "file"), "trace", &p.figures_drawn)
-      << "<figcaption>" << Escape(Str(t, "file")) << " &middot; " << Escape(Str(t, "status"))
-      << "</figcaption></figure>\n"
+      << "<figcaption>" << Escape(Str(t, "file")) << " &middot; " << Escape(DisplayStatus(t))
+      << TraceCaptionFacts(p, t) << "</figcaption></figure>\n"
       << SweepFigure(t, p.out_dir, &p.figures_drawn);
   }
   h << "</div>\n";
@@ -561,7 +865,7 @@ std::string Base64(const std::string& bytes) {
 }
 
 // header -> Table 2 -> inertia tensor (campaigns that roll) -> Table 1 and rig -> ellipse figures and NACA 467 -> per-angle table ->
-// rejected traces -> trace table -> per-trace figures -> footer.
+// rejected traces -> warnings -> trace table -> per-trace figures -> footer.
 std::string BuildReportHtml(const json& results, const std::string& out_dir) {
   ReportPage page(results, out_dir);
   std::ostringstream h;
@@ -572,10 +876,11 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
   WriteEllipseSection(page, h);
   WriteAngleTable(page, h);
   WriteRejectedTraces(page, h);
+  WriteWarnings(page, h);
   WriteTraceTable(page, h);
   WriteTraceFigures(page, h);
   WriteFooter(page, h);
-  return h.str();
+  return ShareSvgGlyphs(ShareStyles(h.str()));
 }
 
 void RunReport(const std::string& out_dir) {

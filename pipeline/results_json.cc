@@ -248,6 +248,9 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
   j["window_s"] = Pair(r.window_s);
   j["amplitude_deg"] = Pair(r.amplitude_deg);
   j["amplitude_band_deg"] = Pair(r.amplitude_band_deg);
+  j["period_s"] = Number(r.period_s);
+  j["frequency_hz"] = Number(r.frequency_hz);
+  j["small_angle_inertia_total_kg_m2"] = Number(r.small_angle_inertia_total_kg_m2);
   j["bias_rad_per_s"] = Number(r.bias_rad_per_s);
   j["residual_rms_rad_per_s"] = Number(r.residual_rms_rad_per_s);
   j["noise_rms_rad_per_s"] = Number(r.noise_rms_rad_per_s);
@@ -365,6 +368,9 @@ TraceRecord TraceRecordFromJson(const json& j) {
     r.prewhitened_autocorr_max = GetNumber(*it, "prewhitened_max");
   }
   r.inertia_window_kg_m2 = GetNumber(j, "inertia_window_kg_m2");
+  r.period_s = GetNumber(j, "period_s");
+  r.frequency_hz = GetNumber(j, "frequency_hz");
+  r.small_angle_inertia_total_kg_m2 = GetNumber(j, "small_angle_inertia_total_kg_m2");
   r.inertia_source = GetString(j, "inertia_source");
   if (auto it = j.find("uncertainty"); it != j.end() && it->is_object()) {
     r.inertia_stat_std_kg_m2 = GetNumber(*it, "statistical_kg_m2");
@@ -541,8 +547,9 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
 std::string TracesCsv(const CampaignResult& result) {
   std::ostringstream out;
   out << "file,role,status,pitch_nominal_deg,pitch_measured_deg,pitch_used_deg,"
-         "inertia_total_kg_m2,inertia_total_std_kg_m2,rig_inertia_kg_m2,inertia_kg_m2,"
-         "inertia_std_kg_m2,inertia_total_std_total_kg_m2,inertia_std_total_kg_m2,"
+         "inertia_total_kg_m2,inertia_total_std_kg_m2,period_s,frequency_hz,"
+         "small_angle_inertia_total_kg_m2,rig_inertia_kg_m2,inertia_kg_m2,inertia_std_kg_m2,"
+         "inertia_total_std_total_kg_m2,inertia_std_total_kg_m2,"
          "std_total_percent,uncertainty_terms,budget_assumed,"
          "budget_total_std_kg_m2,drag_coeff_kg_m2,viscous_coeff_kg_m2_per_s,"
          "window_t0_s,window_t1_s,amplitude_start_deg,amplitude_end_deg,bias_rad_per_s,"
@@ -556,7 +563,9 @@ std::string TracesCsv(const CampaignResult& result) {
         << Cell(r.pitch_nominal_deg ? *r.pitch_nominal_deg : NAN) << ','
         << Cell(r.pitch_measured_deg ? *r.pitch_measured_deg : NAN) << ','
         << Cell(r.pitch_used_deg) << ',' << Cell(r.inertia_total_kg_m2) << ','
-        << Cell(r.inertia_total_std_kg_m2) << ',' << Cell(r.rig_inertia_kg_m2) << ','
+        << Cell(r.inertia_total_std_kg_m2) << ',' << Cell(r.period_s) << ','
+        << Cell(r.frequency_hz) << ',' << Cell(r.small_angle_inertia_total_kg_m2) << ','
+        << Cell(r.rig_inertia_kg_m2) << ','
         << Cell(r.inertia_kg_m2) << ',' << Cell(r.inertia_std_kg_m2) << ','
         << Cell(r.inertia_total_std_total_kg_m2) << ',' << Cell(r.inertia_std_total_kg_m2) << ','
         << Cell(TotalPercent(r)) << ',' << Cell(TermsCell(r)) << ','

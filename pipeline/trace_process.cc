@@ -15,6 +15,7 @@
 #include "fit/sweep_plot.h"
 #include "fit/trace_plot.h"
 #include "fit/window.h"
+#include "pendulum/model.h"
 #include "pipeline/imu_log.h"
 #include "pipeline/plausibility.h"
 #include "pipeline/total_uncertainty.h"
@@ -120,12 +121,12 @@ void Envelope(const std::vector<double>& t, const std::vector<double>& v, size_t
   }
 }
 
-// The report's fit-and-residual thumbnail: measured rate (grey envelope) and the fit (blue) above,
+// The report's fit-and-residual thumbnail: the fit (wide blue) and the measured rate (dark, on top),
 // the residual envelope with the +-noise band beneath. Lines only (fit/trace_plot.h draws a symbol
 // per sample, ~0.1 s per trace; this is a few ms), so a campaign of 60 traces stays fast.
 bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
-                            const std::string& path, int width_px, int height_px,
-                            std::string* why) {
+                            DisplayUnits units, const std::string& path, int width_px,
+                            int height_px, std::string* why) {
   constexpr double kDeg = 180.0 / M_PI;
   // Top: measured and fitted rate at ~250 points (the noise is invisible at this scale; it shows
   // in the residual panel). Bottom: the residual's min/max envelope over 150 buckets.
@@ -153,8 +154,11 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
   // Short labels: the SVG embeds an outline of every distinct glyph (the file name is in the
   // report's caption).
   (void)title;
-  std::snprintf(label, sizeof(label), "I = %.5f #(2233) %.1e kg m#u2#d (%s)",
-                fit.params.inertia_kg_m2, fit.inertia_stat_std_kg_m2, ToString(fit.model));
+  // In the config's units, as every table of the report (I total: rig included).
+  std::snprintf(label, sizeof(label), "I#dtotal#u = %.5f #(2233) %.1e %s (%s)",
+                InertiaToDisplay(fit.params.inertia_kg_m2, units),
+                InertiaToDisplay(fit.inertia_stat_std_kg_m2, units),
+                units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d", ToString(fit.model));
   const std::string top_title = label;
   std::snprintf(label, sizeof(label), "residual: rms = %.2f noise", fit.rms_over_noise);
   const std::string bottom_title = label;
@@ -169,14 +173,17 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
     plcol0(1);
     plbox("bct", 0, 0, "bcntv", 0, 0);
     pllab("", "deg/s", top_title.c_str());
-    plscol0(15, 170, 170, 170);
-    plcol0(15);
-    plwidth(3.0);
-    plline(static_cast<PLINT>(tm.size()), tm.data(), ym.data());
-    plscol0(9, 31, 90, 180);
+    // The fit first (wide, light blue), the measured rate on top of it (thin, dark): where the
+    // two agree the measured line shows inside the fit's band (issue 18).
+    plscol0(9, 150, 185, 235);
     plcol0(9);
-    plwidth(1.0);
+    plwidth(4.0);
     plline(static_cast<PLINT>(tf.size()), tf.data(), yf.data());
+    plscol0(15, 0, 0, 0);
+    plcol0(15);
+    plwidth(1.0);
+    plline(static_cast<PLINT>(tm.size()), tm.data(), ym.data());
+    plscol0(15, 170, 170, 170);
     plvpor(0.1, 0.97, 0.1, 0.32);
     plwind(0, t_end, -r_max, r_max);
     plcol0(1);
@@ -354,6 +361,13 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   record.pitch_measured_deg = axis.pitch_measured_deg;
   if (axis.pitch_measured_deg) record.roll_measured_deg = axis.roll_measured_deg;
   for (int k = 0; k < 3; ++k) record.swing_axis_in_imu[k] = axis.axis_in_imu[k];
+  // The measured period and the small-angle inertia (the hand calculation `inspect` prints).
+  if (window.period_s > 0.0) {
+    record.period_s = window.period_s;
+    record.frequency_hz = 1.0 / window.period_s;
+    record.small_angle_inertia_total_kg_m2 =
+        InertiaFromSmallAnglePeriod(GeometryForRole(config, options.role), window.period_s);
+  }
 
   // 4. Amplitude band.
   AmplitudeBandOptions band_options;
@@ -544,13 +558,16 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
     if (fit.t_s.empty()) break;
     bool drawn = false;
     if (options.compact_figure) {
-      drawn = WriteReportTraceFigure(fit, name, figure_path, options.figure_width_px,
+      drawn = WriteReportTraceFigure(fit, name, config.units, figure_path, options.figure_width_px,
                                      options.figure_height_px, &why);
     } else {
       TracePlotOptions figure_options;
       figure_options.title = name;
       figure_options.width_px = options.figure_width_px;
       figure_options.height_px = options.figure_height_px;
+      figure_options.unit_scale = InertiaToDisplay(1.0, config.units);
+      figure_options.unit_label =
+          config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
       drawn = WriteTraceFitFigure(fit, figure_path, figure_options, &why);
     }
     if (!drawn) {

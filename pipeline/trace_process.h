@@ -52,6 +52,14 @@ struct TraceRecord {
   std::array<double, 2> window_s = {NAN, NAN};       // fitted window [t0, t1] (s)
   std::array<double, 2> amplitude_deg = {NAN, NAN};  // amplitude at start/end of the fitted part
   std::array<double, 2> amplitude_band_deg = {NAN, NAN};  // [min, max] band the fit was held to
+  // The measured period: the window search's mean period over the whole free oscillation (the
+  // same number `bifilar inspect` prints), its inverse, and the classic small-angle inertia
+  // I = m g D^2 T^2 / (16 pi^2 L) of everything suspended, with this trace's geometry (rig +
+  // aircraft, rig alone or rig + reference): a hand check beside the nonlinear fit's
+  // inertia_total_kg_m2 (docs/method.md). NaN when no window was found.
+  double period_s = NAN;
+  double frequency_hz = NAN;
+  double small_angle_inertia_total_kg_m2 = NAN;
   double bias_rad_per_s = NAN;           // gyro bias b
   double residual_rms_rad_per_s = NAN;
   double noise_rms_rad_per_s = NAN;      // gyro noise estimated from the rest segment

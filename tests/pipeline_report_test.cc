@@ -45,6 +45,19 @@ TEST(Report, Base64MatchesRfc4648Vectors) {
   EXPECT_EQ(Base64(std::string("\xff\x00\x10", 3)), "/wAQ");
 }
 
+// Every href="#id" of the page names an id="id" of the page (a shared glyph, a section).
+void ExpectEveryHrefResolves(const std::string& html) {
+  int refs = 0;
+  for (size_t at = html.find("href=\"#"); at != std::string::npos; at = html.find("href=\"#", at + 1)) {
+    const size_t start = at + 7, end = html.find('"', start);
+    ASSERT_NE(end, std::string::npos);
+    const std::string id = html.substr(start, end - start);
+    EXPECT_NE(html.find("id=\"" + id + "\""), std::string::npos) << id;
+    ++refs;
+  }
+  EXPECT_GT(refs, 0);
+}
+
 // A campaign with a fake fit that draws a small figure per trace, so the report has every kind
 // of figure: 4 angles x 2 trials, one log that fails.
 std::string MakeCampaign() {
@@ -78,6 +91,17 @@ std::string MakeCampaign() {
     r.inertia_total_std_kg_m2 = 1e-4;
     r.window_s = {2.0, 40.0};
     r.amplitude_deg = {20.0, 8.0};
+    r.period_s = 2.5;
+    r.frequency_hz = 0.4;
+    r.small_angle_inertia_total_kg_m2 = r.inertia_total_kg_m2 * 1.01;
+    // One fitted trace with a warning (as the sample's pitch_20/trial_2), in SI as the fit
+    // writes it; and the assumed-inputs warning every trace carries, which the report states
+    // once (Table 2), not per trace.
+    if (path.find("pitch_45/trial_2") != std::string::npos) {
+      r.warnings.push_back("I depends on the amplitude beyond its statistical error; I is taken "
+                           "from the lowest-amplitude band with a model-inadequacy std of "
+                           "0.0058 kg m^2");
+    }
     std::string why;
     WriteFigure(o.figure_paths.at(0), FigureOptions{400, 300}, [] {
       PLFLT x[2] = {0, 1}, y[2] = {0, 1};
@@ -136,14 +160,36 @@ TEST(Report, HasEverySectionAndEmbedsEveryFigure) {
     EXPECT_EQ(with_sweep, 4);
   }
   EXPECT_EQ(count("src=\"data:image/png;base64,"), 2);
-  // Inline SVGs' ids are made unique (cairo names every file's glyphs alike).
-  EXPECT_NE(html.find("id=\"f0-glyph"), std::string::npos);
-  EXPECT_NE(html.find("id=\"f7-glyph"), std::string::npos);
+  // Glyph outlines are shared: one <symbol> per distinct outline at the end of the page, and
+  // every <use> of every figure points at an id that exists in the page.
+  EXPECT_EQ(html.find("id=\"f0-glyph"), std::string::npos);
+  EXPECT_NE(html.find("<symbol overflow=\"visible\" id=\"sg0\""), std::string::npos);
+  ExpectEveryHrefResolves(html);
   EXPECT_EQ(html.find("src=\"figures/"), std::string::npos);
   EXPECT_EQ(html.find("(no figure)"), std::string::npos);
   // The failed log is listed with its reason, escaped.
   EXPECT_NE(html.find("trial_&lt;3&gt;.csv"), std::string::npos);
   EXPECT_EQ(html.find("trial_<3>.csv"), std::string::npos);
+  // Warnings (issue 18): the warned trace says so in the status column, is listed in the
+  // Warnings section with its text, and its caption carries the text; under units: imperial
+  // the text's 0.0058 kg m^2 is shown as 0.0058 / 1.35582 = 0.00428 slug ft^2.
+  EXPECT_EQ(count(">ok (warned)</a>"), 1);
+  EXPECT_EQ(count("<tr class=\"warned\">"), 2);  // the Warnings row and the traces row
+  const size_t warnings = html.find("<h2 id=\"warnings\">Warnings</h2>");
+  ASSERT_NE(warnings, std::string::npos);
+  const size_t after = html.find("<h2>", warnings + 1);
+  const std::string section = html.substr(warnings, after - warnings);
+  EXPECT_NE(section.find("1 fitted trace raised warnings"), std::string::npos) << section;
+  EXPECT_NE(section.find("pitch_45/trial_2.csv"), std::string::npos) << section;
+  EXPECT_NE(section.find("model-inadequacy std of 0.00428 slug ft^2"), std::string::npos) << section;
+  EXPECT_EQ(html.find("None: every trace passed"), std::string::npos);
+  EXPECT_EQ(count("warning: I depends on the amplitude"), 1);  // the trace's caption
+  // One unit system: nothing in kg m^2 outside the config text (which names its SI keys).
+  const std::string page = html.substr(0, html.find("<h2>Config used</h2>"));
+  EXPECT_EQ(page.find("kg m"), std::string::npos);
+  // The period and the small-angle inertia in each trace caption, in display units:
+  // 1.01 * I_total / 1.35581795 slug ft^2.
+  EXPECT_EQ(count(" &middot; T = 2.5000 s, small-angle I = "), 8);
   // `bifilar report` rebuilds the same page from results.json alone.
   fs::remove(out + "/report.html");
   RunReport(out);
@@ -201,6 +247,19 @@ TEST(Report, CommittedSampleReportLoadsInChromium) {
   }
   EXPECT_EQ(traces, 57);
   EXPECT_EQ(images, 2);
+  // Issue 18: at most 2 MB for 57 traces (was ~8 MB: SVG paths and glyphs simplified, shared).
+  EXPECT_LE(page.size(), 2u * 1024 * 1024);
+  ExpectEveryHrefResolves(page);
+  // pitch_20/trial_2 has an amplitude-trend warning: listed, and flagged in the traces table.
+  const size_t warnings = page.find("<h2 id=\"warnings\">Warnings</h2>");
+  ASSERT_NE(warnings, std::string::npos);
+  const std::string section = page.substr(warnings, page.find("<h2>", warnings + 1) - warnings);
+  EXPECT_NE(section.find("pitch_20/trial_2.csv.gz"), std::string::npos) << section;
+  EXPECT_NE(page.find(">ok (warned)</a>"), std::string::npos);
+  EXPECT_EQ(page.find("None: every trace passed"), std::string::npos);
+  // units: imperial throughout (figure titles included): no kg m^2 before the config text.
+  const std::string shown = page.substr(0, page.find("<h2>Config used</h2>"));
+  EXPECT_EQ(shown.find("kg m"), std::string::npos);
   char tmpl[] = "/tmp/bifilar_sample_shot_XXXXXX";
   const std::string work = mkdtemp(tmpl);
   EXPECT_GT(ScreenshotInChromium(html, work), 50000u);
