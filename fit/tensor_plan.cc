@@ -1,6 +1,8 @@
 // D-optimal choice of attitudes for a tensor campaign (fit/tensor_plan.h).
 #include "fit/tensor_plan.h"
 
+#include "fit/tensor.h"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -107,11 +109,6 @@ const char* TensorPlanComponentName(int component) {
   return component >= 0 && component < kTensorPlanComponents ? kNames[component] : "?";
 }
 
-std::array<double, 3> PlanDownInBody(double roll_deg, double pitch_deg) {
-  const double phi = roll_deg * kDegToRad, theta = pitch_deg * kDegToRad;
-  return {-std::sin(theta), std::sin(phi) * std::cos(theta), std::cos(phi) * std::cos(theta)};
-}
-
 Row TensorDesignRow(const std::array<double, 3>& axis) {
   const double len = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
   const double x = axis[0] / len, y = axis[1] / len, z = axis[2] / len;
@@ -194,7 +191,7 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
       Candidate c;
       c.roll_deg = roll;
       c.pitch_deg = pitch;
-      c.n = PlanDownInBody(roll, pitch);
+      c.n = DownInBodyFromAttitude(roll, pitch);
       all.push_back(c);
     }
   }

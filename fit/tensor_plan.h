@@ -19,9 +19,8 @@
 // tilts, per radian). Components outside the row space of the reachable axes are named as
 // unobservable, never given a number. Details: docs/method.md, "Planning the attitudes".
 //
-// The geometry below (PlanDownInBody, TensorDesignRow) is the same as fit/tensor.h's
-// DownInBodyFromAttitude and its design rows (branch `tensor`); it is kept here under its own
-// names so both can be joined at merge. This header is plain C++ and Eigen-free.
+// The swing axis of an attitude is fit/tensor.h's DownInBodyFromAttitude, the one the fit uses.
+// This header is plain C++ and Eigen-free.
 #pragma once
 
 #include <array>
@@ -35,8 +34,6 @@ namespace bifilar {
 constexpr int kTensorPlanComponents = 6;
 const char* TensorPlanComponentName(int component);  // "Ixx", ..., "Iyz"
 
-// The down vertical in body axes for roll phi and pitch theta (deg), a unit vector.
-std::array<double, 3> PlanDownInBody(double roll_deg, double pitch_deg);
 // The row of the design matrix for the axis n (normalised first):
 // (nx^2, ny^2, nz^2, -2 nx ny, -2 nx nz, -2 ny nz), so I(n) = row . components.
 std::array<double, kTensorPlanComponents> TensorDesignRow(const std::array<double, 3>& n);

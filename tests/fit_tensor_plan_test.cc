@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "fit/tensor.h"
 #include "fit/tensor_plan.h"
 
 namespace bifilar {
@@ -96,11 +97,11 @@ TEST(TensorPlanGeometry, AxesAndRowsFollowTheConvention) {
     return std::fabs(a[0] - x) < 1e-15 && std::fabs(a[1] - y) < 1e-15 &&
            std::fabs(a[2] - z) < 1e-15;
   };
-  EXPECT_TRUE(near(PlanDownInBody(0, 0), 0, 0, 1));    // level: swings about body z
-  EXPECT_TRUE(near(PlanDownInBody(0, 90), -1, 0, 0));  // nose up 90: about -x (= x)
-  EXPECT_TRUE(near(PlanDownInBody(90, 0), 0, 1, 0));   // right wing down 90: about y
+  EXPECT_TRUE(near(DownInBodyFromAttitude(0, 0), 0, 0, 1));    // level: swings about body z
+  EXPECT_TRUE(near(DownInBodyFromAttitude(0, 90), -1, 0, 0));  // nose up 90: about -x (= x)
+  EXPECT_TRUE(near(DownInBodyFromAttitude(90, 0), 0, 1, 0));   // right wing down 90: about y
   // The row reproduces n^T J n for an oblique axis (roll 30, pitch -20).
-  const auto n = PlanDownInBody(30, -20);
+  const auto n = DownInBodyFromAttitude(30, -20);
   const auto row = TensorDesignRow(n);
   double dot = 0;
   for (int k = 0; k < 6; ++k) dot += row[k] * kTruth[k];
@@ -185,7 +186,7 @@ TEST(TensorPlan, ChosenDesignBeatsRandomDesignsFromTheSameGrid) {
   for (int r = 0; r < 300; ++r) {
     Eigen::MatrixXd info = Eigen::MatrixXd::Zero(6, 6);
     for (int i = 0; i < 12; ++i) {
-      const auto row = TensorDesignRow(PlanDownInBody(5.0 * grid(rng), 5.0 * grid(rng)));
+      const auto row = TensorDesignRow(DownInBodyFromAttitude(5.0 * grid(rng), 5.0 * grid(rng)));
       const Eigen::Map<const Eigen::Matrix<double, 6, 1>> b(row.data());
       info += w * b * b.transpose();
     }
