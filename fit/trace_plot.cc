@@ -141,9 +141,14 @@ bool WriteTraceFitFigure(const TraceFitResult& r, const std::string& path,
       plline(static_cast<PLINT>(n), t.data(), fit.data());
     }
     plwidth(1.0);
-    plcol0(kGrey);
-    plssym(0, 0.35);
-    dots(t, meas, env_t, env_meas);  // measured: small dots (dense: their envelope)
+    plcol0(kBlack);
+    plssym(0, 0.45);
+    // measured: filled dots that show on the line (Hershey code 17; dense: their envelope)
+    if (dense) {
+      dots(t, meas, env_t, env_meas);
+    } else {
+      plpoin(static_cast<PLINT>(n), t.data(), meas.data(), 17);
+    }
     // Legend (top right, inside).
     {
       const double lx = 0.62 * t_hi, ly = 1.22 * y_abs, dx = 0.035 * t_hi;
@@ -154,9 +159,9 @@ bool WriteTraceFitFigure(const TraceFitResult& r, const std::string& path,
       plptex(lx + 1.3 * dx, ly, 1, 0, 0, "fitted");
       const double mx = lx + 0.2 * t_hi;
       const double px[3] = {mx + 0.1 * dx, mx + 0.5 * dx, mx + 0.9 * dx}, py[3] = {ly, ly, ly};
-      plcol0(kGrey);
-      plssym(0, 0.9);
-      plpoin(3, px, py, 1);
+      plcol0(kBlack);
+      plssym(0, 0.45);
+      plpoin(3, px, py, 17);
       plcol0(kBlack);
       plptex(mx + 1.3 * dx, ly, 1, 0, 0, "measured");
     }

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -23,14 +24,38 @@
 namespace bifilar {
 namespace {
 
-// "pitch_10/trial_1.csv" -> "pitch_10_trial_1": figure names that do not collide.
-std::string FigureStem(const std::string& log) {
-  std::string stem = std::filesystem::path(log).lexically_normal().replace_extension().string();
+// A log's name without its folder and extensions ("BaseModel_Ixx_Log-1.csv" ->
+// "BaseModel_Ixx_Log-1", "trial_1.csv.gz" -> "trial_1").
+std::string LogStem(const std::string& log) {
+  std::filesystem::path name = std::filesystem::path(log).filename();
+  if (name.extension() == ".gz") name = name.stem();
+  const std::string ext = name.extension().string();
+  if (ext == ".csv" || ext == ".ulg" || ext == ".txt" || ext == ".tsv") name = name.stem();
+  std::string stem = name.string();
   for (char& c : stem) {
-    if (c == '/' || c == '\\' || c == ' ' || c == ':') c = '_';
+    if (c == ' ' || c == ':') c = '_';
   }
-  while (!stem.empty() && (stem[0] == '.' || stem[0] == '_')) stem.erase(stem.begin());
+  while (!stem.empty() && stem[0] == '.') stem.erase(stem.begin());
   return stem.empty() ? "trace" : stem;
+}
+
+// The figure name of each log: DIR/<log>.svg, as the docs say; logs of the same name in
+// different folders ("pitch_10/trial_1.csv", "pitch_20/trial_1.csv") get their folder in front
+// ("pitch_10_trial_1"), so no figure overwrites another.
+std::vector<std::string> FigureStems(const std::vector<std::string>& logs) {
+  std::map<std::string, int> count;
+  for (const std::string& log : logs) ++count[LogStem(log)];
+  std::vector<std::string> stems;
+  for (const std::string& log : logs) {
+    std::string stem = LogStem(log);
+    if (count[stem] > 1) {
+      const std::string folder =
+          std::filesystem::path(log).lexically_normal().parent_path().filename().string();
+      if (!folder.empty() && folder != "." && folder != "..") stem = folder + "_" + stem;
+    }
+    stems.push_back(stem);
+  }
+  return stems;
 }
 
 // The record's console line, inertias (I, K_D, C and the small-angle I) in the config's units.
@@ -234,7 +259,9 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     std::vector<TraceRecord> records;
     int failed = 0;
     InstallInterruptHandler();
-    for (const std::string& log : args->logs) {
+    const std::vector<std::string> stems = FigureStems(args->logs);
+    for (size_t k = 0; k < args->logs.size(); ++k) {
+      const std::string& log = args->logs[k];
       if (ProcessInterruptFlag().load()) {  // Ctrl-C: what was fitted, then exit 130
         if (args->json || args->repeats) {
           for (const TraceRecord& r : records) std::cout << HumanLine(r, config.units) << std::endl;
@@ -247,7 +274,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       TraceProcessOptions trace = options;
       trace.display_name = log;
       if (!args->plot_dir.empty()) {
-        const std::string base = (std::filesystem::path(args->plot_dir) / FigureStem(log)).string();
+        const std::string base = (std::filesystem::path(args->plot_dir) / stems[k]).string();
         trace.figure_paths = {base + ".svg", base + ".png"};
         trace.sweep_figure_paths = {base + "_sweep.svg", base + "_sweep.png"};
       }

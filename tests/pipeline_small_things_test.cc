@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <string>
 
@@ -77,6 +78,27 @@ TEST(SmallThings, RepeatsPrintTheScatterWarningOnce) {
   // JSON records keep the warning on each member (a record stands alone there).
   ASSERT_EQ(Cli(dir, "fit " + config + logs + " --repeats --json", &out), 0) << out;
   EXPECT_EQ(Count(out, "scatter beyond their own stds"), 4) << out;
+}
+
+// `fit --plot DIR` names the figures DIR/<log>.{svg,png} after the log's own name (issue 18),
+// and puts the folder in front only for logs that share a name ("pitch_10_trial_2").
+TEST(SmallThings, PlotFiguresAreNamedAfterTheLog) {
+  TempDir dir;
+  const std::string logs = kSource + "/sample_runs/prandtl_d/logs";
+  WriteFile(dir.path + "/my_swing.csv.gz", ReadFile(logs + "/pitch_30/trial_1.csv.gz"));
+  std::string out;
+  ASSERT_EQ(Cli(dir,
+                "fit " + kSource + "/configs/prandtl_d.yaml " + logs + "/pitch_10/trial_2.csv.gz " +
+                    logs + "/pitch_20/trial_2.csv.gz " + dir.path + "/my_swing.csv.gz --plot " +
+                    dir.path + "/plots",
+                &out),
+            0)
+      << out;
+  for (const char* name : {"pitch_10_trial_2", "pitch_20_trial_2", "my_swing"}) {
+    for (const char* suffix : {".svg", ".png", "_sweep.svg"}) {
+      EXPECT_TRUE(std::filesystem::exists(dir.path + "/plots/" + name + suffix)) << name << suffix;
+    }
+  }
 }
 
 TEST(SmallThings, HelpNamesUlog) {
