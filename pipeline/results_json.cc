@@ -1,5 +1,6 @@
 #include "pipeline/results_json.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -150,8 +151,15 @@ std::string Cell(double value) {
   std::snprintf(buffer, sizeof(buffer), "%.10g", value);
   return buffer;
 }
+// A text that a CSV reader would take for a non-finite number ("nan", "-Inf": a log named so).
+bool ReadsAsNonFinite(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), ::tolower);
+  if (!text.empty() && (text[0] == '-' || text[0] == '+')) text.erase(text.begin());
+  return text == "nan" || text == "inf" || text == "infinity";
+}
 std::string Cell(const std::string& text) {
-  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  // Text stays text: quoted when it holds a separator or would read as NaN/inf.
+  if (text.find_first_of(",\"\n") == std::string::npos && !ReadsAsNonFinite(text)) return text;
   std::string quoted = "\"";
   for (char c : text) {
     if (c == '"') quoted += '"';

@@ -101,6 +101,24 @@ TEST(SmallThings, PlotFiguresAreNamedAfterTheLog) {
   }
 }
 
+// A text cell that would read as a number stays text: a tare log listed as `nan` (the long
+// stress run's config mutation) is written "nan", quoted, in traces.csv, never a bare nan.
+TEST(SmallThings, TextCellsThatReadAsNaNAreQuoted) {
+  TempDir dir;
+  std::string config = ReadFile(kSource + "/configs/prandtl_d.yaml");
+  const std::string tare = "../sample_runs/prandtl_d/logs/tare/*.csv.gz";
+  const std::string root = "../sample_runs/prandtl_d/logs";
+  ASSERT_NE(config.find(tare), std::string::npos);
+  config.replace(config.find(tare), tare.size(), "nan");
+  config.replace(config.find(root), root.size(), kSource + "/sample_runs/prandtl_d/logs");
+  WriteFile(dir.path + "/c.yaml", config);
+  std::string out;
+  Cli(dir, "process " + dir.path + "/c.yaml --out " + dir.path + "/out --jobs 2", &out);
+  const std::string csv = ReadFile(dir.path + "/out/traces.csv");
+  EXPECT_NE(csv.find("\n\"nan\",tare,error"), std::string::npos) << out;
+  EXPECT_EQ(csv.find("\nnan,"), std::string::npos);
+}
+
 TEST(SmallThings, HelpNamesUlog) {
   TempDir dir("bifilar_small_things");
   std::string out;
