@@ -18,21 +18,8 @@ using nlohmann::json;
 using test_support::ReadFile;
 using test_support::TempDir;
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-CliRun Bifilar(const TempDir& dir, const std::string& args) {
-  const std::string out = dir.path + "/stdout.txt", err = dir.path + "/stderr.txt";
-  const int status =
-      std::system((std::string(BIFILAR_BINARY) + " " + args + " >" + out + " 2>" + err).c_str());
-  CliRun r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = ReadFile(out);
-  r.err = ReadFile(err);
-  return r;
-}
+using test_support::Bifilar;
+using test_support::CliRun;
 
 TEST(TensorPlanCli, JsonMatchesTheLibraryAndUnitsConvert) {
   TempDir dir("bifilar_tensor_plan");

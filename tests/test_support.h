@@ -3,6 +3,8 @@
 // simulated with its glitches changed. Header-only; include from tests only.
 #pragma once
 
+#include <sys/wait.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -46,6 +48,24 @@ struct TempDir {
   TempDir(const TempDir&) = delete;
   TempDir& operator=(const TempDir&) = delete;
 };
+
+// One run of the `bifilar` binary: its exit code (-1 when it did not exit), stdout and stderr.
+struct CliRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+// Runs `bifilar ARGS` with its output in `dir` (stdout.txt, stderr.txt).
+inline CliRun Bifilar(const TempDir& dir, const std::string& args) {
+  const std::string out = dir.path + "/stdout.txt", err = dir.path + "/stderr.txt";
+  const int status =
+      std::system((std::string(BIFILAR_BINARY) + " " + args + " >" + out + " 2>" + err).c_str());
+  CliRun r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = ReadFile(out);
+  r.err = ReadFile(err);
+  return r;
+}
 
 // The config `bifilar fit` reads: geometry, mass, IMU format (no runs).
 inline CampaignConfig LoadFitConfig(const std::string& path) {
