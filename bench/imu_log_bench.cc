@@ -10,8 +10,8 @@
 #include "fit/swing_axis.h"
 #include "fit/window.h"
 #include "pendulum/simulate.h"
-#include "pipeline/imu_log.h"
-#include "pipeline/imu_log_writer.h"
+#include "pipeline/logs/imu_log.h"
+#include "pipeline/logs/imu_log_writer.h"
 
 namespace bifilar {
 namespace {

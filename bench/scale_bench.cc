@@ -21,11 +21,11 @@
 #include <benchmark/benchmark.h>
 
 #include "fit/ellipse.h"
-#include "pipeline/campaign.h"
-#include "pipeline/config.h"
-#include "pipeline/ellipse_table.h"
-#include "pipeline/simulate_spec.h"
-#include "pipeline/trace_process.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/commands/ellipse_table.h"
+#include "pipeline/commands/simulate_spec.h"
+#include "pipeline/config/config.h"
+#include "pipeline/trace/trace_process.h"
 
 namespace bifilar {
 namespace {

@@ -24,15 +24,15 @@
 #include <string>
 #include <vector>
 
+#include "base/user_error.h"
 #include "fit/glitch.h"
 #include "fit/trace_fit.h"
 #include "fit/trace_synth.h"
-#include "pipeline/campaign.h"
-#include "pipeline/config.h"
-#include "pipeline/imu_log.h"
-#include "pipeline/simulate_spec.h"
-#include "pipeline/trace_process.h"
-#include "pipeline/user_error.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/commands/simulate_spec.h"
+#include "pipeline/config/config.h"
+#include "pipeline/logs/imu_log.h"
+#include "pipeline/trace/trace_process.h"
 
 namespace bifilar {
 namespace {

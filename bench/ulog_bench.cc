@@ -10,10 +10,10 @@
 #include <benchmark/benchmark.h>
 
 #include "pendulum/simulate.h"
-#include "pipeline/imu_log.h"
-#include "pipeline/imu_log_writer.h"
-#include "pipeline/ulog.h"
-#include "pipeline/ulog_writer.h"
+#include "pipeline/logs/imu_log.h"
+#include "pipeline/logs/imu_log_writer.h"
+#include "pipeline/logs/ulog.h"
+#include "pipeline/logs/ulog_writer.h"
 
 namespace bifilar {
 namespace {

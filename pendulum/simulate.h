@@ -1,6 +1,6 @@
 // Realistic bifilar-pendulum IMU logs with known truth: one trace or a whole campaign.
-// Physics and IMU synthesis only (no files, no YAML): pipeline/simulate_spec.h reads the spec and
-// writes the files.
+// Physics and IMU synthesis only (no files, no YAML): pipeline/commands/simulate_spec.h reads the
+// spec and writes the files.
 //
 // Conventions (docs/physics.md §2, §3): body axes x forward, y right wing, z down, origin at
 // the CG; pitch theta nose-up positive; the swing axis (down vertical) in body axes is

@@ -1,8 +1,9 @@
 // The Python module's native part, `bifilar._core`: thin bindings over the same library calls the
-// command line makes (pipeline/trace_process.h, pipeline/campaign.h, fit/ellipse.h,
-// pipeline/simulate_spec.h). Records are built by the CLI's own JSON serializers
-// (pipeline/results_json.h, pipeline/ellipse_json.h) and converted to Python dicts, so a field the
-// CLI gains appears here with no change. The public, documented API is python/bifilar/__init__.py.
+// command line makes (pipeline/trace/trace_process.h, pipeline/campaign/campaign.h, fit/ellipse.h,
+// pipeline/commands/simulate_spec.h). Records are built by the CLI's own JSON serializers
+// (pipeline/records/results_json.h, pipeline/records/ellipse_json.h) and converted to Python dicts,
+// so a field the CLI gains appears here with no change. The public, documented API is
+// python/bifilar/__init__.py.
 //
 // Errors: bifilar::UserError (and std::invalid_argument) become ValueError with the message the
 // CLI prints after "bifilar: error: "; nothing here aborts the interpreter. The GIL is released
@@ -30,22 +31,22 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/bounded_read.h"
+#include "base/user_error.h"
 #include "fit/ellipse.h"
 #include "fit/swing_axis.h"
 #include "fit/tensor.h"
 #include "fit/trace_fit.h"
 #include "fit/window.h"
-#include "pipeline/bounded_read.h"
-#include "pipeline/campaign.h"
-#include "pipeline/config.h"
-#include "pipeline/ellipse_json.h"
-#include "pipeline/imu_log.h"
-#include "pipeline/log_inspect.h"
-#include "pipeline/results_json.h"
-#include "pipeline/simulate_spec.h"
-#include "pipeline/tensor_json.h"
-#include "pipeline/trace_process.h"
-#include "pipeline/user_error.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/commands/log_inspect.h"
+#include "pipeline/commands/simulate_spec.h"
+#include "pipeline/config/config.h"
+#include "pipeline/logs/imu_log.h"
+#include "pipeline/records/ellipse_json.h"
+#include "pipeline/records/results_json.h"
+#include "pipeline/records/tensor_json.h"
+#include "pipeline/trace/trace_process.h"
 
 namespace py = pybind11;
 
@@ -262,9 +263,9 @@ py::tuple FitTraceCore(const Array& t_array, const Array& rate_array, const FitT
 
 // ---- read_log ----
 
-// Without a config the format is the one `bifilar inspect` guesses (pipeline/log_inspect.h), and
-// the swing axis, window search and reading limits are the defaults of a config that gives only
-// the format (as the config `bifilar init --log` writes).
+// Without a config the format is the one `bifilar inspect` guesses
+// (pipeline/commands/log_inspect.h), and the swing axis, window search and reading limits are the
+// defaults of a config that gives only the format (as the config `bifilar init --log` writes).
 py::dict ReadLogCore(const std::string& path, const std::optional<std::string>& config_path) {
   CampaignConfig config;
   std::optional<nlohmann::json> guessed_format;
@@ -289,7 +290,7 @@ py::dict ReadLogCore(const std::string& path, const std::optional<std::string>& 
   {
     py::gil_scoped_release release;
     data = ReadImuLog(path, config.imu.format, config.limits.LogOptions());
-    // Step 2 of ProcessTrace (pipeline/trace_process.cc): the swing axis with the config's
+    // Step 2 of ProcessTrace (pipeline/trace/trace_process.cc): the swing axis with the config's
     // settings, over the config's window for this file when it has one (matched as
     // `bifilar fit` matches it, on the path as given).
     window = ConfigWindowFor(config, path);
@@ -587,7 +588,7 @@ std::string ReadText(const std::string& path) {
   return ReadRegularFileOrThrow(path, OutputFileCap());
 }
 
-// The same checks and merging as `bifilar simulate` (pipeline/cli_simulate.cc), with the
+// The same checks and merging as `bifilar simulate` (pipeline/cli/cli_simulate.cc), with the
 // keyword names in the messages.
 py::dict SimulateCore(const SimulateArgs& a) {
   auto positive = [](const std::optional<double>& v, const char* name) {

@@ -14,8 +14,8 @@
 
 #include "fit/trace_fit.h"
 #include "fit/trace_guess.h"
-#include "fit/trace_plot.h"
 #include "fit/trace_synth.h"
+#include "pipeline/figures/trace_plot.h"
 
 namespace bifilar {
 namespace {

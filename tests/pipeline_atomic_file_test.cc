@@ -1,4 +1,4 @@
-// WriteFileAtomically (pipeline/atomic_file.h): the file appears whole or not at all, and a
+// WriteFileAtomically (base/atomic_file.h): the file appears whole or not at all, and a
 // target that is not a regular file (folder, device, FIFO) is refused with its path named and
 // left as it was.
 #include <gtest/gtest.h>
@@ -10,8 +10,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "pipeline/atomic_file.h"
-#include "pipeline/user_error.h"
+#include "base/atomic_file.h"
+#include "base/user_error.h"
 
 namespace bifilar {
 namespace {

@@ -1,5 +1,5 @@
 // Bounded reads (issue 15, items 5 and 6): every input is a regular file within a size cap
-// (pipeline/bounded_read.h), gzip logs are read member after member up to a decompressed cap, and
+// (base/bounded_read.h), gzip logs are read member after member up to a decompressed cap, and
 // YAML aliases are refused. Known truth: files written here with known bytes; a FIFO, /dev/zero
 // and a symlink to /dev/urandom must be refused without being read (a read would block or never
 // end, and CTest's timeout would fail the test).
@@ -9,13 +9,13 @@
 #include <filesystem>
 #include <string>
 
-#include "pipeline/bounded_read.h"
-#include "pipeline/config.h"
-#include "pipeline/gzip.h"
-#include "pipeline/imu_log.h"
-#include "pipeline/output_set.h"
-#include "pipeline/simulate_spec.h"
-#include "pipeline/user_error.h"
+#include "base/bounded_read.h"
+#include "base/gzip.h"
+#include "base/user_error.h"
+#include "pipeline/commands/simulate_spec.h"
+#include "pipeline/config/config.h"
+#include "pipeline/logs/imu_log.h"
+#include "pipeline/store/output_set.h"
 #include "test_support.h"
 
 namespace bifilar {

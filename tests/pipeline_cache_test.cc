@@ -1,6 +1,6 @@
 // Cache: the FNV-1a hash against published test vectors, which config values enter a trace's
 // key (and which do not), and entries surviving a store/load round trip.
-#include "pipeline/cache.h"
+#include "pipeline/store/cache.h"
 
 #include <cstdlib>
 #include <filesystem>

@@ -1,9 +1,9 @@
-// rig.calibration (pipeline/calibration.h): a reference object of known inertia swung on the rig
-// fixes the rig's effective D^2/L. First with a fake trace fit whose inertia scales exactly like
-// the configured D^2/L (so the iteration, the std and the bookkeeping are checked to rounding),
-// then on a simulated mis-measured rig with the real fit (issue 16: true D 1.5 % wider than
-// configured: about 3 % off without calibration, within 0.3 % and 3 sigma with it), then the bad
-// input of the section.
+// rig.calibration (pipeline/campaign/calibration.h): a reference object of known inertia swung on
+// the rig fixes the rig's effective D^2/L. First with a fake trace fit whose inertia scales exactly
+// like the configured D^2/L (so the iteration, the std and the bookkeeping are checked to
+// rounding), then on a simulated mis-measured rig with the real fit (issue 16: true D 1.5 % wider
+// than configured: about 3 % off without calibration, within 0.3 % and 3 sigma with it), then the
+// bad input of the section.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,12 +14,12 @@
 #include <sstream>
 #include <tuple>
 
-#include "pipeline/cache.h"
-#include "pipeline/calibration.h"
-#include "pipeline/campaign.h"
-#include "pipeline/results_json.h"
-#include "pipeline/simulate_spec.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/campaign/calibration.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/commands/simulate_spec.h"
+#include "pipeline/records/results_json.h"
+#include "pipeline/store/cache.h"
 #include "test_support.h"
 
 namespace bifilar {

@@ -1,7 +1,7 @@
 // The campaign pipeline with a fake trace fit (the fit reads the total inertia written in the
 // "log"), so discovery, tare, grouping, ellipse, cache and bad-input handling are tested exactly,
 // independently of the trace fit: the truth is known to the last digit.
-#include "pipeline/campaign.h"
+#include "pipeline/campaign/campaign.h"
 
 #include <atomic>
 #include <cmath>
@@ -13,8 +13,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "pipeline/simulate_spec.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/commands/simulate_spec.h"
 
 namespace bifilar {
 namespace {

@@ -1,6 +1,6 @@
 // Campaign config: every key read, validated, relative paths resolved; typos and missing keys
 // named with file and line.
-#include "pipeline/config.h"
+#include "pipeline/config/config.h"
 
 #include <cstdlib>
 #include <filesystem>
@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/trace_process.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/trace/trace_process.h"
 
 namespace bifilar {
 namespace {

@@ -15,9 +15,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "pipeline/ellipse_json.h"
-#include "pipeline/ellipse_table.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/commands/ellipse_table.h"
+#include "pipeline/records/ellipse_json.h"
 
 namespace bifilar {
 namespace {

@@ -1,5 +1,5 @@
-// `bifilar export` (pipeline/export.h): a worked example per format (a known tensor -> the exact
-// numbers, derived by hand below), the frames checked against a body of point masses whose
+// `bifilar export` (pipeline/report/export.h): a worked example per format (a known tensor -> the
+// exact numbers, derived by hand below), the frames checked against a body of point masses whose
 // elements are computed from their definitions in each format's own frame, the planar sample
 // campaign, and bad input through the real binary.
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/export.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/report/export.h"
 #include "test_support.h"
 
 namespace bifilar {

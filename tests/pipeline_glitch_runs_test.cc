@@ -12,9 +12,9 @@
 #include <gtest/gtest.h>
 
 #include "fit/glitch.h"
-#include "pipeline/config.h"
-#include "pipeline/imu_log.h"
-#include "pipeline/trace_process.h"
+#include "pipeline/config/config.h"
+#include "pipeline/logs/imu_log.h"
+#include "pipeline/trace/trace_process.h"
 #include "test_support.h"
 
 namespace bifilar {

@@ -24,14 +24,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "pipeline/cache.h"
-#include "pipeline/campaign.h"
-#include "pipeline/config.h"
-#include "pipeline/report.h"
-#include "pipeline/results_json.h"
-#include "pipeline/trace_process.h"
+#include "base/user_error.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/config/config.h"
+#include "pipeline/records/results_json.h"
+#include "pipeline/report/report.h"
+#include "pipeline/store/cache.h"
+#include "pipeline/trace/trace_process.h"
 #include "tests/test_support.h"
-#include "pipeline/user_error.h"
 
 namespace bifilar {
 namespace {

@@ -1,6 +1,6 @@
 // IMU CSV reader: units, tolerated oddities, repairs with warnings, and one test per bad input
 // (each error must name the file, and the line/column where there is one).
-#include "pipeline/imu_log.h"
+#include "pipeline/logs/imu_log.h"
 
 #include <cmath>
 #include <cstdio>
@@ -11,10 +11,10 @@
 
 #include <gtest/gtest.h>
 
+#include "base/gzip.h"
+#include "base/user_error.h"
 #include "pendulum/simulate.h"
-#include "pipeline/gzip.h"
-#include "pipeline/imu_log_writer.h"
-#include "pipeline/user_error.h"
+#include "pipeline/logs/imu_log_writer.h"
 
 namespace bifilar {
 namespace {

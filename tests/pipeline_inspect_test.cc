@@ -1,7 +1,7 @@
-// `bifilar inspect` and `bifilar init` (pipeline/log_inspect.h, pipeline/config_template.h):
-// the format guessed from names and data, the period of a simulated swing against the
-// small-angle formula, what a file that is not a log is called, and a starting config that
-// `bifilar fit` accepts as it stands.
+// `bifilar inspect` and `bifilar init` (pipeline/commands/log_inspect.h,
+// pipeline/config/config_template.h): the format guessed from names and data, the period of a
+// simulated swing against the small-angle formula, what a file that is not a log is called, and a
+// starting config that `bifilar fit` accepts as it stands.
 #include <cmath>
 #include <cstdlib>
 
@@ -9,9 +9,9 @@
 
 #include "pendulum/model.h"
 #include "pendulum/simulate.h"
-#include "pipeline/config_template.h"
-#include "pipeline/imu_log_writer.h"
-#include "pipeline/log_inspect.h"
+#include "pipeline/commands/log_inspect.h"
+#include "pipeline/config/config_template.h"
+#include "pipeline/logs/imu_log_writer.h"
 #include "test_support.h"
 
 namespace bifilar {

@@ -11,10 +11,10 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/cache.h"
-#include "pipeline/campaign.h"
-#include "pipeline/config.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/config/config.h"
+#include "pipeline/store/cache.h"
 
 namespace bifilar {
 namespace {

@@ -1,4 +1,4 @@
-// Ctrl-C (pipeline/interrupt.h): SIGINT sent to `bifilar process` mid-campaign stops it with exit
+// Ctrl-C (base/interrupt.h): SIGINT sent to `bifilar process` mid-campaign stops it with exit
 // code 130, a message saying what was finished, the finished fits in the cache and no result
 // file; the next run goes on from the cache.
 #include <signal.h>

@@ -12,8 +12,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "pipeline/config.h"
-#include "pipeline/trace_process.h"
+#include "pipeline/config/config.h"
+#include "pipeline/trace/trace_process.h"
 #include "tests/test_support.h"
 
 namespace bifilar {

@@ -12,12 +12,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "pipeline/campaign.h"
-#include "pipeline/config.h"
-#include "pipeline/ellipse_table.h"
-#include "pipeline/gzip.h"
-#include "pipeline/json_error.h"
-#include "pipeline/user_error.h"
+#include "base/gzip.h"
+#include "base/json_error.h"
+#include "base/user_error.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/commands/ellipse_table.h"
+#include "pipeline/config/config.h"
 
 namespace bifilar {
 namespace {

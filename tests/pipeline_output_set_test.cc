@@ -1,7 +1,7 @@
-// The output folder (pipeline/output_set.h): the user's files are never removed, one run at a
+// The output folder (pipeline/store/output_set.h): the user's files are never removed, one run at a
 // time, a mixed set is detected. A fake trace fit (the "log" holds its total inertia) keeps the
 // runs instant.
-#include "pipeline/output_set.h"
+#include "pipeline/store/output_set.h"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -19,9 +19,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "pipeline/campaign.h"
-#include "pipeline/report.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/report/report.h"
 
 namespace bifilar {
 namespace {

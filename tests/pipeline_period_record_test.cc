@@ -9,9 +9,9 @@
 #include <string>
 
 #include "pendulum/model.h"
-#include "pipeline/campaign.h"
-#include "pipeline/results_json.h"
-#include "pipeline/trace_process.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/records/results_json.h"
+#include "pipeline/trace/trace_process.h"
 #include "tests/test_support.h"
 
 namespace bifilar {

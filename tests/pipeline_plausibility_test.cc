@@ -9,14 +9,14 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/campaign.h"
-#include "pipeline/config.h"
-#include "pipeline/imu_log.h"
-#include "pipeline/imu_log_writer.h"
-#include "pipeline/plausibility.h"
-#include "pipeline/simulate_spec.h"
-#include "pipeline/trace_process.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/commands/simulate_spec.h"
+#include "pipeline/config/config.h"
+#include "pipeline/config/plausibility.h"
+#include "pipeline/logs/imu_log.h"
+#include "pipeline/logs/imu_log_writer.h"
+#include "pipeline/trace/trace_process.h"
 #include "test_support.h"
 
 namespace bifilar {

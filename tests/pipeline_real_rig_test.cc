@@ -15,8 +15,8 @@
 
 #include "fit/trace_fit.h"
 #include "fit/trace_synth.h"
-#include "pipeline/config.h"
-#include "pipeline/trace_process.h"
+#include "pipeline/config/config.h"
+#include "pipeline/trace/trace_process.h"
 #include "tests/test_support.h"
 
 namespace bifilar {

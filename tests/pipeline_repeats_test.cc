@@ -1,7 +1,7 @@
-// Repeats of one set-up (pipeline/repeats.h): grouping by the last number of the file name,
+// Repeats of one set-up (pipeline/trace/repeats.h): grouping by the last number of the file name,
 // DerSimonian-Laird between-repeat std, and on the real quadrotor logs (../shared/data/crazyflie,
 // skipped when absent) the 4 repeats of each set-up within 2.5 sigma of their 4-log mean.
-#include "pipeline/repeats.h"
+#include "pipeline/trace/repeats.h"
 
 #include <cmath>
 #include <cstdio>
@@ -14,7 +14,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/config.h"
+#include "pipeline/config/config.h"
 #include "tests/test_support.h"
 
 namespace bifilar {

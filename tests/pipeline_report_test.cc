@@ -1,7 +1,7 @@
 // report.html: self-contained (figures embedded), every section present, rebuilt from
 // results.json alone, and loading in headless Chromium without console errors where Chromium is
 // installed (/usr/bin/chromium; the test is skipped otherwise).
-#include "pipeline/report.h"
+#include "pipeline/report/report.h"
 
 #include <cstdio>
 #include <cstdlib>
@@ -13,9 +13,9 @@
 #include <nlohmann/json.hpp>
 #include <plplot/plplot.h>
 
-#include "fit/figure.h"
-#include "pipeline/campaign.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/figures/figure.h"
 
 namespace bifilar {
 namespace {

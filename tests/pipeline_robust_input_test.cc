@@ -16,8 +16,8 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/config.h"
-#include "pipeline/trace_process.h"
+#include "pipeline/config/config.h"
+#include "pipeline/trace/trace_process.h"
 #include "tests/test_support.h"
 
 namespace bifilar {

@@ -1,6 +1,6 @@
-// Run discovery (pipeline/run_discovery.h): the pattern rules of configs/README.md (`runs`) —
-// `*` and `?` within one component, `{pitch_deg}` capturing the pitch, '[' and '\' literal,
-// names starting with '.' matched, folders never matched as logs, results in path order.
+// Run discovery (pipeline/campaign/run_discovery.h): the pattern rules of configs/README.md
+// (`runs`) — `*` and `?` within one component, `{pitch_deg}` capturing the pitch, '[' and '\'
+// literal, names starting with '.' matched, folders never matched as logs, results in path order.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -8,8 +8,8 @@
 #include <fstream>
 #include <map>
 
-#include "pipeline/run_discovery.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/campaign/run_discovery.h"
 
 namespace bifilar {
 namespace {

@@ -13,12 +13,12 @@
 
 #include <gtest/gtest.h>
 
+#include "base/user_error.h"
 #include "fit/ellipse.h"
-#include "pipeline/campaign.h"
-#include "pipeline/config.h"
-#include "pipeline/ellipse_command.h"
-#include "pipeline/run_discovery.h"
-#include "pipeline/user_error.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/campaign/run_discovery.h"
+#include "pipeline/commands/ellipse_command.h"
+#include "pipeline/config/config.h"
 #include "test_support.h"
 
 namespace bifilar {

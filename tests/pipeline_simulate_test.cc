@@ -15,9 +15,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "pipeline/imu_log_writer.h"
-#include "pipeline/simulate_spec.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/commands/simulate_spec.h"
+#include "pipeline/logs/imu_log_writer.h"
 
 namespace bifilar {
 namespace {

@@ -14,11 +14,11 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "pipeline/campaign.h"
-#include "pipeline/config.h"
-#include "pipeline/imu_format.h"
-#include "pipeline/imu_log.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/config/config.h"
+#include "pipeline/logs/imu_format.h"
+#include "pipeline/logs/imu_log.h"
 #include "test_support.h"
 
 namespace bifilar {

@@ -1,7 +1,8 @@
-// The amplitude-sweep figure (fit/sweep_plot.h, issue 8 item 3): written beside the fit figure
-// for a trace whose sweep was evaluated, listed in the record's figures (and its JSON), and for a
-// trace too short for a sweep, no file and no entry. Traces are simulated with `bifilar simulate`
-// (PRANDTL-D-like rig, seed 1): 40 s of swing holds ~15 cycles (5 bands of 3), 9 s holds < 6.
+// The amplitude-sweep figure (pipeline/figures/sweep_plot.h, issue 8 item 3): written beside the
+// fit figure for a trace whose sweep was evaluated, listed in the record's figures (and its JSON),
+// and for a trace too short for a sweep, no file and no entry. Traces are simulated with `bifilar
+// simulate` (PRANDTL-D-like rig, seed 1): 40 s of swing holds ~15 cycles (5 bands of 3), 9 s holds
+// < 6.
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -10,10 +11,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "fit/sweep_plot.h"
-#include "pipeline/config.h"
-#include "pipeline/results_json.h"
-#include "pipeline/trace_process.h"
+#include "pipeline/config/config.h"
+#include "pipeline/figures/sweep_plot.h"
+#include "pipeline/records/results_json.h"
+#include "pipeline/trace/trace_process.h"
 
 namespace bifilar {
 namespace {

@@ -1,9 +1,9 @@
-// Tensor campaigns through `process` (pipeline/campaign_tensor.h): attitudes from the runs table
-// and from {roll_deg}, exact recovery through discovery and grouping with a fake trace fit, the
-// minimal three-axis config, bad rolls, the measured-vs-nominal warning, the planar sample bit for
-// bit, a simulated 12 x 2 campaign against its truth (nominal and measured attitudes), and the
+// Tensor campaigns through `process` (pipeline/campaign/campaign_tensor.h): attitudes from the runs
+// table and from {roll_deg}, exact recovery through discovery and grouping with a fake trace fit,
+// the minimal three-axis config, bad rolls, the measured-vs-nominal warning, the planar sample bit
+// for bit, a simulated 12 x 2 campaign against its truth (nominal and measured attitudes), and the
 // real Crazyflie logs when ../shared/data is beside the repository.
-#include "pipeline/campaign.h"
+#include "pipeline/campaign/campaign.h"
 
 #include <cmath>
 #include <filesystem>
@@ -13,10 +13,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "base/user_error.h"
 #include "fit/tensor.h"
-#include "pipeline/campaign_tensor.h"
-#include "pipeline/simulate_spec.h"
-#include "pipeline/user_error.h"
+#include "pipeline/campaign/campaign_tensor.h"
+#include "pipeline/commands/simulate_spec.h"
 #include "test_support.h"
 
 namespace bifilar {

@@ -1,5 +1,5 @@
-// The total uncertainty (pipeline/total_uncertainty.h): named terms in quadrature, the assumed
-// +-1 mm on L and D without rig.uncertainties, the total in every output, and on the real
+// The total uncertainty (pipeline/records/total_uncertainty.h): named terms in quadrature, the
+// assumed +-1 mm on L and D without rig.uncertainties, the total in every output, and on the real
 // quadrotor logs (../shared/data/crazyflie, skipped when absent) the numbers issue 16 asks for.
 #include <gtest/gtest.h>
 
@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/campaign.h"
-#include "pipeline/repeats.h"
-#include "pipeline/total_uncertainty.h"
-#include "pipeline/trace_process.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/records/total_uncertainty.h"
+#include "pipeline/trace/repeats.h"
+#include "pipeline/trace/trace_process.h"
 #include "tests/test_support.h"
 
 namespace bifilar {

@@ -1,8 +1,8 @@
-// PX4 ULog reader (pipeline/ulog.h) and writer (pipeline/ulog_writer.h): the real PX4 logs in
-// ../shared/data/px4/ against a reference reader's numbers, files written here with dropouts,
-// appended sections, nested types and a cut-short tail, bad input (always an error naming the
-// file, never a crash), the config keys, and a simulated campaign processed from .ulg and .csv.
-#include "pipeline/ulog.h"
+// PX4 ULog reader (pipeline/logs/ulog.h) and writer (pipeline/logs/ulog_writer.h): the real PX4
+// logs in ../shared/data/px4/ against a reference reader's numbers, files written here with
+// dropouts, appended sections, nested types and a cut-short tail, bad input (always an error naming
+// the file, never a crash), the config keys, and a simulated campaign processed from .ulg and .csv.
+#include "pipeline/logs/ulog.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -14,13 +14,13 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "pipeline/campaign.h"
-#include "pipeline/config.h"
-#include "pipeline/imu_log.h"
-#include "pipeline/imu_log_writer.h"
-#include "pipeline/simulate_spec.h"
-#include "pipeline/ulog_writer.h"
-#include "pipeline/user_error.h"
+#include "base/user_error.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/commands/simulate_spec.h"
+#include "pipeline/config/config.h"
+#include "pipeline/logs/imu_log.h"
+#include "pipeline/logs/imu_log_writer.h"
+#include "pipeline/logs/ulog_writer.h"
 
 namespace bifilar {
 namespace {

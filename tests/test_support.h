@@ -15,7 +15,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/config.h"
+#include "pipeline/config/config.h"
 
 namespace bifilar {
 namespace test_support {

@@ -20,8 +20,9 @@
 // (results.json, traces.csv, angles.csv, `fit --json`), no file outside OUT changed, added or
 // removed (the workspace beside OUT, with the logs, the config and a fake thesis, hashed
 // before and after every run), the user's files untouched, a consistent
-// output set (pipeline/output_set.h CheckOutputSet) after every run that finished; after cache
-// tampering, a kill or concurrent runs on the pristine campaign, the ellipse equals the baseline.
+// output set (pipeline/store/output_set.h CheckOutputSet) after every run that finished; after
+// cache tampering, a kill or concurrent runs on the pristine campaign, the ellipse equals the
+// baseline.
 //
 //   bifilar_stress --binary build/bifilar --source . [--seed 1] [--cases 150] [--keep]
 // CTest runs `stress/short` (500 cases, 40-60 s on 2 cores); the long mode is --cases 3000
@@ -52,9 +53,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pipeline/cache.h"
-#include "pipeline/gzip.h"
-#include "pipeline/output_set.h"
+#include "base/gzip.h"
+#include "pipeline/store/cache.h"
+#include "pipeline/store/output_set.h"
 
 namespace {
 
@@ -924,7 +925,7 @@ void CaseFifoInOutput(const Args& args, const Workspace& w, int case_no, bool ca
   const Outcome o =
       Wait(Start(ProcessArgv(args, w, false), w.harness + "/hostile"), args.run_timeout_s);
   // `process` checks the manifest first: a recorded file that is no longer a regular file makes
-  // it refuse the manifest, naming the entry (pipeline/output_set.h); either refusal will do.
+  // it refuse the manifest, naming the entry (pipeline/store/output_set.h); either refusal will do.
   const std::string entry = path.substr(w.out.size() + 1);
   const std::string refused = "entry \"" + entry + "\" refused: is not a regular file";
   ExpectStop(o, case_no, kind + " (process)", {2}, o.err,

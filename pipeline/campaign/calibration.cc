@@ -1,0 +1,242 @@
+#include "pipeline/campaign/calibration.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "pipeline/campaign/campaign.h"  // RigInertiaAt
+#include "base/user_error.h"
+#include "pipeline/campaign/run_discovery.h"
+
+namespace bifilar {
+namespace {
+
+std::string Format(const char* format, double a, double b = 0.0, double c = 0.0) {
+  char buffer[640];
+  std::snprintf(buffer, sizeof(buffer), format, a, b, c);
+  return buffer;
+}
+
+double SampleStd(const std::vector<double>& v) {
+  if (v.size() < 2) return NAN;
+  double mean = 0.0;
+  for (double x : v) mean += x / v.size();
+  double s = 0.0;
+  for (double x : v) s += (x - mean) * (x - mean);
+  return std::sqrt(s / (v.size() - 1));
+}
+
+// The message of a record that is not ok, with its file named once.
+std::string Described(const TraceRecord& r) {
+  const std::string prefix = r.file + ": ";
+  const std::string message =
+      r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message;
+  return r.file + ": " + ToString(r.status) + (message.empty() ? "" : " (" + message + ")");
+}
+
+}  // namespace
+
+void MeanAndStandardError(const std::vector<double>& values, const std::vector<double>& stds,
+                          double* mean, double* standard_error) {
+  *mean = NAN;
+  *standard_error = NAN;
+  if (values.empty()) return;
+  const double n = static_cast<double>(values.size());
+  double sum = 0.0, fit_var = 0.0;
+  for (double v : values) sum += v;
+  for (double s : stds) fit_var += s * s / stds.size();
+  *mean = sum / n;
+  const double fit_sem = std::sqrt(fit_var / n);
+  *standard_error =
+      values.size() >= 2 ? std::max(SampleStd(values) / std::sqrt(n), fit_sem) : fit_sem;
+}
+
+GeometryCalibration RigCalibrationResult::Applied() const {
+  GeometryCalibration g;
+  g.applied = applied;
+  g.factor = factor;
+  g.factor_rel_std = factor_rel_std;
+  return g;
+}
+
+std::string RigCalibrationResult::BriefReport() const {
+  char buffer[400];
+  std::snprintf(buffer, sizeof(buffer),
+                "calibration: D^2/L factor k = %.5f +- %.5f (%.2f %%) from %d reference swing%s: "
+                "effective D = %.5f m against %.5f m configured (L = %.4f m kept)",
+                factor, factor_std, 100.0 * factor_rel_std, n_swings, n_swings == 1 ? "" : "s",
+                effective_separation_m, nominal_separation_m, filar_length_m);
+  return buffer;
+}
+
+RigCalibrationResult CalibrateRig(const CampaignConfig& config, const CalibrationFitFunction& fit,
+                                  std::vector<TraceRecord>* records_out) {
+  const RigCalibrationSpec& spec = config.calibration;
+  const RigInertiaSpec::Kind rig_kind = config.rig_inertia.kind;
+  const bool from_tare = rig_kind == RigInertiaSpec::Kind::kTare;
+  RigCalibrationResult out;
+  out.reference_inertia_kg_m2 = spec.reference_inertia_kg_m2;
+  out.reference_inertia_std_kg_m2 = spec.reference_inertia_std_kg_m2;
+  out.reference_mass_kg = spec.reference_mass_kg;
+  out.filar_length_m = config.filar_length_m;
+  out.nominal_separation_m = config.filar_separation_m;
+  out.rig_inertia_source = from_tare                                  ? "tare"
+                           : rig_kind == RigInertiaSpec::Kind::kTable ? "table"
+                                                                      : "value";
+  // A given rig inertia does not depend on k: look it up once.
+  double rig_given = NAN, rig_given_std = NAN;
+  if (!from_tare) {
+    std::string why;
+    if (!RigInertiaAt(config, NAN, NAN, spec.rig_pitch_deg, &rig_given, &rig_given_std, &why)) {
+      throw UserError("rig.calibration: rig inertia at rig_pitch_deg " +
+                      Format("%g", spec.rig_pitch_deg) + " deg: " + why);
+    }
+  }
+
+  double k = 1.0;
+  std::vector<TraceRecord> records;
+  bool converged = false;
+  for (int round = 1; round <= kCalibrationMaxIterations && !converged; ++round) {
+    CampaignConfig trial = config;
+    trial.geometry_calibration = GeometryCalibration();
+    trial.geometry_calibration.factor = k;
+    records = fit(trial);
+    out.iterations = round;
+    std::vector<double> swing, swing_std, tare, tare_std;
+    out.logs.clear();
+    for (const TraceRecord& r : records) {
+      if (!r.cache_key.empty()) out.cache_keys.push_back(r.cache_key);
+      if (r.role == TraceRole::kCalibration) {
+        if (!r.ok()) {
+          throw UserError("rig.calibration: reference swing " + Described(r) +
+                          "; the campaign stops before any aircraft trace is fitted with an "
+                          "unknown geometry: fix this log (e.g. a fit.windows entry) or remove it "
+                          "from rig.calibration.logs");
+        }
+        out.logs.push_back(r.file);
+        swing.push_back(r.inertia_total_kg_m2);
+        swing_std.push_back(r.inertia_total_std_kg_m2);
+      } else if (r.role == TraceRole::kTare && r.ok()) {
+        tare.push_back(r.inertia_total_kg_m2);
+        tare_std.push_back(r.inertia_total_std_kg_m2);
+      }
+    }
+    if (swing.empty()) throw UserError("rig.calibration.logs: no reference swing was found");
+    out.n_swings = static_cast<int>(swing.size());
+    MeanAndStandardError(swing, swing_std, &out.swings_total_kg_m2, &out.swings_total_std_kg_m2);
+    out.swings_scatter_kg_m2 = SampleStd(swing);
+    if (from_tare) {
+      if (tare.empty()) {
+        throw UserError(
+            "rig.calibration: no usable tare log (rig.inertia.tare.logs): the rig's "
+            "own inertia is needed to calibrate; the campaign stops");
+      }
+      MeanAndStandardError(tare, tare_std, &out.rig_inertia_kg_m2, &out.rig_inertia_std_kg_m2);
+    } else {
+      out.rig_inertia_kg_m2 = rig_given;
+      out.rig_inertia_std_kg_m2 = rig_given_std;
+    }
+    // The reference's share of the swings' inertia, which must come out as its known inertia.
+    const double measured_reference = out.swings_total_kg_m2 - out.rig_inertia_kg_m2;
+    if (!(measured_reference > 0.0)) {
+      throw UserError(
+          Format("rig.calibration: the reference swings (I = %.6g kg m^2) are not "
+                 "above the rig alone (%.6g kg m^2): check rig.calibration.logs, "
+                 "reference_mass_kg and rig.inertia",
+                 out.swings_total_kg_m2, out.rig_inertia_kg_m2));
+    }
+    // Tare: I_rig scales with k too, so target/fitted = I_ref / (I_swings - I_tare); given rig:
+    // (I_rig + I_ref) / I_swings.
+    const double ratio = from_tare
+                             ? spec.reference_inertia_kg_m2 / measured_reference
+                             : (rig_given + spec.reference_inertia_kg_m2) / out.swings_total_kg_m2;
+    const double next = k * ratio;
+    if (!(next >= kMinCalibrationFactor && next <= kMaxCalibrationFactor)) {
+      throw UserError(
+          Format("rig.calibration: the reference swings give an effective D^2/L %.4g times the "
+                 "configured one (allowed %g to %g): not a tape-measure error. Check "
+                 "reference_inertia_kg_m2 (about the swing axis, kg m^2), reference_mass_kg (kg), "
+                 "rig.inertia and rig.mass_kg",
+                 next, kMinCalibrationFactor, kMaxCalibrationFactor));
+    }
+    if (std::abs(ratio - 1.0) <= kCalibrationTolerance) {
+      converged = true;  // the records are those of k: keep k
+    } else {
+      k = next;
+    }
+  }
+  if (!converged) {
+    throw UserError("rig.calibration: the effective geometry did not converge in " +
+                    std::to_string(kCalibrationMaxIterations) + " rounds (last factor " +
+                    Format("%.8g", k) + ")");
+  }
+
+  // std(k)/k to first order in each input (docs/method.md §15).
+  const double ref = spec.reference_inertia_kg_m2;
+  if (from_tare) {  // k = I_ref / (S - T): S - T = I_ref at convergence
+    out.rel_std_reference = spec.reference_inertia_std_kg_m2 / ref;
+    out.rel_std_swings = out.swings_total_std_kg_m2 / ref;
+    out.rel_std_rig = out.rig_inertia_std_kg_m2 / ref;
+  } else {  // k = (I_rig + I_ref) / S: S = I_rig + I_ref at convergence
+    const double total = rig_given + ref;
+    out.rel_std_reference = spec.reference_inertia_std_kg_m2 / total;
+    out.rel_std_swings = out.swings_total_std_kg_m2 / out.swings_total_kg_m2;
+    out.rel_std_rig = (std::isfinite(rig_given_std) ? rig_given_std : 0.0) / total;
+  }
+  out.factor = k;
+  out.factor_rel_std =
+      std::sqrt(out.rel_std_reference * out.rel_std_reference +
+                out.rel_std_swings * out.rel_std_swings + out.rel_std_rig * out.rel_std_rig);
+  out.factor_std = k * out.factor_rel_std;
+  out.effective_separation_m = config.filar_separation_m * std::sqrt(k);
+  out.nominal_d2_over_l_m =
+      config.filar_separation_m * config.filar_separation_m / config.filar_length_m;
+  out.effective_d2_over_l_m = k * out.nominal_d2_over_l_m;
+  out.applied = true;
+  if (out.n_swings < kRecommendedReferenceSwings) {
+    out.warnings.push_back(
+        "rig.calibration: " + std::to_string(out.n_swings) + " reference swing" +
+        (out.n_swings == 1 ? "" : "s") + "; swing the reference " +
+        std::to_string(kRecommendedReferenceSwings) +
+        "-5 times, so that their scatter is measured and enters the calibration's std");
+  }
+  if (out.factor_rel_std > 0.01) {
+    out.warnings.push_back(Format(
+        "rig.calibration: the calibration's std is %.2g %%: a heavier reference (inertia well "
+        "above the rig's), more swings or a better known reference inertia shrink it",
+        100.0 * out.factor_rel_std));
+  }
+  if (records_out) *records_out = std::move(records);
+  return out;
+}
+
+RigCalibrationResult CalibrateRigFromLogs(const CampaignConfig& config) {
+  std::vector<RunFile> runs =
+      DiscoverListedLogs(config, config.calibration.log_patterns, TraceRole::kCalibration);
+  if (config.rig_inertia.kind == RigInertiaSpec::Kind::kTare) {
+    std::vector<RunFile> tare =
+        DiscoverListedLogs(config, config.rig_inertia.tare_patterns, TraceRole::kTare);
+    runs.insert(runs.end(), tare.begin(), tare.end());
+  }
+  const CalibrationFitFunction fit = [&](const CampaignConfig& round) {
+    std::vector<TraceRecord> records;
+    for (const RunFile& run : runs) {
+      if (!run.error.empty()) {
+        TraceRecord r;
+        r.file = run.display;
+        r.role = run.role;
+        r.status = TraceStatus::kError;
+        r.message = run.error;
+        records.push_back(r);
+        continue;
+      }
+      TraceProcessOptions options;
+      options.role = run.role;
+      options.display_name = run.display;
+      records.push_back(ProcessTrace(round, run.path, options));
+    }
+    return records;
+  };
+  return CalibrateRig(config, fit);
+}
+
+}  // namespace bifilar

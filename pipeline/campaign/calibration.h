@@ -1,0 +1,86 @@
+// Rig calibration with a reference object (`rig.calibration`, docs/method.md §15): a machined bar
+// or plate of known inertia and mass is swung on the rig; its swings fix the rig's effective
+// D^2/L, which every trace of the campaign (tare logs included) then uses. To leading order the
+// pendulum depends on L, D and g only through g D^2/L (docs/physics.md §2.6), so the tape-measure
+// errors of L and D, and an error of g, are absorbed; the factor's own std becomes one relative
+// term common to every moment (the `calibration` term of each trace's budget).
+//
+// The iteration: with the factor k, every reference swing is fitted (suspended mass = rig +
+// reference) and, when the rig inertia comes from tare logs, every tare log too (their fitted
+// inertia scales with k as well). Fitted inertias scale almost exactly like k (not exactly with
+// the `full` model: the kinetic energy of the rise), so
+//   k <- k * target / fitted,  target: I_reference (tare: fitted reference - fitted tare) or
+//                                      I_rig + I_reference (a given rig inertia: fitted reference)
+// converges in two or three rounds; it stops when the ratio is within kCalibrationTolerance of 1.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "pipeline/config/config.h"
+#include "pipeline/trace/trace_process.h"
+
+namespace bifilar {
+
+constexpr double kCalibrationTolerance = 1e-6;  // |target / fitted - 1| at convergence
+constexpr int kCalibrationMaxIterations = 8;
+// A calibration that moves D^2/L by more than a factor 2 is not a tape-measure error: a wrong
+// reference inertia or mass, a unit slip, or the wrong rig inertia. It is an error.
+constexpr double kMinCalibrationFactor = 0.5, kMaxCalibrationFactor = 2.0;
+constexpr int kRecommendedReferenceSwings = 3;  // fewer: a warning (the scatter is not measured)
+
+// What the calibration found. All inertias are of the final iteration (the calibrated geometry).
+struct RigCalibrationResult {
+  bool applied = false;
+  double factor = 1.0;                  // k = effective D^2/L over the configured D^2/L
+  double factor_std = 0.0;              // std of k
+  double factor_rel_std = 0.0;          // std(k) / k, from the three parts below in quadrature
+  double rel_std_reference = 0.0;       // from reference_inertia_std_kg_m2
+  double rel_std_swings = 0.0;          // from the reference swings' scatter (or their fits' std)
+  double rel_std_rig = 0.0;             // from the rig inertia's std (tare mean or configured std)
+  double filar_length_m = 0.0;          // L, as configured (kept)
+  double nominal_separation_m = 0.0;    // D as configured
+  double effective_separation_m = 0.0;  // D sqrt(k)
+  double nominal_d2_over_l_m = 0.0, effective_d2_over_l_m = 0.0;
+  double reference_inertia_kg_m2 = 0.0, reference_inertia_std_kg_m2 = 0.0;
+  double reference_mass_kg = 0.0;
+  int n_swings = 0;                     // reference swings (every one must fit)
+  double swings_total_kg_m2 = NAN;      // mean fitted rig + reference inertia
+  double swings_total_std_kg_m2 = NAN;  // its standard error (MeanAndStandardError)
+  double swings_scatter_kg_m2 = NAN;    // sample std between the swings (n >= 2)
+  std::string rig_inertia_source;       // "value", "table" or "tare"
+  double rig_inertia_kg_m2 = NAN, rig_inertia_std_kg_m2 = NAN;  // as used
+  int iterations = 0;                                           // fitting rounds
+  std::vector<std::string> logs;  // the reference swings as shown to the user
+  std::vector<std::string> warnings;
+  std::vector<std::string> cache_keys;  // every fit of every round (the campaign keeps them)
+
+  GeometryCalibration Applied() const;  // what the fits use: {applied, factor, factor_rel_std}
+  std::string BriefReport() const;      // one line: factor +- std, effective against nominal D
+};
+
+// Fits every reference swing of rig.calibration, plus every tare log when rig.inertia is `tare`,
+// with `config` (whose geometry_calibration.factor is the round's k). Returns their records.
+using CalibrationFitFunction =
+    std::function<std::vector<TraceRecord>(const CampaignConfig& config)>;
+
+// Runs the iteration above. Throws UserError naming the log when a reference swing is not `ok`
+// (the caller then fits no aircraft trace), naming the key when there is no reference swing, no
+// usable tare log, a reference not above the rig, an implausible factor or no convergence.
+// `records` (optional) receives the final round's records.
+RigCalibrationResult CalibrateRig(const CampaignConfig& config, const CalibrationFitFunction& fit,
+                                  std::vector<TraceRecord>* records = nullptr);
+
+// CalibrateRig for `bifilar fit`: the logs of rig.calibration (and rig.inertia.tare) found with
+// DiscoverListedLogs and fitted with ProcessTrace every round (no cache). Throws UserError as
+// CalibrateRig does, and naming the key when a pattern matches nothing.
+RigCalibrationResult CalibrateRigFromLogs(const CampaignConfig& config);
+
+// The mean of repeated fits of one quantity and its standard error: the larger of the
+// between-fit std / sqrt(n) and the fits' rms std / sqrt(n) (n = 1: the fit's std), so that a few
+// fits that happen to agree closely never claim more than their fits can. NaN when empty.
+void MeanAndStandardError(const std::vector<double>& values, const std::vector<double>& stds,
+                          double* mean, double* standard_error);
+
+}  // namespace bifilar

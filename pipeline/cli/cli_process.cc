@@ -1,0 +1,78 @@
+// `bifilar process CONFIG [--out DIR] [--jobs N] [--force]` and `bifilar report DIR`.
+#include <unistd.h>
+
+#include <filesystem>
+#include <iostream>
+
+#include "base/interrupt.h"
+#include "pipeline/campaign/campaign.h"
+#include "pipeline/cli/cli_commands.h"
+#include "pipeline/config/config.h"
+#include "pipeline/report/report.h"
+
+namespace bifilar {
+
+void RegisterProcessCommands(CLI::App& app, int* exit_code) {
+  struct Args {
+    std::string config;
+    std::string out;
+    int jobs = 0;
+    bool force = false;
+    std::string integrator;
+    std::string runs_root;
+    std::string report_dir;
+  };
+  auto args = std::make_shared<Args>();
+
+  auto* process = app.add_subcommand(
+      "process", "Process a campaign: fit every log, subtract the rig, fit the ellipse, write "
+                 "results.json, traces.csv, angles.csv and report.html");
+  process->add_option("config", args->config, "campaign config (YAML, see configs/README.md)")
+      ->required();
+  process->add_option("--out", args->out, "output folder (default: out/ beside the config)");
+  process->add_option("--jobs", args->jobs, "worker threads (default: all cores)")
+      ->check(CLI::Range(0, kMaxJobs));
+  process->add_flag("--force", args->force, "ignore the cache and refit every log");
+  process->add_option("--integrator", args->integrator,
+                      "ODE solver of the fits: rk853 or cvodes; overrides fit.integrator")
+      ->check(CLI::IsMember({"rk853", "cvodes"}));
+  process->add_option("--runs-root", args->runs_root,
+                      "folder of the aircraft logs, instead of the config's runs.root");
+  process->callback([args, exit_code] {
+    ConfigLoadOptions load;
+    load.runs_root = args->runs_root;
+    CampaignConfig config = LoadCampaignConfig(args->config, load);
+    if (!args->integrator.empty()) ParseIntegratorMethod(args->integrator, &config.fit.integrator);
+    CampaignOptions options;
+    options.out_dir = args->out.empty()
+                          ? (std::filesystem::path(config.folder) / "out").string()
+                          : args->out;
+    options.jobs = args->jobs;
+    options.force = args->force;
+    options.progress = &std::cerr;
+    options.progress_bar = isatty(2) != 0;
+    InstallInterruptHandler();
+    options.cancel = &ProcessInterruptFlag();
+    CampaignResult result;
+    try {
+      result = RunCampaign(config, options);
+    } catch (const CampaignInterrupted& e) {
+      std::cerr << "bifilar: " << e.what() << "\n";
+      *exit_code = kInterruptedExitCode;
+      return;
+    }
+    PrintCampaignSummary(config, result, std::cout);
+    std::cout << "Wrote " << options.out_dir << "/{results.json, traces.csv, angles.csv, report.html}\n";
+    *exit_code = result.summary.exit_code;
+  });
+
+  auto* report = app.add_subcommand("report", "Rebuild DIR/report.html from DIR/results.json");
+  report->add_option("dir", args->report_dir, "output folder of `bifilar process`")->required();
+  report->callback([args, exit_code] {
+    RunReport(args->report_dir);
+    std::cout << "Wrote " << args->report_dir << "/report.html\n";
+    *exit_code = 0;
+  });
+}
+
+}  // namespace bifilar

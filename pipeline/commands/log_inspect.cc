@@ -1,0 +1,726 @@
+#include "pipeline/commands/log_inspect.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "base/bounded_read.h"
+#include "base/gzip.h"
+#include "base/user_error.h"
+#include "fit/swing_axis.h"
+#include "fit/window.h"
+#include "pendulum/model.h"
+#include "pipeline/logs/imu_log.h"
+#include "pipeline/logs/ulog.h"
+#include "pipeline/trace/trace_process.h"
+
+namespace bifilar {
+namespace {
+
+constexpr double kDegPerRad = 57.29577951308232;
+
+// A gyro reading whose 99th percentile exceeds this (in the file's own numbers) is taken to be
+// in deg/s: a pendulum swinging 90 deg at a 0.6 s period peaks at 10 rad/s, and rigs swing at
+// 1-3 s, so 12 "rad/s" is no swing, while 12 deg/s is a 4-deg swing at 2 s.
+constexpr double kDegPerSGuessAbove = 12.0;
+// Steps longer than this many median steps are dropouts (as the window search treats gaps).
+constexpr double kDropoutSteps = 2.5;
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string Trim(const std::string& s) {
+  size_t b = 0, e = s.size();
+  while (b < e && std::isspace(static_cast<unsigned char>(s[b]))) ++b;
+  while (e > b && std::isspace(static_cast<unsigned char>(s[e - 1]))) --e;
+  std::string t = s.substr(b, e - b);
+  if (t.size() >= 2 && (t.front() == '"' || t.front() == '\'') && t.back() == t.front()) {
+    t = t.substr(1, t.size() - 2);
+  }
+  return t;
+}
+
+std::vector<std::string> SplitLine(const std::string& line, char delim) {
+  std::vector<std::string> out;
+  if (delim == ' ') {
+    std::istringstream in(line);
+    std::string cell;
+    while (in >> cell) out.push_back(cell);
+    return out;
+  }
+  std::string cell;
+  for (char c : line) {
+    if (c == delim) {
+      out.push_back(Trim(cell));
+      cell.clear();
+    } else if (c != '\r') {
+      cell += c;
+    }
+  }
+  out.push_back(Trim(cell));
+  return out;
+}
+
+bool IsNumber(const std::string& cell, double* value) {
+  if (cell.empty()) return false;
+  char* end = nullptr;
+  *value = std::strtod(cell.c_str(), &end);
+  return end == cell.c_str() + cell.size() && std::isfinite(*value);
+}
+
+bool IsCommentLine(const std::string& line) {
+  const std::string t = Trim(line);
+  return t.rfind("#", 0) == 0 || t.rfind("%", 0) == 0 || t.rfind("//", 0) == 0;
+}
+
+// The lines of the first `max_lines` of a text, without blank and comment lines above the header.
+std::vector<std::string> HeadLines(const std::string& text, size_t max_lines) {
+  std::vector<std::string> lines;
+  size_t start = 0;
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) start = 3;  // UTF-8 byte-order mark
+  while (start < text.size() && lines.size() < max_lines) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(start, end - start);
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!(lines.empty() && (Trim(line).empty() || IsCommentLine(line)))) lines.push_back(line);
+    start = end + 1;
+  }
+  return lines;
+}
+
+// A column name without its unit in brackets and without separators: "Gyro_X (deg/s)" ->
+// "gyrox", plus the unit it names, if any.
+struct ColumnName {
+  std::string bare;
+  std::string unit_hint;  // "deg/s", "rad/s", "ms", "us", "s", ""
+};
+
+ColumnName Normalise(const std::string& name) {
+  const std::string lower = Lower(name);
+  ColumnName out;
+  std::string inside;  // text in brackets
+  int depth = 0;
+  for (char c : lower) {
+    if (c == '(' || c == '[') {
+      ++depth;
+      continue;
+    }
+    if (c == ')' || c == ']') {
+      depth = std::max(0, depth - 1);
+      continue;
+    }
+    if (depth > 0 && !(std::isdigit(static_cast<unsigned char>(c)) && inside.empty())) {
+      inside += c;
+    }
+    if (depth > 0 && !std::isdigit(static_cast<unsigned char>(c))) continue;
+    if (std::isalnum(static_cast<unsigned char>(c))) out.bare += c;
+  }
+  const std::string all = lower;
+  if (all.find("deg") != std::string::npos || all.find("dps") != std::string::npos) {
+    out.unit_hint = "deg/s";
+  } else if (all.find("rad") != std::string::npos) {
+    out.unit_hint = "rad/s";
+  }
+  return out;
+}
+
+// Column triplets named prefix + {x,y,z} or prefix + {0,1,2}: the index of each axis, or -1.
+std::array<int, 3> FindTriplet(const std::vector<ColumnName>& names,
+                               const std::vector<std::string>& prefixes) {
+  static const char* kSuffixes[][3] = {{"x", "y", "z"}, {"0", "1", "2"}, {"1", "2", "3"}};
+  for (const std::string& prefix : prefixes) {
+    for (const auto& suffix : kSuffixes) {
+      std::array<int, 3> idx = {-1, -1, -1};
+      for (int a = 0; a < 3; ++a) {
+        for (size_t i = 0; i < names.size(); ++i) {
+          if (names[i].bare == prefix + suffix[a]) {
+            idx[a] = static_cast<int>(i);
+            break;
+          }
+        }
+      }
+      if (idx[0] >= 0 && idx[1] >= 0 && idx[2] >= 0) return idx;
+    }
+  }
+  return {-1, -1, -1};
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+std::string Format(const char* fmt, double a) {
+  char buffer[128];
+  std::snprintf(buffer, sizeof(buffer), fmt, a);
+  return buffer;
+}
+
+}  // namespace
+
+FormatGuess GuessCsvFormat(const std::string& text) {
+  FormatGuess guess;
+  const std::vector<std::string> lines = HeadLines(text, 400);
+  if (lines.empty()) {
+    guess.why = "no header line";
+    return guess;
+  }
+  // Delimiter: the one that splits the header into the most cells, consistently with row 2.
+  char delim = ',';
+  size_t best = 1;
+  for (char d : {',', ';', '\t', ' '}) {
+    const size_t n = SplitLine(lines[0], d).size();
+    if (n > best && (lines.size() < 2 || SplitLine(lines[1], d).size() == n)) {
+      best = n;
+      delim = d;
+    }
+  }
+  guess.format.delimiter = delim;
+  const std::vector<std::string> header = SplitLine(lines[0], delim);
+  std::vector<ColumnName> names;
+  for (const std::string& h : header) names.push_back(Normalise(h));
+  // Numeric rows below the header, column by column.
+  std::vector<std::vector<double>> columns(header.size());
+  for (size_t r = 1; r < lines.size(); ++r) {
+    const std::vector<std::string> cells = SplitLine(lines[r], delim);
+    if (cells.size() != header.size()) break;
+    for (size_t c = 0; c < cells.size(); ++c) {
+      double v = 0;
+      if (IsNumber(cells[c], &v)) columns[c].push_back(v);
+    }
+  }
+
+  // Time column: a known name, else the first whose name holds "time".
+  int time = -1;
+  for (const char* n : {"t", "time", "times", "ts", "timestamp", "timeus", "timems",
+                        "timestampus", "timestampms", "sec", "seconds", "elapsed"}) {
+    for (size_t i = 0; i < names.size() && time < 0; ++i) {
+      if (names[i].bare == n) time = static_cast<int>(i);
+    }
+  }
+  for (size_t i = 0; i < names.size() && time < 0; ++i) {
+    if (names[i].bare.find("time") != std::string::npos) time = static_cast<int>(i);
+  }
+  const std::array<int, 3> gyro = FindTriplet(
+      names, {"g", "gyro", "gyr", "w", "omega", "rate", "gyrorad", "angvel", "angularvelocity",
+              "angularrate", "gyroscope", "bodyrate", "wb"});
+  const std::array<int, 3> accel = FindTriplet(
+      names, {"a", "acc", "accel", "accelerometer", "accelerometerms2", "acceleration", "f",
+              "specificforce", "linacc"});
+  if (time < 0 || gyro[0] < 0) {
+    std::string list;
+    for (const std::string& h : header) list += (list.empty() ? "" : ", ") + h;
+    guess.why = std::string(time < 0 ? "no time column" : "no gyro columns") +
+                " recognised among: " + list;
+    return guess;
+  }
+  guess.found = true;
+  guess.format.time_column = Trim(header[time]);
+  for (int a = 0; a < 3; ++a) guess.format.gyro_columns[a] = Trim(header[gyro[a]]);
+  if (accel[0] >= 0) {
+    for (int a = 0; a < 3; ++a) guess.format.accel_columns[a] = Trim(header[accel[a]]);
+  } else {
+    guess.format.accel_columns = {"", "", ""};
+  }
+
+  // Time unit: from the name, else from the median step of the first rows.
+  std::vector<double> steps;
+  const std::vector<double>& tc = columns[time];
+  for (size_t i = 1; i < tc.size(); ++i) {
+    if (tc[i] > tc[i - 1]) steps.push_back(tc[i] - tc[i - 1]);
+  }
+  const double step = Median(steps);
+  const std::string& tname = names[time].bare;
+  std::string time_why;
+  if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "us") == 0) {
+    guess.format.time_unit = TimeUnit::kMicroseconds;
+    time_why = "from its name";
+  } else if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "ms") == 0) {
+    guess.format.time_unit = TimeUnit::kMilliseconds;
+    time_why = "from its name";
+  } else if (std::isfinite(step)) {
+    // IMU logs are sampled at 1 Hz - 2 kHz: a median step above 0.5 s is not seconds.
+    guess.format.time_unit = step < 0.5     ? TimeUnit::kSeconds
+                             : step < 500.0 ? TimeUnit::kMilliseconds
+                                            : TimeUnit::kMicroseconds;
+    time_why = Format("from its median step, %.4g", step);
+  } else {
+    time_why = "default, no steps to judge by";
+  }
+  guess.guesses.push_back("time column '" + guess.format.time_column + "' in " +
+                          ToString(guess.format.time_unit) + " (" + time_why + ")");
+
+  // Gyro unit: from the names, else from the size of the readings.
+  std::string hint;
+  for (int a = 0; a < 3; ++a) {
+    if (!names[gyro[a]].unit_hint.empty()) hint = names[gyro[a]].unit_hint;
+  }
+  std::vector<double> magnitudes;
+  for (int a = 0; a < 3; ++a) {
+    for (double v : columns[gyro[a]]) magnitudes.push_back(std::fabs(v));
+  }
+  std::sort(magnitudes.begin(), magnitudes.end());
+  const double p99 = magnitudes.empty() ? NAN : magnitudes[magnitudes.size() * 99 / 100];
+  std::string gyro_why;
+  if (!hint.empty()) {
+    ParseRateUnit(hint, &guess.format.gyro_unit);
+    guess.gyro_unit_from_names = true;
+    gyro_why = "from the column names";
+  } else if (std::isfinite(p99)) {
+    guess.format.gyro_unit = p99 > kDegPerSGuessAbove ? RateUnit::kDegPerS : RateUnit::kRadPerS;
+    gyro_why = Format("from the readings: 99th percentile of |rate| %.3g", p99) +
+               (p99 > kDegPerSGuessAbove ? " is no pendulum in rad/s" : "");
+  } else {
+    gyro_why = "default";
+  }
+  guess.guesses.push_back("gyro columns " + guess.format.gyro_columns[0] + ", " +
+                          guess.format.gyro_columns[1] + ", " + guess.format.gyro_columns[2] +
+                          " in " + ToString(guess.format.gyro_unit) + " (" + gyro_why + ")");
+  if (accel[0] >= 0) {
+    // Accelerometer unit: gravity reads ~9.8 in m/s^2, ~1 in g.
+    std::vector<double> norms;
+    const size_t n = std::min({columns[accel[0]].size(), columns[accel[1]].size(),
+                               columns[accel[2]].size()});
+    for (size_t i = 0; i < n; ++i) {
+      norms.push_back(std::hypot(columns[accel[0]][i], columns[accel[1]][i], columns[accel[2]][i]));
+    }
+    const double norm = Median(norms);
+    guess.format.accel_unit =
+        std::isfinite(norm) && norm < 3.0 ? AccelUnit::kStandardGravity : AccelUnit::kMetresPerS2;
+    guess.guesses.push_back("accelerometer columns " + guess.format.accel_columns[0] + ", " +
+                            guess.format.accel_columns[1] + ", " + guess.format.accel_columns[2] +
+                            " in " + ToString(guess.format.accel_unit) +
+                            (std::isfinite(norm) ? Format(" (median |f| %.3g)", norm) : ""));
+  } else {
+    guess.guesses.push_back("no accelerometer columns (gyro-only: the swing axis from the gyro)");
+  }
+  if (delim != ',') {
+    guess.guesses.push_back(std::string("delimiter '") + (delim == '\t' ? "\\t" : std::string(1, delim)) + "'");
+  }
+  return guess;
+}
+
+namespace {
+
+// What a file that is not a log looks like.
+std::string ClassifyText(const std::string& text) {
+  const size_t n = std::min<size_t>(text.size(), 4096);
+  size_t odd = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c == 0) return "binary";
+    if (c < 32 && c != '\n' && c != '\r' && c != '\t') ++odd;
+  }
+  if (odd * 20 > n) return "binary";
+  for (const std::string& line : HeadLines(text, 40)) {
+    const std::string t = Trim(line);
+    for (const char* key : {"rig:", "imu:", "runs:", "aircraft:", "fit:", "filar_length_m"}) {
+      if (t.rfind(key, 0) == 0) return "config";
+    }
+  }
+  return "text";
+}
+
+void ReadUlogTopics(const std::string& bytes, const std::string& name, InspectReport* report) {
+  UlogRequest none;
+  const UlogContents contents = ParseUlog(bytes, name, none);
+  for (const UlogSubscription& s : contents.subscriptions) {
+    UlogTopicInfo info;
+    info.topic = s.topic;
+    info.multi_id = s.multi_id;
+    info.samples = s.samples;
+    try {
+      UlogRequest request;
+      request.topic = s.topic;
+      request.multi_id = s.multi_id;
+      request.fields = {"timestamp"};
+      const UlogContents one = ParseUlog(bytes, name, request);
+      info.samples = one.samples();
+      if (one.samples() > 1) {
+        const double span_s = (one.values.back() - one.values.front()) * 1e-6;
+        if (span_s > 0) info.rate_hz = (one.samples() - 1) / span_s;
+      }
+    } catch (const UserError&) {
+      // A topic without a `timestamp` field: listed without a rate.
+    }
+    report->topics.push_back(info);
+  }
+  for (const std::string& w : contents.warnings) report->warnings.push_back(w);
+}
+
+// The first topic with an IMU among those with known defaults.
+bool GuessUlogFormat(InspectReport* report) {
+  for (const char* topic : {"sensor_combined", "vehicle_angular_velocity", "sensor_gyro"}) {
+    for (const UlogTopicInfo& t : report->topics) {
+      if (t.topic == topic && t.samples > 1) {
+        UlogTopicDefaults(topic, &report->format.ulog);
+        report->format.ulog.multi_id = t.multi_id;
+        report->guesses.push_back(std::string("ULog topic '") + topic + "' (" +
+                                  std::to_string(t.samples) + " samples)");
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+// The first rows of a log are often the rest before the twist: the gyro unit guessed there is
+// checked against the 99th percentile of the whole series, and the series rescaled to deg/s when
+// the readings are no pendulum in rad/s.
+void RefineGyroUnitGuess(ImuData* data, InspectReport* report) {
+  if (report->format.gyro_unit != RateUnit::kRadPerS) return;
+  std::vector<double> magnitudes;
+  magnitudes.reserve(3 * data->size());
+  for (const Eigen::Vector3d& w : data->gyro_in_imu) {
+    for (int a = 0; a < 3; ++a) magnitudes.push_back(std::fabs(w[a]));
+  }
+  if (magnitudes.empty()) return;
+  std::nth_element(magnitudes.begin(), magnitudes.begin() + magnitudes.size() * 99 / 100,
+                   magnitudes.end());
+  const double p99 = magnitudes[magnitudes.size() * 99 / 100];
+  if (p99 <= kDegPerSGuessAbove) return;
+  report->format.gyro_unit = RateUnit::kDegPerS;
+  for (Eigen::Vector3d& w : data->gyro_in_imu) w *= ToSi(RateUnit::kDegPerS);
+  for (std::string& g : report->guesses) {
+    if (g.rfind("gyro columns", 0) == 0) {
+      g = "gyro columns " + report->format.gyro_columns[0] + ", " + report->format.gyro_columns[1] +
+          ", " + report->format.gyro_columns[2] +
+          Format(" in deg/s (from the readings: 99th percentile of |rate| %.3g over the log is no "
+                 "pendulum in rad/s)", p99);
+    }
+  }
+}
+
+void SeriesStatistics(const ImuData& data, InspectReport* report) {
+  report->samples = static_cast<long>(data.size());
+  report->has_accel = data.has_accel();
+  if (data.size() < 2) return;
+  report->duration_s = data.t_s.back() - data.t_s.front();
+  report->rate_mean_hz = (data.size() - 1) / report->duration_s;
+  std::vector<double> steps(data.size() - 1);
+  for (size_t i = 1; i < data.size(); ++i) steps[i - 1] = data.t_s[i] - data.t_s[i - 1];
+  report->step_median_s = Median(steps);
+  double sum = 0, sum2 = 0, longest = 0;
+  int kept = 0;
+  for (double s : steps) {
+    longest = std::max(longest, s);
+    if (s > kDropoutSteps * report->step_median_s) {
+      ++report->dropouts;
+      continue;
+    }
+    sum += s;
+    sum2 += s * s;
+    ++kept;
+  }
+  report->longest_gap_s = longest;
+  if (kept > 1) {
+    const double mean = sum / kept;
+    report->step_jitter_s = std::sqrt(std::max(0.0, sum2 / kept - mean * mean));
+  }
+}
+
+void SwingAndWindow(const ImuData& data, const CampaignConfig* config, InspectReport* report) {
+  SwingAxisOptions axis_options =
+      config != nullptr ? SwingAxisOptionsFor(config->imu) : SwingAxisOptions();
+  SwingAxis axis;
+  std::string why;
+  if (!EstimateSwingAxis(data, axis_options, std::nullopt, &axis, &why)) {
+    if (!data.has_accel()) {
+      report->error = "swing axis: " + why;
+      return;
+    }
+    // An accelerometer that does not read gravity: look at the gyro alone, and say so.
+    ImuData gyro_only = data;
+    gyro_only.accel_in_imu.clear();
+    report->warnings.push_back("accelerometer ignored: " + why);
+    if (!EstimateSwingAxis(gyro_only, axis_options, std::nullopt, &axis, &why)) {
+      report->error = "swing axis: " + why;
+      return;
+    }
+  }
+  for (int a = 0; a < 3; ++a) report->swing_axis_in_imu[a] = axis.axis_in_imu[a];
+  report->swing_axis_source = ToString(axis.source);
+  report->pitch_measured_deg = axis.pitch_measured_deg;
+  for (const std::string& w : axis.warnings) report->warnings.push_back(w);
+
+  WindowOptions window_options;
+  if (config != nullptr) window_options.min_periods = config->fit.quality.min_periods;
+  const FreeOscillationWindow window =
+      FindFreeOscillationWindow(data.t_s, axis.rate_rad_per_s, window_options, report->file);
+  report->window_status = ToString(window.status);
+  report->noise_rad_per_s = window.noise_sigma_rad_per_s;
+  if (window.period_s > 0) {
+    report->period_s = window.period_s;
+    report->frequency_hz = 1.0 / window.period_s;
+  }
+  if (!window.IsUsable()) {
+    report->error = window.message;
+    return;
+  }
+  report->window_s = {window.t0_s, window.t1_s};
+  report->window_end = ToString(window.end_reason);
+  report->release_s = window.release_s;
+  if (window.period_s > 0) report->cycles = window.duration_s() / window.period_s;
+  const std::vector<AngleExtreme> extremes = AngleExtremes(data.t_s, axis.rate_rad_per_s, window);
+  if (!extremes.empty()) {
+    double hi = 0, lo = INFINITY;
+    for (const AngleExtreme& e : extremes) {
+      hi = std::max(hi, e.amplitude_deg);
+      lo = std::min(lo, e.amplitude_deg);
+    }
+    report->amplitude_deg = {hi, lo};
+    if (hi < 1.0) {
+      report->warnings.push_back(Format("largest amplitude %.2g deg: a real swing is several deg; "
+                                        "check the gyro unit (imu.gyro.unit)",
+                                        hi));
+    }
+  }
+  if (config != nullptr && report->period_s > 0) {
+    const RigGeometry geometry = config->AircraftGeometry();
+    report->mass_used_kg = geometry.mass_kg;
+    report->small_angle_inertia_kg_m2 = InertiaFromSmallAnglePeriod(geometry, report->period_s);
+  }
+}
+
+}  // namespace
+
+InspectReport InspectLog(const std::string& path, const CampaignConfig* config) {
+  InspectReport report;
+  report.file = path;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
+    report.kind = "missing";
+    report.error = path + ": no such file";
+    return report;
+  }
+  if (std::filesystem::is_directory(path, ec)) {
+    report.kind = "folder";
+    report.error = path + ": is a folder; give the log files inside it";
+    return report;
+  }
+  // The caps of the config's limits, or their defaults.
+  const InputLimits limits = config != nullptr ? config->limits : InputLimits();
+  const ImuLogOptions log_options = limits.LogOptions();
+  std::string bytes, why;
+  if (!ReadRegularFile(path, LogCap(log_options.max_file_bytes), &bytes, &why)) {
+    report.kind = "unreadable";
+    report.error = why;
+    return report;
+  }
+  if (bytes.empty()) {
+    report.kind = "empty";
+    report.error = path + ": the file is empty";
+    return report;
+  }
+  if (LooksGzipped(bytes)) {
+    std::string text;
+    if (!GzipDecompress(bytes, &text, &why, DecompressedLogCap(log_options.max_decompressed_bytes))) {
+      report.kind = "binary";
+      report.error = path + ": gzip data that cannot be read: " + why;
+      return report;
+    }
+    report.compressed = true;
+    bytes.swap(text);
+  }
+  try {
+    ImuData data;
+    if (LooksLikeUlog(bytes)) {
+      report.kind = "ulog";
+      ReadUlogTopics(bytes, path, &report);
+      if (config != nullptr) {
+        report.format = config->imu.format;
+        report.format_from_config = true;
+      } else if (!GuessUlogFormat(&report)) {
+        std::string list;
+        for (const UlogTopicInfo& t : report.topics) list += (list.empty() ? "" : ", ") + t.topic;
+        report.error = path + ": a ULog file without an IMU topic bifilar knows "
+                       "(sensor_combined, vehicle_angular_velocity, sensor_gyro); topics: " + list +
+                       "; name the topic and fields in imu.ulog (configs/README.md)";
+        return report;
+      }
+      data = ReadUlogImu(bytes, path, report.format, log_options);
+    } else {
+      const std::string kind = ClassifyText(bytes);
+      const FormatGuess guess = GuessCsvFormat(bytes);
+      const std::vector<std::string> head = HeadLines(bytes, 1);
+      if (!head.empty()) {
+        for (const std::string& c : SplitLine(head[0], guess.format.delimiter)) {
+          report.columns.push_back(c);
+        }
+      }
+      if (kind != "text" || (!guess.found && config == nullptr)) {
+        report.kind = kind == "text" ? "text" : kind;
+        report.error = kind == "binary" ? path + ": a binary file that is neither a ULog log nor gzip"
+                       : kind == "config" ? path + ": a bifilar config (YAML), not a log; give it with --config"
+                                          : path + ": not a log that bifilar recognises: " + guess.why;
+        report.columns.clear();
+        return report;
+      }
+      report.kind = "csv";
+      if (config != nullptr) {
+        report.format = config->imu.format;
+        report.format_from_config = true;
+      } else {
+        report.format = guess.format;
+        report.guesses = guess.guesses;
+      }
+      data = ReadImuLogFromString(bytes, path, report.format, log_options);
+      if (!report.format_from_config && !guess.gyro_unit_from_names) {
+        RefineGyroUnitGuess(&data, &report);
+      }
+    }
+    for (const std::string& w : data.warnings) report.warnings.push_back(w);
+    SeriesStatistics(data, &report);
+    if (report.samples >= 2) SwingAndWindow(data, config, &report);
+  } catch (const UserError& e) {
+    report.error = e.what();
+  } catch (const std::exception& e) {
+    report.error = path + ": " + e.what();
+  }
+  return report;
+}
+
+std::string InspectReportText(const InspectReport& r) {
+  std::ostringstream out;
+  char line[512];
+  out << r.file << ": " << r.kind << (r.compressed ? " (gzip)" : "") << "\n";
+  if (!r.columns.empty()) {
+    std::string list;
+    for (const std::string& c : r.columns) list += (list.empty() ? "" : ", ") + c;
+    out << "  columns (" << r.columns.size() << "): " << list << "\n";
+  }
+  if (!r.topics.empty()) {
+    out << "  topics (" << r.topics.size() << "):\n";
+    for (const UlogTopicInfo& t : r.topics) {
+      std::snprintf(line, sizeof(line), "    %-32s multi_id %d  %7ld samples", t.topic.c_str(),
+                    t.multi_id, t.samples);
+      out << line;
+      if (t.rate_hz > 0) out << Format("  %.1f Hz", t.rate_hz);
+      out << "\n";
+    }
+  }
+  if (r.is_log()) {
+    if (r.format_from_config) {
+      out << "  format: from the config\n";
+    } else {
+      for (const std::string& g : r.guesses) out << "  guessed: " << g << "\n";
+    }
+  }
+  if (r.samples >= 2) {
+    std::snprintf(line, sizeof(line),
+                  "  samples %ld over %.2f s: %.1f Hz mean, median step %.4g s, jitter %.2g s, "
+                  "%d dropouts (longest gap %.3g s)%s\n",
+                  r.samples, r.duration_s, r.rate_mean_hz, r.step_median_s,
+                  std::isfinite(r.step_jitter_s) ? r.step_jitter_s : 0.0, r.dropouts,
+                  r.longest_gap_s, r.has_accel ? ", accelerometer" : ", no accelerometer");
+    out << line;
+  }
+  if (!r.swing_axis_source.empty()) {
+    std::snprintf(line, sizeof(line), "  swing axis in IMU axes (%.3f, %.3f, %.3f) from %s",
+                  r.swing_axis_in_imu[0], r.swing_axis_in_imu[1], r.swing_axis_in_imu[2],
+                  r.swing_axis_source.c_str());
+    out << line;
+    if (r.pitch_measured_deg) out << Format(", measured pitch %.2f deg", *r.pitch_measured_deg);
+    out << "\n";
+  }
+  if (r.window_status == "ok") {
+    std::snprintf(line, sizeof(line),
+                  "  free oscillation: release at %.2f s, window [%.2f, %.2f] s (%s), %.1f cycles, "
+                  "amplitude %.1f -> %.1f deg\n",
+                  r.release_s, r.window_s[0], r.window_s[1], r.window_end.c_str(), r.cycles,
+                  r.amplitude_deg[0], r.amplitude_deg[1]);
+    out << line;
+  }
+  if (std::isfinite(r.period_s)) {
+    std::snprintf(line, sizeof(line), "  period %.4f s, frequency %.4f Hz, noise %.2g rad/s\n",
+                  r.period_s, r.frequency_hz, r.noise_rad_per_s);
+    out << line;
+  }
+  if (std::isfinite(r.small_angle_inertia_kg_m2)) {
+    std::snprintf(line, sizeof(line),
+                  "  small-angle inertia m g D^2 T^2 / (16 pi^2 L) = %#.5g kg m^2 (m = %.4g kg; "
+                  "the nonlinear fit, `bifilar fit`, corrects it for amplitude and damping)\n",
+                  r.small_angle_inertia_kg_m2, r.mass_used_kg);
+    out << line;
+  }
+  for (const std::string& w : r.warnings) out << "  warning: " << w << "\n";
+  if (!r.error.empty()) out << "  error: " << r.error << "\n";
+  return out.str();
+}
+
+nlohmann::json InspectReportToJson(const InspectReport& r) {
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  nlohmann::json j;
+  j["file"] = r.file;
+  j["kind"] = r.kind;
+  j["compressed"] = r.compressed;
+  j["columns"] = r.columns;
+  nlohmann::json topics = nlohmann::json::array();
+  for (const UlogTopicInfo& t : r.topics) {
+    topics.push_back({{"topic", t.topic},
+                      {"multi_id", t.multi_id},
+                      {"samples", t.samples},
+                      {"rate_hz", number(t.rate_hz)}});
+  }
+  j["topics"] = topics;
+  if (r.is_log()) {
+    nlohmann::json format;
+    format["from_config"] = r.format_from_config;
+    format["guesses"] = r.guesses;
+    if (r.kind == "csv") {
+      format["time_column"] = r.format.time_column;
+      format["time_unit"] = ToString(r.format.time_unit);
+      format["gyro_columns"] = r.format.gyro_columns;
+      format["gyro_unit"] = ToString(r.format.gyro_unit);
+      if (r.format.has_accel()) {
+        format["accel_columns"] = r.format.accel_columns;
+        format["accel_unit"] = ToString(r.format.accel_unit);
+      } else {
+        format["accel_columns"] = nullptr;
+      }
+      format["delimiter"] = std::string(1, r.format.delimiter);
+    } else {
+      format["ulog_topic"] = r.format.ulog.topic;
+      format["ulog_multi_id"] = r.format.ulog.multi_id;
+    }
+    j["format"] = format;
+  }
+  j["samples"] = r.samples;
+  j["duration_s"] = number(r.duration_s);
+  j["rate_mean_hz"] = number(r.rate_mean_hz);
+  j["step_median_s"] = number(r.step_median_s);
+  j["step_jitter_s"] = number(r.step_jitter_s);
+  j["dropouts"] = r.dropouts;
+  j["longest_gap_s"] = number(r.longest_gap_s);
+  j["has_accel"] = r.has_accel;
+  j["swing_axis_in_imu"] = r.swing_axis_source.empty()
+                               ? nlohmann::json()
+                               : nlohmann::json({r.swing_axis_in_imu[0], r.swing_axis_in_imu[1],
+                                                 r.swing_axis_in_imu[2]});
+  j["swing_axis_source"] = r.swing_axis_source;
+  j["pitch_measured_deg"] = r.pitch_measured_deg ? nlohmann::json(*r.pitch_measured_deg)
+                                                 : nlohmann::json();
+  j["window_status"] = r.window_status;
+  j["window_s"] = {number(r.window_s[0]), number(r.window_s[1])};
+  j["window_end"] = r.window_end;
+  j["release_s"] = number(r.release_s);
+  j["period_s"] = number(r.period_s);
+  j["frequency_hz"] = number(r.frequency_hz);
+  j["cycles"] = number(r.cycles);
+  j["amplitude_deg"] = {number(r.amplitude_deg[0]), number(r.amplitude_deg[1])};
+  j["noise_rad_per_s"] = number(r.noise_rad_per_s);
+  j["small_angle_inertia_kg_m2"] = number(r.small_angle_inertia_kg_m2);
+  j["mass_used_kg"] = number(r.mass_used_kg);
+  j["warnings"] = r.warnings;
+  j["error"] = r.error;
+  return j;
+}
+
+}  // namespace bifilar

@@ -1,0 +1,38 @@
+// The typed function behind `bifilar plan --tensor` (the CLI only parses options): which attitudes
+// to swing for the full inertia tensor, with the expected std of each component. The planning
+// itself is fit/tensor_plan.h; conventions docs/physics.md §3 (n = (-sin theta, sin phi cos
+// theta, cos phi cos theta), products positive, I_xy = integral x y dm).
+#pragma once
+
+#include <array>
+#include <nlohmann/json.hpp>
+#include <ostream>
+
+#include "fit/tensor_plan.h"
+#include "pipeline/commands/ellipse_table.h"  // InertiaUnits
+
+namespace bifilar {
+
+struct TensorPlanCommandOptions {
+  // Rig range, grid, orientations, trials, sigma_relative and attitude_std_deg as in
+  // TensorPlanOptions; its SI fields (sigma_kg_m2, guess_kg_m2, target_std_kg_m2) are set by
+  // RunTensorPlanCommand from the values below, which are in `units`.
+  TensorPlanOptions plan;
+  double sigma = 0.0;  // per-swing std, absolute, in `units` (>= 0)
+  std::array<double, kTensorPlanComponents> guess = {0, 0, 0, 0, 0, 0};  // in `units`
+  bool guess_given = false;  // Ixx, Iyy, Izz given (products default 0)
+  double target = 0.0;       // target std of each component, in `units`; 0 = none
+  // Target as a fraction of the largest guessed principal moment (needs the guess); 0 = none.
+  double target_relative = 0.0;
+  InertiaUnits units = InertiaUnits::kSi;  // of the values above and of the console output
+  bool json = false;                       // print JSON (SI) instead of the table
+};
+
+// Plans and prints. Returns 0; throws UserError naming the option on bad input.
+int RunTensorPlanCommand(const TensorPlanCommandOptions& options, std::ostream& out);
+
+// JSON form (SI): rig, orientations, components {Ixx: {observable, std_kg_m2,
+// floor_std_kg_m2, trials_needed}, ...}, unobservable, rank, condition_number, warnings, ...
+nlohmann::json TensorPlanToJson(const TensorPlan& plan, const TensorPlanOptions& options);
+
+}  // namespace bifilar

@@ -1,0 +1,976 @@
+#include "pipeline/config/config.h"
+
+#include "fit/ellipse.h"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include <Eigen/Geometry>
+
+#include "base/bounded_read.h"
+#include "base/user_error.h"
+#include "pipeline/config/plausibility.h"
+#include "pipeline/config/yaml_reader.h"
+#include "pipeline/logs/ulog.h"
+#include "pipeline/records/total_uncertainty.h"
+
+namespace bifilar {
+namespace {
+
+namespace fs = std::filesystem;
+
+// map.Child(key), safe when the key is absent (YamlMap::Child on an absent key keeps an invalid
+// yaml-cpp node whose type queries throw; an empty mapping is what we mean).
+YamlMap Sub(YamlMap& map, const std::string& key) {
+  if (map.Has(key)) return map.Child(key);
+  map.Optional(key);
+  return YamlMap(YAML::Node(YAML::NodeType::Null), map.file(), map.KeyPath(key));
+}
+
+std::string ReadText(const std::string& path) { return ReadRegularFileOrThrow(path, ConfigCap()); }
+
+// Positive finite number, or throw naming the key.
+double Positive(YamlMap& map, const std::string& key) {
+  YAML::Node node = map.Required(key);
+  const double value = map.AsDouble(node, key);
+  if (!(value > 0.0)) throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be > 0");
+  return value;
+}
+
+double NonNegative(YamlMap& map, const std::string& key, double fallback) {
+  YAML::Node node = map.Optional(key);
+  if (!map.Given(node, key, "a number >= 0")) return fallback;
+  const double value = map.AsDouble(node, key);
+  if (value < 0.0) throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be >= 0");
+  return value;
+}
+
+std::array<std::string, 3> ThreeColumns(YamlMap& map, const std::string& key) {
+  YAML::Node node = map.Required(key);
+  if (!node.IsSequence() || node.size() != 3) {
+    throw UserError(map.Where(node) + ": '" + map.KeyPath(key) +
+                    "' must be a list of 3 column names (x, y, z)");
+  }
+  std::array<std::string, 3> columns;
+  for (int i = 0; i < 3; ++i) columns[i] = map.AsString(node[i], key);
+  return columns;
+}
+
+Eigen::Vector3d ThreeVector(const YamlMap& map, const YAML::Node& node, const std::string& key) {
+  if (!node.IsSequence() || node.size() != 3) {
+    throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be a list of 3 numbers");
+  }
+  return Eigen::Vector3d(map.AsDouble(node[0], key), map.AsDouble(node[1], key),
+                         map.AsDouble(node[2], key));
+}
+
+// `imu.format` and `imu.ulog`: which reader a log gets and, for PX4 ULog logs, which topic and
+// fields (pipeline/logs/ulog.h).
+void ReadLogContainer(YamlMap& imu, ImuFormat* format) {
+  const std::string container = imu.OptionalString("format", "auto");
+  if (container == "auto") format->container = LogContainer::kAuto;
+  else if (container == "csv") format->container = LogContainer::kCsv;
+  else if (container == "ulog") format->container = LogContainer::kUlog;
+  else {
+    throw UserError(imu.Where(imu.Optional("format")) + ": 'imu.format' must be auto, csv or ulog, not '" +
+                    container + "'");
+  }
+  YamlMap ulog = Sub(imu, "ulog");
+  UlogSelection& sel = format->ulog;
+  const std::string topic = ulog.OptionalString("topic", sel.topic);
+  const bool known = UlogTopicDefaults(topic, &sel);
+  if (topic.empty()) throw UserError(ulog.Where(ulog.Optional("topic")) + ": 'imu.ulog.topic' is empty");
+  const YAML::Node multi = ulog.Optional("multi_id");
+  sel.multi_id = ulog.OptionalInt("multi_id", 0);
+  if (sel.multi_id < 0 || sel.multi_id > 255) {
+    throw UserError(ulog.Where(multi) + ": 'imu.ulog.multi_id' must be in [0, 255]");
+  }
+  sel.time_field = ulog.OptionalString("time_field", sel.time_field);
+  if (ulog.Has("gyro_fields")) {
+    sel.gyro_fields = ThreeColumns(ulog, "gyro_fields");
+  } else if (!known) {
+    throw UserError(ulog.Where(ulog.Optional("topic")) + ": 'imu.ulog.gyro_fields' is needed for topic '" +
+                    topic + "' (defaults exist for sensor_combined, vehicle_angular_velocity and sensor_gyro)");
+  }
+  if (ulog.Has("accel_fields") && ulog.Optional("accel_fields").IsNull()) {
+    sel.accel_fields = {"", "", ""};
+  } else if (ulog.Has("accel_fields")) {
+    sel.accel_fields = ThreeColumns(ulog, "accel_fields");
+  } else if (!known || !format->has_accel()) {
+    sel.accel_fields = {"", "", ""};  // unknown topic, or `imu.accel: null`: gyro only
+  }
+  std::vector<std::string> names = {sel.time_field, sel.gyro_fields[0], sel.gyro_fields[1],
+                                    sel.gyro_fields[2]};
+  if (!sel.accel_fields[0].empty()) names.insert(names.end(), sel.accel_fields.begin(), sel.accel_fields.end());
+  const std::set<std::string> distinct(names.begin(), names.end());
+  if (distinct.count("") || distinct.size() != names.size()) {
+    throw UserError(ulog.Where(YAML::Node()) + ": 'imu.ulog' field names must be non-empty and distinct");
+  }
+  ulog.Finish();
+}
+
+// `imu.time`, `imu.gyro`, `imu.accel`, `imu.format`/`imu.ulog`: the columns and units of a log.
+void ReadImuColumns(YamlMap& imu, ImuConfig* out) {
+  ImuFormat& format = out->format;
+  {
+    YamlMap time = Sub(imu, "time");
+    format.time_column = time.OptionalString("column", format.time_column);
+    const std::string unit = time.OptionalString("unit", ToString(format.time_unit));
+    if (!ParseTimeUnit(unit, &format.time_unit)) {
+      throw UserError(time.Where(time.Optional("unit")) + ": '" + time.KeyPath("unit") +
+                      "' must be s, ms or us, not '" + unit + "'");
+    }
+    time.Finish();
+  }
+  {
+    YamlMap gyro = Sub(imu, "gyro");
+    if (gyro.Has("columns")) format.gyro_columns = ThreeColumns(gyro, "columns");
+    out->gyro_scale_std = NonNegative(gyro, "scale_std", 0.0);
+    const std::string unit = gyro.OptionalString("unit", ToString(format.gyro_unit));
+    if (!ParseRateUnit(unit, &format.gyro_unit)) {
+      throw UserError(gyro.Where(gyro.Optional("unit")) + ": '" + gyro.KeyPath("unit") +
+                      "' must be rad/s or deg/s, not '" + unit + "'");
+    }
+    gyro.Finish();
+  }
+  if (imu.Has("accel") && imu.Optional("accel").IsNull()) {
+    format.accel_columns = {"", "", ""};  // `accel: null`: the log has no accelerometer
+  } else {
+    YamlMap accel = Sub(imu, "accel");
+    if (accel.Has("columns")) format.accel_columns = ThreeColumns(accel, "columns");
+    const std::string unit = accel.OptionalString("unit", ToString(format.accel_unit));
+    if (!ParseAccelUnit(unit, &format.accel_unit)) {
+      throw UserError(accel.Where(accel.Optional("unit")) + ": '" + accel.KeyPath("unit") +
+                      "' must be m/s^2 or g, not '" + unit + "'");
+    }
+    accel.Finish();
+  }
+  ReadLogContainer(imu, &format);
+  std::string why;
+  if (!format.Check(&why)) throw UserError(imu.file() + ": imu: " + why);
+}
+
+// `imu.swing_axis` (auto or a vector in IMU axes) and `imu.imu_to_body` (matrix or Euler angles).
+void ReadImuMounting(YamlMap& imu, ImuConfig* out) {
+  YAML::Node axis = imu.Optional("swing_axis");
+  if (!axis.IsDefined() || axis.IsNull() || (axis.IsScalar() && axis.Scalar() == "auto")) {
+    out->swing_axis_auto = true;
+  } else {
+    const Eigen::Vector3d v = ThreeVector(imu, axis, "swing_axis");
+    // A direction, normalised here: its length must be neither 0 nor overflow the norm (1e300
+    // gave an infinite norm and a zero axis, so every trace failed instead of the config).
+    const double length = v.cwiseAbs().maxCoeff() > kMaxSwingAxisLength ? HUGE_VAL : v.norm();
+    if (!(length >= kMinSwingAxisLength && length <= kMaxSwingAxisLength)) {
+      char range[96];
+      std::snprintf(range, sizeof(range), "[%g, %g]", kMinSwingAxisLength, kMaxSwingAxisLength);
+      throw UserError(imu.Where(axis) + ": 'imu.swing_axis' must be auto or a direction in IMU "
+                      "axes of length in " + range + ", e.g. [0, 0, 1] (it is normalised)");
+    }
+    out->swing_axis_auto = false;
+    out->swing_axis_in_imu = v.normalized();
+  }
+
+  if (imu.Has("imu_to_body")) {
+    YamlMap mount = Sub(imu, "imu_to_body");
+    const bool has_matrix = mount.Has("matrix"), has_euler = mount.Has("euler_deg");
+    if (has_matrix == has_euler) {
+      throw UserError(mount.Where(imu.Optional("imu_to_body")) +
+                      ": 'imu.imu_to_body' needs exactly one of 'matrix' or 'euler_deg'");
+    }
+    if (has_euler) {
+      YAML::Node node = mount.Optional("euler_deg");
+      const Eigen::Vector3d rpy = ThreeVector(mount, node, "euler_deg") * (M_PI / 180.0);
+      // Body-from-IMU rotation R = Rz(yaw) Ry(pitch) Rx(roll) (aerospace ZYX order).
+      out->imu_to_body = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+                          Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+                          Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+                             .toRotationMatrix();
+    } else {
+      YAML::Node node = mount.Optional("matrix");
+      if (!node.IsSequence() || node.size() != 3) {
+        throw UserError(mount.Where(node) + ": 'imu.imu_to_body.matrix' must be 3 rows of 3");
+      }
+      Eigen::Matrix3d m;
+      for (int r = 0; r < 3; ++r) m.row(r) = ThreeVector(mount, node[r], "matrix").transpose();
+      if (!((m * m.transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-3 &&
+            m.determinant() > 0.0)) {
+        throw UserError(mount.Where(node) +
+                        ": 'imu.imu_to_body.matrix' must be a rotation (orthonormal, det +1)");
+      }
+      out->imu_to_body = m;
+    }
+    mount.Finish();
+  }
+}
+
+// `imu`: columns and units, then how the IMU hangs.
+void ReadImu(YamlMap imu, ImuConfig* out) {
+  ReadImuColumns(imu, out);
+  ReadImuMounting(imu, out);
+  imu.Finish();
+}
+
+// `logs` of a tare or calibration section: a pattern or a list of them, resolved against the
+// config folder; an empty list is an error naming the key.
+std::vector<std::string> ReadLogPatterns(YamlMap& map, const std::string& folder) {
+  std::vector<std::string> patterns;
+  YAML::Node logs = map.Required("logs");
+  if (logs.IsScalar()) {
+    patterns = {ResolvePath(folder, logs.Scalar())};
+  } else {
+    for (const std::string& p : map.OptionalStringList("logs", {})) {
+      patterns.push_back(ResolvePath(folder, p));
+    }
+  }
+  if (patterns.empty()) {
+    throw UserError(map.Where(logs) + ": '" + map.KeyPath("logs") + "' lists no file");
+  }
+  return patterns;
+}
+
+// `rig.calibration`: the reference swings and the reference's inertia, its std and its mass.
+void ReadRigCalibration(YamlMap cal, const std::string& folder, RigCalibrationSpec* out) {
+  out->enabled = true;
+  out->log_patterns = ReadLogPatterns(cal, folder);
+  out->reference_inertia_kg_m2 = Positive(cal, "reference_inertia_kg_m2");
+  const YAML::Node std_node = cal.Required("reference_inertia_std_kg_m2");
+  out->reference_inertia_std_kg_m2 = NonNegative(cal, "reference_inertia_std_kg_m2", 0.0);
+  if (!(out->reference_inertia_std_kg_m2 < out->reference_inertia_kg_m2)) {
+    throw UserError(cal.Where(std_node) + ": '" + cal.KeyPath("reference_inertia_std_kg_m2") +
+                    "' must be below reference_inertia_kg_m2 (the quantity it qualifies)");
+  }
+  out->reference_mass_kg = Positive(cal, "reference_mass_kg");
+  out->rig_pitch_deg = cal.OptionalDouble("rig_pitch_deg", 0.0);
+  if (!(std::abs(out->rig_pitch_deg) <= 180.0)) {
+    throw UserError(cal.Where(cal.Optional("rig_pitch_deg")) + ": '" +
+                    cal.KeyPath("rig_pitch_deg") + "' must be in [-180, 180] deg");
+  }
+  cal.Finish();
+}
+
+void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* out) {
+  const int ways = inertia.Has("inertia_kg_m2") + inertia.Has("table") + inertia.Has("tare");
+  if (ways != 1) {
+    throw UserError(inertia.Where(inertia.Optional("__none__")) +
+                    ": 'rig.inertia' needs exactly one of 'inertia_kg_m2', 'table' or 'tare'");
+  }
+  out->inertia_std_kg_m2 = NonNegative(inertia, "inertia_std_kg_m2", 0.0);
+  if (inertia.Has("inertia_kg_m2")) {
+    out->kind = RigInertiaSpec::Kind::kValue;
+    YAML::Node value = inertia.Required("inertia_kg_m2");  // blank or ~: an error, never 0
+    out->inertia_kg_m2 = inertia.AsDouble(value, "inertia_kg_m2");
+    if (out->inertia_kg_m2 < 0.0) {
+      throw UserError(inertia.Where(value) + ": 'rig.inertia.inertia_kg_m2' must be >= 0");
+    }
+  } else if (inertia.Has("table")) {
+    out->kind = RigInertiaSpec::Kind::kTable;
+    YAML::Node table = inertia.Optional("table");
+    if (!table.IsMap() || table.size() == 0) {
+      throw UserError(inertia.Where(table) +
+                      ": 'rig.inertia.table' must map pitch_deg to inertia_kg_m2, e.g. {0: 0.12}");
+    }
+    std::map<double, YAML::Node> first_key;  // "0" and "0.0" are one pitch: both lines named
+    for (const auto& item : table) {
+      const double pitch = inertia.AsDouble(item.first, "table");
+      const double value = inertia.AsDouble(item.second, "table");
+      if (value < 0.0) throw UserError(inertia.Where(item.second) + ": rig inertia must be >= 0");
+      auto [it, inserted] = first_key.emplace(pitch, item.first);
+      if (!inserted) {
+        throw UserError(inertia.Where(item.first) + ": 'rig.inertia.table' gives pitch " +
+                        item.first.Scalar() + " deg twice (first at " + inertia.Where(it->second) +
+                        ")");
+      }
+      out->table_kg_m2[pitch] = value;
+    }
+  } else {
+    out->kind = RigInertiaSpec::Kind::kTare;
+    YamlMap tare = Sub(inertia, "tare");
+    out->tare_patterns = ReadLogPatterns(tare, folder);
+    tare.Finish();
+  }
+  inertia.Finish();
+}
+
+}  // namespace
+
+const char* ToString(DisplayUnits units) {
+  return units == DisplayUnits::kSi ? "si" : "imperial";
+}
+const char* ToString(PitchSource source) {
+  return source == PitchSource::kNominal ? "nominal" : "measured";
+}
+
+double InertiaToDisplay(double inertia_kg_m2, DisplayUnits units) {
+  return units == DisplayUnits::kSi ? inertia_kg_m2 : inertia_kg_m2 * kSlugFt2PerKgM2;
+}
+const char* InertiaUnitName(DisplayUnits units) {
+  return units == DisplayUnits::kSi ? "kg m^2" : "slug ft^2";
+}
+
+std::string SiTextInDisplayUnits(const std::string& text, DisplayUnits units) {
+  if (units != DisplayUnits::kImperial) return text;
+  const std::string si = " kg m^2";
+  std::string out;
+  size_t at = 0;
+  for (size_t hit = text.find(si); hit != std::string::npos; hit = text.find(si, hit + 1)) {
+    size_t start = hit;
+    while (start > at && (std::isdigit(static_cast<unsigned char>(text[start - 1])) ||
+                          std::strchr(".eE+-", text[start - 1]) != nullptr)) {
+      --start;
+    }
+    char* stop = nullptr;
+    const double value = start < hit ? std::strtod(text.c_str() + start, &stop) : NAN;
+    if (stop != text.c_str() + hit || !std::isfinite(value)) continue;  // not "<number> kg m^2"
+    char buffer[64];
+    std::snprintf(buffer, sizeof(buffer), "%.3g slug ft^2", InertiaToDisplay(value, units));
+    out.append(text, at, start - at);
+    out += buffer;
+    at = hit + si.size();
+  }
+  out.append(text, at, std::string::npos);
+  return out;
+}
+
+std::string ResolvePath(const std::string& folder, const std::string& path) {
+  fs::path p(path);
+  if (p.is_relative()) p = fs::path(folder) / p;
+  return p.lexically_normal().string();
+}
+
+double CampaignConfig::EffectiveSeparationM() const {
+  return filar_separation_m * std::sqrt(geometry_calibration.factor);  // sqrt(1) = 1 exactly
+}
+
+RigGeometry CampaignConfig::AircraftGeometry() const {
+  RigGeometry g;
+  g.filar_length_m = filar_length_m;
+  g.filar_separation_m = EffectiveSeparationM();
+  g.mass_kg = rig_mass_kg + aircraft_mass_kg;
+  g.gravity_mps2 = gravity_mps2;
+  return g;
+}
+
+RigUncertainties RigUncertainties::InEffect() const {
+  if (!Assumed()) return *this;
+  RigUncertainties assumed = *this;
+  assumed.filar_length_std_m = kAssumedLengthStdM;
+  assumed.filar_separation_std_m = kAssumedLengthStdM;
+  return assumed;
+}
+
+RigGeometry CampaignConfig::TareGeometry() const {
+  RigGeometry g = AircraftGeometry();
+  g.mass_kg = rig_mass_kg;
+  return g;
+}
+
+RigGeometry CampaignConfig::CalibrationGeometry() const {
+  RigGeometry g = AircraftGeometry();
+  g.mass_kg = rig_mass_kg + calibration.reference_mass_kg;
+  return g;
+}
+
+bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why) {
+  char buffer[320];
+  if (off_earth) {
+    if (gravity_mps2 > 0.0 && gravity_mps2 <= kMaxOffEarthGravityMps2) return true;
+    std::snprintf(buffer, sizeof(buffer),
+                  "'gravity_mps2' must be in (0, %g] m/s^2 (gravity_off_earth: true), got %g",
+                  kMaxOffEarthGravityMps2, gravity_mps2);
+  } else {
+    if (gravity_mps2 >= kMinEarthGravityMps2 && gravity_mps2 <= kMaxEarthGravityMps2) return true;
+    std::snprintf(buffer, sizeof(buffer),
+                  "'gravity_mps2' = %g m/s^2 is not a gravity found on Earth ([%g, %g] m/s^2, "
+                  "from the equator's mountains to the poles); check for a typo (9.80665 is "
+                  "standard gravity), or set 'gravity_off_earth: true' for a rig elsewhere",
+                  gravity_mps2, kMinEarthGravityMps2, kMaxEarthGravityMps2);
+  }
+  *why = buffer;
+  return false;
+}
+
+bool CampaignConfig::Check(std::string* why) const {
+  std::string reason;
+  if (calibration.enabled) {
+    const RigCalibrationSpec& c = calibration;
+    const char* bad = c.log_patterns.empty()               ? "'rig.calibration.logs' lists no file"
+                      : !(c.reference_inertia_kg_m2 > 0.0) ? "'rig.calibration.reference_inertia_kg_m2' must be > 0"
+                      : !(c.reference_mass_kg > 0.0)       ? "'rig.calibration.reference_mass_kg' must be > 0"
+                      : !(c.reference_inertia_std_kg_m2 >= 0.0 &&
+                          c.reference_inertia_std_kg_m2 < c.reference_inertia_kg_m2)
+                          ? "'rig.calibration.reference_inertia_std_kg_m2' must be >= 0 and below "
+                            "reference_inertia_kg_m2"
+                          : nullptr;
+    if (bad) {
+      *why = bad;
+      return false;
+    }
+  }
+  if (!(geometry_calibration.factor > 0.0 && std::isfinite(geometry_calibration.factor) &&
+        geometry_calibration.factor_rel_std >= 0.0 &&
+        std::isfinite(geometry_calibration.factor_rel_std))) {
+    *why = "rig.calibration: the calibration factor is not a finite number > 0";
+    return false;
+  }
+  if (!CheckGravity(gravity_mps2, gravity_off_earth, why)) return false;
+  if (!AircraftGeometry().Check(&reason)) {
+    *why = "rig/aircraft: " + reason;
+    return false;
+  }
+  if (!imu.format.Check(&reason)) {
+    *why = "imu: " + reason;
+    return false;
+  }
+  if (!CheckPlausible(&reason)) {
+    *why = reason;
+    return false;
+  }
+  // A standard uncertainty is below the quantity it qualifies (a 100 % uncertainty says nothing;
+  // 1e308 overflowed the budget into a "non-finite value" naming no key).
+  const struct {
+    const char* key;
+    double std, of;
+  } stds[] = {
+      {"rig.uncertainties.filar_length_std_m", uncertainties.filar_length_std_m, filar_length_m},
+      {"rig.uncertainties.filar_separation_std_m", uncertainties.filar_separation_std_m,
+       filar_separation_m},
+      {"rig.uncertainties.mass_std_kg", uncertainties.mass_std_kg, rig_mass_kg},
+      {"rig.uncertainties.gravity_std_mps2", uncertainties.gravity_std_mps2, gravity_mps2},
+      {"aircraft.mass_std_kg", aircraft_mass_std_kg,
+       aircraft_mass_kg > 0 ? aircraft_mass_kg : INFINITY},
+      {"imu.gyro.scale_std", imu.gyro_scale_std, 1.0},
+      {"rig.inertia.inertia_std_kg_m2", rig_inertia.inertia_std_kg_m2, kMaxRigInertiaStdKgM2},
+  };
+  for (const auto& s : stds) {
+    if (!(s.std >= 0.0 && s.std < s.of)) {
+      char buffer[240];
+      std::snprintf(buffer, sizeof(buffer), "'%s' must be >= 0 and below %g (the quantity it "
+                    "qualifies), got %g", s.key, s.of, s.std);
+      *why = buffer;
+      return false;
+    }
+  }
+  return fit.Check(why) && ellipse.Check(why);
+}
+
+bool CampaignConfig::CheckPlausible(std::string* why) const {
+  const struct {
+    const char* key;
+    const char* quantity;
+    double value, min, max;
+  } values[] = {
+      {"rig.filar_length_m", "length", filar_length_m, kMinFilarLengthM, kMaxFilarLengthM},
+      {"rig.filar_separation_m", "length", filar_separation_m, kMinFilarSeparationM,
+       kMaxFilarSeparationM},
+      {"rig.mass_kg", "mass", rig_mass_kg, 0.0, kMaxMassKg},
+      {"aircraft.mass_kg", "mass", aircraft_mass_kg, 0.0, kMaxMassKg},
+      {"rig.mass_kg + aircraft.mass_kg", "mass", rig_mass_kg + aircraft_mass_kg,
+       kMinSuspendedMassKg, 2 * kMaxMassKg},
+  };
+  for (const auto& v : values) {
+    *why = ImplausibleValue(v.key, v.quantity, v.value, v.min, v.max);
+    if (!why->empty()) return false;
+  }
+  *why = SeparationNotBelowLength(filar_length_m, filar_separation_m);
+  if (!why->empty()) return false;
+  if (rig_inertia.kind == RigInertiaSpec::Kind::kValue) {
+    *why = ImplausibleRigInertia("rig.inertia.inertia_kg_m2", rig_inertia.inertia_kg_m2,
+                                 rig_mass_kg, filar_separation_m);
+  }
+  for (const auto& [pitch_deg, value] : rig_inertia.table_kg_m2) {
+    if (!why->empty()) break;
+    char key[96];
+    std::snprintf(key, sizeof(key), "rig.inertia.table (pitch %g deg)", pitch_deg);
+    *why = ImplausibleRigInertia(key, value, rig_mass_kg, filar_separation_m);
+  }
+  return why->empty();
+}
+
+GlitchOptions GlitchConfig::Options() const {
+  GlitchOptions o;
+  o.threshold_sigmas = enabled ? threshold_sigmas : 0.0;
+  o.range_factor = range_factor;
+  o.excursion_fraction = excursion_fraction;
+  o.max_fraction = max_fraction;
+  return o;
+}
+
+bool GlitchConfig::IsDefault() const {
+  const GlitchConfig d;
+  return enabled == d.enabled && threshold_sigmas == d.threshold_sigmas &&
+         range_factor == d.range_factor && excursion_fraction == d.excursion_fraction &&
+         max_fraction == d.max_fraction;
+}
+
+namespace {
+
+// The first `fit.glitch` value outside its range: its key (below fit.glitch) and the message.
+bool CheckGlitch(const GlitchConfig& g, std::string* key, std::string* why) {
+  char buffer[200];
+  auto fail = [&](const char* name, const char* range, double value) {
+    *key = name;
+    std::snprintf(buffer, sizeof(buffer), "'fit.glitch.%s' must be in %s, got %g", name, range, value);
+    *why = buffer;
+    return false;
+  };
+  char range[64];
+  std::snprintf(range, sizeof(range), "[%g, %g]", kMinGlitchSigmas, kMaxGlitchSigmas);
+  if (!(g.threshold_sigmas >= kMinGlitchSigmas && g.threshold_sigmas <= kMaxGlitchSigmas)) {
+    return fail("threshold_sigmas", range, g.threshold_sigmas);
+  }
+  std::snprintf(range, sizeof(range), "[%g, %g]", kMinGlitchRange, kMaxGlitchRange);
+  if (!(g.range_factor >= kMinGlitchRange && g.range_factor <= kMaxGlitchRange)) {
+    return fail("range_factor", range, g.range_factor);
+  }
+  std::snprintf(range, sizeof(range), "[0, %g]", kMaxGlitchExcursion);
+  if (!(g.excursion_fraction >= 0.0 && g.excursion_fraction <= kMaxGlitchExcursion)) {
+    return fail("excursion_fraction", range, g.excursion_fraction);
+  }
+  std::snprintf(range, sizeof(range), "(0, %g]", kMaxGlitchFraction);
+  if (!(g.max_fraction > 0.0 && g.max_fraction <= kMaxGlitchFraction)) {
+    return fail("max_fraction", range, g.max_fraction);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool FitConfig::Check(std::string* why) const {
+  char buffer[200];
+  const double max_deg = max_amplitude_deg.value_or(kMaxMaxAmplitudeDeg);
+  if (max_amplitude_deg && !(*max_amplitude_deg >= kMinMaxAmplitudeDeg &&
+                             *max_amplitude_deg <= kMaxMaxAmplitudeDeg)) {
+    std::snprintf(buffer, sizeof(buffer), "'fit.max_amplitude_deg' must be in [%g, %g] deg, got %g",
+                  kMinMaxAmplitudeDeg, kMaxMaxAmplitudeDeg, *max_amplitude_deg);
+    *why = buffer;
+    return false;
+  }
+  if (min_amplitude_deg && !(*min_amplitude_deg >= 0.0 && *min_amplitude_deg < max_deg)) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "'fit.min_amplitude_deg' must be in [0, max_amplitude_deg = %g) deg, got %g",
+                  max_deg, *min_amplitude_deg);
+    *why = buffer;
+    return false;
+  }
+  const QualityThresholds& q = quality;
+  if (!(q.max_rms_over_noise > 1.0) || !(q.max_residual_autocorr > 0.0) ||
+      !(q.max_residual_autocorr < 1.0) || q.whiteness_lags < 1 ||
+      q.whiteness_lags > kMaxWhitenessLags || !(q.max_secondary_motion_ratio >= 0.0) ||
+      !std::isfinite(q.max_secondary_motion_ratio) || !std::isfinite(q.max_rms_over_noise) ||
+      !(q.min_periods >= 2.0 && q.min_periods <= kMaxMinPeriods)) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "'fit.quality' out of range (max_rms_over_noise > 1, 0 < max_residual_autocorr "
+                  "< 1, whiteness_lags in [1, %d], max_secondary_motion_ratio >= 0, min_periods "
+                  "in [2, %g])", kMaxWhitenessLags, kMaxMinPeriods);
+    *why = buffer;
+    return false;
+  }
+  std::string key;
+  return CheckGlitch(glitch, &key, why);
+}
+
+bool EllipseConfig::Check(std::string* why) const {
+  if (bootstrap != 0 &&
+      !(bootstrap >= kMinBootstrapReplicates && bootstrap <= kMaxBootstrapReplicates)) {
+    *why = "'ellipse.bootstrap' must be 0 (off) or in [" +
+           std::to_string(kMinBootstrapReplicates) + ", " +
+           std::to_string(kMaxBootstrapReplicates) + "], got " + std::to_string(bootstrap);
+    return false;
+  }
+  if (!(confidence > 0.0 && confidence < 1.0)) {
+    *why = "'ellipse.confidence' must be in (0, 1)";
+    return false;
+  }
+  if (min_angles < 3 || min_angles > kMaxMinAngles) {
+    *why = "'ellipse.min_angles' must be in [3, " + std::to_string(kMaxMinAngles) + "], got " +
+           std::to_string(min_angles);
+    return false;
+  }
+  if (covariance != "auto" && covariance != "points" && covariance != "angle_means" &&
+      covariance != "absolute") {
+    *why = "'ellipse.covariance' must be auto, points, angle_means or absolute";
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+// ---- The steps of LoadCampaignConfig, in the order of the file's sections ---------------------
+
+// The file itself: its absolute path, folder (relative paths in it are relative to this) and
+// text (kept for the results).
+void ReadConfigFile(const std::string& path, CampaignConfig* config) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw UserError(path + ": is a folder, not a config file");
+  config->file = fs::absolute(path).lexically_normal().string();
+  config->folder = fs::path(config->file).parent_path().string();
+  config->text = ReadText(path);
+}
+
+// `rig` values no lab rig can have (pipeline/config/plausibility.h): an error at the key's line
+// that names the unit the value was probably written in.
+void CheckRigPlausible(YamlMap& rig, const CampaignConfig& c) {
+  const struct {
+    const char* key;
+    const char* quantity;
+    double value, min, max;
+  } values[] = {
+      {"filar_length_m", "length", c.filar_length_m, kMinFilarLengthM, kMaxFilarLengthM},
+      {"filar_separation_m", "length", c.filar_separation_m, kMinFilarSeparationM,
+       kMaxFilarSeparationM},
+      {"mass_kg", "mass", c.rig_mass_kg, 0.0, kMaxMassKg},
+  };
+  for (const auto& v : values) {
+    const std::string why = ImplausibleValue(rig.KeyPath(v.key), v.quantity, v.value, v.min, v.max);
+    if (!why.empty()) throw UserError(rig.Where(rig.Optional(v.key)) + ": " + why);
+  }
+  const std::string why = SeparationNotBelowLength(c.filar_length_m, c.filar_separation_m);
+  if (!why.empty()) throw UserError(rig.Where(rig.Optional("filar_separation_m")) + ": " + why);
+}
+
+// `rig.inertia.inertia_kg_m2` or a `table` value that would make the rig far wider than its wires.
+void CheckRigInertiaPlausible(YamlMap inertia, const CampaignConfig& c) {
+  const RigInertiaSpec& spec = c.rig_inertia;
+  std::string why;
+  if (spec.kind == RigInertiaSpec::Kind::kValue) {
+    why = ImplausibleRigInertia(inertia.KeyPath("inertia_kg_m2"), spec.inertia_kg_m2, c.rig_mass_kg,
+                                c.filar_separation_m);
+    if (!why.empty()) {
+      throw UserError(inertia.Where(inertia.Optional("inertia_kg_m2")) + ": " + why);
+    }
+  } else if (spec.kind == RigInertiaSpec::Kind::kTable) {
+    for (const auto& [pitch_deg, value] : spec.table_kg_m2) {
+      char key[96];
+      std::snprintf(key, sizeof(key), "%s (pitch %g deg)", inertia.KeyPath("table").c_str(),
+                    pitch_deg);
+      why = ImplausibleRigInertia(key, value, c.rig_mass_kg, c.filar_separation_m);
+      if (!why.empty()) throw UserError(inertia.Where(inertia.Optional("table")) + ": " + why);
+    }
+  }
+}
+
+// `rig`: geometry and mass, how its inertia is known (rig.inertia), its uncertainties.
+void ReadRig(YamlMap& root, const std::string& path, const ConfigLoadOptions& options,
+             CampaignConfig* config) {
+  YamlMap rig = Sub(root, "rig");
+  if (!root.Has("rig")) throw UserError(path + ": missing required key 'rig'");
+  config->filar_length_m = Positive(rig, "filar_length_m");
+  config->filar_separation_m = Positive(rig, "filar_separation_m");
+  config->rig_mass_kg = Positive(rig, "mass_kg");
+  CheckRigPlausible(rig, *config);
+  if (rig.Has("inertia")) {
+    ReadRigInertia(Sub(rig, "inertia"), config->folder, &config->rig_inertia);
+    CheckRigInertiaPlausible(Sub(rig, "inertia"), *config);
+  } else if (options.require_runs && root.Has("aircraft")) {
+    throw UserError(path + ": missing required key 'rig.inertia' (or leave out 'aircraft' too: "
+                    "then rig.mass_kg is everything that hangs and no rig inertia is subtracted)");
+  } else {
+    config->rig_inertia_given = false;  // nothing subtracted: the moments of all that hangs
+  }
+  if (rig.Has("calibration")) {
+    if (!rig.Has("inertia")) {
+      throw UserError(rig.Where(rig.Optional("calibration")) +
+                      ": 'rig.calibration' needs 'rig.inertia' (the reference swings measure rig "
+                      "+ reference: the rig's own inertia is needed to calibrate)");
+    }
+    ReadRigCalibration(Sub(rig, "calibration"), config->folder, &config->calibration);
+  }
+  YamlMap unc = Sub(rig, "uncertainties");
+  RigUncertainties& u = config->uncertainties;
+  u.configured = rig.Has("uncertainties");
+  u.filar_length_std_m = NonNegative(unc, "filar_length_std_m", 0.0);
+  u.filar_separation_std_m = NonNegative(unc, "filar_separation_std_m", 0.0);
+  u.mass_std_kg = NonNegative(unc, "mass_std_kg", 0.0);
+  u.gravity_std_mps2 = NonNegative(unc, "gravity_std_mps2", 0.0);
+  unc.Finish();
+  rig.Finish();
+}
+
+// `aircraft` (mass and its std) and `gravity_mps2`.
+void ReadAircraftAndGravity(YamlMap& root, const std::string& path,
+                            const ConfigLoadOptions& options, CampaignConfig* config) {
+  YamlMap aircraft = Sub(root, "aircraft");
+  if (root.Has("aircraft")) {
+    config->aircraft_mass_kg = Positive(aircraft, "mass_kg");
+    const std::string why = ImplausibleValue("aircraft.mass_kg", "mass", config->aircraft_mass_kg,
+                                             0.0, kMaxMassKg);
+    if (!why.empty()) throw UserError(aircraft.Where(aircraft.Optional("mass_kg")) + ": " + why);
+    config->aircraft_mass_std_kg = NonNegative(aircraft, "mass_std_kg", 0.0);
+  } else if (options.require_runs && config->rig_inertia_given) {
+    throw UserError(path + ": missing required key 'aircraft' (or leave out 'rig.inertia' too: "
+                    "then rig.mass_kg is everything that hangs and no rig inertia is subtracted)");
+  }
+  aircraft.Finish();
+  // g is bounded to what is found on Earth (a typo such as 98.0665 would scale every moment);
+  // `gravity_off_earth: true` allows (0, 100] for a rig elsewhere.
+  config->gravity_off_earth = root.OptionalBool("gravity_off_earth", false);
+  YAML::Node g = root.Optional("gravity_mps2");
+  if (root.Given(g, "gravity_mps2", "a number (m/s^2)")) {
+    config->gravity_mps2 = root.AsDouble(g, "gravity_mps2");
+  }
+  std::string why;
+  if (!CheckGravity(config->gravity_mps2, config->gravity_off_earth, &why)) {
+    throw UserError((g.IsDefined() ? root.Where(g) : path) + ": " + why);
+  }
+}
+
+// `runs`: where the aircraft logs are (root + pattern, which may not leave the root, or a
+// table) and which pitch the ellipse uses.
+void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& options,
+              CampaignConfig* config) {
+  if (!root.Has("runs")) {
+    if (options.require_runs) throw UserError(path + ": missing required key 'runs'");
+    return;
+  }
+  YamlMap runs = Sub(root, "runs");
+  RunsConfig& r = config->runs;
+  if (!options.runs_root.empty()) {
+    runs.Optional("root");  // read (not an unknown key), replaced by --runs-root
+    r.root = fs::absolute(options.runs_root).lexically_normal().string();
+  } else {
+    r.root = ResolvePath(config->folder, runs.RequiredString("root"));
+  }
+  const bool has_pattern = runs.Has("pattern"), has_table = runs.Has("table");
+  if (has_pattern == has_table) {
+    throw UserError(runs.Where(root.Optional("runs")) +
+                    ": 'runs' needs exactly one of 'pattern' or 'table'");
+  }
+  if (has_pattern) {
+    r.pattern = runs.RequiredString("pattern");
+    if (fs::path(r.pattern).is_absolute()) {
+      throw UserError(runs.Where(runs.Optional("pattern")) +
+                      ": 'runs.pattern' must be relative to runs.root");
+    }
+    for (const char* placeholder : {"{pitch_deg}", "{roll_deg}"}) {
+      const size_t first = r.pattern.find(placeholder);
+      if (first != std::string::npos && r.pattern.find(placeholder, first + 1) != std::string::npos) {
+        throw UserError(runs.Where(runs.Optional("pattern")) + ": 'runs.pattern' may hold " +
+                        placeholder + " only once, not in two components");
+      }
+    }
+    for (const auto& part : fs::path(r.pattern)) {
+      if (part == "..") {
+        throw UserError(runs.Where(runs.Optional("pattern")) +
+                        ": 'runs.pattern' must stay inside runs.root (no '..'): set runs.root "
+                        "to the folder that holds the logs instead");
+      }
+    }
+  } else {
+    r.table = ResolvePath(config->folder, runs.RequiredString("table"));
+  }
+  const std::string source = runs.OptionalString("pitch_source", "nominal");
+  if (source == "nominal") {
+    r.pitch_source = PitchSource::kNominal;
+  } else if (source == "measured") {
+    r.pitch_source = PitchSource::kMeasured;
+  } else {
+    throw UserError(runs.Where(runs.Optional("pitch_source")) +
+                    ": 'runs.pitch_source' must be nominal or measured, not '" + source + "'");
+  }
+  const YAML::Node tolerance = runs.Optional("attitude_tolerance_deg");
+  if (tolerance.IsDefined() && !tolerance.IsNull()) {
+    r.attitude_tolerance_deg = runs.AsDouble(tolerance, "attitude_tolerance_deg");
+    if (!(r.attitude_tolerance_deg > 0.0 && r.attitude_tolerance_deg <= 180.0)) {
+      throw UserError(runs.Where(tolerance) +
+                      ": 'runs.attitude_tolerance_deg' must be in (0, 180] deg");
+    }
+  }
+  if (r.pitch_source == PitchSource::kMeasured && !config->imu.format.has_accel()) {
+    throw UserError(path + ": 'runs.pitch_source: measured' needs accelerometer columns (imu.accel)");
+  }
+  runs.Finish();
+}
+
+// `fit.windows`: file -> [t0_s, t1_s].
+void ReadFitWindows(YamlMap& fit, FitConfig* out) {
+  YAML::Node windows = fit.Optional("windows");
+  if (!windows.IsDefined() || windows.IsNull()) return;
+  if (!windows.IsMap()) {
+    throw UserError(fit.Where(windows) + ": 'fit.windows' must map file to [t0_s, t1_s]");
+  }
+  for (const auto& item : windows) {
+    const std::string key = "windows." + item.first.Scalar();
+    if (!item.second.IsSequence() || item.second.size() != 2) {
+      throw UserError(fit.Where(item.second) + ": 'fit." + key + "' must be [t0_s, t1_s]");
+    }
+    const double t0 = fit.AsDouble(item.second[0], key), t1 = fit.AsDouble(item.second[1], key);
+    if (!(t1 > t0)) {
+      throw UserError(fit.Where(item.second) + ": 'fit." + key + "' needs t0 < t1");
+    }
+    out->windows_s[item.first.Scalar()] = {t0, t1};
+  }
+}
+
+// `fit.quality`: the thresholds of the quality checks, each in its range.
+void ReadFitQuality(YamlMap& fit, QualityThresholds* q) {
+  YamlMap quality = Sub(fit, "quality");
+  q->max_rms_over_noise = quality.OptionalDouble("max_rms_over_noise", q->max_rms_over_noise);
+  q->max_residual_autocorr =
+      quality.OptionalDouble("max_residual_autocorr", q->max_residual_autocorr);
+  q->whiteness_lags = quality.OptionalInt("whiteness_lags", q->whiteness_lags);
+  q->max_secondary_motion_ratio =
+      quality.OptionalDouble("max_secondary_motion_ratio", q->max_secondary_motion_ratio);
+  q->min_periods = quality.OptionalDouble("min_periods", q->min_periods);
+  q->reject_secondary_motion_ratio = quality.OptionalDouble(
+      "reject_secondary_motion_ratio", std::max(q->reject_secondary_motion_ratio,
+                                                q->max_secondary_motion_ratio));
+  q->reject_residual_fraction =
+      quality.OptionalDouble("reject_residual_fraction", q->reject_residual_fraction);
+  if (!(q->max_rms_over_noise > 1.0) || !(q->max_residual_autocorr > 0.0) ||
+      !(q->max_residual_autocorr < 1.0) || q->whiteness_lags < 1 ||
+      !(q->max_secondary_motion_ratio >= 0.0) || !(q->min_periods >= 2.0) ||
+      !(q->reject_secondary_motion_ratio >= q->max_secondary_motion_ratio) ||
+      !(q->reject_residual_fraction > 0.0 && q->reject_residual_fraction <= 1.0)) {
+    throw UserError(quality.Where(fit.Optional("quality")) +
+                    ": 'fit.quality' out of range (max_rms_over_noise > 1, "
+                    "0 < max_residual_autocorr < 1, whiteness_lags >= 1, "
+                    "max_secondary_motion_ratio >= 0, min_periods >= 2, "
+                    "reject_secondary_motion_ratio >= max_secondary_motion_ratio, "
+                    "0 < reject_residual_fraction <= 1)");
+  }
+  quality.Finish();
+}
+
+// `fit.amplitude_sweep`: I against amplitude band.
+void ReadFitSweep(YamlMap& fit, SweepConfig* sw) {
+  YamlMap sweep = Sub(fit, "amplitude_sweep");
+  sw->enabled = sweep.OptionalBool("enabled", sw->enabled);
+  sw->min_cycles_per_band = sweep.OptionalDouble("min_cycles_per_band", sw->min_cycles_per_band);
+  sw->max_bands = sweep.OptionalInt("max_bands", sw->max_bands);
+  sw->trend_z = sweep.OptionalDouble("trend_z", sw->trend_z);
+  if (!(sw->min_cycles_per_band >= 1.0 && sw->min_cycles_per_band <= 1000.0) ||
+      sw->max_bands < 2 || sw->max_bands > 20 || !(sw->trend_z > 0.0 && sw->trend_z < 1000.0)) {
+    throw UserError(sweep.Where(fit.Optional("amplitude_sweep")) +
+                    ": 'fit.amplitude_sweep' out of range (min_cycles_per_band in [1, 1000], "
+                    "max_bands in [2, 20], trend_z in (0, 1000))");
+  }
+  sweep.Finish();
+}
+
+// `fit.glitch`: the single-sample glitch detector, each value in its range (error at its line).
+void ReadFitGlitch(YamlMap& fit, GlitchConfig* g) {
+  YamlMap glitch = Sub(fit, "glitch");
+  g->enabled = glitch.OptionalBool("enabled", g->enabled);
+  g->threshold_sigmas = glitch.OptionalDouble("threshold_sigmas", g->threshold_sigmas);
+  g->range_factor = glitch.OptionalDouble("range_factor", g->range_factor);
+  g->excursion_fraction = glitch.OptionalDouble("excursion_fraction", g->excursion_fraction);
+  g->max_fraction = glitch.OptionalDouble("max_fraction", g->max_fraction);
+  std::string key, why;
+  if (!CheckGlitch(*g, &key, &why)) throw UserError(glitch.Where(glitch.Optional(key)) + ": " + why);
+  glitch.Finish();
+}
+
+// `fit`: model, integrator, windows, amplitude limits, quality, sweep, glitch; then
+// FitConfig::Check.
+void ReadFit(YamlMap fit, FitConfig* out) {
+  const std::string model = fit.OptionalString("model", "full");
+  if (!ParsePendulumModel(model, &out->model)) {
+    throw UserError(fit.Where(fit.Optional("model")) +
+                    ": 'fit.model' must be full, jardin or linear, not '" + model + "'");
+  }
+  const std::string integrator = fit.OptionalString("integrator", "rk853");
+  if (!ParseIntegratorMethod(integrator, &out->integrator)) {
+    throw UserError(fit.Where(fit.Optional("integrator")) +
+                    ": 'fit.integrator' must be rk853 or cvodes, not '" + integrator + "'");
+  }
+  ReadFitWindows(fit, out);
+  if (fit.Has("max_amplitude_deg")) out->max_amplitude_deg = fit.RequiredDouble("max_amplitude_deg");
+  if (fit.Has("min_amplitude_deg")) out->min_amplitude_deg = fit.RequiredDouble("min_amplitude_deg");
+  ReadFitQuality(fit, &out->quality);
+  ReadFitSweep(fit, &out->sweep);
+  ReadFitGlitch(fit, &out->glitch);
+  std::string why;
+  if (!out->Check(&why)) {
+    const char* key = why.find("max_amplitude") != std::string::npos ? "max_amplitude_deg"
+                      : why.find("min_amplitude") != std::string::npos ? "min_amplitude_deg"
+                                                                       : "quality";
+    throw UserError(fit.Where(fit.Optional(key)) + ": " + why);
+  }
+  fit.Finish();
+}
+
+// `ellipse`: bootstrap, seed, confidence, covariance, min_angles; then EllipseConfig::Check.
+void ReadEllipse(YamlMap ellipse, EllipseConfig* e) {
+  e->bootstrap = ellipse.OptionalInt("bootstrap", e->bootstrap);
+  e->seed = static_cast<unsigned>(
+      ellipse.OptionalIntIn("seed", e->seed, 0, std::numeric_limits<unsigned>::max()));
+  e->confidence = ellipse.OptionalDouble("confidence", e->confidence);
+  e->covariance = ellipse.OptionalString("covariance", e->covariance);
+  e->min_angles = ellipse.OptionalInt("min_angles", e->min_angles);
+  std::string why;
+  if (!e->Check(&why)) {
+    const char* key = why.find("bootstrap") != std::string::npos    ? "bootstrap"
+                      : why.find("confidence") != std::string::npos ? "confidence"
+                      : why.find("min_angles") != std::string::npos ? "min_angles"
+                                                                    : "covariance";
+    throw UserError(ellipse.Where(ellipse.Optional(key)) + ": " + why);
+  }
+  ellipse.Finish();
+}
+
+// `units`: si or imperial (display only; files stay SI).
+DisplayUnits ReadUnits(YamlMap& root) {
+  const std::string units = root.OptionalString("units", "si");
+  if (units == "si") return DisplayUnits::kSi;
+  if (units == "imperial") return DisplayUnits::kImperial;
+  throw UserError(root.Where(root.Optional("units")) + ": 'units' must be si or imperial, not '" +
+                  units + "'");
+}
+
+// `limits`: the size caps of the logs, MB in [1, kMaxLimitMb].
+InputLimits ReadLimits(YamlMap limits) {
+  InputLimits l;
+  for (auto [key, value] : {std::pair<const char*, double*>{"max_log_mb", &l.max_log_mb},
+                            {"max_decompressed_log_mb", &l.max_decompressed_log_mb}}) {
+    YAML::Node node = limits.Optional(key);
+    if (!node.IsDefined()) continue;
+    const double mb = limits.AsDouble(node, key);
+    if (!(mb >= 1 && mb <= kMaxLimitMb)) {
+      throw UserError(limits.Where(node) + ": '" + limits.KeyPath(key) + "' must be in [1, " +
+                      std::to_string(static_cast<long long>(kMaxLimitMb)) + "] (MB)");
+    }
+    *value = mb;
+  }
+  limits.Finish();
+  return l;
+}
+
+}  // namespace
+
+ImuLogOptions InputLimits::LogOptions() const {
+  ImuLogOptions options;
+  options.max_file_bytes = static_cast<uint64_t>(max_log_mb * 1e6);
+  options.max_decompressed_bytes = static_cast<uint64_t>(max_decompressed_log_mb * 1e6);
+  return options;
+}
+
+// read the file -> rig -> aircraft, gravity -> imu -> runs -> fit -> ellipse -> units -> no
+// unknown key -> the ranges that involve several keys (CampaignConfig::Check).
+CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptions& options) {
+  CampaignConfig config;
+  ReadConfigFile(path, &config);
+  YamlMap root = YamlMap::LoadFile(path);
+  ReadRig(root, path, options, &config);
+  ReadAircraftAndGravity(root, path, options, &config);
+  ReadImu(Sub(root, "imu"), &config.imu);
+  ReadRuns(root, path, options, &config);
+  ReadFit(Sub(root, "fit"), &config.fit);
+  ReadEllipse(Sub(root, "ellipse"), &config.ellipse);
+  config.units = ReadUnits(root);
+  config.limits = ReadLimits(Sub(root, "limits"));
+  root.Finish();
+  std::string why;
+  if (!config.Check(&why)) throw UserError(path + ": " + why);
+  return config;
+}
+
+}  // namespace bifilar

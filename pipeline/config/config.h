@@ -1,0 +1,273 @@
+// The campaign configuration (YAML), shared by `bifilar process` and `bifilar fit`. Every key is
+// documented in configs/README.md; unknown keys are errors with their dotted path and line
+// (pipeline/config/yaml_reader.h), missing required keys are named. Relative paths are resolved
+// against the folder of the config file. All values in memory are SI (kg, m, m/s^2, kg m^2, deg for
+// pitch angles); `units` only chooses how the console and the report print them.
+// Conventions (pitch nose-up positive, swing axis = down vertical): docs/physics.md §2, §3.
+#pragma once
+
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fit/glitch.h"
+#include "pendulum/integrator.h"
+#include "pendulum/model.h"
+#include "pipeline/logs/imu_format.h"
+#include "pipeline/logs/imu_log.h"
+
+namespace bifilar {
+
+enum class DisplayUnits { kSi, kImperial };        // "si" (kg m^2), "imperial" (slug ft^2)
+enum class PitchSource { kNominal, kMeasured };    // "nominal", "measured"
+constexpr double kSlugFt2PerKgM2 = 1.0 / 1.35581795;  // docs/physics.md §4
+
+// How the rig's own inertia (subtracted from every total) is known: exactly one of three ways.
+struct RigInertiaSpec {
+  enum class Kind { kValue, kTable, kTare };
+  Kind kind = Kind::kValue;
+  double inertia_kg_m2 = 0.0;      // kValue: the rig's inertia about the swing axis (kg m^2)
+  double inertia_std_kg_m2 = 0.0;  // kValue/kTable: its standard uncertainty (kg m^2); >= 0
+  // kTable: pitch (deg) -> rig inertia (kg m^2); linear interpolation between entries, a pitch
+  // outside the table is an error for that trace.
+  std::map<double, double> table_kg_m2;
+  // kTare: the tare logs (absolute paths after discovery; the patterns as written are kept for
+  // the record). Fitted with the rig's own mass; rig inertia = their mean.
+  std::vector<std::string> tare_patterns;  // glob-like patterns relative to the config folder
+};
+
+// `rig.calibration`: a reference object of known inertia and mass swung on the rig, whose swings
+// fix the rig's effective geometry (docs/method.md §15, docs/physics.md §2.6). Absent: the
+// configured L and D are used as they are.
+struct RigCalibrationSpec {
+  bool enabled = false;                    // the section is present
+  // The reference swings (absolute patterns or files, as rig.inertia.tare.logs); each is fitted
+  // with the rig mass + reference_mass_kg and the suspended inertia rig + reference.
+  std::vector<std::string> log_patterns;
+  double reference_inertia_kg_m2 = 0.0;      // about the swing axis (kg m^2); > 0
+  double reference_inertia_std_kg_m2 = 0.0;  // its standard uncertainty (kg m^2); [0, inertia)
+  double reference_mass_kg = 0.0;            // (kg); > 0
+  // rig.inertia.table only: the rig pitch (deg) at which the reference was swung; default 0.
+  double rig_pitch_deg = 0.0;
+};
+
+// The effective geometry a calibration found, applied to every fit: the D^2/L of the pendulum is
+// `factor` times the configured one. It is realised as an effective separation
+// D_eff = D sqrt(factor) with L as configured (docs/physics.md §2.6: to leading order the
+// dynamics depend on D^2/L only). Not applied: factor 1, the configured geometry.
+struct GeometryCalibration {
+  bool applied = false;
+  double factor = 1.0;           // k = (D^2/L)_effective / (D^2/L)_configured; > 0
+  double factor_rel_std = 0.0;   // std(k) / k: common to every moment of the campaign; >= 0
+};
+
+struct RigUncertainties {
+  double filar_length_std_m = 0.0;      // standard uncertainty of L (m); >= 0; default 0
+  double filar_separation_std_m = 0.0;  // of D (m); >= 0; default 0
+  double mass_std_kg = 0.0;             // of the rig mass (kg); >= 0; default 0
+  double gravity_std_mps2 = 0.0;        // of g (m/s^2); >= 0; default 0
+  // The config has a `rig.uncertainties` section (zeros included). Without one (Assumed()),
+  // InEffect() assumes a tape-measure 1 mm on L and D (pipeline/records/total_uncertainty.h),
+  // labelled.
+  bool configured = false;
+
+  // The stds the budget uses: these when configured, else the assumed ones (1 mm on L and D).
+  RigUncertainties InEffect() const;
+  // Not configured: no section, and no std set in memory either (a config built in code that
+  // sets a std has configured it).
+  bool Assumed() const {
+    return !configured && filar_length_std_m == 0.0 && filar_separation_std_m == 0.0 &&
+           mass_std_kg == 0.0 && gravity_std_mps2 == 0.0;
+  }
+};
+
+// The CSV layout of the logs and how the IMU sits on the aircraft.
+struct ImuConfig {
+  ImuFormat format;                      // columns and units
+  double gyro_scale_std = 0.0;           // 1-sigma gyro scale-factor uncertainty (fraction); >= 0
+  bool swing_axis_auto = true;           // `swing_axis: auto`
+  Eigen::Vector3d swing_axis_in_imu = Eigen::Vector3d::UnitZ();  // fixed axis (unit) otherwise
+  // Rotation taking IMU-frame vectors to body axes (x fwd, y right, z down); default identity.
+  Eigen::Matrix3d imu_to_body = Eigen::Matrix3d::Identity();
+};
+
+// Where the aircraft logs are and how their pitch is known.
+struct RunsConfig {
+  std::string root;      // absolute folder of the logs (resolved from the config folder)
+  // Pattern relative to root, '/'-separated; '*' matches any run of characters within one path
+  // component, '{pitch_deg}' matches a number (the nominal pitch, deg). Empty when `table` used.
+  std::string pattern;
+  std::string table;     // absolute path of a CSV table "path,pitch_deg" (paths relative to root)
+  PitchSource pitch_source = PitchSource::kNominal;
+  // A log whose measured down vector lies farther than this from its nominal one (pitch and
+  // roll of the path or table) gets a warning naming it (deg); (0, 180]. Default 3.
+  double attitude_tolerance_deg = 3.0;
+};
+
+// Quality thresholds of the trace fit (fit/trace_fit.h TraceFitOptions, same names and
+// defaults): the max_* ones give warnings, the reject_* ones reject.
+struct QualityThresholds {
+  double max_rms_over_noise = 3.0;          // residual RMS / noise (dimensionless); > 1
+  double max_residual_autocorr = 0.35;      // prewhitened residual |autocorrelation|; (0,1)
+  int whiteness_lags = 10;                  // L (count); >= 1
+  double max_secondary_motion_ratio = 0.1;  // other-axes energy / swing-axis energy; >= 0
+  double reject_secondary_motion_ratio = 0.5;  // ... above this: rejected; >= the warning level
+  double reject_residual_fraction = 0.3;    // residual RMS / swing rate RMS above: rejected
+  double min_periods = 2.0;                 // periods the window must hold (count); >= 2
+};
+
+// The amplitude sweep (fit/trace_fit.h TraceFitOptions::amplitude_sweep and sweep_*).
+struct SweepConfig {
+  bool enabled = true;
+  double min_cycles_per_band = 2.0;  // [1, 1000]
+  int max_bands = 6;                 // [2, 20]
+  double trend_z = 4.0;              // (0, 1000)
+};
+
+// `fit.glitch`: isolated single-sample gyro glitches (fit/glitch.h), dropped before the swing
+// axis, window and fit, and again on the fit's residuals. Same defaults as GlitchOptions.
+struct GlitchConfig {
+  bool enabled = true;                                            // both passes
+  double threshold_sigmas = GlitchOptions().threshold_sigmas;     // [3, 1000] robust sigmas
+  double range_factor = GlitchOptions().range_factor;             // [1, 100] x neighbours' range
+  double excursion_fraction = GlitchOptions().excursion_fraction; // [0, 10] x series' excursion
+  double max_fraction = GlitchOptions().max_fraction;             // (0, 0.1] of the samples
+
+  GlitchOptions Options() const;  // the detector's options; threshold 0 (off) when !enabled
+  bool IsDefault() const;         // every value at its default (the cache key leaves it out)
+};
+constexpr double kMinGlitchSigmas = 3, kMaxGlitchSigmas = 1000;  // fit.glitch.threshold_sigmas
+constexpr double kMinGlitchRange = 1, kMaxGlitchRange = 100;     // fit.glitch.range_factor
+constexpr double kMaxGlitchExcursion = 10;                       // fit.glitch.excursion_fraction
+constexpr double kMaxGlitchFraction = 0.1;                       // fit.glitch.max_fraction
+
+struct FitConfig {
+  PendulumModel model = PendulumModel::kFull;  // `fit.model`: full | jardin | linear
+  // `fit.integrator`: rk853 (default) | cvodes; the fit's ODE solver (pendulum/integrator.h).
+  IntegratorMethod integrator = IntegratorMethod::kRungeKutta;
+  // Per-file window overrides [t0, t1] (s), keyed by the path as written (relative to runs root
+  // or to the config folder for tare logs); the file names are resolved at load time.
+  std::map<std::string, std::array<double, 2>> windows_s;
+  std::optional<double> max_amplitude_deg;  // amplitude band, upper (deg); default: fit's own
+  std::optional<double> min_amplitude_deg;  // amplitude band, lower (deg); default: fit's own
+  QualityThresholds quality;
+  SweepConfig sweep;
+  GlitchConfig glitch;
+
+  bool Check(std::string* why) const;  // amplitude band, quality, glitch ranges; *why names the key
+};
+
+// Options of the ellipse fit (fit/ellipse.h EllipseOptions, same defaults).
+// Limits of the count-like keys (configs/README.md); ellipse.bootstrap's are in fit/ellipse.h
+// (kMinBootstrapReplicates, kMaxBootstrapReplicates). One set of ranges, checked when the config
+// is loaded (naming the line) and by CampaignConfig::Check before any fit runs.
+constexpr int kMaxMinAngles = 1000;        // ellipse.min_angles in [3, 1000]
+constexpr int kMaxWhitenessLags = 1000;    // fit.quality.whiteness_lags in [1, 1000]
+constexpr double kMaxMinPeriods = 10000;   // fit.quality.min_periods in [2, 10000]
+constexpr double kMinMaxAmplitudeDeg = 1;  // fit.max_amplitude_deg in [1, 90]: the trace fit's
+constexpr double kMaxMaxAmplitudeDeg = 90; //   model holds to 90 deg; below 1 deg is noise
+constexpr double kMinSwingAxisLength = 1e-3;  // imu.swing_axis: a direction whose length lies
+constexpr double kMaxSwingAxisLength = 1e3;   //   in [1e-3, 1e3] (typos and overflow refused)
+constexpr double kMaxRigInertiaStdKgM2 = 1e3;  // rig.inertia.inertia_std_kg_m2 below this
+// The other std keys (rig.uncertainties.*, aircraft.mass_std_kg, imu.gyro.scale_std) must be
+// below the quantity they qualify (L, D, the masses, g; 1 for the scale factor).
+
+struct EllipseConfig {
+  int bootstrap = 2000;           // parametric bootstrap replicates (0 = covariance intervals)
+  unsigned seed = 1;              // seed of the bootstrap
+  double confidence = 0.95;       // confidence level of the intervals, in (0, 1)
+  std::string covariance = "auto";  // auto | points | angle_means | absolute
+  int min_angles = 3;             // distinct pitch angles needed to fit the ellipse; >= 3
+
+  bool Check(std::string* why) const;  // the ranges above; *why names the key
+};
+
+// `limits`: size caps of the logs (MB = 1e6 bytes), README "Input size limits". The other
+// inputs have fixed caps (base/bounded_read.h).
+struct InputLimits {
+  double max_log_mb = kDefaultMaxLogMb;  // a log file as stored; [1, kMaxLimitMb]; default 1000
+  // its text once a .csv.gz is decompressed; [1, kMaxLimitMb]; default 1000
+  double max_decompressed_log_mb = kDefaultMaxDecompressedLogMb;
+
+  ImuLogOptions LogOptions() const;  // the reader's options with these caps (bytes)
+};
+constexpr double kMaxLimitMb = 1e6;  // 1 TB: the largest limits.* accepted
+
+struct CampaignConfig {
+  std::string file;          // absolute path of the config file
+  std::string folder;        // its folder: relative paths are resolved against it
+  std::string text;          // the YAML text as read (stored in results.json)
+
+  double filar_length_m = 0.0;      // L (m)
+  double filar_separation_m = 0.0;  // D (m)
+  double rig_mass_kg = 0.0;         // rig (+ IMU) mass (kg)
+  RigInertiaSpec rig_inertia;
+  RigCalibrationSpec calibration;   // rig.calibration (enabled = false when absent)
+  // The calibration in effect (set by the campaign or `bifilar fit` after the reference swings
+  // are fitted, never read from the file). Applied: the geometries below use D_eff, and the
+  // L, D and g terms of the budget are replaced by one `calibration` term.
+  GeometryCalibration geometry_calibration;
+  // false when `process` runs without `rig.inertia` and `aircraft` (a rig of thread only, like
+  // the Crazyflie's): rig.mass_kg is everything that hangs and the rig inertia is 0.
+  bool rig_inertia_given = true;
+  RigUncertainties uncertainties;
+  double aircraft_mass_kg = 0.0;      // aircraft mass (kg); 0 when only tare logs are fitted
+  double aircraft_mass_std_kg = 0.0;  // its standard uncertainty (kg)
+  double gravity_mps2 = 9.80665;      // local gravity (m/s^2); in [9.76, 9.84] (Earth) unless
+  bool gravity_off_earth = false;     // `gravity_off_earth: true`: then in (0, 100]
+  ImuConfig imu;
+  RunsConfig runs;       // absent (root empty) for a `fit`-only config
+  FitConfig fit;
+  EllipseConfig ellipse;
+  DisplayUnits units = DisplayUnits::kSi;
+  InputLimits limits;
+
+  // Geometry of an aircraft trace (mass = aircraft + rig), of a tare trace (rig alone) and of a
+  // reference swing (rig + reference), with the calibrated separation when one is applied.
+  RigGeometry AircraftGeometry() const;
+  RigGeometry TareGeometry() const;
+  RigGeometry CalibrationGeometry() const;
+  double EffectiveSeparationM() const;  // D sqrt(geometry_calibration.factor)
+
+  bool Check(std::string* why) const;
+  // Values no lab rig can have (pipeline/config/plausibility.h): L, D, the masses, the rig inertia
+  // against the rig's mass and D. Part of Check; *why names the key and the likely unit.
+  bool CheckPlausible(std::string* why) const;
+};
+
+// Gravity on Earth's surface spans 9.7639 (Huascaran, 6.8 km at the equator) to 9.8337 m/s^2
+// (the poles); a config's gravity_mps2 must lie in [9.76, 9.84] unless gravity_off_earth is set,
+// which allows (0, 100] (the Moon 1.62, Mars 3.71, Jupiter 24.8). *why names the key and range.
+constexpr double kMinEarthGravityMps2 = 9.76, kMaxEarthGravityMps2 = 9.84;
+constexpr double kMaxOffEarthGravityMps2 = 100.0;
+bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why);
+
+struct ConfigLoadOptions {
+  bool require_runs = true;      // `process` needs runs/aircraft; `fit` only geometry + IMU
+  // `process --runs-root DIR`: the folder of the aircraft logs, replacing runs.root (which may
+  // then be absent). Empty: runs.root as written.
+  std::string runs_root;
+};
+
+// Reads and validates `path`. Throws UserError naming the file, line and key on any problem.
+CampaignConfig LoadCampaignConfig(const std::string& path,
+                                  const ConfigLoadOptions& options = ConfigLoadOptions());
+
+const char* ToString(DisplayUnits units);
+const char* ToString(PitchSource source);
+
+// Inertia in the display units, and their name ("kg m^2" or "slug ft^2").
+double InertiaToDisplay(double inertia_kg_m2, DisplayUnits units);
+const char* InertiaUnitName(DisplayUnits units);
+// A message written in SI (the fit's warnings) in the display units: under kImperial every
+// "<number> kg m^2" of `text` becomes "<number> slug ft^2" (3 significant digits); kSi: as is.
+std::string SiTextInDisplayUnits(const std::string& text, DisplayUnits units);
+
+// `path` resolved against `folder` unless absolute; lexically normalised.
+std::string ResolvePath(const std::string& folder, const std::string& path);
+
+}  // namespace bifilar

@@ -1,0 +1,146 @@
+#include "pipeline/config/config_template.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include "pendulum/model.h"
+
+namespace bifilar {
+namespace {
+
+// A YAML double-quoted scalar: any column name survives (brackets, colons, spaces).
+std::string Quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string Number(double value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%.10g", value);
+  return buffer;
+}
+
+std::string List3(const std::array<std::string, 3>& names) {
+  return "[" + Quoted(names[0]) + ", " + Quoted(names[1]) + ", " + Quoted(names[2]) + "]";
+}
+
+}  // namespace
+
+bool StartingConfigOptions::Check(std::string* why) const {
+  RigGeometry geometry;
+  geometry.filar_length_m = filar_length_m;
+  geometry.filar_separation_m = filar_separation_m;
+  geometry.mass_kg = mass_kg;
+  geometry.gravity_mps2 = gravity_mps2;
+  if (!geometry.Check(why)) return false;
+  if (format && !format->Check(why)) return false;
+  return true;
+}
+
+bool ParseRigSpec(const std::string& text, StartingConfigOptions* options, std::string* why) {
+  double values[3];
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &values[0], &values[1], &values[2], &tail) != 3) {
+    *why = "--rig '" + text + "': expected L,D,MASS in m, m and kg, e.g. --rig 0.594,0.030,0.0343";
+    return false;
+  }
+  options->filar_length_m = values[0];
+  options->filar_separation_m = values[1];
+  options->mass_kg = values[2];
+  std::string check;
+  if (!options->Check(&check)) {
+    *why = "--rig '" + text + "': " + check;
+    return false;
+  }
+  return true;
+}
+
+std::string StartingConfigText(const StartingConfigOptions& o) {
+  std::ostringstream y;
+  y << "# bifilar config, written by `bifilar init`. Every key: configs/README.md in the bifilar\n"
+       "# repository. Values are SI (m, kg, s); angles in degrees.\n"
+       "#\n"
+       "# Fit one log with it:    bifilar fit THIS.yaml LOG.csv\n"
+       "# Several swings of one set-up (their scatter enters the uncertainty):\n"
+       "#                         bifilar fit THIS.yaml run_1.csv run_2.csv run_3.csv --repeats\n"
+       "# A campaign of pitch angles (the ellipse of inertia): fill in `aircraft`, `rig.inertia`\n"
+       "# and `runs` below, then   bifilar process THIS.yaml --out OUT\n"
+       "\n"
+       "gravity_mps2: "
+    << Number(o.gravity_mps2)
+    << "            # local gravity g\n"
+       "\n"
+       "rig:\n"
+       "  filar_length_m: "
+    << Number(o.filar_length_m)
+    << "        # L, wire length, from the pivot to the rig's attachment\n"
+       "  filar_separation_m: "
+    << Number(o.filar_separation_m)
+    << "    # D, distance between the two wires\n"
+       "  # Everything that hangs. For `bifilar fit` without an `aircraft` section this is the\n"
+       "  # whole suspended mass; for a campaign, the rig (+ IMU) alone, and aircraft.mass_kg is\n"
+       "  # added for aircraft logs.\n"
+       "  mass_kg: "
+    << Number(o.mass_kg)
+    << "\n"
+       "  # How well you measured L, D and the mass (1 sigma). They usually dominate the total\n"
+       "  # uncertainty: a 1 mm error on a 30 mm separation is 6.7 % on I. Measure, then fill in.\n"
+       "  # uncertainties:\n"
+       "  #   filar_length_std_m: 0.001\n"
+       "  #   filar_separation_std_m: 0.001\n"
+       "  #   mass_std_kg: 0.001\n"
+       "  # The rig's own inertia, subtracted from every aircraft moment (campaigns only):\n"
+       "  # inertia:\n"
+       "  #   tare: {logs: tare/*.csv}        # swings of the rig alone, or\n"
+       "  #   # inertia_kg_m2: 0.0             # a known value\n"
+       "\n"
+       "# aircraft:                          # campaigns only\n"
+       "#   mass_kg: 5.5\n"
+       "#   mass_std_kg: 0.01\n"
+       "\n";
+  if (!o.format_source.empty()) y << "# Log format " << o.format_source << ": check it.\n";
+  y << "imu:\n";
+  const ImuFormat format = o.format.value_or(ImuFormat());
+  if (o.ulog) {
+    y << "  format: ulog\n"
+         "  ulog:\n"
+         "    topic: "
+      << Quoted(format.ulog.topic) << "\n    multi_id: " << format.ulog.multi_id
+      << "\n    time_field: " << Quoted(format.ulog.time_field)
+      << "\n    gyro_fields: " << List3(format.ulog.gyro_fields) << "\n";
+    if (format.ulog.accel_fields[0].empty()) y << "    accel_fields: null\n";
+    else y << "    accel_fields: " << List3(format.ulog.accel_fields) << "\n";
+  } else {
+    y << "  time: {column: " << Quoted(format.time_column) << ", unit: " << ToString(format.time_unit)
+      << "}\n"
+         "  gyro: {columns: "
+      << List3(format.gyro_columns) << ", unit: " << ToString(format.gyro_unit) << "}\n";
+    if (format.has_accel()) {
+      y << "  accel: {columns: " << List3(format.accel_columns)
+        << ", unit: " << ToString(format.accel_unit) << "}\n";
+    } else {
+      y << "  accel: null                       # no accelerometer: swing axis from the gyro\n";
+    }
+    if (format.delimiter != ',') {
+      y << "  # the log separates its columns with '"
+        << (format.delimiter == '\t' ? "\\t" : std::string(1, format.delimiter))
+        << "': bifilar reads comma-separated logs, so convert it first\n";
+    }
+  }
+  y << "  swing_axis: auto                   # the down vertical (accelerometer) or the gyro's\n"
+       "                                     # dominant direction\n"
+       "\n"
+       "# runs:                              # campaigns only: where the aircraft logs are\n"
+       "#   root: logs\n"
+       "#   pattern: \"pitch_{pitch_deg}/*.csv\"\n"
+       "\n"
+       "fit:\n"
+       "  model: full                        # the exact bifilar model (docs/physics.md)\n";
+  return y.str();
+}
+
+}  // namespace bifilar

@@ -1,0 +1,33 @@
+// `bifilar init`: a commented starting config. The rig (L, D, mass) comes from the caller
+// (`--rig L,D,MASS` or questions on a terminal); the log format from a log as `inspect` guesses
+// it (pipeline/commands/log_inspect.h), or the defaults. The text it writes is accepted by `bifilar
+// fit` as it stands, and names, commented out, the sections a campaign (`bifilar process`) adds.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "pipeline/logs/imu_format.h"
+
+namespace bifilar {
+
+struct StartingConfigOptions {
+  double filar_length_m = 0.0;      // L (m); > D
+  double filar_separation_m = 0.0;  // D (m); > 0
+  double mass_kg = 0.0;             // everything that hangs (rig + aircraft) for a first fit (kg)
+  double gravity_mps2 = 9.80665;    // local gravity (m/s^2)
+  // The format of the logs; none: the reader's defaults (t, gx/gy/gz rad/s, ax/ay/az m/s^2).
+  std::optional<ImuFormat> format;
+  bool ulog = false;                 // the format is a ULog topic, not CSV columns
+  std::string format_source;         // "guessed from logs/run1.csv", written as a comment
+
+  bool Check(std::string* why) const;
+};
+
+// The YAML text of the starting config.
+std::string StartingConfigText(const StartingConfigOptions& options);
+
+// Parses "L,D,MASS" (m, m, kg) as given to `--rig`; false with *why otherwise.
+bool ParseRigSpec(const std::string& text, StartingConfigOptions* options, std::string* why);
+
+}  // namespace bifilar

@@ -1,0 +1,69 @@
+#include "pipeline/figures/figure.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <mutex>
+
+#include <plplot.h>
+
+namespace bifilar {
+namespace {
+
+std::mutex& PlplotMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+}  // namespace
+
+bool WriteFigure(const std::string& path, const FigureOptions& options,
+                 const std::function<void()>& draw, std::string* why) {
+  const char* device = nullptr;
+  if (EndsWith(path, ".png")) device = "pngcairo";
+  if (EndsWith(path, ".svg")) device = "svgcairo";
+  if (device == nullptr) {
+    *why = path + ": figure file name must end in .png or .svg";
+    return false;
+  }
+  if (options.width_px <= 0 || options.height_px <= 0) {
+    *why = "figure size must be positive";
+    return false;
+  }
+  const std::string temporary = path + ".tmp";
+  // PLplot opens the name as given: a stale temporary, or a link planted under its name, is
+  // removed first so the figure never writes through a link to a file elsewhere.
+  ::unlink(temporary.c_str());
+  {
+    std::lock_guard<std::mutex> lock(PlplotMutex());
+    PLINT stream = 0;
+    plmkstrm(&stream);
+    plsdev(device);
+    plsfnam(temporary.c_str());
+    plspage(0, 0, options.width_px, options.height_px, 0, 0);
+    plscolbg(255, 255, 255);  // white background, dark foreground
+    plscol0(1, 0, 0, 0);
+    plinit();
+    plfontld(1);
+    plscol0(kFigureBlue, 31, 90, 180);
+    plscol0(kFigureRed, 200, 30, 30);
+    plscol0(kFigureGrey, 135, 135, 135);
+    plscol0(kFigureGreen, 20, 140, 60);
+    plscol0(kFigureLight, 220, 220, 220);
+    plscol0(kFigureBand, 120, 160, 220);
+    draw();
+    plend1();
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    std::remove(temporary.c_str());
+    *why = path + ": could not write figure";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace bifilar

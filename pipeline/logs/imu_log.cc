@@ -1,0 +1,558 @@
+#include "pipeline/logs/imu_log.h"
+
+
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <algorithm>
+#include <filesystem>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+#include <fast_float/fast_float.h>
+
+#include "base/gzip.h"
+#include "base/user_error.h"
+#include "pipeline/logs/imu_log_finish.h"
+#include "pipeline/logs/ulog.h"
+
+namespace bifilar {
+namespace {
+
+constexpr int kTime = 0;  // slot of the time column in the needed-column table; gyro 1-3, accel 4-6
+
+std::string_view Trim(std::string_view s) {
+  size_t b = 0, e = s.size();
+  while (b < e && (s[b] == ' ' || s[b] == '\t' || s[b] == '\r')) ++b;
+  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t' || s[e - 1] == '\r')) --e;
+  return s.substr(b, e - b);
+}
+
+std::string_view Unquote(std::string_view s) {
+  s = Trim(s);
+  if (s.size() >= 2 && ((s.front() == '"' && s.back() == '"') || (s.front() == '\'' && s.back() == '\''))) {
+    s = Trim(s.substr(1, s.size() - 2));
+  }
+  return s;
+}
+
+bool IsBlank(std::string_view line) { return Trim(line).empty(); }
+
+// Parses one whole cell as a number: surrounding spaces and quotes allowed, a leading '+' too.
+bool ParseCell(std::string_view cell, double* value) {
+  cell = Unquote(cell);
+  if (!cell.empty() && cell.front() == '+') cell.remove_prefix(1);
+  if (cell.empty()) return false;
+  const auto res = fast_float::from_chars(cell.data(), cell.data() + cell.size(), *value);
+  return res.ec == std::errc() && res.ptr == cell.data() + cell.size();
+}
+
+// Splits `line` on `delim` into `fields` (views into line). Quotes are not interpreted beyond
+// trimming them off a cell, which is enough for numeric logs with quoted header names.
+void Split(std::string_view line, char delim, std::vector<std::string_view>* fields) {
+  fields->clear();
+  if (delim == ' ') {  // space-separated: runs of spaces (and tabs) are one separator
+    size_t i = 0;
+    while (true) {
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+      if (i >= line.size()) return;
+      const size_t b = i;
+      while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
+      fields->push_back(line.substr(b, i - b));
+    }
+  }
+  size_t start = 0;
+  while (true) {
+    const size_t pos = line.find(delim, start);
+    if (pos == std::string_view::npos) {
+      fields->push_back(line.substr(start));
+      return;
+    }
+    fields->push_back(line.substr(start, pos - start));
+    start = pos + 1;
+  }
+}
+
+std::string Printable(std::string_view s, size_t max_len = 40) {
+  std::string out;
+  for (char c : s.substr(0, max_len)) out += (static_cast<unsigned char>(c) < 32) ? '?' : c;
+  if (s.size() > max_len) out += "...";
+  return out;
+}
+
+std::string ListColumns(const std::vector<std::string>& names) {
+  std::string out;
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (i) out += ", ";
+    out += "'" + Printable(names[i]) + "'";
+  }
+  return out.empty() ? "none" : out;
+}
+
+// Iterates the lines of a text buffer: line numbers from 1, '\r' left for Trim to remove.
+class LineReader {
+ public:
+  explicit LineReader(std::string_view text) : text_(text) {}
+  bool Next(std::string_view* line) {
+    if (pos_ >= text_.size()) return false;
+    const void* nl = std::memchr(text_.data() + pos_, '\n', text_.size() - pos_);
+    const size_t end = nl ? static_cast<const char*>(nl) - text_.data() : text_.size();
+    *line = text_.substr(pos_, end - pos_);
+    if (!line->empty() && line->back() == '\r') line->remove_suffix(1);
+    pos_ = end + 1;
+    ++line_number_;
+    return true;
+  }
+  int line_number() const { return line_number_; }
+
+ private:
+  std::string_view text_;
+  size_t pos_ = 0;
+  int line_number_ = 0;
+};
+
+// Non-blank lines the reader has not yet returned (consumes them): the rows after the end of the
+// time series, for the warning.
+int CountNonBlankLinesLeft(LineReader* reader) {
+  int count = 0;
+  std::string_view line;
+  while (reader->Next(&line)) count += IsBlank(line) ? 0 : 1;
+  return count;
+}
+
+std::string FormatNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
+
+[[noreturn]] void Fail(const std::string& message) { throw UserError(message); }
+
+// True when the file name ends in .ulg or .ulg.gz (any case).
+bool NamedLikeUlog(const std::string& path) {
+  std::string lower = path;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  auto ends_with = [&](const std::string& suffix) {
+    return lower.size() >= suffix.size() &&
+           lower.compare(lower.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  return ends_with(".ulg") || ends_with(".ulg.gz");
+}
+
+// The first bytes of `text` for a message: printable ASCII quoted, anything else as hex.
+std::string DescribeStart(std::string_view text) {
+  if (text.empty()) return "nothing: the file is empty";
+  std::string out;
+  const size_t n = std::min<size_t>(text.size(), 8);
+  bool printable = true;
+  for (size_t i = 0; i < n; ++i) printable = printable && text[i] >= 32 && text[i] < 127;
+  if (printable) return "\"" + std::string(text.substr(0, n)) + "\"";
+  char hex[4];
+  for (size_t i = 0; i < n; ++i) {
+    std::snprintf(hex, sizeof(hex), "%s%02x", i ? " " : "", static_cast<unsigned char>(text[i]));
+    out += hex;
+  }
+  return "the bytes " + out;
+}
+
+// `owner`, when given, holds the bytes `text` views; it is released once the rows are parsed, so a
+// long log's text and its samples are not both held while the samples are finished.
+ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& format,
+              const ImuLogOptions& options, std::string* owner = nullptr) {
+  std::string why;
+  if (!format.Check(&why)) Fail(name + ": invalid IMU format: " + why);
+  if (!options.Check(&why)) Fail(name + ": invalid log options: " + why);
+
+  if (text.size() >= 3 && static_cast<unsigned char>(text[0]) == 0xEF &&
+      static_cast<unsigned char>(text[1]) == 0xBB && static_cast<unsigned char>(text[2]) == 0xBF) {
+    text.remove_prefix(3);  // UTF-8 byte-order mark
+  }
+  if (IsBlank(text) || text.find_first_not_of(" \t\r\n") == std::string_view::npos) {
+    Fail(name + ": the file is empty (expected a CSV header with columns " + format.time_column +
+         ", " + format.gyro_columns[0] + ", ...)");
+  }
+  // Binary data: any NUL byte, or more than 1 % control characters in the first 64 KiB.
+  if (const void* nul = std::memchr(text.data(), '\0', text.size())) {
+    Fail(name + ": not a text CSV file (binary data at byte " +
+         std::to_string(static_cast<const char*>(nul) - text.data()) + ")");
+  }
+  {
+    const size_t n = std::min<size_t>(text.size(), 65536);
+    size_t control = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const unsigned char c = text[i];
+      if (c < 32 && c != '\n' && c != '\r' && c != '\t' && c != static_cast<unsigned char>(format.delimiter)) ++control;
+    }
+    if (control * 100 > n) Fail(name + ": not a text CSV file (" + std::to_string(control) +
+                                " control characters in the first " + std::to_string(n) + " bytes)");
+  }
+
+  ImuData data;
+  LineReader reader(text);
+  std::string_view line;
+  std::vector<std::string_view> fields;
+
+  // Header: the first non-blank line that is not a comment ('#', '%' or '//' first: logger
+  // metadata above the header is common).
+  int comment_lines = 0;
+  while (reader.Next(&line)) {
+    const std::string_view trimmed = Trim(line);
+    if (trimmed.empty()) continue;
+    if (trimmed[0] == '#' || trimmed[0] == '%' || trimmed.substr(0, 2) == "//") {
+      ++comment_lines;
+      continue;
+    }
+    break;
+  }
+  const int header_line = reader.line_number();
+  if (IsBlank(line) || Trim(line)[0] == '#' || Trim(line)[0] == '%' || Trim(line).substr(0, 2) == "//") {
+    Fail(name + ": no header row, only " + std::to_string(comment_lines) + " comment line(s)");
+  }
+  if (comment_lines > 0) {
+    data.warnings.push_back("skipped " + std::to_string(comment_lines) +
+                            " comment line(s) before the header");
+  }
+  Split(line, format.delimiter, &fields);
+  std::vector<std::string> header;
+  for (auto f : fields) header.emplace_back(Unquote(f));
+  {
+    bool all_numeric = true;
+    double v;
+    for (auto f : fields) all_numeric = all_numeric && ParseCell(f, &v);
+    if (all_numeric) {
+      Fail(name + ":" + std::to_string(header_line) +
+           ": no header row (the first line holds numbers); expected a header naming the columns " +
+           format.time_column + ", " + format.gyro_columns[0] + ", " + format.gyro_columns[1] +
+           ", " + format.gyro_columns[2] + (format.has_accel() ? ", ..." : ""));
+    }
+  }
+
+  auto find_column = [&](const std::string& col) -> int {
+    int found = -1;
+    for (size_t i = 0; i < header.size(); ++i) {
+      if (header[i] == col) {
+        if (found >= 0) {
+          Fail(name + ":" + std::to_string(header_line) + ": column '" + col +
+               "' appears twice in the header (columns " + std::to_string(found + 1) + " and " +
+               std::to_string(i + 1) + ")");
+        }
+        found = static_cast<int>(i);
+      }
+    }
+    return found;
+  };
+  auto missing = [&](const std::string& col) {
+    std::string hint;
+    if (header.size() == 1) {
+      for (char d : {',', ';', '\t', ' '}) {
+        if (d != format.delimiter && header[0].find(d) != std::string::npos) {
+          hint = std::string("; is the delimiter '") + (d == '\t' ? std::string("\\t") : std::string(1, d)) +
+                 "' rather than '" + std::string(1, format.delimiter) + "'?";
+          break;
+        }
+      }
+    }
+    Fail(name + ":" + std::to_string(header_line) + ": missing column '" + col +
+         "' (columns found: " + ListColumns(header) + hint + ")");
+  };
+
+  std::vector<std::string> names = {format.time_column, format.gyro_columns[0],
+                                    format.gyro_columns[1], format.gyro_columns[2]};
+  std::vector<double> scale = {ToSi(format.time_unit), ToSi(format.gyro_unit),
+                               ToSi(format.gyro_unit), ToSi(format.gyro_unit)};
+  std::vector<int> column;
+  for (const auto& n : names) {
+    const int c = find_column(n);
+    if (c < 0) missing(n);
+    column.push_back(c);
+  }
+  bool with_accel = false;
+  if (format.has_accel()) {
+    int present = 0;
+    std::array<int, 3> accel_col;
+    for (int k = 0; k < 3; ++k) {
+      accel_col[k] = find_column(format.accel_columns[k]);
+      present += accel_col[k] >= 0;
+    }
+    if (present == 0 && !options.require_accel) {
+      data.warnings.push_back("no accelerometer columns (" + format.accel_columns[0] + ", " +
+                              format.accel_columns[1] + ", " + format.accel_columns[2] +
+                              ") in the file; read as gyro-only");
+    } else {
+      for (int k = 0; k < 3; ++k) {
+        if (accel_col[k] < 0) missing(format.accel_columns[k]);
+        names.push_back(format.accel_columns[k]);
+        scale.push_back(ToSi(format.accel_unit));
+        column.push_back(accel_col[k]);
+      }
+      with_accel = true;
+    }
+  }
+  const int needed = static_cast<int>(column.size());
+  int max_column = 0;
+  for (int c : column) max_column = std::max(max_column, c);
+
+  // Rows. The time series ends at a break that is not followed by a row continuing it (a later
+  // time): real loggers append footers (a blank line, then summary rows with text, or whose time
+  // is numeric again but jumps back). A blank line followed by a non-numeric row always ends it.
+  // A non-numeric row followed by a row that continues the time series is corruption inside the
+  // data: an error.
+  std::vector<double> values;  // row-major, `needed` per row, SI
+  std::vector<int> row_line;
+  values.reserve(text.size() / 8);
+  row_line.reserve(text.size() / 48);
+  std::string first_bad;
+  int bad_rows = 0, first_bad_line = 0, first_blank_line = 0, lines_after_end = 0;
+  int end_line = 0;  // line of the break that ended the time series (0: the file's end)
+  std::string end_reason;
+  double row[7];
+  while (reader.Next(&line)) {
+    if (IsBlank(line)) {
+      if (first_blank_line == 0 && !row_line.empty()) first_blank_line = reader.line_number();
+      continue;
+    }
+    Split(line, format.delimiter, &fields);
+    std::string bad;
+    bool non_finite = false;
+    std::string non_finite_message;
+    if (static_cast<int>(fields.size()) <= max_column) {
+      int k = 0;
+      while (column[k] < static_cast<int>(fields.size())) ++k;
+      bad = name + ":" + std::to_string(reader.line_number()) + ": the row has only " +
+            std::to_string(fields.size()) + " field(s); column '" + names[k] + "' is field " +
+            std::to_string(column[k] + 1) + " ('" + Printable(Trim(line)) + "')";
+    } else {
+      for (int k = 0; k < needed; ++k) {
+        const std::string_view cell = fields[column[k]];
+        if (!ParseCell(cell, &row[k])) {
+          bad = name + ":" + std::to_string(reader.line_number()) + ":" +
+                std::to_string(column[k] + 1) + ": column '" + names[k] + "' holds '" +
+                Printable(Trim(cell)) + "', which is not a number";
+          break;
+        }
+        if (!std::isfinite(row[k]) && !non_finite) {
+          non_finite = true;
+          non_finite_message = name + ":" + std::to_string(reader.line_number()) + ":" +
+                               std::to_string(column[k] + 1) + ": column '" + names[k] +
+                               "' holds '" + Printable(Trim(cell)) +
+                               "'; NaN and infinite values are not allowed";
+        } else if (k != kTime && !non_finite) {
+          // A reading no sensor gives (imu_log.h): an error like NaN, if the row is data.
+          const bool gyro = k <= 3;
+          const double bound = gyro ? kMaxGyroRateRadPerS : kMaxAccelMps2;
+          if (std::abs(row[k] * scale[k]) > bound) {
+            non_finite = true;
+            non_finite_message = name + ":" + std::to_string(reader.line_number()) + ":" +
+                                 std::to_string(column[k] + 1) + ": column '" + names[k] +
+                                 "' holds '" + Printable(Trim(cell)) + "' = " +
+                                 FormatNumber(row[k] * scale[k]) +
+                                 (gyro ? " rad/s, beyond any gyro (|rate| <= 1e4 rad/s)"
+                                       : " m/s^2, beyond any accelerometer (|f| <= 1e5 m/s^2)") +
+                                 ": a corrupt value, or the wrong unit or column";
+          }
+        }
+      }
+    }
+    if (!bad.empty()) {
+      if (bad_rows == 0) {
+        first_bad = bad;
+        first_bad_line = reader.line_number();
+      }
+      ++bad_rows;
+      if (first_blank_line > 0 && first_blank_line < first_bad_line) {
+        // A blank line, then a non-numeric row: a footer. The time series ended at the blank.
+        end_line = first_blank_line;
+        end_reason = "a blank line, then a non-numeric row";
+        lines_after_end = bad_rows + CountNonBlankLinesLeft(&reader);
+        break;
+      }
+      continue;
+    }
+    // A numeric row after a break: does it continue the time series?
+    const bool after_break = bad_rows > 0 || first_blank_line > 0;
+    const bool continues = row_line.empty() || row[kTime] * scale[kTime] >
+                                                   values[(row_line.size() - 1) * needed + kTime];
+    if (after_break && !continues) {
+      end_line = bad_rows > 0 && (first_blank_line == 0 || first_bad_line < first_blank_line)
+                     ? first_bad_line
+                     : first_blank_line;
+      end_reason = end_line == first_bad_line && bad_rows > 0
+                       ? "a non-numeric row, then rows whose time does not continue it"
+                       : "a blank line, then rows whose time does not continue it";
+      lines_after_end = 1 + bad_rows + CountNonBlankLinesLeft(&reader);
+      break;
+    }
+    if (bad_rows > 0) Fail(first_bad);  // a bad cell with the time series going on after it
+    if (non_finite) Fail(non_finite_message);
+    first_blank_line = 0;
+    for (int k = 0; k < needed; ++k) values.push_back(row[k] * scale[k]);
+    row_line.push_back(reader.line_number());
+  }
+  if (owner != nullptr) std::string().swap(*owner);  // `text` and `line` are not used below
+  const size_t rows = row_line.size();
+  if (rows == 0) {
+    if (bad_rows > 0) {
+      Fail(name + ": no numeric data rows after the header (line " + std::to_string(header_line) +
+           "): " + std::to_string(bad_rows) + " row(s), none of them numbers (a footer only, or "
+           "the wrong columns?); the first: " + first_bad);
+    }
+    Fail(name + ":" + std::to_string(header_line) + ": header only, no data rows");
+  }
+  if (end_line > 0) {
+    data.warnings.push_back("the time series ends at line " + std::to_string(end_line) + " (" +
+                            end_reason + "); " +
+                            std::to_string(lines_after_end) +
+                            " row(s) after it (a footer?) are ignored");
+  } else if (bad_rows > 0) {
+    data.warnings.push_back("skipped " + std::to_string(bad_rows) +
+                            " trailing non-numeric row(s) from line " +
+                            std::to_string(first_bad_line) + " (" + first_bad + ")");
+  }
+
+  return FinishImuLog(name, options, values, needed, row_line, scale, with_accel, std::move(data));
+}
+
+}  // namespace
+
+ImuData FinishImuLog(const std::string& name, const ImuLogOptions& options,
+                     const std::vector<double>& values, int needed,
+                     const std::vector<int>& row_line, [[maybe_unused]] const std::vector<double>& scale,
+                     bool with_accel, ImuData data) {
+  const size_t rows = row_line.size();
+  // Timestamps must increase. A sample whose time does not exceed the last kept one is dropped,
+  // unless the last kept one was itself a forward glitch (the new time fits between the two
+  // before), in which case the glitch is replaced.
+  // A jump back in time after which no row ever passes the last two kept times ends the time
+  // series (a footer of numeric summary rows, or a second log appended): the rest is ignored
+  // with a warning. (The second-last, so that a forward glitch in the last kept row is repaired
+  // below instead.)
+  std::vector<double> later_max(rows + 1, -HUGE_VAL);  // max time over rows r.. (suffix)
+  for (size_t r = rows; r-- > 0;) later_max[r] = std::max(later_max[r + 1], values[r * needed + kTime]);
+  std::vector<size_t> keep;
+  keep.reserve(rows);
+  size_t dropped = 0;
+  int first_drop_line = 0;
+  for (size_t r = 0; r < rows; ++r) {
+    const double t = values[r * needed + kTime];
+    if (keep.empty() || t > values[keep.back() * needed + kTime]) {
+      keep.push_back(r);
+      continue;
+    }
+    if (keep.size() >= 2 && !(later_max[r] > values[keep[keep.size() - 2] * needed + kTime])) {
+      data.warnings.push_back("the time series ends at line " + std::to_string(row_line[r]) +
+                              " (time jumps back from " + FormatNumber(values[keep.back() * needed + kTime] / scale[kTime]) +
+                              " to " + FormatNumber(t / scale[kTime]) + " and never passes it again); " +
+                              std::to_string(rows - r) + " row(s) from there are ignored");
+      break;
+    }
+    if (dropped++ == 0) first_drop_line = row_line[r];
+    if (keep.size() >= 2 && t > values[keep[keep.size() - 2] * needed + kTime]) keep.back() = r;
+  }
+  if (dropped > 0) {
+    const double fraction = static_cast<double>(dropped) / static_cast<double>(rows);
+    const std::string what = std::to_string(dropped) + " of " + std::to_string(rows) +
+                             " samples had a timestamp that did not increase (first near line " +
+                             std::to_string(first_drop_line) + ")";
+    if (fraction > options.max_dropped_fraction) {
+      char limit[32];
+      std::snprintf(limit, sizeof(limit), "%g", 100.0 * options.max_dropped_fraction);
+      Fail(name + ": " + what + "; more than " + limit +
+           " % of the samples, so the file is rejected (clock reset, or several logs in one "
+           "file?)");
+    }
+    data.warnings.push_back("dropped " + what);
+  }
+  if (static_cast<int>(keep.size()) < options.min_rows) {
+    Fail(name + ": only " + std::to_string(keep.size()) + " usable data row(s); at least " +
+         std::to_string(options.min_rows) + " needed");
+  }
+
+  data.t_s.resize(keep.size());
+  data.gyro_in_imu.resize(keep.size());
+  if (with_accel) data.accel_in_imu.resize(keep.size());
+  for (size_t i = 0; i < keep.size(); ++i) {
+    const double* v = &values[keep[i] * needed];
+    data.t_s[i] = v[0];
+    data.gyro_in_imu[i] = Eigen::Vector3d(v[1], v[2], v[3]);
+    if (with_accel) data.accel_in_imu[i] = Eigen::Vector3d(v[4], v[5], v[6]);
+  }
+  return data;
+}
+
+namespace {
+
+// The log's text: the file (bounded_read.h: a regular file within the cap), decompressed when
+// it is a .csv.gz (within the decompressed cap).
+std::string ReadWholeFile(const std::string& path, const ImuLogOptions& options) {
+  std::string text, why;
+  if (!ReadRegularFile(path, LogCap(options.max_file_bytes), &text, &why)) Fail(why);
+  if (LooksGzipped(text)) {  // a .csv.gz log: inflate it in memory
+    std::string inflated;
+    if (!GzipDecompress(text, &inflated, &why,
+                        DecompressedLogCap(options.max_decompressed_bytes))) {
+      Fail(path + ": " + why);
+    }
+    return inflated;
+  }
+  return text;
+}
+
+}  // namespace
+
+bool ImuLogOptions::Check(std::string* why) const {
+  if (!(max_dropped_fraction >= 0.0 && max_dropped_fraction <= 1.0)) {
+    *why = "max_dropped_fraction must be in [0, 1]";
+    return false;
+  }
+  if (min_rows < 1) {
+    *why = "min_rows must be at least 1";
+    return false;
+  }
+  if (max_file_bytes < 1 || max_decompressed_bytes < 1) {
+    *why = "max_file_bytes and max_decompressed_bytes must be at least 1";
+    return false;
+  }
+  return true;
+}
+
+ImuData ReadImuLogFromString(const std::string& text, const std::string& name,
+                             const ImuFormat& format, const ImuLogOptions& options) {
+  if (UseUlogReader(text, format)) return ReadUlogImu(text, name, format, options);
+  return Parse(text, name, format, options);
+}
+
+ImuData ReadImuLog(const std::string& path, const ImuFormat& format,
+                   const ImuLogOptions& options) {
+  std::string text = ReadWholeFile(path, options);
+  if (UseUlogReader(text, format)) return ReadUlogImu(text, path, format, options);
+  // A .ulg without the ULog magic is read as CSV (a CSV named .ulg still works); when that fails
+  // too, say so rather than "missing column 't'", which points at the wrong problem.
+  if (NamedLikeUlog(path)) {
+    try {
+      return Parse(text, path, format, options, &text);
+    } catch (const UserError& e) {
+      Fail(path + ": not a valid ULog file (a .ulg starts with the bytes \"ULog\" 01 12 35; " +
+           "this one starts with " + DescribeStart(text) + ") and not a CSV log either (" +
+           e.what() + ")");
+    }
+  }
+  return Parse(text, path, format, options, &text);
+}
+
+bool TryReadImuLog(const std::string& path, const ImuFormat& format, const ImuLogOptions& options,
+                   ImuData* data, std::string* error) {
+  try {
+    *data = ReadImuLog(path, format, options);
+    return true;
+  } catch (const UserError& e) {
+    *error = e.what();
+  } catch (const std::bad_alloc&) {
+    *error = path + ": out of memory while reading the log";
+  }
+  return false;
+}
+
+}  // namespace bifilar

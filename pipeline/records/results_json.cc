@@ -1,0 +1,617 @@
+#include "pipeline/records/results_json.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "base/user_error.h"
+#include "pipeline/records/total_uncertainty.h"
+
+#ifndef BIFILAR_VERSION
+#define BIFILAR_VERSION "unknown"
+#endif
+
+namespace bifilar {
+namespace {
+
+using nlohmann::json;
+
+json Number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+
+json Pair(const std::array<double, 2>& v) {
+  if (!std::isfinite(v[0]) || !std::isfinite(v[1])) return json(nullptr);
+  return json::array({v[0], v[1]});
+}
+
+double GetNumber(const json& j, const char* key) {
+  auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return NAN;
+  if (!it->is_number()) throw UserError(std::string("trace record: '") + key + "' is not a number");
+  return it->get<double>();
+}
+
+std::array<double, 2> GetPair(const json& j, const char* key) {
+  auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return {NAN, NAN};
+  if (!it->is_array() || it->size() != 2) {
+    throw UserError(std::string("trace record: '") + key + "' is not a pair");
+  }
+  return {(*it)[0].is_number() ? (*it)[0].get<double>() : NAN,
+          (*it)[1].is_number() ? (*it)[1].get<double>() : NAN};
+}
+
+std::string GetString(const json& j, const char* key) {
+  auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return "";
+  if (!it->is_string()) throw UserError(std::string("trace record: '") + key + "' is not text");
+  return it->get<std::string>();
+}
+
+std::vector<std::string> GetStrings(const json& j, const char* key) {
+  std::vector<std::string> out;
+  auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return out;
+  if (!it->is_array()) throw UserError(std::string("trace record: '") + key + "' is not a list");
+  for (const auto& v : *it) {
+    if (!v.is_string()) throw UserError(std::string("trace record: '") + key + "' holds non-text");
+    out.push_back(v.get<std::string>());
+  }
+  return out;
+}
+
+json SweepToJson(const AmplitudeSweep& s) {
+  json bands = json::array();
+  for (const AmplitudeSweepBand& b : s.bands) {
+    bands.push_back({{"window_s", json::array({b.t0_s, b.t1_s})},
+                     {"samples", b.num_samples},
+                     {"cycles", Number(b.cycles)},
+                     {"amplitude_deg", json::array({Number(b.amplitude_start_deg),
+                                                    Number(b.amplitude_end_deg)})},
+                     {"amplitude_mean_deg", Number(b.amplitude_mean_deg)},
+                     {"inertia_kg_m2", b.ok ? Number(b.inertia_kg_m2) : json(nullptr)},
+                     {"inertia_std_kg_m2", b.ok ? Number(b.inertia_std_kg_m2) : json(nullptr)},
+                     {"ok", b.ok}});
+  }
+  json j = {{"evaluated", s.evaluated}, {"note", s.note}, {"bands", bands}, {"low_band", s.low_band}};
+  if (s.evaluated) {
+    j["trend_exponent"] = Number(s.trend_exponent);
+    j["trend_coeff_per_deg_p"] = Number(s.trend_coeff);
+    j["trend_coeff_std_per_deg_p"] = Number(s.trend_coeff_std);
+    j["trend_z"] = Number(s.trend_z);
+    j["trend_chi2"] = Number(s.trend_chi2);
+    j["trend_dof"] = s.trend_dof;
+    j["trend_scale"] = Number(s.trend_scale);
+    j["std_scale"] = Number(s.std_scale);
+    j["trend_percent_per_10deg"] = Number(s.trend_percent_per_10deg);
+    j["inertia_zero_amplitude_kg_m2"] = Number(s.inertia_zero_amplitude_kg_m2);
+    j["trend_detected"] = s.trend_detected;
+  }
+  return j;
+}
+
+double NumberOr0(const json& j, const char* key) {
+  const double v = GetNumber(j, key);
+  return std::isfinite(v) ? v : 0.0;
+}
+
+AmplitudeSweep SweepFromJson(const json& j) {
+  AmplitudeSweep s;
+  s.evaluated = j.value("evaluated", false);
+  s.note = GetString(j, "note");
+  if (auto it = j.find("bands"); it != j.end() && it->is_array()) {
+    for (const json& b : *it) {
+      if (!b.is_object()) throw UserError("trace record: a sweep band is not an object");
+      AmplitudeSweepBand band;
+      const std::array<double, 2> w = GetPair(b, "window_s");
+      const std::array<double, 2> a = GetPair(b, "amplitude_deg");
+      band.t0_s = w[0];
+      band.t1_s = w[1];
+      band.num_samples = b.value("samples", 0);
+      band.cycles = NumberOr0(b, "cycles");
+      band.amplitude_start_deg = a[0];
+      band.amplitude_end_deg = a[1];
+      band.amplitude_mean_deg = NumberOr0(b, "amplitude_mean_deg");
+      band.inertia_kg_m2 = NumberOr0(b, "inertia_kg_m2");
+      band.inertia_std_kg_m2 = NumberOr0(b, "inertia_std_kg_m2");
+      band.ok = b.value("ok", false);
+      s.bands.push_back(band);
+    }
+  }
+  if (auto it = j.find("low_band"); it != j.end() && it->is_number_integer() && *it >= 0 &&
+                                      *it < static_cast<int>(s.bands.size())) {
+    s.low_band = it->get<int>();
+  }
+  if (s.evaluated) {
+    // Records of earlier versions carry the A^2 line only (trend_coeff_per_deg2).
+    const bool power = j.contains("trend_exponent");
+    s.trend_exponent = power ? NumberOr0(j, "trend_exponent") : 2.0;
+    s.trend_coeff = NumberOr0(j, power ? "trend_coeff_per_deg_p" : "trend_coeff_per_deg2");
+    s.trend_coeff_std =
+        NumberOr0(j, power ? "trend_coeff_std_per_deg_p" : "trend_coeff_std_per_deg2");
+    s.trend_z = NumberOr0(j, "trend_z");
+    s.trend_chi2 = NumberOr0(j, "trend_chi2");
+    s.trend_dof = static_cast<int>(NumberOr0(j, "trend_dof"));
+    s.trend_scale = j.contains("trend_scale") ? NumberOr0(j, "trend_scale") : 1.0;
+    s.std_scale = j.contains("std_scale") ? NumberOr0(j, "std_scale") : 1.0;
+    s.trend_percent_per_10deg = NumberOr0(j, "trend_percent_per_10deg");
+    s.inertia_zero_amplitude_kg_m2 = NumberOr0(j, "inertia_zero_amplitude_kg_m2");
+    s.trend_detected = j.value("trend_detected", false);
+  }
+  return s;
+}
+
+// CSV cell: numbers with full precision, NaN empty; text quoted when needed.
+std::string Cell(double value) {
+  if (!std::isfinite(value)) return "";
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.10g", value);
+  return buffer;
+}
+// A text that a CSV reader would take for a non-finite number ("nan", "-Inf": a log named so).
+bool ReadsAsNonFinite(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), ::tolower);
+  if (!text.empty() && (text[0] == '-' || text[0] == '+')) text.erase(text.begin());
+  return text == "nan" || text == "inf" || text == "infinity";
+}
+std::string Cell(const std::string& text) {
+  // Text stays text: quoted when it holds a separator or would read as NaN/inf.
+  if (text.find_first_of(",\"\n") == std::string::npos && !ReadsAsNonFinite(text)) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c == '\n' ? ' ' : c;
+  }
+  return quoted + "\"";
+}
+
+std::string Join(const std::vector<std::string>& parts, const char* separator) {
+  std::string out;
+  for (size_t i = 0; i < parts.size(); ++i) out += (i ? separator : "") + parts[i];
+  return out;
+}
+
+// The headline total as a percentage of the headline I: the aircraft's after a tare, else the
+// whole suspended I's.
+double TotalPercent(const TraceRecord& r) {
+  if (std::isfinite(r.inertia_std_total_kg_m2) && r.inertia_kg_m2 > 0.0)
+    return 100.0 * r.inertia_std_total_kg_m2 / r.inertia_kg_m2;
+  if (r.inertia_total_kg_m2 > 0.0) return 100.0 * r.inertia_total_std_total_kg_m2 / r.inertia_total_kg_m2;
+  return NAN;
+}
+
+// The terms of I_total's total in one cell: "statistical:2.1e-09 model_inadequacy:0 ...", the
+// assumed one marked "(assumed)"; "" without a fit.
+std::string TermsCell(const TraceRecord& r) {
+  if (!std::isfinite(r.inertia_total_kg_m2)) return "";
+  std::string out;
+  char buffer[96];
+  for (const UncertaintyTerm& t : ComposeTotalUncertainty(r).terms) {
+    std::snprintf(buffer, sizeof(buffer), "%s%s:%.3g%s", out.empty() ? "" : " ", t.name.c_str(),
+                  t.std_kg_m2, t.assumed ? "(assumed)" : "");
+    out += buffer;
+  }
+  return out;
+}
+
+// The total uncertainty of I_total into the record's "uncertainty" object: every named term
+// (pipeline/records/total_uncertainty.h), the stat, common-mode and total stds, and what was
+// assumed.
+void AddTotalUncertainty(const TraceRecord& r, json* u) {
+  const TotalUncertainty total = ComposeTotalUncertainty(r);
+  const bool fitted = std::isfinite(r.inertia_total_kg_m2);
+  json terms = json::array();
+  for (const UncertaintyTerm& t : total.terms) {
+    json term = {{"name", t.name},
+                 {"std_kg_m2", fitted ? Number(t.std_kg_m2) : json(nullptr)},
+                 {"kind", t.common_mode ? "common_mode" : "per_log"}};
+    if (t.assumed) term["assumed"] = true;
+    terms.push_back(term);
+  }
+  (*u)["terms"] = terms;
+  (*u)["stat_kg_m2"] = fitted ? Number(total.stat_std_kg_m2) : json(nullptr);
+  (*u)["common_mode_kg_m2"] = fitted ? Number(total.common_mode_std_kg_m2) : json(nullptr);
+  (*u)["total_kg_m2"] = Number(r.inertia_total_std_total_kg_m2);
+  (*u)["total_percent"] =
+      fitted && r.inertia_total_kg_m2 > 0.0
+          ? Number(100.0 * r.inertia_total_std_total_kg_m2 / r.inertia_total_kg_m2)
+          : json(nullptr);
+  (*u)["configured_inputs_assumed"] = r.budget_assumed;
+  (*u)["assumed_inputs"] = r.budget_assumed
+                               ? json({{"filar_length_std_m", kAssumedLengthStdM},
+                                       {"filar_separation_std_m", kAssumedLengthStdM}})
+                               : json(nullptr);
+  (*u)["calibrated"] = r.calibrated;
+  (*u)["calibration_relative_std"] = r.calibration_relative_std;
+}
+
+}  // namespace
+
+std::string SweepSummary(const AmplitudeSweep& sweep) {
+  // "A_deg:I+-std" per band, amplitude decreasing, separated by spaces.
+  std::string out;
+  char buf[96];
+  for (const AmplitudeSweepBand& b : sweep.bands) {
+    if (!b.ok) continue;
+    std::snprintf(buf, sizeof(buf), "%s%.1f:%.5g+-%.2g", out.empty() ? "" : " ",
+                  b.amplitude_mean_deg, b.inertia_kg_m2, b.inertia_std_kg_m2);
+    out += buf;
+  }
+  return out;
+}
+
+const char* ProgramVersion() { return BIFILAR_VERSION; }
+
+json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
+  json j;
+  j["file"] = r.file;
+  j["status"] = ToString(r.status);
+  j["message"] = r.message;
+  j["inertia_total_kg_m2"] = Number(r.inertia_total_kg_m2);
+  j["inertia_total_std_kg_m2"] = Number(r.inertia_total_std_kg_m2);
+  j["drag_coeff_kg_m2"] = Number(r.drag_coeff_kg_m2);
+  j["viscous_coeff_kg_m2_per_s"] = Number(r.viscous_coeff_kg_m2_per_s);
+  j["window_s"] = Pair(r.window_s);
+  j["amplitude_deg"] = Pair(r.amplitude_deg);
+  j["amplitude_band_deg"] = Pair(r.amplitude_band_deg);
+  j["period_s"] = Number(r.period_s);
+  j["frequency_hz"] = Number(r.frequency_hz);
+  j["small_angle_inertia_total_kg_m2"] = Number(r.small_angle_inertia_total_kg_m2);
+  j["bias_rad_per_s"] = Number(r.bias_rad_per_s);
+  j["residual_rms_rad_per_s"] = Number(r.residual_rms_rad_per_s);
+  j["noise_rms_rad_per_s"] = Number(r.noise_rms_rad_per_s);
+  j["pitch_measured_deg"] = r.pitch_measured_deg ? Number(*r.pitch_measured_deg) : json(nullptr);
+  j["roll_measured_deg"] = r.roll_measured_deg ? Number(*r.roll_measured_deg) : json(nullptr);
+  j["model"] = r.model;
+  j["iterations"] = r.iterations;
+  j["fit_seconds"] = r.fit_seconds;
+  json budget = json::object();
+  for (const BudgetTerm& term : r.budget) budget[term.name + "_kg_m2"] = Number(term.std_kg_m2);
+  budget["total_kg_m2"] = Number(r.budget_total_std_kg_m2);
+  j["budget"] = budget;
+  j["flags"] = r.flags;
+  j["warnings"] = r.warnings;
+  j["figure"] = r.figure;
+  j["figures"] = r.figures;
+  j["sweep_figure"] = r.sweep_figure;
+  j["swing_axis_in_imu"] = std::isfinite(r.swing_axis_in_imu[0])
+                               ? json::array({r.swing_axis_in_imu[0], r.swing_axis_in_imu[1],
+                                              r.swing_axis_in_imu[2]})
+                               : json(nullptr);
+  j["secondary_motion_ratio"] = Number(r.secondary_motion_ratio);
+  j["rms_over_noise"] = Number(r.rms_over_noise);
+  j["residual_autocorrelation"] = {{"lag1", Number(r.residual_autocorr_lag1)},
+                                   {"ar1_phi", Number(r.residual_ar1_phi)},
+                                   {"prewhitened_max", Number(r.prewhitened_autocorr_max)}};
+  j["inertia_window_kg_m2"] = Number(r.inertia_window_kg_m2);
+  j["inertia_source"] = r.inertia_source;
+  j["uncertainty"] = {{"statistical_kg_m2", Number(r.inertia_stat_std_kg_m2)},
+                      {"iid_kg_m2", Number(r.inertia_iid_std_kg_m2)},
+                      {"hac_bandwidth", r.hac_bandwidth},
+                      {"model_inadequacy_kg_m2", Number(r.model_inadequacy_std_kg_m2)}};
+  if (std::isfinite(r.repeat_scatter_std_kg_m2))
+    j["uncertainty"]["repeat_scatter_kg_m2"] = r.repeat_scatter_std_kg_m2;
+  if (std::isfinite(r.amplitude_correction_kg_m2)) {
+    j["amplitude_correction"] = {{"correction_kg_m2", Number(r.amplitude_correction_kg_m2)},
+                                 {"std_kg_m2", Number(r.amplitude_correction_std_kg_m2)},
+                                 {"from_amplitude_deg", Number(r.amplitude_correction_from_deg)},
+                                 {"to_amplitude_deg", 0.0}};
+  }
+  j["inertia_total_std_total_kg_m2"] = Number(r.inertia_total_std_total_kg_m2);
+  AddTotalUncertainty(r, &j["uncertainty"]);
+  j["amplitude_sweep"] = SweepToJson(r.sweep);
+  if (campaign_fields) {
+    j["role"] = ToString(r.role);
+    j["content_hash"] = r.content_hash;
+    j["cache_key"] = r.cache_key;
+    j["from_cache"] = r.from_cache;
+    j["pitch_nominal_deg"] = r.pitch_nominal_deg ? Number(*r.pitch_nominal_deg) : json(nullptr);
+    j["pitch_used_deg"] = Number(r.pitch_used_deg);
+    j["roll_nominal_deg"] = r.roll_nominal_deg ? Number(*r.roll_nominal_deg) : json(nullptr);
+    j["roll_used_deg"] = Number(r.roll_used_deg);
+    j["rig_inertia_kg_m2"] = Number(r.rig_inertia_kg_m2);
+    j["inertia_kg_m2"] = Number(r.inertia_kg_m2);
+    j["inertia_std_kg_m2"] = Number(r.inertia_std_kg_m2);
+    j["inertia_std_total_kg_m2"] = Number(r.inertia_std_total_kg_m2);
+    j["aircraft_scale_std_kg_m2"] = Number(r.aircraft_scale_std_kg_m2);
+  }
+  return j;
+}
+
+TraceRecord TraceRecordFromJson(const json& j) {
+  if (!j.is_object()) throw UserError("trace record: not a JSON object");
+  TraceRecord r;
+  r.file = GetString(j, "file");
+  if (!ParseTraceStatus(GetString(j, "status"), &r.status)) {
+    throw UserError("trace record: bad 'status'");
+  }
+  r.message = GetString(j, "message");
+  r.inertia_total_kg_m2 = GetNumber(j, "inertia_total_kg_m2");
+  r.inertia_total_std_kg_m2 = GetNumber(j, "inertia_total_std_kg_m2");
+  r.drag_coeff_kg_m2 = GetNumber(j, "drag_coeff_kg_m2");
+  r.viscous_coeff_kg_m2_per_s = GetNumber(j, "viscous_coeff_kg_m2_per_s");
+  r.window_s = GetPair(j, "window_s");
+  r.amplitude_deg = GetPair(j, "amplitude_deg");
+  r.amplitude_band_deg = GetPair(j, "amplitude_band_deg");
+  r.bias_rad_per_s = GetNumber(j, "bias_rad_per_s");
+  r.residual_rms_rad_per_s = GetNumber(j, "residual_rms_rad_per_s");
+  r.noise_rms_rad_per_s = GetNumber(j, "noise_rms_rad_per_s");
+  const double pitch = GetNumber(j, "pitch_measured_deg");
+  if (std::isfinite(pitch)) r.pitch_measured_deg = pitch;
+  const double roll = GetNumber(j, "roll_measured_deg");
+  if (std::isfinite(roll)) r.roll_measured_deg = roll;
+  r.model = GetString(j, "model");
+  r.iterations = j.value("iterations", 0);
+  r.fit_seconds = GetNumber(j, "fit_seconds");
+  if (auto it = j.find("budget"); it != j.end() && it->is_object()) {
+    for (auto& [key, value] : it->items()) {
+      const std::string suffix = "_kg_m2";
+      std::string name = key.size() > suffix.size() ? key.substr(0, key.size() - suffix.size()) : key;
+      const double v = value.is_number() ? value.get<double>() : NAN;
+      if (name == "total") {
+        r.budget_total_std_kg_m2 = v;
+      } else {
+        r.budget.push_back({name, v});
+      }
+    }
+  }
+  if (auto it = j.find("flags"); it != j.end() && it->is_array()) {
+    for (const auto& flag : *it) r.flags.push_back(flag.get<std::string>());
+  }
+  r.figure = GetString(j, "figure");
+  r.warnings = GetStrings(j, "warnings");
+  r.figures = GetStrings(j, "figures");
+  r.sweep_figure = GetString(j, "sweep_figure");
+  if (auto it = j.find("swing_axis_in_imu"); it != j.end() && it->is_array() && it->size() == 3) {
+    for (int k = 0; k < 3; ++k)
+      r.swing_axis_in_imu[k] = (*it)[k].is_number() ? (*it)[k].get<double>() : NAN;
+  }
+  r.secondary_motion_ratio = GetNumber(j, "secondary_motion_ratio");
+  r.rms_over_noise = GetNumber(j, "rms_over_noise");
+  if (auto it = j.find("residual_autocorrelation"); it != j.end() && it->is_object()) {
+    r.residual_autocorr_lag1 = GetNumber(*it, "lag1");
+    r.residual_ar1_phi = GetNumber(*it, "ar1_phi");
+    r.prewhitened_autocorr_max = GetNumber(*it, "prewhitened_max");
+  }
+  r.inertia_window_kg_m2 = GetNumber(j, "inertia_window_kg_m2");
+  r.period_s = GetNumber(j, "period_s");
+  r.frequency_hz = GetNumber(j, "frequency_hz");
+  r.small_angle_inertia_total_kg_m2 = GetNumber(j, "small_angle_inertia_total_kg_m2");
+  r.inertia_source = GetString(j, "inertia_source");
+  if (auto it = j.find("uncertainty"); it != j.end() && it->is_object()) {
+    r.inertia_stat_std_kg_m2 = GetNumber(*it, "statistical_kg_m2");
+    r.inertia_iid_std_kg_m2 = GetNumber(*it, "iid_kg_m2");
+    r.hac_bandwidth = it->value("hac_bandwidth", 0);
+    r.model_inadequacy_std_kg_m2 = GetNumber(*it, "model_inadequacy_kg_m2");
+    if (it->contains("repeat_scatter_kg_m2"))
+      r.repeat_scatter_std_kg_m2 = GetNumber(*it, "repeat_scatter_kg_m2");
+    r.budget_assumed = it->value("configured_inputs_assumed", false);
+    r.calibrated = it->value("calibrated", false);
+    r.calibration_relative_std = NumberOr0(*it, "calibration_relative_std");
+  }
+  if (auto it = j.find("amplitude_correction"); it != j.end() && it->is_object()) {
+    r.amplitude_correction_kg_m2 = GetNumber(*it, "correction_kg_m2");
+    r.amplitude_correction_std_kg_m2 = GetNumber(*it, "std_kg_m2");
+    r.amplitude_correction_from_deg = GetNumber(*it, "from_amplitude_deg");
+  }
+  if (auto it = j.find("amplitude_sweep"); it != j.end() && it->is_object()) r.sweep = SweepFromJson(*it);
+  if (j.contains("role") && !ParseTraceRole(GetString(j, "role"), &r.role)) {
+    throw UserError("trace record: bad 'role'");
+  }
+  r.content_hash = GetString(j, "content_hash");
+  r.cache_key = GetString(j, "cache_key");
+  r.from_cache = j.value("from_cache", false);
+  const double nominal = GetNumber(j, "pitch_nominal_deg");
+  if (std::isfinite(nominal)) r.pitch_nominal_deg = nominal;
+  r.pitch_used_deg = GetNumber(j, "pitch_used_deg");
+  const double roll_nominal = GetNumber(j, "roll_nominal_deg");
+  if (std::isfinite(roll_nominal)) r.roll_nominal_deg = roll_nominal;
+  r.roll_used_deg = GetNumber(j, "roll_used_deg");
+  r.rig_inertia_kg_m2 = GetNumber(j, "rig_inertia_kg_m2");
+  r.inertia_kg_m2 = GetNumber(j, "inertia_kg_m2");
+  r.inertia_std_kg_m2 = GetNumber(j, "inertia_std_kg_m2");
+  r.inertia_std_total_kg_m2 = GetNumber(j, "inertia_std_total_kg_m2");
+  r.aircraft_scale_std_kg_m2 = GetNumber(j, "aircraft_scale_std_kg_m2");
+  // composed from the fields just read (pipeline/records/total_uncertainty.h)
+  UpdateTotalUncertainty(&r);
+  return r;
+}
+
+json CalibrationToJson(const RigCalibrationResult& c) {
+  return {{"applied", c.applied},
+          {"factor", Number(c.factor)},
+          {"factor_std", Number(c.factor_std)},
+          {"factor_relative_std", Number(c.factor_rel_std)},
+          {"relative_std_parts", {{"reference_inertia", Number(c.rel_std_reference)},
+                                  {"reference_swings", Number(c.rel_std_swings)},
+                                  {"rig_inertia", Number(c.rel_std_rig)}}},
+          {"nominal", {{"filar_length_m", Number(c.filar_length_m)},
+                       {"filar_separation_m", Number(c.nominal_separation_m)},
+                       {"d2_over_l_m", Number(c.nominal_d2_over_l_m)}}},
+          {"effective", {{"filar_length_m", Number(c.filar_length_m)},
+                         {"filar_separation_m", Number(c.effective_separation_m)},
+                         {"d2_over_l_m", Number(c.effective_d2_over_l_m)}}},
+          {"reference", {{"inertia_kg_m2", Number(c.reference_inertia_kg_m2)},
+                         {"inertia_std_kg_m2", Number(c.reference_inertia_std_kg_m2)},
+                         {"mass_kg", Number(c.reference_mass_kg)}}},
+          {"swings", {{"n", c.n_swings},
+                      {"logs", c.logs},
+                      {"total_mean_kg_m2", Number(c.swings_total_kg_m2)},
+                      {"total_standard_error_kg_m2", Number(c.swings_total_std_kg_m2)},
+                      {"scatter_kg_m2", Number(c.swings_scatter_kg_m2)}}},
+          {"rig_inertia", {{"source", c.rig_inertia_source},
+                           {"inertia_kg_m2", Number(c.rig_inertia_kg_m2)},
+                           {"inertia_std_kg_m2", Number(c.rig_inertia_std_kg_m2)}}},
+          {"iterations", c.iterations},
+          {"warnings", c.warnings}};
+}
+
+json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
+  json j;
+  j["program"] = "bifilar";
+  j["version"] = ProgramVersion();
+  // Relative to the working folder when below it (results do not carry the machine's layout).
+  std::error_code ec;
+  const std::string relative =
+      std::filesystem::path(config.file).lexically_relative(std::filesystem::current_path(ec)).string();
+  j["config_file"] = !relative.empty() && relative.rfind("..", 0) != 0 ? relative : config.file;
+  j["config"] = config.text;
+  j["units"] = ToString(config.units);
+  j["pitch_source"] = ToString(config.runs.pitch_source);
+  // The fit settings in effect: the config's, with the command line's overrides (--integrator),
+  // which the config text above does not show.
+  const GlitchConfig& glitch = config.fit.glitch;
+  j["fit_settings"] = {
+      {"model", ToString(config.fit.model)},
+      {"integrator", ToString(config.fit.integrator)},
+      {"amplitude_sweep", config.fit.sweep.enabled},
+      {"glitch", {{"enabled", glitch.enabled},
+                  {"threshold_sigmas", glitch.threshold_sigmas},
+                  {"range_factor", glitch.range_factor},
+                  {"excursion_fraction", glitch.excursion_fraction},
+                  {"max_fraction", glitch.max_fraction}}}};
+  json summary;
+  const CampaignSummary& s = result.summary;
+  summary["n_traces"] = s.n_traces;
+  summary["n_ok"] = s.n_ok;
+  summary["n_rejected"] = s.n_rejected;
+  summary["n_error"] = s.n_error;
+  summary["n_fitted"] = s.n_fitted;
+  summary["n_reused"] = s.n_reused;
+  summary["wall_s"] = s.wall_s;
+  summary["ellipse_fitted"] = s.ellipse_fitted;
+  summary["ellipse_message"] = s.ellipse_message;
+  summary["tensor_fitted"] = s.tensor_fitted;
+  summary["tensor_message"] = s.tensor_message;
+  summary["exit_code"] = s.exit_code;
+  j["summary"] = summary;
+  json rig;
+  rig["filar_length_m"] = config.filar_length_m;
+  rig["filar_separation_m"] = config.filar_separation_m;
+  rig["mass_kg"] = config.rig_mass_kg;
+  rig["aircraft_mass_kg"] = config.aircraft_mass_kg;
+  rig["gravity_mps2"] = config.gravity_mps2;
+  rig["inertia_source"] = !config.rig_inertia_given ? "none"
+                          : config.rig_inertia.kind == RigInertiaSpec::Kind::kValue   ? "value"
+                          : config.rig_inertia.kind == RigInertiaSpec::Kind::kTable ? "table"
+                                                                                    : "tare";
+  rig["inertia_kg_m2"] = Number(result.rig_inertia_kg_m2);
+  rig["inertia_std_kg_m2"] = Number(result.rig_inertia_std_kg_m2);
+  rig["tare_n"] = result.rig_tare_n;
+  j["rig"] = rig;
+  json table1;
+  table1["raw_sigma_kg_m2"] = Number(result.raw_sigma_kg_m2);
+  table1["cv_percent"] = Number(result.cv_percent);
+  table1["regression_rmse_kg_m2"] = Number(result.regression_rmse_kg_m2);
+  j["table1"] = table1;
+  j["systematic_relative_std"] = Number(result.systematic_relative_std);
+  // rig.calibration: the effective geometry of every fit; its relative std is the `calibration`
+  // term of each trace's budget (and so inside systematic_relative_std). null without one.
+  j["calibration"] = result.calibration ? CalibrationToJson(*result.calibration) : json(nullptr);
+  // Table 2's total (pipeline/records/total_uncertainty.h): each moment's std and the common-mode
+  // scale fraction in quadrature; tau has no scale term.
+  json total = {{"common_mode_relative_std", Number(result.common_mode_relative_std)},
+                {"configured_inputs_assumed", result.common_mode_assumed},
+                {"note", result.assumed_inputs_note}};
+  if (result.ellipse_fit) {
+    const EllipseResult& e = *result.ellipse_fit;
+    const double rel = result.common_mode_relative_std;
+    auto moment = [&](const EllipseEstimate& est) {
+      return est.defined ? Number(WithCommonModeScale(est.value, est.std, rel)) : json(nullptr);
+    };
+    total["Ix_kg_m2"] = moment(e.ix);
+    total["Iz_kg_m2"] = moment(e.iz);
+    total["Ixz_kg_m2"] = moment(e.ixz);
+    total["Ixp_kg_m2"] = moment(e.ixp);
+    total["Izp_kg_m2"] = moment(e.izp);
+    total["tau_deg"] = e.tau_deg.defined ? Number(e.tau_deg.std) : json(nullptr);
+  }
+  j["total_uncertainty"] = total;
+  json traces = json::array();
+  for (const TraceRecord& r : result.traces) traces.push_back(TraceRecordToJson(r));
+  j["traces"] = traces;
+  json angles = json::array();
+  for (const AngleStats& a : result.angles) {
+    angles.push_back({{"pitch_deg", Number(a.pitch_deg)},
+                      {"n", a.n},
+                      {"inertia_mean_kg_m2", Number(a.inertia_mean_kg_m2)},
+                      {"inertia_std_kg_m2", Number(a.inertia_std_kg_m2)},
+                      {"inertia_sem_kg_m2", Number(a.inertia_sem_kg_m2)},
+                      {"cv_percent", Number(a.cv_percent)},
+                      {"fit_std_mean_kg_m2", Number(a.fit_std_mean_kg_m2)},
+                      {"common_mode_std_kg_m2", Number(a.common_mode_std_kg_m2)},
+                      {"inertia_std_total_kg_m2", Number(a.inertia_std_total_kg_m2)},
+                      {"roll_deg", Number(a.roll_deg)}});
+  }
+  j["angles"] = angles;
+  j["ellipse"] = result.ellipse;
+  j["tensor"] = result.tensor;
+  j["figures"] = {{"moments", result.moments_figure}, {"polar", result.polar_figure},
+                  {"tensor", result.tensor_figure}};
+  return j;
+}
+
+std::string TracesCsv(const CampaignResult& result) {
+  std::ostringstream out;
+  out << "file,role,status,pitch_nominal_deg,pitch_measured_deg,pitch_used_deg,"
+         "inertia_total_kg_m2,inertia_total_std_kg_m2,period_s,frequency_hz,"
+         "small_angle_inertia_total_kg_m2,rig_inertia_kg_m2,inertia_kg_m2,inertia_std_kg_m2,"
+         "inertia_total_std_total_kg_m2,inertia_std_total_kg_m2,"
+         "std_total_percent,uncertainty_terms,budget_assumed,"
+         "budget_total_std_kg_m2,drag_coeff_kg_m2,viscous_coeff_kg_m2_per_s,"
+         "window_t0_s,window_t1_s,amplitude_start_deg,amplitude_end_deg,bias_rad_per_s,"
+         "residual_rms_rad_per_s,model,iterations,fit_seconds,from_cache,inertia_source,"
+         "inertia_window_kg_m2,model_inadequacy_std_kg_m2,secondary_motion_ratio,rms_over_noise,"
+         "residual_ar1_phi,sweep_bands,sweep_trend_percent_per_10deg,sweep_trend_z,"
+         "sweep_trend_detected,sweep_inertia_by_amplitude,warnings,message,roll_nominal_deg,"
+         "roll_measured_deg,roll_used_deg\n";
+  for (const TraceRecord& r : result.traces) {
+    out << Cell(r.file) << ',' << ToString(r.role) << ',' << ToString(r.status) << ','
+        << Cell(r.pitch_nominal_deg ? *r.pitch_nominal_deg : NAN) << ','
+        << Cell(r.pitch_measured_deg ? *r.pitch_measured_deg : NAN) << ','
+        << Cell(r.pitch_used_deg) << ',' << Cell(r.inertia_total_kg_m2) << ','
+        << Cell(r.inertia_total_std_kg_m2) << ',' << Cell(r.period_s) << ','
+        << Cell(r.frequency_hz) << ',' << Cell(r.small_angle_inertia_total_kg_m2) << ','
+        << Cell(r.rig_inertia_kg_m2) << ','
+        << Cell(r.inertia_kg_m2) << ',' << Cell(r.inertia_std_kg_m2) << ','
+        << Cell(r.inertia_total_std_total_kg_m2) << ',' << Cell(r.inertia_std_total_kg_m2) << ','
+        << Cell(TotalPercent(r)) << ',' << Cell(TermsCell(r)) << ','
+        << (r.budget_assumed ? "true" : "false") << ',' << Cell(r.budget_total_std_kg_m2) << ',' << Cell(r.drag_coeff_kg_m2) << ','
+        << Cell(r.viscous_coeff_kg_m2_per_s) << ',' << Cell(r.window_s[0]) << ','
+        << Cell(r.window_s[1]) << ',' << Cell(r.amplitude_deg[0]) << ','
+        << Cell(r.amplitude_deg[1]) << ',' << Cell(r.bias_rad_per_s) << ','
+        << Cell(r.residual_rms_rad_per_s) << ',' << Cell(r.model) << ',' << r.iterations << ','
+        << Cell(r.fit_seconds) << ',' << (r.from_cache ? "true" : "false") << ','
+        << Cell(r.inertia_source) << ',' << Cell(r.inertia_window_kg_m2) << ','
+        << Cell(r.model_inadequacy_std_kg_m2) << ',' << Cell(r.secondary_motion_ratio) << ','
+        << Cell(r.rms_over_noise) << ',' << Cell(r.residual_ar1_phi) << ','
+        << r.sweep.bands.size() << ','
+        << (r.sweep.evaluated ? Cell(r.sweep.trend_percent_per_10deg) : "") << ','
+        << (r.sweep.evaluated ? Cell(r.sweep.trend_z) : "") << ','
+        << (r.sweep.evaluated ? (r.sweep.trend_detected ? "true" : "false") : "") << ','
+        << Cell(SweepSummary(r.sweep)) << ',' << Cell(Join(r.warnings, " | ")) << ','
+        << Cell(r.message) << ',' << Cell(r.roll_nominal_deg ? *r.roll_nominal_deg : NAN) << ','
+        << Cell(r.roll_measured_deg ? *r.roll_measured_deg : NAN) << ',' << Cell(r.roll_used_deg)
+        << '\n';
+  }
+  return out.str();
+}
+
+std::string AnglesCsv(const CampaignResult& result) {
+  std::ostringstream out;
+  out << "pitch_deg,n,inertia_mean_kg_m2,inertia_std_kg_m2,inertia_sem_kg_m2,cv_percent,"
+         "fit_std_mean_kg_m2,common_mode_std_kg_m2,inertia_std_total_kg_m2,roll_deg\n";
+  for (const AngleStats& a : result.angles) {
+    out << Cell(a.pitch_deg) << ',' << a.n << ',' << Cell(a.inertia_mean_kg_m2) << ','
+        << Cell(a.inertia_std_kg_m2) << ',' << Cell(a.inertia_sem_kg_m2) << ','
+        << Cell(a.cv_percent) << ',' << Cell(a.fit_std_mean_kg_m2) << ','
+        << Cell(a.common_mode_std_kg_m2) << ',' << Cell(a.inertia_std_total_kg_m2) << ','
+        << Cell(a.roll_deg) << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace bifilar

@@ -1,0 +1,466 @@
+#include "pipeline/report/export.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "base/atomic_file.h"
+#include "base/bounded_read.h"
+#include "base/json_error.h"
+#include "base/user_error.h"
+
+namespace bifilar {
+namespace {
+
+using nlohmann::json;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+enum { kIxx = 0, kIyy, kIzz, kIxy, kIxz, kIyz };
+
+// Numbers in the files: 10 significant digits (a bifilar std is >= 1e-5 of the moment), the C
+// locale's '.', no "-0".
+std::string Num(double v) {
+  if (v == 0.0) v = 0.0;
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+// A number, or "" when it is not known (CSV).
+std::string CsvNum(double v) { return std::isfinite(v) ? Num(v) : std::string(); }
+
+// Text for an XML comment: "--" is not allowed inside one (nor a final "-"): "--set" becomes
+// "- -set".
+std::string CommentSafe(std::string s) {
+  for (size_t at = s.find("--"); at != std::string::npos; at = s.find("--", at)) {
+    s.insert(at + 1, " ");
+  }
+  if (!s.empty() && s.back() == '-') s += ' ';
+  return s;
+}
+
+// A CSV field: quoted when it holds a comma, quote or line break.
+std::string CsvField(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+// A number or null at j[key]; anything else is an error naming the key.
+double NumberOrNull(const json& j, const std::string& key, const std::string& where,
+                    const std::string& name) {
+  if (!j.contains(key) || j[key].is_null()) return kNaN;
+  if (!j[key].is_number()) {
+    throw UserError(name + ": " + where + "." + key + " is not a number (" +
+                    std::string(j[key].type_name()) + ")");
+  }
+  const double v = j[key].get<double>();
+  if (!std::isfinite(v)) throw UserError(name + ": " + where + "." + key + " is not finite");
+  return v;
+}
+
+// The elements written for URDF/SDF in `frame` (ixx iyy izz ixy ixz iyz).
+std::array<double, 6> UrdfElements(const ExportInertia& in, ExportFrame frame) {
+  const auto& v = in.value_kg_m2;
+  // FLU = a half turn about x: I_xy and I_xz change sign, I_yz does not; the element is minus
+  // the product.
+  if (frame == ExportFrame::kFlu) return {v[kIxx], v[kIyy], v[kIzz], v[kIxy], v[kIxz], -v[kIyz]};
+  return {v[kIxx], v[kIyy], v[kIzz], -v[kIxy], -v[kIxz], -v[kIyz]};
+}
+
+// Missing components or mass: an error naming them and how to supply them.
+void RequireComplete(const ExportInertia& in, const char* format) {
+  const std::vector<std::string> missing = in.Missing();
+  if (!missing.empty()) {
+    std::string names;
+    for (const std::string& m : missing) names += (names.empty() ? "" : ", ") + m;
+    const bool planar = in.section == "ellipse" ||
+                        (missing.size() == 3 && missing[0] == "Iyy" && missing[1] == "Ixy");
+    throw UserError(
+        in.results_name + ": " + format + " needs all six components, and " + names +
+        (missing.size() == 1 ? " is" : " are") + " not in this result" +
+        (planar ? " (a pitch-only campaign measures Ixx, Izz and Ixz)" : "") + "; give " +
+        (missing.size() == 1 ? "it" : "them") +
+        " with --set NAME=VALUE (kg m^2, body axes, products positive)" +
+        (std::find(missing.begin(), missing.end(), "Ixy") != missing.end() ||
+                 std::find(missing.begin(), missing.end(), "Iyz") != missing.end()
+             ? ", or --symmetric for Ixy = Iyz = 0 (an aircraft symmetric about its x-z plane)"
+             : "") +
+        ", or export --format csv, which leaves them empty");
+  }
+  if (!std::isfinite(in.mass_kg)) {
+    throw UserError(in.results_name + ": " + format +
+                    " needs the mass, and the config stored in this result has no "
+                    "aircraft.mass_kg; give it with --mass-kg");
+  }
+}
+
+// The comment every XML file starts with: source, frame and sign, what is not measured.
+std::string XmlHeader(const ExportInertia& in, const std::string& frame_text,
+                      const std::string& sign_text, const char* cg_text) {
+  std::string s = "bifilar export of " + in.results_name + " (section '" + in.section + "').\n";
+  s += "     Frame: " + frame_text + "\n     Signs: " + sign_text + "\n";
+  s += "     Inertia about the CG in body axes (x forward, y right, z down; products positive, "
+       "I_xy = integral x y dm), kg m^2, value +- std:\n";
+  for (int k = 0; k < 6; ++k) {
+    s += "       " + std::string(ExportComponentName(k)) + " ";
+    if (in.source[k] == "measured") {
+      s += Num(in.value_kg_m2[k]) + " +- " +
+           (std::isfinite(in.std_kg_m2[k]) ? Num(in.std_kg_m2[k]) : std::string("unknown")) + "\n";
+    } else {
+      s += Num(in.value_kg_m2[k]) + " (not measured: " +
+           (in.source[k] == "set" ? "given by the user"
+                                  : "assumed 0, aircraft symmetric about x-z") +
+           ")\n";
+    }
+  }
+  s += "     NOT MEASURED by the bifilar: the mass (" + Num(in.mass_kg) + " kg, from " +
+       (in.mass_source == "--mass-kg" ? std::string("the command line") : in.mass_source) +
+       ") and the CG: " + cg_text + " Move it to the measured CG; the inertia is about the CG.";
+  return "<!-- " + CommentSafe(s) + " -->\n";
+}
+
+}  // namespace
+
+const char* ExportComponentName(int component) {
+  static const char* const kNames[6] = {"Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"};
+  return component >= 0 && component < 6 ? kNames[component] : "?";
+}
+
+bool ParseExportFormat(const std::string& name, ExportFormat* format) {
+  if (name == "urdf") {
+    *format = ExportFormat::kUrdf;
+  } else if (name == "sdf") {
+    *format = ExportFormat::kSdf;
+  } else if (name == "jsbsim") {
+    *format = ExportFormat::kJsbsim;
+  } else if (name == "csv") {
+    *format = ExportFormat::kCsv;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+const char* ExportFormatName(ExportFormat format) {
+  switch (format) {
+    case ExportFormat::kUrdf:
+      return "urdf";
+    case ExportFormat::kSdf:
+      return "sdf";
+    case ExportFormat::kJsbsim:
+      return "jsbsim";
+    case ExportFormat::kCsv:
+      return "csv";
+  }
+  return "?";
+}
+
+bool ParseExportFrame(const std::string& name, ExportFrame* frame) {
+  if (name == "flu") {
+    *frame = ExportFrame::kFlu;
+  } else if (name == "frd") {
+    *frame = ExportFrame::kFrd;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+bool ExportOptions::Check(std::string* why) const {
+  const auto fail = [why](const std::string& m) {
+    if (why != nullptr) *why = m;
+    return false;
+  };
+  if (results_path.empty()) return fail("no results.json given");
+  if (frame_given && format != ExportFormat::kUrdf && format != ExportFormat::kSdf) {
+    return fail(std::string("--frame applies to urdf and sdf only (") + ExportFormatName(format) +
+                " has a fixed frame)");
+  }
+  if (!std::isnan(mass_kg) && !(std::isfinite(mass_kg) && mass_kg > 0)) {
+    return fail("--mass-kg must be a positive number");
+  }
+  for (const auto& [name, value] : set_kg_m2) {
+    int k = 0;
+    while (k < 6 && name != ExportComponentName(k)) ++k;
+    if (k == 6) {
+      return fail("--set " + name + ": unknown component (Ixx, Iyy, Izz, Ixy, Ixz or Iyz)");
+    }
+    if (!std::isfinite(value) || (k < 3 && !(value > 0))) {
+      return fail("--set " + name + ": the value must be a finite number" +
+                  (k < 3 ? ", > 0 for a moment" : ""));
+    }
+  }
+  return true;
+}
+
+std::vector<std::string> ExportInertia::Missing() const {
+  std::vector<std::string> m;
+  for (int k = 0; k < 6; ++k) {
+    if (source[k] == "missing") m.push_back(ExportComponentName(k));
+  }
+  return m;
+}
+
+ExportInertia ReadExportInertia(const std::string& text, const std::string& name,
+                                const ExportOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) throw UserError("export: " + why);
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const std::exception& e) {
+    throw UserError(name + ": not valid JSON (" + DescribeJsonError(e) +
+                    "); export reads the results.json written by `bifilar process`");
+  }
+  if (!j.is_object() || !j.contains("program") || j["program"] != "bifilar") {
+    throw UserError(name +
+                    ": not a results.json written by bifilar (no \"program\": "
+                    "\"bifilar\"); export reads the results.json of `bifilar process`");
+  }
+  ExportInertia in;
+  in.results_name = name;
+  in.value_kg_m2.fill(kNaN);
+  in.std_kg_m2.fill(kNaN);
+  in.source.fill("missing");
+  // The tensor section (issue 17) when it holds a number, else the ellipse's I_x, I_z, I_xz.
+  bool found = false;
+  if (j.contains("tensor") && j["tensor"].is_object()) {
+    const json& t = j["tensor"];
+    for (int k = 0; k < 6; ++k) {
+      const std::string key = std::string(ExportComponentName(k)) + "_kg_m2";
+      in.value_kg_m2[k] = NumberOrNull(t, key, "tensor", name);
+      if (std::isnan(in.value_kg_m2[k])) continue;
+      in.std_kg_m2[k] = NumberOrNull(t, key + "_std", "tensor", name);
+      in.source[k] = "measured";
+      found = true;
+    }
+    if (found) in.section = "tensor";
+  }
+  if (!found && j.contains("ellipse") && j["ellipse"].is_object()) {
+    const json& e = j["ellipse"];
+    const std::pair<int, const char*> keys[] = {
+        {kIxx, "Ix_kg_m2"}, {kIzz, "Iz_kg_m2"}, {kIxz, "Ixz_kg_m2"}};
+    for (const auto& [k, key] : keys) {
+      in.value_kg_m2[k] = NumberOrNull(e, key, "ellipse", name);
+      if (std::isnan(in.value_kg_m2[k])) continue;
+      in.std_kg_m2[k] = NumberOrNull(e, std::string(key) + "_std", "ellipse", name);
+      in.source[k] = "measured";
+      found = true;
+    }
+    if (found) in.section = "ellipse";
+  }
+  if (!found) {
+    throw UserError(name +
+                    ": holds no inertia to export (no 'tensor' or 'ellipse' section with "
+                    "a number; did the campaign's fit fail? see its summary)");
+  }
+  // Fill what the result does not hold.
+  for (const auto& [component, value] : options.set_kg_m2) {
+    int k = 0;
+    while (ExportComponentName(k) != component) ++k;
+    if (in.source[k] == "measured") {
+      throw UserError("export: --set " + component + ": " + name + " measured " + component + " (" +
+                      Num(in.value_kg_m2[k]) +
+                      " kg m^2); --set only fills components the result does not hold");
+    }
+    in.value_kg_m2[k] = value;
+    in.source[k] = "set";
+  }
+  if (options.symmetric) {
+    for (int k : {kIxy, kIyz}) {
+      if (in.source[k] != "missing") continue;
+      in.value_kg_m2[k] = 0.0;
+      in.std_kg_m2[k] = kNaN;
+      in.source[k] = "symmetric";
+    }
+  }
+  // Mass: the option, else the config stored in results.json.
+  if (!std::isnan(options.mass_kg)) {
+    in.mass_kg = options.mass_kg;
+    in.mass_source = "--mass-kg";
+  } else if (j.contains("config") && j["config"].is_string()) {
+    try {
+      const YAML::Node config = YAML::Load(j["config"].get<std::string>());
+      const YAML::Node aircraft = config.IsMap() ? config["aircraft"] : YAML::Node();
+      if (aircraft.IsMap() && aircraft["mass_kg"].IsScalar()) {
+        in.mass_kg = aircraft["mass_kg"].as<double>();
+        in.mass_source = "config aircraft.mass_kg";
+        if (aircraft["mass_std_kg"].IsScalar()) {
+          in.mass_std_kg = aircraft["mass_std_kg"].as<double>();
+        }
+      }
+    } catch (const YAML::Exception& e) {
+      in.warnings.push_back(name + ": the stored config could not be read for the mass (" +
+                            e.what() + ")");
+    }
+    if (!(std::isfinite(in.mass_kg) && in.mass_kg > 0)) {
+      in.mass_kg = kNaN;
+      in.mass_source.clear();
+    }
+  }
+  // A tensor a simulator accepts: positive definite, and the triangle inequality of a rigid
+  // body (the largest principal moment at most the sum of the other two).
+  if (in.Missing().empty()) {
+    const auto& v = in.value_kg_m2;
+    Eigen::Matrix3d t;
+    t << v[kIxx], -v[kIxy], -v[kIxz], -v[kIxy], v[kIyy], -v[kIyz], -v[kIxz], -v[kIyz], v[kIzz];
+    const Eigen::Vector3d p = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(t).eigenvalues();
+    if (!(p[0] > 0)) {
+      in.warnings.push_back(name + ": the tensor is not positive definite (principal moments " +
+                            Num(p[0]) + ", " + Num(p[1]) + ", " + Num(p[2]) +
+                            " kg m^2): no rigid body has it, and simulators reject it");
+    } else if (p[2] > p[0] + p[1]) {
+      in.warnings.push_back(name + ": the principal moments " + Num(p[0]) + ", " + Num(p[1]) +
+                            ", " + Num(p[2]) +
+                            " kg m^2 break the triangle inequality (largest > "
+                            "sum of the others): no rigid body has them; check the products");
+    }
+  }
+  return in;
+}
+
+std::string FormatUrdfInertial(const ExportInertia& in, ExportFrame frame) {
+  RequireComplete(in, "URDF");
+  const std::array<double, 6> e = UrdfElements(in, frame);
+  std::string s =
+      XmlHeader(in,
+                frame == ExportFrame::kFlu
+                    ? "the link frame as ROS REP 103 takes it, x forward, y left, z up (FLU)"
+                    : "the body axes as measured, x forward, y right, z down (FRD)",
+                frame == ExportFrame::kFlu
+                    ? "URDF elements of the inertia matrix: ixy = +I_xy, ixz = +I_xz, iyz = -I_yz"
+                    : "URDF elements of the inertia matrix: ixy = -I_xy, ixz = -I_xz, iyz = -I_yz",
+                "the <origin> is the link origin, 0 0 0.");
+  s += "<inertial>\n";
+  s += "  <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n";
+  s += "  <mass value=\"" + Num(in.mass_kg) + "\"/>\n";
+  s += "  <inertia ixx=\"" + Num(e[0]) + "\" ixy=\"" + Num(e[3]) + "\" ixz=\"" + Num(e[4]) +
+       "\" iyy=\"" + Num(e[1]) + "\" iyz=\"" + Num(e[5]) + "\" izz=\"" + Num(e[2]) + "\"/>\n";
+  s += "</inertial>\n";
+  return s;
+}
+
+std::string FormatSdfInertial(const ExportInertia& in, ExportFrame frame) {
+  RequireComplete(in, "SDF");
+  const std::array<double, 6> e = UrdfElements(in, frame);
+  std::string s = XmlHeader(
+      in,
+      frame == ExportFrame::kFlu
+          ? "the link frame as Gazebo takes it, x forward, y left, z up (FLU)"
+          : "the body axes as measured, x forward, y right, z down (FRD)",
+      frame == ExportFrame::kFlu
+          ? "SDFormat products are -m x y (not +m x y): ixy = +I_xy, ixz = +I_xz, iyz = -I_yz"
+          : "SDFormat products are -m x y (not +m x y): ixy = -I_xy, ixz = -I_xz, iyz = -I_yz",
+      "the <pose> is the link origin, 0 0 0.");
+  s += "<inertial>\n";
+  s += "  <pose>0 0 0 0 0 0</pose>\n";
+  s += "  <mass>" + Num(in.mass_kg) + "</mass>\n";
+  s += "  <inertia>\n";
+  s += "    <ixx>" + Num(e[0]) + "</ixx>\n";
+  s += "    <ixy>" + Num(e[3]) + "</ixy>\n";
+  s += "    <ixz>" + Num(e[4]) + "</ixz>\n";
+  s += "    <iyy>" + Num(e[1]) + "</iyy>\n";
+  s += "    <iyz>" + Num(e[5]) + "</iyz>\n";
+  s += "    <izz>" + Num(e[2]) + "</izz>\n";
+  s += "  </inertia>\n";
+  s += "</inertial>\n";
+  return s;
+}
+
+std::string FormatJsbsimMassBalance(const ExportInertia& in) {
+  RequireComplete(in, "JSBSim");
+  const auto& v = in.value_kg_m2;
+  std::string s =
+      XmlHeader(in, "JSBSim's structural frame, x aft, y right, z up",
+                "negated_crossproduct_inertia=\"true\": <ixy> etc. are the matrix elements, "
+                "-integral x y dm in the structural frame: ixy = +I_xy, ixz = -I_xz, iyz = +I_yz",
+                "the <location name=\"CG\"> is 0 0 0 of the structural frame.");
+  const auto element = [](const char* tag, double value) {
+    return std::string("  <") + tag + " unit=\"KG*M2\"> " + Num(value) + " </" + tag + ">\n";
+  };
+  s += "<mass_balance negated_crossproduct_inertia=\"true\">\n";
+  s += element("ixx", v[kIxx]);
+  s += element("iyy", v[kIyy]);
+  s += element("izz", v[kIzz]);
+  s += element("ixy", v[kIxy]);
+  s += element("ixz", -v[kIxz]);
+  s += element("iyz", v[kIyz]);
+  s += "  <emptywt unit=\"KG\"> " + Num(in.mass_kg) + " </emptywt>\n";
+  s += "  <location name=\"CG\" unit=\"M\">\n";
+  s += "    <x> 0 </x>\n    <y> 0 </y>\n    <z> 0 </z>\n";
+  s += "  </location>\n";
+  s += "</mass_balance>\n";
+  return s;
+}
+
+std::string FormatInertiaCsv(const ExportInertia& in) {
+  std::string header = "results_file,section,frame,mass_kg,mass_std_kg,mass_source";
+  std::string row = CsvField(in.results_name) + "," + in.section +
+                    ",body FRD (x forward y right z down) products +integral x y dm," +
+                    CsvNum(in.mass_kg) + "," + CsvNum(in.mass_std_kg) + "," +
+                    CsvField(in.mass_source.empty() ? "missing" : in.mass_source);
+  for (int k = 0; k < 6; ++k) {
+    const std::string n = ExportComponentName(k);
+    header += "," + n + "_kg_m2," + n + "_std_kg_m2," + n + "_source";
+    row += "," + CsvNum(in.value_kg_m2[k]) + "," + CsvNum(in.std_kg_m2[k]) + "," + in.source[k];
+  }
+  return header + "\n" + row + "\n";
+}
+
+int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err) {
+  std::string why;
+  if (!options.Check(&why)) throw UserError("export: " + why);
+  std::string path = options.results_path;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {  // the output folder of `bifilar process`
+    path = (std::filesystem::path(path) / "results.json").string();
+  }
+  std::string text;
+  if (!ReadRegularFile(path, OutputFileCap(), &text, &why)) throw UserError(why);
+  const ExportInertia in = ReadExportInertia(text, path, options);
+  std::string body;
+  switch (options.format) {
+    case ExportFormat::kUrdf:
+      body = FormatUrdfInertial(in, options.frame);
+      break;
+    case ExportFormat::kSdf:
+      body = FormatSdfInertial(in, options.frame);
+      break;
+    case ExportFormat::kJsbsim:
+      body = FormatJsbsimMassBalance(in);
+      break;
+    case ExportFormat::kCsv:
+      body = FormatInertiaCsv(in);
+      break;
+  }
+  for (const std::string& w : in.warnings) err << "bifilar: warning: " << w << "\n";
+  const std::vector<std::string> missing = in.Missing();
+  if (!missing.empty()) {  // CSV only: the XML formats refused above
+    std::string names;
+    for (const std::string& m : missing) names += (names.empty() ? "" : ", ") + m;
+    err << "bifilar: warning: " << path << ": " << names
+        << " not in this result; left empty in the CSV\n";
+  }
+  err << "bifilar: note: the bifilar measures neither the mass nor the CG: "
+      << (std::isfinite(in.mass_kg)
+              ? "the mass written (" + Num(in.mass_kg) + " kg) is from " + in.mass_source + ", and "
+              : std::string())
+      << "the inertia is about the CG, which the "
+      << (options.format == ExportFormat::kCsv ? "CSV does not locate" : "file puts at its origin")
+      << "\n";
+  if (options.out_path.empty()) {
+    out << body;
+  } else {
+    WriteFileAtomically(options.out_path, body);
+    err << "wrote " << options.out_path << " (" << ExportFormatName(options.format) << ")\n";
+  }
+  return 0;
+}
+
+}  // namespace bifilar

@@ -1,0 +1,115 @@
+// Repeats of one set-up: several swings of the same body about the same axis on the same rig.
+//
+// A single log's std is built from that log alone (HAC covariance, the amplitude sweep). What one
+// log cannot see is what changes from release to release: the release amplitude on a rig that
+// departs from the ideal model, a slow wander of the period, re-hanging. Repeats see it. Their
+// scatter beyond their own stds is measured by Cochran's Q and the between-repeat variance
+// tau^2 of DerSimonian and Laird (random-effects meta-analysis), and tau is added in quadrature
+// to every repeat's std, so that each log's std covers what a repeat of it would give. The
+// combined value is the random-effects mean, weights 1 / (sigma_i^2 + tau^2).
+//
+// Before that, the release amplitude is taken out: on a rig that departs from the ideal model, I
+// grows with the amplitude, and repeats released at different amplitudes scatter for that
+// reason. One relative coefficient c of I_0 (1 + c A^2), pooled over every set-up of the run
+// (each with its own I_0), moves each log's I from the amplitude of its result to zero amplitude,
+// with the std of c propagated (common to all logs of a set-up: it enters each log's std and the
+// set-up mean's std, not the scatter between repeats). The scatter is reported before and after.
+//
+// `bifilar fit --repeats` groups the logs whose paths differ only in the last number of the
+// file name (`BaseModel_Ixx_Log-1.csv` ... `-4.csv`; `pitch_10/trial_1.csv` ... `trial_5.csv`).
+// docs/method.md, "Repeats".
+#ifndef BIFILAR_PIPELINE_REPEATS_H_
+#define BIFILAR_PIPELINE_REPEATS_H_
+
+#include <string>
+#include <vector>
+
+#include "pipeline/trace/trace_process.h"
+
+namespace bifilar {
+
+struct RepeatGroup {
+  std::string name;          // the common path, the repeat number replaced by '*'
+  std::vector<int> members;  // indices into the records given to CombineRepeats
+  int n_used = 0;            // members with a usable I and std (status ok)
+  double mean_kg_m2 = NAN;   // random-effects mean
+  double mean_std_kg_m2 = NAN;
+  double plain_mean_kg_m2 = NAN;  // unweighted mean of the used members
+  // Cochran's Q about the fixed-effect mean, n_used - 1 dof, on the per-log stds with the part
+  // of the amplitude correction's std that differs between the repeats,
+  // I_i (A_i^2 - mean A^2) std(c); the part common to the set-up does not scatter them.
+  double q = NAN;
+  double tau_kg_m2 = NAN;    // between-repeat std beyond those stds (0: none)
+  // Largest |I_i - mean_kg_m2| / std_i over the used members, std_i those stds with tau added.
+  double max_abs_z = NAN;
+  // Across the repeats, I against the mean squared amplitude of each log's fit (weighted line):
+  // the slope in % per 10 deg at the repeats' amplitudes and its z. A rig that departs from the
+  // ideal model shows here even when each log is too short to show it.
+  double amplitude_trend_percent_per_10deg = NAN;
+  double amplitude_trend_z = NAN;
+  // The scatter of the used members before and after the amplitude correction: sample standard
+  // deviation of I over their plain mean (%), and Cochran's Q; the largest |I_i - plain mean| /
+  // std_i before (per-log std alone). q, tau, max_abs_z above are after the
+  // correction (the same as before when none was applied).
+  double spread_before_percent = NAN;
+  double spread_after_percent = NAN;
+  double q_before = NAN;
+  double max_abs_z_before = NAN;
+  // The correction's std for the set-up mean (common to its members), included in mean_std_kg_m2.
+  double correction_std_kg_m2 = NAN;
+  // Total uncertainty of the mean (pipeline/records/total_uncertainty.h): mean_std_kg_m2 and the
+  // members' common-mode terms (budget, calibration; their mean fraction of I times the mean) in
+  // quadrature: what the `--repeats` line and JSON give as the set-up's total.
+  double common_mode_std_kg_m2 = NAN;
+  double total_std_kg_m2 = NAN;
+  std::string note;          // why nothing was combined (fewer than 2 usable members)
+};
+
+// Groups `paths` by the path with its last number in the file name removed; a path without a
+// number is a group of its own.
+// True for the warning CombineRepeats puts on each member of a group whose repeats scatter
+// beyond their stds (the same text on every member: `fit --repeats` prints it once).
+bool IsRepeatScatterWarning(const std::string& warning);
+
+std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths);
+
+// The amplitude correction pooled over the groups (fit/amplitude_trend.h,
+// FitPooledAmplitudeTrend on each usable log's I, std and result amplitude: the lowest band's
+// when the result comes from it, else the RMS of the fitted start and end amplitudes).
+struct RepeatsAmplitudeCorrection {
+  bool applied = false;
+  double coeff_per_deg2 = NAN;      // c of I_0 (1 + c A^2), relative
+  double coeff_std_per_deg2 = NAN;  // with the between-log scatter in the weights
+  double z = NAN;
+  double birge = NAN;               // scatter about the pooled fit over the stds, sqrt(chi^2/dof)
+  double scatter_percent = NAN;     // between-log relative std in the pooled fit's weights (%)
+  int dof = 0;
+  int n_logs = 0, n_groups = 0;     // used by the pooled fit
+  int n_corrected = 0;              // logs moved to zero amplitude
+  // Logs whose result is the lowest band of their own sweep's trend (inertia_source
+  // "low_amplitude_band"): points of the fit, but not corrected (their model-inadequacy std
+  // already covers the change to zero amplitude).
+  int n_low_band_kept = 0;
+  double amplitude_min_deg = NAN, amplitude_max_deg = NAN;
+  std::string note;                 // why it was not applied (the fields above may be set)
+};
+
+// Combines each group's usable members (status ok, finite I, std > 0). First the amplitude
+// correction: c pooled over the groups with >= 2 usable members; every usable record whose result
+// is not already a low-amplitude band gets amplitude_correction_* set, the correction subtracted
+// from inertia_total_kg_m2. Then per group:
+// the statistics, and for every used member repeat_scatter_std_kg_m2 = tau, tau and the
+// correction's std added in quadrature to inertia_total_std_kg_m2 (and its total updated) and,
+// when tau > 0, a warning.
+RepeatsAmplitudeCorrection CombineRepeats(std::vector<RepeatGroup>* groups,
+                                          std::vector<TraceRecord>* records);
+
+// One line per group for the console.
+std::string RepeatGroupLine(const RepeatGroup& group);
+
+// One line for the console: the pooled coefficient, or why no correction was applied.
+std::string AmplitudeCorrectionLine(const RepeatsAmplitudeCorrection& correction);
+
+}  // namespace bifilar
+
+#endif  // BIFILAR_PIPELINE_REPEATS_H_

@@ -1,0 +1,655 @@
+#include "pipeline/trace/trace_process.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <new>
+
+#include "base/user_error.h"
+#include "fit/block_mean.h"
+#include "fit/glitch.h"
+#include "fit/swing_axis.h"
+#include "fit/trace_fit.h"
+#include "fit/window.h"
+#include "pendulum/model.h"
+#include "pipeline/config/plausibility.h"
+#include "pipeline/figures/figure.h"
+#include "pipeline/figures/sweep_plot.h"
+#include "pipeline/figures/trace_plot.h"
+#include "pipeline/logs/imu_log.h"
+#include "pipeline/records/total_uncertainty.h"
+#include <plplot.h>
+
+
+namespace bifilar {
+
+const char* ToString(TraceStatus status) {
+  switch (status) {
+    case TraceStatus::kOk: return "ok";
+    case TraceStatus::kRejected: return "rejected";
+    case TraceStatus::kError: return "error";
+  }
+  return "error";
+}
+
+bool ParseTraceStatus(const std::string& name, TraceStatus* status) {
+  if (name == "ok") *status = TraceStatus::kOk;
+  else if (name == "rejected") *status = TraceStatus::kRejected;
+  else if (name == "error") *status = TraceStatus::kError;
+  else return false;
+  return true;
+}
+
+const char* ToString(TraceRole role) {
+  switch (role) {
+    case TraceRole::kAircraft: return "aircraft";
+    case TraceRole::kTare: return "tare";
+    case TraceRole::kCalibration: return "calibration";
+  }
+  return "aircraft";
+}
+
+bool ParseTraceRole(const std::string& name, TraceRole* role) {
+  if (name == "aircraft") *role = TraceRole::kAircraft;
+  else if (name == "tare") *role = TraceRole::kTare;
+  else if (name == "calibration") *role = TraceRole::kCalibration;
+  else return false;
+  return true;
+}
+
+RigGeometry GeometryForRole(const CampaignConfig& config, TraceRole role) {
+  switch (role) {
+    case TraceRole::kTare: return config.TareGeometry();
+    case TraceRole::kCalibration: return config.CalibrationGeometry();
+    case TraceRole::kAircraft: break;
+  }
+  return config.AircraftGeometry();
+}
+
+std::optional<std::array<double, 2>> ConfigWindowFor(const CampaignConfig& config,
+                                                     const std::string& path) {
+  const std::string target = std::filesystem::path(path).lexically_normal().string();
+  for (const auto& [key, window] : config.fit.windows_s) {
+    if ((!config.runs.root.empty() && ResolvePath(config.runs.root, key) == target) ||
+        ResolvePath(config.folder, key) == target) {
+      return window;
+    }
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+// The log's own path at the start of a reader message becomes the display name.
+std::string Renamed(const std::string& message, const std::string& path, const std::string& name) {
+  if (message.rfind(path, 0) == 0) return name + message.substr(path.size());
+  if (message.find(name) != std::string::npos) return message;
+  return name + ": " + message;
+}
+
+// Min/max envelope of v over `buckets` equal index ranges, as a zigzag polyline (2 points per
+// bucket, in time order): what a line of every sample looks like at thumbnail size, for a fraction
+// of the drawing cost.
+void Envelope(const std::vector<double>& t, const std::vector<double>& v, size_t buckets,
+              double scale, std::vector<PLFLT>* x, std::vector<PLFLT>* y) {
+  const size_t n = t.size();
+  x->clear();
+  y->clear();
+  if (n == 0) return;
+  if (n <= 2 * buckets) {
+    for (size_t i = 0; i < n; ++i) {
+      x->push_back(t[i] - t[0]);
+      y->push_back(scale * v[i]);
+    }
+    return;
+  }
+  for (size_t b = 0; b < buckets; ++b) {
+    const size_t lo = b * n / buckets, hi = (b + 1) * n / buckets;
+    size_t i_min = lo, i_max = lo;
+    for (size_t i = lo; i < hi; ++i) {
+      if (v[i] < v[i_min]) i_min = i;
+      if (v[i] > v[i_max]) i_max = i;
+    }
+    const size_t first = std::min(i_min, i_max), second = std::max(i_min, i_max);
+    x->push_back(t[first] - t[0]);
+    y->push_back(scale * v[first]);
+    x->push_back(t[second] - t[0]);
+    y->push_back(scale * v[second]);
+  }
+}
+
+// The report's fit-and-residual thumbnail: the fit (wide blue) and the measured rate (dark, on top),
+// the residual envelope with the +-noise band beneath. Lines only (pipeline/figures/trace_plot.h
+// draws a symbol per sample, ~0.1 s per trace; this is a few ms), so a campaign of 60 traces stays
+// fast.
+bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
+                            DisplayUnits units, const std::string& path, int width_px,
+                            int height_px, std::string* why) {
+  constexpr double kDeg = 180.0 / M_PI;
+  // Top: measured and fitted rate at ~250 points (the noise is invisible at this scale; it shows
+  // in the residual panel). Bottom: the residual's min/max envelope over 150 buckets.
+  std::vector<PLFLT> tm, ym, tf, yf, tr, yr;
+  const size_t stride = std::max<size_t>(1, fit.t_s.size() / 250);
+  for (size_t i = 0; i < fit.t_s.size(); i += stride) {
+    tm.push_back(fit.t_s[i] - fit.t_s[0]);
+    ym.push_back(kDeg * fit.measured_rate_rad_per_s[i]);
+    yf.push_back(kDeg * fit.fitted_rate_rad_per_s[i]);
+  }
+  tf = tm;
+  Envelope(fit.t_s, fit.residual_rad_per_s, 150, -kDeg, &tr, &yr);  // measured - fitted
+  if (tm.size() < 2) {
+    *why = "nothing to plot";
+    return false;
+  }
+  const double t_end = tm.back();
+  double y_max = 0.0, r_max = 0.0;
+  for (double v : ym) y_max = std::max(y_max, std::abs(v));
+  for (double v : yr) r_max = std::max(r_max, std::abs(v));
+  const double noise = kDeg * fit.noise_rad_per_s;
+  r_max = std::max(r_max, 2.5 * noise) * 1.1;
+  y_max = std::max(y_max, 1e-6) * 1.1;
+  char label[256];
+  // Short labels: the SVG embeds an outline of every distinct glyph (the file name is in the
+  // report's caption).
+  (void)title;
+  // In the config's units, as every table of the report (I total: rig included).
+  std::snprintf(label, sizeof(label), "I#dtotal#u = %.5f #(2233) %.1e %s (%s)",
+                InertiaToDisplay(fit.params.inertia_kg_m2, units),
+                InertiaToDisplay(fit.inertia_stat_std_kg_m2, units),
+                units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d", ToString(fit.model));
+  const std::string top_title = label;
+  std::snprintf(label, sizeof(label), "residual: rms = %.2f noise", fit.rms_over_noise);
+  const std::string bottom_title = label;
+  FigureOptions figure;
+  figure.width_px = width_px;
+  figure.height_px = height_px;
+  return WriteFigure(path, figure, [&] {
+    pladv(0);
+    plschr(0, 0.8);
+    plvpor(0.1, 0.97, 0.42, 0.9);
+    plwind(0, t_end, -y_max, y_max);
+    plcol0(1);
+    plbox("bct", 0, 0, "bcntv", 0, 0);
+    pllab("", "deg/s", top_title.c_str());
+    // The fit first (wide, light blue), the measured rate on top of it (thin, dark): where the
+    // two agree the measured line shows inside the fit's band (issue 18).
+    plscol0(9, 150, 185, 235);
+    plcol0(9);
+    plwidth(4.0);
+    plline(static_cast<PLINT>(tf.size()), tf.data(), yf.data());
+    plscol0(15, 0, 0, 0);
+    plcol0(15);
+    plwidth(1.0);
+    plline(static_cast<PLINT>(tm.size()), tm.data(), ym.data());
+    plscol0(15, 170, 170, 170);
+    plvpor(0.1, 0.97, 0.1, 0.32);
+    plwind(0, t_end, -r_max, r_max);
+    plcol0(1);
+    plbox("bcnt", 0, 0, "bcntv", 0, 0);
+    pllab("s", "deg/s", bottom_title.c_str());
+    plcol0(15);
+    plline(static_cast<PLINT>(tr.size()), tr.data(), yr.data());
+    plscol0(10, 200, 60, 40);
+    plcol0(10);
+    for (double level : {noise, -noise}) {
+      PLFLT xs[2] = {0, t_end}, ys[2] = {level, level};
+      plline(2, xs, ys);  // solid: PLplot draws a dashed line as one path per dash
+    }
+  }, why);
+}
+
+TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, const ImuData& data,
+                        const TraceProcessOptions& options, TraceRecord record,
+                        TraceFitResult* fit_out);
+
+// A user window checked against the log, said in the log's own terms (its span in seconds, and
+// the window read as ms or us when that would fit), before the swing axis or the window code look
+// inside it. A window that overlaps the log has its open or too-large end(s) clamped to the log,
+// with *note saying so; one that misses the log is an error naming the wrong end (returned).
+// Inside means up to half a mean sample step beyond the ends, as ApplyWindowOverride allows.
+std::string WindowOutsideLog(const ImuData& data, std::array<double, 2>* window_s, bool from_cli,
+                             TimeUnit time_unit, std::string* note) {
+  const std::vector<double>& t = data.t_s;
+  if (t.size() < 2) return "";
+  const double half_dt = 0.5 * (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+  auto inside = [&](double t0, double t1) {
+    return t0 >= t.front() - half_dt && t1 <= t.back() + half_dt;
+  };
+  const double t0 = (*window_s)[0], t1 = (*window_s)[1];
+  if (inside(t0, t1)) return "";
+  const char* key = from_cli ? "--window" : "fit.windows";
+  char buf[512];
+  // The window read as ms or us, when that lies inside the log: a unit mistake, never clamped.
+  std::string unit_hint;
+  for (const auto& [factor, unit] : {std::make_pair(1e-3, "ms"), std::make_pair(1e-6, "us")}) {
+    const double s0 = t0 * factor, s1 = t1 * factor;
+    if (inside(s0, s1)) {
+      std::snprintf(buf, sizeof(buf), "; if these are %s, give %g:%g", unit, s0, s1);
+      unit_hint = buf;
+      break;
+    }
+  }
+  if (unit_hint.empty() && t0 < t.back() && t1 > t.front()) {  // overlaps: clamp what is beyond
+    std::string clamped;
+    if (t0 < t.front() - half_dt) {
+      std::snprintf(buf, sizeof(buf), "start %g s is before the log's start %g s", t0, t.front());
+      clamped = buf;
+      (*window_s)[0] = t.front();
+    }
+    if (t1 > t.back() + half_dt) {
+      std::snprintf(buf, sizeof(buf), "%send %g s is after the log's end %g s",
+                    clamped.empty() ? "" : " and its ", t1, t.back());
+      clamped += buf;
+      (*window_s)[1] = t.back();
+    }
+    std::snprintf(buf, sizeof(buf), "%s %g-%g s: its %s; clamped to %g-%g s", key, t0, t1,
+                  clamped.c_str(), (*window_s)[0], (*window_s)[1]);
+    *note = buf;
+    return "";
+  }
+  std::snprintf(buf, sizeof(buf), "window %g-%g s is outside the log (%g-%g s); %s takes seconds",
+                t0, t1, t.front(), t.back(), key);
+  std::string message = buf;
+  if (time_unit != TimeUnit::kSeconds) {
+    message += std::string(" (the file's time column is in ") + ToString(time_unit) +
+               ", converted to seconds)";
+  }
+  // Which end is wrong: the start after the log's end, the end before its start, or both ends
+  // beyond the log (read in another unit).
+  if (t0 >= t.back()) {
+    std::snprintf(buf, sizeof(buf), "; its start %g s is after the log's end", t0);
+  } else if (t1 <= t.front()) {
+    std::snprintf(buf, sizeof(buf), "; its end %g s is before the log's start", t1);
+  } else {
+    std::snprintf(buf, sizeof(buf), "; %s", t0 < t.front() - half_dt && t1 > t.back() + half_dt
+                                                ? "both ends are beyond the log"
+                                                : t0 < t.front() - half_dt
+                                                    ? "its start is before the log's start"
+                                                    : "its end is after the log's end");
+  }
+  return message + buf + unit_hint;
+}
+
+TraceRecord Process(const CampaignConfig& config, const std::string& path,
+                    const TraceProcessOptions& options, TraceRecord record) {
+  const std::string& name = record.file;
+  auto fail = [&](TraceStatus status, const std::string& message) {
+    record.status = status;
+    record.message = Renamed(message, path, name);
+    return record;
+  };
+
+  // 1. Read.
+  ImuData data;
+  std::string why;
+  if (!TryReadImuLog(path, config.imu.format, config.limits.LogOptions(), &data, &why)) {
+    return fail(TraceStatus::kError, why);
+  }
+  return ProcessData(config, path, data, options, std::move(record), nullptr);
+}
+
+TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, const ImuData& raw,
+                        const TraceProcessOptions& options, TraceRecord record,
+                        TraceFitResult* fit_out) {
+  const std::string& name = record.file;
+  auto fail = [&](TraceStatus status, const std::string& message) {
+    record.status = status;
+    record.message = Renamed(message, path, name);
+    return record;
+  };
+  std::string why;
+  record.warnings = raw.warnings;
+
+  // 1b. Isolated glitch samples (fit/glitch.h, `fit.glitch`) are dropped before anything looks at
+  // the data.
+  const std::vector<size_t> glitches = FindGyroGlitches(raw, config.fit.glitch.Options());
+  ImuData cleaned;
+  if (!glitches.empty()) {
+    record.warnings.push_back(DescribeGlitches(raw, glitches));
+    cleaned = WithoutSamples(raw, glitches);
+  }
+  const ImuData& data = glitches.empty() ? raw : cleaned;
+
+  // 2. Swing axis (and the pitch, from the accelerometer at rest).
+  std::optional<std::array<double, 2>> override_s =
+      options.window_s ? options.window_s : ConfigWindowFor(config, path);
+  if (override_s) {
+    std::string clamped;
+    const std::string outside = WindowOutsideLog(data, &*override_s, options.window_s.has_value(),
+                                                 config.imu.format.time_unit, &clamped);
+    if (!outside.empty()) return fail(TraceStatus::kError, name + ": " + outside);
+    if (!clamped.empty()) record.warnings.push_back(clamped);
+  }
+  const SwingAxisOptions axis_options = SwingAxisOptionsFor(config.imu);
+  std::optional<std::pair<double, double>> axis_window;
+  if (override_s) axis_window = std::make_pair((*override_s)[0], (*override_s)[1]);
+  SwingAxis axis;
+  if (!EstimateSwingAxis(data, axis_options, axis_window, &axis, &why)) {
+    return fail(TraceStatus::kError, why);
+  }
+  for (const std::string& w : axis.warnings) record.warnings.push_back(w);
+
+  // 3. Free-oscillation window.
+  WindowOptions window_options;
+  window_options.min_periods = config.fit.quality.min_periods;
+  const FreeOscillationWindow window =
+      override_s ? ApplyWindowOverride(data.t_s, axis.rate_rad_per_s, (*override_s)[0],
+                                       (*override_s)[1], window_options, name)
+                 : FindFreeOscillationWindow(data.t_s, axis.rate_rad_per_s, window_options, name);
+  if (!window.IsUsable()) {
+    // Time in s declared ms (or the reverse) puts every period 1000 times outside the range.
+    const std::string hint =
+        !override_s && config.imu.format.container != LogContainer::kUlog &&
+                window.message.find("no oscillation found") != std::string::npos
+            ? TimeUnitHint(data.t_s, axis.rate_rad_per_s, window_options,
+                           config.imu.format.time_unit)
+            : "";
+    return fail(window.status == WindowStatus::kError ? TraceStatus::kError : TraceStatus::kRejected,
+                window.message + hint);
+  }
+  // No rest seen: the accelerometer averaged over the window still gives the pitch.
+  if (!axis.pitch_measured_deg && data.has_accel() && !axis.accel_ignored && !axis_window) {
+    SwingAxis again;
+    if (EstimateSwingAxis(data, axis_options, std::make_pair(window.t0_s, window.t1_s), &again,
+                          &why)) {
+      axis.pitch_measured_deg = again.pitch_measured_deg;
+      axis.roll_measured_deg = again.roll_measured_deg;
+    }
+  }
+  record.pitch_measured_deg = axis.pitch_measured_deg;
+  if (axis.pitch_measured_deg) record.roll_measured_deg = axis.roll_measured_deg;
+  for (int k = 0; k < 3; ++k) record.swing_axis_in_imu[k] = axis.axis_in_imu[k];
+  // The measured period and the small-angle inertia (the hand calculation `inspect` prints).
+  if (window.period_s > 0.0) {
+    record.period_s = window.period_s;
+    record.frequency_hz = 1.0 / window.period_s;
+    record.small_angle_inertia_total_kg_m2 =
+        InertiaFromSmallAnglePeriod(GeometryForRole(config, options.role), window.period_s);
+  }
+
+  // 4. Amplitude band.
+  AmplitudeBandOptions band_options;
+  band_options.max_amplitude_deg = config.fit.max_amplitude_deg.value_or(kDefaultMaxAmplitudeDeg);
+  band_options.min_amplitude_deg = config.fit.min_amplitude_deg.value_or(0.0);
+  band_options.min_periods = config.fit.quality.min_periods;
+  record.amplitude_band_deg = {band_options.min_amplitude_deg, band_options.max_amplitude_deg};
+  const AmplitudeBand band =
+      TrimToAmplitudeBand(data.t_s, axis.rate_rad_per_s, window, band_options, name);
+  record.window_s = {window.t0_s, window.t1_s};
+  // A swing beyond 180 deg (deg/s read as rad/s): a hint on a rejection, a warning on a fit.
+  double largest_deg = 0.0, smallest_deg = INFINITY;
+  for (const AngleExtreme& e : band.extremes) {
+    largest_deg = std::max(largest_deg, e.amplitude_deg);
+    smallest_deg = std::min(smallest_deg, e.amplitude_deg);
+  }
+  const std::string impossible =
+      ImpossibleAmplitude(largest_deg, smallest_deg, config.imu.format.gyro_unit);
+  if (!band.IsUsable()) {
+    return fail(band.status == WindowStatus::kError ? TraceStatus::kError : TraceStatus::kRejected,
+                band.message + (impossible.empty() ? "" : "; " + impossible));
+  }
+  if (!impossible.empty()) record.warnings.push_back(impossible);
+  record.window_s = {band.t0_s, band.t1_s};
+
+  // 5. Fit.
+  TraceFitInput input;
+  // The band's samples, or their block means when the log is dense (fit/block_mean.h).
+  FitSeries series = MakeFitSeries(data.t_s, axis.rate_rad_per_s, band.first_index,
+                                   band.last_index, window.period_s,
+                                   window.noise_from_rest ? window.noise_sigma_rad_per_s : 0.0,
+                                   window.rest_end_s);
+  input.t_s = std::move(series.t_s);
+  input.rate_rad_per_s = std::move(series.rate_rad_per_s);
+  input.noise_rad_per_s = series.noise_rad_per_s;
+  input.secondary_motion_ratio =
+      SecondaryMotionRatio(data, axis.axis_in_imu, band.t0_s, band.t1_s);
+  input.geometry = GeometryForRole(config, options.role);
+  input.label = name;
+  TraceFitOptions fit_options;
+  fit_options.model = config.fit.model;
+  fit_options.integrator = fit_options.integrator.WithMethod(config.fit.integrator);
+  const QualityThresholds& q = config.fit.quality;
+  fit_options.max_rms_over_noise = q.max_rms_over_noise;
+  fit_options.max_residual_autocorr = q.max_residual_autocorr;
+  fit_options.whiteness_lags = q.whiteness_lags;
+  fit_options.max_secondary_motion_ratio = q.max_secondary_motion_ratio;
+  fit_options.reject_secondary_motion_ratio = q.reject_secondary_motion_ratio;
+  fit_options.reject_residual_fraction = q.reject_residual_fraction;
+  fit_options.amplitude_sweep = config.fit.sweep.enabled;
+  fit_options.sweep_min_cycles_per_band = config.fit.sweep.min_cycles_per_band;
+  fit_options.sweep_max_bands = config.fit.sweep.max_bands;
+  fit_options.sweep_trend_z = config.fit.sweep.trend_z;
+  fit_options.min_periods = q.min_periods;
+  fit_options.max_amplitude_deg = band_options.max_amplitude_deg;
+  fit_options.min_amplitude_deg = std::min(fit_options.min_amplitude_deg, band_options.min_amplitude_deg);
+  // A calibrated geometry absorbs L, D and g (docs/physics.md §2.6): their terms are replaced by
+  // the calibration's own (added below). Without rig.uncertainties the budget counts the assumed
+  // +-1 mm on L and D (pipeline/records/total_uncertainty.h), unless the rig is calibrated.
+  const bool calibrated = config.geometry_calibration.applied;
+  const RigUncertainties uncertainties = config.uncertainties.InEffect();
+  fit_options.filar_length_std_m = calibrated ? 0.0 : uncertainties.filar_length_std_m;
+  fit_options.filar_separation_std_m = calibrated ? 0.0 : uncertainties.filar_separation_std_m;
+  fit_options.mass_std_kg = options.role == TraceRole::kAircraft
+                                ? std::hypot(uncertainties.mass_std_kg,
+                                             config.aircraft_mass_std_kg)
+                                : uncertainties.mass_std_kg;
+  fit_options.gravity_std_mps2 = calibrated ? 0.0 : uncertainties.gravity_std_mps2;
+  fit_options.gyro_scale_std = config.imu.gyro_scale_std;
+  // The residual series is kept for the second glitch pass below (and dropped after it when
+  // neither a figure nor the caller wants it).
+  const bool keep_series = !options.figure_paths.empty() || fit_out != nullptr;
+  fit_options.keep_series = true;
+  TraceFitResult fit = FitTrace(input, fit_options);
+  // 5b. Glitches too small for the raw-series test (below half the swing) but isolated and far
+  // outside the fit's residual noise: the same test on the residual series (fit/glitch.h), whose
+  // noise is the gyro's, not the swing's. Dropped, and the window fitted again.
+  if (fit.HasFit() && fit.residual_rad_per_s.size() == input.t_s.size()) {
+    const std::vector<size_t> more = FindGlitches(fit.t_s, fit.residual_rad_per_s,
+                                                     config.fit.glitch.Options());
+    if (!more.empty()) {
+      double largest = 0.0;
+      for (size_t k : more) largest = std::max(largest, std::abs(fit.residual_rad_per_s[k]));
+      char text[160];
+      std::snprintf(text, sizeof(text), "%zu glitch sample%s ignored (isolated readings off the "
+                    "fit by up to %.3g rad/s) at t =", more.size(), more.size() == 1 ? "" : "s",
+                    largest);
+      std::string warning = text;
+      for (size_t i = 0; i < more.size() && i < 5; ++i) {
+        std::snprintf(text, sizeof(text), "%s %.6g", i ? "," : "", input.t_s[more[i]]);
+        warning += text;
+      }
+      record.warnings.push_back(warning + (more.size() > 5 ? ", ... s" : " s"));
+      std::vector<double> t, rate;
+      size_t next = 0;
+      for (size_t k = 0; k < input.t_s.size(); ++k) {
+        if (next < more.size() && more[next] == k) {
+          ++next;
+          continue;
+        }
+        t.push_back(input.t_s[k]);
+        rate.push_back(input.rate_rad_per_s[k]);
+      }
+      input.t_s = std::move(t);
+      input.rate_rad_per_s = std::move(rate);
+      fit = FitTrace(input, fit_options);
+    }
+  }
+  if (!keep_series) {
+    fit.t_s.clear();
+    fit.measured_rate_rad_per_s.clear();
+    fit.fitted_rate_rad_per_s.clear();
+    fit.residual_rad_per_s.clear();
+  }
+
+  record.status = fit.status == TraceFitStatus::kOk         ? TraceStatus::kOk
+                  : fit.status == TraceFitStatus::kRejected ? TraceStatus::kRejected
+                                                            : TraceStatus::kError;
+  record.message = fit.message.empty() ? "" : Renamed(fit.message, path, name);
+  record.flags = fit.flags;
+  if (series.block_means()) {
+    char flag[64];
+    std::snprintf(flag, sizeof(flag), "block_means_of_%.0f_samples", series.samples_per_point);
+    record.flags.push_back(flag);
+  }
+  for (const std::string& w : fit.warnings) record.warnings.push_back(w);
+  if (fit.HasFit()) {  // an amplitude or radius of gyration no real rig gives: units (issue 16)
+    for (const std::string& w : FitPlausibilityWarnings(
+             fit.params.inertia_kg_m2, input.geometry.mass_kg, input.geometry.filar_separation_m,
+             input.geometry.filar_length_m, fit.amplitude_start_deg, config.imu.format.gyro_unit)) {
+      record.warnings.push_back(w);
+    }
+  }
+  record.model = ToString(fit.model);
+  record.iterations = fit.iterations;
+  record.secondary_motion_ratio = input.secondary_motion_ratio >= 0.0 ? input.secondary_motion_ratio : NAN;
+  if (fit.HasFit()) {
+    record.inertia_total_kg_m2 = fit.params.inertia_kg_m2;
+    record.inertia_total_std_kg_m2 =
+        std::hypot(fit.inertia_stat_std_kg_m2, fit.model_inadequacy_std_kg_m2);
+    record.inertia_stat_std_kg_m2 = fit.inertia_stat_std_kg_m2;
+    record.inertia_iid_std_kg_m2 = fit.inertia_iid_std_kg_m2;
+    record.model_inadequacy_std_kg_m2 = fit.model_inadequacy_std_kg_m2;
+    record.hac_bandwidth = fit.hac_bandwidth;
+    record.inertia_window_kg_m2 = fit.inertia_window_kg_m2;
+    record.inertia_source = fit.inertia_source;
+    record.sweep = fit.sweep;
+    record.rms_over_noise = fit.rms_over_noise > 0.0 ? fit.rms_over_noise : NAN;
+    record.residual_autocorr_lag1 = fit.residual_autocorr_lag1;
+    record.residual_ar1_phi = fit.residual_ar1_phi;
+    record.prewhitened_autocorr_max = fit.prewhitened_autocorr_max;
+    record.drag_coeff_kg_m2 = fit.params.drag_coeff_kg_m2;
+    record.viscous_coeff_kg_m2_per_s = fit.params.viscous_coeff_kg_m2_per_s;
+    record.amplitude_deg = {fit.amplitude_start_deg, fit.amplitude_end_deg};
+    record.bias_rad_per_s = fit.bias_rad_per_s;
+    record.residual_rms_rad_per_s = fit.residual_rms_rad_per_s;
+    record.noise_rms_rad_per_s = fit.noise_rad_per_s;
+    for (const UncertaintyContribution& c : fit.budget) {
+      record.budget.push_back({c.name, c.contribution_kg_m2});
+    }
+    record.budget_total_std_kg_m2 = fit.inertia_budget_std_kg_m2;
+    if (calibrated) {  // k's std moves I (and every other moment) by the same fraction
+      const double term = config.geometry_calibration.factor_rel_std * fit.params.inertia_kg_m2;
+      record.budget.push_back({"calibration", term});
+      record.budget_total_std_kg_m2 = std::hypot(record.budget_total_std_kg_m2, term);
+      record.calibrated = true;
+      record.calibration_relative_std = config.geometry_calibration.factor_rel_std;
+    }
+    record.budget_assumed = config.uncertainties.Assumed() && !calibrated;
+    UpdateTotalUncertainty(&record);
+    // Every record says what the assumption adds on this rig (the console says it once).
+    if (record.budget_assumed) {
+      record.flags.push_back(kAssumedInputsFlag);
+      record.warnings.push_back(AssumedInputsWarning(record));
+    }
+  }
+  if (record.status == TraceStatus::kOk && !record.warnings.empty()) {
+    record.message = name + ": " + record.warnings.front() +
+                     (record.warnings.size() > 1 ? " (+" + std::to_string(record.warnings.size() - 1) +
+                                                       " more warnings)"
+                                                 : "");
+  }
+
+  if (fit_out) *fit_out = fit;
+
+  // 6. Figure (only of a fit that ran).
+  for (const std::string& figure_path : options.figure_paths) {
+    if (fit.t_s.empty()) break;
+    bool drawn = false;
+    if (options.compact_figure) {
+      drawn = WriteReportTraceFigure(fit, name, config.units, figure_path, options.figure_width_px,
+                                     options.figure_height_px, &why);
+    } else {
+      TracePlotOptions figure_options;
+      figure_options.title = name;
+      figure_options.width_px = options.figure_width_px;
+      figure_options.height_px = options.figure_height_px;
+      figure_options.unit_scale = InertiaToDisplay(1.0, config.units);
+      figure_options.unit_label =
+          config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+      drawn = WriteTraceFitFigure(fit, figure_path, figure_options, &why);
+    }
+    if (!drawn) {
+      record.flags.push_back("figure_failed");
+      record.warnings.push_back("figure " + figure_path + " could not be written: " + why);
+    } else {
+      record.figures.push_back(figure_path);
+    }
+  }
+  // 7. I against amplitude (only when the sweep was evaluated: no figure, and no link, without).
+  if (fit.HasFit() && fit.sweep.evaluated) {
+    SweepPlotOptions sweep_options;
+    sweep_options.title = name;
+    sweep_options.unit_scale = InertiaToDisplay(1.0, config.units);
+    sweep_options.unit_label =
+        config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+    sweep_options.figure.width_px = options.figure_width_px;
+    sweep_options.figure.height_px = options.figure_height_px;
+    sweep_options.compact = options.compact_figure;  // the report explains it in the caption
+    for (const std::string& figure_path : options.sweep_figure_paths) {
+      if (WriteAmplitudeSweepFigure(fit.sweep, record.inertia_total_kg_m2,
+                                    record.inertia_total_std_kg_m2, figure_path, sweep_options,
+                                    &why)) {
+        record.figures.push_back(figure_path);
+      } else {
+        record.flags.push_back("figure_failed");
+        record.warnings.push_back("figure " + figure_path + " could not be written: " + why);
+      }
+    }
+  }
+  return record;
+}
+
+
+// Runs process(record) on a fresh record of `path`, timed; an exception becomes an error record.
+template <typename Process>
+TraceRecord Guarded(const CampaignConfig& config, const std::string& path,
+                    const TraceProcessOptions& options, const Process& process) {
+  const auto start = std::chrono::steady_clock::now();
+  TraceRecord record;
+  record.file = options.display_name.empty() ? path : options.display_name;
+  record.role = options.role;
+  record.model = ToString(config.fit.model);
+  try {
+    record = process(record);
+  } catch (const std::bad_alloc&) {  // never a bare "std::bad_alloc"
+    record.status = TraceStatus::kError;
+    record.message = record.file + ": out of memory while reading or fitting this log (is it far "
+                                   "larger than a pendulum log?)";
+  } catch (const std::exception& e) {
+    record.status = TraceStatus::kError;
+    record.message = Renamed(e.what(), path, record.file);
+  }
+  record.fit_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return record;
+}
+
+}  // namespace
+
+TraceRecord ProcessTrace(const CampaignConfig& config, const std::string& path,
+                         const TraceProcessOptions& options) {
+  return Guarded(config, path, options, [&](const TraceRecord& record) {
+    return Process(config, path, options, record);
+  });
+}
+
+TraceRecord ProcessTraceData(const CampaignConfig& config, const ImuData& data,
+                             const std::string& path, const TraceProcessOptions& options,
+                             TraceFitResult* fit) {
+  return Guarded(config, path, options, [&](const TraceRecord& record) {
+    return ProcessData(config, path, data, options, record, fit);
+  });
+}
+
+SwingAxisOptions SwingAxisOptionsFor(const ImuConfig& imu) {
+  SwingAxisOptions options;
+  options.mode = imu.swing_axis_auto ? SwingAxisMode::kAuto : SwingAxisMode::kFixed;
+  options.fixed_axis_in_imu = imu.swing_axis_in_imu;
+  options.imu_to_body = imu.imu_to_body;
+  return options;
+}
+
+}  // namespace bifilar
