@@ -17,8 +17,11 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
-#include "fit/trace_fit.h"
+#include "fit/trace_input.h"
+#include "pendulum/integrator.h"
+#include "pendulum/model.h"
 
 namespace bifilar {
 
