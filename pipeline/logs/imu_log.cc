@@ -415,75 +415,6 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
   return FinishImuLog(name, options, values, needed, row_line, scale, with_accel, std::move(data));
 }
 
-}  // namespace
-
-ImuData FinishImuLog(const std::string& name, const ImuLogOptions& options,
-                     const std::vector<double>& values, int needed,
-                     const std::vector<int>& row_line, [[maybe_unused]] const std::vector<double>& scale,
-                     bool with_accel, ImuData data) {
-  const size_t rows = row_line.size();
-  // Timestamps must increase. A sample whose time does not exceed the last kept one is dropped,
-  // unless the last kept one was itself a forward glitch (the new time fits between the two
-  // before), in which case the glitch is replaced.
-  // A jump back in time after which no row ever passes the last two kept times ends the time
-  // series (a footer of numeric summary rows, or a second log appended): the rest is ignored
-  // with a warning. (The second-last, so that a forward glitch in the last kept row is repaired
-  // below instead.)
-  std::vector<double> later_max(rows + 1, -HUGE_VAL);  // max time over rows r.. (suffix)
-  for (size_t r = rows; r-- > 0;) later_max[r] = std::max(later_max[r + 1], values[r * needed + kTime]);
-  std::vector<size_t> keep;
-  keep.reserve(rows);
-  size_t dropped = 0;
-  int first_drop_line = 0;
-  for (size_t r = 0; r < rows; ++r) {
-    const double t = values[r * needed + kTime];
-    if (keep.empty() || t > values[keep.back() * needed + kTime]) {
-      keep.push_back(r);
-      continue;
-    }
-    if (keep.size() >= 2 && !(later_max[r] > values[keep[keep.size() - 2] * needed + kTime])) {
-      data.warnings.push_back("the time series ends at line " + std::to_string(row_line[r]) +
-                              " (time jumps back from " + FormatNumber(values[keep.back() * needed + kTime] / scale[kTime]) +
-                              " to " + FormatNumber(t / scale[kTime]) + " and never passes it again); " +
-                              std::to_string(rows - r) + " row(s) from there are ignored");
-      break;
-    }
-    if (dropped++ == 0) first_drop_line = row_line[r];
-    if (keep.size() >= 2 && t > values[keep[keep.size() - 2] * needed + kTime]) keep.back() = r;
-  }
-  if (dropped > 0) {
-    const double fraction = static_cast<double>(dropped) / static_cast<double>(rows);
-    const std::string what = std::to_string(dropped) + " of " + std::to_string(rows) +
-                             " samples had a timestamp that did not increase (first near line " +
-                             std::to_string(first_drop_line) + ")";
-    if (fraction > options.max_dropped_fraction) {
-      char limit[32];
-      std::snprintf(limit, sizeof(limit), "%g", 100.0 * options.max_dropped_fraction);
-      Fail(name + ": " + what + "; more than " + limit +
-           " % of the samples, so the file is rejected (clock reset, or several logs in one "
-           "file?)");
-    }
-    data.warnings.push_back("dropped " + what);
-  }
-  if (static_cast<int>(keep.size()) < options.min_rows) {
-    Fail(name + ": only " + std::to_string(keep.size()) + " usable data row(s); at least " +
-         std::to_string(options.min_rows) + " needed");
-  }
-
-  data.t_s.resize(keep.size());
-  data.gyro_in_imu.resize(keep.size());
-  if (with_accel) data.accel_in_imu.resize(keep.size());
-  for (size_t i = 0; i < keep.size(); ++i) {
-    const double* v = &values[keep[i] * needed];
-    data.t_s[i] = v[0];
-    data.gyro_in_imu[i] = Eigen::Vector3d(v[1], v[2], v[3]);
-    if (with_accel) data.accel_in_imu[i] = Eigen::Vector3d(v[4], v[5], v[6]);
-  }
-  return data;
-}
-
-namespace {
-
 // The log's text: the file (bounded_read.h: a regular file within the cap), decompressed when
 // it is a .csv.gz (within the decompressed cap).
 std::string ReadWholeFile(const std::string& path, const ImuLogOptions& options) {
@@ -501,22 +432,6 @@ std::string ReadWholeFile(const std::string& path, const ImuLogOptions& options)
 }
 
 }  // namespace
-
-bool ImuLogOptions::Check(std::string* why) const {
-  if (!(max_dropped_fraction >= 0.0 && max_dropped_fraction <= 1.0)) {
-    *why = "max_dropped_fraction must be in [0, 1]";
-    return false;
-  }
-  if (min_rows < 1) {
-    *why = "min_rows must be at least 1";
-    return false;
-  }
-  if (max_file_bytes < 1 || max_decompressed_bytes < 1) {
-    *why = "max_file_bytes and max_decompressed_bytes must be at least 1";
-    return false;
-  }
-  return true;
-}
 
 ImuData ReadImuLogFromString(const std::string& text, const std::string& name,
                              const ImuFormat& format, const ImuLogOptions& options) {

@@ -30,40 +30,11 @@
 #include <cstdint>
 #include <string>
 
-#include "base/bounded_read.h"
 #include "pendulum/imu_data.h"
 #include "pipeline/logs/imu_format.h"
+#include "pipeline/logs/imu_log_options.h"
 
 namespace bifilar {
-
-// Physical bounds of a reading (SI, after the unit conversion). 1e4 rad/s is 95 000 rpm, 150x
-// the range of the widest MEMS gyros (+-4000 deg/s); 1e5 m/s^2 is ~10 000 g, 25x the widest
-// accelerometers (+-400 g). Beyond them the cell is corrupt or the unit wrong (deg/s read as
-// rad/s stays below 1e4 for any real swing).
-constexpr double kMaxGyroRateRadPerS = 1e4;
-constexpr double kMaxAccelMps2 = 1e5;
-
-struct ImuLogOptions {
-  // Largest fraction of the data rows that may be dropped because their timestamp does not
-  // increase (duplicate or out of order) before the whole file is rejected. Default 0.01 (1 %):
-  // a wireless logger that reorders the odd packet is fine; a clock that jumps back or a file
-  // that is two logs glued together is not.
-  double max_dropped_fraction = 0.01;
-  // The file must hold the accelerometer columns named in the format. Default false: when the
-  // format names accelerometer columns but none of the three is in the file, the log is read
-  // gyro-only with a warning (a file with only some of the three is always an error).
-  bool require_accel = false;
-  // Fewest data rows accepted (after repairs). Default 2.
-  int min_rows = 2;
-  // Size caps (bytes): the file as stored, and its text once a .csv.gz is decompressed. Defaults
-  // kDefaultMaxLogMb and kDefaultMaxDecompressedLogMb MB (base/bounded_read.h); the config's
-  // limits.max_log_mb and limits.max_decompressed_log_mb set them. A FIFO, device or folder is
-  // refused whatever the caps.
-  uint64_t max_file_bytes = static_cast<uint64_t>(kDefaultMaxLogMb * 1e6);
-  uint64_t max_decompressed_bytes = static_cast<uint64_t>(kDefaultMaxDecompressedLogMb * 1e6);
-
-  bool Check(std::string* why) const;
-};
 
 // Reads `path`. Throws UserError (message starts with the path) on any bad input listed above.
 ImuData ReadImuLog(const std::string& path, const ImuFormat& format,

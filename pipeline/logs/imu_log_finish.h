@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "pendulum/imu_data.h"
-#include "pipeline/logs/imu_log.h"
+#include "pipeline/logs/imu_log_options.h"
 
 namespace bifilar {
 

@@ -26,7 +26,7 @@
 
 #include "pendulum/imu_data.h"
 #include "pipeline/logs/imu_format.h"
-#include "pipeline/logs/imu_log.h"
+#include "pipeline/logs/imu_log_options.h"
 
 namespace bifilar {
 
