@@ -2,6 +2,7 @@
 // DerSimonian-Laird between-repeat std, and on the real quadrotor logs (../shared/data/crazyflie,
 // skipped when absent) the 4 repeats of each set-up within 2.5 sigma of their 4-log mean.
 #include "pipeline/trace/repeats.h"
+#include "pipeline/trace/trace_process.h"
 
 #include <cmath>
 #include <cstdio>

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "pipeline/config/config.h"
-#include "pipeline/trace/trace_process.h"
+#include "pipeline/records/trace_record.h"
 
 namespace bifilar {
 

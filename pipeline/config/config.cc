@@ -20,7 +20,6 @@
 #include "pipeline/config/plausibility.h"
 #include "pipeline/config/yaml_reader.h"
 #include "pipeline/logs/ulog.h"
-#include "pipeline/records/total_uncertainty.h"
 
 namespace bifilar {
 namespace {

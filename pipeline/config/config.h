@@ -18,7 +18,7 @@
 #include "pendulum/integrator.h"
 #include "pendulum/model.h"
 #include "pipeline/logs/imu_format.h"
-#include "pipeline/logs/imu_log.h"
+#include "pipeline/logs/imu_log_options.h"
 
 namespace bifilar {
 
@@ -65,14 +65,16 @@ struct GeometryCalibration {
   double factor_rel_std = 0.0;   // std(k) / k: common to every moment of the campaign; >= 0
 };
 
+// The assumed 1-sigma of L and D (m) when the config has no `rig.uncertainties`: a tape measure.
+constexpr double kAssumedLengthStdM = 0.001;
+
 struct RigUncertainties {
   double filar_length_std_m = 0.0;      // standard uncertainty of L (m); >= 0; default 0
   double filar_separation_std_m = 0.0;  // of D (m); >= 0; default 0
   double mass_std_kg = 0.0;             // of the rig mass (kg); >= 0; default 0
   double gravity_std_mps2 = 0.0;        // of g (m/s^2); >= 0; default 0
   // The config has a `rig.uncertainties` section (zeros included). Without one (Assumed()),
-  // InEffect() assumes a tape-measure 1 mm on L and D (pipeline/records/total_uncertainty.h),
-  // labelled.
+  // InEffect() assumes a tape-measure 1 mm on L and D (kAssumedLengthStdM), labelled.
   bool configured = false;
 
   // The stds the budget uses: these when configured, else the assumed ones (1 mm on L and D).

@@ -21,12 +21,9 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/trace/trace_process.h"
+#include "pipeline/records/trace_record.h"
 
 namespace bifilar {
-
-// The assumed 1-sigma of L and D (m) when the config has no `rig.uncertainties`: a tape measure.
-constexpr double kAssumedLengthStdM = 0.001;
 
 // Term names, in the order of TotalUncertainty::terms.
 constexpr const char* kTermStatistical = "statistical";             // HAC, Birge-scaled (per log)

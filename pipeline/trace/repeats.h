@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/trace/trace_process.h"
+#include "pipeline/records/trace_record.h"
 
 namespace bifilar {
 
