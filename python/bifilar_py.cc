@@ -33,6 +33,7 @@
 
 #include "base/bounded_read.h"
 #include "base/user_error.h"
+#include "base/version.h"
 #include "fit/ellipse.h"
 #include "fit/swing_axis.h"
 #include "fit/tensor.h"

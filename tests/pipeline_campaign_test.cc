@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/user_error.h"
+#include "pipeline/campaign/rig_inertia.h"
 #include "pipeline/commands/simulate_spec.h"
 
 namespace bifilar {

@@ -13,6 +13,7 @@
 
 #include "base/user_error.h"
 #include "pipeline/campaign/campaign.h"
+#include "pipeline/campaign/campaign_summary.h"
 #include "pipeline/config/config.h"
 #include "pipeline/store/cache.h"
 

@@ -16,6 +16,7 @@
 #include "base/user_error.h"
 #include "fit/ellipse.h"
 #include "pipeline/campaign/campaign.h"
+#include "pipeline/campaign/campaign_summary.h"
 #include "pipeline/campaign/run_discovery.h"
 #include "pipeline/commands/ellipse_command.h"
 #include "pipeline/config/config.h"

@@ -15,6 +15,7 @@
 
 #include "base/user_error.h"
 #include "fit/tensor.h"
+#include "pipeline/campaign/campaign_summary.h"
 #include "pipeline/campaign/campaign_tensor.h"
 #include "pipeline/commands/simulate_spec.h"
 #include "test_support.h"

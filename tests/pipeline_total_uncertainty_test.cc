@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "pipeline/campaign/campaign.h"
+#include "pipeline/campaign/campaign_summary.h"
 #include "pipeline/records/total_uncertainty.h"
 #include "pipeline/trace/repeats.h"
 #include "pipeline/trace/trace_process.h"

@@ -3,9 +3,10 @@
 #include <cmath>
 #include <cstdio>
 
-#include "pipeline/campaign/campaign.h"  // RigInertiaAt
 #include "base/user_error.h"
+#include "pipeline/campaign/rig_inertia.h"
 #include "pipeline/campaign/run_discovery.h"
+#include "pipeline/trace/trace_process.h"
 
 namespace bifilar {
 namespace {
@@ -48,24 +49,6 @@ void MeanAndStandardError(const std::vector<double>& values, const std::vector<d
   const double fit_sem = std::sqrt(fit_var / n);
   *standard_error =
       values.size() >= 2 ? std::max(SampleStd(values) / std::sqrt(n), fit_sem) : fit_sem;
-}
-
-GeometryCalibration RigCalibrationResult::Applied() const {
-  GeometryCalibration g;
-  g.applied = applied;
-  g.factor = factor;
-  g.factor_rel_std = factor_rel_std;
-  return g;
-}
-
-std::string RigCalibrationResult::BriefReport() const {
-  char buffer[400];
-  std::snprintf(buffer, sizeof(buffer),
-                "calibration: D^2/L factor k = %.5f +- %.5f (%.2f %%) from %d reference swing%s: "
-                "effective D = %.5f m against %.5f m configured (L = %.4f m kept)",
-                factor, factor_std, 100.0 * factor_rel_std, n_swings, n_swings == 1 ? "" : "s",
-                effective_separation_m, nominal_separation_m, filar_length_m);
-  return buffer;
 }
 
 RigCalibrationResult CalibrateRig(const CampaignConfig& config, const CalibrationFitFunction& fit,

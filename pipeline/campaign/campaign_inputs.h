@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/campaign/campaign.h"
+#include "pipeline/campaign/run_discovery.h"
 #include "pipeline/config/config.h"
 
 namespace bifilar {

@@ -1,9 +1,11 @@
+#include "pipeline/campaign/campaign_summary.h"
+
 #include <cmath>
 #include <cstdio>
 #include <ostream>
 
-#include "pipeline/campaign/campaign.h"
 #include "pipeline/campaign/campaign_tensor.h"
+#include "pipeline/campaign/rig_inertia.h"
 #include "pipeline/records/total_uncertainty.h"
 
 namespace bifilar {

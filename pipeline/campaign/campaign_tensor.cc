@@ -7,10 +7,10 @@
 #include <ostream>
 #include <sstream>
 
+#include "base/hash.h"
+#include "base/version.h"
 #include "pipeline/figures/tensor_plot.h"
-#include "pipeline/records/results_json.h"
 #include "pipeline/records/tensor_json.h"
-#include "pipeline/store/cache.h"
 
 namespace bifilar {
 namespace {

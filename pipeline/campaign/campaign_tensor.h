@@ -15,7 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/campaign/campaign.h"
+#include "pipeline/config/config.h"
+#include "pipeline/records/campaign_result.h"
 
 namespace bifilar {
 

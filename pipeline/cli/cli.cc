@@ -10,6 +10,7 @@
 #include <string>
 
 #include "base/json_error.h"
+#include "base/version.h"
 #include "fit/solver_logging.h"
 #include "pipeline/cli/cli_commands.h"
 
@@ -74,7 +75,7 @@ uint64_t ParseSeed(const std::string& text, const std::string& flag, uint64_t ma
 int RunCommandLine(int argc, char** argv) {
   QuietSolverLogging();  // fit/solver_logging.h: no glog preamble or solver chatter
   CLI::App app{"bifilar: aircraft mass properties from bifilar pendulum IMU logs"};
-  app.set_version_flag("--version", std::string("bifilar ") + BIFILAR_VERSION);
+  app.set_version_flag("--version", std::string("bifilar ") + ProgramVersion());
   app.require_subcommand(1);
   int exit_code = 0;
   RegisterProcessCommands(app, &exit_code);

@@ -6,6 +6,7 @@
 
 #include "base/interrupt.h"
 #include "pipeline/campaign/campaign.h"
+#include "pipeline/campaign/campaign_summary.h"
 #include "pipeline/cli/cli_commands.h"
 #include "pipeline/config/config.h"
 #include "pipeline/report/report.h"

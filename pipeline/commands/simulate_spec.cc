@@ -10,14 +10,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/atomic_file.h"
 #include "base/gzip.h"
 #include "base/user_error.h"
+#include "base/version.h"
 #include "pipeline/config/yaml_reader.h"
 #include "pipeline/logs/ulog_writer.h"
-
-#ifndef BIFILAR_VERSION
-#define BIFILAR_VERSION "unknown"
-#endif
 
 namespace bifilar {
 namespace {
@@ -810,7 +808,7 @@ std::string SimulateRunSummary::BriefReport() const {
 std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<CampaignTrace>& traces) {
   const CampaignSpec& c = spec.campaign;
   nlohmann::json j;
-  j["generator"] = std::string("bifilar simulate ") + BIFILAR_VERSION;
+  j["generator"] = std::string("bifilar simulate ") + ProgramVersion();
   j["seed"] = spec.seed;
   j["spec"] = spec.file;
   j["geometry"] = {{"filar_length_m", c.filar_length_m},
@@ -1014,7 +1012,7 @@ SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string&
     throw UserError("simulate: " + why);
   }
   nlohmann::json j;
-  j["generator"] = std::string("bifilar simulate ") + BIFILAR_VERSION;
+  j["generator"] = std::string("bifilar simulate ") + ProgramVersion();
   j["seed"] = spec.seed;
   j["spec"] = spec.file;
   j["geometry"] = {{"filar_length_m", length},

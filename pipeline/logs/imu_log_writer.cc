@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "base/atomic_file.h"
 #include "base/gzip.h"
 #include "base/user_error.h"
 

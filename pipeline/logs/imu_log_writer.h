@@ -9,7 +9,6 @@
 #include <string>
 
 #include "pendulum/imu_data.h"
-#include "base/atomic_file.h"  // WriteFileAtomically, used by several writers
 #include "pipeline/logs/imu_format.h"
 
 namespace bifilar {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "base/atomic_file.h"
 #include "base/gzip.h"
 #include "base/user_error.h"
 #include "pipeline/logs/imu_log_writer.h"

@@ -9,11 +9,8 @@
 #include <thread>
 
 #include "base/user_error.h"
+#include "base/version.h"
 #include "pipeline/records/total_uncertainty.h"
-
-#ifndef BIFILAR_VERSION
-#define BIFILAR_VERSION "unknown"
-#endif
 
 namespace bifilar {
 namespace {
@@ -242,8 +239,6 @@ std::string SweepSummary(const AmplitudeSweep& sweep) {
   }
   return out;
 }
-
-const char* ProgramVersion() { return BIFILAR_VERSION; }
 
 json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
   json j;

@@ -7,9 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pipeline/campaign/campaign.h"
-#include "pipeline/logs/imu_log_writer.h"  // WriteFileAtomically
-#include "pipeline/trace/trace_process.h"
+#include "pipeline/config/config.h"
+#include "pipeline/records/campaign_result.h"
+#include "pipeline/records/trace_record.h"
 
 namespace bifilar {
 
@@ -31,8 +31,5 @@ std::string AnglesCsv(const CampaignResult& result);  // one row per pitch angle
 
 // The amplitude sweep in one cell: "A_deg:I+-std" per band, amplitude decreasing.
 std::string SweepSummary(const AmplitudeSweep& sweep);
-
-// Program version stamped into results and cache keys.
-const char* ProgramVersion();
 
 }  // namespace bifilar

@@ -10,12 +10,13 @@
 #include <sstream>
 #include <vector>
 
+#include "base/atomic_file.h"
 #include "base/bounded_read.h"
+#include "base/hash.h"
 #include "base/json_error.h"
 #include "base/user_error.h"
-#include "pipeline/records/results_json.h"
+#include "pipeline/config/config.h"
 #include "pipeline/records/total_uncertainty.h"
-#include "pipeline/store/cache.h"
 #include "pipeline/store/output_set.h"
 
 namespace bifilar {

@@ -7,23 +7,17 @@
 // (tare logs/value/table), the pitch source, the ellipse options, the units — changing those
 // refits no trace. The fit figure is stored beside it in OUT/figures/<key>.svg.
 //
-// Hash: FNV-1a 64 (offset basis 0xcbf29ce484222325, prime 0x100000001b3), one byte at a time:
-// fast enough (about 1 GB/s) for logs of a few hundred kB, not cryptographic.
+// Hash: FNV-1a 64 (base/hash.h).
 #pragma once
 
 #include <cstdint>
 #include <string>
 
+#include "base/hash.h"
 #include "pipeline/config/config.h"
-#include "pipeline/trace/trace_process.h"
+#include "pipeline/records/trace_record.h"
 
 namespace bifilar {
-
-constexpr uint64_t kFnvOffsetBasis = 0xcbf29ce484222325ULL;
-
-uint64_t Fnv1a64(const void* data, size_t size, uint64_t hash = kFnvOffsetBasis);
-uint64_t Fnv1a64(const std::string& text, uint64_t hash = kFnvOffsetBasis);
-std::string HashToHex(uint64_t hash);  // 16 lowercase hex digits
 
 // The text of every config value that affects the fit of one trace of `role` (see above),
 // including the window override that applies to this file.

@@ -13,9 +13,9 @@
 
 #include "base/atomic_file.h"
 #include "base/bounded_read.h"
+#include "base/hash.h"
 #include "base/json_error.h"
 #include "base/user_error.h"
-#include "pipeline/store/cache.h"
 
 namespace bifilar {
 namespace {
