@@ -51,7 +51,7 @@ std::string EllipseTable(int rows) {
 void BM_ScaleEllipseTable(benchmark::State& state) {
   const std::string text = EllipseTable(static_cast<int>(state.range(0)));
   for (auto _ : state) {
-    const std::vector<EllipsePoint> points = ParseEllipseTable(text, "table.csv", InertiaUnits::kSi);
+    const std::vector<EllipsePoint> points = ParseEllipseTable(text, "table.csv", DisplayUnits::kSi);
     EllipseResult result;
     std::string why;
     if (!FitEllipse(points, EllipseOptions(), &result, &why)) state.SkipWithError(why.c_str());

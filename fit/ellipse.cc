@@ -28,7 +28,7 @@ std::string Num(double v) {
 }
 
 Eigen::RowVector3d DesignRow(double pitch_deg) {
-  const double t = 2.0 * pitch_deg * kDegToRad;
+  const double t = 2.0 * pitch_deg * kRadPerDeg;
   return Eigen::RowVector3d(1.0, std::cos(t), std::sin(t));
 }
 
@@ -72,7 +72,7 @@ EllipseParameters SixFromAbc(double a, double b, double c, double two_tau_ref_ra
   p.ix_kg_m2 = a - b;
   p.iz_kg_m2 = a + b;
   p.ixz_kg_m2 = c;
-  p.tau_deg = 0.5 * phi * kRadToDeg;
+  p.tau_deg = 0.5 * phi * kDegPerRad;
   p.izp_kg_m2 = a + sign * r;
   p.ixp_kg_m2 = a - sign * r;
   return p;
@@ -85,7 +85,7 @@ Jac63 SixJacobian(double b, double c, double sign_r) {
   j.row(1) << 1, 1, 0;
   j.row(2) << 0, 0, 1;
   if (r > 0) {
-    j.row(3) << 0, -0.5 * c / r2 * kRadToDeg, 0.5 * b / r2 * kRadToDeg;
+    j.row(3) << 0, -0.5 * c / r2 * kDegPerRad, 0.5 * b / r2 * kDegPerRad;
     j.row(4) << 1, -sign_r * b / r, -sign_r * c / r;
     j.row(5) << 1, sign_r * b / r, sign_r * c / r;
   }

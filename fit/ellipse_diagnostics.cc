@@ -105,9 +105,9 @@ void NacaEstimates(const PreparedData& data, const ClosedFormFit& closed,
   if (!measured(0.0, &iz, &iz_std)) {
     diag->warnings.push_back("no moment measured at 0 deg: NACA estimates use the fitted I_z");
   }
-  const double min_sin = std::sin(2 * options.naca_exclusion_deg * kDegToRad);
+  const double min_sin = std::sin(2 * options.naca_exclusion_deg * kRadPerDeg);
   for (int g = 0; g < m; ++g) {
-    const double phi = (90.0 + groups[g].pitch_deg) * kDegToRad;
+    const double phi = (90.0 + groups[g].pitch_deg) * kRadPerDeg;
     const double s2 = std::sin(2 * phi);
     if (std::fabs(s2) <= min_sin + 1e-12) continue;
     const double c = std::cos(phi), s = std::sin(phi);

@@ -131,7 +131,7 @@ Eq7Problem MakeEq7Problem(const PreparedData& data, const ClosedFormFit& closed)
   e.weight.resize(n);
   e.sqrt_weight.resize(n);
   for (int i = 0; i < n; ++i) {
-    e.pitch_rad[i] = data.points[i].pitch_deg * kDegToRad;
+    e.pitch_rad[i] = data.points[i].pitch_deg * kRadPerDeg;
     e.inertia_kg_m2[i] = data.y(i);
     e.weight[i] = data.w(i);
     e.sqrt_weight[i] = data.sqrt_w(i);

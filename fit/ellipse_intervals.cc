@@ -153,7 +153,7 @@ void BootstrapIntervals(const PreparedData& data, const ClosedFormFit& closed,
   }
   const Eigen::Matrix3d chol = Eigen::LLT<Eigen::Matrix3d>(closed.normal_inv).matrixL();
   const double offset_var = options.common_offset_std_kg_m2 * options.common_offset_std_kg_m2;
-  const double two_tau_ref_rad = 2 * closed.best.tau_deg * kDegToRad;
+  const double two_tau_ref_rad = 2 * closed.best.tau_deg * kRadPerDeg;
   std::vector<TailQuantiles> tails(6, TailQuantiles(nb, alpha / 2, 1 - alpha / 2));
   for (int b = 0; b < nb; ++b) {
     double vf = cov.variance_factor;

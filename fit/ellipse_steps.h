@@ -16,6 +16,7 @@
 // collected per step and joined in this order.
 #pragma once
 
+#include "base/units.h"
 #include "fit/ellipse.h"
 
 #include <chrono>
@@ -26,10 +27,6 @@
 
 namespace bifilar {
 namespace ellipse {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegToRad = kPi / 180.0;
-constexpr double kRadToDeg = 180.0 / kPi;
 
 using Clock = std::chrono::steady_clock;
 double SecondsSince(Clock::time_point start);

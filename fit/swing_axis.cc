@@ -7,12 +7,10 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "base/units.h"
+
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kStandardGravityMps2 = 9.80665;
-constexpr double kRadToDeg = 180.0 / kPi;
 
 // Index range [begin, end) of the samples with t0 <= t <= t1.
 std::pair<size_t, size_t> IndexRange(const std::vector<double>& t, double t0, double t1) {
@@ -136,11 +134,11 @@ bool SwingAxisOptions::Check(std::string* why) const {
 }
 
 double PitchFromDownDeg(const Eigen::Vector3d& down_in_body) {
-  return std::atan2(-down_in_body.x(), std::hypot(down_in_body.y(), down_in_body.z())) * kRadToDeg;
+  return std::atan2(-down_in_body.x(), std::hypot(down_in_body.y(), down_in_body.z())) * kDegPerRad;
 }
 
 double RollFromDownDeg(const Eigen::Vector3d& down_in_body) {
-  return std::atan2(down_in_body.y(), down_in_body.z()) * kRadToDeg;
+  return std::atan2(down_in_body.y(), down_in_body.z()) * kDegPerRad;
 }
 
 bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,

@@ -4,6 +4,7 @@
 // tensor_steps.h lists the steps. Conventions: fit/tensor.h, docs/physics.md §3.5.
 #include "fit/tensor.h"
 
+#include "base/units.h"
 #include "fit/ellipse_steps.h"
 #include "fit/solver_logging.h"
 #include "fit/tensor_steps.h"
@@ -17,8 +18,6 @@
 namespace bifilar {
 namespace tensor {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 std::string Num(double v) {

@@ -1,6 +1,7 @@
 // D-optimal choice of attitudes for a tensor campaign (fit/tensor_plan.h).
 #include "fit/tensor_plan.h"
 
+#include "base/units.h"
 #include "fit/tensor.h"
 
 #include <Eigen/Dense>
@@ -12,9 +13,6 @@
 
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegToRad = kPi / 180.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 using Row = std::array<double, kTensorPlanComponents>;
@@ -203,7 +201,7 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
   });
   std::vector<Candidate> cand;
   std::map<std::tuple<long long, long long, long long>, int> seen;
-  const double tilt_std_rad = options.attitude_std_deg * kDegToRad;
+  const double tilt_std_rad = options.attitude_std_deg * kRadPerDeg;
   const double trials = options.trials_per_orientation;
   for (Candidate& c : all) {
     if (!seen.emplace(AxisKey(c.n), static_cast<int>(cand.size())).second) continue;

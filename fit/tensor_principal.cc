@@ -2,6 +2,7 @@
 // first-order std), the Euler angles of the principal frame matched to the body axes, and the
 // intervals of the components and principal moments (seeded parametric bootstrap, as the
 // ellipse's: fit/ellipse_intervals.cc). Conventions: fit/tensor.h, docs/physics.md §3.5.
+#include "base/units.h"
 #include "fit/ellipse_steps.h"
 #include "fit/tensor_steps.h"
 
@@ -13,8 +14,6 @@
 namespace bifilar {
 namespace tensor {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 // d(v_j^T J v_k)/d beta: the bilinear form of each component's unit tensor.
 Vec6 Bilinear(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -71,7 +70,7 @@ Eigen::Matrix3d Matched(const Eigen::Matrix3d& axes, const Eigen::Matrix3d& refe
 Eigen::Vector3d EulerDeg(const Eigen::Matrix3d& r) {
   const double pitch = std::asin(std::clamp(-r(2, 0), -1.0, 1.0));
   return Eigen::Vector3d(std::atan2(r(2, 1), r(2, 2)), pitch, std::atan2(r(1, 0), r(0, 0))) *
-         kRadToDeg;
+         kDegPerRad;
 }
 
 double Quantile(std::vector<double>* v, double p) {
@@ -103,7 +102,7 @@ Principal ComputePrincipal(const Vec6& beta, const Mat6& cov) {
       const Vec6 h = Bilinear(p.axes.col(j), p.axes.col(k)) / (p.moments(k) - p.moments(j));
       var += h.dot(cov * h);
     }
-    p.axes_std_deg(k) = std::sqrt(std::max(0.0, var)) * kRadToDeg;
+    p.axes_std_deg(k) = std::sqrt(std::max(0.0, var)) * kDegPerRad;
   }
   for (int k = 0; k + 1 < 3; ++k) {
     const double gap = p.moments(k + 1) - p.moments(k);

@@ -24,6 +24,7 @@
 // warnings are collected per step and joined in this order.
 #pragma once
 
+#include "base/units.h"
 #include "fit/trace_fit.h"
 
 #include <array>
@@ -38,9 +39,6 @@
 
 namespace bifilar {
 namespace trace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegPerRad = 180.0 / kPi;
 
 // Scaled parameters, indexed by TraceParamIndex (fit/trace_cost.h).
 using Params = std::array<double, kNumTraceParams>;

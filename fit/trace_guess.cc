@@ -7,10 +7,10 @@
 
 #include <Eigen/Dense>
 
+#include "base/units.h"
+
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 double Median(std::vector<double> v) {
   if (v.empty()) return 0.0;

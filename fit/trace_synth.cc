@@ -4,10 +4,11 @@
 #include <cmath>
 #include <random>
 
+#include "base/units.h"
+
 namespace bifilar {
 
 bool MakeSyntheticTrace(const SyntheticTraceOptions& o, TraceFitInput* input) {
-  constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
   std::mt19937_64 rng(o.seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> normal(0.0, 1.0);

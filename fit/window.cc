@@ -6,11 +6,10 @@
 #include <cstdlib>
 #include <limits>
 
+#include "base/units.h"
+
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kRadToDeg = 180.0 / kPi;
 
 std::string Prefix(const std::string& name) { return name.empty() ? "" : name + ": "; }
 
@@ -701,7 +700,7 @@ std::vector<AngleExtreme> AngleExtremes(const std::vector<double>& t, const std:
     if (j == 0) ref = ext[1].second;
     else if (j + 1 == ext.size()) ref = ext[j - 1].second;
     else ref = 0.5 * (ext[j - 1].second + ext[j + 1].second);
-    out.push_back({ext[j].first, 0.5 * std::abs(ext[j].second - ref) * kRadToDeg});
+    out.push_back({ext[j].first, 0.5 * std::abs(ext[j].second - ref) * kDegPerRad});
   }
   // The end extremes have one neighbour, so the value above is the mean of two successive
   // extremes; with four or more, extrapolate the decay geometrically from the interior ones.

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <sstream>
 
+#include "base/units.h"
+
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Everything about the rise h(psi) that the models need, computed once:
 //   s = sqrt(L^2 - (D^2/2)(1 - cos psi)),  k = D^2/4

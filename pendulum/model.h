@@ -12,6 +12,8 @@
 
 #include <string>
 
+#include "base/units.h"
+
 namespace bifilar {
 
 enum class PendulumModel { kFull, kJardin, kLinear };
@@ -26,7 +28,7 @@ struct RigGeometry {
   double filar_length_m = 0.0;      // L, wire length (m); > 0 and > D (wires never go slack).
   double filar_separation_m = 0.0;  // D, distance between the wires (m); > 0.
   double mass_kg = 0.0;             // m, whole suspended mass (kg); > 0.
-  double gravity_mps2 = 9.80665;    // g, local gravity (m/s^2); > 0.
+  double gravity_mps2 = kStandardGravityMps2;    // g, local gravity (m/s^2); > 0.
 
   // True when every field is finite and in range; otherwise names the field and the range.
   bool Check(std::string* why) const;

@@ -11,11 +11,10 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "base/units.h"
+
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
 
 // Portable random numbers: std::mt19937_64 is fully specified by the standard, but the standard
 // distributions are not, so uniforms and normals are made here (same seed -> same bytes anywhere).
@@ -161,7 +160,7 @@ double SofteningHarmonicConstant(double exponent) {
 double SofteningCoefficient(double excess_at_30deg, double exponent) {
   // I_app / I = 1 / (1 - x) = 1 + excess at 30 deg, x = c_p k (30 deg)^p.
   const double x = excess_at_30deg / (1.0 + excess_at_30deg);
-  return x / (SofteningHarmonicConstant(exponent) * std::pow(30.0 * kDeg, exponent));
+  return x / (SofteningHarmonicConstant(exponent) * std::pow(30.0 * kRadPerDeg, exponent));
 }
 
 double ApparentInertiaExcess(double k, double exponent, double amplitude_rad) {
@@ -267,13 +266,16 @@ bool TraceSetup::Check(std::string* why) const {
                          Num(g.filar_separation_m) + " (the wires would go slack); allowed L > D");
   }
   if (!std::isfinite(pitch_rad) || std::abs(pitch_rad) > kPi / 2 + 1e-9) {
-    return Fail(why, "pitch = " + Num(pitch_rad / kDeg) + " deg is out of range; allowed [-90, 90]");
+    return Fail(why, "pitch = " + Num(pitch_rad / kRadPerDeg) +
+                         " deg is out of range; allowed [-90, 90]");
   }
   if (!std::isfinite(roll_rad) || std::abs(roll_rad) > kPi + 1e-9) {
-    return Fail(why, "roll = " + Num(roll_rad / kDeg) + " deg is out of range; allowed [-180, 180]");
+    return Fail(why, "roll = " + Num(roll_rad / kRadPerDeg) +
+                         " deg is out of range; allowed [-180, 180]");
   }
-  if (!std::isfinite(amplitude_rad) || amplitude_rad == 0.0 || std::abs(amplitude_rad) >= 89 * kDeg) {
-    return Fail(why, "amplitude = " + Num(amplitude_rad / kDeg) +
+  if (!std::isfinite(amplitude_rad) || amplitude_rad == 0.0 ||
+      std::abs(amplitude_rad) >= 89 * kRadPerDeg) {
+    return Fail(why, "amplitude = " + Num(amplitude_rad / kRadPerDeg) +
                          " deg is out of range; allowed 0 < |amplitude| < 89 deg");
   }
   if (!body_from_imu.allFinite() ||
@@ -305,19 +307,19 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
   const double free = rng.Uniform(tl.free_s);
   const bool stopped = rng.Uniform() < tl.stop_probability;
   const double rest_after = rng.Uniform(tl.rest_after_s);
-  const double release_rate = rng.Normal(tl.release_rate_sigma_deg_per_s * kDeg);
+  const double release_rate = rng.Normal(tl.release_rate_sigma_deg_per_s * kRadPerDeg);
   double tremor_amp[3], tremor_omega[3], tremor_phase[3];
   for (int i = 0; i < 3; ++i) {
     // Three sinusoids of equal amplitude: RMS of the sum = amp * sqrt(3/2).
-    tremor_amp[i] = tl.tremor_deg * kDeg / std::sqrt(1.5) * (0.5 + rng.Uniform());
+    tremor_amp[i] = tl.tremor_deg * kRadPerDeg / std::sqrt(1.5) * (0.5 + rng.Uniform());
     tremor_omega[i] = 2.0 * kPi * rng.Uniform(tl.tremor_hz);
     tremor_phase[i] = 2.0 * kPi * rng.Uniform();
   }
   Eigen::Vector3d gyro_bias, gyro_scale, accel_bias;
-  for (int i = 0; i < 3; ++i) gyro_bias[i] = rng.Normal(so.gyro_bias_sigma_deg_per_s * kDeg);
+  for (int i = 0; i < 3; ++i) gyro_bias[i] = rng.Normal(so.gyro_bias_sigma_deg_per_s * kRadPerDeg);
   for (int i = 0; i < 3; ++i) gyro_scale[i] = rng.Normal(so.gyro_scale_error_sigma);
   for (int i = 0; i < 3; ++i) accel_bias[i] = rng.Normal(so.accel_bias_sigma_mps2);
-  const double rocking_amp = so.rocking_max_deg * kDeg * rng.Uniform();
+  const double rocking_amp = so.rocking_max_deg * kRadPerDeg * rng.Uniform();
   const double rocking_hz =
       so.rocking_frequency_hz > 0
           ? so.rocking_frequency_hz
@@ -432,7 +434,7 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
 
   TruthDynamics dyn{options.model, setup.geometry, setup.params};
   if (options.sway_coupling_at_60deg > 0) {
-    const double a60 = 60.0 * kDeg;
+    const double a60 = 60.0 * kRadPerDeg;
     dyn.sway_k = 8.0 / 5.0 * options.sway_coupling_at_60deg / (a60 * a60 * a60 * a60);
   }
   if (options.softening_at_30deg > 0) {
@@ -444,7 +446,7 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
       return Fail(why, "swing.softening_percent_at_30deg = " + Num(100 * options.softening_at_30deg) +
                            " with swing.softening_exponent = " + Num(dyn.soft_p) + " removes " +
                            Num(100 * weakening) + " % of the restoring torque at the amplitude " +
-                           Num(std::abs(amplitude) / kDeg) +
+                           Num(std::abs(amplitude) / kRadPerDeg) +
                            " deg (at most 50 % allowed); lower the softening or the amplitude");
     }
   }
@@ -506,12 +508,12 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
   const Eigen::Vector3d n_cross_r = n_body.cross(r);
   const double g = setup.geometry.gravity_mps2;
   const double rock_omega = 2 * kPi * rocking_hz;
-  const double gyro_noise = so.gyro_noise_sigma_deg_per_s * kDeg;
+  const double gyro_noise = so.gyro_noise_sigma_deg_per_s * kRadPerDeg;
   const double phi_ar = so.gyro_noise_ar1_phi;
   const double ar_innovation = std::sqrt(1.0 - phi_ar * phi_ar);
   Eigen::Vector3d ar_state = Eigen::Vector3d::Zero();
   // Optional realism from streams of their own (off: no draws, the log is as before).
-  const double walk_rate = so.gyro_bias_walk_deg_per_s_per_sqrt_s * kDeg;
+  const double walk_rate = so.gyro_bias_walk_deg_per_s_per_sqrt_s * kRadPerDeg;
   Rng walk_rng(DeriveSeed(seed, "gyro_bias_walk"));
   Eigen::Vector3d walk = Eigen::Vector3d::Zero();
   const bool gravity_removed = so.accelerometer && so.accel_gravity_removed;
@@ -519,7 +521,7 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
   if (gravity_removed) {
     // The firmware's static down, tilted by its attitude error about a random horizontal axis.
     Rng accel_rng(DeriveSeed(seed, "gravity_removed"));
-    truth.gravity_removal_error_rad = accel_rng.Uniform(so.gravity_removal_error_deg) * kDeg;
+    truth.gravity_removal_error_rad = accel_rng.Uniform(so.gravity_removal_error_deg) * kRadPerDeg;
     const double beta = 2.0 * kPi * accel_rng.Uniform();
     const Eigen::Vector3d tilt_axis =
         (std::cos(beta) * lateral + std::sin(beta) * horizontal).normalized();
@@ -848,9 +850,9 @@ uint64_t DeriveSeed(uint64_t seed, const std::string& name) {
 }
 
 Eigen::Matrix3d MountingFromRollPitchYawDeg(double roll_deg, double pitch_deg, double yaw_deg) {
-  return (Eigen::AngleAxisd(yaw_deg * kDeg, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(pitch_deg * kDeg, Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(roll_deg * kDeg, Eigen::Vector3d::UnitX()))
+  return (Eigen::AngleAxisd(yaw_deg * kRadPerDeg, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(pitch_deg * kRadPerDeg, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll_deg * kRadPerDeg, Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
 }
 
@@ -897,7 +899,8 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
     spec.rig.InertiaAtPitch(nominal_deg, &ct.inertia_rig_kg_m2);
     ct.inertia_aircraft_kg_m2 =
         tare ? 0.0
-             : spec.aircraft.InertiaAtAttitude(ct.true_roll_deg * kDeg, ct.true_pitch_deg * kDeg);
+             : spec.aircraft.InertiaAtAttitude(ct.true_roll_deg * kRadPerDeg,
+                                               ct.true_pitch_deg * kRadPerDeg);
     ct.inertia_reference_kg_m2 = kind == kReferenceLog ? spec.reference_inertia_kg_m2 : 0.0;
     TraceSetup& s = ct.setup;
     s.geometry.filar_length_m = spec.TrueLengthM();
@@ -910,9 +913,9 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
         ct.inertia_aircraft_kg_m2 + ct.inertia_rig_kg_m2 + ct.inertia_reference_kg_m2;
     s.params.drag_coeff_kg_m2 = drag;
     s.params.viscous_coeff_kg_m2_per_s = viscous;
-    s.pitch_rad = ct.true_pitch_deg * kDeg;
-    s.roll_rad = ct.true_roll_deg * kDeg;
-    s.amplitude_rad = sign * amplitude_deg * kDeg;
+    s.pitch_rad = ct.true_pitch_deg * kRadPerDeg;
+    s.roll_rad = ct.true_roll_deg * kRadPerDeg;
+    s.amplitude_rad = sign * amplitude_deg * kRadPerDeg;
     s.body_from_imu = spec.rig.body_from_imu;
     s.imu_offset_in_body_m = spec.rig.imu_offset_in_body_m;
     std::string trace_why;

@@ -33,6 +33,7 @@
 
 #include <Eigen/Core>
 
+#include "base/units.h"
 #include "pendulum/imu_data.h"
 #include "pendulum/integrator.h"
 #include "pendulum/model.h"
@@ -267,7 +268,7 @@ struct CampaignSpec {
   RigTruth rig;
   double filar_length_m = 0.0;       // L; > D
   double filar_separation_m = 0.0;   // D; > 0
-  double gravity_mps2 = 9.80665;     // > 0
+  double gravity_mps2 = kStandardGravityMps2;     // > 0
   std::vector<double> pitch_deg;     // nominal pitch angles (deg), distinct, in [-90, 90]
   // Attitudes (roll, pitch) in deg instead of pitch_deg (a tensor campaign): folders
   // roll_{R}_pitch_{P}; roll in [-180, 180], pitch in [-90, 90]; needs aircraft.iy_kg_m2.

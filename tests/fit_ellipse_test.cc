@@ -10,10 +10,11 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
+
 namespace bifilar {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kSlugFt2 = 1.35581795;  // kg m^2 per slug ft^2
 
 struct Truth {

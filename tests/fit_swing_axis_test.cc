@@ -8,12 +8,12 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "base/units.h"
 #include "pendulum/simulate.h"
 
 namespace bifilar {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 constexpr double kG = 9.80665;
 

@@ -12,12 +12,12 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include "base/units.h"
 #include "fit/ellipse.h"
 
 namespace bifilar {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 using Tensor = std::array<double, 6>;  // Ixx, Iyy, Izz, Ixy, Ixz, Iyz
 
 // A small UAV with an off-centre payload: products 2-4 % of the moments.

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "base/units.h"
 #include "fit/trace_fit.h"
 #include "fit/trace_guess.h"
 #include "fit/trace_synth.h"
@@ -19,9 +20,6 @@
 
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kRadPerDeg = kPi / 180.0;
 
 // The docs/physics.md §2 example rig: D/L = 0.44 and m (D/2)^2 / I = 1 at I = 1.1616 kg m^2, where
 // the full model's kinetic term matters (period ~2.8 s).

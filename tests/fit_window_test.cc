@@ -10,13 +10,13 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
 #include "fit/swing_axis.h"
 #include "pendulum/simulate.h"
 
 namespace bifilar {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 
 struct Synth {

@@ -12,10 +12,11 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
+
 namespace bifilar {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 const PendulumModel kModels[] = {PendulumModel::kFull, PendulumModel::kJardin,
                                  PendulumModel::kLinear};

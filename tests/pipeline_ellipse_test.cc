@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "base/units.h"
 #include "base/user_error.h"
 #include "pipeline/commands/ellipse_table.h"
 #include "pipeline/records/ellipse_json.h"
@@ -23,7 +24,6 @@ namespace bifilar {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
 
 struct CliRun {
   int exit_code = -1;
@@ -219,12 +219,12 @@ TEST_F(EllipseCli, PlanPredictsStandardErrors) {
 TEST(EllipseTable, ParsesUnitsCommentsAndWhitespace) {
   const auto points = ParseEllipseTable(
       "# comment\n\n pitch_deg , inertia , std \n-10, 2.5, 0.01\n+20,2.6e0,1e-2\r\n",
-      "t.csv", InertiaUnits::kImperial);
+      "t.csv", DisplayUnits::kImperial);
   ASSERT_EQ(points.size(), 2u);
   EXPECT_EQ(points[0].pitch_deg, -10.0);
   EXPECT_DOUBLE_EQ(points[1].inertia_kg_m2, 2.6 * kKgM2PerSlugFt2);
   EXPECT_DOUBLE_EQ(points[1].std_kg_m2, 0.01 * kKgM2PerSlugFt2);
-  EXPECT_THROW(ParseEllipseTable("pitch_deg,inertia,inertia\n", "t.csv", InertiaUnits::kSi),
+  EXPECT_THROW(ParseEllipseTable("pitch_deg,inertia,inertia\n", "t.csv", DisplayUnits::kSi),
                UserError);
 }
 

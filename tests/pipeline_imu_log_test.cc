@@ -12,14 +12,13 @@
 #include <gtest/gtest.h>
 
 #include "base/gzip.h"
+#include "base/units.h"
 #include "base/user_error.h"
 #include "pendulum/simulate.h"
 #include "pipeline/logs/imu_log_writer.h"
 
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // The UserError message of reading `text`, or "" when it reads.
 std::string ErrorOf(const std::string& text, const ImuFormat& format = ImuFormat(),

@@ -78,19 +78,19 @@ TEST(Messages, EllipseTableWithBomGzipOrBinary) {
   TempDir dir;
   // A BOM (spreadsheet export) is not part of 'pitch_deg'.
   WriteFile(dir.path + "/bom.csv", std::string("\xEF\xBB\xBF") + kTable);
-  EXPECT_EQ(ReadEllipseTable(dir.path + "/bom.csv", InertiaUnits::kSi).size(), 5u);
+  EXPECT_EQ(ReadEllipseTable(dir.path + "/bom.csv", DisplayUnits::kSi).size(), 5u);
   // A .csv.gz table is inflated like a .csv.gz log.
   WriteFile(dir.path + "/t.csv.gz", GzipCompress(kTable));
-  EXPECT_EQ(ReadEllipseTable(dir.path + "/t.csv.gz", InertiaUnits::kSi).size(), 5u);
+  EXPECT_EQ(ReadEllipseTable(dir.path + "/t.csv.gz", DisplayUnits::kSi).size(), 5u);
   // Binary: named, no raw bytes in the message.
   std::string binary = "\x01\x02\xff\xfe,\x00\x07\x80";
   binary += std::string(100, '\x9c');
   WriteFile(dir.path + "/b.csv", binary);
-  std::string message = ErrorOf([&] { ReadEllipseTable(dir.path + "/b.csv", InertiaUnits::kSi); });
+  std::string message = ErrorOf([&] { ReadEllipseTable(dir.path + "/b.csv", DisplayUnits::kSi); });
   EXPECT_NE(message.find("b.csv"), std::string::npos) << message;
   EXPECT_TRUE(Printable(message)) << message;
   WriteFile(dir.path + "/c.csv", "p\xc3\xa9tch,\x9c\x9d\n1,2\n");
-  message = ErrorOf([&] { ReadEllipseTable(dir.path + "/c.csv", InertiaUnits::kSi); });
+  message = ErrorOf([&] { ReadEllipseTable(dir.path + "/c.csv", DisplayUnits::kSi); });
   EXPECT_NE(message.find("c.csv:1"), std::string::npos) << message;
   EXPECT_TRUE(Printable(message)) << message;
 }

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "base/units.h"
 #include "base/user_error.h"
 #include "pipeline/commands/simulate_spec.h"
 #include "pipeline/logs/imu_log_writer.h"
@@ -23,7 +24,6 @@ namespace bifilar {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 
 std::string ReadText(const fs::path& path) {

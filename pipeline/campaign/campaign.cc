@@ -18,6 +18,7 @@
 #include "base/hash.h"
 #include "base/interrupt.h"
 #include "base/parallel_runner.h"
+#include "base/units.h"
 #include "base/user_error.h"
 #include "base/version.h"
 #include "fit/tensor.h"
@@ -431,7 +432,7 @@ void WarnIfAttitudesDisagree(const CampaignConfig& config, TraceRecord* r) {
       DownInBodyFromAttitude(r->roll_measured_deg.value_or(0.0), *r->pitch_measured_deg);
   double dot = 0.0;
   for (int k = 0; k < 3; ++k) dot += nominal[k] * measured[k];
-  const double angle_deg = std::acos(std::clamp(dot, -1.0, 1.0)) * 180.0 / M_PI;
+  const double angle_deg = std::acos(std::clamp(dot, -1.0, 1.0)) * 180.0 / kPi;
   if (angle_deg <= config.runs.attitude_tolerance_deg) return;
   char buffer[320];
   std::snprintf(buffer, sizeof(buffer),

@@ -9,7 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "pipeline/commands/ellipse_table.h"  // InertiaUnits
+#include "base/units.h"
 #include "base/user_error.h"
 
 namespace bifilar {
@@ -36,6 +36,6 @@ struct TensorPlanCli;
 std::shared_ptr<TensorPlanCli> AddTensorPlanOptions(CLI::App* plan);
 bool TensorPlanRequested(const TensorPlanCli& tensor_plan);
 int RunTensorPlanFromCli(const TensorPlanCli& tensor_plan, const CLI::App& plan, int trials,
-                         double sigma, double ixz, bool ixz_given, InertiaUnits units, bool json);
+                         double sigma, double ixz, bool ixz_given, DisplayUnits units, bool json);
 
 }  // namespace bifilar

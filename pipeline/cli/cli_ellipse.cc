@@ -53,10 +53,10 @@ std::vector<double> ParseAngleList(const std::string& list) {
   return angles;
 }
 
-InertiaUnits Units(const std::string& name) {
-  InertiaUnits units;
-  if (!ParseInertiaUnits(name, &units)) {
-    throw UserError("--units must be 'si' or 'imperial', got '" + name + "'");
+DisplayUnits Units(const std::string& name) {
+  DisplayUnits units;
+  if (!ParseDisplayUnits(name, &units)) {
+    throw UserError("--units must be " + DisplayUnitsAllowedValues() + ", got '" + name + "'");
   }
   return units;
 }

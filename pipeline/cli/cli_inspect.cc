@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "base/atomic_file.h"
+#include "base/units.h"
 #include "pipeline/cli/cli_commands.h"
 #include "pipeline/commands/log_inspect.h"
 #include "pipeline/config/config.h"
@@ -74,7 +75,7 @@ void RegisterInitCommand(CLI::App& app, int* exit_code) {
   struct Args {
     std::string path = "bifilar.yaml";
     std::string log, rig;
-    double gravity_mps2 = 9.80665;
+    double gravity_mps2 = kStandardGravityMps2;
     bool force = false;
   };
   auto args = std::make_shared<Args>();

@@ -107,7 +107,7 @@ bool TensorPlanRequested(const TensorPlanCli& t) {
 }
 
 int RunTensorPlanFromCli(const TensorPlanCli& t, const CLI::App& plan, int trials, double sigma,
-                         double ixz, bool ixz_given, InertiaUnits units, bool json) {
+                         double ixz, bool ixz_given, DisplayUnits units, bool json) {
   for (const char* name : {"--angles", "--ix", "--iz"}) {
     if (plan.count(name) > 0) {
       throw UserError(std::string("plan --tensor: ") + name +

@@ -35,9 +35,9 @@ void Row(std::ostream& out, const std::string& name, const std::string& a, const
 
 }  // namespace
 
-void PrintEllipseReport(const EllipseResult& r, InertiaUnits units, std::ostream& out) {
+void PrintEllipseReport(const EllipseResult& r, DisplayUnits units, std::ostream& out) {
   const double k = 1.0 / InertiaToSi(units);  // SI -> display
-  const std::string u = InertiaUnitLabel(units);
+  const std::string u = InertiaUnitName(units);
   const char* f = "%.5f";
   out << "Ellipse of inertia: " << r.n_points << " points at " << r.n_angles
       << " angle(s), " << (r.weighted ? "weighted by the given std" : "unweighted")
@@ -148,14 +148,14 @@ void PrintEllipseReport(const EllipseResult& r, InertiaUnits units, std::ostream
   for (const auto& w : r.warnings) out << "warning: " << w << "\n";
 }
 
-std::vector<std::string> WriteEllipsePlots(const EllipseResult& result, InertiaUnits units,
+std::vector<std::string> WriteEllipsePlots(const EllipseResult& result, DisplayUnits units,
                                            const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw UserError(dir + ": cannot create the plot directory: " + ec.message());
   EllipsePlotOptions plot;
   plot.unit_scale = 1.0 / InertiaToSi(units);
-  plot.unit_label = units == InertiaUnits::kSi ? "kg m#u2#d" : "slug ft#u2#d";
+  plot.unit_label = units == DisplayUnits::kSi ? "kg m#u2#d" : "slug ft#u2#d";
   std::vector<std::string> written;
   for (const char* ext : {".png", ".svg"}) {
     const std::string moments = (std::filesystem::path(dir) / "ellipse_moments").string() + ext;
@@ -212,7 +212,7 @@ int RunPlanCommand(const PlanCommandOptions& options, std::ostream& out) {
     return 0;
   }
   const double k = 1.0 / to_si;
-  const std::string u = InertiaUnitLabel(options.units);
+  const std::string u = InertiaUnitName(options.units);
   out << "Planned design: " << options.pitch_deg.size() << " angle(s) x "
       << options.trials_per_angle << " trial(s) = " << plan.n_points << " points, per-trial sigma "
       << Fmt("%.5g ", options.sigma) << u << "\n";

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "base/units.h"
 #include "fit/ellipse.h"
 #include "pipeline/commands/ellipse_table.h"
 
@@ -13,7 +14,7 @@ namespace bifilar {
 
 struct EllipseCommandOptions {
   std::string table_path;                       // CSV: pitch_deg, inertia[, std]
-  InertiaUnits units = InertiaUnits::kSi;       // units of the table and of the console output
+  DisplayUnits units = DisplayUnits::kSi;       // units of the table and of the console output
   bool json = false;                            // print JSON (SI) instead of tables
   std::string plot_dir;                         // write figures here when non-empty
   EllipseOptions fit;                           // seed, bootstrap, covariance, ...
@@ -25,11 +26,11 @@ int RunEllipseCommand(const EllipseCommandOptions& options, std::ostream& out);
 
 // Human-readable report of a fit in the given units (the three fits side by side, Table 1 and
 // Table 2, NACA comparison, outliers, warnings).
-void PrintEllipseReport(const EllipseResult& result, InertiaUnits units, std::ostream& out);
+void PrintEllipseReport(const EllipseResult& result, DisplayUnits units, std::ostream& out);
 
 // Writes ellipse_moments.{png,svg} and ellipse_polar.{png,svg} into dir (created if missing);
 // returns the paths written. Throws UserError if a figure cannot be written.
-std::vector<std::string> WriteEllipsePlots(const EllipseResult& result, InertiaUnits units,
+std::vector<std::string> WriteEllipsePlots(const EllipseResult& result, DisplayUnits units,
                                            const std::string& dir);
 
 struct PlanCommandOptions {
@@ -40,7 +41,7 @@ struct PlanCommandOptions {
   // 2.3596, 2.8477, 0.0178), converted when units are SI.
   double ix = 0.0, iz = 0.0, ixz = 0.0;
   bool guesses_given = false;                   // false: use the defaults above
-  InertiaUnits units = InertiaUnits::kSi;
+  DisplayUnits units = DisplayUnits::kSi;
   bool json = false;
 };
 

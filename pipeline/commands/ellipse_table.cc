@@ -49,28 +49,8 @@ std::string Shown(const std::string& cell) {
 
 }  // namespace
 
-bool ParseInertiaUnits(const std::string& name, InertiaUnits* units) {
-  if (name == "si") {
-    *units = InertiaUnits::kSi;
-    return true;
-  }
-  if (name == "imperial") {
-    *units = InertiaUnits::kImperial;
-    return true;
-  }
-  return false;
-}
-
-double InertiaToSi(InertiaUnits units) {
-  return units == InertiaUnits::kSi ? 1.0 : kKgM2PerSlugFt2;
-}
-
-const char* InertiaUnitLabel(InertiaUnits units) {
-  return units == InertiaUnits::kSi ? "kg m^2" : "slug ft^2";
-}
-
 std::vector<EllipsePoint> ParseEllipseTable(const std::string& text, const std::string& name,
-                                            InertiaUnits units) {
+                                            DisplayUnits units) {
   const double to_si = InertiaToSi(units);
   // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
   const bool bom = text.compare(0, 3, "\xEF\xBB\xBF") == 0;
@@ -145,7 +125,7 @@ std::vector<EllipsePoint> ParseEllipseTable(const std::string& text, const std::
   return points;
 }
 
-std::vector<EllipsePoint> ReadEllipseTable(const std::string& path, InertiaUnits units) {
+std::vector<EllipsePoint> ReadEllipseTable(const std::string& path, DisplayUnits units) {
   std::string bytes = ReadRegularFileOrThrow(path, TableCap("moments table"));
   if (LooksGzipped(bytes)) {  // a .csv.gz table is read like a .csv.gz log
     std::string inflated, why;

@@ -8,21 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "base/units.h"
 #include "fit/ellipse.h"
 
 namespace bifilar {
 
-// Inertia units of a table or a report.
-enum class InertiaUnits { kSi, kImperial };  // "si" = kg m^2, "imperial" = slug ft^2
-
-constexpr double kKgM2PerSlugFt2 = 1.35581795;
-
-// Parses "si" or "imperial"; false otherwise.
-bool ParseInertiaUnits(const std::string& name, InertiaUnits* units);
-// Multiply a value in `units` by this to get kg m^2.
-double InertiaToSi(InertiaUnits units);
-// "kg m^2" or "slug ft^2".
-const char* InertiaUnitLabel(InertiaUnits units);
 
 // Parses the table text; `name` (the file name) prefixes error messages. Throws UserError naming
 // the line and column on: no header, missing pitch_deg or inertia column, an unknown or repeated
@@ -30,9 +20,9 @@ const char* InertiaUnitLabel(InertiaUnits units);
 // [-180, 180], a non-finite or non-positive inertia, a missing, NaN or non-positive std, or no
 // data rows.
 std::vector<EllipsePoint> ParseEllipseTable(const std::string& text, const std::string& name,
-                                            InertiaUnits units);
+                                            DisplayUnits units);
 
 // Reads and parses a table file; throws UserError if the file cannot be read.
-std::vector<EllipsePoint> ReadEllipseTable(const std::string& path, InertiaUnits units);
+std::vector<EllipsePoint> ReadEllipseTable(const std::string& path, DisplayUnits units);
 
 }  // namespace bifilar

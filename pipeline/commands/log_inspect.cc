@@ -9,6 +9,7 @@
 
 #include "base/bounded_read.h"
 #include "base/gzip.h"
+#include "base/units.h"
 #include "base/user_error.h"
 #include "fit/swing_axis.h"
 #include "fit/window.h"
@@ -19,8 +20,6 @@
 
 namespace bifilar {
 namespace {
-
-constexpr double kDegPerRad = 57.29577951308232;
 
 // A gyro reading whose 99th percentile exceeds this (in the file's own numbers) is taken to be
 // in deg/s: a pendulum swinging 90 deg at a 0.6 s period peaks at 10 rad/s, and rigs swing at

@@ -12,6 +12,7 @@
 
 #include "base/atomic_file.h"
 #include "base/gzip.h"
+#include "base/units.h"
 #include "base/user_error.h"
 #include "base/version.h"
 #include "pipeline/config/yaml_reader.h"
@@ -19,10 +20,6 @@
 
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
-constexpr double kSlugFt2ToKgM2 = 1.35581795;  // docs/physics.md §4
 constexpr int kFooterRows = 4;                  // blank line + 3 summary rows (format.footer)
 
 // root.Child(key), safe when the section is absent (yaml-cpp's const operator[] returns an
@@ -274,7 +271,7 @@ double ReadInertia(YamlMap& map, const std::string& stem, bool required, double 
   }
   if (has_imperial) {
     map.Optional(si);
-    return kSlugFt2ToKgM2 * ReadValue(map, imperial, 0, lower, lower_open, 1e9);
+    return kKgM2PerSlugFt2 * ReadValue(map, imperial, 0, lower, lower_open, 1e9);
   }
   map.Optional(imperial);
   if (!has_si && required) {
@@ -341,7 +338,7 @@ SimulateSpec ParseSpec(YamlMap root) {
     }
   }
   std::optional<double> length, separation, true_length, true_separation;
-  double gravity = 9.80665;
+  double gravity = kStandardGravityMps2;
   ReadGeometry(Section(root, "geometry"), &length, &separation, &gravity, &true_length,
                &true_separation);
   ReadFormat(Section(root, "format"), &spec);
@@ -623,7 +620,7 @@ nlohmann::json TraceJson(const CampaignTrace& ct, const SimulateSpec& spec) {
   if (!spec.campaign.attitudes_deg.empty()) {
     j["nominal_roll_deg"] = ct.nominal_roll_deg;
     j["true_roll_deg"] = ct.true_roll_deg;
-    const double p = ct.true_pitch_deg * kDeg, r = ct.true_roll_deg * kDeg;
+    const double p = ct.true_pitch_deg * kRadPerDeg, r = ct.true_roll_deg * kRadPerDeg;
     j["swing_axis_in_body"] = Vec(Eigen::Vector3d(-std::sin(p), std::sin(r) * std::cos(p),
                                                   std::cos(r) * std::cos(p)));
   }
@@ -634,9 +631,9 @@ nlohmann::json TraceJson(const CampaignTrace& ct, const SimulateSpec& spec) {
   j["drag_coeff_kg_m2"] = s.params.drag_coeff_kg_m2;
   j["viscous_coeff_kg_m2_per_s"] = s.params.viscous_coeff_kg_m2_per_s;
   j["small_angle_period_s"] = SmallAnglePeriod(s.geometry, s.params.inertia_kg_m2);
-  j["amplitude_deg"] = t.amplitude_rad / kDeg;
-  j["release_rate_deg_per_s"] = t.release_rate_rad_per_s / kDeg;
-  j["amplitude_at_end_deg"] = t.amplitude_at_stop_rad / kDeg;
+  j["amplitude_deg"] = t.amplitude_rad / kRadPerDeg;
+  j["release_rate_deg_per_s"] = t.release_rate_rad_per_s / kRadPerDeg;
+  j["amplitude_at_end_deg"] = t.amplitude_at_stop_rad / kRadPerDeg;
   j["start_time_s"] = t.start_time_s;
   j["t_twist_s"] = t.t_twist_s;
   j["t_release_s"] = t.t_release_s;
@@ -649,24 +646,24 @@ nlohmann::json TraceJson(const CampaignTrace& ct, const SimulateSpec& spec) {
   j["samples_dropped"] = t.samples_dropped;
   j["free_samples"] = t.free_samples;
   j["swing_axis_in_imu"] = Vec(t.swing_axis_in_imu);
-  j["gyro_bias_deg_per_s"] = Vec(t.gyro_bias_rad_per_s, 1.0 / kDeg);
+  j["gyro_bias_deg_per_s"] = Vec(t.gyro_bias_rad_per_s, 1.0 / kRadPerDeg);
   j["gyro_scale_error"] = Vec(t.gyro_scale_error);
   j["gyro_noise_sigma_deg_per_s"] = so.gyro_noise_sigma_deg_per_s;
   if (so.accelerometer) {
     j["accel_bias_mps2"] = Vec(t.accel_bias_mps2);
     j["accel_noise_sigma_mps2"] = so.accel_noise_sigma_mps2;
   }
-  j["rocking_amplitude_deg"] = t.rocking_amplitude_rad / kDeg;
+  j["rocking_amplitude_deg"] = t.rocking_amplitude_rad / kRadPerDeg;
   j["rocking_frequency_hz"] = t.rocking_frequency_hz;
   j["rocking_axis_in_body"] = Vec(t.rocking_axis_in_body);
   // Realism, recorded when on (see OptionsJson).
   if (so.gyro_bias_walk_deg_per_s_per_sqrt_s > 0) {
-    j["gyro_bias_end_deg_per_s"] = Vec(t.gyro_bias_end_rad_per_s, 1.0 / kDeg);
+    j["gyro_bias_end_deg_per_s"] = Vec(t.gyro_bias_end_rad_per_s, 1.0 / kRadPerDeg);
   }
   if (so.gyro_noise_ar1_phi > 0) j["gyro_noise_ar1_phi"] = so.gyro_noise_ar1_phi;
   if (so.accelerometer && so.accel_gravity_removed) {
     j["accelerometer"] = "gravity_removed";
-    j["gravity_removal_error_deg"] = t.gravity_removal_error_rad / kDeg;
+    j["gravity_removal_error_deg"] = t.gravity_removal_error_rad / kRadPerDeg;
   }
   if (!t.spikes.empty()) {
     nlohmann::json spikes = nlohmann::json::array();
@@ -834,10 +831,10 @@ std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<Campai
                    {"ix_kg_m2", c.aircraft.ix_kg_m2},
                    {"iz_kg_m2", c.aircraft.iz_kg_m2},
                    {"ixz_kg_m2", c.aircraft.ixz_kg_m2},
-                   {"tau_deg", tau / kDeg},
-                   {"ix_slug_ft2", c.aircraft.ix_kg_m2 / kSlugFt2ToKgM2},
-                   {"iz_slug_ft2", c.aircraft.iz_kg_m2 / kSlugFt2ToKgM2},
-                   {"ixz_slug_ft2", c.aircraft.ixz_kg_m2 / kSlugFt2ToKgM2}};
+                   {"tau_deg", tau / kRadPerDeg},
+                   {"ix_slug_ft2", c.aircraft.ix_kg_m2 / kKgM2PerSlugFt2},
+                   {"iz_slug_ft2", c.aircraft.iz_kg_m2 / kKgM2PerSlugFt2},
+                   {"ixz_slug_ft2", c.aircraft.ixz_kg_m2 / kKgM2PerSlugFt2}};
   // Principal moments: I(theta) at theta = tau (z principal) and tau + 90 deg (x principal).
   j["aircraft"]["izp_kg_m2"] = c.aircraft.InertiaAtPitch(tau);
   j["aircraft"]["ixp_kg_m2"] = c.aircraft.InertiaAtPitch(tau + kPi / 2);
@@ -1000,8 +997,8 @@ SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string&
   s.params.inertia_kg_m2 = inertia;
   s.params.drag_coeff_kg_m2 = r.drag_coeff_kg_m2;
   s.params.viscous_coeff_kg_m2_per_s = r.viscous_coeff_kg_m2_per_s;
-  s.pitch_rad = r.pitch_deg * kDeg;
-  s.amplitude_rad = r.amplitude_deg * kDeg;
+  s.pitch_rad = r.pitch_deg * kRadPerDeg;
+  s.amplitude_rad = r.amplitude_deg * kRadPerDeg;
   s.imu_offset_in_body_m = r.imu_offset_m;
   s.body_from_imu = MountingFromRollPitchYawDeg(r.imu_mounting_rpy_deg[0], r.imu_mounting_rpy_deg[1],
                                                 r.imu_mounting_rpy_deg[2]);

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "base/units.h"
 #include "pendulum/simulate.h"
 #include "pipeline/logs/imu_format.h"
 #include "pipeline/logs/imu_log_writer.h"
@@ -21,7 +22,7 @@ struct TraceRequest {
   std::optional<double> mass_kg;            // whole suspended mass m (required)
   std::optional<double> filar_length_m;     // L (required)
   std::optional<double> filar_separation_m; // D (required)
-  double gravity_mps2 = 9.80665;
+  double gravity_mps2 = kStandardGravityMps2;
   double pitch_deg = 0.0;                   // true pitch of the body axes
   double amplitude_deg = 20.0;              // psi at release (sign = twist direction)
   double drag_coeff_kg_m2 = 0.04;           // K_D

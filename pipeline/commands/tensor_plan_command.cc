@@ -132,7 +132,7 @@ int RunTensorPlanCommand(const TensorPlanCommandOptions& options, std::ostream& 
   }
 
   const double k = 1.0 / to_si;
-  const std::string u = InertiaUnitLabel(options.units);
+  const std::string u = InertiaUnitName(options.units);
   out << "Tensor plan: " << plan.orientations.size() << " orientation(s) x "
       << o.trials_per_orientation << " trial(s) = " << plan.n_points << " swings, chosen "
       << "D-optimally from " << plan.n_candidates << " distinct reachable swing axes (roll "

@@ -8,8 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
+#include "base/units.h"
 #include "fit/tensor_plan.h"
-#include "pipeline/commands/ellipse_table.h"  // InertiaUnits
 
 namespace bifilar {
 
@@ -24,7 +24,7 @@ struct TensorPlanCommandOptions {
   double target = 0.0;       // target std of each component, in `units`; 0 = none
   // Target as a fraction of the largest guessed principal moment (needs the guess); 0 = none.
   double target_relative = 0.0;
-  InertiaUnits units = InertiaUnits::kSi;  // of the values above and of the console output
+  DisplayUnits units = DisplayUnits::kSi;  // of the values above and of the console output
   bool json = false;                       // print JSON (SI) instead of the table
 };
 

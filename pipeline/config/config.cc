@@ -1,5 +1,6 @@
 #include "pipeline/config/config.h"
 
+#include "base/units.h"
 #include "fit/ellipse.h"
 
 #include <cctype>
@@ -186,7 +187,7 @@ void ReadImuMounting(YamlMap& imu, ImuConfig* out) {
     }
     if (has_euler) {
       YAML::Node node = mount.Optional("euler_deg");
-      const Eigen::Vector3d rpy = ThreeVector(mount, node, "euler_deg") * (M_PI / 180.0);
+      const Eigen::Vector3d rpy = ThreeVector(mount, node, "euler_deg") * kRadPerDeg;
       // Body-from-IMU rotation R = Rz(yaw) Ry(pitch) Rx(roll) (aerospace ZYX order).
       out->imu_to_body = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
                           Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
@@ -300,42 +301,8 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
 
 }  // namespace
 
-const char* ToString(DisplayUnits units) {
-  return units == DisplayUnits::kSi ? "si" : "imperial";
-}
 const char* ToString(PitchSource source) {
   return source == PitchSource::kNominal ? "nominal" : "measured";
-}
-
-double InertiaToDisplay(double inertia_kg_m2, DisplayUnits units) {
-  return units == DisplayUnits::kSi ? inertia_kg_m2 : inertia_kg_m2 * kSlugFt2PerKgM2;
-}
-const char* InertiaUnitName(DisplayUnits units) {
-  return units == DisplayUnits::kSi ? "kg m^2" : "slug ft^2";
-}
-
-std::string SiTextInDisplayUnits(const std::string& text, DisplayUnits units) {
-  if (units != DisplayUnits::kImperial) return text;
-  const std::string si = " kg m^2";
-  std::string out;
-  size_t at = 0;
-  for (size_t hit = text.find(si); hit != std::string::npos; hit = text.find(si, hit + 1)) {
-    size_t start = hit;
-    while (start > at && (std::isdigit(static_cast<unsigned char>(text[start - 1])) ||
-                          std::strchr(".eE+-", text[start - 1]) != nullptr)) {
-      --start;
-    }
-    char* stop = nullptr;
-    const double value = start < hit ? std::strtod(text.c_str() + start, &stop) : NAN;
-    if (stop != text.c_str() + hit || !std::isfinite(value)) continue;  // not "<number> kg m^2"
-    char buffer[64];
-    std::snprintf(buffer, sizeof(buffer), "%.3g slug ft^2", InertiaToDisplay(value, units));
-    out.append(text, at, start - at);
-    out += buffer;
-    at = hit + si.size();
-  }
-  out.append(text, at, std::string::npos);
-  return out;
 }
 
 std::string ResolvePath(const std::string& folder, const std::string& path) {
@@ -919,10 +886,10 @@ void ReadEllipse(YamlMap ellipse, EllipseConfig* e) {
 // `units`: si or imperial (display only; files stay SI).
 DisplayUnits ReadUnits(YamlMap& root) {
   const std::string units = root.OptionalString("units", "si");
-  if (units == "si") return DisplayUnits::kSi;
-  if (units == "imperial") return DisplayUnits::kImperial;
-  throw UserError(root.Where(root.Optional("units")) + ": 'units' must be si or imperial, not '" +
-                  units + "'");
+  DisplayUnits parsed;
+  if (ParseDisplayUnits(units, &parsed)) return parsed;
+  throw UserError(root.Where(root.Optional("units")) + ": 'units' must be " +
+                  DisplayUnitsAllowedValues() + ", not '" + units + "'");
 }
 
 // `limits`: the size caps of the logs, MB in [1, kMaxLimitMb].

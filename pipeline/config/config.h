@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include "base/units.h"
 #include "fit/glitch.h"
 #include "pendulum/integrator.h"
 #include "pendulum/model.h"
@@ -22,9 +23,7 @@
 
 namespace bifilar {
 
-enum class DisplayUnits { kSi, kImperial };        // "si" (kg m^2), "imperial" (slug ft^2)
 enum class PitchSource { kNominal, kMeasured };    // "nominal", "measured"
-constexpr double kSlugFt2PerKgM2 = 1.0 / 1.35581795;  // docs/physics.md §4
 
 // How the rig's own inertia (subtracted from every total) is known: exactly one of three ways.
 struct RigInertiaSpec {
@@ -219,7 +218,8 @@ struct CampaignConfig {
   RigUncertainties uncertainties;
   double aircraft_mass_kg = 0.0;      // aircraft mass (kg); 0 when only tare logs are fitted
   double aircraft_mass_std_kg = 0.0;  // its standard uncertainty (kg)
-  double gravity_mps2 = 9.80665;      // local gravity (m/s^2); in [9.76, 9.84] (Earth) unless
+  // Local gravity (m/s^2); in [9.76, 9.84] (Earth) unless
+  double gravity_mps2 = kStandardGravityMps2;
   bool gravity_off_earth = false;     // `gravity_off_earth: true`: then in (0, 100]
   ImuConfig imu;
   RunsConfig runs;       // absent (root empty) for a `fit`-only config
@@ -259,15 +259,7 @@ struct ConfigLoadOptions {
 CampaignConfig LoadCampaignConfig(const std::string& path,
                                   const ConfigLoadOptions& options = ConfigLoadOptions());
 
-const char* ToString(DisplayUnits units);
 const char* ToString(PitchSource source);
-
-// Inertia in the display units, and their name ("kg m^2" or "slug ft^2").
-double InertiaToDisplay(double inertia_kg_m2, DisplayUnits units);
-const char* InertiaUnitName(DisplayUnits units);
-// A message written in SI (the fit's warnings) in the display units: under kImperial every
-// "<number> kg m^2" of `text` becomes "<number> slug ft^2" (3 significant digits); kSi: as is.
-std::string SiTextInDisplayUnits(const std::string& text, DisplayUnits units);
 
 // `path` resolved against `folder` unless absolute; lexically normalised.
 std::string ResolvePath(const std::string& folder, const std::string& path);

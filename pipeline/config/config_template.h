@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "base/units.h"
 #include "pipeline/logs/imu_format.h"
 
 namespace bifilar {
@@ -15,7 +16,7 @@ struct StartingConfigOptions {
   double filar_length_m = 0.0;      // L (m); > D
   double filar_separation_m = 0.0;  // D (m); > 0
   double mass_kg = 0.0;             // everything that hangs (rig + aircraft) for a first fit (kg)
-  double gravity_mps2 = 9.80665;    // local gravity (m/s^2)
+  double gravity_mps2 = kStandardGravityMps2;    // local gravity (m/s^2)
   // The format of the logs; none: the reader's defaults (t, gx/gy/gz rad/s, ax/ay/az m/s^2).
   std::optional<ImuFormat> format;
   bool ulog = false;                 // the format is a ULog topic, not CSV columns

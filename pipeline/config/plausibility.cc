@@ -3,10 +3,10 @@
 #include <cmath>
 #include <cstdio>
 
+#include "base/units.h"
+
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 struct UnitGuess {
   const char* name;  // as the user would write it: "mm", "g", "kg cm^2"
@@ -20,7 +20,7 @@ constexpr UnitGuess kInertiaUnits[] = {{"kg cm^2", 1e-4},
                                        {"kg mm^2", 1e-6},
                                        {"g cm^2", 1e-7},
                                        {"lb in^2", 2.9263965e-4},
-                                       {"slug ft^2", 1.35581795}};
+                                       {"slug ft^2", kKgM2PerSlugFt2}};
 
 std::string Num(double value) {
   char buffer[64];
@@ -134,7 +134,7 @@ std::string ImpossibleAmplitude(double largest_amplitude_deg, double smallest_am
   if (!(largest_amplitude_deg > kMaxSwingAmplitudeDeg)) return "";
   char buffer[400];
   if (gyro_unit == RateUnit::kRadPerS) {
-    const double scale = kPi / 180.0;  // deg/s read as rad/s is 57.3 times too large
+    const double scale = kRadPerDeg;  // deg/s read as rad/s is 57.3 times too large
     std::snprintf(
         buffer, sizeof(buffer),
         "the swing reaches %.4g deg, beyond the 180 deg where a bifilar's wires cross: if "

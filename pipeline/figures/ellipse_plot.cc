@@ -7,11 +7,10 @@
 
 #include <plplot.h>
 
+#include "base/units.h"
+
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegToRad = kPi / 180.0;
 
 enum Colour {
   kBlack = kFigureBlack, kBlue = kFigureBlue, kRed = kFigureRed, kGrey = kFigureGrey,
@@ -186,7 +185,7 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
   // Direction of the swing axis at pitch theta in the plot (x forward right, z down):
   // n = (-sin theta, cos theta) in (x, z) -> plot (x, -z) = (-sin theta, -cos theta).
   auto dir = [](double pitch_deg, double* px, double* py) {
-    const double t = pitch_deg * kDegToRad;
+    const double t = pitch_deg * kRadPerDeg;
     *px = -std::sin(t);
     *py = -std::cos(t);
   };

@@ -7,6 +7,8 @@
 
 #include <plplot.h>
 
+#include "base/units.h"
+
 namespace bifilar {
 namespace {
 
@@ -26,8 +28,8 @@ std::string Fmt(const char* format, double v) {
 void DrawRing(double mx, double my, double rx, double ry) {
   PLFLT cx[41], cy[41];
   for (int j = 0; j <= 40; ++j) {
-    cx[j] = mx + rx * std::cos(2.0 * M_PI * j / 40.0);
-    cy[j] = my + ry * std::sin(2.0 * M_PI * j / 40.0);
+    cx[j] = mx + rx * std::cos(2.0 * kPi * j / 40.0);
+    cy[j] = my + ry * std::sin(2.0 * kPi * j / 40.0);
   }
   plcol0(kRed);
   plwidth(2.0);

@@ -7,10 +7,10 @@
 
 #include <plplot.h>
 
+#include "base/units.h"
+
 namespace bifilar {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string Fmt(const char* format, double v) {
   char buf[64];

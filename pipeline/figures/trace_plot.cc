@@ -7,6 +7,7 @@
 
 #include <plplot.h>
 
+#include "base/units.h"
 #include "pipeline/figures/figure.h"
 
 namespace bifilar {
@@ -22,8 +23,6 @@ std::string Fmt(const char* format, double v) {
   std::snprintf(buf, sizeof buf, format, v);
   return buf;
 }
-
-constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
 
 // Above this many samples a dot per sample is drawn no more (a 3 M-sample log took 110 s and gave
 // a 750 MB SVG): each series becomes its min/max envelope over `buckets` equal index ranges, as a

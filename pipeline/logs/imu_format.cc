@@ -2,10 +2,9 @@
 
 #include <set>
 
-namespace bifilar {
+#include "base/units.h"
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kStandardGravityMps2 = 9.80665;
+namespace bifilar {
 
 bool ParseTimeUnit(const std::string& name, TimeUnit* unit) {
   if (name == "s") *unit = TimeUnit::kSeconds;
@@ -50,7 +49,7 @@ double ToSi(TimeUnit unit) {
   return 1.0;
 }
 
-double ToSi(RateUnit unit) { return unit == RateUnit::kRadPerS ? 1.0 : kPi / 180.0; }
+double ToSi(RateUnit unit) { return unit == RateUnit::kRadPerS ? 1.0 : kRadPerDeg; }
 double ToSi(AccelUnit unit) { return unit == AccelUnit::kMetresPerS2 ? 1.0 : kStandardGravityMps2; }
 
 bool ImuFormat::Check(std::string* why) const {

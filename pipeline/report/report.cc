@@ -14,8 +14,8 @@
 #include "base/bounded_read.h"
 #include "base/hash.h"
 #include "base/json_error.h"
+#include "base/units.h"
 #include "base/user_error.h"
-#include "pipeline/config/config.h"
 #include "pipeline/records/total_uncertainty.h"
 #include "pipeline/store/output_set.h"
 
@@ -413,7 +413,7 @@ struct ReportPage {
       : results(results_in), out_dir(out_dir_in) {
     if (Str(results, "units") == "imperial") {
       u.imperial = true;
-      u.scale = 1.0 / 1.35581795;
+      u.scale = kSlugFt2PerKgM2;
       u.name = "slug ft<sup>2</sup>";
     }
   }

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <new>
 
+#include "base/units.h"
 #include "base/user_error.h"
 #include "fit/block_mean.h"
 #include "fit/glitch.h"
@@ -85,18 +86,17 @@ void Envelope(const std::vector<double>& t, const std::vector<double>& v, size_t
 bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
                             DisplayUnits units, const std::string& path, int width_px,
                             int height_px, std::string* why) {
-  constexpr double kDeg = 180.0 / M_PI;
   // Top: measured and fitted rate at ~250 points (the noise is invisible at this scale; it shows
   // in the residual panel). Bottom: the residual's min/max envelope over 150 buckets.
   std::vector<PLFLT> tm, ym, tf, yf, tr, yr;
   const size_t stride = std::max<size_t>(1, fit.t_s.size() / 250);
   for (size_t i = 0; i < fit.t_s.size(); i += stride) {
     tm.push_back(fit.t_s[i] - fit.t_s[0]);
-    ym.push_back(kDeg * fit.measured_rate_rad_per_s[i]);
-    yf.push_back(kDeg * fit.fitted_rate_rad_per_s[i]);
+    ym.push_back(kDegPerRad * fit.measured_rate_rad_per_s[i]);
+    yf.push_back(kDegPerRad * fit.fitted_rate_rad_per_s[i]);
   }
   tf = tm;
-  Envelope(fit.t_s, fit.residual_rad_per_s, 150, -kDeg, &tr, &yr);  // measured - fitted
+  Envelope(fit.t_s, fit.residual_rad_per_s, 150, -kDegPerRad, &tr, &yr);  // measured - fitted
   if (tm.size() < 2) {
     *why = "nothing to plot";
     return false;
@@ -105,7 +105,7 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
   double y_max = 0.0, r_max = 0.0;
   for (double v : ym) y_max = std::max(y_max, std::abs(v));
   for (double v : yr) r_max = std::max(r_max, std::abs(v));
-  const double noise = kDeg * fit.noise_rad_per_s;
+  const double noise = kDegPerRad * fit.noise_rad_per_s;
   r_max = std::max(r_max, 2.5 * noise) * 1.1;
   y_max = std::max(y_max, 1e-6) * 1.1;
   char label[256];
