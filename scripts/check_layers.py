@@ -2,6 +2,7 @@
 """The walls of issue 24: fails (exit 1) on an include cycle between units, or on an include that
 goes against the declared component dependencies. Run by CTest as layout/layers:
   python3 scripts/check_layers.py SOURCE_DIR
+  python3 scripts/check_layers.py --self-test   # CTest layout/layers_self_test: it finds faults
 A unit is x.h + x.cc + a private x_steps.h in one folder. A component is a folder below; a file
 may include its own component and any component reachable through its declared dependencies:
 the same graph that target_link_libraries declares in CMakeLists.txt and pipeline/CMakeLists.txt
@@ -179,5 +180,45 @@ def main():
     return 1 if errors else 0
 
 
+def self_test():
+    """The check finds what it must: run on a small tree with one fault of each kind."""
+    import shutil, subprocess, tempfile
+    tmp = tempfile.mkdtemp()
+    try:
+        def write(path, text):
+            os.makedirs(os.path.join(tmp, os.path.dirname(path)), exist_ok=True)
+            open(os.path.join(tmp, path), "w").write(text)
+        links = "".join("bifilar_component(%s %s)\ntarget_link_libraries(bifilar_%s %s)\n"
+                        % (n, f, n, " ".join("bifilar::" + d for d in deps))
+                        for n, (f, deps) in COMPONENTS.items())
+        write("CMakeLists.txt", links)
+        write("fit/a.h", '#include "fit/b.h"\n')
+        write("fit/b.h", "")
+        write("fit/b.cc", '#include "fit/a.h"\n')            # cycle a <-> b (b.h + b.cc)
+        write("pipeline/config/c.h", "")
+        write("pipeline/logs/d.cc", '#include "pipeline/config/c.h"\n')  # logs below config
+        write("pipeline/stray.h", "")                          # no component
+        out = subprocess.run([sys.executable, os.path.abspath(__file__), tmp],
+                             capture_output=True, text=True).stdout
+        want = ["include cycle between units fit/a fit/b",
+                "pipeline/logs/d.cc:1: pipeline/logs/d.cc (logs) may not include",
+                "pipeline/stray.h: not in a component folder", "3 problems"]
+        missing = [w for w in want if w not in out]
+        write("CMakeLists.txt", links.replace("bifilar_component(cli pipeline/cli)", ""))
+        for f in ("fit/a.h", "fit/b.h", "fit/b.cc", "pipeline/logs/d.cc", "pipeline/stray.h"):
+            os.remove(os.path.join(tmp, f))
+        out2 = subprocess.run([sys.executable, os.path.abspath(__file__), tmp],
+                              capture_output=True, text=True).stdout
+        if "CMake: no bifilar_component(cli pipeline/cli)" not in out2:
+            missing.append("a component missing from CMake")
+        print(out + out2)
+        print("self-test: " + ("missed " + "; ".join(missing) if missing else "ok"))
+        return 1 if missing else 0
+    finally:
+        shutil.rmtree(tmp)
+
+
 if __name__ == "__main__":
+    if sys.argv[1:2] == ["--self-test"]:
+        sys.exit(self_test())
     sys.exit(main())
