@@ -386,12 +386,14 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
     try {
       const YAML::Node config = YAML::Load(j["config"].get<std::string>());
       const YAML::Node aircraft = config.IsMap() ? config["aircraft"] : YAML::Node();
-      if (aircraft.IsMap() && aircraft["mass_kg"].IsScalar()) {
+      // A key that is absent gives an invalid node, whose IsScalar() throws: IsDefined first.
+      const auto scalar = [&aircraft](const char* key) {
+        return aircraft[key].IsDefined() && aircraft[key].IsScalar();
+      };
+      if (aircraft.IsMap() && scalar("mass_kg")) {
         in.mass_kg = aircraft["mass_kg"].as<double>();
         in.mass_source = "config aircraft.mass_kg";
-        if (aircraft["mass_std_kg"].IsScalar()) {
-          in.mass_std_kg = aircraft["mass_std_kg"].as<double>();
-        }
+        if (scalar("mass_std_kg")) in.mass_std_kg = aircraft["mass_std_kg"].as<double>();
       }
     } catch (const YAML::Exception& e) {
       in.warnings.push_back(name + ": the stored config could not be read for the mass (" +
@@ -507,8 +509,11 @@ int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err
   }
   if (!options.out_path.empty()) {
     RefuseCampaignFile(options.out_path, path);
-    CheckFileTarget(options.out_path);  // a link, device, folder (pipeline/atomic_file.h)
-    if (!WrittenByExport(options.out_path)) RefuseToReplace(options.out_path, "export --out", options.force);
+    // A link, device or folder first: only a regular file is opened to see who wrote it.
+    CheckFileTarget(options.out_path);  // pipeline/atomic_file.h
+    if (!WrittenByExport(options.out_path)) {
+      RefuseToReplace(options.out_path, "export --out", options.force);
+    }
   }
   std::string text;
   if (!ReadRegularFile(path, OutputFileCap(), &text, &why)) throw UserError(why);
