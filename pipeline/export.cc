@@ -204,13 +204,16 @@ void RefuseCampaignFile(const std::string& out_path, const std::string& results_
   const fs::path folder = input.parent_path();
   const fs::path relative = out.lexically_relative(folder);
   if (relative.empty() || *relative.begin() == "..") return;  // outside the output folder
+  // The folder is a campaign's when the input is its results.json or it holds a manifest.
+  const bool has_manifest = fs::exists(folder / OutputManifest::kFileName, ec);
+  if (input.filename() != "results.json" && !has_manifest) return;
   const std::string first = relative.begin()->string();
   bool owned = first == "cache" || first == "figures" || first == OutputManifest::kFileName ||
                first == ".bifilar.lock";
   for (const char* name : {"results.json", "traces.csv", "angles.csv", "report.html"}) {
     owned = owned || relative == name;
   }
-  if (!owned && fs::exists(folder / OutputManifest::kFileName, ec)) {
+  if (!owned && has_manifest) {
     try {
       owned = OutputManifest(folder.string()).Contains(relative.generic_string());
     } catch (const UserError&) {

@@ -1,7 +1,5 @@
 #include "pipeline/ulog.h"
 
-#include "pipeline/simulated_log.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
