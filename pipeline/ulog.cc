@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "pipeline/imu_log_finish.h"
+#include "pipeline/simulated_log.h"
 #include "pipeline/user_error.h"
 
 namespace bifilar {
@@ -145,6 +146,7 @@ class Parser {
   void OnFormat(uint64_t offset, const unsigned char* body, uint32_t size);
   void OnSubscription(uint64_t offset, const unsigned char* body, uint32_t size);
   void OnData(uint64_t offset, const unsigned char* body, uint32_t size);
+  void NoteSimulatedInfo(const unsigned char* body, uint32_t size);
 
   uint32_t SizeOf(const std::string& type, uint64_t offset, int depth);
   void Flatten(const std::string& type, const std::string& prefix, uint32_t base, uint64_t offset,
@@ -156,6 +158,7 @@ class Parser {
   const std::string& name_;
   const UlogRequest& request_;
   UlogContents out_;
+  bool simulated_noted_ = false;
 
   std::map<std::string, RawFormat> formats_;
   std::map<std::string, uint32_t> sizes_;  // memoised SizeOf
@@ -267,11 +270,26 @@ void Parser::OnMessage(uint64_t offset, char type, const unsigned char* body, ui
                          (size > skip ? std::to_string(body[skip]) : std::string("missing")) +
                          " exceeds the message (" + std::to_string(size) + " bytes)");
       }
+      if (type == 'I') NoteSimulatedInfo(body, size);  // pipeline/simulated_log.h
       return;
     }
     default:
       return;  // 'S' (sync) and message types newer than this reader: skipped, as the spec asks
   }
+}
+
+// An info message "char[N] bifilar_simulated" (the key length was checked): a log written by
+// `bifilar simulate` says so once in the warnings (pipeline/simulated_log.h).
+void Parser::NoteSimulatedInfo(const unsigned char* body, uint32_t size) {
+  const std::string_view key(reinterpret_cast<const char*>(body) + 1, body[0]);
+  const std::string suffix = std::string("] ") + kSimulatedUlogInfoKey;
+  if (key.substr(0, 5) != "char[" || key.size() < suffix.size() ||
+      key.substr(key.size() - suffix.size()) != suffix || simulated_noted_) {
+    return;
+  }
+  simulated_noted_ = true;
+  out_.warnings.push_back(SimulatedLogWarning(std::string_view(
+      reinterpret_cast<const char*>(body) + 1 + body[0], size - 1 - body[0])));
 }
 
 void Parser::OnFlagBits(uint64_t offset, const unsigned char* body, uint32_t size) {

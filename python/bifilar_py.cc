@@ -580,6 +580,7 @@ struct SimulateArgs {
   std::optional<double> inertia_kg_m2, mass_kg, length_m, separation_m, g, amplitude_deg,
       pitch_deg, duration_s, sample_rate_hz;
   bool no_accel = false;
+  bool force = false;  // replace files that exist (as `bifilar simulate --force`)
 };
 
 // A file simulate just wrote (truth.json), read back within the result-file cap.
@@ -631,7 +632,7 @@ py::dict SimulateCore(const SimulateArgs& a) {
       if (a.separation_m) spec.campaign.filar_separation_m = *a.separation_m;
       if (a.g) spec.campaign.gravity_mps2 = *a.g;
       if (!spec.campaign.Check(&why) || !spec.options.Check(&why)) throw UserError(why);
-      summary = RunSimulateCampaign(spec, *a.out);
+      summary = RunSimulateCampaign(spec, *a.out, a.force);
     } else {  // one trace, into trace= or in memory (a temporary file read back)
       if (spec.has_campaign) {
         throw std::invalid_argument(*a.spec + ": has campaign sections (aircraft, rig, "
@@ -665,7 +666,7 @@ py::dict SimulateCore(const SimulateArgs& a) {
         csv = (temp / "trace.csv").string();
       }
       try {
-        summary = RunSimulateTrace(spec, csv, a.truth.value_or(""));
+        summary = RunSimulateTrace(spec, csv, a.truth.value_or(""), a.force);
         data = ReadImuLog(csv, spec.format);
       } catch (...) {
         if (!temp.empty()) std::filesystem::remove_all(temp);
@@ -851,6 +852,7 @@ PYBIND11_MODULE(_core, m) {
         get("duration_s", &a.duration_s);
         get("sample_rate_hz", &a.sample_rate_hz);
         if (kwargs.contains("no_accel")) a.no_accel = kwargs["no_accel"].cast<bool>();
+        if (kwargs.contains("force")) a.force = kwargs["force"].cast<bool>();
         return SimulateCore(a);
       },
       "simulate(**settings) -> dict: `bifilar simulate`, a campaign (spec, out) or one trace "
