@@ -23,7 +23,10 @@ constexpr int kMaxNestingDepth = kUlogMaxNestingDepth;  // nested type levels, t
 // never be logged. So a topic flattens to at most 65535 fields.
 constexpr uint64_t kMaxTypeSize = 65535;
 constexpr uint64_t kMaxFlatNameBytes = kUlogMaxFlatNameBytes;  // all flattened names of a type
-constexpr uint64_t kMaxFormatWork = 10000000;  // format fields visited while sizing, per file
+// Format fields visited while sizing, locating timestamps and flattening, per file: a file that
+// redefines formats or re-subscribes topics over and over cannot make the reader quadratic.
+// PX4 logs take ~1e4; 2e6 take ~1 s.
+constexpr uint64_t kMaxFormatWork = 2000000;
 
 enum class Kind : uint8_t { kI8, kU8, kI16, kU16, kI32, kU32, kI64, kU64, kF32, kF64, kBool, kChar, kNested };
 
@@ -186,7 +189,20 @@ class Parser {
   std::map<std::string, RawFormat> formats_;
   std::map<std::string, TypeInfo> measured_;  // memoised Measure
   std::vector<std::string> resolving_;        // types being measured, outermost first
-  uint64_t format_work_ = 0;                  // fields visited by Measure
+  uint64_t format_work_ = 0;                  // steps of Measure, FindTimestamp and Flatten
+  // Memoised FindTimestamp (offset, or -1: none) and Resolve of the wanted topic; cleared with
+  // measured_ when a format is redefined.
+  std::map<std::string, std::pair<int32_t, Kind>> timestamps_;
+  std::map<std::string, Layout> layouts_;
+  // Counts `steps` of format work; fails past kMaxFormatWork.
+  void Spend(uint64_t steps, uint64_t offset) {
+    format_work_ += steps;
+    if (format_work_ > kMaxFormatWork) {
+      Fail(offset, "the format definitions need more than " + std::to_string(kMaxFormatWork) +
+                       " steps to resolve (formats redefined or topics subscribed over and "
+                       "over?): the file is damaged or crafted");
+    }
+  }
   std::vector<uint64_t> appended_offsets_;
   std::vector<uint8_t> msg_role_;          // by msg_id
   std::vector<int> subscription_index_;    // by msg_id into out_.subscriptions (-1: none)
@@ -376,7 +392,11 @@ void Parser::OnFormat(uint64_t offset, const unsigned char* body, uint32_t size)
   if (format.fields.empty()) Fail(offset, "format '" + Printable(type_name) + "' has no fields");
   // A new type changes no measured one (a type used before its definition was not measured);
   // a redefinition may.
-  if (formats_.count(type_name) != 0) measured_.clear();
+  if (formats_.count(type_name) != 0) {
+    measured_.clear();
+    timestamps_.clear();
+    layouts_.clear();
+  }
   formats_[type_name] = std::move(format);
 }
 
@@ -403,10 +423,7 @@ Parser::TypeInfo Parser::Measure(const std::string& type, uint64_t offset) {
   TypeInfo info;
   uint64_t size = 0;
   for (const RawField& f : it->second.fields) {
-    if (++format_work_ > kMaxFormatWork) {
-      Fail(at, "the format definitions need more than " + std::to_string(kMaxFormatWork) +
-                   " steps to size (redefined over and over?): the file is damaged or crafted");
-    }
+    Spend(1, at);
     const TypeInfo element = Measure(f.type, at);
     size += static_cast<uint64_t>(element.size) * f.array_len;
     if (size > kMaxTypeSize) {
@@ -440,6 +457,7 @@ void Parser::Flatten(const std::string& type, const std::string& prefix, uint32_
   const RawFormat& format = formats_.at(type);
   uint32_t at = base;
   for (const RawField& f : format.fields) {
+    Spend(IsPadding(f) ? 1 : f.array_len, format.byte_offset);
     const uint32_t element = SizeOf(f.type, format.byte_offset);
     const Scalar* scalar = FindScalar(f.type);
     for (uint32_t i = 0; i < f.array_len && !IsPadding(f); ++i) {
@@ -456,6 +474,7 @@ void Parser::Flatten(const std::string& type, const std::string& prefix, uint32_
 }
 
 Layout Parser::Resolve(const std::string& topic, uint64_t offset) {
+  if (const auto it = layouts_.find(topic); it != layouts_.end()) return it->second;
   if (formats_.find(topic) == formats_.end()) {
     Fail(offset, "topic '" + Printable(topic) + "' is subscribed but has no format definition");
   }
@@ -466,28 +485,39 @@ Layout Parser::Resolve(const std::string& topic, uint64_t offset) {
   Flatten(topic, "", 0, &layout);
   const RawField& last = formats_.at(topic).fields.back();
   if (IsPadding(last)) layout.trailing_padding = SizeOf(last.type, offset) * last.array_len;
+  layouts_[topic] = layout;
   return layout;
 }
 
 bool Parser::FindTimestamp(const std::string& topic, uint64_t offset, uint32_t* at, Kind* kind) {
+  if (const auto it = timestamps_.find(topic); it != timestamps_.end()) {
+    *at = static_cast<uint32_t>(std::max(0, it->second.first));
+    *kind = it->second.second;
+    return it->second.first >= 0;
+  }
   const auto it = formats_.find(topic);
-  if (it == formats_.end()) return false;
+  if (it == formats_.end()) return false;  // not memoised: the format may come later
+  std::pair<int32_t, Kind> found{-1, Kind::kU64};
   try {
-    uint32_t position = 0;
+    uint64_t position = 0;
     for (const RawField& f : it->second.fields) {
+      Spend(1, offset);
       const Scalar* scalar = FindScalar(f.type);
       if (f.name == "timestamp" && !f.is_array && scalar != nullptr) {
-        *at = position;
-        *kind = scalar->kind;
-        return true;
+        found = {static_cast<int32_t>(position), scalar->kind};
+        break;
       }
-      position += SizeOf(f.type, offset) * f.array_len;
-      if (position > kMaxTypeSize) return false;
+      position += static_cast<uint64_t>(SizeOf(f.type, offset)) * f.array_len;
+      if (position > kMaxTypeSize) break;
     }
   } catch (const UserError&) {
-    resolving_.clear();  // the topic is listed without a rate; a later use names the fault
+    resolving_.clear();  // listed without a rate; a use of the topic names the fault
+    if (format_work_ > kMaxFormatWork) throw;
   }
-  return false;
+  timestamps_[topic] = found;
+  *at = static_cast<uint32_t>(std::max(0, found.first));
+  *kind = found.second;
+  return found.first >= 0;
 }
 
 // What is lost when the last section ends inside a message at `pos`.
@@ -534,6 +564,7 @@ void Parser::OnSubscription(uint64_t offset, const unsigned char* body, uint32_t
   if (s.topic == request_.topic && s.multi_id == request_.multi_id) {
     msg_role_[s.msg_id] = kWanted;
     const Layout layout = Resolve(s.topic, offset);
+    Spend(layout.fields.size() * (1 + request_.fields.size()), offset);  // copied and searched
     out_.fields.clear();
     out_.field_types.clear();
     for (const FlatField& f : layout.fields) {
