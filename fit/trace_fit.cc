@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 #include <tuple>
 
@@ -68,6 +69,21 @@ bool ValidateTraceFit(const TraceFitInput& input, const TraceFitOptions& options
         << " s)";
       return fail(s.str());
     }
+  }
+  // Timestamps the integrator can step through: a span of at most 1e6 s, and a double at the
+  // largest |t| resolving 1e-3 of the median step (as the log readers require).
+  if (n >= 2) {
+    const double span = input.t_s.back() - input.t_s.front();
+    std::vector<double> steps(n - 1);
+    for (size_t k = 1; k < n; ++k) steps[k - 1] = input.t_s[k] - input.t_s[k - 1];
+    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+    const double largest = std::max(std::abs(input.t_s.front()), std::abs(input.t_s.back()));
+    if (span > 1e6)
+      return fail("the window spans " + Fmt("%g", span) + " s, more than 1e6 s: check the time unit");
+    if (largest * std::numeric_limits<double>::epsilon() > 1e-3 * steps[steps.size() / 2])
+      return fail("timestamps near " + Fmt("%g", largest) + " s are too large for samples " +
+                  Fmt("%g", steps[steps.size() / 2]) +
+                  " s apart (a double resolves them too coarsely); subtract the start time");
   }
   if (!std::isfinite(input.noise_rad_per_s) || !std::isfinite(input.secondary_motion_ratio))
     return fail("non-finite noise or secondary motion ratio");

@@ -112,6 +112,17 @@ TEST(TraceFitBounds, BoundsAndFlagLeaveANormalFitUnchanged) {
   EXPECT_FALSE(r.interrupted);
 }
 
+// Timestamps too large for a double to resolve the steps: an error naming them, not Ceres'
+// "Residual and Jacobian evaluation failed".
+TEST(TraceFitBounds, HugeTimestampsAreAnErrorBeforeTheSolver) {
+  TraceFitInput input = Simulated(false);
+  for (double& t : input.t_s) t += 1e12;
+  const TraceFitResult r = FitTrace(input, TraceFitOptions());
+  EXPECT_EQ(r.status, TraceFitStatus::kError);
+  EXPECT_EQ(r.message.rfind("sim.csv: timestamps near 1e+12 s are too large for samples", 0), 0u)
+      << r.message;
+}
+
 TEST(TraceFitBounds, OptionsCheckNamesTheBounds) {
   TraceFitOptions options;
   std::string why;

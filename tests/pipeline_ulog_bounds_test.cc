@@ -4,6 +4,7 @@
 // Each is refused with a message naming the file and the format, or read in one pass; the time
 // and memory these take are measured by bench/ulog_bench.cc, not asserted here.
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -220,6 +221,35 @@ TEST(UlogBounds, InspectDoesNotEchoAHugeLine) {
   EXPECT_LT(r.error.size(), 400u) << r.error.substr(0, 300);
   EXPECT_TRUE(Contains(r.error, "column0, column1")) << r.error;
   EXPECT_TRUE(Contains(r.error, "\u2026")) << r.error;
+}
+
+// Timestamps a fit cannot use (issue 23: they ended in Ceres' "Residual and Jacobian evaluation
+// failed"): refused by the reader, naming the file.
+TEST(LogTimestamps, HugeOrSpreadTimestampsAreRefusedByName) {
+  auto csv = [](double t0, double dt) {
+    std::string text = "t,gx,gy,gz\n";
+    char line[128];
+    for (int k = 0; k < 50; ++k) {
+      std::snprintf(line, sizeof(line), "%.17g,0.1,0,0\n", t0 + k * dt);
+      text += line;
+    }
+    return text;
+  };
+  EXPECT_NO_THROW(ReadImuLogFromString(csv(1.7e9, 0.01), "unix.csv", ImuFormat()));  // Unix time
+  std::string e = ErrorOf([&] { ReadImuLogFromString(csv(1e12, 0.01), "huge.csv", ImuFormat()); });
+  EXPECT_EQ(e.rfind("huge.csv: timestamps near 1e+12 s are too large for samples 0.01", 0), 0u)
+      << e;
+  e = ErrorOf([&] { ReadImuLogFromString(csv(0.0, 1e5), "spread.csv", ImuFormat()); });
+  EXPECT_EQ(e.rfind("spread.csv: the timestamps span 4.9e+06 s", 0), 0u) << e;
+  // A ULog whose uint64 timestamps (us) are near 2^63.
+  ImuData in;
+  for (int k = 0; k < 50; ++k) {
+    in.t_s.push_back(9e12 + 0.004 * k);
+    in.gyro_in_imu.emplace_back(0.1, 0.0, 0.0);
+    in.accel_in_imu.emplace_back(0.0, 0.0, -9.8);
+  }
+  e = ErrorOf([&] { ReadUlogImu(FormatImuUlog(in), "huge.ulg", ImuFormat()); });
+  EXPECT_EQ(e.rfind("huge.ulg: timestamps near 9e+12 s are too large", 0), 0u) << e;
 }
 
 }  // namespace
