@@ -259,8 +259,13 @@ py::tuple FitTraceCore(const Array& t_array, const Array& rate_array, const FitT
   std::mutex mutex;
   std::condition_variable cv;
   bool finished = false;
+  std::exception_ptr error;  // ProcessTraceData never throws, but memory may run out
   std::thread worker([&] {
-    record = ProcessTraceData(config, data, args.name, options, &fit);  // never throws
+    try {
+      record = ProcessTraceData(config, data, args.name, options, &fit);
+    } catch (...) {
+      error = std::current_exception();
+    }
     const std::lock_guard<std::mutex> lock(mutex);
     finished = true;
     cv.notify_one();
@@ -284,6 +289,7 @@ py::tuple FitTraceCore(const Array& t_array, const Array& rate_array, const FitT
     worker.join();
   }
   if (interrupted) throw py::error_already_set();
+  if (error) std::rethrow_exception(error);
   if (record.status == TraceStatus::kError) throw UserError(record.message);
   return py::make_tuple(ToPython(TraceRecordToJson(record, false)), ToNumpy(fit.t_s),
                         ToNumpy(fit.measured_rate_rad_per_s), ToNumpy(fit.fitted_rate_rad_per_s),
