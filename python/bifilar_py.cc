@@ -15,6 +15,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -246,14 +247,49 @@ py::tuple FitTraceCore(const Array& t_array, const Array& rate_array, const FitT
 
   TraceRecord record;
   TraceFitResult fit;
+  ImuData data;
+  data.t_s = std::move(t);
+  data.gyro_in_imu.resize(rate.size());
+  for (size_t i = 0; i < rate.size(); ++i) data.gyro_in_imu[i] = Eigen::Vector3d(0, 0, rate[i]);
+  // The fit runs on a thread of its own while this (the caller's) thread waits, checking for
+  // Ctrl-C every 20 ms: KeyboardInterrupt then stops the fit between solver iterations
+  // (TraceFitOptions::interrupt) and is raised as soon as the fit has stopped.
+  std::atomic<bool> interrupt{false};
+  options.interrupt = &interrupt;
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool finished = false;
+  std::exception_ptr error;  // ProcessTraceData never throws, but memory may run out
+  std::thread worker([&] {
+    try {
+      record = ProcessTraceData(config, data, args.name, options, &fit);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    const std::lock_guard<std::mutex> lock(mutex);
+    finished = true;
+    cv.notify_one();
+  });
+  bool interrupted = false;
+  while (true) {
+    bool done = false;
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(mutex);
+      done = cv.wait_for(lock, std::chrono::milliseconds(20), [&] { return finished; });
+    }
+    if (done) break;
+    if (!interrupted && PyErr_CheckSignals() != 0) {  // the exception stays set until raised
+      interrupted = true;
+      interrupt = true;
+    }
+  }
   {
     py::gil_scoped_release release;
-    ImuData data;
-    data.t_s = std::move(t);
-    data.gyro_in_imu.resize(rate.size());
-    for (size_t i = 0; i < rate.size(); ++i) data.gyro_in_imu[i] = Eigen::Vector3d(0, 0, rate[i]);
-    record = ProcessTraceData(config, data, args.name, options, &fit);
+    worker.join();
   }
+  if (interrupted) throw py::error_already_set();
+  if (error) std::rethrow_exception(error);
   if (record.status == TraceStatus::kError) throw UserError(record.message);
   return py::make_tuple(ToPython(TraceRecordToJson(record, false)), ToNumpy(fit.t_s),
                         ToNumpy(fit.measured_rate_rad_per_s), ToNumpy(fit.fitted_rate_rad_per_s),
