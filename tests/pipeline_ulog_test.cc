@@ -407,7 +407,9 @@ TEST(UlogReader, FuzzedFilesNeverCrash) {
       const ImuData d = ReadUlogImu(bytes, "fuzz.ulg", ImuFormat());
       for (size_t k = 0; k < d.size(); ++k) {
         ASSERT_TRUE(std::isfinite(d.t_s[k]) && d.gyro_in_imu[k].allFinite()) << what;
-        if (k > 0) ASSERT_GT(d.t_s[k], d.t_s[k - 1]) << what;
+        if (k > 0) {
+          ASSERT_GT(d.t_s[k], d.t_s[k - 1]) << what;
+        }
       }
     } catch (const UserError& e) {
       ASSERT_EQ(std::string(e.what()).rfind("fuzz.ulg: ", 0), 0u) << what << ": " << e.what();
