@@ -129,10 +129,10 @@ enum class RealData { kFound, kNotNamed, kMissing, kUnlabelled };
 // Finds `relative` ("crazyflie", "px4/sample_log_small.ulg") in the data folder: sets `*path`
 // (always, so a message can name it) and, unless found, `*why`.
 inline RealData FindRealData(const std::string& relative, std::string* path, std::string* why) {
-  const char* label = std::getenv("BIFILAR_REALDATA_LABEL");  // set by CTest for every test
+  const char* label = std::getenv("BIFILAR_REALDATA_LABEL");  // "0": CTest, not labelled
   const char* dir = std::getenv("BIFILAR_DATA_DIR");
   *path = std::string(dir != nullptr ? dir : "") + "/" + relative;
-  if (label != nullptr && std::string(label) != "1") {
+  if (label != nullptr && std::string(label) == "0") {
     *why = "this test reads real data (" + relative +
            ") but CTest runs it without the label realdata: add its name to realdata_tests in "
            "tests/CMakeLists.txt";

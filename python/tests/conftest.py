@@ -54,7 +54,7 @@ def real_data(relative):
     needs @pytest.mark.realdata, which python/CMakeLists.txt registers with the label)."""
     folder = os.environ.get("BIFILAR_DATA_DIR", "")
     path = pathlib.Path(folder) / relative
-    if os.environ.get("BIFILAR_REALDATA_LABEL", "1") != "1":
+    if os.environ.get("BIFILAR_REALDATA_LABEL") == "0":
         pytest.fail(f"this test reads real data ({relative}) but runs without the realdata "
                     "label: mark it @pytest.mark.realdata")
     if not folder:
