@@ -30,11 +30,12 @@ log="$here/build/Testing/test_sh_ctest.log"
 mkdir -p "$(dirname "$log")"
 status=0
 ctest --output-on-failure -j"$(nproc)" 2>&1 | tee "$log" || status=$?
-# Real-data tests that did not run: CTest lists skipped tests as "  NUMBER - NAME (Skipped)".
+# Real-data tests that did not run: CTest's line "Test #N: NAME ....***Skipped".
 labelled=$(ctest -N -L realdata | sed -n 's/^ *Test *#[0-9]*: //p')
 skipped=0
 while read -r name; do
-  [ -n "$name" ] && grep -qE " - ${name//./\\.} \(Skipped\)" "$log" && skipped=$((skipped + 1))
+  [ -n "$name" ] && grep -qE "Test +#[0-9]+: ${name//./\\.} \.*\*+Skipped" "$log" &&
+    skipped=$((skipped + 1))
 done <<< "$labelled"
 total=$(printf '%s\n' "$labelled" | grep -c . || true)
 folder=$(sed -n 's/^BIFILAR_DATA_DIR:PATH=//p' CMakeCache.txt)
