@@ -19,6 +19,7 @@
 #include "pipeline/simulate_spec.h"
 #include "pipeline/simulated_log.h"
 #include "pipeline/user_error.h"
+#include "test_support.h"
 
 namespace bifilar {
 namespace {
@@ -573,16 +574,13 @@ TEST(SimulatePresets, QuadrotorLooksLikeTheCrazyflieLogs) {
   const StepStats sim = Steps(simulated);
   EXPECT_GE(sim.min, 0.008 - 1e-9);
   EXPECT_NEAR(sim.median, 0.031, 0.003);
-  // The real logs, when present (../shared/data/crazyflie/, beside the repository).
-  const fs::path real_dir = fs::path(BIFILAR_SOURCE_DIR) / "../shared/data/crazyflie";
-  std::vector<std::vector<double>> real;
-  if (fs::is_directory(real_dir)) {
-    for (const auto& entry : fs::directory_iterator(real_dir)) {
-      if (entry.path().extension() == ".csv") real.push_back(CrazyflieTimes(entry.path()));
-    }
-  }
+  // The real logs (crazyflie/ of the data folder; without one named the test ends here).
   fs::remove_all(dir);
-  if (real.empty()) GTEST_SKIP() << "no Crazyflie logs in " << real_dir;
+  BIFILAR_REAL_DATA(real_dir, "crazyflie");
+  std::vector<std::vector<double>> real;
+  for (const auto& entry : fs::directory_iterator(real_dir)) {
+    if (entry.path().extension() == ".csv") real.push_back(CrazyflieTimes(entry.path()));
+  }
   const StepStats measured = Steps(real);
   ASSERT_GT(measured.count, 10000u);
   // Median 31.1 ms, mean 40.9 ms, 95th percentile 103 ms on the 24 real logs; the preset within
