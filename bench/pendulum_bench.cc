@@ -3,8 +3,8 @@
 // D = 0.8 m, released from rest at 20 deg, small damping. Default tolerances (1e-10/1e-12 for
 // rk853, 3e-11/3e-13 for cvodes: IntegratorOptions::WithMethod).
 //
-//   build/bench/bifilar_bench --benchmark_filter=Pendulum --benchmark_repetitions=10 \
-//       --benchmark_report_aggregates_only=true
+//   build/bench/bifilar_bench --benchmark_filter=Pendulum --benchmark_repetitions=10
+//       --benchmark_report_aggregates_only=true   (one command line)
 //
 // Arguments: model (0 full, 1 jardin, 2 linear), sensitivities (0/1), timestamps (0 uniform,
 // 1 jittered: +-3 ms jitter and 2 % dropped samples, like a wireless IMU log).

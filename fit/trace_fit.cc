@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 #include <tuple>
 
@@ -68,6 +69,21 @@ bool ValidateTraceFit(const TraceFitInput& input, const TraceFitOptions& options
         << " s)";
       return fail(s.str());
     }
+  }
+  // Timestamps the integrator can step through: a span of at most 1e6 s, and a double at the
+  // largest |t| resolving 1e-3 of the median step (as the log readers require).
+  if (n >= 2) {
+    const double span = input.t_s.back() - input.t_s.front();
+    std::vector<double> steps(n - 1);
+    for (size_t k = 1; k < n; ++k) steps[k - 1] = input.t_s[k] - input.t_s[k - 1];
+    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+    const double largest = std::max(std::abs(input.t_s.front()), std::abs(input.t_s.back()));
+    if (span > 1e6)
+      return fail("the window spans " + Fmt("%g", span) + " s, more than 1e6 s: check the time unit");
+    if (largest * std::numeric_limits<double>::epsilon() > 1e-3 * steps[steps.size() / 2])
+      return fail("timestamps near " + Fmt("%g", largest) + " s are too large for samples " +
+                  Fmt("%g", steps[steps.size() / 2]) +
+                  " s apart (a double resolves them too coarsely); subtract the start time");
   }
   if (!std::isfinite(input.noise_rad_per_s) || !std::isfinite(input.secondary_motion_ratio))
     return fail("non-finite noise or secondary motion ratio");
@@ -211,6 +227,22 @@ TraceFitResult AssembleResult(const TraceFitInput& input, const TraceFitOptions&
   return result;
 }
 
+// A fit stopped by its budget: rejected (a bound) or an error (interrupted), with no parameters.
+TraceFitResult Stopped(TraceFitResult result, const SolveBudget& budget) {
+  result.iterations = budget.iterations();
+  result.message = budget.Message();
+  if (budget.stop() == SolveBudget::Stop::kInterrupted) {
+    result.status = TraceFitStatus::kError;
+    result.interrupted = true;
+    result.flags.push_back("interrupted");
+  } else {
+    result.status = TraceFitStatus::kRejected;
+    result.solver_bound = true;
+    result.flags.push_back("solver_bound");
+  }
+  return result;
+}
+
 // The wall time, and the label in front of any message.
 TraceFitResult Finish(TraceFitResult r, const std::string& label,
                       std::chrono::steady_clock::time_point start) {
@@ -246,6 +278,9 @@ bool TraceFitOptions::Check(std::string* why) const {
   std::string integ_why;
   if (!integrator.Check(&integ_why)) return fail("integrator: " + integ_why);
   if (max_iterations <= 0) return fail("max_iterations must be > 0");
+  if (max_total_iterations < 1) return fail("max_total_iterations must be >= 1");
+  if (!(max_fit_cpu_seconds > 0.0) || !std::isfinite(max_fit_cpu_seconds))
+    return fail("max_fit_cpu_seconds must be finite and > 0");
   if (!(max_rms_over_noise > 1.0)) return fail("max_rms_over_noise must be > 1");
   if (!(max_residual_autocorr > 0.0 && max_residual_autocorr < 1.0))
     return fail("max_residual_autocorr must be in (0, 1)");
@@ -316,13 +351,17 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
   // 3. Levenberg-Marquardt from the guess, with an active set for K_D, C >= 0 and one retry.
   const TraceRateCost cost(&input.t_s, &input.rate_rad_per_s, options.model, input.geometry,
                            options.integrator, guess.params.inertia_kg_m2);
+  // Every solver step below spends from one budget (iterations, CPU time, interrupt).
+  SolveBudget solve_budget(options);
   const Params from_guess = StartFromGuess(guess);
-  Minimum minimum = MinimizeLm(cost, from_guess, options.max_iterations);
+  Minimum minimum = MinimizeLm(cost, from_guess, options.max_iterations, &solve_budget);
+  if (solve_budget.Exhausted()) return finish(Stopped(std::move(result), solve_budget));
   if (!minimum.lm.ok) return finish(Error(result, "fit failed: " + minimum.lm.message));
 
   // 4. NLopt refinement of I when that first fit is poor.
   if (NeedsRefinement(minimum, noise, options))
-    RefineInertia(cost, from_guess, options.max_iterations, &minimum);
+    RefineInertia(cost, from_guess, options.max_iterations, &minimum, &solve_budget);
+  if (solve_budget.Exhausted()) return finish(Stopped(std::move(result), solve_budget));
 
   // 5. The solution: parameters, residual RMS, fitted trajectory and amplitude.
   const Solution solution = MakeSolution(input, cost, minimum, guess.period_s, noise);
@@ -335,8 +374,9 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
   const AmplitudeSweep sweep =
       options.amplitude_sweep ? RunAmplitudeSweep(input, options, minimum.p.data(),
                                                   cost.inertia_scale(), solution.trajectory,
-                                                  guess.period_s)
+                                                  guess.period_s, &solve_budget)
                               : AmplitudeSweep();
+  if (solve_budget.Exhausted()) return finish(Stopped(std::move(result), solve_budget));
   const SweepRule rule = ApplySweepRule(sweep, solution, stat);
 
   // 9. Whiteness of the residuals against their own AR(1) noise, 10. quality.

@@ -12,6 +12,7 @@
 // fit/: nothing here exposes a Ceres or NLopt type.
 #pragma once
 
+#include <atomic>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -29,7 +30,20 @@ struct TraceFitOptions {
   // The integration error of the rate is then ~1e-8 rad/s, five orders below 0.25 deg/s gyro
   // noise, and moves I by < 1e-7 relative (tests/fit_trace_fit_test.cc compares with 1e-11).
   IntegratorOptions integrator = DefaultIntegrator();
-  int max_iterations = 50;  // Levenberg-Marquardt iterations (count); > 0.
+  int max_iterations = 50;  // Levenberg-Marquardt iterations per solve (count); > 0.
+  // Bounds of one FitTrace call, over all its solves (the window fit with its active-set rounds
+  // and retry, the NLopt refinement, the amplitude-sweep bands): at most max_total_iterations
+  // Levenberg-Marquardt iterations and max_fit_cpu_seconds of CPU time of the calling thread
+  // (CPU, not wall time, so a busy machine never changes a result). A fit stopped by either is
+  // rejected with flag `solver_bound` and the message "the solver was stopped after N
+  // iterations and T s ...". Fits of real and simulated logs take < 100 iterations and < 1 s
+  // (at most 65536 points, fit/block_mean.h), so neither bound changes a normal result; they
+  // stop a window that does not hold a free swing, which can otherwise drift for minutes.
+  int max_total_iterations = 500;     // (count) >= 1
+  double max_fit_cpu_seconds = 20.0;  // (s) > 0
+  // Set (by Ctrl-C, for example) to stop the fit between solver iterations: the result is then
+  // kError with `interrupted` true. Not owned; nullptr: never interrupted.
+  const std::atomic<bool>* interrupt = nullptr;
 
   // Quality. Three outcomes (docs/method.md, "Quality"): `rejected` only for a fit that should
   // not be used (no oscillation, a failed fit, a fit that does not follow the data, heavy
@@ -217,6 +231,8 @@ struct TraceFitResult {
   double initial_cost = 0.0;  // 1/2 sum r^2 at the initial guess (rad^2/s^2)
   double final_cost = 0.0;
   bool nlopt_refined = false;  // NLopt refinement of I was run
+  bool interrupted = false;    // stopped by TraceFitOptions::interrupt (status kError)
+  bool solver_bound = false;   // stopped by max_total_iterations or max_fit_cpu_seconds
   double fit_seconds = 0.0;    // wall time of FitTrace
   TraceInitialGuess guess;
 

@@ -74,6 +74,35 @@ inline double RmsOfCost(double cost, size_t n) { return std::sqrt(2.0 * cost / n
 bool ValidateTraceFit(const TraceFitInput& input, const TraceFitOptions& options,
                       std::string* why);
 
+// --- The bounds of one fit (trace_solve.cc).
+
+// What every solver step of one FitTrace may spend: Levenberg-Marquardt iterations over all its
+// solves (TraceFitOptions::max_total_iterations) and CPU time of the calling thread
+// (max_fit_cpu_seconds; CPU, not wall time, so that a busy machine cannot change a result), and
+// the caller's interrupt flag. Checked between solver iterations, before each cost evaluation
+// of a solve and each NLopt evaluation; once exhausted it stays so and every later solve
+// returns at once (not ok).
+class SolveBudget {
+ public:
+  enum class Stop { kNone, kIterations, kTime, kInterrupted };
+  explicit SolveBudget(const TraceFitOptions& options);
+  // Counts one solver iteration.
+  void CountIteration() { ++iterations_; }
+  // True (and stays true) once a bound is reached or the interrupt flag is set.
+  bool Exhausted();
+  Stop stop() const { return stop_; }
+  int iterations() const { return iterations_; }
+  double cpu_seconds() const;
+  // "stopped after 1000 iterations and 3.2 s of CPU time (bound: ...)" / "interrupted ...".
+  std::string Message() const;
+
+ private:
+  const TraceFitOptions& options_;
+  double start_cpu_s_ = 0.0;
+  int iterations_ = 0;
+  Stop stop_ = Stop::kNone;
+};
+
 // --- Steps 3-4: the minimisation (trace_solve.cc).
 
 // 1/2 sum r^2 at p, the residuals in *r (sized N); HUGE_VAL when the integration fails.
@@ -93,7 +122,7 @@ struct SolveOutcome {
 // Levenberg-Marquardt on p (in place), K_D and C held where fixed[0], fixed[1]; with
 // stop_at_bound, ends when a free damping coefficient lands on 0.
 SolveOutcome SolveLm(const TraceRateCost& cost, int max_iterations, const bool fixed[2],
-                     bool stop_at_bound, double* p);
+                     bool stop_at_bound, double* p, SolveBudget* budget);
 
 // The start of the minimisation: the initial guess, I scaled to 1.
 Params StartFromGuess(const TraceInitialGuess& guess);
@@ -112,7 +141,8 @@ struct Minimum {
 // Levenberg-Marquardt with the active set from `start`; when it fails, once more from `start`
 // with K_D = C = 0 (a bad damping guess can make the first integration fail). lm.ok false:
 // both failed, lm.message says why.
-Minimum MinimizeLm(const TraceRateCost& cost, const Params& start, int max_iterations);
+Minimum MinimizeLm(const TraceRateCost& cost, const Params& start, int max_iterations,
+                   SolveBudget* budget);
 
 // The first fit is poor: residual RMS above options.refine_rms_over_noise times the noise.
 bool NeedsRefinement(const Minimum& minimum, double noise_rad_per_s,
@@ -121,7 +151,7 @@ bool NeedsRefinement(const Minimum& minimum, double noise_rad_per_s,
 // NLopt DIRECT-L along I over +-10 % of the guess (other parameters at `start`), then
 // Levenberg-Marquardt from there; *minimum takes the result when its cost is lower.
 void RefineInertia(const TraceRateCost& cost, const Params& start, int max_iterations,
-                   Minimum* minimum);
+                   Minimum* minimum, SolveBudget* budget);
 
 // --- Step 5: the solution (trace_fit.cc).
 
@@ -185,7 +215,7 @@ InputBudget ComputeInputBudget(const TraceFitInput& input, const TraceFitOptions
 // band's first sample, K_D and C held at the window fit; then the trend of I against A^p.
 AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptions& options,
                                  const double* p, double scale, const Trajectory& traj,
-                                 double period_s);
+                                 double period_s, SolveBudget* budget);
 
 // I and its statistical std after the sweep's rule.
 struct SweepRule {

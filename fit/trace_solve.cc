@@ -1,7 +1,10 @@
 // Steps 3-4 of FitTrace (fit/trace_fit_steps.h): Levenberg-Marquardt with an active set for the
 // damping coefficients, and the NLopt refinement of I when that first fit is poor.
+#include <time.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 
 #include <ceres/ceres.h>
@@ -20,19 +23,41 @@ namespace {
 // invalid step for Ceres) when CVODES fails, never an invented number.
 class TraceCeresCost : public ceres::CostFunction {
  public:
-  explicit TraceCeresCost(const TraceRateCost* cost) : cost_(cost) {
+  TraceCeresCost(const TraceRateCost* cost, SolveBudget* budget) : cost_(cost), budget_(budget) {
     set_num_residuals(cost->num_residuals());
     mutable_parameter_block_sizes()->push_back(kNumTraceParams);
   }
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
+    if (budget_->Exhausted()) return false;  // Ceres then stops (at the start) or the watch does
     return cost_->Evaluate(parameters[0], residuals,
                            jacobians != nullptr ? jacobians[0] : nullptr, nullptr);
   }
 
  private:
   const TraceRateCost* cost_;  // not owned
+  SolveBudget* budget_;        // not owned
 };
+
+// Counts the iterations of a solve against the fit's budget and aborts the solve when it is
+// exhausted. Reads nothing of the solver's state, so it changes no result of a solve it lets run.
+class BudgetWatch : public ceres::IterationCallback {
+ public:
+  explicit BudgetWatch(SolveBudget* budget) : budget_(budget) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration > 0) budget_->CountIteration();
+    return budget_->Exhausted() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  SolveBudget* budget_;
+};
+
+double ThreadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 // Ends the solve when a free damping coefficient lands on its bound (0) after an accepted step:
 // Ceres handles bounds by projecting the step, and with the coefficient pinned there
@@ -64,8 +89,8 @@ class BoundWatch : public ceres::IterationCallback {
 // Adds the residual to *problem with I > 0 and K_D, C >= 0, the damping coefficients marked in
 // fixed[0] (K_D), fixed[1] (C) held constant at their current value.
 void AddTraceResidual(const TraceRateCost& cost, const bool fixed[2], double* p,
-                      ceres::Problem* problem) {
-  problem->AddResidualBlock(new TraceCeresCost(&cost), nullptr, p);
+                      SolveBudget* budget, ceres::Problem* problem) {
+  problem->AddResidualBlock(new TraceCeresCost(&cost, budget), nullptr, p);
   std::vector<int> constant;
   if (fixed[0]) constant.push_back(kTraceDrag);
   if (fixed[1]) constant.push_back(kTraceViscous);
@@ -82,14 +107,14 @@ void AddTraceResidual(const TraceRateCost& cost, const bool fixed[2], double* p,
 // than 0.05 sigma^2 (quadratic model with the other parameters re-optimised:
 // g_j^2 (H^-1)_jj / 2, g = J^T r, H = J^T J). fixed[] returns the final active set.
 SolveOutcome SolveWithActiveSet(const TraceRateCost& cost, int max_iterations, double* p,
-                                bool fixed[2]) {
+                                bool fixed[2], SolveBudget* budget) {
   fixed[0] = fixed[1] = false;
   SolveOutcome lm;
   int iterations = 0;
   double initial_cost = 0.0;
   const int n = cost.num_residuals();
   for (int round = 0; round < 4; ++round) {
-    lm = SolveLm(cost, max_iterations, fixed, round < 3, p);
+    lm = SolveLm(cost, max_iterations, fixed, round < 3, p, budget);
     if (round == 0) initial_cost = lm.initial_cost;
     iterations += lm.iterations;
     if (!lm.ok) break;
@@ -124,6 +149,45 @@ SolveOutcome SolveWithActiveSet(const TraceRateCost& cost, int max_iterations, d
 
 }  // namespace
 
+SolveBudget::SolveBudget(const TraceFitOptions& options)
+    : options_(options), start_cpu_s_(ThreadCpuSeconds()) {}
+
+double SolveBudget::cpu_seconds() const { return ThreadCpuSeconds() - start_cpu_s_; }
+
+bool SolveBudget::Exhausted() {
+  if (stop_ != Stop::kNone) return true;
+  if (options_.interrupt != nullptr && options_.interrupt->load()) {
+    stop_ = Stop::kInterrupted;
+  } else if (iterations_ >= options_.max_total_iterations) {
+    stop_ = Stop::kIterations;
+  } else if (cpu_seconds() > options_.max_fit_cpu_seconds) {
+    stop_ = Stop::kTime;
+  }
+  return stop_ != Stop::kNone;
+}
+
+std::string SolveBudget::Message() const {
+  char text[320];
+  const double cpu = cpu_seconds();
+  switch (stop_) {
+    case Stop::kInterrupted:
+      std::snprintf(text, sizeof(text), "interrupted after %d iterations and %.1f s", iterations_,
+                    cpu);
+      break;
+    case Stop::kIterations:
+    case Stop::kTime:
+      std::snprintf(text, sizeof(text),
+                    "the solver was stopped after %d iterations and %.1f s of CPU time (bounds: "
+                    "%d iterations, %g s per fit), before the fit settled; set a window on the "
+                    "free oscillation (fit.windows or --window)",
+                    iterations_, cpu, options_.max_total_iterations, options_.max_fit_cpu_seconds);
+      break;
+    case Stop::kNone:
+      return "";
+  }
+  return text;
+}
+
 double Cost(const TraceRateCost& cost, const double* p, std::vector<double>* r) {
   if (!cost.Evaluate(p, r->data(), nullptr, nullptr)) return HUGE_VAL;
   double s = 0.0;
@@ -132,10 +196,15 @@ double Cost(const TraceRateCost& cost, const double* p, std::vector<double>* r) 
 }
 
 SolveOutcome SolveLm(const TraceRateCost& cost, int max_iterations, const bool fixed[2],
-                     bool stop_at_bound, double* p) {
+                     bool stop_at_bound, double* p, SolveBudget* budget) {
+  if (budget->Exhausted()) {
+    SolveOutcome out;
+    out.message = budget->Message();
+    return out;
+  }
   QuietSolverLogging();  // also from the Python module and tests, not only the command line
   ceres::Problem problem;
-  AddTraceResidual(cost, fixed, p, &problem);
+  AddTraceResidual(cost, fixed, p, budget, &problem);
   ceres::Solver::Options options;
   options.minimizer_type = ceres::TRUST_REGION;
   options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
@@ -156,6 +225,8 @@ SolveOutcome SolveLm(const TraceRateCost& cost, int max_iterations, const bool f
     options.update_state_every_iteration = true;
     options.callbacks.push_back(&watch);
   }
+  BudgetWatch budget_watch(budget);
+  options.callbacks.push_back(&budget_watch);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   SolveOutcome out;
@@ -165,7 +236,7 @@ SolveOutcome SolveLm(const TraceRateCost& cost, int max_iterations, const bool f
   out.stopped_at_bound = watch.triggered();
   out.converged = summary.termination_type == ceres::CONVERGENCE;
   out.ok = summary.IsSolutionUsable() && std::isfinite(summary.final_cost);
-  out.message = summary.message;
+  out.message = budget->stop() != SolveBudget::Stop::kNone ? budget->Message() : summary.message;
   return out;
 }
 
@@ -181,16 +252,17 @@ Params StartFromGuess(const TraceInitialGuess& guess) {
   return p;
 }
 
-Minimum MinimizeLm(const TraceRateCost& cost, const Params& start, int max_iterations) {
+Minimum MinimizeLm(const TraceRateCost& cost, const Params& start, int max_iterations,
+                   SolveBudget* budget) {
   Minimum m;
   m.p = start;
-  m.lm = SolveWithActiveSet(cost, max_iterations, m.p.data(), m.fixed);
-  if (!m.lm.ok) {
+  m.lm = SolveWithActiveSet(cost, max_iterations, m.p.data(), m.fixed, budget);
+  if (!m.lm.ok && !budget->Exhausted()) {
     // One retry from the guess with K_D, C started at zero.
     m.p = start;
     m.p[kTraceDrag] = 0.0;
     m.p[kTraceViscous] = 0.0;
-    m.lm = SolveWithActiveSet(cost, max_iterations, m.p.data(), m.fixed);
+    m.lm = SolveWithActiveSet(cost, max_iterations, m.p.data(), m.fixed, budget);
   }
   if (!m.lm.ok) return m;
   m.initial_cost = m.lm.initial_cost;
@@ -208,19 +280,23 @@ bool NeedsRefinement(const Minimum& minimum, double noise_rad_per_s,
 }
 
 void RefineInertia(const TraceRateCost& cost, const Params& start, int max_iterations,
-                   Minimum* minimum) {
+                   Minimum* minimum, SolveBudget* budget) {
   const size_t n = minimum->residuals.size();
   minimum->nlopt_refined = true;
   // Cost along I alone with the other parameters at the guess: a sum of squares whose global
   // minimum over a +-10 % bracket is near the true I; local minima are phase wraps.
   Params q = start;
   std::vector<double> rr(n);
+  nlopt::opt global(nlopt::GN_DIRECT_L, 1);
   auto objective = [&](double inertia_scaled) {
+    if (budget->Exhausted()) {
+      global.force_stop();  // optimize() then throws nlopt::forced_stop, caught below
+      return 1e300;
+    }
     q[kTraceInertia] = inertia_scaled;
     const double c = Cost(cost, q.data(), &rr);
     return std::isfinite(c) ? c : 1e300;
   };
-  nlopt::opt global(nlopt::GN_DIRECT_L, 1);
   global.set_lower_bounds(std::vector<double>{0.9});
   global.set_upper_bounds(std::vector<double>{1.1});
   global.set_maxeval(120);
@@ -240,7 +316,7 @@ void RefineInertia(const TraceRateCost& cost, const Params& start, int max_itera
   Params p2 = start;
   p2[kTraceInertia] = x[0];
   bool fixed2[2];
-  const SolveOutcome lm2 = SolveWithActiveSet(cost, max_iterations, p2.data(), fixed2);
+  const SolveOutcome lm2 = SolveWithActiveSet(cost, max_iterations, p2.data(), fixed2, budget);
   std::vector<double> r2(n);
   const double cost2 = lm2.ok ? Cost(cost, p2.data(), &r2) : HUGE_VAL;
   if (cost2 < minimum->final_cost) {

@@ -27,7 +27,7 @@ double ChiSquare95(int dof) {
 // first sample, K_D and C held. ok false when the fit or its std fails.
 AmplitudeSweepBand FitBand(const TraceFitInput& input, const TraceFitOptions& options,
                            const double* p, double scale, const Trajectory& traj, double period_s,
-                           size_t first, size_t last) {
+                           size_t first, size_t last, SolveBudget* budget) {
   const std::vector<int> free = {kTraceInertia, kTraceAngle0, kTraceRate0, kTraceBias};
   const bool fixed[2] = {true, true};
   AmplitudeSweepBand band;
@@ -43,7 +43,7 @@ AmplitudeSweepBand FitBand(const TraceFitInput& input, const TraceFitOptions& op
   std::copy(p, p + kNumTraceParams, q);
   q[kTraceAngle0] = traj.angle_rad[first];
   q[kTraceRate0] = traj.rate_rad_per_s[first];
-  const SolveOutcome lm = SolveLm(cost, options.max_iterations, fixed, false, q);
+  const SolveOutcome lm = SolveLm(cost, options.max_iterations, fixed, false, q, budget);
   if (!lm.ok) return band;
   const FreeParamStd stat = StatisticalStd(cost, q, free);
   {
@@ -131,7 +131,7 @@ void FitTrend(const TraceFitOptions& options, double ref, AmplitudeSweep* sweep)
 
 AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptions& options,
                                  const double* p, double scale, const Trajectory& traj,
-                                 double period_s) {
+                                 double period_s, SolveBudget* budget) {
   AmplitudeSweep sweep;
   const double t0 = input.t_s.front(), t1 = input.t_s.back();
   const double cycles = period_s > 0.0 ? (t1 - t0) / period_s : 0.0;
@@ -151,7 +151,8 @@ AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptio
     size_t last = first;
     while (last < n && input.t_s[last] < tb) ++last;  // band = [first, last)
     if (last - first >= 20)
-      sweep.bands.push_back(FitBand(input, options, p, scale, traj, period_s, first, last));
+      sweep.bands.push_back(FitBand(input, options, p, scale, traj, period_s, first, last,
+                                     budget));
     first = last;
   }
   FitTrend(options, scale, &sweep);

@@ -13,10 +13,36 @@ namespace {
 
 std::string Prefix(const std::string& name) { return name.empty() ? "" : name + ": "; }
 
+
 std::string Fmt(const char* format, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
   char buf[256];
   std::snprintf(buf, sizeof(buf), format, a, b, c, d);
   return buf;
+}
+
+// A window [first, last] of samples with a gap (a step between two samples) longer than
+// max_gap_periods periods cannot be fitted as one swing: the phase across it is not observed
+// (and the two sides may be different swings). False with *message naming the longest gap.
+bool GapFree(const std::vector<double>& t, size_t first, size_t last, double period_s,
+             const WindowOptions& o, const std::string& name, std::string* message) {
+  if (!(period_s > 0.0) || last >= t.size()) return true;
+  double longest = 0.0;
+  size_t at = first;
+  for (size_t k = first; k < last; ++k) {
+    if (t[k + 1] - t[k] > longest) {
+      longest = t[k + 1] - t[k];
+      at = k;
+    }
+  }
+  if (longest <= o.max_gap_periods * period_s) return true;
+  *message = Prefix(name) +
+             Fmt("a gap of %.3g s without samples (from %.3f s", longest, t[at]) +
+             Fmt(" to %.3f s) lies inside the window", t[at + 1]) +
+             Fmt(" [%.3f, ", t[first]) + Fmt("%.3f] s", t[last]) +
+             Fmt(", longer than %g period(s)", o.max_gap_periods) +
+             Fmt(" (%.3f s): the swing cannot be followed across it; give a window on one side "
+                 "of it (fit.windows or --window)", period_s);
+  return false;
 }
 
 double Median(std::vector<double> v) {
@@ -380,6 +406,7 @@ bool WindowOptions::Check(std::string* why) const {
   if (!(start_delay_periods >= 0.0 && end_margin_periods >= 0.0)) return fail("start_delay_periods and end_margin_periods must be >= 0");
   if (!(min_periods > 0.0)) return fail("min_periods must be > 0");
   if (!(blip_fraction >= 0.0 && blip_fraction < 0.5)) return fail("blip_fraction must be in [0, 0.5)");
+  if (!(max_gap_periods > 0.0)) return fail("max_gap_periods must be > 0");
   return true;
 }
 
@@ -566,14 +593,30 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
   }
   if (w.t1_s - w.t0_s < o.min_periods * period) {
     w.status = WindowStatus::kRejected;
-    w.message = Prefix(name) +
-                Fmt("free oscillation shorter than %g periods: [%.3f, %.3f] s with a period of %.3f s",
-                    o.min_periods, w.t0_s, w.t1_s, period) +
-                " (ends: " + ToString(best->end) + ")";
+    if (w.t1_s > w.t0_s) {
+      w.message = Prefix(name) +
+                  Fmt("free oscillation shorter than %g periods: [%.3f, ", o.min_periods, w.t0_s) +
+                  Fmt("%.3f] s with a period of %.3f s", w.t1_s, period) +
+                  " (ends: " + ToString(best->end) + ")";
+    } else {
+      // The swing ends before a window can start (after the first extreme): say what was found.
+      const double end_s = best->end == WindowEnd::kLogEnd ? t.back() : cycles[best->last].end_s;
+      w.message = Prefix(name) +
+                  Fmt("free oscillation shorter than %g periods: the swing released at ",
+                      o.min_periods) +
+                  Fmt("%.3f s ends at ", w.release_s) + Fmt("%.3f s", end_s) + " (" +
+                  ToString(best->end) + Fmt("), %.2f periods", (end_s - w.release_s) / period) +
+                  Fmt(" of %.3f s later, before a window could start (at ", period) +
+                  Fmt("%.3f s, after the first extreme)", w.t0_s);
+    }
     return w;
   }
   w.first_index = FirstAtOrAfter(t, w.t0_s);
   w.last_index = LastAtOrBefore(t, w.t1_s);
+  if (!GapFree(t, w.first_index, w.last_index, period, o, name, &w.message)) {
+    w.status = WindowStatus::kRejected;
+    return w;
+  }
   FillPeaks(a, &w);
   w.status = WindowStatus::kOk;
   return w;
@@ -625,6 +668,10 @@ FreeOscillationWindow ApplyWindowOverride(const std::vector<double>& t,
     w.status = WindowStatus::kRejected;
     w.message = Prefix(name) + Fmt("window [%.3f, %.3f] s is shorter than %g periods (period %.3f s)",
                                    w.t0_s, w.t1_s, o.min_periods, w.period_s);
+    return w;
+  }
+  if (!GapFree(t, w.first_index, w.last_index, w.period_s, o, name, &w.message)) {
+    w.status = WindowStatus::kRejected;
     return w;
   }
   FillPeaks(a, &w);

@@ -59,6 +59,10 @@ struct WindowOptions {
   // but their union is (step 3b). [0, 0.5); 0 disables. Default 0.25: a real half-cycle is never
   // a quarter of its neighbours' length, nor a single sample.
   double blip_fraction = 0.25;
+  // A window with a gap between two samples longer than this many periods is rejected (found or
+  // given): the phase across it is not observed, and the two sides may be different swings.
+  // Default 1: dropped packets last tens of ms, a rig's period 1-3 s. > 0.
+  double max_gap_periods = 1.0;
 
   bool Check(std::string* why) const;
 };

@@ -16,6 +16,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -248,14 +249,49 @@ py::tuple FitTraceCore(const Array& t_array, const Array& rate_array, const FitT
 
   TraceRecord record;
   TraceFitResult fit;
+  ImuData data;
+  data.t_s = std::move(t);
+  data.gyro_in_imu.resize(rate.size());
+  for (size_t i = 0; i < rate.size(); ++i) data.gyro_in_imu[i] = Eigen::Vector3d(0, 0, rate[i]);
+  // The fit runs on a thread of its own while this (the caller's) thread waits, checking for
+  // Ctrl-C every 20 ms: KeyboardInterrupt then stops the fit between solver iterations
+  // (TraceFitOptions::interrupt) and is raised as soon as the fit has stopped.
+  std::atomic<bool> interrupt{false};
+  options.interrupt = &interrupt;
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool finished = false;
+  std::exception_ptr error;  // ProcessTraceData never throws, but memory may run out
+  std::thread worker([&] {
+    try {
+      record = ProcessTraceData(config, data, args.name, options, &fit);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    const std::lock_guard<std::mutex> lock(mutex);
+    finished = true;
+    cv.notify_one();
+  });
+  bool interrupted = false;
+  while (true) {
+    bool done = false;
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(mutex);
+      done = cv.wait_for(lock, std::chrono::milliseconds(20), [&] { return finished; });
+    }
+    if (done) break;
+    if (!interrupted && PyErr_CheckSignals() != 0) {  // the exception stays set until raised
+      interrupted = true;
+      interrupt = true;
+    }
+  }
   {
     py::gil_scoped_release release;
-    ImuData data;
-    data.t_s = std::move(t);
-    data.gyro_in_imu.resize(rate.size());
-    for (size_t i = 0; i < rate.size(); ++i) data.gyro_in_imu[i] = Eigen::Vector3d(0, 0, rate[i]);
-    record = ProcessTraceData(config, data, args.name, options, &fit);
+    worker.join();
   }
+  if (interrupted) throw py::error_already_set();
+  if (error) std::rethrow_exception(error);
   if (record.status == TraceStatus::kError) throw UserError(record.message);
   return py::make_tuple(ToPython(TraceRecordToJson(record, false)), ToNumpy(fit.t_s),
                         ToNumpy(fit.measured_rate_rad_per_s), ToNumpy(fit.fitted_rate_rad_per_s),
@@ -582,6 +618,7 @@ struct SimulateArgs {
   std::optional<double> inertia_kg_m2, mass_kg, length_m, separation_m, g, amplitude_deg,
       pitch_deg, duration_s, sample_rate_hz;
   bool no_accel = false;
+  bool force = false;  // replace files that exist (as `bifilar simulate --force`)
 };
 
 // A file simulate just wrote (truth.json), read back within the result-file cap.
@@ -633,7 +670,7 @@ py::dict SimulateCore(const SimulateArgs& a) {
       if (a.separation_m) spec.campaign.filar_separation_m = *a.separation_m;
       if (a.g) spec.campaign.gravity_mps2 = *a.g;
       if (!spec.campaign.Check(&why) || !spec.options.Check(&why)) throw UserError(why);
-      summary = RunSimulateCampaign(spec, *a.out);
+      summary = RunSimulateCampaign(spec, *a.out, a.force);
     } else {  // one trace, into trace= or in memory (a temporary file read back)
       if (spec.has_campaign) {
         throw std::invalid_argument(*a.spec + ": has campaign sections (aircraft, rig, "
@@ -667,7 +704,7 @@ py::dict SimulateCore(const SimulateArgs& a) {
         csv = (temp / "trace.csv").string();
       }
       try {
-        summary = RunSimulateTrace(spec, csv, a.truth.value_or(""));
+        summary = RunSimulateTrace(spec, csv, a.truth.value_or(""), a.force);
         data = ReadImuLog(csv, spec.format);
       } catch (...) {
         if (!temp.empty()) std::filesystem::remove_all(temp);
@@ -853,6 +890,7 @@ PYBIND11_MODULE(_core, m) {
         get("duration_s", &a.duration_s);
         get("sample_rate_hz", &a.sample_rate_hz);
         if (kwargs.contains("no_accel")) a.no_accel = kwargs["no_accel"].cast<bool>();
+        if (kwargs.contains("force")) a.force = kwargs["force"].cast<bool>();
         return SimulateCore(a);
       },
       "simulate(**settings) -> dict: `bifilar simulate`, a campaign (spec, out) or one trace "

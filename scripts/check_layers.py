@@ -102,7 +102,7 @@ def cmake_links():
     for path in ("CMakeLists.txt", "pipeline/CMakeLists.txt"):
         if os.path.exists(path):
             text += re.sub(r"#[^\n]*", "", open(path, encoding="utf-8").read()) + "\n"
-    folders = dict(re.findall(r"bifilar_component\(\s*(\w+)\s+([\w/]+)\s*\)", text))
+    folders = dict(re.findall(r"bifilar_component\(\s*(\w+)\s+([\w/]+)(?:\s+\w+)*\s*\)", text))
     links = {}
     for target, body in re.findall(r"target_link_libraries\(\s*bifilar_(\w+)\s([^)]*)\)", text):
         if target in folders:

@@ -45,7 +45,9 @@ TEST(BlockMean, MeansAreExactForALineAndNeverSpanAGap) {
   for (size_t j = 0; j < bt.size(); ++j) {
     EXPECT_NEAR(bv[j], 3.0 + 2.0 * bt[j], 1e-12);  // the mean of a line is the line at mean t
     EXPECT_FALSE(bt[j] > 0.999 && bt[j] < 1.5) << "a block spans the gap at " << bt[j];
-    if (j > 0) EXPECT_GT(bt[j], bt[j - 1]);
+    if (j > 0) {
+      EXPECT_GT(bt[j], bt[j - 1]);
+    }
   }
   // span <= 0: the samples themselves.
   BlockMeans(t, v, 10, 19, 0.0, &bt, &bv);

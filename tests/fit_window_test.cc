@@ -504,3 +504,70 @@ TEST(Window, SimulatedCampaign) {
 
 }  // namespace
 }  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// Issue 23: a swing that ends before a window can start was reported as "[40.430, 40.225] s".
+// Whatever the swing's length, a rejection never shows a window that ends before it starts.
+TEST(WindowMessages, ShortSwingSaysWhatWasFound) {
+  int ends_before_start = 0;
+  for (double free_s : {1.0, 1.2, 1.4, 1.6, 1.8, 2.0, 2.2, 2.6, 3.0}) {
+    for (uint64_t seed : {1, 2, 3}) {
+      Synth s;
+      s.free_s = free_s;
+      s.stop = true;
+      s.seed = seed;
+      const SynthLog log = MakeLog(s);
+      const auto w = FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions(), "short.csv");
+      if (w.IsUsable()) continue;
+      const size_t open = w.message.find('[');
+      if (open != std::string::npos) {
+        double a = 0, b = 0;
+        ASSERT_EQ(std::sscanf(w.message.c_str() + open, "[%lf, %lf]", &a, &b), 2) << w.message;
+        EXPECT_LT(a, b) << w.message;
+      }
+      if (w.message.find("before a window could start") != std::string::npos) {
+        ++ends_before_start;
+        EXPECT_NE(w.message.find("short.csv: free oscillation shorter than 2 periods: the swing "
+                                 "released at "),
+                  std::string::npos)
+            << w.message;
+        EXPECT_NE(w.message.find(" ends at "), std::string::npos) << w.message;
+      }
+    }
+  }
+  EXPECT_GT(ends_before_start, 0) << "no case of a swing ending before its window";
+}
+
+// A 100 s gap inside the free swing: the search and a given window are both rejected, naming it.
+TEST(WindowMessages, LongGapInsideTheWindowIsRejected) {
+  Synth s;
+  s.free_s = 40.0;
+  SynthLog log = MakeLog(s);
+  const double gap_at = log.t_release_s + 20.0;
+  for (double& t : log.t_s) {
+    if (t > gap_at) t += 100.0;
+  }
+  const auto found = FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions(), "gap.csv");
+  if (found.IsUsable()) {
+    // The search kept to one side of the gap.
+    EXPECT_TRUE(found.t1_s <= gap_at || found.t0_s > gap_at + 100.0) << found.BriefReport();
+  } else {
+    EXPECT_NE(found.message.find("gap.csv: a gap of 100 s without samples"), std::string::npos)
+        << found.message;
+  }
+  const auto given = ApplyWindowOverride(log.t_s, log.rate_rad_per_s, log.t_release_s + 2.0,
+                                         log.t_s.back(), WindowOptions(), "gap.csv");
+  EXPECT_EQ(given.status, WindowStatus::kRejected) << given.BriefReport();
+  EXPECT_NE(given.message.find("gap.csv: a gap of 100 s without samples (from "), std::string::npos)
+      << given.message;
+  EXPECT_NE(given.message.find("longer than 1 period(s)"), std::string::npos) << given.message;
+  // A window on one side of it is fine.
+  const auto before = ApplyWindowOverride(log.t_s, log.rate_rad_per_s, log.t_release_s + 2.0,
+                                          gap_at - 0.1, WindowOptions(), "gap.csv");
+  EXPECT_TRUE(before.IsUsable()) << before.BriefReport();
+}
+
+}  // namespace
+}  // namespace bifilar

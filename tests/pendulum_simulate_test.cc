@@ -454,7 +454,9 @@ TEST(SimulateRealism, SpikesHaveTheirCountAndSizeAndChangeNothingElse) {
   // Distinct, in sample order, at least one inside the free oscillation.
   int inside = 0;
   for (size_t i = 0; i < spikes.size(); ++i) {
-    if (i > 0) EXPECT_GT(spikes[i].sample, spikes[i - 1].sample);
+    if (i > 0) {
+      EXPECT_GT(spikes[i].sample, spikes[i - 1].sample);
+    }
     inside += spikes[i].t_s >= spiked.truth.t_release_s && spikes[i].t_s < spiked.truth.t_stop_s;
   }
   EXPECT_GE(inside, 1);

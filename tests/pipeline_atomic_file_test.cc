@@ -83,11 +83,11 @@ TEST(AtomicFile, RefusesAFifoAndLeavesItAFifo) {
   EXPECT_EQ(message.rfind(fifo.string() + ": exists and is not a regular file", 0), 0u) << message;
   EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
   ExpectOnly(dir.path, {"traces.csv"});
-  // A link to it is the same target.
+  // A link to it is refused as a link.
   fs::create_symlink(fifo, dir.path / "link.csv");
   EXPECT_NE(ErrorOf([&] {
               WriteFileAtomically((dir.path / "link.csv").string(), "x");
-            }).find("is not a regular file"),
+            }).find("is a symbolic link"),
             std::string::npos);
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir.path / "link.csv")));
 }
@@ -100,19 +100,59 @@ TEST(AtomicFile, RefusesADevice) {
   const fs::path link = dir.path / "report.html";
   fs::create_symlink("/dev/full", link);
   const std::string message = ErrorOf([&] { WriteFileAtomically(link.string(), "x"); });
-  EXPECT_EQ(message.rfind(link.string() + ": exists and is not a regular file", 0), 0u) << message;
+  EXPECT_EQ(message.rfind(link.string() + ": is a symbolic link (to /dev/full)", 0), 0u) << message;
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
   ExpectOnly(dir.path, {"report.html"});
 }
 
-TEST(AtomicFile, ReplacesTheLinkToARegularFileNotItsTarget) {
+// Issue 23: a link is neither replaced nor written through, whatever it points to: a regular
+// file, a dangling name, or /proc/self/fd/1 (what /dev/stdout is; the link lives in our folder,
+// the real /dev/stdout is never touched).
+TEST(AtomicFile, RefusesASymbolicLinkAndLeavesItAndItsTarget) {
   TempDir dir;
   std::ofstream(dir.path / "real.txt") << "real";
   fs::create_symlink(dir.path / "real.txt", dir.path / "link.txt");
-  WriteFileAtomically((dir.path / "link.txt").string(), "new");
-  EXPECT_EQ(ReadFile(dir.path / "link.txt"), "new");
-  EXPECT_EQ(ReadFile(dir.path / "real.txt"), "real");  // unchanged: rename replaced the link
-  EXPECT_FALSE(fs::is_symlink(fs::symlink_status(dir.path / "link.txt")));
+  fs::create_symlink(dir.path / "nothing", dir.path / "dangling.txt");
+  fs::create_symlink("/proc/self/fd/1", dir.path / "stdout");
+  for (const char* name : {"link.txt", "dangling.txt", "stdout"}) {
+    const std::string link = (dir.path / name).string();
+    const std::string message = ErrorOf([&] { WriteFileAtomically(link, "new"); });
+    EXPECT_EQ(message.rfind(link + ": is a symbolic link", 0), 0u) << message;
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link))) << name;
+    EXPECT_NE(ErrorOf([&] { CheckFileTarget(link); }), "") << name;
+  }
+  EXPECT_EQ(ReadFile(dir.path / "real.txt"), "real");
+  ExpectOnly(dir.path, {"dangling.txt", "link.txt", "real.txt", "stdout"});
+}
+
+// Issue 23: a 255-byte name (the most ext4 allows) is written through a short temporary name;
+// a longer one is refused with the reason.
+TEST(AtomicFile, WritesA255ByteNameAndRefusesALongerOneWithTheReason) {
+  TempDir dir;
+  const std::string longest(255, 'a');
+  const std::string temp = AtomicTemporaryName((dir.path / longest).string());
+  EXPECT_LE(fs::path(temp).filename().string().size(), 255u);
+  EXPECT_EQ(fs::path(temp).parent_path(), dir.path);
+  WriteFileAtomically((dir.path / longest).string(), "x");
+  EXPECT_EQ(ReadFile(dir.path / longest), "x");
+  ExpectOnly(dir.path, {longest});
+  const std::string too_long = (dir.path / std::string(256, 'b')).string();
+  const std::string message = ErrorOf([&] { WriteFileAtomically(too_long, "x"); });
+  EXPECT_NE(message.find("the file name is 256 bytes long, more than this file system allows (255)"),
+            std::string::npos)
+      << message;
+  ExpectOnly(dir.path, {longest});
+}
+
+TEST(AtomicFile, RefuseToReplaceNamesTheFileAndHonoursForce) {
+  TempDir dir;
+  const std::string file = (dir.path / "mine.csv").string();
+  EXPECT_EQ(ErrorOf([&] { RefuseToReplace(file, "simulate --trace", false); }), "");
+  std::ofstream(file) << "mine";
+  EXPECT_EQ(ErrorOf([&] { RefuseToReplace(file, "simulate --trace", false); }),
+            "simulate --trace: " + file +
+                " exists; choose another name, or add --force to overwrite it");
+  EXPECT_EQ(ErrorOf([&] { RefuseToReplace(file, "simulate --trace", true); }), "");
 }
 
 }  // namespace

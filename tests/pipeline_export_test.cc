@@ -221,7 +221,8 @@ TEST(ExportRead, PlanarResultsExportIxxIzzIxzAndNameWhatIsMissing) {
   o.results_path = path;
   ExportInertia in = ReadExportInertia(ReadFile(path), path, o);
   // A sample written since the tensor merge also has a tensor section (mode planar_xz) whose
-  // x-z components repeat the ellipse's: export reads it, with the same numbers.
+  // x-z components repeat the ellipse's: export reads it, with the same numbers (exactly: both
+  // sections of the one committed file, written in one run; nothing is recomputed here).
   const bool planar_tensor = j.contains("tensor") && j["tensor"].is_object() &&
                              j["tensor"].value("mode", std::string()) == "planar_xz";
   EXPECT_EQ(in.section, planar_tensor ? "tensor" : "ellipse");

@@ -79,11 +79,10 @@ TEST(GlitchRuns, ShortRunsNeitherRejectNorMoveTheWindow) {
   }
 }
 
-// The 24 public Crazyflie logs (../shared/data/crazyflie, README there): no sample of theirs is a
+// The 24 public Crazyflie logs (crazyflie/ of the data folder, README there): no sample of theirs is a
 // glitch, alone or in a run (measured: 0 of 13 741 samples; docs/method.md section 1).
 TEST(GlitchRuns, RealCrazyflieLogsLoseNoSample) {
-  const std::string folder = std::string(BIFILAR_SOURCE_DIR) + "/../shared/data/crazyflie";
-  if (!fs::is_directory(folder)) GTEST_SKIP() << folder << " absent";
+  BIFILAR_REAL_DATA(folder, "crazyflie");
   test_support::TempDir dir("bifilar_glitch_runs");
   const CampaignConfig config =
       LoadFitConfig(WriteFile(dir.path + "/fit.yaml", test_support::QuadrotorFitConfig()));

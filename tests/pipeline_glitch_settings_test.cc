@@ -176,7 +176,9 @@ TEST(GlitchSettings, AGlitchAfterALongGapDoesNotMoveTheWindow) {
       std::istringstream in(ReadFile(path));
       for (std::string line; std::getline(in, line);) lines.push_back(line);
       std::vector<Row> rows;
-      for (size_t i = 1; i < lines.size(); ++i) {
+      size_t header = 0;  // after the simulated log's mark (pipeline/logs/simulated_log.h)
+      while (header < lines.size() && lines[header].rfind("#", 0) == 0) ++header;
+      for (size_t i = header + 1; i < lines.size(); ++i) {
         Row r;
         r.line = i;
         if (std::sscanf(lines[i].c_str(), "%lf,%lf,%lf,%lf", &r.t, &r.w[0], &r.w[1], &r.w[2]) != 4) break;

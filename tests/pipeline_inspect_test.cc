@@ -145,8 +145,7 @@ TEST(InspectLog, SaysWhatAFileIsWhenItIsNotALog) {
 }
 
 TEST(InspectLog, RealUlogListsTopicsWithRates) {
-  const std::string path = kSource + "/../shared/data/px4/sample_log_small.ulg";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  BIFILAR_REAL_DATA(path, "px4/sample_log_small.ulg");
   const InspectReport r = InspectLog(path, nullptr);
   EXPECT_EQ(r.kind, "ulog");
   bool found = false;
@@ -164,8 +163,7 @@ TEST(InspectLog, RealUlogListsTopicsWithRates) {
 }
 
 TEST(InspectLog, RealQuadrotorLogGuessedAsTheAuthorsDescribeIt) {
-  const std::string path = kSource + "/../shared/data/crazyflie/BaseModel_Ixx_Log-1.csv";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  BIFILAR_REAL_DATA(path, "crazyflie/BaseModel_Ixx_Log-1.csv");
   const InspectReport r = InspectLog(path, nullptr);
   ASSERT_TRUE(r.error.empty()) << r.error;
   EXPECT_EQ(r.format.time_column, "t");

@@ -395,7 +395,9 @@ TEST(OutputSet, LockThatIsNotARegularFileOfItsOwnIsRefusedAndNeverWritten) {
     }
     EXPECT_TRUE(thesis.Intact());
     EXPECT_FALSE(fs::exists(c.dir + "/precious/new.txt"));
-    if (k.what == "user's file") EXPECT_EQ(ReadFile(lock), "my own text\n");
+    if (k.what == "user's file") {
+      EXPECT_EQ(ReadFile(lock), "my own text\n");
+    }
     EXPECT_FALSE(fs::exists(c.out + "/results.json"));
     fs::remove_all(lock);
   }

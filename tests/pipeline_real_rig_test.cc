@@ -1,6 +1,6 @@
 // Issue 8: defaults that work on real IMU logs, honest uncertainty under coloured noise, and the
-// amplitude sweep. Real logs are read from ../shared/data/crazyflie beside the repository (the
-// test skips when they are absent); simulated ones come from fit/trace_synth.h and from the
+// amplitude sweep. Real logs are read from crazyflie/ of the data folder (BIFILAR_REAL_DATA in
+// tests/test_support.h: skipped when no folder is named); simulated ones come from fit/trace_synth.h and from the
 // simulator's presets (configs/simulate_nonideal_rig.yaml).
 #include <algorithm>
 #include <cmath>
@@ -24,7 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kSource = BIFILAR_SOURCE_DIR;
-const std::string kCrazyflie = kSource + "/../shared/data/crazyflie";
 
 CampaignConfig LoadFitConfig(const std::string& path) {
   ConfigLoadOptions options;
@@ -43,24 +42,24 @@ std::string WriteConfig(const std::string& dir, const std::string& name, const s
   return path;
 }
 
-// The Crazyflie rig of ../shared/data/README.md, with only geometry, mass and format configured.
+// The Crazyflie rig of the data folder's README.md, with only geometry, mass and format configured.
 std::string CrazyflieConfig(const std::string& dir, double mass_kg) {
   return WriteConfig(dir, mass_kg < 0.036 ? "base.yaml" : "narrow.yaml",
                      test_support::QuadrotorFitConfig(mass_kg));
 }
 
 TEST(RealRig, CrazyflieLogsAllGiveANumberWithDefaults) {
-  if (!fs::is_directory(kCrazyflie)) GTEST_SKIP() << kCrazyflie << " absent";
+  BIFILAR_REAL_DATA(crazyflie, "crazyflie");
   const std::string dir = TempDir();
   const CampaignConfig base = LoadFitConfig(CrazyflieConfig(dir, 0.0343));
   const CampaignConfig narrow = LoadFitConfig(CrazyflieConfig(dir, 0.0381));
-  // The authors' own script rerun on these logs (small-angle formula, ../shared/data/README.md);
+  // The authors' own script rerun on these logs (small-angle formula, the data folder's README.md);
   // a fit of the nonlinear model at 10-25 deg comes out slightly below it.
   const std::map<std::string, double> authors = {
       {"BaseModel_Ixx", 15.78e-6}, {"BaseModel_Izz", 31.96e-6}, {"NarrowMedium_Ixx", 25.68e-6},
       {"NarrowMedium_Iyy", 27.45e-6}, {"NarrowMedium_Izz", 43.32e-6}};
   int n = 0, with_number = 0, rejected = 0;
-  for (const auto& entry : fs::directory_iterator(kCrazyflie)) {
+  for (const auto& entry : fs::directory_iterator(crazyflie)) {
     const std::string name = entry.path().filename().string();
     if (entry.path().extension() != ".csv") continue;
     ++n;

@@ -1,6 +1,6 @@
 // Repeats of one set-up (pipeline/trace/repeats.h): grouping by the last number of the file name,
-// DerSimonian-Laird between-repeat std, and on the real quadrotor logs (../shared/data/crazyflie,
-// skipped when absent) the 4 repeats of each set-up within 2.5 sigma of their 4-log mean.
+// DerSimonian-Laird between-repeat std, and on the real quadrotor logs (crazyflie/ of the data
+// folder, tests/test_support.h) the 4 repeats of each set-up within 2.5 sigma of their 4-log mean.
 #include "pipeline/trace/repeats.h"
 #include "pipeline/trace/trace_process.h"
 
@@ -23,7 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kSource = BIFILAR_SOURCE_DIR;
-const std::string kCrazyflie = kSource + "/../shared/data/crazyflie";
 
 TraceRecord Record(double inertia, double std) {
   TraceRecord r;
@@ -190,7 +189,7 @@ TEST(Repeats, FitCommandCombinesSimulatedQuadrotorRepeats) {
 // mean: with its reported std, and (max_abs_z) with the stricter std that leaves out the part
 // of the correction's std common to the set-up, which moves its mean as well.
 TEST(Repeats, QuadrotorRepeatsAreWithinTheirStd) {
-  if (!fs::is_directory(kCrazyflie)) GTEST_SKIP() << kCrazyflie << " absent";
+  BIFILAR_REAL_DATA(crazyflie, "crazyflie");
   const test_support::TempDir dir("bifilar_repeats");
   std::vector<std::string> paths;
   std::vector<TraceRecord> records;
@@ -200,7 +199,7 @@ TEST(Repeats, QuadrotorRepeatsAreWithinTheirStd) {
         dir.path + "/" + airframe + ".yaml", test_support::QuadrotorFitConfig(mass)));
     for (const char* axis : {"Ixx", "Iyy", "Izz"}) {
       for (int k = 1; k <= 4; ++k) {
-        paths.push_back(kCrazyflie + "/" + airframe + "_" + axis + "_Log-" + std::to_string(k) + ".csv");
+        paths.push_back(crazyflie + "/" + airframe + "_" + axis + "_Log-" + std::to_string(k) + ".csv");
         records.push_back(ProcessTrace(config, paths.back(), {}));
         ASSERT_TRUE(records.back().ok()) << paths.back() << ": " << records.back().message;
       }

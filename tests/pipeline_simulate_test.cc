@@ -19,6 +19,8 @@
 #include "base/user_error.h"
 #include "pipeline/commands/simulate_spec.h"
 #include "pipeline/logs/imu_log_writer.h"
+#include "pipeline/logs/simulated_log.h"
+#include "test_support.h"
 
 namespace bifilar {
 namespace {
@@ -172,8 +174,11 @@ TEST(SimulateCampaign, SameSeedSameBytesAndTruthConsistent) {
     EXPECT_EQ(ReadText(a / f), ReadText(b / f)) << f;
     EXPECT_NE(ReadText(a / f), ReadText(c / f)) << f;
   }
-  // Header in the spec's format; no temporary files left behind.
-  EXPECT_EQ(ReadText(a / files[0]).substr(0, 20), "t,wx,wy,wz,ax,ay,az\n");
+  // The mark of a simulated log with its seed (pipeline/logs/simulated_log.h), then the header in the
+  // spec's format; no temporary files left behind.
+  const std::string head =
+      SimulatedCsvMarkerLine(SimulatedLogOrigin(spec.seed)) + "\nt,wx,wy,wz,ax,ay,az\n";
+  EXPECT_EQ(ReadText(a / files[0]).substr(0, head.size()), head);
   for (const auto& entry : fs::recursive_directory_iterator(a)) {
     EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
   }
@@ -200,7 +205,7 @@ TEST(SimulateCampaign, SameSeedSameBytesAndTruthConsistent) {
     EXPECT_NEAR(t["mass_kg"].get<double>(), 6.75, 1e-12);
     // The CSV rows and the truth agree; the release lies inside the log.
     const std::string csv = ReadText(a / t["file"].get<std::string>());
-    const long rows = std::count(csv.begin(), csv.end(), '\n') - 1;
+    const long rows = std::count(csv.begin(), csv.end(), '\n') - 2;  // the mark and the header
     EXPECT_EQ(rows, t["samples"].get<long>());
     EXPECT_GT(t["t_release_s"].get<double>(), t["t_twist_s"].get<double>());
     EXPECT_TRUE(t["t_stop_s"].is_null() || t["t_stop_s"].get<double>() > t["t_release_s"].get<double>());
@@ -414,13 +419,22 @@ TEST(SimulateCli, RefusesTargetsThatAreNotRegularFilesOrTheSameFile) {
     EXPECT_NE(err.find(c.expect), std::string::npos) << c.args << "\n" << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << "one line: " << err;
   }
-  // A symlink and a hard link to the CSV are the same file too.
+  // A hard link to the CSV is the same file too (with --force, which lets an existing file be
+  // replaced); a symbolic link is refused as a link (base/atomic_file.h), and without
+  // --force an existing file is refused as such (issue 23).
   std::ofstream(dir / "c.csv") << "mine\n";
   fs::create_symlink(dir / "c.csv", dir / "c_link.json");
   fs::create_hard_link(dir / "c.csv", dir / "c_hard.json");
-  for (const std::string other : {"c_link.json", "c_hard.json"}) {
-    EXPECT_EQ(RunCliCapture("simulate --trace " + d + "c.csv --truth " + d + other + good, dir, &err), 2);
-    EXPECT_NE(err.find("are the same file"), std::string::npos) << err;
+  const struct {
+    std::string args, expect;
+  } links[] = {
+      {"--truth " + d + "c_hard.json --force", "are the same file"},
+      {"--truth " + d + "c_link.json --force", "c_link.json: is a symbolic link"},
+      {"--truth " + d + "c_hard.json", "simulate --trace: " + d + "c.csv exists"},
+  };
+  for (const auto& c : links) {
+    EXPECT_EQ(RunCliCapture("simulate --trace " + d + "c.csv " + c.args + good, dir, &err), 2);
+    EXPECT_NE(err.find(c.expect), std::string::npos) << c.args << "\n" << err;
   }
   // Nothing was written: the FIFO is still a FIFO, the link still a link, no new files.
   EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
@@ -546,7 +560,9 @@ TEST(SimulatePresets, QuadrotorLooksLikeTheCrazyflieLogs) {
     ASSERT_EQ(t["spikes"].size(), 1u);
     EXPECT_EQ(std::abs(t["spikes"][0]["rate_rad_per_s"].get<double>()), 5.0);
     EXPECT_GE(t["spikes"][0]["t_s"].get<double>(), t["t_release_s"].get<double>());
-    const std::string csv = ReadText(dir / t["file"].get<std::string>());
+    std::string csv = ReadText(dir / t["file"].get<std::string>());
+    ASSERT_EQ(csv.rfind("# simulated by bifilar ", 0), 0u);  // the mark, then the real log's form
+    csv.erase(0, csv.find('\n') + 1);
     EXPECT_EQ(csv.substr(0, 11), "t,wx,wy,wz\n");                       // no accelerometer
     EXPECT_NE(csv.find("\n\n,,,Rollout Completed"), std::string::npos);  // the footer
     std::ofstream(dir / "one.csv") << csv;
@@ -558,16 +574,13 @@ TEST(SimulatePresets, QuadrotorLooksLikeTheCrazyflieLogs) {
   const StepStats sim = Steps(simulated);
   EXPECT_GE(sim.min, 0.008 - 1e-9);
   EXPECT_NEAR(sim.median, 0.031, 0.003);
-  // The real logs, when present (../shared/data/crazyflie/, beside the repository).
-  const fs::path real_dir = fs::path(BIFILAR_SOURCE_DIR) / "../shared/data/crazyflie";
-  std::vector<std::vector<double>> real;
-  if (fs::is_directory(real_dir)) {
-    for (const auto& entry : fs::directory_iterator(real_dir)) {
-      if (entry.path().extension() == ".csv") real.push_back(CrazyflieTimes(entry.path()));
-    }
-  }
+  // The real logs (crazyflie/ of the data folder; without one named the test ends here).
   fs::remove_all(dir);
-  if (real.empty()) GTEST_SKIP() << "no Crazyflie logs in " << real_dir;
+  BIFILAR_REAL_DATA(real_dir, "crazyflie");
+  std::vector<std::vector<double>> real;
+  for (const auto& entry : fs::directory_iterator(real_dir)) {
+    if (entry.path().extension() == ".csv") real.push_back(CrazyflieTimes(entry.path()));
+  }
   const StepStats measured = Steps(real);
   ASSERT_GT(measured.count, 10000u);
   // Median 31.1 ms, mean 40.9 ms, 95th percentile 103 ms on the 24 real logs; the preset within
@@ -606,6 +619,8 @@ TEST(SimulatePresets, NonidealRigRecordsItsSoftening) {
     // Gravity removed: the mean accelerometer reading is 0.07-0.26 g, not 1 g.
     std::istringstream csv(ReadText(a / file));
     std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line.rfind("# simulated by bifilar ", 0), 0u) << line;
     std::getline(csv, line);
     EXPECT_EQ(line, "t,gx,gy,gz,ax,ay,az");
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();

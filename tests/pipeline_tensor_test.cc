@@ -1,8 +1,8 @@
-// Tensor campaigns through `process` (pipeline/campaign/campaign_tensor.h): attitudes from the runs
-// table and from {roll_deg}, exact recovery through discovery and grouping with a fake trace fit,
-// the minimal three-axis config, bad rolls, the measured-vs-nominal warning, the planar sample bit
-// for bit, a simulated 12 x 2 campaign against its truth (nominal and measured attitudes), and the
-// real Crazyflie logs when ../shared/data is beside the repository.
+// Tensor campaigns through `process` (pipeline/campaign/campaign_tensor.h): attitudes from the runs table
+// and from {roll_deg}, exact recovery through discovery and grouping with a fake trace fit, the
+// minimal three-axis config, bad rolls, the measured-vs-nominal warning, the planar sample's
+// committed ellipse, a simulated 12 x 2 campaign against its truth (nominal and measured attitudes), and the
+// real Crazyflie logs of the data folder (BIFILAR_REAL_DATA, tests/test_support.h).
 #include "pipeline/campaign/campaign.h"
 
 #include <cmath>
@@ -246,8 +246,14 @@ TEST(TensorCampaign, MeasuredAttitudeFarFromTheNominalWarnsNamingTheLog) {
   for (int c = 0; c < 6; ++c) EXPECT_NEAR(result.tensor_fit->components[c].value, kTruth[c], 1e-9);
 }
 
-TEST(TensorCampaign, PlanarSampleGivesTodaysEllipseBitForBit) {
-  // The committed sample's results.json (written before the tensor existed) against a fresh run.
+// The committed sample's results.json (written on another machine) against a fresh run: the
+// ellipse and its stds to 1e-9 relative. Another machine differs in the last digits (its BLAS,
+// libm code path and CPU; measured up to 7e-11 relative, issue 22), so bit for bit holds only
+// within one build; a change in the code moves these by far more (a 1 % of std change is ~5e-6
+// relative, SmallThings.CommittedSampleOutputsHoldTheCodesNumbers). Within this run, the tensor
+// section repeats the ellipse bit for bit.
+TEST(TensorCampaign, PlanarSampleGivesTheCommittedEllipse) {
+  constexpr double kRelTol = 1e-9;
   const std::string source = BIFILAR_SOURCE_DIR;
   TempDir dir("bifilar_tensor");
   CampaignOptions options;
@@ -262,7 +268,9 @@ TEST(TensorCampaign, PlanarSampleGivesTodaysEllipseBitForBit) {
   ASSERT_TRUE(result.ellipse_fit.has_value());
   for (const char* key : {"Ix_kg_m2", "Iz_kg_m2", "Ixz_kg_m2", "tau_deg", "Ix_kg_m2_std",
                           "Iz_kg_m2_std", "Ixz_kg_m2_std", "tau_deg_std"}) {
-    EXPECT_EQ(result.ellipse[key].get<double>(), before["ellipse"][key].get<double>()) << key;
+    const double committed = before["ellipse"][key].get<double>();
+    EXPECT_NEAR(result.ellipse[key].get<double>(), committed, kRelTol * std::fabs(committed))
+        << key;
   }
   // The tensor section repeats them.
   EXPECT_EQ(result.tensor["mode"], "planar_xz");
@@ -315,8 +323,7 @@ TEST(TensorCampaign, SimulatedCampaignMeetsTheIssueNumbers) {
 }
 
 TEST(TensorCampaign, CrazyflieAirframeGivesItsThreeMoments) {
-  const std::string data = std::string(BIFILAR_SOURCE_DIR) + "/../shared/data/crazyflie";
-  if (!fs::exists(data + "/BaseModel_Ixx_Log-1.csv")) GTEST_SKIP() << "no " << data;
+  BIFILAR_REAL_DATA(data, "crazyflie");
   TempDir dir("bifilar_tensor");
   ConfigLoadOptions load;
   load.runs_root = data;
@@ -334,7 +341,7 @@ TEST(TensorCampaign, CrazyflieAirframeGivesItsThreeMoments) {
   EXPECT_EQ(t.unobservable.size(), 3u);
   // The authors' own script rerun on these logs (small-angle formula, which a fit of the
   // nonlinear model comes out slightly below: 10-25 deg swings): 15.78e-6, 15.26e-6 (Iyy from
-  // logs 1-3) and 31.96e-6 kg m^2 (../shared/data/README.md). Within 4 %, and the repeats'
+  // logs 1-3) and 31.96e-6 kg m^2 (the data folder's README.md). Within 4 %, and the repeats'
   // 0.2-0.3 % scatter shows in the std (not 20-40 x smaller).
   EXPECT_NEAR(t.components[kIxx].value, 15.78e-6, 0.04 * 15.78e-6);
   EXPECT_NEAR(t.components[kIyy].value, 15.6e-6, 0.05 * 15.6e-6);

@@ -1,7 +1,7 @@
-// PX4 ULog reader (pipeline/logs/ulog.h) and writer (pipeline/logs/ulog_writer.h): the real PX4
-// logs in ../shared/data/px4/ against a reference reader's numbers, files written here with
-// dropouts, appended sections, nested types and a cut-short tail, bad input (always an error naming
-// the file, never a crash), the config keys, and a simulated campaign processed from .ulg and .csv.
+// PX4 ULog reader (pipeline/logs/ulog.h) and writer (pipeline/logs/ulog_writer.h): the real PX4 logs in
+// px4/ of the data folder (tests/test_support.h) against a reference reader's numbers, files written here with dropouts,
+// appended sections, nested types and a cut-short tail, bad input (always an error naming the
+// file, never a crash), the config keys, and a simulated campaign processed from .ulg and .csv.
 #include "pipeline/logs/ulog.h"
 
 #include <cmath>
@@ -21,6 +21,7 @@
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/logs/imu_log_writer.h"
 #include "pipeline/logs/ulog_writer.h"
+#include "test_support.h"
 
 namespace bifilar {
 namespace {
@@ -44,11 +45,6 @@ void WriteFile(const std::string& path, const std::string& text) {
 std::string TempDir() {
   char tmpl[] = "/tmp/bifilar_ulog_test_XXXXXX";
   return mkdtemp(tmpl);
-}
-
-// The real PX4 logs (BSD-3, from PX4's pyulog test data), beside the repository.
-std::string Px4Log(const std::string& file) {
-  return std::string(BIFILAR_SOURCE_DIR) + "/../shared/data/px4/" + file;
 }
 
 // The UserError message of `f()`, or "" when it does not throw.
@@ -93,8 +89,8 @@ constexpr Reference kReferences[] = {
 
 TEST(Ulog, RealLogsMatchTheReferenceReader) {
   for (const Reference& ref : kReferences) {
-    const std::string path = Px4Log(ref.file);
-    if (!fs::exists(path)) GTEST_SKIP() << path << " absent";
+    // The real PX4 logs (BSD-3, from PX4's pyulog test data).
+    BIFILAR_REAL_DATA(path, "px4/" + std::string(ref.file));
     const std::string bytes = ReadFile(path);
     UlogRequest request;
     request.topic = ref.topic;
@@ -109,8 +105,7 @@ TEST(Ulog, RealLogsMatchTheReferenceReader) {
 }
 
 TEST(Ulog, RealLogReadsAsImuDataByItsMagic) {
-  const std::string path = Px4Log("sample_log_small.ulg");
-  if (!fs::exists(path)) GTEST_SKIP() << path << " absent";
+  BIFILAR_REAL_DATA(path, "px4/sample_log_small.ulg");
   const ImuData d = ReadImuLog(path, ImuFormat());  // CSV defaults: the magic picks ULog
   ASSERT_EQ(d.size(), 1298u);
   ASSERT_TRUE(d.has_accel());
@@ -131,8 +126,7 @@ TEST(Ulog, RealLogReadsAsImuDataByItsMagic) {
 }
 
 TEST(Ulog, RealLogMissingTopicOrFieldListsWhatThereIs) {
-  const std::string path = Px4Log("sample_log_small.ulg");
-  if (!fs::exists(path)) GTEST_SKIP() << path << " absent";
+  BIFILAR_REAL_DATA(path, "px4/sample_log_small.ulg");
   ImuFormat format;
   format.ulog.topic = "sensor_combined_x";
   std::string e = ErrorOf([&] { ReadImuLog(path, format); });
@@ -151,8 +145,7 @@ TEST(Ulog, RealLogMissingTopicOrFieldListsWhatThereIs) {
 }
 
 TEST(Ulog, RealLogCutOrDamagedNeverCrashes) {
-  const std::string path = Px4Log("sample_log_small.ulg");
-  if (!fs::exists(path)) GTEST_SKIP() << path << " absent";
+  BIFILAR_REAL_DATA(path, "px4/sample_log_small.ulg");
   const std::string good = ReadFile(path);
   std::mt19937 rng(5);
   for (int trial = 0; trial < 400; ++trial) {
@@ -414,7 +407,9 @@ TEST(UlogReader, FuzzedFilesNeverCrash) {
       const ImuData d = ReadUlogImu(bytes, "fuzz.ulg", ImuFormat());
       for (size_t k = 0; k < d.size(); ++k) {
         ASSERT_TRUE(std::isfinite(d.t_s[k]) && d.gyro_in_imu[k].allFinite()) << what;
-        if (k > 0) ASSERT_GT(d.t_s[k], d.t_s[k - 1]) << what;
+        if (k > 0) {
+          ASSERT_GT(d.t_s[k], d.t_s[k - 1]) << what;
+        }
       }
     } catch (const UserError& e) {
       ASSERT_EQ(std::string(e.what()).rfind("fuzz.ulg: ", 0), 0u) << what << ": " << e.what();

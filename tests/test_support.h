@@ -1,6 +1,7 @@
 // What several tests share: files, a temporary folder, the `bifilar fit` config of the
-// quadrotor rig (the Crazyflie logs of ../shared/data and the simulator's preset), and that preset
-// simulated with its glitches changed. Header-only; include from tests only.
+// quadrotor rig (the real Crazyflie logs and the simulator's preset), and that preset
+// simulated with its glitches changed, and where the real logs are (BIFILAR_REAL_DATA).
+// Header-only; include from tests only.
 #pragma once
 
 #include <sys/wait.h>
@@ -111,6 +112,58 @@ inline std::string SimulateQuadrotor(const TempDir& dir, int spike_count, double
   EXPECT_EQ(std::system(command.c_str()), 0);
   return dir.path + "/" + name;
 }
+
+// The real logs (Crazyflie CSV in crazyflie/, PX4 ULog in px4/; their README says where they come
+// from) live outside the repository, in a folder named by the environment variable
+// BIFILAR_DATA_DIR. CTest sets it from the CMake cache variable of the same name for the tests
+// labelled `realdata` (the list in tests/CMakeLists.txt); scripts/test.sh names ../shared/data
+// when that folder is beside the checkout. What a real-data test does:
+//   - no folder named: skipped, saying so (a newcomer without the data gets a green suite, and
+//     scripts/test.sh prints how many real-data tests did not run);
+//   - a folder named, but it or the file asked for is missing: FAILS (data that CI has cannot
+//     vanish without a red suite);
+//   - run by CTest without the `realdata` label (a new real-data test not yet in the list):
+//     FAILS, naming the list.
+enum class RealData { kFound, kNotNamed, kMissing, kUnlabelled };
+
+// Finds `relative` ("crazyflie", "px4/sample_log_small.ulg") in the data folder: sets `*path`
+// (always, so a message can name it) and, unless found, `*why`.
+inline RealData FindRealData(const std::string& relative, std::string* path, std::string* why) {
+  const char* label = std::getenv("BIFILAR_REALDATA_LABEL");  // "0": CTest, not labelled
+  const char* dir = std::getenv("BIFILAR_DATA_DIR");
+  *path = std::string(dir != nullptr ? dir : "") + "/" + relative;
+  if (label != nullptr && std::string(label) == "0") {
+    *why = "this test reads real data (" + relative +
+           ") but CTest runs it without the label realdata: add its name to realdata_tests in "
+           "tests/CMakeLists.txt";
+    return RealData::kUnlabelled;
+  }
+  if (dir == nullptr || *dir == '\0') {
+    *why = "real data not run: no data folder named (BIFILAR_DATA_DIR; cmake "
+           "-DBIFILAR_DATA_DIR=DIR, or scripts/test.sh with ../shared/data beside the checkout)";
+    return RealData::kNotNamed;
+  }
+  std::error_code ec;
+  if (!std::filesystem::exists(*path, ec)) {
+    *why = "the data folder named by BIFILAR_DATA_DIR has no " + *path;
+    return RealData::kMissing;
+  }
+  return RealData::kFound;
+}
+
+// In a TEST body: declares std::string `var`, the path of `relative` in the data folder, or
+// ends the test as FindRealData says (skip when no folder is named, failure otherwise).
+#define BIFILAR_REAL_DATA(var, relative)                                                  \
+  std::string var;                                                                        \
+  do {                                                                                    \
+    std::string bifilar_real_data_why;                                                    \
+    const ::bifilar::test_support::RealData bifilar_real_data_found =                     \
+        ::bifilar::test_support::FindRealData(relative, &var, &bifilar_real_data_why);    \
+    if (bifilar_real_data_found == ::bifilar::test_support::RealData::kNotNamed)          \
+      GTEST_SKIP() << bifilar_real_data_why;                                              \
+    if (bifilar_real_data_found != ::bifilar::test_support::RealData::kFound)             \
+      FAIL() << bifilar_real_data_why;                                                    \
+  } while (false)
 
 }  // namespace test_support
 }  // namespace bifilar

@@ -34,6 +34,9 @@ void RegisterExportCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--set", *sets,
                   "NAME=VALUE: a component the result does not hold, in kg m^2, body axes, "
                   "products positive (I_xy = integral x y dm), e.g. --set Iyy=0.42; repeatable");
+  cmd->add_flag("--force", opts->force,
+                "replace an --out file that export did not write, and write a urdf/sdf/jsbsim "
+                "file of a tensor that is not physical (the warning stays)");
   cmd->add_flag("--symmetric", opts->symmetric,
                 "take Ixy = Iyz = 0 when the result does not hold them (aircraft symmetric about "
                 "its x-z plane)");

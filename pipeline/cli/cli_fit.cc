@@ -262,9 +262,12 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     int failed = 0;
     InstallInterruptHandler();
     const std::vector<std::string> stems = FigureStems(args->logs);
-    for (size_t k = 0; k < args->logs.size(); ++k) {
-      const std::string& log = args->logs[k];
-      if (ProcessInterruptFlag().load()) {  // Ctrl-C: what was fitted, then exit 130
+    bool mid_fit = false;  // the last fit was stopped by Ctrl-C: its log is not fitted
+    for (size_t k = 0; k <= args->logs.size(); ++k) {
+      // Ctrl-C, between logs or inside a fit (which then stops between solver iterations, and
+      // its log counts as not fitted): what was fitted, then exit 130.
+      if (ProcessInterruptFlag().load()) {
+        if (mid_fit) records.pop_back();
         if (args->json || args->repeats) {
           for (const TraceRecord& r : records) std::cout << HumanLine(r, config.units) << std::endl;
         }
@@ -273,14 +276,21 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
         *exit_code = kInterruptedExitCode;
         return;
       }
+      if (k == args->logs.size()) break;
+      const std::string& log = args->logs[k];
       TraceProcessOptions trace = options;
       trace.display_name = log;
+      trace.interrupt = &ProcessInterruptFlag();
       if (!args->plot_dir.empty()) {
         const std::string base = (std::filesystem::path(args->plot_dir) / stems[k]).string();
         trace.figure_paths = {base + ".svg", base + ".png"};
         trace.sweep_figure_paths = {base + "_sweep.svg", base + "_sweep.png"};
       }
       records.push_back(ProcessTrace(config, log, trace));
+      if (ProcessInterruptFlag().load()) {  // not printed: handled at the loop's top
+        mid_fit = true;
+        continue;
+      }
       if (!records.back().ok()) ++failed;
       // Without --repeats each line is printed as soon as its log is fitted.
       if (!args->json && !args->repeats) std::cout << HumanLine(records.back(), config.units) << std::endl;

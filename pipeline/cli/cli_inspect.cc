@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 
@@ -87,17 +88,20 @@ void RegisterInitCommand(CLI::App& app, int* exit_code) {
   sub->add_option("--rig", args->rig,
                   "L,D,MASS: wire length (m), wire separation (m), suspended mass (kg); asked on "
                   "a terminal when not given");
-  sub->add_option("--gravity", args->gravity_mps2, "local gravity (m/s^2), default 9.80665")
-      ->check(CLI::Range(9.7, 9.9));
+  char gravity_help[160];
+  std::snprintf(gravity_help, sizeof(gravity_help),
+                "local gravity (m/s^2) in [%g, %g], the range a config accepts; default 9.80665",
+                kMinEarthGravityMps2, kMaxEarthGravityMps2);
+  sub->add_option("--gravity", args->gravity_mps2, gravity_help)->check(FiniteNumber());
   sub->add_flag("--force", args->force, "overwrite PATH if it exists");
   sub->callback([args, exit_code] {
-    std::error_code ec;
-    if (std::filesystem::exists(std::filesystem::symlink_status(args->path, ec)) && !args->force) {
-      throw UserError("init: " + args->path +
-                      " exists; choose another name, or add --force to overwrite it");
-    }
+    RefuseToReplace(args->path, "init", args->force);  // base/atomic_file.h
     StartingConfigOptions options;
     options.gravity_mps2 = args->gravity_mps2;
+    {
+      std::string why;  // the config's own bound and message (pipeline/config/config.h)
+      if (!CheckGravity(args->gravity_mps2, false, &why)) throw UserError("init: --gravity: " + why);
+    }
     if (!args->rig.empty()) {
       std::string why;
       if (!ParseRigSpec(args->rig, &options, &why)) throw UserError(why);
@@ -119,10 +123,10 @@ void RegisterInitCommand(CLI::App& app, int* exit_code) {
       }
       options.format = report.format;
       options.ulog = report.kind == "ulog";
-      options.format_source = "guessed from " + args->log;
+      options.format_source = args->log;
       for (const std::string& g : report.guesses) std::cout << "guessed: " << g << "\n";
     }
-    WriteFileAtomically(args->path, StartingConfigText(options));
+    WriteFileAtomically(args->path, CheckedStartingConfigText(options, args->path));
     std::cout << "wrote " << args->path << "; next: bifilar fit " << args->path << " LOG\n";
     *exit_code = 0;
   });

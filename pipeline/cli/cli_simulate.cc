@@ -3,6 +3,8 @@
 //   single trace: bifilar simulate --trace OUT.csv --inertia-kg-m2 I --mass-kg M -L L -D D
 //                 [--amplitude-deg A] [--pitch-deg P] [--duration-s T] [--model M] [--seed N]
 //                 [SPEC.yaml for sensor/timeline/format settings and defaults]
+//   either: [--force] to overwrite files that exist (refused otherwise, naming the file). Every
+//   log is marked as simulated, with its seed (pipeline/logs/simulated_log.h).
 #include <iostream>
 #include <limits>
 #include <optional>
@@ -19,6 +21,7 @@ struct SimulateArgs {
   std::optional<double> inertia, mass, length, separation, gravity, amplitude, pitch, duration;
   std::optional<double> sample_rate;
   bool no_accel = false;
+  bool force = false;  // replace files that exist (issue 23: never without being told)
 };
 
 // CLI11 2.1 binds plain values; an option given on the command line fills the std::optional.
@@ -75,7 +78,7 @@ void Run(const SimulateArgs& a, int* exit_code) {
     if (a.duration) spec.options.timeline.free_s = {*a.duration, *a.duration};
     std::string why;
     if (!spec.options.Check(&why)) throw UserError(why);
-    const SimulateRunSummary summary = RunSimulateTrace(spec, a.trace_csv, a.truth_json);
+    const SimulateRunSummary summary = RunSimulateTrace(spec, a.trace_csv, a.truth_json, a.force);
     std::cout << "wrote " << a.trace_csv << ": " << summary.BriefReport() << "\n";
     *exit_code = 0;
     return;
@@ -95,7 +98,7 @@ void Run(const SimulateArgs& a, int* exit_code) {
   if (a.duration) spec.options.timeline.free_s = {*a.duration, *a.duration};
   std::string why;
   if (!spec.campaign.Check(&why) || !spec.options.Check(&why)) throw UserError(why);
-  const SimulateRunSummary summary = RunSimulateCampaign(spec, a.out_dir);
+  const SimulateRunSummary summary = RunSimulateCampaign(spec, a.out_dir, a.force);
   std::cout << "wrote " << a.out_dir << ": " << summary.BriefReport() << "\n";
   *exit_code = 0;
 }
@@ -134,6 +137,9 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
   }
   sub->add_option("--model", args->model, "truth model: full (default), jardin, linear");
   sub->add_flag("--no-accel", args->no_accel, "write no accelerometer columns");
+  sub->add_flag("--force", args->force,
+                "overwrite files that exist (--trace, --truth, or the logs and truth.json of "
+                "--out); without it simulate refuses, naming the file");
   sub->callback([args, raw, exit_code] {
     SimulateArgs& a = *args;
     if (raw->o_seed->count() > 0) {

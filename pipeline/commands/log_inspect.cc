@@ -156,6 +156,15 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// At most `max_bytes` of `s` (cut at a UTF-8 character boundary) and "…" when cut: a file's own
+// text echoed in a message (a 50 MB one-line file is not echoed whole).
+std::string Abbreviated(const std::string& s, size_t max_bytes = 80) {
+  if (s.size() <= max_bytes) return s;
+  size_t cut = max_bytes;
+  while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;
+  return s.substr(0, cut) + "\u2026 (" + std::to_string(s.size()) + " bytes)";
+}
+
 std::string Format(const char* fmt, double a) {
   char buffer[128];
   std::snprintf(buffer, sizeof(buffer), fmt, a);
@@ -217,7 +226,8 @@ FormatGuess GuessCsvFormat(const std::string& text) {
     std::string list;
     for (const std::string& h : header) list += (list.empty() ? "" : ", ") + h;
     guess.why = std::string(time < 0 ? "no time column" : "no gyro columns") +
-                " recognised among: " + list;
+                " recognised among the " + std::to_string(header.size()) +
+                " column(s) of the first line: " + Abbreviated(list);
     return guess;
   }
   guess.found = true;
@@ -327,27 +337,19 @@ std::string ClassifyText(const std::string& text) {
   return "text";
 }
 
+// Every subscription with its sample count and rate, in one pass over the file.
 void ReadUlogTopics(const std::string& bytes, const std::string& name, InspectReport* report) {
   UlogRequest none;
+  none.topic_timestamps = true;
   const UlogContents contents = ParseUlog(bytes, name, none);
   for (const UlogSubscription& s : contents.subscriptions) {
     UlogTopicInfo info;
     info.topic = s.topic;
     info.multi_id = s.multi_id;
     info.samples = s.samples;
-    try {
-      UlogRequest request;
-      request.topic = s.topic;
-      request.multi_id = s.multi_id;
-      request.fields = {"timestamp"};
-      const UlogContents one = ParseUlog(bytes, name, request);
-      info.samples = one.samples();
-      if (one.samples() > 1) {
-        const double span_s = (one.values.back() - one.values.front()) * 1e-6;
-        if (span_s > 0) info.rate_hz = (one.samples() - 1) / span_s;
-      }
-    } catch (const UserError&) {
-      // A topic without a `timestamp` field: listed without a rate.
+    if (s.samples > 1 && std::isfinite(s.first_timestamp_us) && std::isfinite(s.last_timestamp_us)) {
+      const double span_s = (s.last_timestamp_us - s.first_timestamp_us) * 1e-6;
+      if (span_s > 0) info.rate_hz = (s.samples - 1) / span_s;
     }
     report->topics.push_back(info);
   }
@@ -540,7 +542,8 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config) 
         std::string list;
         for (const UlogTopicInfo& t : report.topics) list += (list.empty() ? "" : ", ") + t.topic;
         report.error = path + ": a ULog file without an IMU topic bifilar knows "
-                       "(sensor_combined, vehicle_angular_velocity, sensor_gyro); topics: " + list +
+                       "(sensor_combined, vehicle_angular_velocity, sensor_gyro); topics: " +
+                       Abbreviated(list, 400) +
                        "; name the topic and fields in imu.ulog (configs/README.md)";
         return report;
       }
@@ -593,7 +596,7 @@ std::string InspectReportText(const InspectReport& r) {
   if (!r.columns.empty()) {
     std::string list;
     for (const std::string& c : r.columns) list += (list.empty() ? "" : ", ") + c;
-    out << "  columns (" << r.columns.size() << "): " << list << "\n";
+    out << "  columns (" << r.columns.size() << "): " << Abbreviated(list, 400) << "\n";
   }
   if (!r.topics.empty()) {
     out << "  topics (" << r.topics.size() << "):\n";

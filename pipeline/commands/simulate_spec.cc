@@ -16,6 +16,7 @@
 #include "base/user_error.h"
 #include "base/version.h"
 #include "pipeline/config/yaml_reader.h"
+#include "pipeline/logs/simulated_log.h"
 #include "pipeline/logs/ulog_writer.h"
 
 namespace bifilar {
@@ -708,20 +709,20 @@ std::string Footer(const SimulatedTrace& trace, const ImuFormat& format, const s
          row("0", "0", "Impact Data");
 }
 
+// Every log simulate writes carries the mark of a simulated log with its seed
+// (pipeline/logs/simulated_log.h): the CSV's first line, or a ULog information message.
 void WriteTrace(const std::string& path, const SimulatedTrace& trace, const SimulateSpec& spec) {
+  const std::string origin = SimulatedLogOrigin(spec.seed);
   if (spec.ulog || path.find(".ulg") != std::string::npos) {  // pipeline/logs/ulog_writer.h
     ImuData imu = trace.imu;
     if (!spec.options.sensor.accelerometer) imu.accel_in_imu.clear();
-    return WriteImuUlog(path, imu);
+    return WriteImuUlog(path, imu, origin);
   }
   ImuFormat format = spec.format;
   if (!spec.options.sensor.accelerometer) format.accel_columns = {"", "", ""};
-  if (!spec.footer) {
-    WriteImuLog(path, trace.imu, format, spec.write);
-    return;
-  }
-  const std::string text =
-      FormatImuLog(trace.imu, format, spec.write) + Footer(trace, format, spec.write.line_end);
+  std::string text = SimulatedCsvMarkerLine(origin) + spec.write.line_end +
+                     FormatImuLog(trace.imu, format, spec.write);
+  if (spec.footer) text += Footer(trace, format, spec.write.line_end);
   const bool gzip = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;
   WriteFileAtomically(path, gzip ? GzipCompress(text) : text);
 }
@@ -770,8 +771,13 @@ void CheckOutputFileTarget(const std::string& path, const std::string& what) {
                       ": exists and is not a regular file (a device, FIFO or socket); "
                       "simulate only writes regular files: choose another path");
     }
-    return;
   }
+  try {
+    CheckFileTarget(path);  // a symbolic link, a name too long (base/atomic_file.h)
+  } catch (const UserError& e) {
+    throw UserError(what + " " + e.what());
+  }
+  if (fs::exists(status)) return;
   // A missing file: its nearest existing ancestor must be a folder.
   for (fs::path parent = fs::path(path).parent_path(); !parent.empty();
        parent = parent.parent_path()) {
@@ -900,7 +906,8 @@ std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<Campai
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
-SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::string& out_dir) {
+SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::string& out_dir,
+                                       bool force) {
   namespace fs = std::filesystem;
   if (!spec.has_campaign) {
     throw UserError((spec.file.empty() ? std::string("spec") : spec.file) +
@@ -912,6 +919,7 @@ SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::stri
     throw UserError(out_dir + ": output path exists and is not a folder");
   }
   CheckOutputFileTarget((fs::path(out_dir) / "truth.json").string(), "--out");  // fail early
+  RefuseToReplace((fs::path(out_dir) / "truth.json").string(), "simulate --out", force);
   std::vector<CampaignTrace> traces;
   std::string why;
   if (!SimulateCampaign(spec.campaign, spec.options, spec.seed, &traces, &why)) {
@@ -924,11 +932,29 @@ SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::stri
     for (auto& ct : traces) ct.relative_path += ".gz";
   }
   const std::string truth = CampaignTruthJson(spec, traces);
-  // Every target is checked before the first file is written.
-  for (const auto& ct : traces) {
-    CheckOutputFileTarget((fs::path(out_dir) / ct.relative_path).string(), "--out");
+  // Every target is checked before the first file is written: a regular file or nothing, and
+  // nothing at all without --force (issue 23: the logs of a real campaign in OUT/pitch_0/).
+  std::vector<std::string> targets;
+  for (const auto& ct : traces) targets.push_back((fs::path(out_dir) / ct.relative_path).string());
+  targets.push_back((fs::path(out_dir) / "truth.json").string());
+  for (const std::string& target : targets) CheckOutputFileTarget(target, "--out");
+  if (!force) {
+    int existing = 0;
+    std::string first;
+    for (const std::string& target : targets) {
+      if (fs::exists(fs::symlink_status(target, ec))) {
+        if (existing++ == 0) first = target;
+      }
+    }
+    if (existing > 0) {
+      throw UserError("simulate --out: " + first + " exists" +
+                      (existing > 1 ? " (and " + std::to_string(existing - 1) +
+                                          " more of the files this campaign writes)"
+                                    : std::string()) +
+                      "; simulate writes over no file without --force: choose another "
+                      "folder, or add --force to overwrite them");
+    }
   }
-  CheckOutputFileTarget((fs::path(out_dir) / "truth.json").string(), "--out");
   SimulateRunSummary summary;
   for (const auto& ct : traces) {
     WriteTrace((fs::path(out_dir) / ct.relative_path).string(), ct.trace, spec);
@@ -942,7 +968,7 @@ SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::stri
 }
 
 SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string& csv_path,
-                                    const std::string& truth_path_in) {
+                                    const std::string& truth_path_in, bool force) {
   const TraceRequest& r = spec.trace;
   auto need = [](const std::optional<double>& v, const char* name, const char* flag) {
     if (!v) {
@@ -970,6 +996,8 @@ SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string&
     namespace fs = std::filesystem;
     CheckOutputFileTarget(csv_path, "--trace");
     CheckOutputFileTarget(truth_path, "--truth");
+    RefuseToReplace(csv_path, "simulate --trace", force);
+    RefuseToReplace(truth_path, "simulate --truth", force);
     // The same file under two spellings: compare normalised absolute paths (symlinks resolved
     // where they exist), then, when both exist, the files themselves (hard links).
     std::error_code ec;

@@ -77,17 +77,22 @@ struct SimulateRunSummary {
 
 // Campaign: simulates every log in memory first (any error -> UserError, nothing written), then
 // writes OUT/pitch_{P}/trial_{k}.csv, OUT/tare/tare_{k}.csv and OUT/truth.json, each atomically.
+// Every log is marked as simulated, with its seed (pipeline/logs/simulated_log.h).
 // Requires spec.has_campaign. Throws UserError, before writing anything, when out_dir exists and
-// is not a folder, or one of the files it would write exists and is not a regular file.
-SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::string& out_dir);
+// is not a folder, or one of the files it would write exists and is not a regular file, or
+// (unless `force`) exists at all: simulate replaces no file without --force (issue 23).
+SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::string& out_dir,
+                                       bool force = false);
 
 // One trace from spec.trace (flags already merged in): writes `csv_path` and the truth JSON at
 // `truth_path` (default: csv_path with ".csv" replaced by ".truth.json"). Throws UserError naming
 // the parameter on bad input; nothing is written then. Also refused, before anything is written:
 // a target that is not a regular file (CheckOutputFileTarget) and a truth path that is the CSV
-// path, however spelled (./a.csv, d/../a.csv, a symlink or a hard link to it).
+// path, however spelled (./a.csv, d/../a.csv, a symlink or a hard link to it), and, unless
+// `force`, either path existing (RefuseToReplace, base/atomic_file.h). The log is marked as
+// simulated, with its seed (pipeline/logs/simulated_log.h).
 SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string& csv_path,
-                                    const std::string& truth_path = "");
+                                    const std::string& truth_path = "", bool force = false);
 
 // The truth JSON text of a campaign / a single trace (what the Run functions write).
 std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<CampaignTrace>& traces);

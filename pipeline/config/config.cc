@@ -924,7 +924,16 @@ ImuLogOptions InputLimits::LogOptions() const {
 CampaignConfig LoadCampaignConfig(const std::string& path, const ConfigLoadOptions& options) {
   CampaignConfig config;
   ReadConfigFile(path, &config);
-  YamlMap root = YamlMap::LoadFile(path);
+  return LoadCampaignConfigText(config.text, path, options);
+}
+
+CampaignConfig LoadCampaignConfigText(const std::string& text, const std::string& path,
+                                      const ConfigLoadOptions& options) {
+  CampaignConfig config;
+  config.file = fs::absolute(path).lexically_normal().string();
+  config.folder = fs::path(config.file).parent_path().string();
+  config.text = text;
+  YamlMap root = YamlMap::LoadText(text, path);
   ReadRig(root, path, options, &config);
   ReadAircraftAndGravity(root, path, options, &config);
   ReadImu(Sub(root, "imu"), &config.imu);

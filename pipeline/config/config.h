@@ -258,6 +258,11 @@ struct ConfigLoadOptions {
 // Reads and validates `path`. Throws UserError naming the file, line and key on any problem.
 CampaignConfig LoadCampaignConfig(const std::string& path,
                                   const ConfigLoadOptions& options = ConfigLoadOptions());
+// The same checks on YAML text not (yet) in a file, as if it were `path` (relative paths resolve
+// against path's folder): `init` loads the config it is about to write, so it writes none that
+// `fit` rejects.
+CampaignConfig LoadCampaignConfigText(const std::string& text, const std::string& path,
+                                      const ConfigLoadOptions& options = ConfigLoadOptions());
 
 const char* ToString(PitchSource source);
 

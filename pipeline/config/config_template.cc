@@ -4,16 +4,45 @@
 #include <sstream>
 
 #include "pendulum/model.h"
+#include "pipeline/config/config.h"
+#include "base/user_error.h"
 
 namespace bifilar {
 namespace {
 
-// A YAML double-quoted scalar: any column name survives (brackets, colons, spaces).
+// The one way a string enters the YAML init writes (issue 23: a log named
+// "swing\naircraft: {mass_kg: 0.5}\n#.csv" injected a key): a double-quoted scalar in which
+// every character that could end it, start a new line or be read differently is escaped (quote,
+// backslash, control characters, DEL, and the Unicode line breaks NEL, LS and PS). Column names
+// with brackets, colons, '#', a leading dash or any other UTF-8 survive as they are.
 std::string Quoted(const std::string& text) {
   std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    const auto next = [&](size_t k) {
+      return i + k < text.size() ? static_cast<unsigned char>(text[i + k]) : 0;
+    };
+    if (c == '"' || c == '\\') {
+      (out += '\\') += static_cast<char>(c);
+    } else if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c < 0x20 || c == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof(hex), "\\x%02x", c);
+      out += hex;
+    } else if (c == 0xc2 && next(1) == 0x85) {  // NEL
+      out += "\\N";
+      ++i;
+    } else if (c == 0xe2 && next(1) == 0x80 && (next(2) == 0xa8 || next(2) == 0xa9)) {  // LS, PS
+      out += next(2) == 0xa8 ? "\\L" : "\\P";
+      i += 2;
+    } else {
+      out += static_cast<char>(c);
+    }
   }
   return out + "\"";
 }
@@ -102,7 +131,9 @@ std::string StartingConfigText(const StartingConfigOptions& o) {
        "#   mass_kg: 5.5\n"
        "#   mass_std_kg: 0.01\n"
        "\n";
-  if (!o.format_source.empty()) y << "# Log format " << o.format_source << ": check it.\n";
+  if (!o.format_source.empty()) {
+    y << "# Log format guessed from " << Quoted(o.format_source) << ": check it.\n";
+  }
   y << "imu:\n";
   const ImuFormat format = o.format.value_or(ImuFormat());
   if (o.ulog) {
@@ -126,9 +157,8 @@ std::string StartingConfigText(const StartingConfigOptions& o) {
       y << "  accel: null                       # no accelerometer: swing axis from the gyro\n";
     }
     if (format.delimiter != ',') {
-      y << "  # the log separates its columns with '"
-        << (format.delimiter == '\t' ? "\\t" : std::string(1, format.delimiter))
-        << "': bifilar reads comma-separated logs, so convert it first\n";
+      y << "  # the log separates its columns with " << Quoted(std::string(1, format.delimiter))
+        << ": bifilar reads comma-separated logs, so convert it first\n";
     }
   }
   y << "  swing_axis: auto                   # the down vertical (accelerometer) or the gyro's\n"
@@ -141,6 +171,38 @@ std::string StartingConfigText(const StartingConfigOptions& o) {
        "fit:\n"
        "  model: full                        # the exact bifilar model (docs/physics.md)\n";
   return y.str();
+}
+
+std::string CheckedStartingConfigText(const StartingConfigOptions& options,
+                                      const std::string& path) {
+  const std::string text = StartingConfigText(options);
+  ConfigLoadOptions load;
+  load.require_runs = false;  // what `bifilar fit` asks of a config
+  CampaignConfig config;
+  try {
+    config = LoadCampaignConfigText(text, path, load);
+  } catch (const UserError& e) {
+    throw UserError("init: " + path + ": the config it would write is one `bifilar fit` rejects: " +
+                    e.what());
+  }
+  // The names read back are the names meant (a YAML scalar that changed one would fit the
+  // wrong columns, or none).
+  const ImuFormat meant = options.format.value_or(ImuFormat());
+  const ImuFormat& read = config.imu.format;
+  const bool same =
+      options.ulog
+          ? read.ulog.topic == meant.ulog.topic && read.ulog.time_field == meant.ulog.time_field &&
+                read.ulog.gyro_fields == meant.ulog.gyro_fields &&
+                (meant.ulog.accel_fields[0].empty() ? read.ulog.accel_fields[0].empty()
+                                                    : read.ulog.accel_fields == meant.ulog.accel_fields)
+          : read.time_column == meant.time_column && read.gyro_columns == meant.gyro_columns &&
+                (meant.has_accel() ? read.accel_columns == meant.accel_columns : !read.has_accel());
+  if (!same) {
+    throw UserError("init: " + path + ": a column, topic or field name of the log" +
+                    (options.format_source.empty() ? std::string() : " " + options.format_source) +
+                    " does not survive in YAML (invalid UTF-8?); write the config by hand");
+  }
+  return text;
 }
 
 }  // namespace bifilar

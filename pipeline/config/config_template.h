@@ -20,13 +20,21 @@ struct StartingConfigOptions {
   // The format of the logs; none: the reader's defaults (t, gx/gy/gz rad/s, ax/ay/az m/s^2).
   std::optional<ImuFormat> format;
   bool ulog = false;                 // the format is a ULog topic, not CSV columns
-  std::string format_source;         // "guessed from logs/run1.csv", written as a comment
+  std::string format_source;         // the log the format was guessed from, quoted in a comment
 
   bool Check(std::string* why) const;
 };
 
-// The YAML text of the starting config.
+// The YAML text of the starting config. Every string in it (column, topic and field names, the
+// log's name) is a double-quoted YAML scalar with anything that could end it or start a line
+// escaped, so no name can add a key (issue 23).
 std::string StartingConfigText(const StartingConfigOptions& options);
+
+// The config init writes at `path`, checked before anything is written: the text is loaded with
+// the loader `fit` uses (LoadCampaignConfigText, pipeline/config/config.h: one set of bounds), and the
+// log format read back must be the one meant (a name no YAML scalar carries intact is refused).
+// Throws UserError "init: <path>: the config would be rejected: <the loader's message>".
+std::string CheckedStartingConfigText(const StartingConfigOptions& options, const std::string& path);
 
 // Parses "L,D,MASS" (m, m, kg) as given to `--rig`; false with *why otherwise.
 bool ParseRigSpec(const std::string& text, StartingConfigOptions* options, std::string* why);

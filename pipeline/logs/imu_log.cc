@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <cstring>
 #include <algorithm>
@@ -17,6 +18,7 @@
 #include "base/gzip.h"
 #include "base/user_error.h"
 #include "pipeline/logs/imu_log_finish.h"
+#include "pipeline/logs/simulated_log.h"
 #include "pipeline/logs/ulog.h"
 
 namespace bifilar {
@@ -198,9 +200,11 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
   // Header: the first non-blank line that is not a comment ('#', '%' or '//' first: logger
   // metadata above the header is common).
   int comment_lines = 0;
+  std::string simulated;  // the mark of `bifilar simulate` (pipeline/logs/simulated_log.h)
   while (reader.Next(&line)) {
     const std::string_view trimmed = Trim(line);
     if (trimmed.empty()) continue;
+    if (simulated.empty() && ParseSimulatedCsvMarker(trimmed, &simulated)) continue;
     if (trimmed[0] == '#' || trimmed[0] == '%' || trimmed.substr(0, 2) == "//") {
       ++comment_lines;
       continue;
@@ -211,6 +215,7 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
   if (IsBlank(line) || Trim(line)[0] == '#' || Trim(line)[0] == '%' || Trim(line).substr(0, 2) == "//") {
     Fail(name + ": no header row, only " + std::to_string(comment_lines) + " comment line(s)");
   }
+  if (!simulated.empty()) data.warnings.push_back(simulated);
   if (comment_lines > 0) {
     data.warnings.push_back("skipped " + std::to_string(comment_lines) +
                             " comment line(s) before the header");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <utility>
 
 #include "base/user_error.h"
@@ -10,6 +11,11 @@
 namespace bifilar {
 namespace {
 
+// Bounds on the timestamps of a log (FinishImuLog): its span (11.6 days), and the resolution of
+// a double at the largest timestamp, at most this fraction of the median sample step (Unix
+// time in s, 1.7e9, resolves 4e-7 s: fine for a 1 kHz log).
+constexpr double kMaxLogSpanS = 1e6;
+constexpr double kMinStepsPerResolution = 1e-3;
 constexpr int kTime = 0;  // slot of the time column in a row of `values`; gyro 1-3, accel 4-6
 
 std::string FormatNumber(double v) {
@@ -73,6 +79,39 @@ ImuData FinishImuLog(const std::string& name, const ImuLogOptions& options,
   if (static_cast<int>(keep.size()) < options.min_rows) {
     Fail(name + ": only " + std::to_string(keep.size()) + " usable data row(s); at least " +
          std::to_string(options.min_rows) + " needed");
+  }
+
+  // Timestamps a fit can use: finite, a span of at most kMaxLogSpanS, and small enough that a
+  // double resolves the sample steps (the integrator's steps are relative to t): a clock in the
+  // wrong unit or a corrupt timestamp otherwise ends deep inside the solver.
+  {
+    const double first = values[keep.front() * needed + kTime];
+    const double last = values[keep.back() * needed + kTime];
+    if (!std::isfinite(first) || !std::isfinite(last)) {
+      Fail(name + ": a timestamp is not a finite number");
+    }
+    if (last - first > kMaxLogSpanS) {
+      Fail(name + ": the timestamps span " + FormatNumber(last - first) + " s (from " +
+           FormatNumber(first) + " to " + FormatNumber(last) + " s), more than " +
+           FormatNumber(kMaxLogSpanS) + " s: check the time column and its unit " +
+           "(imu.time.unit), or a corrupt timestamp");
+    }
+    if (keep.size() >= 2) {
+      std::vector<double> steps(keep.size() - 1);
+      for (size_t i = 1; i < keep.size(); ++i) {
+        steps[i - 1] = values[keep[i] * needed + kTime] - values[keep[i - 1] * needed + kTime];
+      }
+      std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+      const double step = steps[steps.size() / 2];
+      const double largest = std::max(std::abs(first), std::abs(last));
+      const double resolution = largest * std::numeric_limits<double>::epsilon();
+      if (resolution > kMinStepsPerResolution * step) {
+        Fail(name + ": timestamps near " + FormatNumber(largest) + " s are too large for " +
+             "samples " + FormatNumber(step) + " s apart (a number that large is resolved " +
+             "only to " + FormatNumber(resolution) + " s); subtract the start time from the " +
+             "time column, or check its unit (imu.time.unit)");
+      }
+    }
   }
 
   data.t_s.resize(keep.size());

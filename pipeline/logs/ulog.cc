@@ -10,6 +10,7 @@
 
 #include "base/user_error.h"
 #include "pipeline/logs/imu_log_finish.h"
+#include "pipeline/logs/simulated_log.h"
 
 namespace bifilar {
 namespace {
@@ -17,8 +18,16 @@ namespace {
 constexpr size_t kHeaderSize = 16;      // magic (7), version (1), start timestamp (8)
 constexpr size_t kMessageHeader = 3;    // uint16_t msg_size, uint8_t msg_type
 constexpr size_t kFlagBitsSize = 40;    // compat[8], incompat[8], appended_offsets[3]
-constexpr int kMaxNesting = 32;         // deeper nesting is taken for a circular definition
-constexpr uint64_t kMaxFormatSize = 1u << 20;  // no message can hold more than 64 KiB anyway
+// Bounds checked before anything is allocated for a format (pipeline/logs/ulog.h):
+constexpr int kMaxNestingDepth = kUlogMaxNestingDepth;  // nested type levels, the topic's included
+// A data message holds at most 65535 - 2 bytes of payload; a type larger than 65535 bytes can
+// never be logged. So a topic flattens to at most 65535 fields.
+constexpr uint64_t kMaxTypeSize = 65535;
+constexpr uint64_t kMaxFlatNameBytes = kUlogMaxFlatNameBytes;  // all flattened names of a type
+// Format fields visited while sizing, locating timestamps and flattening, per file: a file that
+// redefines formats or re-subscribes topics over and over cannot make the reader quadratic.
+// PX4 logs take ~1e4; 2e6 take ~1 s.
+constexpr uint64_t kMaxFormatWork = 2000000;
 
 enum class Kind : uint8_t { kI8, kU8, kI16, kU16, kI32, kU32, kI64, kU64, kF32, kF64, kBool, kChar, kNested };
 
@@ -32,6 +41,13 @@ constexpr Scalar kScalars[] = {
     {"uint16_t", Kind::kU16, 2}, {"int32_t", Kind::kI32, 4},  {"uint32_t", Kind::kU32, 4},
     {"int64_t", Kind::kI64, 8},  {"uint64_t", Kind::kU64, 8}, {"float", Kind::kF32, 4},
     {"double", Kind::kF64, 8},   {"bool", Kind::kBool, 1},    {"char", Kind::kChar, 1}};
+
+int KindSize(Kind kind) {
+  for (const Scalar& s : kScalars) {
+    if (s.kind == kind) return s.size;
+  }
+  return 0;
+}
 
 const Scalar* FindScalar(std::string_view type) {
   for (const Scalar& s : kScalars) {
@@ -145,20 +161,51 @@ class Parser {
   void OnFormat(uint64_t offset, const unsigned char* body, uint32_t size);
   void OnSubscription(uint64_t offset, const unsigned char* body, uint32_t size);
   void OnData(uint64_t offset, const unsigned char* body, uint32_t size);
+  void NoteSimulatedInfo(const unsigned char* body, uint32_t size);
 
-  uint32_t SizeOf(const std::string& type, uint64_t offset, int depth);
-  void Flatten(const std::string& type, const std::string& prefix, uint32_t base, uint64_t offset,
-               int depth, Layout* layout);
+  // What a type flattens to: its size (bytes), its fields (padding left out) and the bytes of
+  // their flattened names.
+  struct TypeInfo {
+    uint32_t size = 0;
+    uint64_t fields = 0;
+    uint64_t name_bytes = 0;
+  };
+  // Memoised; fails (naming the format) on an undefined or circular type, nesting deeper than
+  // kMaxNestingDepth, and a type that could not fit a message or would flatten to more than
+  // kMaxFlatNameBytes of names: all before anything is allocated for it.
+  TypeInfo Measure(const std::string& type, uint64_t offset);
+  uint32_t SizeOf(const std::string& type, uint64_t offset) { return Measure(type, offset).size; }
+  void Flatten(const std::string& type, const std::string& prefix, uint32_t base, Layout* layout);
   Layout Resolve(const std::string& topic, uint64_t offset);
+  // The offset and kind of the top-level scalar `timestamp` of `topic` (false: none, or its
+  // format cannot be resolved).
+  bool FindTimestamp(const std::string& topic, uint64_t offset, uint32_t* at, Kind* kind);
+  std::string DroppedTail(uint64_t pos) const;
 
   const unsigned char* data_;
   uint64_t size_;
   const std::string& name_;
   const UlogRequest& request_;
   UlogContents out_;
+  bool simulated_noted_ = false;
 
   std::map<std::string, RawFormat> formats_;
-  std::map<std::string, uint32_t> sizes_;  // memoised SizeOf
+  std::map<std::string, TypeInfo> measured_;  // memoised Measure
+  std::vector<std::string> resolving_;        // types being measured, outermost first
+  uint64_t format_work_ = 0;                  // steps of Measure, FindTimestamp and Flatten
+  // Memoised FindTimestamp (offset, or -1: none) and Resolve of the wanted topic; cleared with
+  // measured_ when a format is redefined.
+  std::map<std::string, std::pair<int32_t, Kind>> timestamps_;
+  std::map<std::string, Layout> layouts_;
+  // Counts `steps` of format work; fails past kMaxFormatWork.
+  void Spend(uint64_t steps, uint64_t offset) {
+    format_work_ += steps;
+    if (format_work_ > kMaxFormatWork) {
+      Fail(offset, "the format definitions need more than " + std::to_string(kMaxFormatWork) +
+                       " steps to resolve (formats redefined or topics subscribed over and "
+                       "over?): the file is damaged or crafted");
+    }
+  }
   std::vector<uint64_t> appended_offsets_;
   std::vector<uint8_t> msg_role_;          // by msg_id
   std::vector<int> subscription_index_;    // by msg_id into out_.subscriptions (-1: none)
@@ -167,6 +214,11 @@ class Parser {
   // The wanted topic, once subscribed.
   std::vector<std::pair<uint32_t, Kind>> wanted_;  // offset and kind of each requested field
   uint32_t wanted_min_size_ = 0, wanted_max_size_ = 0;
+  uint64_t first_wanted_offset_ = 0;  // of the first wanted sample
+
+  // request_.topic_timestamps: where each subscription's `timestamp` is (by msg_id; -1: none).
+  std::vector<int32_t> timestamp_at_;
+  std::vector<Kind> timestamp_kind_;
 };
 
 void Parser::ReadHeader() {
@@ -187,6 +239,10 @@ void Parser::ReadHeader() {
 
 UlogContents Parser::Run() {
   subscription_index_.assign(65536, -1);
+  if (request_.topic_timestamps) {
+    timestamp_at_.assign(65536, -1);
+    timestamp_kind_.assign(65536, Kind::kU64);
+  }
   ReadHeader();
   // The first message must be the flag bits (if any); it tells where appended sections start.
   uint64_t end = size_;
@@ -214,11 +270,7 @@ void Parser::ReadSection(uint64_t pos, uint64_t end, bool last) {
                                               LoadUnsigned<uint16_t>(data_ + pos) > end) {
       // A message cut short: by the end of the file (the logger stopped mid-write) or by the
       // next appended section (the spec's way of appending to a log that may end anywhere).
-      if (last) {
-        out_.warnings.push_back("the log ends inside a message at byte " + std::to_string(pos) +
-                                " of " + std::to_string(size_) +
-                                " (cut short while logging?); that message is ignored");
-      }
+      if (last) out_.warnings.push_back(DroppedTail(pos));
       return;
     }
     const uint32_t msg_size = LoadUnsigned<uint16_t>(data_ + pos);
@@ -267,11 +319,26 @@ void Parser::OnMessage(uint64_t offset, char type, const unsigned char* body, ui
                          (size > skip ? std::to_string(body[skip]) : std::string("missing")) +
                          " exceeds the message (" + std::to_string(size) + " bytes)");
       }
+      if (type == 'I') NoteSimulatedInfo(body, size);  // pipeline/logs/simulated_log.h
       return;
     }
     default:
       return;  // 'S' (sync) and message types newer than this reader: skipped, as the spec asks
   }
+}
+
+// An info message "char[N] bifilar_simulated" (the key length was checked): a log written by
+// `bifilar simulate` says so once in the warnings (pipeline/logs/simulated_log.h).
+void Parser::NoteSimulatedInfo(const unsigned char* body, uint32_t size) {
+  const std::string_view key(reinterpret_cast<const char*>(body) + 1, body[0]);
+  const std::string suffix = std::string("] ") + kSimulatedUlogInfoKey;
+  if (key.substr(0, 5) != "char[" || key.size() < suffix.size() ||
+      key.substr(key.size() - suffix.size()) != suffix || simulated_noted_) {
+    return;
+  }
+  simulated_noted_ = true;
+  out_.warnings.push_back(SimulatedLogWarning(std::string_view(
+      reinterpret_cast<const char*>(body) + 1 + body[0], size - 1 - body[0])));
 }
 
 void Parser::OnFlagBits(uint64_t offset, const unsigned char* body, uint32_t size) {
@@ -341,40 +408,83 @@ void Parser::OnFormat(uint64_t offset, const unsigned char* body, uint32_t size)
     format.fields.push_back(std::move(f));
   }
   if (format.fields.empty()) Fail(offset, "format '" + Printable(type_name) + "' has no fields");
+  // A new type changes no measured one (a type used before its definition was not measured);
+  // a redefinition may.
+  if (formats_.count(type_name) != 0) {
+    measured_.clear();
+    timestamps_.clear();
+    layouts_.clear();
+  }
   formats_[type_name] = std::move(format);
-  sizes_.clear();
 }
 
-uint32_t Parser::SizeOf(const std::string& type, uint64_t offset, int depth) {
-  if (const Scalar* s = FindScalar(type)) return static_cast<uint32_t>(s->size);
-  if (const auto it = sizes_.find(type); it != sizes_.end()) return it->second;
-  if (depth > kMaxNesting) Fail(offset, "format '" + Printable(type) + "' nests itself (circular definition)");
+bool IsPadding(const RawField& f) { return f.name.rfind("_padding", 0) == 0; }
+
+Parser::TypeInfo Parser::Measure(const std::string& type, uint64_t offset) {
+  if (const Scalar* s = FindScalar(type)) return {static_cast<uint32_t>(s->size), 1, 0};
+  if (const auto it = measured_.find(type); it != measured_.end()) return it->second;
   const auto it = formats_.find(type);
   if (it == formats_.end()) Fail(offset, "type '" + Printable(type) + "' is used but never defined");
-  uint64_t total = 0;
-  for (const RawField& f : it->second.fields) {
-    total += static_cast<uint64_t>(SizeOf(f.type, it->second.byte_offset, depth + 1)) * f.array_len;
-    if (total > kMaxFormatSize) Fail(it->second.byte_offset, "format '" + Printable(type) + "' is too large");
+  const uint64_t at = it->second.byte_offset;
+  if (std::find(resolving_.begin(), resolving_.end(), type) != resolving_.end()) {
+    std::string chain;
+    for (const std::string& t : resolving_) chain += Printable(t, 40) + " -> ";
+    Fail(at, "format '" + Printable(type) + "' contains itself (circular definition: " + chain +
+                 Printable(type, 40) + ")");
   }
-  sizes_[type] = static_cast<uint32_t>(total);
-  return static_cast<uint32_t>(total);
+  if (static_cast<int>(resolving_.size()) >= kMaxNestingDepth) {
+    Fail(at, "format '" + Printable(resolving_.front()) + "' nests types more than " +
+                 std::to_string(kMaxNestingDepth) + " levels deep (at '" + Printable(type) +
+                 "'); this reader accepts at most " + std::to_string(kMaxNestingDepth));
+  }
+  resolving_.push_back(type);
+  TypeInfo info;
+  uint64_t size = 0;
+  for (const RawField& f : it->second.fields) {
+    Spend(1, at);
+    const TypeInfo element = Measure(f.type, at);
+    size += static_cast<uint64_t>(element.size) * f.array_len;
+    if (size > kMaxTypeSize) {
+      Fail(at, "format '" + Printable(type) + "' is more than " + std::to_string(kMaxTypeSize) +
+                   " bytes (at field '" + Printable(f.name) +
+                   "'), more than a ULog data message can hold");
+    }
+    if (IsPadding(f)) continue;
+    // Each element's name: the field name, "[i]" for an array, "." before a nested field.
+    const uint64_t own = f.name.size() + (f.is_array ? 2 + std::to_string(f.array_len).size() : 0) +
+                         (FindScalar(f.type) ? 0 : 1);
+    info.fields += static_cast<uint64_t>(f.array_len) * element.fields;
+    info.name_bytes += static_cast<uint64_t>(f.array_len) * (element.fields * own + element.name_bytes);
+    if (info.name_bytes > kMaxFlatNameBytes) {
+      Fail(at, "format '" + Printable(type) + "' flattens to " + std::to_string(info.fields) +
+                   " or more fields whose names take more than " +
+                   std::to_string(kMaxFlatNameBytes >> 20) + " MiB (at field '" +
+                   Printable(f.name) + "'): no real log has such a topic");
+    }
+  }
+  resolving_.pop_back();
+  info.size = static_cast<uint32_t>(size);
+  measured_[type] = info;
+  return info;
 }
 
+// Every field of a measured type visits at least one byte of it, so this is bounded by the
+// type's size (<= 65535) plus its fields; the names by kMaxFlatNameBytes.
 void Parser::Flatten(const std::string& type, const std::string& prefix, uint32_t base,
-                     uint64_t offset, int depth, Layout* layout) {
+                     Layout* layout) {
   const RawFormat& format = formats_.at(type);
   uint32_t at = base;
   for (const RawField& f : format.fields) {
-    const uint32_t element = SizeOf(f.type, format.byte_offset, depth + 1);
-    const bool padding = f.name.rfind("_padding", 0) == 0;
+    Spend(IsPadding(f) ? 1 : f.array_len, format.byte_offset);
+    const uint32_t element = SizeOf(f.type, format.byte_offset);
     const Scalar* scalar = FindScalar(f.type);
-    for (uint32_t i = 0; i < f.array_len && !padding; ++i) {
+    for (uint32_t i = 0; i < f.array_len && !IsPadding(f); ++i) {
       const std::string name = prefix + f.name + (f.is_array ? "[" + std::to_string(i) + "]" : "");
       const uint32_t where = at + i * element;
       if (scalar) {
         layout->fields.push_back({name, f.type, scalar->kind, where});
       } else {
-        Flatten(f.type, name + ".", where, offset, depth + 1, layout);
+        Flatten(f.type, name + ".", where, layout);
       }
     }
     at += element * f.array_len;
@@ -382,17 +492,76 @@ void Parser::Flatten(const std::string& type, const std::string& prefix, uint32_
 }
 
 Layout Parser::Resolve(const std::string& topic, uint64_t offset) {
+  if (const auto it = layouts_.find(topic); it != layouts_.end()) return it->second;
   if (formats_.find(topic) == formats_.end()) {
     Fail(offset, "topic '" + Printable(topic) + "' is subscribed but has no format definition");
   }
   Layout layout;
-  layout.size = SizeOf(topic, offset, 0);
-  Flatten(topic, "", 0, offset, 0, &layout);
+  const TypeInfo info = Measure(topic, offset);  // bounds the allocations below
+  layout.size = info.size;
+  layout.fields.reserve(info.fields);
+  Flatten(topic, "", 0, &layout);
   const RawField& last = formats_.at(topic).fields.back();
-  if (last.name.rfind("_padding", 0) == 0) {
-    layout.trailing_padding = SizeOf(last.type, offset, 1) * last.array_len;
-  }
+  if (IsPadding(last)) layout.trailing_padding = SizeOf(last.type, offset) * last.array_len;
+  layouts_[topic] = layout;
   return layout;
+}
+
+bool Parser::FindTimestamp(const std::string& topic, uint64_t offset, uint32_t* at, Kind* kind) {
+  if (const auto it = timestamps_.find(topic); it != timestamps_.end()) {
+    *at = static_cast<uint32_t>(std::max(0, it->second.first));
+    *kind = it->second.second;
+    return it->second.first >= 0;
+  }
+  const auto it = formats_.find(topic);
+  if (it == formats_.end()) return false;  // not memoised: the format may come later
+  std::pair<int32_t, Kind> found{-1, Kind::kU64};
+  try {
+    uint64_t position = 0;
+    for (const RawField& f : it->second.fields) {
+      Spend(1, offset);
+      const Scalar* scalar = FindScalar(f.type);
+      if (f.name == "timestamp" && !f.is_array && scalar != nullptr) {
+        found = {static_cast<int32_t>(position), scalar->kind};
+        break;
+      }
+      position += static_cast<uint64_t>(SizeOf(f.type, offset)) * f.array_len;
+      if (position > kMaxTypeSize) break;
+    }
+  } catch (const UserError&) {
+    resolving_.clear();  // listed without a rate; a use of the topic names the fault
+    if (format_work_ > kMaxFormatWork) throw;
+  }
+  timestamps_[topic] = found;
+  *at = static_cast<uint32_t>(std::max(0, found.first));
+  *kind = found.second;
+  return found.first >= 0;
+}
+
+// What is lost when the last section ends inside a message at `pos`.
+std::string Parser::DroppedTail(uint64_t pos) const {
+  const uint64_t rest = size_ - pos;
+  std::string what = "the log ends inside a message at byte " + std::to_string(pos) + " of " +
+                     std::to_string(size_);
+  if (size_ - pos >= kMessageHeader) {
+    what += " (its header claims " + std::to_string(LoadUnsigned<uint16_t>(data_ + pos)) +
+            " bytes, " + std::to_string(rest - kMessageHeader) + " remain)";
+  }
+  char percent[32];
+  std::snprintf(percent, sizeof(percent), "%.2g", 100.0 * static_cast<double>(rest) / size_);
+  what += ": the last " + std::to_string(rest) + " bytes (" + percent +
+          " % of the file) are not read (the log was cut short while logging, or that size "
+          "field is damaged)";
+  const long samples = out_.samples();
+  if (samples > 1 && pos > first_wanted_offset_) {
+    const double bytes_per_sample = static_cast<double>(pos - first_wanted_offset_) / (samples - 1);
+    const long lost = std::lround(static_cast<double>(rest) / bytes_per_sample);
+    if (lost > 0) {
+      what += "; at the rate of the data before it, that is about " + std::to_string(lost) +
+              " sample(s) of topic '" + Printable(request_.topic) + "'";
+    }
+  }
+  return what;
 }
 
 void Parser::OnSubscription(uint64_t offset, const unsigned char* body, uint32_t size) {
@@ -403,9 +572,17 @@ void Parser::OnSubscription(uint64_t offset, const unsigned char* body, uint32_t
   s.topic.assign(reinterpret_cast<const char*>(body + 3), size - 3);
   subscription_index_[s.msg_id] = static_cast<int>(out_.subscriptions.size());
   msg_role_[s.msg_id] = kOther;
+  if (request_.topic_timestamps) {
+    uint32_t at = 0;
+    Kind kind = Kind::kU64;
+    const bool has = FindTimestamp(s.topic, offset, &at, &kind);
+    timestamp_at_[s.msg_id] = has ? static_cast<int32_t>(at) : -1;
+    timestamp_kind_[s.msg_id] = kind;
+  }
   if (s.topic == request_.topic && s.multi_id == request_.multi_id) {
     msg_role_[s.msg_id] = kWanted;
     const Layout layout = Resolve(s.topic, offset);
+    Spend(layout.fields.size() * (1 + request_.fields.size()), offset);  // copied and searched
     out_.fields.clear();
     out_.field_types.clear();
     for (const FlatField& f : layout.fields) {
@@ -439,7 +616,20 @@ void Parser::OnData(uint64_t offset, const unsigned char* body, uint32_t size) {
     Fail(offset, "data for msg_id " + std::to_string(msg_id) +
                      ", which no subscription ('A' message) before it announced: the file is damaged");
   }
-  ++out_.subscriptions[subscription_index_[msg_id]].samples;
+  UlogSubscription& subscription = out_.subscriptions[subscription_index_[msg_id]];
+  ++subscription.samples;
+  if (!timestamp_at_.empty() && timestamp_at_[msg_id] >= 0) {
+    const uint32_t at = static_cast<uint32_t>(timestamp_at_[msg_id]);
+    const Kind kind = timestamp_kind_[msg_id];
+    if (size - 2 >= at + static_cast<uint32_t>(KindSize(kind))) {
+      const double t = Decode(body + 2 + at, kind);
+      if (subscription.samples == 1) subscription.first_timestamp_us = t;
+      subscription.last_timestamp_us = t;
+    } else {
+      timestamp_at_[msg_id] = -1;  // a sample too short for it: no rate
+      subscription.first_timestamp_us = subscription.last_timestamp_us = NAN;
+    }
+  }
   if (role != kWanted) return;
   const uint32_t n = size - 2;
   if (n < wanted_min_size_ || n > wanted_max_size_) {
@@ -450,6 +640,7 @@ void Parser::OnData(uint64_t offset, const unsigned char* body, uint32_t size) {
                           : std::string()) + ": the file is damaged");
   }
   const unsigned char* p = body + 2;
+  if (out_.value_offsets.empty()) first_wanted_offset_ = offset;
   for (const auto& [field_offset, kind] : wanted_) out_.values.push_back(Decode(p + field_offset, kind));
   out_.value_offsets.push_back(offset);
 }

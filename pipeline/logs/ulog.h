@@ -13,12 +13,18 @@
 //
 // Bad input is a UserError naming the file and the byte offset, never a crash: a file shorter
 // than the header, bad magic, unknown incompatible flags, a message header that cannot be one
-// (size 0, type not a letter), a bad format definition (unknown or circular nested type), data
+// (size 0, type not a letter), a bad format definition (unknown or circular nested type, nesting
+// deeper than kUlogMaxNestingDepth levels, a type larger than a data message can hold (65535
+// bytes) or whose flattened field names exceed kUlogMaxFlatNameBytes: all checked before
+// anything is allocated for the type, so a crafted file cannot make the reader allocate more
+// than a few times its own size plus ~10 MB), data
 // for a msg_id that was never subscribed, data of the wrong size for its format, NaN or inf in a
 // requested field. A log that ends inside a message (the logger stopped mid-write) is read up to
-// the last whole message, with a warning, as the specification requires.
+// the last whole message, with a warning saying how many bytes (and about how many samples of
+// the requested topic) that leaves unread, as the specification requires.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -32,6 +38,13 @@ namespace bifilar {
 
 // The 7 magic bytes every ULog file starts with.
 inline constexpr char kUlogMagic[] = {'U', 'L', 'o', 'g', '\x01', '\x12', '\x35'};
+
+// Nested types may be this many levels deep (the topic counts as one level; PX4's deepest topics
+// use 3). Deeper definitions are refused with a message saying so.
+inline constexpr int kUlogMaxNestingDepth = 64;
+// The flattened field names of one type ("v[1].xy[0]", ...) may take at most this many bytes in
+// all (PX4's largest topics take ~10 kB).
+inline constexpr uint64_t kUlogMaxFlatNameBytes = uint64_t{4} << 20;
 
 // True when `bytes` starts with the ULog magic.
 bool LooksLikeUlog(std::string_view bytes);
@@ -51,6 +64,9 @@ struct UlogRequest {
   std::string topic;                // message name, case sensitive
   int multi_id = 0;                 // instance
   std::vector<std::string> fields;  // each must exist in the topic's format
+  // Also note each subscription's first and last top-level `timestamp` (UlogSubscription), so
+  // one pass lists every topic with its rate (`bifilar inspect`).
+  bool topic_timestamps = false;
 };
 
 struct UlogSubscription {
@@ -58,6 +74,9 @@ struct UlogSubscription {
   int multi_id = 0;
   int msg_id = 0;
   long samples = 0;  // data messages seen
+  // With UlogRequest::topic_timestamps: the first and last value of the topic's top-level scalar
+  // `timestamp` field (as stored, us); NaN when it has none or a sample is too short to hold it.
+  double first_timestamp_us = NAN, last_timestamp_us = NAN;
 };
 
 struct UlogDropout {

@@ -7,6 +7,7 @@
 #include "base/gzip.h"
 #include "base/user_error.h"
 #include "pipeline/logs/imu_log_writer.h"
+#include "pipeline/logs/simulated_log.h"
 #include "pipeline/logs/ulog.h"
 
 namespace bifilar {
@@ -94,13 +95,14 @@ bool UlogWriter::BeginAppendedSection() {
   return true;
 }
 
-std::string FormatImuUlog(const ImuData& data) {
+std::string FormatImuUlog(const ImuData& data, const std::string& simulated_origin) {
   const size_t n = data.t_s.size();
   if (data.gyro_in_imu.size() != n) throw UserError("IMU log: gyro and time lengths differ");
   const bool accel = data.has_accel();
   if (accel && data.accel_in_imu.size() != n) throw UserError("IMU log: accelerometer and time lengths differ");
   UlogWriter w(0);
   w.Info("sys_name", "bifilar simulate");
+  if (!simulated_origin.empty()) w.Info(kSimulatedUlogInfoKey, simulated_origin);
   if (accel) {
     // PX4's sensor_combined; the trailing padding field is not logged (spec).
     w.Format("sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
@@ -135,8 +137,9 @@ std::string FormatImuUlog(const ImuData& data) {
   return w.bytes();
 }
 
-void WriteImuUlog(const std::string& path, const ImuData& data) {
-  const std::string bytes = FormatImuUlog(data);
+void WriteImuUlog(const std::string& path, const ImuData& data,
+                  const std::string& simulated_origin) {
+  const std::string bytes = FormatImuUlog(data, simulated_origin);
   const bool gzip = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;
   WriteFileAtomically(path, gzip ? GzipCompress(bytes) : bytes);
 }

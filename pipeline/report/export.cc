@@ -7,12 +7,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "base/atomic_file.h"
 #include "base/bounded_read.h"
 #include "base/json_error.h"
 #include "base/user_error.h"
+#include "pipeline/store/output_set.h"
 
 namespace bifilar {
 namespace {
@@ -94,9 +96,11 @@ void RequireComplete(const ExportInertia& in, const char* format) {
         ", or export --format csv, which leaves them empty");
   }
   if (!std::isfinite(in.mass_kg)) {
-    throw UserError(in.results_name + ": " + format +
-                    " needs the mass, and the config stored in this result has no "
-                    "aircraft.mass_kg; give it with --mass-kg");
+    throw UserError(in.results_name + ": " + format + " needs the mass, and " +
+                    (in.mass_problem.empty()
+                         ? std::string("the config stored in this result has no aircraft.mass_kg")
+                         : in.mass_problem) +
+                    "; give it with --mass-kg");
   }
 }
 
@@ -123,6 +127,103 @@ std::string XmlHeader(const ExportInertia& in, const std::string& frame_text,
        (in.mass_source == "--mass-kg" ? std::string("the command line") : in.mass_source) +
        ") and the CG: " + cg_text + " Move it to the measured CG; the inertia is about the CG.";
   return "<!-- " + CommentSafe(s) + " -->\n";
+}
+
+// The first condition of a physical inertia that `in` fails, "" when none (see
+// ExportInertia::nonphysical).
+std::string NonPhysical(const ExportInertia& in) {
+  const auto& v = in.value_kg_m2;
+  for (int k = 0; k < 6; ++k) {
+    if (in.source[k] == "missing") continue;
+    const std::string what = std::string(k < 3 ? "the moment " : "the product ") +
+                             ExportComponentName(k) + " = " + Num(v[k]) + " kg m^2";
+    if (!std::isfinite(v[k])) return what + " is not finite";
+    if (std::abs(v[k]) > kMaxExportInertiaKgM2) {
+      return what + " is beyond any aircraft (|I| <= " + Num(kMaxExportInertiaKgM2) +
+             " kg m^2): a corrupt or mis-scaled result";
+    }
+    if (k < 3 && !(v[k] > 0)) return what + " is not positive: no body has it";
+  }
+  if (in.Missing().empty()) {
+    Eigen::Matrix3d t;
+    t << v[kIxx], -v[kIxy], -v[kIxz], -v[kIxy], v[kIyy], -v[kIyz], -v[kIxz], -v[kIyz], v[kIzz];
+    const Eigen::Vector3d p = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(t).eigenvalues();
+    if (!(p[0] > 0)) {
+      return "the tensor is not positive definite (principal moments " + Num(p[0]) + ", " +
+             Num(p[1]) + ", " + Num(p[2]) + " kg m^2): no rigid body has it, and simulators "
+             "reject it";
+    }
+    if (p[2] > (p[0] + p[1]) * (1 + 1e-12)) {
+      return "the principal moments " + Num(p[0]) + ", " + Num(p[1]) + ", " + Num(p[2]) +
+             " kg m^2 break the triangle inequality (largest > sum of the others): no rigid "
+             "body has them; check the products";
+    }
+    return "";
+  }
+  // A partial result: every 2x2 block of moments and their product that it holds is positive
+  // definite (a block of a positive definite tensor is).
+  const int pairs[3][3] = {{kIxx, kIyy, kIxy}, {kIxx, kIzz, kIxz}, {kIyy, kIzz, kIyz}};
+  for (const auto& pr : pairs) {
+    if (in.source[pr[0]] == "missing" || in.source[pr[1]] == "missing" ||
+        in.source[pr[2]] == "missing") {
+      continue;
+    }
+    if (!(v[pr[0]] * v[pr[1]] > v[pr[2]] * v[pr[2]])) {
+      return std::string("the product ") + ExportComponentName(pr[2]) + " = " + Num(v[pr[2]]) +
+             " kg m^2 is too large for the moments " + ExportComponentName(pr[0]) + " = " +
+             Num(v[pr[0]]) + " and " + ExportComponentName(pr[1]) + " = " + Num(v[pr[1]]) +
+             " (" + ExportComponentName(pr[2]) + "^2 >= " + ExportComponentName(pr[0]) + " " +
+             ExportComponentName(pr[1]) + "): the tensor is not positive definite";
+    }
+  }
+  return "";
+}
+
+// True when the file at `path` starts as a file `bifilar export` writes (an XML comment
+// "<!-- bifilar export of" or the CSV header): replacing it replaces export's own output.
+bool WrittenByExport(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  char head[64] = {};
+  file.read(head, sizeof(head));
+  const std::string start(head, static_cast<size_t>(file.gcount()));
+  return start.rfind("<!-- bifilar export of ", 0) == 0 ||
+         start.rfind("results_file,section,frame,mass_kg,", 0) == 0;
+}
+
+// Throws UserError when --out is the input or a file of its output folder (see RunExport).
+void RefuseCampaignFile(const std::string& out_path, const std::string& results_path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(fs::absolute(out_path, ec), ec);
+  const fs::path input = fs::weakly_canonical(fs::absolute(results_path, ec), ec);
+  const std::string refused = "export: --out " + out_path + " is ";
+  const std::string advice = "; export writes a new file: choose a name outside it";
+  if (out == input || (fs::exists(out_path, ec) && fs::equivalent(out_path, results_path, ec))) {
+    throw UserError(refused + "the input " + results_path + " itself" + advice);
+  }
+  const fs::path folder = input.parent_path();
+  const fs::path relative = out.lexically_relative(folder);
+  if (relative.empty() || *relative.begin() == "..") return;  // outside the output folder
+  // The folder is a campaign's when the input is its results.json or it holds a manifest.
+  const bool has_manifest = fs::exists(folder / OutputManifest::kFileName, ec);
+  if (input.filename() != "results.json" && !has_manifest) return;
+  const std::string first = relative.begin()->string();
+  bool owned = first == "cache" || first == "figures" || first == OutputManifest::kFileName ||
+               first == ".bifilar.lock";
+  for (const char* name : {"results.json", "traces.csv", "angles.csv", "report.html"}) {
+    owned = owned || relative == name;
+  }
+  if (!owned && has_manifest) {
+    try {
+      owned = OutputManifest(folder.string()).Contains(relative.generic_string());
+    } catch (const UserError&) {
+      owned = true;  // a damaged manifest: nothing in the folder is safe to replace
+    }
+  }
+  if (owned) {
+    throw UserError(refused + relative.generic_string() + " of the output folder " +
+                    folder.string() + " that holds " + results_path + advice);
+  }
 }
 
 }  // namespace
@@ -288,40 +389,28 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
     try {
       const YAML::Node config = YAML::Load(j["config"].get<std::string>());
       const YAML::Node aircraft = config.IsMap() ? config["aircraft"] : YAML::Node();
-      if (aircraft.IsMap() && aircraft["mass_kg"].IsScalar()) {
+      // A key that is absent gives an invalid node, whose IsScalar() throws: IsDefined first.
+      const auto scalar = [&aircraft](const char* key) {
+        return aircraft[key].IsDefined() && aircraft[key].IsScalar();
+      };
+      if (aircraft.IsMap() && scalar("mass_kg")) {
         in.mass_kg = aircraft["mass_kg"].as<double>();
         in.mass_source = "config aircraft.mass_kg";
-        if (aircraft["mass_std_kg"].IsScalar()) {
-          in.mass_std_kg = aircraft["mass_std_kg"].as<double>();
-        }
+        if (scalar("mass_std_kg")) in.mass_std_kg = aircraft["mass_std_kg"].as<double>();
       }
     } catch (const YAML::Exception& e) {
       in.warnings.push_back(name + ": the stored config could not be read for the mass (" +
                             e.what() + ")");
     }
-    if (!(std::isfinite(in.mass_kg) && in.mass_kg > 0)) {
+    if (!in.mass_source.empty() && !(std::isfinite(in.mass_kg) && in.mass_kg > 0)) {
+      in.mass_problem = "aircraft.mass_kg = " + Num(in.mass_kg) +
+                        " in the config stored in this result is not a positive mass";
       in.mass_kg = kNaN;
       in.mass_source.clear();
     }
   }
-  // A tensor a simulator accepts: positive definite, and the triangle inequality of a rigid
-  // body (the largest principal moment at most the sum of the other two).
-  if (in.Missing().empty()) {
-    const auto& v = in.value_kg_m2;
-    Eigen::Matrix3d t;
-    t << v[kIxx], -v[kIxy], -v[kIxz], -v[kIxy], v[kIyy], -v[kIyz], -v[kIxz], -v[kIyz], v[kIzz];
-    const Eigen::Vector3d p = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(t).eigenvalues();
-    if (!(p[0] > 0)) {
-      in.warnings.push_back(name + ": the tensor is not positive definite (principal moments " +
-                            Num(p[0]) + ", " + Num(p[1]) + ", " + Num(p[2]) +
-                            " kg m^2): no rigid body has it, and simulators reject it");
-    } else if (p[2] > p[0] + p[1]) {
-      in.warnings.push_back(name + ": the principal moments " + Num(p[0]) + ", " + Num(p[1]) +
-                            ", " + Num(p[2]) +
-                            " kg m^2 break the triangle inequality (largest > "
-                            "sum of the others): no rigid body has them; check the products");
-    }
-  }
+  in.nonphysical = NonPhysical(in);
+  if (!in.nonphysical.empty()) in.warnings.push_back(name + ": " + in.nonphysical);
   return in;
 }
 
@@ -421,9 +510,23 @@ int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err
   if (std::filesystem::is_directory(path, ec)) {  // the output folder of `bifilar process`
     path = (std::filesystem::path(path) / "results.json").string();
   }
+  if (!options.out_path.empty()) {
+    RefuseCampaignFile(options.out_path, path);
+    // A link, device or folder first: only a regular file is opened to see who wrote it.
+    CheckFileTarget(options.out_path);  // base/atomic_file.h
+    if (!WrittenByExport(options.out_path)) {
+      RefuseToReplace(options.out_path, "export --out", options.force);
+    }
+  }
   std::string text;
   if (!ReadRegularFile(path, OutputFileCap(), &text, &why)) throw UserError(why);
   const ExportInertia in = ReadExportInertia(text, path, options);
+  if (!in.nonphysical.empty() && options.format != ExportFormat::kCsv && !options.force) {
+    err << "bifilar: error: " << path << ": " << in.nonphysical << "; not written: a "
+        << ExportFormatName(options.format)
+        << " file must be physically valid (--force writes it anyway)\n";
+    return 1;
+  }
   std::string body;
   switch (options.format) {
     case ExportFormat::kUrdf:

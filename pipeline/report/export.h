@@ -60,9 +60,17 @@ struct ExportOptions {
   // Take Ixy = Iyz = 0 when the result does not hold them: an aircraft symmetric about its x-z
   // plane (the paper's assumption for a pitch-only campaign).
   bool symmetric = false;
+  // --force: replace an --out file that `bifilar export` did not write, and write a URDF, SDF or
+  // JSBSim file of a tensor that is not physical (the warning stays). Never lets --out be the
+  // input or a file of the campaign's output folder.
+  bool force = false;
 
   bool Check(std::string* why) const;
 };
+
+// The largest moment or product accepted (kg m^2): 1e8 is twice an A380's yaw inertia; a value
+// beyond it is a corrupt or mis-scaled result, not an aircraft.
+constexpr double kMaxExportInertiaKgM2 = 1e8;
 
 // The inertia to export: six components (kg m^2, body FRD, products positive, order Ixx, Iyy,
 // Izz, Ixy, Ixz, Iyz), each with its std and where it came from.
@@ -75,6 +83,15 @@ struct ExportInertia {
   double mass_kg = std::numeric_limits<double>::quiet_NaN();
   double mass_std_kg = std::numeric_limits<double>::quiet_NaN();
   std::string mass_source;   // "config aircraft.mass_kg", "--mass-kg" or "" (none)
+  // Why the stored config gave no usable mass ("" when it gave one or has none): e.g.
+  // "aircraft.mass_kg = -5 in the stored config is not a positive mass".
+  std::string mass_problem;
+  // The first condition of a physical inertia that the components fail ("" when they pass or
+  // none is there): finite, |value| <= kMaxExportInertiaKgM2, moments > 0, and when all six are
+  // there positive definite and the triangle inequality of the principal moments (largest <=
+  // sum of the others); of a partial result, the moments and products it holds (Ixx, Izz, Ixz
+  // of a pitch campaign: the 2x2 block positive definite). Also in `warnings`.
+  std::string nonphysical;
   std::string results_name;  // the file, for comments
   std::vector<std::string> warnings;
 
@@ -98,7 +115,12 @@ std::string FormatJsbsimMassBalance(const ExportInertia& inertia);
 std::string FormatInertiaCsv(const ExportInertia& inertia);
 
 // Reads options.results_path, formats, writes options.out_path atomically (or the text to `out`),
-// and prints warnings and the CG/mass note to `err`. Returns 0; throws UserError.
+// and prints warnings and the CG/mass note to `err`. Returns 0, or 1 (nothing written, the
+// failed condition printed) for a URDF, SDF or JSBSim file of a non-physical tensor without
+// options.force. Throws UserError, before writing, when --out resolves (links, "..", hard links)
+// to the input results.json or to a file of the input's output folder (a result file, the
+// manifest or lock, cache/, figures/, or a name its manifest lists), or exists and was not
+// written by `bifilar export` (its first line is not export's) and options.force is false.
 int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace bifilar

@@ -16,6 +16,7 @@
 #include "base/json_error.h"
 #include "base/units.h"
 #include "base/user_error.h"
+#include "pipeline/logs/simulated_log.h"
 #include "pipeline/records/total_uncertainty.h"
 #include "pipeline/store/output_set.h"
 
@@ -453,6 +454,21 @@ void WriteHeader(const ReportPage& p, std::ostream& h) {
     << " (<span class=\"ok\">" << summary.value("n_ok", 0) << " ok</span>, "
     << summary.value("n_rejected", 0) << " rejected, " << summary.value("n_error", 0)
     << " error); fits reused from cache: " << summary.value("n_reused", 0) << ".</p>\n";
+  // Simulated logs say so in their warnings (pipeline/logs/simulated_log.h): the page says it first.
+  int simulated = 0;
+  for (const auto& t : p.traces) {
+    bool marked = false;
+    if (t.is_object() && t.contains("warnings") && t["warnings"].is_array()) {
+      for (const auto& w : t["warnings"]) {
+        marked = marked || (w.is_string() && IsSimulatedLogWarning(w.get<std::string>()));
+      }
+    }
+    simulated += marked ? 1 : 0;
+  }
+  if (simulated > 0) {
+    h << "<p class=\"bad\">Simulated data: " << simulated << " of the " << p.traces.size()
+      << " logs were written by <code>bifilar simulate</code>, not measured (see Warnings).</p>\n";
+  }
 }
 
 // Table 2: I_x, I_z, I_xz, tau and the principal moments with std and interval, the systematic

@@ -399,6 +399,7 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   // neither a figure nor the caller wants it).
   const bool keep_series = !options.figure_paths.empty() || fit_out != nullptr;
   fit_options.keep_series = true;
+  fit_options.interrupt = options.interrupt;
   TraceFitResult fit = FitTrace(input, fit_options);
   // 5b. Glitches too small for the raw-series test (below half the swing) but isolated and far
   // outside the fit's residual noise: the same test on the residual series (fit/glitch.h), whose

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <optional>
 #include <string>
 #include <vector>
@@ -41,6 +42,9 @@ struct TraceProcessOptions {
   // of these (.svg or .png) when the sweep was evaluated; a trace without a sweep gets none.
   std::vector<std::string> sweep_figure_paths;
   int figure_width_px = 1100, figure_height_px = 700;  // page size of both figures (px)
+  // Set (by Ctrl-C) to stop the fit between solver iterations (TraceFitOptions::interrupt): the
+  // record is then an error saying "interrupted". Not owned; nullptr: never.
+  const std::atomic<bool>* interrupt = nullptr;
 };
 
 // Processes one log. Never throws: every failure is a record with status error naming the file.

@@ -606,7 +606,7 @@ def process(config_path, out=None, jobs=None, *, force=False, figures=True, prog
 def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=None,
              inertia_kg_m2=None, mass_kg=None, length_m=None, separation_m=None, g=None,
              amplitude_deg=None, pitch_deg=None, duration_s=None, sample_rate_hz=None,
-             no_accel=False):
+             no_accel=False, force=False):
     """Simulate realistic IMU logs with known truth, as ``bifilar simulate``.
 
     Three uses:
@@ -635,6 +635,10 @@ def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=No
         Free-oscillation duration (s) and IMU sample rate (Hz).
     no_accel : bool
         Write no accelerometer.
+    force : bool
+        Replace files that exist (``trace``, ``truth``, the files of ``out``); without it an
+        existing file is refused (ValueError naming it). Every log written is marked as
+        simulated, with its seed.
 
     Returns
     -------
@@ -655,7 +659,7 @@ def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=No
                     inertia_kg_m2=inertia_kg_m2, mass_kg=mass_kg, length_m=length_m,
                     separation_m=separation_m, g=g, amplitude_deg=amplitude_deg,
                     pitch_deg=pitch_deg, duration_s=duration_s, sample_rate_hz=sample_rate_hz,
-                    no_accel=bool(no_accel))
+                    no_accel=bool(no_accel), force=bool(force))
     for key in ("spec", "out", "trace", "truth"):
         settings[key] = _path("simulate", key, settings[key])
     if settings["model"] is not None:

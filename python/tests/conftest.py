@@ -42,6 +42,30 @@ def cli_fit_json(cli):
     return fit
 
 
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "realdata: reads the real logs of BIFILAR_DATA_DIR (CTest label realdata)")
+
+
+def real_data(relative):
+    """The path of `relative` in the real-data folder (BIFILAR_DATA_DIR), as the C++ tests'
+    BIFILAR_REAL_DATA (tests/test_support.h): skips when no folder is named, fails when the
+    folder is named but the file is missing, or when CTest runs the test unlabelled (the test
+    needs @pytest.mark.realdata, which python/CMakeLists.txt registers with the label)."""
+    folder = os.environ.get("BIFILAR_DATA_DIR", "")
+    path = pathlib.Path(folder) / relative
+    if os.environ.get("BIFILAR_REALDATA_LABEL") == "0":
+        pytest.fail(f"this test reads real data ({relative}) but runs without the realdata "
+                    "label: mark it @pytest.mark.realdata")
+    if not folder:
+        pytest.skip("real data not run: no data folder named (BIFILAR_DATA_DIR; cmake "
+                    "-DBIFILAR_DATA_DIR=DIR, or scripts/test.sh with ../shared/data beside "
+                    "the checkout)")
+    if not path.exists():
+        pytest.fail(f"the data folder named by BIFILAR_DATA_DIR has no {path}")
+    return path
+
+
 def sample_log(pitch, trial=1):
     """A sample log, relative to the repository (as a user would type it there)."""
     path = SAMPLE_LOGS / f"pitch_{pitch}" / f"trial_{trial}.csv.gz"

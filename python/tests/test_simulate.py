@@ -2,6 +2,7 @@
 import json
 
 import numpy as np
+import pytest
 
 import bifilar
 from conftest import SAMPLE_CONFIG, without_timings
@@ -49,3 +50,14 @@ def test_campaign_matches_the_cli(cli, repo, tmp_path):
             assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
     cli_truth = json.loads((tmp_path / "cli" / "truth.json").read_text())
     assert summary.truth["traces"] == cli_truth["traces"]
+
+
+def test_an_existing_file_is_replaced_only_with_force(tmp_path):
+    """Issue 23: simulate writes over no file without force=True, and marks what it writes."""
+    real = tmp_path / "real_log.csv"
+    real.write_text("t,gx,gy,gz\n0,0,0,0\n")
+    with pytest.raises(ValueError, match="real_log.csv exists"):
+        bifilar.simulate(trace=real, **TRACE)
+    assert real.read_text() == "t,gx,gy,gz\n0,0,0,0\n"
+    bifilar.simulate(trace=real, force=True, **TRACE)
+    assert real.read_text().startswith("# simulated by bifilar ")

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import bifilar
-from conftest import REPO, SAMPLE_CONFIG, sample_log
+from conftest import REPO, SAMPLE_CONFIG, real_data, sample_log
 
 GEOMETRY = dict(length_m=2.0, separation_m=0.9, mass_kg=6.0)
 
@@ -147,10 +147,9 @@ def test_read_log_without_config_reads_a_simulated_ulog_as_inspect(cli, tmp_path
     assert guessed.pitch_measured_deg == pytest.approx(30, abs=1.0)
 
 
+@pytest.mark.realdata
 def test_read_log_without_config_reads_a_real_px4_ulog(cli):
-    log = REPO.parent / "shared" / "data" / "px4" / "sample_log_small.ulg"
-    if not log.exists():
-        pytest.skip(f"{log} absent")
+    log = real_data("px4/sample_log_small.ulg")
     guessed = bifilar.read_log(log)
     report = _inspect(cli, log)
     assert guessed.format_guessed == report["format"]

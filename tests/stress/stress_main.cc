@@ -13,7 +13,8 @@
 // Then, once each, hostile inputs that must stop quickly with a clear message
 // (issue 15): a FIFO and a symlink to /dev/urandom among the logs, /dev/zero as the config, a
 // multi-member gzip log (the baseline's ellipse), a gzip bomb, a FIFO as results.json and as a
-// cache entry (process and report), a YAML alias bomb.
+// cache entry (process and report), a YAML alias bomb; (issue 23) simulate, init and export
+// aimed at a user's file, a log, the campaign's results or a link to /proc/self/fd/1.
 //
 // Asserted for every run: no crash (signal), no hang (each run is bounded by --run-timeout-s,
 // default 60 s, far above the ~0.3 s a run takes), exit code 0, 1 or 2, no NaN or inf written
@@ -958,6 +959,55 @@ void CaseAliasBomb(const Args& args, const Workspace& w, int case_no, Failures* 
   w.RestoreConfig();
 }
 
+// Issue 23: commands that would write over a user's file, the campaign's input or outputs, or a
+// link to a descriptor, refuse (exit 2, the file named); the sentinel and CheckRun assert that
+// nothing outside OUT changed. The link to /proc/self/fd/1 lives in the harness folder.
+void CaseNoOverwrite(const Args& args, const Workspace& w, int case_no, Failures* failures) {
+  const std::string log = w.logs + "/pitch_0/trial_1.csv";
+  const std::string link = w.harness + "/stdout_link";
+  std::error_code ec;
+  fs::remove(link, ec);
+  fs::create_symlink("/proc/self/fd/1", link, ec);
+  const std::vector<std::string> trace = {"--inertia-kg-m2", "0.4", "--mass-kg", "6", "-L", "2",
+                                          "-D", "1", "--duration-s", "10"};
+  struct Run {
+    std::vector<std::string> argv;
+    std::string message;
+  };
+  std::vector<Run> runs = {
+      {{args.binary, "simulate", "--trace", log}, "simulate --trace: " + log + " exists"},
+      {{args.binary, "simulate", "--trace", w.harness + "/sim.csv", "--truth", w.thesis},
+       "simulate --truth: " + w.thesis + " exists"},
+      {{args.binary, "simulate", "--trace", link, "--force"}, link + ": is a symbolic link"},
+      {{args.binary, "init", w.thesis, "--rig", "2,1,6"}, "init: " + w.thesis + " exists"},
+      {{args.binary, "init", link, "--rig", "2,1,6", "--force"}, link + ": is a symbolic link"},
+      {{args.binary, "init", w.harness + "/i.yaml", "--rig", "2000,1000,6"}, "if this is in mm"},
+      {{args.binary, "export", w.out, "--format", "csv", "--out", w.out + "/results.json",
+        "--force"},
+       "is the input"},
+      {{args.binary, "export", w.out, "--format", "csv", "--out", w.out + "/../" +
+        fs::path(w.out).filename().string() + "/traces.csv", "--force"},
+       "of the output folder"},
+      {{args.binary, "export", w.out, "--format", "csv", "--out", w.thesis}, "exists"},
+      {{args.binary, "export", w.out, "--format", "csv", "--out", link, "--force"},
+       "is a symbolic link"},
+  };
+  for (Run& run : runs) {
+    if (run.argv[1] == "simulate") run.argv.insert(run.argv.end(), trace.begin(), trace.end());
+    const std::string kind = "no overwrite: bifilar " + run.argv[1] + " " + run.argv[2] + " " +
+                             run.argv[3];
+    const Outcome o = Wait(Start(run.argv, w.harness + "/hostile"), args.run_timeout_s);
+    CheckRun(o, w, case_no, kind, failures);
+    ExpectStop(o, case_no, kind, {2}, o.err, run.message, failures, /*after_check_run=*/true);
+    if (!fs::is_symlink(fs::symlink_status(link, ec))) {
+      failures->Add(case_no, kind, link + " (a link to /proc/self/fd/1) was replaced");
+      fs::remove(link, ec);
+      fs::create_symlink("/proc/self/fd/1", link, ec);
+    }
+  }
+  w.RestoreLogs();
+}
+
 // Runs the cases above once each; returns how many ran.
 int RunHostileInputCases(const Args& args, Workspace& w, int first_case_no, Failures* failures) {
   int c = first_case_no;
@@ -969,6 +1019,7 @@ int RunHostileInputCases(const Args& args, Workspace& w, int first_case_no, Fail
   CaseFifoInOutput(args, w, c++, /*cache_entry=*/false, failures);
   CaseFifoInOutput(args, w, c++, /*cache_entry=*/true, failures);
   CaseAliasBomb(args, w, c++, failures);
+  CaseNoOverwrite(args, w, c++, failures);
   return c - first_case_no;
 }
 

@@ -1,0 +1,139 @@
+// The bounds of one trace fit (TraceFitOptions::max_total_iterations, max_fit_cpu_seconds) and
+// its interrupt flag (issue 23 item 5): a window over a whole simulated log (rest, twist, hold
+// and swing) that Levenberg-Marquardt cannot fit stops at the bound with a message saying so;
+// a raised flag stops a fit with an `interrupted` error; neither changes a normal fit. No
+// wall-clock assertion: the bounds are set so that they trip deterministically.
+#include <atomic>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "fit/trace_fit.h"
+#include "pendulum/simulate.h"
+
+namespace bifilar {
+namespace {
+
+// A simulated log at 100 Hz: 3 s rest, 1 s twist, 1.5 s hold, then 30 s of free swing (the same
+// setup as `bifilar simulate --trace`). `whole` true: every sample, rest and twist included (a
+// window `fit --window 0:END` would give); false: the free swing only.
+TraceFitInput Simulated(bool whole) {
+  TraceSetup setup;
+  setup.geometry.filar_length_m = 1.0;
+  setup.geometry.filar_separation_m = 0.4;
+  setup.geometry.mass_kg = 1.5;
+  setup.params.inertia_kg_m2 = 0.05;
+  setup.params.drag_coeff_kg_m2 = 0.002;
+  setup.params.viscous_coeff_kg_m2_per_s = 0.0005;
+  setup.amplitude_rad = 0.35;
+  SimulationOptions options;
+  options.timeline.rest_before_s = {3.0, 3.0};
+  options.timeline.twist_s = {1.0, 1.0};
+  options.timeline.hold_s = {1.5, 1.5};
+  options.timeline.free_s = {30.0, 30.0};
+  options.timeline.stop_probability = 0.0;
+  SimulatedTrace trace;
+  std::string why;
+  EXPECT_TRUE(SimulateTrace(setup, options, 7, &trace, &why)) << why;
+  TraceFitInput input;
+  input.geometry = setup.geometry;
+  input.label = "sim.csv";
+  const double release_s = trace.imu.t_s.front() + 5.5;
+  for (size_t k = 0; k < trace.imu.size(); ++k) {
+    if (!whole && trace.imu.t_s[k] < release_s + 1.0) continue;
+    input.t_s.push_back(trace.imu.t_s[k]);
+    input.rate_rad_per_s.push_back(trace.imu.gyro_in_imu[k].z());
+  }
+  return input;
+}
+
+TEST(TraceFitBounds, IterationBoundStopsAHostileWindowWithAMessage) {
+  const TraceFitInput input = Simulated(true);
+  TraceFitOptions options;
+  options.max_total_iterations = 5;
+  const TraceFitResult r = FitTrace(input, options);
+  EXPECT_EQ(r.status, TraceFitStatus::kRejected) << r.BriefReport();
+  EXPECT_TRUE(r.solver_bound);
+  EXPECT_FALSE(r.interrupted);
+  EXPECT_FALSE(r.HasFit()) << "a stopped fit reports no inertia";
+  EXPECT_EQ(r.iterations, 5);
+  EXPECT_EQ(r.message.rfind("sim.csv: the solver was stopped after 5 iterations and ", 0), 0u)
+      << r.message;
+  EXPECT_NE(r.message.find("(bounds: 5 iterations, 20 s per fit)"), std::string::npos) << r.message;
+  ASSERT_FALSE(r.flags.empty());
+  EXPECT_EQ(r.flags.back(), "solver_bound");
+}
+
+TEST(TraceFitBounds, CpuTimeBoundStopsTheFit) {
+  const TraceFitInput input = Simulated(true);
+  TraceFitOptions options;
+  options.max_fit_cpu_seconds = 1e-9;  // spent before the first iteration ends
+  const TraceFitResult r = FitTrace(input, options);
+  EXPECT_EQ(r.status, TraceFitStatus::kRejected) << r.BriefReport();
+  EXPECT_TRUE(r.solver_bound);
+  EXPECT_NE(r.message.find("s of CPU time (bounds: 500 iterations, 1e-09 s per fit)"),
+            std::string::npos)
+      << r.message;
+}
+
+TEST(TraceFitBounds, RaisedInterruptFlagStopsTheFitAsInterrupted) {
+  const TraceFitInput input = Simulated(true);
+  std::atomic<bool> flag{true};
+  TraceFitOptions options;
+  options.interrupt = &flag;
+  const TraceFitResult r = FitTrace(input, options);
+  EXPECT_EQ(r.status, TraceFitStatus::kError) << r.BriefReport();
+  EXPECT_TRUE(r.interrupted);
+  EXPECT_FALSE(r.solver_bound);
+  EXPECT_EQ(r.message.rfind("sim.csv: interrupted after 0 iterations", 0), 0u) << r.message;
+  ASSERT_FALSE(r.flags.empty());
+  EXPECT_EQ(r.flags.back(), "interrupted");
+}
+
+// On the free swing the bounds and an unraised flag change nothing, bit for bit: the budget's
+// callback reads no solver state.
+TEST(TraceFitBounds, BoundsAndFlagLeaveANormalFitUnchanged) {
+  const TraceFitInput input = Simulated(false);
+  TraceFitOptions loose;
+  loose.max_total_iterations = 1000000;
+  loose.max_fit_cpu_seconds = 1e9;
+  const TraceFitResult reference = FitTrace(input, loose);
+  ASSERT_EQ(reference.status, TraceFitStatus::kOk) << reference.BriefReport();
+  EXPECT_LT(reference.iterations, 100);
+  std::atomic<bool> flag{false};
+  TraceFitOptions options;  // default bounds
+  options.interrupt = &flag;
+  const TraceFitResult r = FitTrace(input, options);
+  ASSERT_EQ(r.status, TraceFitStatus::kOk) << r.BriefReport();
+  EXPECT_EQ(r.params.inertia_kg_m2, reference.params.inertia_kg_m2);
+  EXPECT_EQ(r.inertia_std_kg_m2, reference.inertia_std_kg_m2);
+  EXPECT_EQ(r.iterations, reference.iterations);
+  EXPECT_FALSE(r.solver_bound);
+  EXPECT_FALSE(r.interrupted);
+}
+
+// Timestamps too large for a double to resolve the steps: an error naming them, not Ceres'
+// "Residual and Jacobian evaluation failed".
+TEST(TraceFitBounds, HugeTimestampsAreAnErrorBeforeTheSolver) {
+  TraceFitInput input = Simulated(false);
+  for (double& t : input.t_s) t += 1e12;
+  const TraceFitResult r = FitTrace(input, TraceFitOptions());
+  EXPECT_EQ(r.status, TraceFitStatus::kError);
+  EXPECT_EQ(r.message.rfind("sim.csv: timestamps near 1e+12 s are too large for samples", 0), 0u)
+      << r.message;
+}
+
+TEST(TraceFitBounds, OptionsCheckNamesTheBounds) {
+  TraceFitOptions options;
+  std::string why;
+  options.max_total_iterations = 0;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "max_total_iterations must be >= 1");
+  options = TraceFitOptions();
+  options.max_fit_cpu_seconds = NAN;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "max_fit_cpu_seconds must be finite and > 0");
+}
+
+}  // namespace
+}  // namespace bifilar
