@@ -20,7 +20,9 @@ process(config_path, out=None, jobs=None)
 simulate(...)
     Realistic logs with known truth (``bifilar simulate``), in memory or on disk.
 
-Units are SI throughout (s, rad/s, m, kg, kg m^2), pitch and amplitudes in degrees. Bad input
+Units are SI throughout (s, rad/s, m, kg, kg m^2), pitch and amplitudes in degrees. Paths are
+str, bytes or os.PathLike (anything else: TypeError); numbers are numbers, not bools, and whole
+numbers lie in their range (``_core.int_ranges``). Bad input
 raises ValueError with the command line's message; a file given that does not exist raises
 FileNotFoundError (a subclass of ValueError too, so older ``except ValueError`` code still
 catches it). Results are :class:`Record` objects: dicts
@@ -406,7 +408,7 @@ def read_log(path, config=None):
 
     Parameters
     ----------
-    path : str
+    path : str, bytes or os.PathLike
         The log (CSV or ULog, optionally .gz), as given to ``bifilar fit``.
     config : str, optional
         The YAML config naming the columns and units (``imu`` section, configs/README.md).
