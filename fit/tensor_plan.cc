@@ -254,12 +254,12 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
     const Stds& s = stds[i];
     cand[i].swing_var = std::pow(s.absolute / scale, 2) + std::pow(s.relative / scale, 2);
     cand[i].tilt_var = std::pow(s.tilt / scale, 2);
-    if (!(cand[i].swing_var > 0.0)) {
-      // Only a relative std, at an axis whose moment is below 1e-150 of the largest std: a
-      // weight no arithmetic holds. PlanTensor's guess is positive definite, so this needs a
-      // guess whose principal moments span 150 decades.
+    // The smallest variance used is that of the floor, at 1e12 trials: it must stay a normal
+    // number, so every weight is finite. Only a relative std at an axis whose moment is 139
+    // decades below the largest std, and no attitude error there, fails this.
+    if (!(cand[i].swing_var / 1e12 + cand[i].tilt_var >= 1e-290)) {
       return fail("the per-swing std at roll " + Num(cand[i].roll_deg) + " deg, pitch " +
-                  Num(cand[i].pitch_deg) + " deg is below 1e-150 of the largest (" + Num(scale) +
+                  Num(cand[i].pitch_deg) + " deg is below 1e-139 of the largest (" + Num(scale) +
                   " kg m^2): give an absolute --sigma too, or check the guessed tensor");
     }
   }
@@ -321,7 +321,7 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
   }
 
   // 3. D-optimal choice. Weights of the orientation means at the planned trials (in 1/scale^2,
-  // so between 1 / (1 + 1/trials) and 1e300).
+  // so between 1 / (1 + 2 / trials) and 1e290: finite).
   Eigen::VectorXd w_all(n_cand);
   for (int i = 0; i < n_cand; ++i) w_all[i] = 1.0 / (cand[i].swing_var / trials + cand[i].tilt_var);
   double largest = 0.0;
@@ -468,7 +468,7 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
     o.pitch_deg = c.pitch_deg;
     o.axis_in_body = c.n;
     o.inertia_kg_m2 = c.inertia_kg_m2;
-    o.swing_std_kg_m2 = scale * std::sqrt(c.swing_var);
+    o.swing_std_kg_m2 = std::hypot(stds[i].absolute, stds[i].relative);
     o.mean_std_kg_m2 = scale * std::sqrt(c.swing_var / trials + c.tilt_var);
     plan->orientations.push_back(o);
   }

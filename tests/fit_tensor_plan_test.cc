@@ -341,6 +341,19 @@ TEST(TensorPlan, TinyAndHugeSigmasGiveTheSameDesignScaled) {
   for (int k = 0; k < 6; ++k) {
     EXPECT_NEAR(tiny.std_kg_m2[k] / 1e-168 / reference.std_kg_m2[k], 1.0, kRelTol);
   }
+  // A relative std of 1e-170 beside an attitude error of 0.5 deg: the tilt dominates every
+  // variance, the swing std is still reported as what it is (1e-170 of the moment).
+  rel.attitude_std_deg = 0.5;
+  TensorPlan tilted;
+  ASSERT_TRUE(PlanTensor(rel, &tilted, &why)) << why;
+  for (const TensorPlanOrientation& o : tilted.orientations) {
+    EXPECT_NEAR(o.swing_std_kg_m2 / (1e-170 * o.inertia_kg_m2), 1.0, kRelTol);
+    EXPECT_TRUE(std::isfinite(o.mean_std_kg_m2) && o.mean_std_kg_m2 > 0);
+  }
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_TRUE(std::isfinite(tilted.std_kg_m2[k]) && tilted.std_kg_m2[k] > 0) << k;
+    EXPECT_NEAR(tilted.floor_std_kg_m2[k] / tilted.std_kg_m2[k], 1.0, 1e-6) << k;  // all tilt
+  }
   // Below 1e-300 kg m^2 the stds would be subnormal: refused, as too small to compute with.
   for (double sigma : {1e-301, 4.9e-324}) {
     TensorPlanOptions o = base;
