@@ -226,7 +226,7 @@ bool FitEllipse(const std::vector<EllipsePoint>& points, const EllipseOptions& o
 struct EllipsePlanOptions {
   std::vector<double> pitch_deg;  // proposed pitch angles (deg), >= 3 distinct mod 180
   int trials_per_angle = 3;       // trials at each angle, >= 1
-  double sigma_kg_m2 = 0.0;       // per-trial standard deviation (kg m^2), > 0
+  double sigma_kg_m2 = 0.0;       // per-trial standard deviation (kg m^2), in [1e-300, 1e100]
   // Guesses of the aircraft (kg m^2); tau's error depends on I_z - I_x and I_xz.
   double ix_kg_m2 = 0.0;          // > 0
   double iz_kg_m2 = 0.0;          // > 0

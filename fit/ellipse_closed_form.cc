@@ -166,13 +166,17 @@ bool EllipsePlanOptions::Check(std::string* why) const {
     *why = "trials per angle must be >= 1, got " + std::to_string(trials_per_angle);
     return false;
   }
-  if (!(sigma_kg_m2 > 0.0) || !std::isfinite(sigma_kg_m2)) {
-    *why = "sigma must be finite and > 0, got " + Num(sigma_kg_m2);
+  // 1e100 kg m^2 bounds every moment and std, as the fits' inputs; any sigma down to 1e-300
+  // works (the plan is computed for sigma 1 and scaled, as the stds are linear in it).
+  constexpr double kMax = 1e100;
+  if (!(sigma_kg_m2 >= 1e-300) || !(sigma_kg_m2 <= kMax)) {
+    *why = "sigma must be in [1e-300, 1e100] kg m^2, got " + Num(sigma_kg_m2);
     return false;
   }
-  if (!(ix_kg_m2 > 0.0) || !(iz_kg_m2 > 0.0) || !std::isfinite(ix_kg_m2) ||
-      !std::isfinite(iz_kg_m2) || !std::isfinite(ixz_kg_m2)) {
-    *why = "I_x and I_z guesses must be finite and > 0 and I_xz finite";
+  if (!(ix_kg_m2 > 0.0) || !(iz_kg_m2 > 0.0) || !(ix_kg_m2 <= kMax) || !(iz_kg_m2 <= kMax) ||
+      !(std::fabs(ixz_kg_m2) <= kMax)) {
+    *why = "I_x and I_z guesses must be in (0, 1e100] kg m^2 and |I_xz| <= 1e100, got " +
+           Num(ix_kg_m2) + ", " + Num(iz_kg_m2) + ", " + Num(ixz_kg_m2);
     return false;
   }
   for (double a : pitch_deg) {
@@ -199,7 +203,9 @@ bool PlanEllipse(const EllipsePlanOptions& options, EllipsePlan* plan, std::stri
     const Eigen::RowVector3d row = DesignRow(a);
     normal += options.trials_per_angle * row.transpose() * row;
   }
-  const Eigen::Matrix3d cov = normal.inverse() * options.sigma_kg_m2 * options.sigma_kg_m2;
+  // The covariance for sigma = 1: the stds are linear in sigma and multiplied by it below, so
+  // no sigma^2 overflows (1e200) or underflows (1e-170) on the way.
+  const Eigen::Matrix3d cov = normal.inverse();
   const double a = 0.5 * (options.ix_kg_m2 + options.iz_kg_m2);
   const double b = 0.5 * (options.iz_kg_m2 - options.ix_kg_m2);
   const double c = options.ixz_kg_m2;
@@ -209,7 +215,13 @@ bool PlanEllipse(const EllipsePlanOptions& options, EllipsePlan* plan, std::stri
   plan->tau_defined = std::hypot(b, c) > 0;
   const double sign_r = plan->truth.izp_kg_m2 >= plan->truth.ixp_kg_m2 ? 1.0 : -1.0;
   const Jac63 j = SixJacobian(b, c, sign_r);
-  plan->std = FromVec(StdFromCovariance(j, cov));
+  plan->std = FromVec(StdFromCovariance(j, cov) * options.sigma_kg_m2);
+  for (double s : {plan->std.ix_kg_m2, plan->std.iz_kg_m2, plan->std.ixz_kg_m2}) {
+    if (!(std::isfinite(s) && s > 0)) {
+      *why = "internal: a predicted std is " + Num(s) + "; please report this with the command line";
+      return false;
+    }
+  }
   return true;
 }
 

@@ -108,12 +108,29 @@ bool PrepareTensorData(const std::vector<TensorPoint>& points, const TensorOptio
     const std::string where = "point " + std::to_string(i + 1) + ": ";
     used[i] = ToVector(p.direction_in_body);
     nominal[i] = ToVector(p.nominal_in_body);
-    if (!used[i].allFinite() || !(used[i].norm() > 1e-12) || !nominal[i].allFinite()) {
-      *why = where + "the swing axis must be a finite, non-zero vector";
+    // Normalised after dividing by the largest component, so no square overflows or underflows:
+    // (1e308, 0, 1) used to get norm() = inf and become (0, 0, 0), an axis that silently observed
+    // nothing (and, alone, crashed the SVD). Any finite, non-zero vector is an axis.
+    const auto axis = [&](const Eigen::Vector3d& v, const char* what, bool zero_allowed,
+                          Eigen::Vector3d* unit) {
+      const double largest = v.cwiseAbs().maxCoeff();
+      if (v.allFinite() && largest > 0) {
+        const Eigen::Vector3d scaled = v / largest;
+        *unit = scaled / scaled.norm();
+        return true;
+      }
+      if (zero_allowed && largest == 0) return true;
+      *why = where + "the " + what + " must be a finite, non-zero vector" +
+             (zero_allowed ? " (or all zero: the swing axis)" : "") + ", got (" + Num(v(0)) +
+             ", " + Num(v(1)) + ", " + Num(v(2)) + ")";
+      return false;
+    };
+    Eigen::Vector3d nominal_unit = Eigen::Vector3d::Zero();
+    if (!axis(used[i], "swing axis", false, &used[i]) ||
+        !axis(nominal[i], "nominal swing axis", true, &nominal_unit)) {
       return false;
     }
-    used[i].normalize();
-    nominal[i] = nominal[i].norm() > 1e-12 ? nominal[i].normalized() : used[i];
+    nominal[i] = nominal_unit.isZero(0.0) ? used[i] : nominal_unit;
     if (!std::isfinite(p.inertia_kg_m2) || !(p.inertia_kg_m2 > 0.0) || p.inertia_kg_m2 > 1e100 ||
         p.inertia_kg_m2 < 1e-100) {
       *why = where + "inertia must be finite and in [1e-100, 1e100] kg m^2, got " +
@@ -188,6 +205,11 @@ bool AnalyseDesign(const Prepared& data, const TensorOptions& options, Design* d
   g.rank = 0;
   for (int k = 0; k < s.size(); ++k) {
     if (s(k) > options.rank_tolerance * s_max) ++g.rank;
+  }
+  if (g.rank == 0) {  // an SVD of the 6 x 0 rest below is undefined (it dereferenced null)
+    *why = "the swing axes determine none of the six components (the design has rank 0): swing "
+           "about more axes";
+    return false;
   }
   const Eigen::MatrixXd v = svd.matrixV();
   g.basis = v.leftCols(g.rank);
@@ -322,7 +344,10 @@ std::array<double, 3> DownInBodyFromAttitude(double roll_deg, double pitch_deg) 
 double TensorMoment(const std::array<double, kTensorComponents>& c, const std::array<double, 3>& n) {
   Vec6 beta;
   for (int k = 0; k < 6; ++k) beta(k) = c[k];
-  const Eigen::Vector3d u = Eigen::Vector3d(n[0], n[1], n[2]).normalized();
+  // Scaled by the largest component first: no square of a huge or tiny component overflows.
+  Eigen::Vector3d u(n[0], n[1], n[2]);
+  u /= u.cwiseAbs().maxCoeff();
+  u.normalize();
   return DesignRow(u) * beta;
 }
 

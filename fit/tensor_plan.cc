@@ -14,6 +14,7 @@
 namespace bifilar {
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kMaxMomentKgM2 = 1e100;  // bound of any moment or std (kg m^2)
 
 using Row = std::array<double, kTensorPlanComponents>;
 
@@ -108,8 +109,11 @@ const char* TensorPlanComponentName(int component) {
 }
 
 Row TensorDesignRow(const std::array<double, 3>& axis) {
-  const double len = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
-  const double x = axis[0] / len, y = axis[1] / len, z = axis[2] / len;
+  // Scaled by the largest component first: no square of a huge or tiny component overflows.
+  const double big = std::max({std::fabs(axis[0]), std::fabs(axis[1]), std::fabs(axis[2])});
+  const double a = axis[0] / big, b = axis[1] / big, c = axis[2] / big;
+  const double len = std::sqrt(a * a + b * b + c * c);
+  const double x = a / len, y = b / len, z = c / len;
   return {x * x, y * y, z * z, -2 * x * y, -2 * x * z, -2 * y * z};
 }
 
@@ -136,9 +140,12 @@ bool TensorPlanOptions::Check(std::string* why) const {
   if (trials_per_orientation < 1 || trials_per_orientation > 1000000) {
     return fail("the trials per orientation must lie in [1, 1000000]");
   }
-  if (!finite(sigma_kg_m2) || sigma_kg_m2 < 0 || !finite(sigma_relative) || sigma_relative < 0 ||
-      sigma_relative >= 1) {
-    return fail("the per-swing std must be >= 0 (absolute) and in [0, 1) (relative)");
+  // 1e100 kg m^2 bounds every moment and std, as the tensor fit's inputs: their squares (the
+  // covariance) stay finite. Small stds need no bound: the plan works in units of the largest.
+  if (!finite(sigma_kg_m2) || sigma_kg_m2 < 0 || sigma_kg_m2 > kMaxMomentKgM2 ||
+      !finite(sigma_relative) || sigma_relative < 0 || sigma_relative >= 1) {
+    return fail("the per-swing std must be in [0, 1e100] kg m^2 (absolute, got " +
+                Num(sigma_kg_m2) + ") and in [0, 1) (relative, got " + Num(sigma_relative) + ")");
   }
   if (sigma_kg_m2 == 0 && sigma_relative == 0) {
     return fail("give a per-swing std (absolute or relative), > 0");
@@ -152,10 +159,14 @@ bool TensorPlanOptions::Check(std::string* why) const {
         "Ixx, Iyy, Izz)");
   }
   for (double g : guess_kg_m2) {
-    if (!finite(g)) return fail("the guessed tensor has a value that is not a finite number");
+    if (!finite(g) || std::fabs(g) > kMaxMomentKgM2) {
+      return fail("the guessed tensor has a value that is not a finite number within +-1e100 "
+                  "kg m^2 (got " + Num(g) + ")");
+    }
   }
-  if (!finite(target_std_kg_m2) || target_std_kg_m2 < 0) {
-    return fail("the target std must be > 0 (or 0 for none)");
+  if (!finite(target_std_kg_m2) || target_std_kg_m2 < 0 || target_std_kg_m2 > kMaxMomentKgM2) {
+    return fail("the target std must be in (0, 1e100] kg m^2 (or 0 for none), got " +
+                Num(target_std_kg_m2));
   }
   if (!(rank_tolerance > 0 && rank_tolerance < 1)) return fail("rank_tolerance must be in (0, 1)");
   return true;
@@ -203,22 +214,52 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
   std::map<std::tuple<long long, long long, long long>, int> seen;
   const double tilt_std_rad = options.attitude_std_deg * kRadPerDeg;
   const double trials = options.trials_per_orientation;
+  // The stds of each candidate (kg m^2): absolute, relative and from the attitude error.
+  struct Stds {
+    double absolute = 0.0, relative = 0.0, tilt = 0.0;
+  };
+  std::vector<Stds> stds;
   for (Candidate& c : all) {
     if (!seen.emplace(AxisKey(c.n), static_cast<int>(cand.size())).second) continue;
     c.row = TensorDesignRow(c.n);
-    double swing_var = options.sigma_kg_m2 * options.sigma_kg_m2;
+    Stds s;
+    s.absolute = options.sigma_kg_m2;
     if (options.guess_given) {
       const Eigen::Vector3d n(c.n[0], c.n[1], c.n[2]);
       const Eigen::Vector3d jn = j_guess * n;
       c.inertia_kg_m2 = n.dot(jn);
-      swing_var += std::pow(options.sigma_relative * c.inertia_kg_m2, 2);
+      s.relative = options.sigma_relative * c.inertia_kg_m2;
       // dI/d(tilt) = 2 (1 - n n^T) J n: the moment's rate of change per radian of tilt; an
       // isotropic tilt error of std s per axis moves I by s |that| (first order).
-      const double g = 2.0 * (jn - n * n.dot(jn)).norm();
-      c.tilt_var = std::pow(tilt_std_rad * g, 2);
+      s.tilt = tilt_std_rad * 2.0 * (jn - n * n.dot(jn)).stableNorm();
     }
-    c.swing_var = swing_var;
+    stds.push_back(s);
     cand.push_back(c);
+  }
+  // Every variance is held in units of scale^2, scale the largest std of any candidate: the
+  // choice (D-optimal is blind to one factor on every weight) and the stds (which scale with it)
+  // come out the same for a sigma of 1e-160 or 1e200 kg m^2, whose squares would underflow to
+  // 0 (infinite weights) or overflow to inf (zero weights). Stds are scaled back at the end.
+  double scale = 0.0;
+  for (const Stds& s : stds) scale = std::max({scale, s.absolute, s.relative, s.tilt});
+  // Below 1e-300 kg m^2 the stds themselves (about the per-swing std) would be subnormal or 0.
+  if (!(scale >= 1e-300) || !std::isfinite(scale)) {
+    return fail("the per-swing std (absolute " + Num(options.sigma_kg_m2) + " kg m^2, relative " +
+                Num(options.sigma_relative) + ") gives no std of a moment in [1e-300, 1e100] "
+                "kg m^2 (largest " + Num(scale) + "): too small to compute with");
+  }
+  for (size_t i = 0; i < cand.size(); ++i) {
+    const Stds& s = stds[i];
+    cand[i].swing_var = std::pow(s.absolute / scale, 2) + std::pow(s.relative / scale, 2);
+    cand[i].tilt_var = std::pow(s.tilt / scale, 2);
+    // The smallest variance used is that of the floor, at 1e12 trials: it must stay a normal
+    // number, so every weight is finite. Only a relative std at an axis whose moment is 139
+    // decades below the largest std, and no attitude error there, fails this.
+    if (!(cand[i].swing_var / 1e12 + cand[i].tilt_var >= 1e-290)) {
+      return fail("the per-swing std at roll " + Num(cand[i].roll_deg) + " deg, pitch " +
+                  Num(cand[i].pitch_deg) + " deg is below 1e-139 of the largest (" + Num(scale) +
+                  " kg m^2): give an absolute --sigma too, or check the guessed tensor");
+    }
   }
   const int n_cand = static_cast<int>(cand.size());
   plan->n_candidates = n_cand;
@@ -277,14 +318,17 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
                 std::to_string(rank));
   }
 
-  // 3. D-optimal choice. Weights of the orientation means at the planned trials.
+  // 3. D-optimal choice. Weights of the orientation means at the planned trials (in 1/scale^2,
+  // so between 1 / (1 + 2 / trials) and 1e290: finite).
   Eigen::VectorXd w_all(n_cand);
   for (int i = 0; i < n_cand; ++i) w_all[i] = 1.0 / (cand[i].swing_var / trials + cand[i].tilt_var);
-  double scale = 0.0;
-  for (int i = 0; i < n_cand; ++i) scale = std::max(scale, w_all[i] * reduced.row(i).squaredNorm());
+  double largest = 0.0;
+  for (int i = 0; i < n_cand; ++i) {
+    largest = std::max(largest, w_all[i] * reduced.row(i).squaredNorm());
+  }
   // A ridge of 1e-10 of the largest single contribution keeps the information matrix invertible
   // while fewer than `rank` orientations are chosen; it only breaks ties among them.
-  const Eigen::MatrixXd ridge = 1e-10 * scale * Eigen::MatrixXd::Identity(rank, rank);
+  const Eigen::MatrixXd ridge = 1e-10 * largest * Eigen::MatrixXd::Identity(rank, rank);
   std::vector<int> chosen;
   std::vector<char> in_design(n_cand, 0);
   Eigen::MatrixXd info = ridge;
@@ -307,6 +351,10 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
   for (int k = 0; k < n; ++k) {
     double d = 0.0;
     const int c = best_addition(info, &d);
+    if (c < 0) {  // every weight is finite and positive (above), so a candidate always adds
+      return fail("internal: no orientation adds information to the plan (variance function " +
+                  Num(d) + "); please report this with the command line");
+    }
     chosen.push_back(c);
     in_design[c] = 1;
     const Eigen::VectorXd b = reduced.row(c).transpose();
@@ -350,14 +398,18 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
   const Eigen::VectorXd w = Weights(cand, chosen, trials);
   const Eigen::MatrixXd cov =
       Covariance6(reduced, chosen, w, basis, plan->observable, &plan->log_det_information);
+  // Back from units of scale^2: the information matrix is 1/scale^2 of the one computed.
+  plan->log_det_information -= 2.0 * rank * std::log(scale);
   for (int k = 0; k < kTensorPlanComponents; ++k) {
-    plan->std_kg_m2[k] = plan->observable[k] ? std::sqrt(cov(k, k)) : kNaN;
-    for (int l = 0; l < kTensorPlanComponents; ++l) plan->covariance[k][l] = cov(k, l);
+    plan->std_kg_m2[k] = plan->observable[k] ? scale * std::sqrt(cov(k, k)) : kNaN;
+    for (int l = 0; l < kTensorPlanComponents; ++l) {
+      plan->covariance[k][l] = cov(k, l) * scale * scale;
+    }
   }
   const auto std_at = [&](double t, int k) {
     const Eigen::MatrixXd c =
         Covariance6(reduced, chosen, Weights(cand, chosen, t), basis, plan->observable, nullptr);
-    return std::sqrt(c(k, k));
+    return scale * std::sqrt(c(k, k));
   };
   for (int k = 0; k < kTensorPlanComponents; ++k) {
     // The floor: the attitude error alone, as the trials grow without bound (1e12 stands for
@@ -395,6 +447,12 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
     }
   }
 
+  for (int k = 0; k < kTensorPlanComponents; ++k) {
+    if (plan->observable[k] && !(std::isfinite(plan->std_kg_m2[k]) && plan->std_kg_m2[k] > 0)) {
+      return fail(std::string("internal: the predicted std of ") + TensorPlanComponentName(k) +
+                  " is " + Num(plan->std_kg_m2[k]) + "; please report this with the command line");
+    }
+  }
   plan->n_points = n * options.trials_per_orientation;
   // Listed by roll, then pitch: the order a crew re-rigs in.
   std::sort(chosen.begin(), chosen.end(), [&cand](int x, int y) {
@@ -408,8 +466,8 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
     o.pitch_deg = c.pitch_deg;
     o.axis_in_body = c.n;
     o.inertia_kg_m2 = c.inertia_kg_m2;
-    o.swing_std_kg_m2 = std::sqrt(c.swing_var);
-    o.mean_std_kg_m2 = std::sqrt(c.swing_var / trials + c.tilt_var);
+    o.swing_std_kg_m2 = std::hypot(stds[i].absolute, stds[i].relative);
+    o.mean_std_kg_m2 = scale * std::sqrt(c.swing_var / trials + c.tilt_var);
     plan->orientations.push_back(o);
   }
   return true;

@@ -54,18 +54,22 @@ struct TensorPlanOptions {
   // Swings (trials) per orientation, in [1, 1e6]. Default 3.
   int trials_per_orientation = 3;
   // Per-swing standard deviation of a measured moment: absolute (kg m^2) and relative (fraction
-  // of the moment I(n)), added in quadrature; >= 0, not both 0. Defaults 0.
+  // of the moment I(n)), added in quadrature; absolute in [0, 1e100], relative in [0, 1), not both
+  // 0. Any std of a moment down to 1e-300 kg m^2 works (the plan is computed in units of the
+  // largest std). Defaults 0.
   double sigma_kg_m2 = 0.0;
   double sigma_relative = 0.0;
   // Standard deviation (deg, per tilt axis) of the attitude actually set against the nominal one,
   // shared by the trials of an orientation, in [0, 10]. Default 0 (attitudes exact).
   double attitude_std_deg = 0.0;
   // The guessed tensor (kg m^2; Ixx, Iyy, Izz, Ixy, Ixz, Iyz, products positive convention).
-  // Needed (and must be positive definite) when sigma_relative > 0 or attitude_std_deg > 0;
+  // Each within +-1e100. Needed (and positive definite) when sigma_relative > 0 or
+  // attitude_std_deg > 0;
   // otherwise unused, and `guess_given` may be false.
   std::array<double, kTensorPlanComponents> guess_kg_m2 = {0, 0, 0, 0, 0, 0};
   bool guess_given = false;
-  // Target standard error of every observable component (kg m^2), > 0, or 0 for none. Default 0.
+  // Target standard error of every observable component (kg m^2), in (0, 1e100], or 0 for none.
+  // Default 0.
   double target_std_kg_m2 = 0.0;
   // A singular value of the reachable axes' design below this fraction of the largest is a
   // direction the rig cannot observe; (0, 1). Default 1e-6 (as the tensor fit).

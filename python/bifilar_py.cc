@@ -57,6 +57,22 @@ namespace {
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
+// A C++ string as a str. Bytes that are not UTF-8 (a file name given as bytes, say) are kept
+// as Python's os functions keep them (surrogateescape: os.fsencode gives the bytes back), never
+// a UnicodeDecodeError after the work is done.
+py::str Text(const std::string& s) {
+  PyObject* text =
+      PyUnicode_DecodeUTF8(s.data(), static_cast<Py_ssize_t>(s.size()), "surrogateescape");
+  if (text == nullptr) throw py::error_already_set();
+  return py::reinterpret_steal<py::str>(text);
+}
+
+py::list Texts(const std::vector<std::string>& v) {
+  py::list list;
+  for (const std::string& s : v) list.append(Text(s));
+  return list;
+}
+
 // nlohmann::json -> dict / list / float / int / str / bool / None.
 py::object ToPython(const nlohmann::json& j) {
   using Type = nlohmann::json::value_t;
@@ -66,7 +82,7 @@ py::object ToPython(const nlohmann::json& j) {
     case Type::number_integer: return py::int_(j.get<std::int64_t>());
     case Type::number_unsigned: return py::int_(j.get<std::uint64_t>());
     case Type::number_float: return py::float_(j.get<double>());
-    case Type::string: return py::str(j.get_ref<const std::string&>());
+    case Type::string: return Text(j.get_ref<const std::string&>());
     case Type::array: {
       py::list list;
       for (const nlohmann::json& item : j) list.append(ToPython(item));
@@ -74,7 +90,7 @@ py::object ToPython(const nlohmann::json& j) {
     }
     case Type::object: {
       py::dict dict;
-      for (const auto& [key, value] : j.items()) dict[py::str(key)] = ToPython(value);
+      for (const auto& [key, value] : j.items()) dict[Text(key)] = ToPython(value);
       return std::move(dict);
     }
     default: return py::none();  // binary / discarded: never produced by the serializers
@@ -340,7 +356,7 @@ py::dict ReadLogCore(const std::string& path, const std::optional<std::string>& 
     }
   }
   py::dict out;
-  out["file"] = path;
+  out["file"] = Text(path);
   out["t_s"] = ToNumpy(data.t_s);
   out["rate_rad_per_s"] = ToNumpy(axis.rate_rad_per_s);
   out["gyro_rad_per_s"] = ToNumpy(data.gyro_in_imu);
@@ -356,8 +372,8 @@ py::dict ReadLogCore(const std::string& path, const std::optional<std::string>& 
                                  ? py::object(py::float_(*axis.roll_measured_deg))
                                  : py::none();
   out["window_s"] = window ? py::object(py::make_tuple((*window)[0], (*window)[1])) : py::none();
-  out["warnings"] = data.warnings;
-  out["notes"] = axis.notes;
+  out["warnings"] = Texts(data.warnings);
+  out["notes"] = Texts(axis.notes);
   // The format used: the guess (its "guesses" say what was guessed from what), or None when the
   // config gave it.
   out["format_guessed"] = guessed_format ? ToPython(*guessed_format) : py::object(py::none());
@@ -728,15 +744,15 @@ py::dict SimulateCore(const SimulateArgs& a) {
   result["truth"] = ToPython(truth);
   if (a.out) {
     result["files_written"] = summary.files_written;
-    result["out"] = *a.out;
+    result["out"] = Text(*a.out);
   } else {
     result["t_s"] = ToNumpy(data.t_s);
     result["gyro_rad_per_s"] = ToNumpy(data.gyro_in_imu);
     result["accel_mps2"] = data.has_accel() ? py::object(ToNumpy(data.accel_in_imu)) : py::none();
-    if (a.trace) result["file"] = *a.trace;
+    if (a.trace) result["file"] = Text(*a.trace);
   }
   result["truth_path"] = summary.truth_path.empty() ? py::object(py::none())
-                                                    : py::object(py::str(summary.truth_path));
+                                                    : py::object(Text(summary.truth_path));
   return result;
 }
 
@@ -821,10 +837,10 @@ PYBIND11_MODULE(_core, m) {
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
-    } catch (const UserError& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const UserError& e) {  // (a message naming a non-UTF-8 file name: surrogates)
+      PyErr_SetObject(PyExc_ValueError, Text(e.what()).ptr());
     } catch (const std::invalid_argument& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
+      PyErr_SetObject(PyExc_ValueError, Text(e.what()).ptr());
     }
   });
 
@@ -896,4 +912,12 @@ PYBIND11_MODULE(_core, m) {
       "simulate(**settings) -> dict: `bifilar simulate`, a campaign (spec, out) or one trace "
       "(written to trace= or returned as arrays).");
   m.attr("version") = ProgramVersion();
+  // The ranges of the whole-number arguments, from the constants the C++ checks use:
+  // bifilar/__init__.py refuses a value outside them by name, before a cast to int could fail
+  // ("Unable to cast Python instance of type <class 'int'> to C++ type").
+  py::dict int_ranges;
+  int_ranges["whiteness_lags"] = py::make_tuple(1, kMaxWhitenessLags);
+  int_ranges["bootstrap"] = py::make_tuple(0, kMaxBootstrapReplicates);
+  int_ranges["jobs"] = py::make_tuple(0, kMaxJobs);
+  m.attr("int_ranges") = int_ranges;
 }

@@ -464,8 +464,44 @@ TEST(EllipseFit, BadInputIsRejectedWithAMessage) {
   EXPECT_FALSE(PlanEllipse(plan, &out, &why));
 }
 
+// Issue 23 item 6: `plan --sigma 1e200` squared sigma to inf and predicted stds of 0 (exit 0).
+// The covariance is computed for sigma 1 and the stds multiplied by sigma (they are linear in
+// it); above 1e100 kg m^2 sigma and the guesses are refused, naming the value.
+TEST(EllipsePlan, StdsScaleWithAnySigmaAndHugeInputsAreRefused) {
+  EllipsePlanOptions plan;
+  plan.pitch_deg = PaperAngles();
+  plan.trials_per_angle = 3;
+  plan.sigma_kg_m2 = 1.0;
+  plan.ix_kg_m2 = kPaper.ix;
+  plan.iz_kg_m2 = kPaper.iz;
+  plan.ixz_kg_m2 = kPaper.ixz;
+  EllipsePlan unit, p;
+  std::string why;
+  ASSERT_TRUE(PlanEllipse(plan, &unit, &why)) << why;
+  constexpr double kRelTol = 1e-14;  // one multiplication: a few ulp
+  for (double sigma : {1e-300, 1e-170, 1e-3, 1e100}) {
+    SCOPED_TRACE(sigma);
+    plan.sigma_kg_m2 = sigma;
+    ASSERT_TRUE(PlanEllipse(plan, &p, &why)) << why;
+    EXPECT_NEAR(p.std.ix_kg_m2 / sigma / unit.std.ix_kg_m2, 1.0, kRelTol);
+    EXPECT_NEAR(p.std.iz_kg_m2 / sigma / unit.std.iz_kg_m2, 1.0, kRelTol);
+    EXPECT_NEAR(p.std.ixz_kg_m2 / sigma / unit.std.ixz_kg_m2, 1.0, kRelTol);
+    EXPECT_NEAR(p.std.tau_deg / sigma / unit.std.tau_deg, 1.0, kRelTol);
+  }
+  for (double sigma : {1.0001e100, 1e200, 1.7e308, 4.9e-324, 0.0, -1.0}) {
+    plan.sigma_kg_m2 = sigma;
+    EXPECT_FALSE(PlanEllipse(plan, &p, &why));
+    EXPECT_NE(why.find("sigma must be in [1e-300, 1e100] kg m^2"), std::string::npos) << why;
+  }
+  plan.sigma_kg_m2 = 1.0;
+  plan.ix_kg_m2 = 1e308;
+  EXPECT_FALSE(PlanEllipse(plan, &p, &why));
+  EXPECT_NE(why.find("(0, 1e100]"), std::string::npos) << why;
+}
+
 }  // namespace
 }  // namespace bifilar
+
 
 namespace bifilar {
 namespace {

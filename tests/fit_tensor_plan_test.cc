@@ -290,5 +290,92 @@ TEST(TensorPlan, BadOptionsSayWhatIsWrong) {
   EXPECT_NE(why.find("plan at least 6"), std::string::npos) << why;
 }
 
+// Issue 23 item 4: --sigma 1e-160 (or --sigma-rel 1e-170) squared to a subnormal, the weights
+// became infinite, no candidate added information and in_design[-1] was written (a heap
+// corruption). Item 6: --sigma 1e200 squared to inf, NaN stds and 12 near-identical attitudes.
+// The plan is computed in units of the largest std, so the choice is the same at any scale and
+// the stds scale with sigma; a sigma above 1e100 kg m^2 is refused by name.
+TEST(TensorPlan, TinyAndHugeSigmasGiveTheSameDesignScaled) {
+  TensorPlanOptions base = FullRig();
+  base.roll_min_deg = -45;
+  base.roll_max_deg = 45;
+  base.sigma_kg_m2 = 1.0;
+  TensorPlan reference;
+  std::string why;
+  ASSERT_TRUE(PlanTensor(base, &reference, &why)) << why;
+  // Equal designs give equal stds to rounding: 1e-12 relative is ~5000 ulp.
+  constexpr double kRelTol = 1e-12;
+  for (double sigma : {1e-160, 1e-300, 1e-100, 1e99}) {
+    SCOPED_TRACE(sigma);
+    TensorPlanOptions o = base;
+    o.sigma_kg_m2 = sigma;
+    TensorPlan plan;
+    ASSERT_TRUE(PlanTensor(o, &plan, &why)) << why;
+    ASSERT_EQ(plan.orientations.size(), reference.orientations.size());
+    for (size_t i = 0; i < plan.orientations.size(); ++i) {
+      EXPECT_EQ(plan.orientations[i].roll_deg, reference.orientations[i].roll_deg);
+      EXPECT_EQ(plan.orientations[i].pitch_deg, reference.orientations[i].pitch_deg);
+      EXPECT_NEAR(plan.orientations[i].mean_std_kg_m2 / sigma,
+                  reference.orientations[i].mean_std_kg_m2, kRelTol);
+    }
+    for (int k = 0; k < 6; ++k) {
+      ASSERT_TRUE(std::isfinite(plan.std_kg_m2[k]));
+      EXPECT_NEAR(plan.std_kg_m2[k] / sigma / reference.std_kg_m2[k], 1.0, kRelTol);
+    }
+  }
+  // Relative std only, 1e-170 of the moment: the same design as 1e-2, stds 1e-168 of them.
+  TensorPlanOptions rel = base;
+  rel.sigma_kg_m2 = 0;
+  rel.guess_given = true;
+  rel.guess_kg_m2 = kTruth;
+  rel.sigma_relative = 1e-2;
+  ASSERT_TRUE(PlanTensor(rel, &reference, &why)) << why;
+  rel.sigma_relative = 1e-170;
+  TensorPlan tiny;
+  ASSERT_TRUE(PlanTensor(rel, &tiny, &why)) << why;
+  ASSERT_EQ(tiny.orientations.size(), reference.orientations.size());
+  for (size_t i = 0; i < tiny.orientations.size(); ++i) {
+    EXPECT_EQ(tiny.orientations[i].roll_deg, reference.orientations[i].roll_deg);
+    EXPECT_EQ(tiny.orientations[i].pitch_deg, reference.orientations[i].pitch_deg);
+  }
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_NEAR(tiny.std_kg_m2[k] / 1e-168 / reference.std_kg_m2[k], 1.0, kRelTol);
+  }
+  // A relative std of 1e-170 beside an attitude error of 0.5 deg: the tilt dominates every
+  // variance, the swing std is still reported as what it is (1e-170 of the moment).
+  rel.attitude_std_deg = 0.5;
+  TensorPlan tilted;
+  ASSERT_TRUE(PlanTensor(rel, &tilted, &why)) << why;
+  for (const TensorPlanOrientation& o : tilted.orientations) {
+    EXPECT_NEAR(o.swing_std_kg_m2 / (1e-170 * o.inertia_kg_m2), 1.0, kRelTol);
+    EXPECT_TRUE(std::isfinite(o.mean_std_kg_m2) && o.mean_std_kg_m2 > 0);
+  }
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_TRUE(std::isfinite(tilted.std_kg_m2[k]) && tilted.std_kg_m2[k] > 0) << k;
+    EXPECT_NEAR(tilted.floor_std_kg_m2[k] / tilted.std_kg_m2[k], 1.0, 1e-6) << k;  // all tilt
+  }
+  // Below 1e-300 kg m^2 the stds would be subnormal: refused, as too small to compute with.
+  for (double sigma : {1e-301, 4.9e-324}) {
+    TensorPlanOptions o = base;
+    o.sigma_kg_m2 = sigma;
+    TensorPlan plan;
+    EXPECT_FALSE(PlanTensor(o, &plan, &why));
+    EXPECT_NE(why.find("too small to compute with"), std::string::npos) << why;
+  }
+  // Above 1e100 kg m^2 (its square would overflow the covariance): refused, naming the value.
+  for (double sigma : {1e101, 1e200, 1.7e308}) {
+    TensorPlanOptions o = base;
+    o.sigma_kg_m2 = sigma;
+    TensorPlan plan;
+    EXPECT_FALSE(PlanTensor(o, &plan, &why));
+    EXPECT_NE(why.find("per-swing std must be in [0, 1e100] kg m^2"), std::string::npos) << why;
+  }
+  TensorPlanOptions huge_guess = rel;
+  huge_guess.guess_kg_m2 = {1e300, 1e300, 1e300, 0, 0, 0};
+  TensorPlan plan;
+  EXPECT_FALSE(PlanTensor(huge_guess, &plan, &why));
+  EXPECT_NE(why.find("guessed tensor"), std::string::npos) << why;
+}
+
 }  // namespace
 }  // namespace bifilar

@@ -431,5 +431,60 @@ TEST(Tensor, BadInputSaysWhich) {
   EXPECT_FALSE(FitTensor({}, TensorOptions(), &r, &why));
 }
 
+// Issue 23 item 4: (1e308, 0, 1) had norm() = inf, was "normalised" to (0, 0, 0), and six such
+// points crashed the SVD (SIGSEGV from Python); beside valid axes it was silently an axis that
+// observed nothing. Axes are now scaled by their largest component before normalising: any
+// finite non-zero vector is its direction; inf, NaN and zero are errors naming the point.
+TEST(Tensor, HugeAndTinyDirectionsAreTheirDirectionsAndNonFiniteOnesAreErrors) {
+  std::vector<TensorPoint> huge(6), unit(6);
+  for (int i = 0; i < 6; ++i) {
+    huge[i].direction_in_body = {1e308, 0, 1};
+    huge[i].inertia_kg_m2 = 0.45 + 0.001 * i;
+    unit[i] = huge[i];
+    unit[i].direction_in_body = {1, 0, 0};
+  }
+  TensorOptions options;
+  options.bootstrap_replicates = 0;
+  TensorResult a, b;
+  std::string why;
+  ASSERT_TRUE(FitTensor(huge, options, &a, &why)) << why;
+  ASSERT_TRUE(FitTensor(unit, options, &b, &why)) << why;
+  EXPECT_EQ(a.rank, 1);
+  EXPECT_NEAR(a.components[kIxx].value, 0.4525, 1e-12);  // the mean of the six moments about x
+  EXPECT_EQ(a.unobservable, b.unobservable);
+
+  // Beside valid axes: the huge one counts as the x axis, exactly as (1, 0, 0) would.
+  std::mt19937_64 rng(5);
+  std::vector<TensorPoint> mixed = Campaign(kTruth, 2, 0.0, &rng);
+  std::vector<TensorPoint> plain = mixed;
+  mixed[0].direction_in_body = {1e308, 0, 1};
+  plain[0].direction_in_body = {1, 0, 0};
+  mixed[1].direction_in_body = {0, 1e-300, 0};  // tiny: the y axis
+  plain[1].direction_in_body = {0, 1, 0};
+  mixed[0].inertia_kg_m2 = plain[0].inertia_kg_m2 = TensorMoment(kTruth, {1, 0, 0});
+  mixed[1].inertia_kg_m2 = plain[1].inertia_kg_m2 = TensorMoment(kTruth, {0, 1, 0});
+  ASSERT_TRUE(FitTensor(mixed, options, &a, &why)) << why;
+  ASSERT_TRUE(FitTensor(plain, options, &b, &why)) << why;
+  EXPECT_EQ(a.rank, 6);
+  EXPECT_NEAR(a.components[kIxx].value, b.components[kIxx].value, 1e-12);
+  EXPECT_NEAR(a.components[kIxx].value, kTruth[0], 1e-9);
+  EXPECT_NEAR(TensorMoment(kTruth, {1e308, 0, 1}), kTruth[0], 1e-15);
+
+  // Not finite, or zero: an error naming the point and the vector, never a crash.
+  for (const std::array<double, 3>& bad :
+       {std::array<double, 3>{INFINITY, 0, 1}, {NAN, 0, 0}, {0, 0, 0}, {1e308, -INFINITY, 0}}) {
+    std::vector<TensorPoint> points = plain;
+    points[2].direction_in_body = bad;
+    EXPECT_FALSE(FitTensor(points, options, &a, &why));
+    EXPECT_NE(why.find("point 3: the swing axis must be a finite, non-zero vector"),
+              std::string::npos)
+        << why;
+  }
+  std::vector<TensorPoint> points = plain;
+  points[4].nominal_in_body = {INFINITY, 0, 0};
+  EXPECT_FALSE(FitTensor(points, options, &a, &why));
+  EXPECT_NE(why.find("point 5: the nominal swing axis"), std::string::npos) << why;
+}
+
 }  // namespace
 }  // namespace bifilar

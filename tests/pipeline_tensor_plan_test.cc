@@ -103,5 +103,46 @@ TEST(TensorPlanCli, BadOptionsAreOneLineErrors) {
   }
 }
 
+// Issue 23 items 4, 6 and 7: `--sigma 1e-160` ended in "double free or corruption", `--sigma
+// 1e200` printed -nan stds (tensor) or stds of 0 (pitch plane) with exit 0, and `--sigma 1e-308`
+// was "not a number". Tiny sigmas now plan as any other (stds scaled); huge ones are refused.
+TEST(TensorPlanCli, TinySigmasPlanAndHugeOnesAreRefused) {
+  TempDir dir("bifilar_tensor_plan");
+  for (const std::string sigma : {"--sigma 1e-160", "--sigma 1e-300", "--sigma-rel 1e-170 "
+                                  "--ixx 1 --iyy 2 --izz 2.5"}) {
+    SCOPED_TRACE(sigma);
+    const CliRun r =
+        Bifilar(dir, "plan --tensor --roll=-45:45 --pitch=-90:90 " + sigma + " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const json j = json::parse(r.out);
+    ASSERT_EQ(j["orientations"].size(), 12u);
+    for (int k = 0; k < kTensorPlanComponents; ++k) {
+      const json& std_json = j["components"][TensorPlanComponentName(k)]["std_kg_m2"];
+      ASSERT_TRUE(std_json.is_number()) << std_json;
+      EXPECT_GT(std_json.get<double>(), 0.0);
+    }
+  }
+  const CliRun plain = Bifilar(dir, "plan --angles 0:90:10 --sigma 1e-200 --json");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_GT(json::parse(plain.out)["Ix_kg_m2_std"].get<double>(), 0.0) << plain.out;
+  const struct {
+    std::string args, expect;
+  } refused[] = {
+      {"plan --tensor --roll=-45:45 --sigma 1e200", "per-swing std must be in [0, 1e100] kg m^2"},
+      {"plan --tensor --roll=-45:45 --sigma 4.9e-324", "too small to compute with"},
+      {"plan --angles 0:90:10 --sigma 1e200", "sigma must be in [1e-300, 1e100] kg m^2"},
+      {"plan --angles 0:90:10 --sigma 1e400", "'1e400' is out of range"},
+      // A subnormal is a number, named as too small, not "not a number".
+      {"plan --angles 0:90:10 --sigma 1e-308", "[1e-300, 1e100] kg m^2, got 1e-308"},
+  };
+  for (const auto& c : refused) {
+    SCOPED_TRACE(c.args);
+    const CliRun r = Bifilar(dir, c.args);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
+  }
+}
+
 }  // namespace
 }  // namespace bifilar

@@ -1,5 +1,6 @@
 #include "pipeline/campaign/calibration.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -35,6 +36,44 @@ std::string Described(const TraceRecord& r) {
 }
 
 }  // namespace
+
+double GeometryFactorAllowance(const CampaignConfig& config, const RigCalibrationResult& c) {
+  // k absorbs the errors of L, D and g (they enter as g D^2 / L): relative std
+  // sqrt((2 s_D / D)^2 + (s_L / L)^2 + (s_g / g)^2), with the calibration's own std beside it.
+  const RigUncertainties u = config.uncertainties.InEffect();
+  const double d = 2.0 * u.filar_separation_std_m / config.filar_separation_m;
+  const double l = u.filar_length_std_m / config.filar_length_m;
+  const double g = u.gravity_std_mps2 / config.gravity_mps2;
+  const double expected =
+      std::sqrt(d * d + l * l + g * g + c.factor_rel_std * c.factor_rel_std);
+  return std::min(kCalibrationFactorSigmas * expected, kCalibrationFactorWarnFraction);
+}
+
+std::string FarFromOneWarning(const CampaignConfig& config, const RigCalibrationResult& c) {
+  const double allowed = GeometryFactorAllowance(config, c);
+  if (!(std::abs(c.factor - 1.0) > allowed)) return "";
+  const RigUncertainties u = config.uncertainties.InEffect();
+  char buffer[1400];
+  std::snprintf(
+      buffer, sizeof(buffer),
+      "rig.calibration: the factor k = %.4g moves D^2/L by %+.1f %%, beyond the %.2g %% that the "
+      "configured uncertainties allow (3 sigma of L +- %.3g m, D +- %.3g m%s and the "
+      "calibration's own %.2g %%; never more than %g %%). It implies an effective D of %.4g m "
+      "against the %.4g m measured (%+.1f %%, L kept), or L = %.4g m against %.4g m (D kept): "
+      "far more than a tape measure misses. More likely rig.calibration.reference_inertia_kg_m2 "
+      "(%.6g kg m^2, about the swing axis) or rig.calibration.reference_mass_kg (%.6g kg) is "
+      "wrong, or rig.inertia (%.6g kg m^2, from %s): every inertia of the run scales with k, "
+      "and its std does not cover such an error",
+      c.factor, 100.0 * (c.factor - 1.0), 100.0 * allowed, u.filar_length_std_m,
+      u.filar_separation_std_m,
+      u.gravity_std_mps2 > 0 ? (", g +- " + Format("%.3g", u.gravity_std_mps2) + " m/s^2").c_str()
+                             : "",
+      100.0 * c.factor_rel_std, 100.0 * kCalibrationFactorWarnFraction, c.effective_separation_m,
+      c.nominal_separation_m, 100.0 * (std::sqrt(c.factor) - 1.0), c.filar_length_m / c.factor,
+      c.filar_length_m, c.reference_inertia_kg_m2, c.reference_mass_kg, c.rig_inertia_kg_m2,
+      c.rig_inertia_source == "tare" ? "the tare logs" : ("rig.inertia " + c.rig_inertia_source).c_str());
+  return buffer;
+}
 
 void MeanAndStandardError(const std::vector<double>& values, const std::vector<double>& stds,
                           double* mean, double* standard_error) {
@@ -188,6 +227,8 @@ RigCalibrationResult CalibrateRig(const CampaignConfig& config, const Calibratio
         "above the rig's), more swings or a better known reference inertia shrink it",
         100.0 * out.factor_rel_std));
   }
+  const std::string far = FarFromOneWarning(config, out);
+  if (!far.empty()) out.warnings.push_back(far);
   if (records_out) *records_out = std::move(records);
   return out;
 }

@@ -30,6 +30,12 @@ constexpr int kCalibrationMaxIterations = 8;
 // reference inertia or mass, a unit slip, or the wrong rig inertia. It is an error.
 constexpr double kMinCalibrationFactor = 0.5, kMaxCalibrationFactor = 2.0;
 constexpr int kRecommendedReferenceSwings = 3;  // fewer: a warning (the scatter is not measured)
+// A factor further from 1 than kCalibrationFactorSigmas times the std the configured L, D and g
+// uncertainties (and the calibration's own std) give it, and always one beyond +-10 %, warns
+// (FarFromOneWarning): a reference inertia 45 % low gave k = 0.567 with a std of 0.09 % and no
+// word, and every moment of the run 43 % low.
+constexpr double kCalibrationFactorSigmas = 3.0;
+constexpr double kCalibrationFactorWarnFraction = 0.10;
 
 // Fits every reference swing of rig.calibration, plus every tare log when rig.inertia is `tare`,
 // with `config` (whose geometry_calibration.factor is the round's k). Returns their records.
@@ -42,6 +48,16 @@ using CalibrationFitFunction =
 // `records` (optional) receives the final round's records.
 RigCalibrationResult CalibrateRig(const CampaignConfig& config, const CalibrationFitFunction& fit,
                                   std::vector<TraceRecord>* records = nullptr);
+
+// How far from 1 the factor may lie without a warning (fraction): kCalibrationFactorSigmas times
+// sqrt((2 s_D / D)^2 + (s_L / L)^2 + (s_g / g)^2 + factor_rel_std^2), the stds in effect
+// (RigUncertainties::InEffect: 1 mm on L and D when none are configured), at most
+// kCalibrationFactorWarnFraction.
+double GeometryFactorAllowance(const CampaignConfig& config, const RigCalibrationResult& c);
+// "" when |k - 1| is within that allowance; else a warning naming the reference keys and what
+// k implies for D (and for L). CalibrateRig adds it to `warnings` (console, results.json,
+// report).
+std::string FarFromOneWarning(const CampaignConfig& config, const RigCalibrationResult& c);
 
 // CalibrateRig for `bifilar fit`: the logs of rig.calibration (and rig.inertia.tare) found with
 // DiscoverListedLogs and fitted with ProcessTrace every round (no cache). Throws UserError as

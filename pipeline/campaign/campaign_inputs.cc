@@ -6,6 +6,7 @@
 #include <map>
 
 #include "base/user_error.h"
+#include "pipeline/trace/trace_process.h"
 
 namespace bifilar {
 
@@ -73,15 +74,19 @@ std::vector<std::optional<std::array<double, 2>>> WindowsForRuns(
     const CampaignConfig& config, const std::vector<RunFile>& runs) {
   // Each entry resolved the two ways ConfigWindowFor does: against runs.root, then the config
   // folder.
+  // Canonical paths on both sides (CanonicalLogPath), as ConfigWindowFor matches for `fit`.
   std::map<std::string, std::string> key_of;  // resolved path -> entry
   for (const auto& [key, window] : config.fit.windows_s) {
-    if (!config.runs.root.empty()) key_of.emplace(ResolvePath(config.runs.root, key), key);
-    key_of.emplace(ResolvePath(config.folder, key), key);
+    if (!config.runs.root.empty()) {
+      key_of.emplace(CanonicalLogPath(ResolvePath(config.runs.root, key)), key);
+    }
+    key_of.emplace(CanonicalLogPath(ResolvePath(config.folder, key)), key);
   }
   std::vector<std::optional<std::array<double, 2>>> windows(runs.size());
   std::map<std::string, bool> used;
+  if (config.fit.windows_s.empty()) return windows;
   for (size_t i = 0; i < runs.size(); ++i) {
-    const std::string target = fs::path(runs[i].path).lexically_normal().string();
+    const std::string target = CanonicalLogPath(runs[i].path);
     const auto it = key_of.find(target);
     const std::string key = it == key_of.end() ? std::string() : it->second;
     if (key.empty()) continue;
@@ -96,6 +101,22 @@ std::vector<std::optional<std::array<double, 2>>> WindowsForRuns(
     }
   }
   return windows;
+}
+
+void CheckWindowEntriesExist(const CampaignConfig& config) {
+  for (const auto& [key, window] : config.fit.windows_s) {
+    std::error_code ec;
+    const bool in_root = !config.runs.root.empty() &&
+                         fs::is_regular_file(ResolvePath(config.runs.root, key), ec);
+    if (in_root || fs::is_regular_file(ResolvePath(config.folder, key), ec)) continue;
+    throw UserError(config.file + ": 'fit.windows." + key + "' names no log that exists (" +
+                    (config.runs.root.empty() ? std::string()
+                                              : "relative to runs.root " + config.runs.root +
+                                                    " or ") +
+                    "relative to the config folder " +
+                    (config.folder.empty() ? std::string(".") : config.folder) +
+                    "); fix the file name or remove the entry");
+  }
 }
 
 }  // namespace bifilar

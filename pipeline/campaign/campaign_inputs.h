@@ -27,4 +27,10 @@ int DropOutputFolder(const std::string& out_dir, std::vector<RunFile>* runs);
 std::vector<std::optional<std::array<double, 2>>> WindowsForRuns(const CampaignConfig& config,
                                                                   const std::vector<RunFile>& runs);
 
+// `bifilar fit`'s check of fit.windows, as WindowsForRuns's for `process`: throws UserError
+// naming the entry when it names no file that exists (relative to runs.root or the config
+// folder). The logs fit is given need not be all of them; each finds its entry through
+// ConfigWindowFor (pipeline/trace/trace_process.h), matched as `process` matches it.
+void CheckWindowEntriesExist(const CampaignConfig& config);
+
 }  // namespace bifilar

@@ -41,14 +41,17 @@ std::string CommandAndInputs(int argc, char** argv) {
 CLI::Validator FiniteNumber() {
   return CLI::Validator(
       [](std::string& input) {
-        double value = 0.0;
-        size_t used = 0;
-        try {
-          value = std::stod(input, &used);
-        } catch (const std::exception&) {
+        // strtod, not stod: stod throws on underflow too, which called 1e-308 (a subnormal
+        // number) "not a number". A value beyond the double range is out of range.
+        char* end = nullptr;
+        errno = 0;
+        const double value = std::strtod(input.c_str(), &end);
+        if (input.empty() || end != input.c_str() + input.size()) {
           return "'" + input + "' is not a number";
         }
-        if (used != input.size()) return "'" + input + "' is not a number";
+        if (errno == ERANGE && std::fabs(value) > 1.0) {
+          return "'" + input + "' is out of range (a finite number within +-1.8e308)";
+        }
         if (!std::isfinite(value)) return "'" + input + "' is not a finite number";
         return std::string();
       },

@@ -9,12 +9,15 @@
 #include <iostream>
 #include <map>
 #include <optional>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
 #include "base/interrupt.h"
 #include "fit/window.h"
+#include "base/hash.h"
 #include "pipeline/campaign/calibration.h"
+#include "pipeline/campaign/campaign_inputs.h"
 #include "pipeline/cli/cli_commands.h"
 #include "pipeline/config/config.h"
 #include "pipeline/records/results_json.h"
@@ -40,21 +43,50 @@ std::string LogStem(const std::string& log) {
   return stem.empty() ? "trace" : stem;
 }
 
-// The figure name of each log: DIR/<log>.svg, as the docs say; logs of the same name in
-// different folders ("pitch_10/trial_1.csv", "pitch_20/trial_1.csv") get their folder in front
-// ("pitch_10_trial_1"), so no figure overwrites another.
+// The figure name of each log: DIR/<log>.svg, as the docs say. Names are unique among the
+// logs of the run, and one log (the same canonical path, however it is written) has one name:
+// logs of the same name in different folders ("pitch_10/trial_1.csv", "pitch_20/trial_1.csv")
+// get their folder in front ("pitch_10_trial_1"); a name still shared by different logs (with
+// its "_sweep" figure too: "x/t.csv", "x_t.csv", or "a.csv" and "a_sweep.csv") gets 8 hex
+// digits of the hash of the log's canonical path ("x_t-1f0c9a3e"), and, should even those
+// meet, the log's position in the command line.
 std::vector<std::string> FigureStems(const std::vector<std::string>& logs) {
-  std::map<std::string, int> count;
-  for (const std::string& log : logs) ++count[LogStem(log)];
-  std::vector<std::string> stems;
-  for (const std::string& log : logs) {
-    std::string stem = LogStem(log);
-    if (count[stem] > 1) {
-      const std::string folder =
-          std::filesystem::path(log).lexically_normal().parent_path().filename().string();
-      if (!folder.empty() && folder != "." && folder != "..") stem = folder + "_" + stem;
+  const size_t n = logs.size();
+  std::vector<std::string> key(n), stems(n);
+  std::map<std::string, std::set<std::string>> logs_of_stem;  // stem -> canonical paths
+  for (size_t i = 0; i < n; ++i) {
+    key[i] = CanonicalLogPath(logs[i]);
+    stems[i] = LogStem(logs[i]);
+    logs_of_stem[stems[i]].insert(key[i]);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    if (logs_of_stem[LogStem(logs[i])].size() < 2) continue;
+    const std::string folder =
+        std::filesystem::path(logs[i]).lexically_normal().parent_path().filename().string();
+    if (!folder.empty() && folder != "." && folder != "..") stems[i] = folder + "_" + stems[i];
+  }
+  // Each file name a log's figures take (<stem> and <stem>_sweep), and the logs taking it.
+  const auto clashes = [&]() {
+    std::map<std::string, std::set<std::string>> users;
+    for (size_t i = 0; i < n; ++i) {
+      users[stems[i]].insert(key[i]);
+      users[stems[i] + "_sweep"].insert(key[i]);
     }
-    stems.push_back(stem);
+    std::vector<bool> clash(n, false);
+    for (size_t i = 0; i < n; ++i) {
+      clash[i] = users[stems[i]].size() > 1 || users[stems[i] + "_sweep"].size() > 1;
+    }
+    return clash;
+  };
+  std::vector<bool> clash = clashes();
+  for (size_t i = 0; i < n; ++i) {
+    if (clash[i]) stems[i] += "-" + HashToHex(Fnv1a64(key[i])).substr(0, 8);
+  }
+  clash = clashes();
+  std::map<std::string, size_t> first_of_key;
+  for (size_t i = 0; i < n; ++i) {
+    const size_t first = first_of_key.emplace(key[i], i).first->second;  // one name per log
+    if (clash[i]) stems[i] += "-" + std::to_string(first + 1);
   }
   return stems;
 }
@@ -136,6 +168,11 @@ std::string HumanLine(const TraceRecord& r, DisplayUnits units) {
     const std::string shown = SiTextInDisplayUnits(w, units);
     if (message.find(shown) == std::string::npos && !IsAssumedInputsWarning(w))
       line += "\n    warning: " + shown;
+  }
+  // --plot: which files are this log's figures (a name may carry a hash: FigureStems).
+  if (!r.figures.empty()) {
+    line += "\n    figures:";
+    for (const std::string& f : r.figures) line += " " + f;
   }
   return line;
 }
@@ -233,6 +270,9 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
         throw UserError("--max-amplitude must exceed fit.min_amplitude_deg of the config");
       }
     }
+    // fit.windows as `process` reads it: an entry naming no log is an error before any fit, and
+    // each log finds its entry however its path is written (ConfigWindowFor).
+    CheckWindowEntriesExist(config);
     TraceProcessOptions options;
     if (!args->window.empty()) {
       double t0 = 0, t1 = 0;
@@ -258,12 +298,23 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
         for (const std::string& w : calibration->warnings) std::cout << "warning: " << w << std::endl;
       }
     }
+    // --repeats: identical data is one repeat; the copies are named and dropped before fitting.
+    DistinctLogs distinct;
+    if (args->repeats) {
+      distinct = DropIdenticalLogs(args->logs);
+    } else {
+      distinct.kept = args->logs;
+    }
+    const std::vector<std::string>& logs = distinct.kept;
+    if (!args->json) {
+      for (const std::string& w : distinct.warnings) std::cout << "warning: " << w << std::endl;
+    }
     std::vector<TraceRecord> records;
     int failed = 0;
     InstallInterruptHandler();
-    const std::vector<std::string> stems = FigureStems(args->logs);
+    const std::vector<std::string> stems = FigureStems(logs);
     bool mid_fit = false;  // the last fit was stopped by Ctrl-C: its log is not fitted
-    for (size_t k = 0; k <= args->logs.size(); ++k) {
+    for (size_t k = 0; k <= logs.size(); ++k) {
       // Ctrl-C, between logs or inside a fit (which then stops between solver iterations, and
       // its log counts as not fitted): what was fitted, then exit 130.
       if (ProcessInterruptFlag().load()) {
@@ -271,13 +322,13 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
         if (args->json || args->repeats) {
           for (const TraceRecord& r : records) std::cout << HumanLine(r, config.units) << std::endl;
         }
-        std::cerr << "bifilar: interrupted: " << records.size() << " of " << args->logs.size()
+        std::cerr << "bifilar: interrupted: " << records.size() << " of " << logs.size()
                   << " logs fitted (above)\n";
         *exit_code = kInterruptedExitCode;
         return;
       }
-      if (k == args->logs.size()) break;
-      const std::string& log = args->logs[k];
+      if (k == logs.size()) break;
+      const std::string& log = logs[k];
       TraceProcessOptions trace = options;
       trace.display_name = log;
       trace.interrupt = &ProcessInterruptFlag();
@@ -298,7 +349,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     std::vector<RepeatGroup> groups;
     RepeatsAmplitudeCorrection correction;
     if (args->repeats) {
-      groups = GroupRepeats(args->logs);
+      groups = GroupRepeats(logs);
       correction = CombineRepeats(&groups, &records);
     }
     if (args->json) {
@@ -309,6 +360,13 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       if (args->repeats) {
         out["repeats"] = RepeatGroupsToJson(groups);
         out["amplitude_correction"] = AmplitudeCorrectionToJson(correction);
+        nlohmann::json dropped = nlohmann::json::array();
+        for (size_t i = 0; i < distinct.dropped.size(); ++i) {
+          dropped.push_back({{"file", distinct.dropped[i].first},
+                             {"same_as", distinct.dropped[i].second},
+                             {"warning", distinct.warnings[i]}});
+        }
+        out["identical_logs_dropped"] = dropped;
       }
       if (calibration) out["calibration"] = CalibrationToJson(*calibration);
       // Invalid UTF-8 (a log's bytes in a message) is replaced, never a json exception.

@@ -22,6 +22,7 @@
 #define BIFILAR_PIPELINE_REPEATS_H_
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pipeline/records/trace_record.h"
@@ -72,6 +73,22 @@ struct RepeatGroup {
 bool IsRepeatScatterWarning(const std::string& warning);
 
 std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths);
+
+// One swing is one repeat: a log given twice (the same file under one or two names) or a
+// byte-identical copy under another name would count twice, give Q = 0 and shrink the std by
+// sqrt(2). For each path, the index of the first earlier path with the same bytes, or -1 (also
+// for a file that cannot be read: its fit reports that). Files are compared byte for byte, only
+// those of equal size.
+std::vector<int> FindIdenticalLogs(const std::vector<std::string>& paths);
+
+// The logs of `paths` that FindIdenticalLogs keeps (first of each content, in order), and one
+// warning per dropped log naming it and the log it repeats.
+struct DistinctLogs {
+  std::vector<std::string> kept;
+  std::vector<std::pair<std::string, std::string>> dropped;  // (dropped log, the kept one)
+  std::vector<std::string> warnings;
+};
+DistinctLogs DropIdenticalLogs(const std::vector<std::string>& paths);
 
 // The amplitude correction pooled over the groups (fit/amplitude_trend.h,
 // FitPooledAmplitudeTrend on each usable log's I, std and result amplitude: the lowest band's

@@ -27,12 +27,22 @@
 
 namespace bifilar {
 
+std::string CanonicalLogPath(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+  if (ec) return std::filesystem::path(path).lexically_normal().string();
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(absolute, ec);
+  return ec ? absolute.lexically_normal().string() : canonical.string();
+}
+
 std::optional<std::array<double, 2>> ConfigWindowFor(const CampaignConfig& config,
                                                      const std::string& path) {
-  const std::string target = std::filesystem::path(path).lexically_normal().string();
+  if (config.fit.windows_s.empty()) return std::nullopt;
+  const std::string target = CanonicalLogPath(path);
   for (const auto& [key, window] : config.fit.windows_s) {
-    if ((!config.runs.root.empty() && ResolvePath(config.runs.root, key) == target) ||
-        ResolvePath(config.folder, key) == target) {
+    if ((!config.runs.root.empty() &&
+         CanonicalLogPath(ResolvePath(config.runs.root, key)) == target) ||
+        CanonicalLogPath(ResolvePath(config.folder, key)) == target) {
       return window;
     }
   }

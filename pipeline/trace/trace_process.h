@@ -58,10 +58,16 @@ TraceRecord ProcessTraceData(const CampaignConfig& config, const ImuData& data,
                              const std::string& path, const TraceProcessOptions& options,
                              TraceFitResult* fit = nullptr);
 
-// The window override of the config for `path` (absolute), if any: keys of fit.windows are
-// matched relative to runs.root and to the config folder.
+// The window override of the config for `path` (as given: relative to the working folder or
+// absolute), if any: keys of fit.windows are resolved relative to runs.root and to the config
+// folder, and matched as canonical paths (CanonicalLogPath), so `bifilar fit` given
+// `./pitch_0/trial_1.csv` or an absolute path finds the entry `bifilar process` finds.
 std::optional<std::array<double, 2>> ConfigWindowFor(const CampaignConfig& config,
                                                      const std::string& path);
+
+// `path` absolute, with symbolic links, "." and ".." resolved as far as it exists
+// (std::filesystem::weakly_canonical); the lexically normal absolute path when that fails.
+std::string CanonicalLogPath(const std::string& path);
 
 // The swing-axis settings of the config's `imu` section (auto or fixed axis, mounting).
 SwingAxisOptions SwingAxisOptionsFor(const ImuConfig& imu);

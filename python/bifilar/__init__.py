@@ -20,7 +20,9 @@ process(config_path, out=None, jobs=None)
 simulate(...)
     Realistic logs with known truth (``bifilar simulate``), in memory or on disk.
 
-Units are SI throughout (s, rad/s, m, kg, kg m^2), pitch and amplitudes in degrees. Bad input
+Units are SI throughout (s, rad/s, m, kg, kg m^2), pitch and amplitudes in degrees. Paths are
+str, bytes or os.PathLike (anything else: TypeError); numbers are numbers, not bools, and whole
+numbers lie in their range (``_core.int_ranges``). Bad input
 raises ValueError with the command line's message; a file given that does not exist raises
 FileNotFoundError (a subclass of ValueError too, so older ``except ValueError`` code still
 catches it). Results are :class:`Record` objects: dicts
@@ -216,10 +218,10 @@ def _calling(inputs, call, *args, **kwargs):
     except ValueError as error:
         for path in inputs:
             if path is not None and not _os.path.exists(path):
-                message = str(error)
-                if path not in message:
-                    message = "%s: no such file" % path
-                raise _FileNotFoundError(message, path) from None
+                message, shown = str(error), _os.fsdecode(path)
+                if shown not in message:
+                    message = "%s: no such file" % shown
+                raise _FileNotFoundError(message, shown) from None
         raise
 
 
@@ -244,13 +246,23 @@ def _series(values, name):
 
 
 def _path(function, name, value):
-    """None, or the path as a str; ValueError when it holds a NUL (the C library would read
-    only the part before it: another file, silently)."""
+    """None, or the path for the core: a str, bytes or os.PathLike given (bytes decoded as the
+    file system does, os.fsdecode); TypeError for anything else; ValueError when it holds a NUL
+    (the C library would read only the part before it: another file, silently). A name that is
+    not valid UTF-8 goes on as bytes (the core takes them as they are)."""
     if value is None:
         return None
-    text = str(value)
+    try:
+        text = _os.fsdecode(value)
+    except TypeError:
+        raise TypeError(f"{function}: {name} must be a path (str, bytes or os.PathLike), got "
+                        f"{type(value).__name__} {value!r}") from None
     if "\0" in text:
         raise ValueError(f"{function}: {name} contains a NUL character: {text!r}")
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:  # undecodable bytes, held as surrogates by os.fsdecode
+        return _os.fsencode(text)
     return text
 
 
@@ -278,9 +290,13 @@ def _seed(function, value):
 
 def _number(function, name, value, kind=float):
     """None, or the value as a float (or int); ValueError naming the argument otherwise (NaN
-    and infinities too: a number the computation cannot use is never passed on)."""
+    and infinities too: a number the computation cannot use is never passed on; a bool, which
+    Python would take as 0 or 1, too). A whole number outside its range (_core.int_ranges, or
+    the range of a C int) is refused with that range."""
     if value is None:
         return None
+    if isinstance(value, bool) or (_np is not None and isinstance(value, _np.bool_)):
+        raise ValueError(f"{function}: {name} must be a number, got the bool {value!r}")
     try:
         number = float(value)
     except (TypeError, ValueError, OverflowError):
@@ -288,8 +304,10 @@ def _number(function, name, value, kind=float):
     if not _math.isfinite(number):
         raise ValueError(f"{function}: {name} must be a finite number, got {value!r}")
     if kind is int:
-        if not number.is_integer():
-            raise ValueError(f"{function}: {name} must be a whole number, got {value!r}")
+        low, high = _core.int_ranges.get(name, (-2**31, 2**31 - 1))
+        if not number.is_integer() or not low <= number <= high:
+            raise ValueError(f"{function}: {name} must be a whole number in [{low}, {high}], "
+                             f"got {value!r}")
         return int(number)
     return number
 
@@ -390,7 +408,7 @@ def read_log(path, config=None):
 
     Parameters
     ----------
-    path : str
+    path : str, bytes or os.PathLike
         The log (CSV or ULog, optionally .gz), as given to ``bifilar fit``.
     config : str, optional
         The YAML config naming the columns and units (``imu`` section, configs/README.md).
@@ -481,10 +499,17 @@ def down_in_body(roll_deg, pitch_deg):
     """The down vertical in body axes of an aircraft hung at roll and pitch (deg), a numpy array.
 
     n = (-sin pitch, sin roll cos pitch, cos roll cos pitch) (docs/physics.md 3.5); scalars give
-    shape (3,), arrays of N attitudes shape (N, 3).
+    shape (3,), arrays of N attitudes shape (N, 3). A NaN or infinite angle raises ValueError.
     """
-    roll = _np.radians(_series(roll_deg, "roll_deg"))
-    pitch = _np.radians(_series(pitch_deg, "pitch_deg"))
+    angles = {"roll_deg": _series(roll_deg, "roll_deg"), "pitch_deg": _series(pitch_deg, "pitch_deg")}
+    for name, value in angles.items():
+        bad = _np.flatnonzero(~_np.isfinite(value))
+        if bad.size:  # NaN in, NaN out would pass for an axis
+            where = "" if value.ndim == 0 else "[%d]" % bad[0]
+            raise ValueError("down_in_body: %s%s is %r; every angle must be a finite number (deg)"
+                             % (name, where, float(value.flat[bad[0]])))
+    roll = _np.radians(angles["roll_deg"])
+    pitch = _np.radians(angles["pitch_deg"])
     return _np.stack([-_np.sin(pitch), _np.sin(roll) * _np.cos(pitch),
                       _np.cos(roll) * _np.cos(pitch)], axis=-1)
 

@@ -161,3 +161,104 @@ def test_nan_setting_is_refused():
     with pytest.raises(ValueError, match="fit_trace: max_amplitude_deg must be a finite number"):
         bifilar.fit_trace(np.arange(10.0), np.zeros(10), max_amplitude_deg=float("nan"),
                           **GEOMETRY)
+
+
+# ---- issue 23: hostile input (items 4 and 7) ----
+
+def test_whole_numbers_outside_their_range_name_the_argument_and_range():
+    # 10**12 reached pybind11 and raised "Unable to cast Python instance of type <class 'int'>".
+    t = np.arange(100) * 0.01
+    with pytest.raises(ValueError,
+                       match=r"fit_trace: whiteness_lags must be a whole number in \[1, 1000\], "
+                             r"got 1000000000000"):
+        bifilar.fit_trace(t, np.zeros(100), whiteness_lags=10**12, **GEOMETRY)
+    with pytest.raises(ValueError, match=r"whiteness_lags must be a whole number in \[1, 1000\]"):
+        bifilar.fit_trace(t, np.zeros(100), whiteness_lags=0, **GEOMETRY)
+    with pytest.raises(ValueError, match=r"fit_ellipse: bootstrap must be a whole number in "
+                                         r"\[0, 100000\], got 1000000000000"):
+        bifilar.fit_ellipse([0, 30, 60], [1.0, 1.1, 1.2], bootstrap=10**12)
+    with pytest.raises(ValueError, match=r"process: jobs must be a whole number in \[0, 256\]"):
+        bifilar.process("c.yaml", jobs=2**40)
+
+
+@pytest.mark.parametrize("flag", [True, False, np.bool_(True)])
+def test_a_bool_is_not_a_number(flag):
+    # length_m=True was taken as 1 m.
+    t = np.arange(100) * 0.01
+    with pytest.raises(ValueError, match="fit_trace: length_m must be a number, got the bool"):
+        bifilar.fit_trace(t, np.zeros(100), length_m=flag, separation_m=0.9, mass_kg=6.0)
+    with pytest.raises(ValueError, match="simulate: mass_kg must be a number, got the bool"):
+        bifilar.simulate(inertia_kg_m2=1.0, mass_kg=flag, length_m=2.0, separation_m=0.9)
+
+
+def test_bytes_and_pathlike_paths_are_paths(tmp_path):
+    # A bytes path was str()-ed to "b'...'" and reported as "no such file".
+    import pathlib
+    as_str = bifilar.read_log(sample_log(0), str(SAMPLE_CONFIG))
+    as_bytes = bifilar.read_log(sample_log(0).encode(), bytes(SAMPLE_CONFIG))
+    as_pathlike = bifilar.read_log(pathlib.Path(sample_log(0)), SAMPLE_CONFIG)
+    for other in (as_bytes, as_pathlike):
+        np.testing.assert_array_equal(other.t_s, as_str.t_s)
+        np.testing.assert_array_equal(other.rate_rad_per_s, as_str.rate_rad_per_s)
+    missing = str(tmp_path / "missing.csv")
+    with pytest.raises(FileNotFoundError) as error:
+        bifilar.read_log(missing.encode(), SAMPLE_CONFIG)
+    assert missing in str(error.value) and "b'" not in str(error.value)
+    with pytest.raises(TypeError, match=r"read_log: path must be a path \(str, bytes or "
+                                        r"os.PathLike\), got int"):
+        bifilar.read_log(42)
+
+
+def test_a_bytes_path_that_is_not_utf8_reaches_the_file(tmp_path):
+    name = tmp_path / "trial_\xe9.csv"  # a Latin-1 byte in the name: not valid UTF-8
+    raw = bytes(tmp_path) + b"/trial_\xe9.csv"
+    with open(sample_log(0), "rb") as source:
+        import gzip
+        data = gzip.decompress(source.read())
+    with open(raw, "wb") as target:
+        target.write(data)
+    got = bifilar.read_log(raw, SAMPLE_CONFIG)
+    assert len(got.t_s) == len(bifilar.read_log(sample_log(0), SAMPLE_CONFIG).t_s)
+    del name
+
+
+@pytest.mark.parametrize("roll, pitch, named", [
+    (float("nan"), 0.0, r"roll_deg is nan"),
+    (0.0, float("inf"), r"pitch_deg is inf"),
+    ([0.0, 10.0, float("nan")], [0.0, 0.0, 0.0], r"roll_deg\[2\] is nan"),
+])
+def test_down_in_body_refuses_angles_that_are_not_finite(roll, pitch, named):
+    # down_in_body(nan) returned NaN, an "axis" that fit_tensor then refused far from its cause.
+    with pytest.raises(ValueError, match="down_in_body: " + named):
+        bifilar.down_in_body(roll, pitch)
+
+
+def test_fit_tensor_with_a_huge_axis_does_not_crash_the_interpreter():
+    # [[1e308, 0, 1]] * 6 overflowed the axis's norm and killed the interpreter (SIGSEGV in
+    # JacobiSVD). In a child, so that a crash is a failed assertion here, not a lost run.
+    import subprocess
+    import sys
+    code = ("import bifilar, json\n"
+            "r = bifilar.fit_tensor([[1e308, 0, 1]] * 6, [0.45] * 6, bootstrap=0)\n"
+            "print(json.dumps([r['Ixx_kg_m2'], r['unobservable']]))\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    ixx, unobservable = json.loads(done.stdout)
+    assert ixx == pytest.approx(0.45, rel=1e-12)  # the axis is x: six moments of 0.45 about it
+    assert unobservable == ["Iyy", "Izz", "Ixy", "Ixz", "Iyz"]
+    # Beside valid axes the huge one is the x axis, not a silent zero.
+    axes = bifilar.down_in_body([0, 0, 90, 45, 0, 45, 30], [0, 90, 0, 0, 45, 45, -30])
+    truth = np.array([[2.0, -0.1, -0.2], [-0.1, 3.0, -0.05], [-0.2, -0.05, 4.0]])
+    moments = [float(a @ truth @ a) for a in axes]
+    fitted = bifilar.fit_tensor(axes, moments, bootstrap=0)
+    huge = axes.copy()
+    huge[1] = [1e308, 0, 1e-300]  # the pitch-90 axis, (-1, 0, 0), scaled
+    fitted_huge = bifilar.fit_tensor(huge, moments, bootstrap=0)
+    for key in ("Ixx_kg_m2", "Iyy_kg_m2", "Izz_kg_m2", "Ixy_kg_m2", "Ixz_kg_m2", "Iyz_kg_m2"):
+        assert fitted_huge[key] == pytest.approx(fitted[key], rel=1e-9, abs=1e-12), key
+    for bad in ([np.inf, 0, 1], [0, 0, 0]):
+        axes_bad = axes.copy()
+        axes_bad[3] = bad
+        with pytest.raises(ValueError, match=r"directions\[3\] is not finite|point 4: the swing "
+                                             r"axis must be a finite, non-zero vector"):
+            bifilar.fit_tensor(axes_bad, moments, bootstrap=0)
