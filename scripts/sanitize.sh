@@ -19,7 +19,9 @@
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 build="${1:-$here/build-sanitize}"
-cmake_args="-DBIFILAR_SANITIZE=ON -DBIFILAR_PYTHON=OFF -DBIFILAR_WERROR=ON -DBIFILAR_STRESS_CASES=100"
+# No -Werror here: at -O1 with the sanitizers GCC 12 warns falsely inside std::regex and
+# std::function (-Wmaybe-uninitialized); the warning check is the normal build's (test.sh).
+cmake_args="-DBIFILAR_SANITIZE=ON -DBIFILAR_PYTHON=OFF -DBIFILAR_WERROR=OFF -DBIFILAR_STRESS_CASES=100"
 data="${BIFILAR_DATA_DIR:-}"
 if [ -z "$data" ] && [ -d "$here/../shared/data" ]; then data="$(cd "$here/../shared/data" && pwd)"; fi
 if [ -n "$data" ]; then cmake_args="$cmake_args -DBIFILAR_DATA_DIR=$data"; fi
