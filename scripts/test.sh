@@ -41,7 +41,7 @@ total=$(printf '%s\n' "$labelled" | grep -c . || true)
 folder=$(sed -n 's/^BIFILAR_DATA_DIR:PATH=//p' CMakeCache.txt)
 if [ "$skipped" -gt 0 ]; then
   echo "test: $skipped of $total real-data tests (label realdata) did not run: no data folder named"\
-       "(put the data at ../shared/data beside the checkout, or set BIFILAR_DATA_DIR)"
+       "(set BIFILAR_DATA_DIR to a folder of the real logs: crazyflie/, px4/)"
 else
   echo "test: all $total real-data tests (label realdata) ran, on ${folder:-?}"
 fi
