@@ -221,8 +221,35 @@ def self_test():
     long = [n for n, f, l in functions(SELF_TEST_SOURCE % body) if l - f + 1 > LIMIT]
     if long != ["Long"]:
         missing.append("over the limit: %s, want ['Long']" % long)
+    missing += allow_list_self_test(body)
     print("self-test: " + ("missed " + "; ".join(missing) if missing else "ok"))
     return 1 if missing else 0
+
+
+def allow_list_self_test(body):
+    """A tree with one long function: fails without an entry, passes with it, fails on a stale
+    entry or one without a reason."""
+    import contextlib, io, tempfile
+    missing = []
+    with tempfile.TemporaryDirectory() as src:
+        os.makedirs(os.path.join(src, "fit"))
+        os.makedirs(os.path.join(src, "scripts"))
+        with open(os.path.join(src, "fit", "long.cc"), "w") as f:
+            f.write(SELF_TEST_SOURCE % body)
+
+        def run(allow_text):
+            with open(os.path.join(src, ALLOW_FILE), "w") as f:
+                f.write(allow_text)
+            with contextlib.redirect_stdout(io.StringIO()):
+                return main(src)
+        cases = [("no entry", "", 1),
+                 ("an entry with a reason", "fit/long.cc:Long  # split later\n", 0),
+                 ("an entry without a reason", "fit/long.cc:Long\n", 1),
+                 ("a stale entry", "fit/long.cc:Long  # x\nfit/long.cc:Short  # y\n", 1)]
+        for what, text, want in cases:
+            if run(text) != want:
+                missing.append("allow list with %s: exit %d, want %d" % (what, 1 - want, want))
+    return missing
 
 
 if __name__ == "__main__":
