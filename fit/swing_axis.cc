@@ -179,9 +179,12 @@ int DownFromTurningPoints(const ImuData& data, IndexPair range, const Eigen::Vec
   const size_t n = data.size();
   Eigen::Vector3d f_all = Eigen::Vector3d::Zero();
   for (size_t i = range.first; i < range.second; ++i) f_all += data.accel_in_imu[i];
-  const Eigen::Vector3d n0 = f_all.norm() > 0.0 ? Eigen::Vector3d(-f_all.normalized()) : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d n0 =
+      f_all.norm() > 0.0 ? Eigen::Vector3d(-f_all.normalized()) : Eigen::Vector3d::UnitZ();
   double peak = 0.0;
-  for (size_t i = range.first; i < range.second; ++i) peak = std::max(peak, std::abs((data.gyro_in_imu[i] - bias).dot(n0)));
+  for (size_t i = range.first; i < range.second; ++i) {
+    peak = std::max(peak, std::abs((data.gyro_in_imu[i] - bias).dot(n0)));
+  }
   // Turning points at +A and at -A are averaged separately (the sign of the rate's slope
   // tells them apart) and the two means weighted equally, so that one extra turning point of
   // one sign does not leave a net tangential acceleration.
@@ -342,7 +345,8 @@ bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
                        std::string* why) {
   if (!options.Check(why)) return false;
   const size_t n = data.size();
-  if (n < 2 || data.gyro_in_imu.size() != n || (data.has_accel() && data.accel_in_imu.size() != n)) {
+  if (n < 2 || data.gyro_in_imu.size() != n ||
+      (data.has_accel() && data.accel_in_imu.size() != n)) {
     *why = "swing axis: the log needs at least 2 samples with matching gyro/accelerometer sizes";
     return false;
   }

@@ -455,7 +455,9 @@ double MarkPacketGaps(const std::vector<double>& t, std::vector<HalfCycle>* cycl
   for (auto& c : *cycles) {
     const size_t b = std::lower_bound(t.begin(), t.end(), c.start_s) - t.begin();
     const size_t e = std::upper_bound(t.begin(), t.end(), c.end_s) - t.begin();
-    for (size_t k = (b > 0 ? b - 1 : 0); k + 1 < t.size() && k < e; ++k) c.max_gap_s = std::max(c.max_gap_s, steps[k]);
+    for (size_t k = (b > 0 ? b - 1 : 0); k + 1 < t.size() && k < e; ++k) {
+      c.max_gap_s = std::max(c.max_gap_s, steps[k]);
+    }
   }
   return dt_typical;
 }
@@ -628,8 +630,8 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
   for (const auto& c : a.cycles) max_peak = std::max(max_peak, c.peak);
   const double half = HalfPeriod(a.cycles, std::max(floor, 0.1 * max_peak), o);
   if (half <= 0.0) {
-    w.message = Prefix(name) + Fmt("no oscillation found (no swing with a period in [%g, %g] s above "
-                                   "the noise floor of %.3g rad/s)",
+    w.message = Prefix(name) + Fmt("no oscillation found (no swing with a period in [%g, %g] s "
+                                   "above the noise floor of %.3g rad/s)",
                                    o.min_period_s, o.max_period_s, floor);
     return w;
   }

@@ -345,7 +345,9 @@ RandomInputs DrawRandomInputs(const TraceSetup& setup, const SimulationOptions& 
     in.tremor_omega[i] = 2.0 * kPi * rng.Uniform(tl.tremor_hz);
     in.tremor_phase[i] = 2.0 * kPi * rng.Uniform();
   }
-  for (int i = 0; i < 3; ++i) in.gyro_bias[i] = rng.Normal(so.gyro_bias_sigma_deg_per_s * kRadPerDeg);
+  for (int i = 0; i < 3; ++i) {
+    in.gyro_bias[i] = rng.Normal(so.gyro_bias_sigma_deg_per_s * kRadPerDeg);
+  }
   for (int i = 0; i < 3; ++i) in.gyro_scale[i] = rng.Normal(so.gyro_scale_error_sigma);
   for (int i = 0; i < 3; ++i) in.accel_bias[i] = rng.Normal(so.accel_bias_sigma_mps2);
   in.rocking_amp = so.rocking_max_deg * kRadPerDeg * rng.Uniform();
@@ -484,7 +486,9 @@ bool HandBeforeRelease(const TraceSetup& setup, const RandomInputs& in, const Ti
       samples->free_times.push_back(t);
     }
   }
-  if (samples->free_index.size() < 2) return Fail(why, "the free oscillation has fewer than 2 samples");
+  if (samples->free_index.size() < 2) {
+    return Fail(why, "the free oscillation has fewer than 2 samples");
+  }
   samples->free_times.push_back(tm.t_stop);  // the state at the stop starts the hand's deceleration
   return true;
 }
@@ -556,7 +560,9 @@ double FreeSwingAndStop(const TraceSetup& setup, const TruthDynamics& dyn, const
     psi[k] = free_angle[i + 1];
     dpsi[k] = free_rate[i + 1];
     ddpsi[k] = dyn.Accel(psi[k], dpsi[k]);
-    if (times[k] >= tm.t_stop - small_period) envelope_at_stop = std::max(envelope_at_stop, std::abs(psi[k]));
+    if (times[k] >= tm.t_stop - small_period) {
+      envelope_at_stop = std::max(envelope_at_stop, std::abs(psi[k]));
+    }
   }
   const double psi_stop = free_angle.back(), rate_stop = free_rate.back();
   const double stop_tau = tm.stop_tau;
@@ -601,7 +607,8 @@ Eigen::Vector3d DownEstimateInImu(uint64_t seed, const SensorOptions& so, const 
   const double beta = 2.0 * kPi * accel_rng.Uniform();
   const Eigen::Vector3d tilt_axis =
       (std::cos(beta) * f.lateral + std::sin(beta) * f.horizontal).normalized();
-  return f.imu_from_body * (Eigen::AngleAxisd(truth->gravity_removal_error_rad, tilt_axis) * f.n_body);
+  return f.imu_from_body *
+         (Eigen::AngleAxisd(truth->gravity_removal_error_rad, tilt_axis) * f.n_body);
 }
 
 // Rocking of the body about rock_axis after the release: phi and its derivatives at t.
@@ -721,7 +728,9 @@ bool AddSpikes(const SensorOptions& so, uint64_t seed, const SwingFrame& f,
     truth.spikes.push_back({static_cast<int>(k), times[k], axis, value});
   }
   std::sort(truth.spikes.begin(), truth.spikes.end(),
-            [](const TraceTruth::Spike& a, const TraceTruth::Spike& b) { return a.sample < b.sample; });
+            [](const TraceTruth::Spike& a, const TraceTruth::Spike& b) {
+              return a.sample < b.sample;
+            });
   return true;
 }
 

@@ -26,7 +26,7 @@ CTOR_INIT = re.compile(r"([A-Za-z_~][\w:~]*)\s*\([^;{}]*\)\s*(?:noexcept\s*)?:[^
 
 
 def strip_code(text):
-    """Comments, string and char literals blanked (newlines kept), so braces in them do not count."""
+    """Comments, string and char literals blanked (newlines kept): braces in them do not count."""
     out, i, n = [], 0, len(text)
     while i < n:
         c = text[i]
@@ -38,7 +38,8 @@ def strip_code(text):
             j = text.find("*/", i + 2)
             j = n if j < 0 else j + 2
             out.append(re.sub(r"[^\n]", " ", text[i:j])); i = j
-        elif text.startswith('R"', i) and (i == 0 or not (text[i - 1].isalnum() or text[i - 1] == "_")):
+        elif text.startswith('R"', i) and (i == 0 or not (text[i - 1].isalnum()
+                                                          or text[i - 1] == "_")):
             k = text.find("(", i)
             delim = ")" + text[i + 2:k] + '"'
             j = text.find(delim, k)
@@ -138,7 +139,8 @@ def read_allow(path):
         if not entry:
             continue
         if ":" not in entry or not reason.strip():
-            problems.append("%s:%d: want `path:function  # reason`, got %r" % (ALLOW_FILE, k, line.strip()))
+            problems.append("%s:%d: want `path:function  # reason`, got %r"
+                            % (ALLOW_FILE, k, line.strip()))
             continue
         allow.add(entry)
     return allow, problems
