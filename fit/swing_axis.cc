@@ -141,164 +141,182 @@ double RollFromDownDeg(const Eigen::Vector3d& down_in_body) {
   return std::atan2(down_in_body.y(), down_in_body.z()) * kDegPerRad;
 }
 
-bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
-                       std::optional<std::pair<double, double>> window_s, SwingAxis* axis,
-                       std::string* why) {
-  if (!options.Check(why)) return false;
-  const size_t n = data.size();
-  if (n < 2 || data.gyro_in_imu.size() != n || (data.has_accel() && data.accel_in_imu.size() != n)) {
-    *why = "swing axis: the log needs at least 2 samples with matching gyro/accelerometer sizes";
-    return false;
-  }
-  if (window_s && !(window_s->second > window_s->first)) {
-    *why = "swing axis: window end must be after its start";
-    return false;
-  }
-  *axis = SwingAxis();
-  const auto range = window_s ? IndexRange(data.t_s, window_s->first, window_s->second)
-                              : std::make_pair<size_t, size_t>(0, static_cast<size_t>(n));
+namespace {
 
-  // Down vertical from the accelerometer: at rest if the log shows enough rest, else averaged over
-  // the window (or the whole log).
-  std::optional<Eigen::Vector3d> down_in_imu;
-  bool down_at_rest = false;
-  if (data.has_accel()) {
-    Eigen::Vector3d bias = QuietestBlockMean(data);
-    std::vector<char> rest;
-    for (int pass = 0; pass < 2; ++pass) {  // second pass: bias from the first pass's rest samples
-      rest = RestMask(data, bias, options.rest_rate_threshold_rad_per_s, options.rest_half_width_s);
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      int count = 0;
-      for (size_t i = 0; i < n; ++i) {
-        if (rest[i]) {
-          sum += data.gyro_in_imu[i];
-          ++count;
-        }
-      }
-      if (count == 0) break;
-      bias = sum / count;
-    }
-    Eigen::Vector3d f_sum = Eigen::Vector3d::Zero();
+using IndexPair = std::pair<size_t, size_t>;
+
+// Rest samples of the log and the gyro bias: a first pass with the quietest block's mean as the
+// bias, a second with the mean of the first pass's rest samples.
+std::vector<char> RestSamples(const ImuData& data, const SwingAxisOptions& options,
+                              Eigen::Vector3d* bias_out) {
+  const size_t n = data.size();
+  Eigen::Vector3d bias = QuietestBlockMean(data);
+  std::vector<char> rest;
+  for (int pass = 0; pass < 2; ++pass) {  // second pass: bias from the first pass's rest samples
+    rest = RestMask(data, bias, options.rest_rate_threshold_rad_per_s, options.rest_half_width_s);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     int count = 0;
     for (size_t i = 0; i < n; ++i) {
       if (rest[i]) {
-        f_sum += data.accel_in_imu[i];
+        sum += data.gyro_in_imu[i];
         ++count;
       }
     }
-    if (count >= options.min_rest_samples) {
-      down_at_rest = true;
-      axis->rest_samples = count;
-    } else {
-      // No rest: average over the turning points of the swing in the window (or the whole log),
-      // where the rate is small. There the centripetal acceleration psi'^2 r, which always points
-      // the same way and would tilt a plain average by ~<psi'^2> r / g (about 1 deg for a 30 deg
-      // swing with the IMU 0.3 m off axis), nearly vanishes, and the tangential psi'' r
-      // alternates in sign from one turning point to the next and averages out.
-      axis->notes.push_back("accelerometer: only " + std::to_string(count) +
-                            " samples at rest; down vector averaged over the swing's turning "
-                            "points in " + (window_s ? "the window" : "the whole log"));
-      Eigen::Vector3d f_all = Eigen::Vector3d::Zero();
-      for (size_t i = range.first; i < range.second; ++i) f_all += data.accel_in_imu[i];
-      const Eigen::Vector3d n0 = f_all.norm() > 0.0 ? Eigen::Vector3d(-f_all.normalized()) : Eigen::Vector3d::UnitZ();
-      double peak = 0.0;
-      for (size_t i = range.first; i < range.second; ++i) peak = std::max(peak, std::abs((data.gyro_in_imu[i] - bias).dot(n0)));
-      // Turning points at +A and at -A are averaged separately (the sign of the rate's slope
-      // tells them apart) and the two means weighted equally, so that one extra turning point of
-      // one sign does not leave a net tangential acceleration.
-      Eigen::Vector3d f_group[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-      int n_group[2] = {0, 0};
-      for (size_t i = std::max<size_t>(range.first, 1); i < range.second && i + 1 < n; ++i) {
-        if (std::abs((data.gyro_in_imu[i] - bias).dot(n0)) <= 0.15 * peak) {
-          const int g = (data.gyro_in_imu[i + 1] - data.gyro_in_imu[i - 1]).dot(n0) > 0.0 ? 1 : 0;
-          f_group[g] += data.accel_in_imu[i];
-          ++n_group[g];
-        }
-      }
-      count = n_group[0] + n_group[1];
-      if (n_group[0] >= 5 && n_group[1] >= 5) {
-        f_sum = 0.5 * count * (f_group[0] / n_group[0] + f_group[1] / n_group[1]);
-      } else {
-        count = 0;
-      }
-      if (count < 10) {
-        f_sum = f_all;
-        count = static_cast<int>(range.second - range.first);
-      }
-    }
-    if (count > 0) {
-      const Eigen::Vector3d f_mean = f_sum / count;
-      axis->rest_accel_mps2 = f_mean.norm();
-      // An accelerometer that does not read gravity is ignored with a warning: a yaw, pitch or
-      // roll swing needs only the gyro (the axis from its principal direction), and only a caller
-      // that needs the down vector (options.accel_required, or a campaign's measured pitch)
-      // turns it into an error. The warning says what the reading looks like:
-      //  - gravity removed by the logger (f + g n_est): the residual g (n_est - n) of its tilt
-      //    estimate is small and nearly perpendicular to the down vertical n, which is the swing
-      //    axis: below gravity_removed_below_g and more than 60 deg from the gyro's principal
-      //    direction;
-      //  - a unit mix-up: 1 g logged in g and read as m/s^2 (0.102 g), or in m/s^2 read as g
-      //    (9.81 g), within gravity_tolerance;
-      //  - anything else (a scale, a column or a broken sensor: the fixed-wing logs' 0.27 g).
-      const double g_read = f_mean.norm() / kStandardGravityMps2;  // in standard gravities
-      const double tol = options.gravity_tolerance;
-      const bool gravity_ok = f_mean.allFinite() && std::abs(g_read - 1.0) <= tol;
-      if (!gravity_ok) {
-        bool gravity_removed = false;
-        if (f_mean.allFinite() && g_read < options.gravity_removed_below_g && g_read > 0.0) {
-          const std::optional<Eigen::Vector3d> principal =
-              GyroPrincipalDirection(data, range.first, range.second);
-          gravity_removed = principal && std::abs(principal->dot(f_mean.normalized())) < 0.5;
-        }
-        const char* where = down_at_rest ? "at rest" : "over the swing";
-        char buf[640];
-        if (!f_mean.allFinite()) {
-          std::snprintf(buf, sizeof(buf), "the mean accelerometer reading %s is not finite", where);
-        } else if (gravity_removed) {
-          std::snprintf(buf, sizeof(buf),
-                        "the accelerometer reads %.3g g (%.3g m/s^2) %s instead of 1 g: gravity "
-                        "removed by the logger?",
-                        g_read, f_mean.norm(), where);
-        } else if (std::abs(g_read * kStandardGravityMps2 - 1.0) <= tol) {
-          std::snprintf(buf, sizeof(buf),
-                        "the accelerometer reads %.3g m/s^2 %s, 1/9.81 of gravity: a log in g "
-                        "declared m/s^2? (set imu.accel.unit: g)",
-                        f_mean.norm(), where);
-        } else if (std::abs(g_read / kStandardGravityMps2 - 1.0) <= tol) {
-          std::snprintf(buf, sizeof(buf),
-                        "the accelerometer reads %.3g g %s, 9.81 times gravity: a log in m/s^2 "
-                        "declared g? (set imu.accel.unit: m/s^2)",
-                        g_read, where);
-        } else {
-          std::snprintf(buf, sizeof(buf),
-                        "the accelerometer reads %.3g g (%.3g m/s^2) %s: neither gravity (1 g "
-                        "+- %.0f %%) nor removed gravity; check imu.accel.columns and "
-                        "imu.accel.unit",
-                        g_read, f_mean.norm(), where, 100.0 * tol);
-        }
-        const std::string text = buf;
-        const std::string message =
-            text + (text.back() == '?' ? " " : ". ") + kAccelIgnoredSentence;
-        if (options.accel_required) {
-          *why = "swing axis: " + message;
-          return false;
-        }
-        axis->warnings.push_back(message);
-        axis->accel_ignored = true;
-        axis->rest_samples = 0;
-        count = 0;
-      }
-      if (!axis->accel_ignored) down_in_imu = Eigen::Vector3d(-f_mean / f_mean.norm());
-    }
+    if (count == 0) break;
+    bias = sum / count;
   }
-  // The pitch is reported from rest, or from the window's turning points; a whole-log average
-  // (no rest, no window) includes the hand and is only used for the axis.
-  if (down_in_imu && (down_at_rest || window_s)) {
-    const Eigen::Vector3d down_in_body = options.imu_to_body * *down_in_imu;
-    axis->pitch_measured_deg = PitchFromDownDeg(down_in_body);
-    axis->roll_measured_deg = RollFromDownDeg(down_in_body);
-  }
+  *bias_out = bias;
+  return rest;
+}
 
+// No rest: average over the turning points of the swing in the window (or the whole log), where
+// the rate is small. There the centripetal acceleration psi'^2 r, which always points the same
+// way and would tilt a plain average by ~<psi'^2> r / g (about 1 deg for a 30 deg swing with the
+// IMU 0.3 m off axis), nearly vanishes, and the tangential psi'' r alternates in sign from one
+// turning point to the next and averages out. Returns the sample count behind *f_sum.
+int DownFromTurningPoints(const ImuData& data, IndexPair range, const Eigen::Vector3d& bias,
+                          Eigen::Vector3d* f_sum) {
+  const size_t n = data.size();
+  Eigen::Vector3d f_all = Eigen::Vector3d::Zero();
+  for (size_t i = range.first; i < range.second; ++i) f_all += data.accel_in_imu[i];
+  const Eigen::Vector3d n0 =
+      f_all.norm() > 0.0 ? Eigen::Vector3d(-f_all.normalized()) : Eigen::Vector3d::UnitZ();
+  double peak = 0.0;
+  for (size_t i = range.first; i < range.second; ++i) {
+    peak = std::max(peak, std::abs((data.gyro_in_imu[i] - bias).dot(n0)));
+  }
+  // Turning points at +A and at -A are averaged separately (the sign of the rate's slope
+  // tells them apart) and the two means weighted equally, so that one extra turning point of
+  // one sign does not leave a net tangential acceleration.
+  Eigen::Vector3d f_group[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  int n_group[2] = {0, 0};
+  for (size_t i = std::max<size_t>(range.first, 1); i < range.second && i + 1 < n; ++i) {
+    if (std::abs((data.gyro_in_imu[i] - bias).dot(n0)) <= 0.15 * peak) {
+      const int g = (data.gyro_in_imu[i + 1] - data.gyro_in_imu[i - 1]).dot(n0) > 0.0 ? 1 : 0;
+      f_group[g] += data.accel_in_imu[i];
+      ++n_group[g];
+    }
+  }
+  int count = n_group[0] + n_group[1];
+  if (n_group[0] >= 5 && n_group[1] >= 5) {
+    *f_sum = 0.5 * count * (f_group[0] / n_group[0] + f_group[1] / n_group[1]);
+  } else {
+    count = 0;
+  }
+  if (count < 10) {
+    *f_sum = f_all;
+    count = static_cast<int>(range.second - range.first);
+  }
+  return count;
+}
+
+// What a mean accelerometer reading that is not 1 g looks like, and that it is ignored:
+//  - gravity removed by the logger (f + g n_est): the residual g (n_est - n) of its tilt
+//    estimate is small and nearly perpendicular to the down vertical n, which is the swing
+//    axis: below gravity_removed_below_g and more than 60 deg from the gyro's principal
+//    direction;
+//  - a unit mix-up: 1 g logged in g and read as m/s^2 (0.102 g), or in m/s^2 read as g
+//    (9.81 g), within gravity_tolerance;
+//  - anything else (a scale, a column or a broken sensor: the fixed-wing logs' 0.27 g).
+std::string AccelNotGravityMessage(const ImuData& data, IndexPair range,
+                                   const SwingAxisOptions& options, const Eigen::Vector3d& f_mean,
+                                   bool down_at_rest) {
+  const double g_read = f_mean.norm() / kStandardGravityMps2;  // in standard gravities
+  const double tol = options.gravity_tolerance;
+  bool gravity_removed = false;
+  if (f_mean.allFinite() && g_read < options.gravity_removed_below_g && g_read > 0.0) {
+    const std::optional<Eigen::Vector3d> principal =
+        GyroPrincipalDirection(data, range.first, range.second);
+    gravity_removed = principal && std::abs(principal->dot(f_mean.normalized())) < 0.5;
+  }
+  const char* where = down_at_rest ? "at rest" : "over the swing";
+  char buf[640];
+  if (!f_mean.allFinite()) {
+    std::snprintf(buf, sizeof(buf), "the mean accelerometer reading %s is not finite", where);
+  } else if (gravity_removed) {
+    std::snprintf(buf, sizeof(buf),
+                  "the accelerometer reads %.3g g (%.3g m/s^2) %s instead of 1 g: gravity "
+                  "removed by the logger?",
+                  g_read, f_mean.norm(), where);
+  } else if (std::abs(g_read * kStandardGravityMps2 - 1.0) <= tol) {
+    std::snprintf(buf, sizeof(buf),
+                  "the accelerometer reads %.3g m/s^2 %s, 1/9.81 of gravity: a log in g "
+                  "declared m/s^2? (set imu.accel.unit: g)",
+                  f_mean.norm(), where);
+  } else if (std::abs(g_read / kStandardGravityMps2 - 1.0) <= tol) {
+    std::snprintf(buf, sizeof(buf),
+                  "the accelerometer reads %.3g g %s, 9.81 times gravity: a log in m/s^2 "
+                  "declared g? (set imu.accel.unit: m/s^2)",
+                  g_read, where);
+  } else {
+    std::snprintf(buf, sizeof(buf),
+                  "the accelerometer reads %.3g g (%.3g m/s^2) %s: neither gravity (1 g "
+                  "+- %.0f %%) nor removed gravity; check imu.accel.columns and "
+                  "imu.accel.unit",
+                  g_read, f_mean.norm(), where, 100.0 * tol);
+  }
+  const std::string text = buf;
+  return text + (text.back() == '?' ? " " : ". ") + kAccelIgnoredSentence;
+}
+
+// An accelerometer that does not read gravity is ignored with a warning: a yaw, pitch or roll
+// swing needs only the gyro (the axis from its principal direction), and only a caller that
+// needs the down vector (options.accel_required, or a campaign's measured pitch) turns it into
+// an error. Sets *down_in_imu when the mean reading is gravity.
+bool CheckAccelReadsGravity(const ImuData& data, IndexPair range, const SwingAxisOptions& options,
+                            const Eigen::Vector3d& f_mean, bool down_at_rest, SwingAxis* axis,
+                            std::optional<Eigen::Vector3d>* down_in_imu, std::string* why) {
+  axis->rest_accel_mps2 = f_mean.norm();
+  const double g_read = f_mean.norm() / kStandardGravityMps2;  // in standard gravities
+  const bool gravity_ok = f_mean.allFinite() && std::abs(g_read - 1.0) <= options.gravity_tolerance;
+  if (!gravity_ok) {
+    const std::string message = AccelNotGravityMessage(data, range, options, f_mean, down_at_rest);
+    if (options.accel_required) {
+      *why = "swing axis: " + message;
+      return false;
+    }
+    axis->warnings.push_back(message);
+    axis->accel_ignored = true;
+    axis->rest_samples = 0;
+  }
+  if (!axis->accel_ignored) *down_in_imu = Eigen::Vector3d(-f_mean / f_mean.norm());
+  return true;
+}
+
+// Down vertical from the accelerometer: at rest if the log shows enough rest, else averaged over
+// the window (or the whole log).
+bool DownFromAccel(const ImuData& data, const SwingAxisOptions& options, bool in_window,
+                   IndexPair range, SwingAxis* axis, std::optional<Eigen::Vector3d>* down_in_imu,
+                   bool* down_at_rest, std::string* why) {
+  const size_t n = data.size();
+  Eigen::Vector3d bias;
+  const std::vector<char> rest = RestSamples(data, options, &bias);
+  Eigen::Vector3d f_sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (rest[i]) {
+      f_sum += data.accel_in_imu[i];
+      ++count;
+    }
+  }
+  if (count >= options.min_rest_samples) {
+    *down_at_rest = true;
+    axis->rest_samples = count;
+  } else {
+    axis->notes.push_back("accelerometer: only " + std::to_string(count) +
+                          " samples at rest; down vector averaged over the swing's turning "
+                          "points in " + (in_window ? "the window" : "the whole log"));
+    count = DownFromTurningPoints(data, range, bias, &f_sum);
+  }
+  if (count <= 0) return true;
+  return CheckAccelReadsGravity(data, range, options, f_sum / count, *down_at_rest, axis,
+                                down_in_imu, why);
+}
+
+// The swing axis: fixed, the down vertical, or the gyro's principal direction.
+bool ChooseAxis(const ImuData& data, const SwingAxisOptions& options, bool in_window,
+                IndexPair range, const std::optional<Eigen::Vector3d>& down_in_imu,
+                bool down_at_rest, SwingAxis* axis, std::string* why) {
   if (options.mode == SwingAxisMode::kFixed) {
     axis->axis_in_imu = options.fixed_axis_in_imu.normalized();
     axis->source = SwingAxisSource::kFixed;
@@ -311,11 +329,50 @@ bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
         GyroPrincipalDirection(data, range.first, range.second);
     if (!principal) {
       *why = "swing axis: the gyro signal is constant over " +
-             std::string(window_s ? "the window" : "the log") + ", so it shows no swing axis";
+             std::string(in_window ? "the window" : "the log") + ", so it shows no swing axis";
       return false;
     }
     axis->axis_in_imu = BodySignedAxis(*principal, options.imu_to_body);
     axis->source = SwingAxisSource::kGyroPrincipal;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
+                       std::optional<std::pair<double, double>> window_s, SwingAxis* axis,
+                       std::string* why) {
+  if (!options.Check(why)) return false;
+  const size_t n = data.size();
+  if (n < 2 || data.gyro_in_imu.size() != n ||
+      (data.has_accel() && data.accel_in_imu.size() != n)) {
+    *why = "swing axis: the log needs at least 2 samples with matching gyro/accelerometer sizes";
+    return false;
+  }
+  if (window_s && !(window_s->second > window_s->first)) {
+    *why = "swing axis: window end must be after its start";
+    return false;
+  }
+  *axis = SwingAxis();
+  const auto range = window_s ? IndexRange(data.t_s, window_s->first, window_s->second)
+                              : std::make_pair<size_t, size_t>(0, static_cast<size_t>(n));
+  std::optional<Eigen::Vector3d> down_in_imu;
+  bool down_at_rest = false;
+  if (data.has_accel() && !DownFromAccel(data, options, window_s.has_value(), range, axis,
+                                         &down_in_imu, &down_at_rest, why)) {
+    return false;
+  }
+  // The pitch is reported from rest, or from the window's turning points; a whole-log average
+  // (no rest, no window) includes the hand and is only used for the axis.
+  if (down_in_imu && (down_at_rest || window_s)) {
+    const Eigen::Vector3d down_in_body = options.imu_to_body * *down_in_imu;
+    axis->pitch_measured_deg = PitchFromDownDeg(down_in_body);
+    axis->roll_measured_deg = RollFromDownDeg(down_in_body);
+  }
+  if (!ChooseAxis(data, options, window_s.has_value(), range, down_in_imu, down_at_rest, axis,
+                  why)) {
+    return false;
   }
   axis->axis_in_body = options.imu_to_body * axis->axis_in_imu;
   axis->rate_rad_per_s.resize(n);

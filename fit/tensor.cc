@@ -535,6 +535,121 @@ bool OrientationsScatterBeyondTrials(const Prepared& data, const Design& design,
   return FDistributionUpperTail(f, m - r, n - m) < 0.05;
 }
 
+// The covariance mode (kAuto: orientation means when the orientations scatter beyond their
+// trials, points otherwise).
+EllipseCovariance CovarianceMode(const Prepared& data, const Design& design,
+                                 const Solution& closed, const TensorOptions& options) {
+  if (options.covariance != EllipseCovariance::kAuto) return options.covariance;
+  return OrientationsScatterBeyondTrials(data, design, closed) ? EllipseCovariance::kAngleMeans
+                                                               : EllipseCovariance::kPointResiduals;
+}
+
+// Counts, design, covariance mode and goodness of fit of the solution.
+void FillFitSummary(const Prepared& data, const Design& design, const Solution& solved,
+                    const Covariance& cov, TensorResult* result) {
+  TensorResult& r = *result;
+  r.n_points = data.n;
+  r.n_orientations = static_cast<int>(data.groups.size());
+  r.rank = design.rank;
+  r.weighted = data.weighted;
+  r.full = design.rank == 6;
+  r.condition_number = design.condition_number;
+  for (int k = 0; k < 6; ++k) r.design_singular_values[k] = design.singular_values(k);
+  r.covariance_used = data.covariance;
+  r.variance_factor = cov.variance_factor;
+  r.dof = cov.dof;
+  r.reduced_chi2 = data.n > design.rank ? solved.chi2 / (data.n - design.rank) : 0.0;
+  r.rmse_kg_m2 = std::sqrt(solved.resid.squaredNorm() / data.n);
+  r.unobservable = design.unobservable;
+  r.observable_combinations = design.combinations;
+}
+
+// Ceres against the closed form, relative to the largest moment; warns above 1e-6.
+void CompareWithClosedForm(const Solution& closed, const Solution& solved, TensorResult* result) {
+  TensorResult& r = *result;
+  double scale = 0.0;
+  for (int k = 0; k < 3; ++k) scale = std::max(scale, std::fabs(closed.beta(k)));
+  for (int k = 0; k < 6; ++k) {
+    r.closed_form_max_relative_difference =
+        std::max(r.closed_form_max_relative_difference,
+                 std::fabs(solved.beta(k) - closed.beta(k)) / std::max(scale, 1e-300));
+  }
+  if (r.closed_form_max_relative_difference > 1e-6) {
+    r.warnings.push_back("Ceres and the closed form disagree by " +
+                         Num(r.closed_form_max_relative_difference) + " of the largest moment");
+  }
+}
+
+// The six components with their std, intervals and covariance (NaN where not observable).
+void FillComponents(const Design& design, const Solution& solved, const Covariance& cov,
+                    const TensorIntervalSet& intervals, TensorResult* result) {
+  TensorResult& r = *result;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  for (int k = 0; k < 6; ++k) {
+    TensorEstimate& e = r.components[k];
+    e.observable = design.observable[k];
+    e.value = e.observable ? solved.beta(k) : kNaN;
+    e.std = e.observable ? std::sqrt(std::max(0.0, cov.cov(k, k))) : kNaN;
+    e.ci_lo = e.observable ? intervals.lo(k) : kNaN;
+    e.ci_hi = e.observable ? intervals.hi(k) : kNaN;
+    for (int l = 0; l < 6; ++l) {
+      r.covariance[k][l] = design.observable[k] && design.observable[l] ? cov.cov(k, l) : kNaN;
+    }
+  }
+}
+
+// Names the components the swing axes cannot see, and the combinations they can.
+void WarnUnobservable(TensorResult* result) {
+  TensorResult& r = *result;
+  if (r.unobservable.empty()) return;
+  std::string names;
+  for (const std::string& u : r.unobservable) names += (names.empty() ? "" : ", ") + u;
+  std::string text = "not observable from these swing axes: " + names;
+  if (!r.observable_combinations.empty()) {
+    text += " (the data determine only";
+    for (size_t k = 0; k < r.observable_combinations.size(); ++k) {
+      text += (k ? "; " : " ") + r.observable_combinations[k];
+    }
+    text += ")";
+  }
+  r.warnings.push_back(text + "; swing about axes that mix them to measure them");
+}
+
+// Principal moments, axes and Euler angles of a full tensor (NaN otherwise).
+void FillPrincipal(const Solution& solved, const Covariance& cov,
+                   const TensorIntervalSet& intervals, const TensorOptions& options,
+                   TensorResult* result) {
+  TensorResult& r = *result;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  if (!r.full) {
+    for (int k = 0; k < 3; ++k) {
+      r.principal_moments[k] = {kNaN, kNaN, kNaN, kNaN, false};
+      r.euler_deg[k] = {kNaN, kNaN, kNaN, kNaN, false};
+      r.principal_axes_std_deg[k] = kNaN;
+      r.principal_moments_matched_kg_m2[k] = kNaN;
+      for (int c = 0; c < 3; ++c) r.principal_axes[k][c] = kNaN;
+    }
+    return;
+  }
+  const Principal p = ComputePrincipal(solved.beta, cov.cov);
+  for (int k = 0; k < 3; ++k) {
+    r.principal_moments[k] = {p.moments(k), p.moments_std(k), intervals.principal_lo(k),
+                              intervals.principal_hi(k), true};
+    for (int c = 0; c < 3; ++c) r.principal_axes[k][c] = p.axes(c, k);
+    r.principal_axes_std_deg[k] = p.axes_std_deg(k);
+    // Euler intervals: normal, value -+ z std (first order; the angles are not bootstrapped).
+    const double z = ellipse::NormalQuantile(0.5 + 0.5 * options.confidence);
+    r.euler_deg[k] = {p.euler_deg(k), p.euler_std_deg(k), p.euler_deg(k) - z * p.euler_std_deg(k),
+                      p.euler_deg(k) + z * p.euler_std_deg(k), true};
+    r.principal_moments_matched_kg_m2[k] = p.matched_moments(k);
+  }
+  r.warnings.insert(r.warnings.end(), p.warnings.begin(), p.warnings.end());
+  if (r.condition_number > 100) {
+    r.warnings.push_back("the swing axes are nearly degenerate (design condition number " +
+                         Num(r.condition_number) + "): some components are poorly determined");
+  }
+}
+
 }  // namespace
 
 bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& options,
@@ -556,103 +671,21 @@ bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& opti
     *why = "the refit with the attitude scatter failed (singular fit)";
     return false;
   }
-  // The covariance mode (kAuto: orientation means when the orientations scatter beyond their
-  // trials, points otherwise).
-  const int m = static_cast<int>(data.groups.size());
-  data.covariance = options.covariance;
-  if (data.covariance == EllipseCovariance::kAuto) {
-    data.covariance = OrientationsScatterBeyondTrials(data, design, closed)
-                          ? EllipseCovariance::kAngleMeans
-                          : EllipseCovariance::kPointResiduals;
-  }
+  data.covariance = CovarianceMode(data, design, closed, options);
   TensorResult r;
   const Solution solved = FitTensorCeres(data, design, closed, &r.ceres);
   Covariance cov;
   if (!EstimateTensorCovariance(data, design, solved, options, &cov, why)) return false;
-
-  r.n_points = data.n;
-  r.n_orientations = m;
-  r.rank = design.rank;
-  r.weighted = data.weighted;
+  FillFitSummary(data, design, solved, cov, &r);
   r.attitude_scatter_deg = attitude_scatter_rad * 180.0 / kPi;
   r.relative_scatter = relative_scatter;
-  r.full = design.rank == 6;
-  r.condition_number = design.condition_number;
-  for (int k = 0; k < 6; ++k) r.design_singular_values[k] = design.singular_values(k);
-  r.covariance_used = data.covariance;
-  r.variance_factor = cov.variance_factor;
-  r.dof = cov.dof;
-  r.reduced_chi2 = data.n > design.rank ? solved.chi2 / (data.n - design.rank) : 0.0;
-  r.rmse_kg_m2 = std::sqrt(solved.resid.squaredNorm() / data.n);
-  r.unobservable = design.unobservable;
-  r.observable_combinations = design.combinations;
-  double scale = 0.0;
-  for (int k = 0; k < 3; ++k) scale = std::max(scale, std::fabs(closed.beta(k)));
-  for (int k = 0; k < 6; ++k) {
-    r.closed_form_max_relative_difference =
-        std::max(r.closed_form_max_relative_difference,
-                 std::fabs(solved.beta(k) - closed.beta(k)) / std::max(scale, 1e-300));
-  }
-  if (r.closed_form_max_relative_difference > 1e-6) {
-    r.warnings.push_back("Ceres and the closed form disagree by " +
-                         Num(r.closed_form_max_relative_difference) + " of the largest moment");
-  }
-
+  CompareWithClosedForm(closed, solved, &r);
   const TensorIntervalSet intervals =
       TensorIntervals(data, design, solved, cov, options, r.full);
   r.bootstrap_replicates = intervals.replicates;
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  for (int k = 0; k < 6; ++k) {
-    TensorEstimate& e = r.components[k];
-    e.observable = design.observable[k];
-    e.value = e.observable ? solved.beta(k) : kNaN;
-    e.std = e.observable ? std::sqrt(std::max(0.0, cov.cov(k, k))) : kNaN;
-    e.ci_lo = e.observable ? intervals.lo(k) : kNaN;
-    e.ci_hi = e.observable ? intervals.hi(k) : kNaN;
-    for (int l = 0; l < 6; ++l) {
-      r.covariance[k][l] = design.observable[k] && design.observable[l] ? cov.cov(k, l) : kNaN;
-    }
-  }
-  if (!r.unobservable.empty()) {
-    std::string names;
-    for (const std::string& u : r.unobservable) names += (names.empty() ? "" : ", ") + u;
-    std::string text = "not observable from these swing axes: " + names;
-    if (!r.observable_combinations.empty()) {
-      text += " (the data determine only";
-      for (size_t k = 0; k < r.observable_combinations.size(); ++k) {
-        text += (k ? "; " : " ") + r.observable_combinations[k];
-      }
-      text += ")";
-    }
-    r.warnings.push_back(text + "; swing about axes that mix them to measure them");
-  }
-  if (r.full) {
-    const Principal p = ComputePrincipal(solved.beta, cov.cov);
-    for (int k = 0; k < 3; ++k) {
-      r.principal_moments[k] = {p.moments(k), p.moments_std(k), intervals.principal_lo(k),
-                                intervals.principal_hi(k), true};
-      for (int c = 0; c < 3; ++c) r.principal_axes[k][c] = p.axes(c, k);
-      r.principal_axes_std_deg[k] = p.axes_std_deg(k);
-      // Euler intervals: normal, value -+ z std (first order; the angles are not bootstrapped).
-      const double z = ellipse::NormalQuantile(0.5 + 0.5 * options.confidence);
-      r.euler_deg[k] = {p.euler_deg(k), p.euler_std_deg(k), p.euler_deg(k) - z * p.euler_std_deg(k),
-                        p.euler_deg(k) + z * p.euler_std_deg(k), true};
-      r.principal_moments_matched_kg_m2[k] = p.matched_moments(k);
-    }
-    r.warnings.insert(r.warnings.end(), p.warnings.begin(), p.warnings.end());
-    if (r.condition_number > 100) {
-      r.warnings.push_back("the swing axes are nearly degenerate (design condition number " +
-                           Num(r.condition_number) + "): some components are poorly determined");
-    }
-  } else {
-    for (int k = 0; k < 3; ++k) {
-      r.principal_moments[k] = {kNaN, kNaN, kNaN, kNaN, false};
-      r.euler_deg[k] = {kNaN, kNaN, kNaN, kNaN, false};
-      r.principal_axes_std_deg[k] = kNaN;
-      r.principal_moments_matched_kg_m2[k] = kNaN;
-      for (int c = 0; c < 3; ++c) r.principal_axes[k][c] = kNaN;
-    }
-  }
+  FillComponents(design, solved, cov, intervals, &r);
+  WarnUnobservable(&r);
+  FillPrincipal(solved, cov, intervals, options, &r);
   DiagnoseTensor(data, design, solved, cov, options, &r);
   r.warnings.insert(r.warnings.begin(), data.warnings.begin(), data.warnings.end());
   r.warnings.insert(r.warnings.end(), cov.warnings.begin(), cov.warnings.end());

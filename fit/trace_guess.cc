@@ -148,6 +148,184 @@ double EstimateSampleNoise(const std::vector<double>& t_s, const std::vector<dou
   return 1.4826 * Median(std::move(e));
 }
 
+namespace {
+
+// Robust half peak-to-peak: 2nd and 98th percentiles.
+double RobustHalfPeakToPeak(const std::vector<double>& x) {
+  const size_t n = x.size();
+  std::vector<double> sorted = x;
+  std::sort(sorted.begin(), sorted.end());
+  const double p_lo = sorted[static_cast<size_t>(0.02 * (n - 1))];
+  const double p_hi = sorted[static_cast<size_t>(0.98 * (n - 1))];
+  return 0.5 * (p_hi - p_lo);
+}
+
+// Crossings with hysteresis, twice: the second pass uses the bias over whole cycles (*bias in,
+// the mean rate; out, the bias of the crossings).
+std::vector<Crossing> ZeroCrossings(const std::vector<double>& t, const std::vector<double>& x,
+                                    double band, double* bias) {
+  std::vector<Crossing> cross;
+  for (int pass = 0; pass < 2; ++pass) {
+    cross = WithoutGlitchPairs(t, x, *bias, band, FindCrossings(t, x, *bias, band));
+    if (cross.size() < 3) break;
+    // Whole cycles: from the first crossing to the last crossing of the same direction.
+    size_t last = cross.size() - 1;
+    if (cross[last].upward != cross[0].upward) --last;
+    if (last >= 2) *bias = MeanOver(t, x, cross[0].t_s, cross[last].t_s);
+  }
+  return cross;
+}
+
+// Period: least-squares line through crossing times vs index (slope = T/2).
+double PeriodFromCrossings(const std::vector<Crossing>& cross) {
+  const size_t m = cross.size();
+  double si = 0, st = 0, sii = 0, sit = 0;
+  for (size_t i = 0; i < m; ++i) {
+    si += i;
+    st += cross[i].t_s;
+    sii += double(i) * i;
+    sit += i * cross[i].t_s;
+  }
+  const double half_period = (m * sit - si * st) / (m * sii - si * si);
+  return 2.0 * half_period;
+}
+
+// The largest |rate - bias| between consecutive crossings, and its time.
+void HalfCyclePeaks(const std::vector<double>& t, const std::vector<double>& x,
+                    const std::vector<Crossing>& cross, double bias, std::vector<double>* peak_t,
+                    std::vector<double>* peak_a) {
+  const size_t n = x.size();
+  const size_t m = cross.size();
+  for (size_t i = 0; i + 1 < m; ++i) {
+    double best = 0.0, best_t = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+      if (t[k] < cross[i].t_s) continue;
+      if (t[k] > cross[i + 1].t_s) break;
+      if (std::abs(x[k] - bias) > best) {
+        best = std::abs(x[k] - bias);
+        best_t = t[k];
+      }
+    }
+    if (best > 0.0) {
+      peak_t->push_back(best_t);
+      peak_a->push_back(best);
+    }
+  }
+}
+
+// Log decrement of the peaks: minus the slope of ln(peak) against time, >= 0.
+double DecayRateOfPeaks(const std::vector<double>& peak_t, const std::vector<double>& peak_a) {
+  double lambda = 0.0;
+  if (peak_a.size() >= 3) {
+    double a = 0, b = 0, c = 0, d = 0;
+    const double k = peak_a.size();
+    for (size_t i = 0; i < peak_a.size(); ++i) {
+      a += peak_t[i];
+      b += std::log(peak_a[i]);
+      c += peak_t[i] * peak_t[i];
+      d += peak_t[i] * std::log(peak_a[i]);
+    }
+    const double slope = (k * d - a * b) / (k * c - a * a);
+    if (std::isfinite(slope)) lambda = std::max(0.0, -slope);
+  }
+  return lambda;
+}
+
+// Split of the decay: the angle amplitude A obeys dA/dt = -(lambda_v + kappa A) A with
+// lambda_v = C / (2 I) and kappa = (4 / (3 pi)) (K_D / I) omega. Pairs of peaks `stride`
+// half-cycles apart give the local rate ln(a_i / a_j) / (t_j - t_i) at A = sqrt(a_i a_j) / w;
+// a straight line through them gives lambda_v (intercept) and kappa (slope), both >= 0.
+void SplitDecay(const std::vector<double>& peak_t, const std::vector<double>& peak_a,
+                double omega0, double lambda, double* lambda_v_out, double* kappa_out) {
+  double lambda_v = 0.8 * lambda, kappa = 0.0;
+  const size_t np = peak_a.size();
+  const size_t stride = std::max<size_t>(1, np / 6);
+  std::vector<double> amp, rate;
+  for (size_t i = 0; i + stride < np; ++i) {
+    const double dt = peak_t[i + stride] - peak_t[i];
+    if (!(dt > 0.0)) continue;
+    amp.push_back(std::sqrt(peak_a[i] * peak_a[i + stride]) / omega0);
+    rate.push_back(std::log(peak_a[i] / peak_a[i + stride]) / dt);
+  }
+  if (amp.size() >= 3) {
+    double sa = 0, sr = 0, saa = 0, sar = 0;
+    const double m_pairs = amp.size();
+    for (size_t i = 0; i < amp.size(); ++i) {
+      sa += amp[i];
+      sr += rate[i];
+      saa += amp[i] * amp[i];
+      sar += amp[i] * rate[i];
+    }
+    const double den = m_pairs * saa - sa * sa;
+    double slope = den > 0.0 ? (m_pairs * sar - sa * sr) / den : 0.0;
+    double intercept = (sr - slope * sa) / m_pairs;
+    if (!std::isfinite(slope) || !std::isfinite(intercept)) slope = 0.0, intercept = lambda;
+    if (slope < 0.0) {
+      slope = 0.0;
+      intercept = sr / m_pairs;
+    }
+    if (intercept < 0.0) {
+      intercept = 0.0;
+      slope = saa > 0.0 ? std::max(0.0, sar / saa) : 0.0;
+    }
+    lambda_v = intercept;
+    kappa = slope;
+  }
+  *lambda_v_out = lambda_v;
+  *kappa_out = kappa;
+}
+
+// First cycle: rate ~ e^{-lambda0 tau}(a cos w tau + b sin w tau) + c, tau = t - t0. The angle
+// psi = e^{-lambda0 tau}(alpha cos + beta sin) with psi' = rate has
+// alpha = psi(t0) = -(lambda0 a + w b) / (lambda0^2 + w^2) (zero-mean about the equilibrium).
+void FirstCycleFit(const std::vector<double>& t, const std::vector<double>& x, double period,
+                   double omega_d, double lambda0, TraceInitialGuess* guess) {
+  const size_t n = x.size();
+  const double t0 = t.front();
+  std::vector<size_t> first;
+  for (size_t k = 0; k < n && t[k] <= t0 + period; ++k) first.push_back(k);
+  Eigen::MatrixXd A(first.size(), 3);
+  Eigen::VectorXd y(first.size());
+  for (size_t i = 0; i < first.size(); ++i) {
+    const double tau = t[first[i]] - t0, env = std::exp(-lambda0 * tau);
+    A(i, 0) = env * std::cos(omega_d * tau);
+    A(i, 1) = env * std::sin(omega_d * tau);
+    A(i, 2) = 1.0;
+    y(i) = x[first[i]];
+  }
+  const Eigen::Vector3d coef = A.colPivHouseholderQr().solve(y);
+  guess->rate0_rad_per_s = coef(0);
+  guess->rate_amplitude_rad_per_s = std::hypot(coef(0), coef(1));
+  guess->angle0_rad =
+      -(lambda0 * coef(0) + omega_d * coef(1)) / (lambda0 * lambda0 + omega_d * omega_d);
+}
+
+// Inertia: small-angle formula at the undamped frequency, then corrected for amplitude.
+double InertiaFromGuess(const TraceFitInput& input, PendulumModel model,
+                        const IntegratorOptions& integrator, const std::vector<double>& peak_a,
+                        double omega0) {
+  const double period0 = 2.0 * kPi / omega0;
+  double inertia = InertiaFromSmallAnglePeriod(input.geometry, period0);
+  double sum_a2 = 0.0;
+  for (double a : peak_a) sum_a2 += (a / omega0) * (a / omega0);
+  const double amp_rms = peak_a.empty() ? 0.0 : std::sqrt(sum_a2 / peak_a.size());
+  if (model != PendulumModel::kLinear && amp_rms > 1e-3) {
+    const int iterations = model == PendulumModel::kFull ? 2 : 1;
+    for (int it = 0; it < iterations; ++it) {
+      double model_period = 0.0;
+      if (!ModelPeriod(model, input.geometry, integrator, inertia, std::min(amp_rms, 1.4),
+                       period0, &model_period) ||
+          !(model_period > 0.0)) {
+        break;  // keep the small-angle value; the fit still starts close
+      }
+      inertia *= (period0 / model_period) * (period0 / model_period);
+    }
+  }
+  return inertia;
+}
+
+}  // namespace
+
 bool EstimateTraceGuess(const TraceFitInput& input, PendulumModel model,
                         const IntegratorOptions& integrator, double min_periods,
                         TraceInitialGuess* guess, std::string* why) {
@@ -166,13 +344,7 @@ bool EstimateTraceGuess(const TraceFitInput& input, PendulumModel model,
   }
   const double noise = EstimateSampleNoise(t, x);
   guess->data_noise_rad_per_s = noise;
-
-  // Robust half peak-to-peak: 2nd and 98th percentiles.
-  std::vector<double> sorted = x;
-  std::sort(sorted.begin(), sorted.end());
-  const double p_lo = sorted[static_cast<size_t>(0.02 * (n - 1))];
-  const double p_hi = sorted[static_cast<size_t>(0.98 * (n - 1))];
-  const double half_range = 0.5 * (p_hi - p_lo);
+  const double half_range = RobustHalfPeakToPeak(x);
   const double noise_ref = std::max(noise, input.noise_rad_per_s);
   if (!(half_range > 5.0 * noise_ref)) {
     std::ostringstream s;
@@ -181,19 +353,9 @@ bool EstimateTraceGuess(const TraceFitInput& input, PendulumModel model,
     *why = s.str();
     return false;
   }
-
-  // Crossings with hysteresis, twice: the second pass uses the bias over whole cycles.
   const double band = std::max(3.0 * noise_ref, 0.05 * half_range);
   double bias = std::accumulate(x.begin(), x.end(), 0.0) / n;
-  std::vector<Crossing> cross;
-  for (int pass = 0; pass < 2; ++pass) {
-    cross = WithoutGlitchPairs(t, x, bias, band, FindCrossings(t, x, bias, band));
-    if (cross.size() < 3) break;
-    // Whole cycles: from the first crossing to the last crossing of the same direction.
-    size_t last = cross.size() - 1;
-    if (cross[last].upward != cross[0].upward) --last;
-    if (last >= 2) bias = MeanOver(t, x, cross[0].t_s, cross[last].t_s);
-  }
+  const std::vector<Crossing> cross = ZeroCrossings(t, x, band, &bias);
   const double duration = t.back() - t.front();
   if (cross.size() < 3) {
     std::ostringstream s;
@@ -202,17 +364,7 @@ bool EstimateTraceGuess(const TraceFitInput& input, PendulumModel model,
     *why = s.str();
     return false;
   }
-  // Period: least-squares line through crossing times vs index (slope = T/2).
-  const size_t m = cross.size();
-  double si = 0, st = 0, sii = 0, sit = 0;
-  for (size_t i = 0; i < m; ++i) {
-    si += i;
-    st += cross[i].t_s;
-    sii += double(i) * i;
-    sit += i * cross[i].t_s;
-  }
-  const double half_period = (m * sit - si * st) / (m * sii - si * si);
-  const double period = 2.0 * half_period;
+  const double period = PeriodFromCrossings(cross);
   if (!(period > 0.0) || !std::isfinite(period)) {
     *why = "no regular oscillation: zero crossings do not give a period";
     return false;
@@ -228,123 +380,20 @@ bool EstimateTraceGuess(const TraceFitInput& input, PendulumModel model,
   }
   guess->bias_rad_per_s = bias;
 
-  // Half-cycle peaks and their log decrement.
   std::vector<double> peak_t, peak_a;
-  for (size_t i = 0; i + 1 < m; ++i) {
-    double best = 0.0, best_t = 0.0;
-    for (size_t k = 0; k < n; ++k) {
-      if (t[k] < cross[i].t_s) continue;
-      if (t[k] > cross[i + 1].t_s) break;
-      if (std::abs(x[k] - bias) > best) {
-        best = std::abs(x[k] - bias);
-        best_t = t[k];
-      }
-    }
-    if (best > 0.0) {
-      peak_t.push_back(best_t);
-      peak_a.push_back(best);
-    }
-  }
+  HalfCyclePeaks(t, x, cross, bias, &peak_t, &peak_a);
   const double omega_d = 2.0 * kPi / period;
-  double lambda = 0.0;
-  if (peak_a.size() >= 3) {
-    double a = 0, b = 0, c = 0, d = 0;
-    const double k = peak_a.size();
-    for (size_t i = 0; i < peak_a.size(); ++i) {
-      a += peak_t[i];
-      b += std::log(peak_a[i]);
-      c += peak_t[i] * peak_t[i];
-      d += peak_t[i] * std::log(peak_a[i]);
-    }
-    const double slope = (k * d - a * b) / (k * c - a * a);
-    if (std::isfinite(slope)) lambda = std::max(0.0, -slope);
-  }
+  const double lambda = DecayRateOfPeaks(peak_t, peak_a);
   guess->decay_rate_per_s = lambda;
   const double omega0 = std::sqrt(omega_d * omega_d + lambda * lambda);
-
-  // Split of the decay: the angle amplitude A obeys dA/dt = -(lambda_v + kappa A) A with
-  // lambda_v = C / (2 I) and kappa = (4 / (3 pi)) (K_D / I) omega. Pairs of peaks `stride`
-  // half-cycles apart give the local rate ln(a_i / a_j) / (t_j - t_i) at A = sqrt(a_i a_j) / w;
-  // a straight line through them gives lambda_v (intercept) and kappa (slope), both >= 0.
-  double lambda_v = 0.8 * lambda, kappa = 0.0;
-  {
-    const size_t np = peak_a.size();
-    const size_t stride = std::max<size_t>(1, np / 6);
-    std::vector<double> amp, rate;
-    for (size_t i = 0; i + stride < np; ++i) {
-      const double dt = peak_t[i + stride] - peak_t[i];
-      if (!(dt > 0.0)) continue;
-      amp.push_back(std::sqrt(peak_a[i] * peak_a[i + stride]) / omega0);
-      rate.push_back(std::log(peak_a[i] / peak_a[i + stride]) / dt);
-    }
-    if (amp.size() >= 3) {
-      double sa = 0, sr = 0, saa = 0, sar = 0;
-      const double m_pairs = amp.size();
-      for (size_t i = 0; i < amp.size(); ++i) {
-        sa += amp[i];
-        sr += rate[i];
-        saa += amp[i] * amp[i];
-        sar += amp[i] * rate[i];
-      }
-      const double den = m_pairs * saa - sa * sa;
-      double slope = den > 0.0 ? (m_pairs * sar - sa * sr) / den : 0.0;
-      double intercept = (sr - slope * sa) / m_pairs;
-      if (!std::isfinite(slope) || !std::isfinite(intercept)) slope = 0.0, intercept = lambda;
-      if (slope < 0.0) {
-        slope = 0.0;
-        intercept = sr / m_pairs;
-      }
-      if (intercept < 0.0) {
-        intercept = 0.0;
-        slope = saa > 0.0 ? std::max(0.0, sar / saa) : 0.0;
-      }
-      lambda_v = intercept;
-      kappa = slope;
-    }
-  }
+  double lambda_v = 0.0, kappa = 0.0;
+  SplitDecay(peak_t, peak_a, omega0, lambda, &lambda_v, &kappa);
   // Decay rate at the start of the window (largest amplitude).
   const double amp_first = peak_a.empty() ? 0.0 : peak_a.front() / omega0;
   const double lambda0 = std::max(0.0, lambda_v + kappa * amp_first);
+  FirstCycleFit(t, x, period, omega_d, lambda0, guess);
 
-  // First cycle: rate ~ e^{-lambda0 tau}(a cos w tau + b sin w tau) + c, tau = t - t0. The angle
-  // psi = e^{-lambda0 tau}(alpha cos + beta sin) with psi' = rate has
-  // alpha = psi(t0) = -(lambda0 a + w b) / (lambda0^2 + w^2) (zero-mean about the equilibrium).
-  const double t0 = t.front();
-  std::vector<size_t> first;
-  for (size_t k = 0; k < n && t[k] <= t0 + period; ++k) first.push_back(k);
-  Eigen::MatrixXd A(first.size(), 3);
-  Eigen::VectorXd y(first.size());
-  for (size_t i = 0; i < first.size(); ++i) {
-    const double tau = t[first[i]] - t0, env = std::exp(-lambda0 * tau);
-    A(i, 0) = env * std::cos(omega_d * tau);
-    A(i, 1) = env * std::sin(omega_d * tau);
-    A(i, 2) = 1.0;
-    y(i) = x[first[i]];
-  }
-  const Eigen::Vector3d coef = A.colPivHouseholderQr().solve(y);
-  guess->rate0_rad_per_s = coef(0);
-  guess->rate_amplitude_rad_per_s = std::hypot(coef(0), coef(1));
-  guess->angle0_rad =
-      -(lambda0 * coef(0) + omega_d * coef(1)) / (lambda0 * lambda0 + omega_d * omega_d);
-
-  // Inertia: small-angle formula at the undamped frequency, then corrected for amplitude.
-  const double period0 = 2.0 * kPi / omega0;
-  double inertia = InertiaFromSmallAnglePeriod(input.geometry, period0);
-  double sum_a2 = 0.0;
-  for (double a : peak_a) sum_a2 += (a / omega0) * (a / omega0);
-  const double amp_rms = peak_a.empty() ? 0.0 : std::sqrt(sum_a2 / peak_a.size());
-  if (model != PendulumModel::kLinear && amp_rms > 1e-3) {
-    const int iterations = model == PendulumModel::kFull ? 2 : 1;
-    for (int it = 0; it < iterations; ++it) {
-      double model_period = 0.0;
-      if (!ModelPeriod(model, input.geometry, integrator, inertia, std::min(amp_rms, 1.4),
-                       period0, &model_period) ||
-          !(model_period > 0.0)) {
-        break;  // keep the small-angle value; the fit still starts close
-      }
-      inertia *= (period0 / model_period) * (period0 / model_period);
-    }
-  }
+  const double inertia = InertiaFromGuess(input, model, integrator, peak_a, omega0);
   guess->params.inertia_kg_m2 = inertia;
   guess->params.viscous_coeff_kg_m2_per_s = 2.0 * inertia * lambda_v;
   guess->params.drag_coeff_kg_m2 = kappa * inertia * 3.0 * kPi / (4.0 * omega0);

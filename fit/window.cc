@@ -417,37 +417,23 @@ std::string FreeOscillationWindow::BriefReport() const {
          (noise_from_rest ? " (rest)" : " (no rest: high-frequency estimate)");
 }
 
-FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
-                                                const std::vector<double>& r,
-                                                const WindowOptions& o, const std::string& name) {
-  FreeOscillationWindow w;
-  Analysis a;
-  if (!Analyse(t, r, o, name, &a, &w)) return w;
-  const double sigma_eff = std::max({a.sigma, 1e-6 * a.range, 1e-12});
-  const double floor = o.noise_floor_sigmas * sigma_eff;
-  double max_peak = 0.0;
-  for (const auto& c : a.cycles) max_peak = std::max(max_peak, c.peak);
-  const double half = HalfPeriod(a.cycles, std::max(floor, 0.1 * max_peak), o);
-  if (half <= 0.0) {
-    w.message = Prefix(name) + Fmt("no oscillation found (no swing with a period in [%g, %g] s above "
-                                   "the noise floor of %.3g rad/s)",
-                                   o.min_period_s, o.max_period_s, floor);
-    return w;
-  }
+namespace {
+
+// What a free half-cycle looks like at this half period and noise floor.
+struct HalfCycleRules {
+  const std::vector<double>& t;
+  const WindowOptions& o;
+  double half = 0.0;        // half period, s
+  double floor = 0.0;       // noise floor, rad/s
+  double sigma_eff = 0.0;   // noise, rad/s
+  double dt_typical = 0.0;  // median time step, s
+
   // Dropped packets: a half-cycle with a gap longer than 2.5 typical steps may have lost its
   // peak, so its peak is not compared, and its duration gets the gap as extra slack.
-  std::vector<double> steps(t.size() - 1);
-  for (size_t k = 0; k + 1 < t.size(); ++k) steps[k] = t[k + 1] - t[k];
-  const double dt_typical = Median(steps);
-  std::vector<HalfCycle> cycles = a.cycles;
-  for (auto& c : cycles) {
-    const size_t b = std::lower_bound(t.begin(), t.end(), c.start_s) - t.begin();
-    const size_t e = std::upper_bound(t.begin(), t.end(), c.end_s) - t.begin();
-    for (size_t k = (b > 0 ? b - 1 : 0); k + 1 < t.size() && k < e; ++k) c.max_gap_s = std::max(c.max_gap_s, steps[k]);
-  }
-  auto gappy = [&](const HalfCycle& c) { return c.max_gap_s > 2.5 * dt_typical; };
-  auto duration_ok = [&](const HalfCycle& c) {
-    const double slack = gappy(c) ? c.max_gap_s : 0.0;
+  bool Gappy(const HalfCycle& c) const { return c.max_gap_s > 2.5 * dt_typical; }
+
+  bool DurationOk(const HalfCycle& c) const {
+    const double slack = Gappy(c) ? c.max_gap_s : 0.0;
     if (c.open) {
       // The log ended inside it: fine unless the swing should have crossed zero by now (a quarter
       // period after the peak), which means it was stopped or died out.
@@ -458,25 +444,51 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
     // quarter period of the peak (a hand that grabs near a peak leaves a long, flat tail).
     return std::abs(c.duration() - half) <= o.half_period_tolerance * half + slack &&
            c.end_s - t[c.robust_peak_index] <= 0.5 * (1.0 + o.half_period_tolerance) * half + slack;
-  };
-  // 3b. A glitch that split a half-cycle inside the swing (between two whole half-cycles, or one
-  // and the log's end): merged back, so it neither breaks the run nor moves t0. Tremor lobes
-  // (around the release or a stop) have short lobes around them and stay as they are.
-  cycles = MergeGlitchSplits(
-      cycles, o.blip_fraction * half,
+  }
+};
+
+// The half-cycles with their longest time step (dropped packets); returns the median step.
+double MarkPacketGaps(const std::vector<double>& t, std::vector<HalfCycle>* cycles) {
+  std::vector<double> steps(t.size() - 1);
+  for (size_t k = 0; k + 1 < t.size(); ++k) steps[k] = t[k + 1] - t[k];
+  const double dt_typical = Median(steps);
+  for (auto& c : *cycles) {
+    const size_t b = std::lower_bound(t.begin(), t.end(), c.start_s) - t.begin();
+    const size_t e = std::upper_bound(t.begin(), t.end(), c.end_s) - t.begin();
+    for (size_t k = (b > 0 ? b - 1 : 0); k + 1 < t.size() && k < e; ++k) {
+      c.max_gap_s = std::max(c.max_gap_s, steps[k]);
+    }
+  }
+  return dt_typical;
+}
+
+// 3b. A glitch that split a half-cycle inside the swing (between two whole half-cycles, or one
+// and the log's end): merged back, so it neither breaks the run nor moves t0. Tremor lobes
+// (around the release or a stop) have short lobes around them and stay as they are.
+std::vector<HalfCycle> MergeGlitchSplitHalfCycles(const std::vector<HalfCycle>& cycles,
+                                                  const HalfCycleRules& rules) {
+  return MergeGlitchSplits(
+      cycles, rules.o.blip_fraction * rules.half,
       [&](const HalfCycle& joined, const HalfCycle& before, const HalfCycle& after,
           const HalfCycle* outer_before, const HalfCycle* outer_after) {
-        return duration_ok(joined) && joined.robust_peak >= floor &&
-               !(duration_ok(before) && duration_ok(after)) && outer_before &&
-               !outer_before->open && duration_ok(*outer_before) &&
-               (!outer_after || duration_ok(*outer_after));
+        return rules.DurationOk(joined) && joined.robust_peak >= rules.floor &&
+               !(rules.DurationOk(before) && rules.DurationOk(after)) && outer_before &&
+               !outer_before->open && rules.DurationOk(*outer_before) &&
+               (!outer_after || rules.DurationOk(*outer_after));
       });
+}
 
-  // Runs of free oscillation.
-  struct Run {
-    size_t first = 0, last = 0;  // cycle indices, inclusive
-    WindowEnd end = WindowEnd::kLogEnd;
-  };
+// A run of free oscillation.
+struct Run {
+  size_t first = 0, last = 0;  // cycle indices, inclusive
+  WindowEnd end = WindowEnd::kLogEnd;
+};
+
+// Runs of free oscillation: half-cycles of the right duration whose peaks decay steadily; a run
+// ends at a drop (a hand), the noise floor, a wrong duration, or a push.
+std::vector<Run> FreeRuns(const std::vector<HalfCycle>& cycles, const HalfCycleRules& rules) {
+  const WindowOptions& o = rules.o;
+  const double half = rules.half, floor = rules.floor, sigma_eff = rules.sigma_eff;
   std::vector<Run> runs;
   bool in_run = false;
   Run run;
@@ -494,7 +506,7 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
       const double n_steps = static_cast<double>(j - ref_index);
       const double prev = ref_peak * std::pow(rho, n_steps - 1.0);  // expected previous peak
       const bool short_open = c.open && c.duration() < 0.8 * half;  // peak maybe not reached yet
-      const bool unreliable = short_open || gappy(c) || ref_peak <= 0.0;
+      const bool unreliable = short_open || rules.Gappy(c) || ref_peak <= 0.0;
       WindowEnd reason = WindowEnd::kLogEnd;
       bool broken = false;
       bool restart = false;
@@ -504,7 +516,7 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
       } else if (!unreliable && c.robust_peak < floor) {
         broken = true;
         reason = WindowEnd::kNoiseFloor;
-      } else if (!duration_ok(c)) {
+      } else if (!rules.DurationOk(c)) {
         broken = true;
         reason = c.robust_peak < floor || prev < 2.0 * floor ? WindowEnd::kNoiseFloor : WindowEnd::kStopped;
       } else if (!unreliable && c.robust_peak > prev * (1.0 + o.growth_tolerance) + 3.0 * sigma_eff) {
@@ -513,7 +525,7 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
         restart = true;
       }
       if (!broken) {
-        if (!short_open && !gappy(c)) {
+        if (!short_open && !rules.Gappy(c)) {
           if (ref_peak > 0.0) ratios.push_back(std::pow(c.robust_peak / ref_peak, 1.0 / n_steps));
           ref_peak = c.robust_peak;
           ref_index = j;
@@ -526,12 +538,12 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
       in_run = false;
       if (!restart) continue;
     }
-    if (!c.open && duration_ok(c) && c.robust_peak >= floor) {
+    if (!c.open && rules.DurationOk(c) && c.robust_peak >= floor) {
       in_run = true;
       run = Run();
       run.first = run.last = j;
       ratios.clear();
-      ref_peak = gappy(c) ? 0.0 : c.robust_peak;  // 0: no reliable peak yet
+      ref_peak = rules.Gappy(c) ? 0.0 : c.robust_peak;  // 0: no reliable peak yet
       ref_index = j;
     }
   }
@@ -539,7 +551,11 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
     run.end = WindowEnd::kLogEnd;
     runs.push_back(run);
   }
-  // The longest run in time.
+  return runs;
+}
+
+// The longest run in time with at least two half-cycles, or null.
+const Run* LongestRun(const std::vector<Run>& runs, const std::vector<HalfCycle>& cycles) {
   const Run* best = nullptr;
   double best_span = 0.0;
   for (const auto& rn : runs) {
@@ -549,6 +565,82 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
       best = &rn;
     }
   }
+  return best;
+}
+
+// Window end of a run that lasts to the log's end. A swing stopped by hand shortly before the
+// log ends leaves a quiet tail inside the last, open half-cycle: 3 or more samples with |rate|
+// below the noise floor over more than a tenth of a period, which a free swing never shows (it
+// is below the floor for about floor/peak of a period around each crossing). The window then
+// ends half a period before the tail, clear of the hand.
+void TrimHandStopTail(const std::vector<double>& t, const Analysis& a, double floor,
+                      double period, FreeOscillationWindow* w) {
+  w->t1_s = t.back();
+  size_t k = a.x.size();
+  while (k > 0 && std::abs(a.x[k - 1]) < floor) --k;
+  if (k > 0 && a.x.size() - k >= 3 && t.back() - t[k - 1] > 0.1 * period) {
+    w->t1_s = t[k - 1] - 0.5 * period;
+    w->end_reason = WindowEnd::kStopped;
+  }
+}
+
+// No rest: bias = mean rate over whole periods of the free oscillation.
+void BiasFromRun(const std::vector<double>& t, const std::vector<double>& r,
+                 const std::vector<HalfCycle>& cycles, const Run& best, size_t closed_last,
+                 FreeOscillationWindow* w) {
+  double s = 0.0;
+  size_t count = 0;
+  const size_t b = FirstAtOrAfter(t, cycles[best.first].start_s);
+  const size_t e = LastAtOrBefore(t, cycles[closed_last].end_s);
+  for (size_t k = b; k <= e && k < t.size(); ++k, ++count) s += r[k];
+  if (count > 0) w->rest_bias_rad_per_s = s / count;
+}
+
+// Why a window shorter than min_periods periods is rejected.
+std::string TooShortMessage(const std::vector<double>& t, const std::vector<HalfCycle>& cycles,
+                            const Run& best, double period, const WindowOptions& o,
+                            const std::string& name, const FreeOscillationWindow& w) {
+  if (w.t1_s > w.t0_s) {
+    return Prefix(name) +
+           Fmt("free oscillation shorter than %g periods: [%.3f, ", o.min_periods, w.t0_s) +
+           Fmt("%.3f] s with a period of %.3f s", w.t1_s, period) +
+           " (ends: " + ToString(best.end) + ")";
+  }
+  // The swing ends before a window can start (after the first extreme): say what was found.
+  const double end_s = best.end == WindowEnd::kLogEnd ? t.back() : cycles[best.last].end_s;
+  return Prefix(name) +
+         Fmt("free oscillation shorter than %g periods: the swing released at ", o.min_periods) +
+         Fmt("%.3f s ends at ", w.release_s) + Fmt("%.3f s", end_s) + " (" +
+         ToString(best.end) + Fmt("), %.2f periods", (end_s - w.release_s) / period) +
+         Fmt(" of %.3f s later, before a window could start (at ", period) +
+         Fmt("%.3f s, after the first extreme)", w.t0_s);
+}
+
+}  // namespace
+
+FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
+                                                const std::vector<double>& r,
+                                                const WindowOptions& o, const std::string& name) {
+  FreeOscillationWindow w;
+  Analysis a;
+  if (!Analyse(t, r, o, name, &a, &w)) return w;
+  const double sigma_eff = std::max({a.sigma, 1e-6 * a.range, 1e-12});
+  const double floor = o.noise_floor_sigmas * sigma_eff;
+  double max_peak = 0.0;
+  for (const auto& c : a.cycles) max_peak = std::max(max_peak, c.peak);
+  const double half = HalfPeriod(a.cycles, std::max(floor, 0.1 * max_peak), o);
+  if (half <= 0.0) {
+    w.message = Prefix(name) + Fmt("no oscillation found (no swing with a period in [%g, %g] s "
+                                   "above the noise floor of %.3g rad/s)",
+                                   o.min_period_s, o.max_period_s, floor);
+    return w;
+  }
+  std::vector<HalfCycle> cycles = a.cycles;
+  const double dt_typical = MarkPacketGaps(t, &cycles);
+  const HalfCycleRules rules{t, o, half, floor, sigma_eff, dt_typical};
+  cycles = MergeGlitchSplitHalfCycles(cycles, rules);
+  const std::vector<Run> runs = FreeRuns(cycles, rules);
+  const Run* best = LongestRun(runs, cycles);
   if (!best) {
     w.message = Prefix(name) + "no oscillation found (no sequence of half-cycles that decays like a "
                                "free swing)";
@@ -564,51 +656,14 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
   w.end_reason = best->end;
   w.t0_s = cycles[best->first].end_s + o.start_delay_periods * period;
   switch (best->end) {
-    case WindowEnd::kLogEnd: {
-      w.t1_s = t.back();
-      // A swing stopped by hand shortly before the log ends leaves a quiet tail inside the last,
-      // open half-cycle: 3 or more samples with |rate| below the noise floor over more than a
-      // tenth of a period, which a free swing never shows (it is below the floor for about
-      // floor/peak of a period around each crossing). The window then ends half a period
-      // before the tail, clear of the hand.
-      size_t k = a.x.size();
-      while (k > 0 && std::abs(a.x[k - 1]) < floor) --k;
-      if (k > 0 && a.x.size() - k >= 3 && t.back() - t[k - 1] > 0.1 * period) {
-        w.t1_s = t[k - 1] - 0.5 * period;
-        w.end_reason = WindowEnd::kStopped;
-      }
-      break;
-    }
+    case WindowEnd::kLogEnd: TrimHandStopTail(t, a, floor, period, &w); break;
     case WindowEnd::kNoiseFloor: w.t1_s = cycles[best->last].end_s; break;
     default: w.t1_s = t[cycles[best->last].peak_index] - o.end_margin_periods * period; break;
   }
-  if (!a.from_rest) {
-    // No rest: bias = mean rate over whole periods of the free oscillation.
-    double s = 0.0;
-    size_t count = 0;
-    const size_t b = FirstAtOrAfter(t, cycles[best->first].start_s);
-    const size_t e = LastAtOrBefore(t, cycles[closed_last].end_s);
-    for (size_t k = b; k <= e && k < t.size(); ++k, ++count) s += r[k];
-    if (count > 0) w.rest_bias_rad_per_s = s / count;
-  }
+  if (!a.from_rest) BiasFromRun(t, r, cycles, *best, closed_last, &w);
   if (w.t1_s - w.t0_s < o.min_periods * period) {
     w.status = WindowStatus::kRejected;
-    if (w.t1_s > w.t0_s) {
-      w.message = Prefix(name) +
-                  Fmt("free oscillation shorter than %g periods: [%.3f, ", o.min_periods, w.t0_s) +
-                  Fmt("%.3f] s with a period of %.3f s", w.t1_s, period) +
-                  " (ends: " + ToString(best->end) + ")";
-    } else {
-      // The swing ends before a window can start (after the first extreme): say what was found.
-      const double end_s = best->end == WindowEnd::kLogEnd ? t.back() : cycles[best->last].end_s;
-      w.message = Prefix(name) +
-                  Fmt("free oscillation shorter than %g periods: the swing released at ",
-                      o.min_periods) +
-                  Fmt("%.3f s ends at ", w.release_s) + Fmt("%.3f s", end_s) + " (" +
-                  ToString(best->end) + Fmt("), %.2f periods", (end_s - w.release_s) / period) +
-                  Fmt(" of %.3f s later, before a window could start (at ", period) +
-                  Fmt("%.3f s, after the first extreme)", w.t0_s);
-    }
+    w.message = TooShortMessage(t, cycles, *best, period, o, name, w);
     return w;
   }
   w.first_index = FirstAtOrAfter(t, w.t0_s);

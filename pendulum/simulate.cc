@@ -290,78 +290,128 @@ bool TraceSetup::Check(std::string* why) const {
 }
 
 // ---------------------------------------------------------------------------------------------
-bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, uint64_t seed,
-                   SimulatedTrace* out, std::string* why) {
-  if (!options.Check(why) || !setup.Check(why)) return false;
+namespace {
+
+// Everything random that the main stream draws before the samples, in its fixed order.
+struct RandomInputs {
+  double start_time = 0.0, rest_before = 0.0, twist = 0.0, hold = 0.0, free = 0.0;
+  bool stopped = false;
+  double rest_after = 0.0, release_rate = 0.0;
+  double tremor_amp[3] = {}, tremor_omega[3] = {}, tremor_phase[3] = {};
+  Eigen::Vector3d gyro_bias, gyro_scale, accel_bias;
+  double rocking_amp = 0.0, rocking_hz = 0.0, rocking_beta = 0.0;
+};
+
+// The phases of the log (s) and its sampling.
+struct Timeline {
+  double t_twist = 0.0, t_hold = 0.0, t_release = 0.0, t_stop = 0.0, t_end = 0.0;
+  double stop_tau = 0.0;  // time constant of the hand's stop
+  double dt = 0.0;        // nominal sample step
+  bool lognormal = false;
+  double samples_real = 0.0;  // nominal samples (or the most irregular steps could give)
+};
+
+// The kept samples: times, and which of them lie in the free oscillation.
+struct Samples {
+  std::vector<double> times;
+  int n_nominal = 0, dropped = 0;
+  std::vector<size_t> free_index;
+  std::vector<double> free_times;  // t_release, the free samples' times, t_stop
+};
+
+// The swing axis n and the two horizontal directions in the body frame, and the IMU's view.
+struct SwingFrame {
+  Eigen::Vector3d n_body, horizontal, lateral, rock_axis;
+  Eigen::Matrix3d imu_from_body;
+};
+
+// Everything random is drawn here, in a fixed order.
+RandomInputs DrawRandomInputs(const TraceSetup& setup, const SimulationOptions& options,
+                              Rng& rng) {
   const TimelineOptions& tl = options.timeline;
   const SensorOptions& so = options.sensor;
-  Rng rng(seed);
-  *out = SimulatedTrace();
-  TraceTruth& truth = out->truth;
-
-  // Everything random is drawn here, in a fixed order.
-  const double start_time = rng.Uniform(so.start_time_s);
-  const double rest_before = rng.Uniform(tl.rest_before_s);
-  const double twist = rng.Uniform(tl.twist_s);
-  const double hold = rng.Uniform(tl.hold_s);
-  const double free = rng.Uniform(tl.free_s);
-  const bool stopped = rng.Uniform() < tl.stop_probability;
-  const double rest_after = rng.Uniform(tl.rest_after_s);
-  const double release_rate = rng.Normal(tl.release_rate_sigma_deg_per_s * kRadPerDeg);
-  double tremor_amp[3], tremor_omega[3], tremor_phase[3];
+  RandomInputs in;
+  in.start_time = rng.Uniform(so.start_time_s);
+  in.rest_before = rng.Uniform(tl.rest_before_s);
+  in.twist = rng.Uniform(tl.twist_s);
+  in.hold = rng.Uniform(tl.hold_s);
+  in.free = rng.Uniform(tl.free_s);
+  in.stopped = rng.Uniform() < tl.stop_probability;
+  in.rest_after = rng.Uniform(tl.rest_after_s);
+  in.release_rate = rng.Normal(tl.release_rate_sigma_deg_per_s * kRadPerDeg);
   for (int i = 0; i < 3; ++i) {
     // Three sinusoids of equal amplitude: RMS of the sum = amp * sqrt(3/2).
-    tremor_amp[i] = tl.tremor_deg * kRadPerDeg / std::sqrt(1.5) * (0.5 + rng.Uniform());
-    tremor_omega[i] = 2.0 * kPi * rng.Uniform(tl.tremor_hz);
-    tremor_phase[i] = 2.0 * kPi * rng.Uniform();
+    in.tremor_amp[i] = tl.tremor_deg * kRadPerDeg / std::sqrt(1.5) * (0.5 + rng.Uniform());
+    in.tremor_omega[i] = 2.0 * kPi * rng.Uniform(tl.tremor_hz);
+    in.tremor_phase[i] = 2.0 * kPi * rng.Uniform();
   }
-  Eigen::Vector3d gyro_bias, gyro_scale, accel_bias;
-  for (int i = 0; i < 3; ++i) gyro_bias[i] = rng.Normal(so.gyro_bias_sigma_deg_per_s * kRadPerDeg);
-  for (int i = 0; i < 3; ++i) gyro_scale[i] = rng.Normal(so.gyro_scale_error_sigma);
-  for (int i = 0; i < 3; ++i) accel_bias[i] = rng.Normal(so.accel_bias_sigma_mps2);
-  const double rocking_amp = so.rocking_max_deg * kRadPerDeg * rng.Uniform();
-  const double rocking_hz =
+  for (int i = 0; i < 3; ++i) {
+    in.gyro_bias[i] = rng.Normal(so.gyro_bias_sigma_deg_per_s * kRadPerDeg);
+  }
+  for (int i = 0; i < 3; ++i) in.gyro_scale[i] = rng.Normal(so.gyro_scale_error_sigma);
+  for (int i = 0; i < 3; ++i) in.accel_bias[i] = rng.Normal(so.accel_bias_sigma_mps2);
+  in.rocking_amp = so.rocking_max_deg * kRadPerDeg * rng.Uniform();
+  in.rocking_hz =
       so.rocking_frequency_hz > 0
           ? so.rocking_frequency_hz
           : std::sqrt(setup.geometry.gravity_mps2 / setup.geometry.filar_length_m) / (2 * kPi) *
                 (0.9 + 0.2 * rng.Uniform());
-  const double rocking_beta = 2.0 * kPi * rng.Uniform();
+  in.rocking_beta = 2.0 * kPi * rng.Uniform();
+  return in;
+}
 
-  // Timeline.
-  const double t_twist = start_time + rest_before;
-  const double t_hold = t_twist + twist;
-  const double t_release = t_hold + hold;
-  const double t_stop = t_release + free;
-  const double stop_tau = tl.stop_time_constant_s;
-  const double t_end = stopped ? t_stop + 5.0 * stop_tau + rest_after : t_stop;
-  const double dt = 1.0 / so.sample_rate_hz;
-  const bool lognormal = so.sample_steps == SampleSteps::kLogNormal;
-  const double samples_real =
-      lognormal ? std::floor((t_end - start_time) / so.step_range_s.min) + 1.0
-                : std::floor((t_end - start_time) * so.sample_rate_hz) + 1.0;
-  if (samples_real > 5e7) {
-    return Fail(why, "log too long: up to " + Num(samples_real) + " samples (" +
-                         Num(t_end - start_time) + " s at " +
-                         (lognormal ? "steps down to " + Num(so.step_range_s.min) + " s"
-                                    : Num(so.sample_rate_hz) + " Hz") +
+// Timeline: rest, twist, hold, free swing, and the hand's stop with the rest after it.
+bool MakeTimeline(const RandomInputs& in, const SimulationOptions& options, Timeline* timeline,
+                  std::string* why) {
+  const TimelineOptions& tl = options.timeline;
+  const SensorOptions& so = options.sensor;
+  Timeline& tm = *timeline;
+  tm.t_twist = in.start_time + in.rest_before;
+  tm.t_hold = tm.t_twist + in.twist;
+  tm.t_release = tm.t_hold + in.hold;
+  tm.t_stop = tm.t_release + in.free;
+  tm.stop_tau = tl.stop_time_constant_s;
+  tm.t_end = in.stopped ? tm.t_stop + 5.0 * tm.stop_tau + in.rest_after : tm.t_stop;
+  tm.dt = 1.0 / so.sample_rate_hz;
+  tm.lognormal = so.sample_steps == SampleSteps::kLogNormal;
+  tm.samples_real =
+      tm.lognormal ? std::floor((tm.t_end - in.start_time) / so.step_range_s.min) + 1.0
+                   : std::floor((tm.t_end - in.start_time) * so.sample_rate_hz) + 1.0;
+  if (tm.samples_real > 5e7) {
+    return Fail(why, "log too long: up to " + Num(tm.samples_real) + " samples (" +
+                         Num(tm.t_end - in.start_time) + " s at " +
+                         (tm.lognormal ? "steps down to " + Num(so.step_range_s.min) + " s"
+                                       : Num(so.sample_rate_hz) + " Hz") +
                          "); the limit is 5e7: shorten timeline.free_s or lower "
                          "sensor.sample_rate_hz");
   }
-  // Irregular (log-normal) steps come from their own stream: the other draws stay as they are.
-  std::vector<double> irregular;
-  if (lognormal) {
-    Rng step_rng(DeriveSeed(seed, "sample_steps"));
-    for (double t = start_time; t <= t_end;) {
-      irregular.push_back(t);
-      const double step = dt * std::exp(step_rng.Normal(so.step_log_sigma));
-      t += std::clamp(step, so.step_range_s.min, so.step_range_s.max);
-    }
-  }
-  const int n_nominal = lognormal ? static_cast<int>(irregular.size()) : static_cast<int>(samples_real);
+  return true;
+}
 
-  // Timestamps: nominal grid + clipped jitter (strictly increasing), or the irregular steps; then
-  // dropped packets.
-  std::vector<double> times;
+// Irregular (log-normal) steps come from their own stream: the other draws stay as they are.
+std::vector<double> IrregularSteps(uint64_t seed, const SensorOptions& so, double start_time,
+                                   const Timeline& tm) {
+  std::vector<double> irregular;
+  if (!tm.lognormal) return irregular;
+  Rng step_rng(DeriveSeed(seed, "sample_steps"));
+  for (double t = start_time; t <= tm.t_end;) {
+    irregular.push_back(t);
+    const double step = tm.dt * std::exp(step_rng.Normal(so.step_log_sigma));
+    t += std::clamp(step, so.step_range_s.min, so.step_range_s.max);
+  }
+  return irregular;
+}
+
+// Timestamps: nominal grid + clipped jitter (strictly increasing), or the irregular steps; then
+// dropped packets.
+bool SampleTimes(const SensorOptions& so, double start_time, const Timeline& tm,
+                 const std::vector<double>& irregular, Rng& rng, Samples* samples,
+                 std::string* why) {
+  const double dt = tm.dt;
+  const int n_nominal =
+      tm.lognormal ? static_cast<int>(irregular.size()) : static_cast<int>(tm.samples_real);
+  samples->n_nominal = n_nominal;
+  std::vector<double>& times = samples->times;
   times.reserve(n_nominal);
   const double mean_drop_run =
       (1.0 - so.drop_burst_probability) + so.drop_burst_probability * (2.0 + so.drop_burst_max_samples) / 2.0;
@@ -383,12 +433,19 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
       ++dropped;
       continue;
     }
-    times.push_back(lognormal ? irregular[k] : start_time + k * dt + jitter);
+    times.push_back(tm.lognormal ? irregular[k] : start_time + k * dt + jitter);
   }
-  const size_t n = times.size();
-  if (n < 2) return Fail(why, "the log would have fewer than 2 samples");
+  samples->dropped = dropped;
+  if (times.size() < 2) return Fail(why, "the log would have fewer than 2 samples");
+  return true;
+}
 
-  // The swing angle psi and its derivatives at every kept sample.
+// The swing angle psi and its derivatives before the release: the hand twists the aircraft to
+// the amplitude, then holds it with a tremor. Collects the free oscillation's samples.
+bool HandBeforeRelease(const TraceSetup& setup, const RandomInputs& in, const Timeline& tm,
+                       Samples* samples, SimulatedTrace* out, std::string* why) {
+  const std::vector<double>& times = samples->times;
+  const size_t n = times.size();
   std::vector<double>& psi = out->angle_rad;
   std::vector<double>& dpsi = out->rate_rad_per_s;
   std::vector<double>& ddpsi = out->accel_rad_per_s2;
@@ -396,26 +453,26 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
   dpsi.assign(n, 0.0);
   ddpsi.assign(n, 0.0);
   const double amplitude = setup.amplitude_rad;
-  std::vector<size_t> free_index;
-  std::vector<double> free_times{t_release};
+  const double twist = in.twist, hold = in.hold;
+  samples->free_times = {tm.t_release};
   for (size_t k = 0; k < n; ++k) {
     const double t = times[k];
-    if (t < t_twist) continue;
-    if (t < t_hold) {
+    if (t < tm.t_twist) continue;
+    if (t < tm.t_hold) {
       double q, dq, ddq;
-      Smoothstep((t - t_twist) / twist, &q, &dq, &ddq);
+      Smoothstep((t - tm.t_twist) / twist, &q, &dq, &ddq);
       psi[k] = amplitude * q;
       dpsi[k] = amplitude * dq / twist;
       ddpsi[k] = amplitude * ddq / (twist * twist);
-    } else if (t < t_release) {
+    } else if (t < tm.t_release) {
       // Tremor, windowed by sin^2 so the hold starts and ends smoothly.
       double tr = 0, dtr = 0, ddtr = 0;
-      const double s = t - t_hold;
+      const double s = t - tm.t_hold;
       for (int i = 0; i < 3; ++i) {
-        const double ph = tremor_omega[i] * s + tremor_phase[i];
-        tr += tremor_amp[i] * std::sin(ph);
-        dtr += tremor_amp[i] * tremor_omega[i] * std::cos(ph);
-        ddtr -= tremor_amp[i] * tremor_omega[i] * tremor_omega[i] * std::sin(ph);
+        const double ph = in.tremor_omega[i] * s + in.tremor_phase[i];
+        tr += in.tremor_amp[i] * std::sin(ph);
+        dtr += in.tremor_amp[i] * in.tremor_omega[i] * std::cos(ph);
+        ddtr -= in.tremor_amp[i] * in.tremor_omega[i] * in.tremor_omega[i] * std::sin(ph);
       }
       const double w_arg = kPi * s / hold;
       const double w = std::sin(w_arg) * std::sin(w_arg);
@@ -424,15 +481,22 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
       psi[k] = amplitude + tr * w;
       dpsi[k] = dtr * w + tr * dw;
       ddpsi[k] = ddtr * w + 2 * dtr * dw + tr * ddw;
-    } else if (t < t_stop) {
-      free_index.push_back(k);
-      free_times.push_back(t);
+    } else if (t < tm.t_stop) {
+      samples->free_index.push_back(k);
+      samples->free_times.push_back(t);
     }
   }
-  if (free_index.size() < 2) return Fail(why, "the free oscillation has fewer than 2 samples");
-  free_times.push_back(t_stop);  // the state at the stop starts the hand's deceleration
+  if (samples->free_index.size() < 2) {
+    return Fail(why, "the free oscillation has fewer than 2 samples");
+  }
+  samples->free_times.push_back(tm.t_stop);  // the state at the stop starts the hand's deceleration
+  return true;
+}
 
-  TruthDynamics dyn{options.model, setup.geometry, setup.params};
+// The truth's departures from the fit's models: the sway coupling and the amplitude softening.
+bool AddTruthDiscrepancies(const TraceSetup& setup, const SimulationOptions& options,
+                           TruthDynamics* dyn_out, std::string* why) {
+  TruthDynamics& dyn = *dyn_out;
   if (options.sway_coupling_at_60deg > 0) {
     const double a60 = 60.0 * kRadPerDeg;
     dyn.sway_k = 8.0 / 5.0 * options.sway_coupling_at_60deg / (a60 * a60 * a60 * a60);
@@ -441,6 +505,7 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
     dyn.soft_p = options.softening_exponent;
     dyn.soft_k = SofteningCoefficient(options.softening_at_30deg, options.softening_exponent);
     // The term must weaken the restoring torque, not reverse it, over the whole swing.
+    const double amplitude = setup.amplitude_rad;
     const double weakening = dyn.soft_k * std::pow(std::abs(amplitude), dyn.soft_p);
     if (weakening > 0.5) {
       return Fail(why, "swing.softening_percent_at_30deg = " + Num(100 * options.softening_at_30deg) +
@@ -450,7 +515,16 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
                            " deg (at most 50 % allowed); lower the softening or the amplitude");
     }
   }
-  std::vector<double> free_angle, free_rate;
+  return true;
+}
+
+// The free oscillation from the release (amplitude, release rate) through free_times: the
+// integrator of the fit, or RK4 when the truth has terms the fit's models lack.
+bool IntegrateFreeSwing(const TraceSetup& setup, const SimulationOptions& options,
+                        const TruthDynamics& dyn, double release_rate,
+                        const std::vector<double>& free_times, std::vector<double>* free_angle,
+                        std::vector<double>* free_rate, std::string* why) {
+  const double amplitude = setup.amplitude_rad;
   if (dyn.sway_k == 0.0 && dyn.soft_k == 0.0) {
     PendulumIntegrator integrator(options.model, setup.geometry, options.integrator);
     Trajectory trajectory;
@@ -459,55 +533,115 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
                               &integrator_why)) {
       return Fail(why, "integration of the free oscillation failed: " + integrator_why);
     }
-    free_angle = trajectory.angle_rad;
-    free_rate = trajectory.rate_rad_per_s;
-  } else if (!IntegrateRk4(dyn, amplitude, release_rate, free_times, &free_angle, &free_rate, why)) {
+    *free_angle = trajectory.angle_rad;
+    *free_rate = trajectory.rate_rad_per_s;
+  } else if (!IntegrateRk4(dyn, amplitude, release_rate, free_times, free_angle, free_rate, why)) {
     return false;
   }
-  if (free_angle.size() != free_times.size() || free_rate.size() != free_times.size()) {
+  if (free_angle->size() != free_times.size() || free_rate->size() != free_times.size()) {
     return Fail(why, "integrator returned the wrong number of samples");
   }
+  return true;
+}
+
+// The free swing into psi, and the hand's stop after it: the rate decays exponentially, the
+// angle settles rate_stop * tau further on. Returns the envelope over the last period.
+double FreeSwingAndStop(const TraceSetup& setup, const TruthDynamics& dyn, const Timeline& tm,
+                        const Samples& samples, const std::vector<double>& free_angle,
+                        const std::vector<double>& free_rate, SimulatedTrace* out) {
+  const std::vector<double>& times = samples.times;
+  std::vector<double>& psi = out->angle_rad;
+  std::vector<double>& dpsi = out->rate_rad_per_s;
+  std::vector<double>& ddpsi = out->accel_rad_per_s2;
   double envelope_at_stop = 0.0;
   const double small_period = SmallAnglePeriod(setup.geometry, setup.params.inertia_kg_m2);
-  for (size_t i = 0; i < free_index.size(); ++i) {
-    const size_t k = free_index[i];
+  for (size_t i = 0; i < samples.free_index.size(); ++i) {
+    const size_t k = samples.free_index[i];
     psi[k] = free_angle[i + 1];
     dpsi[k] = free_rate[i + 1];
     ddpsi[k] = dyn.Accel(psi[k], dpsi[k]);
-    if (times[k] >= t_stop - small_period) envelope_at_stop = std::max(envelope_at_stop, std::abs(psi[k]));
+    if (times[k] >= tm.t_stop - small_period) {
+      envelope_at_stop = std::max(envelope_at_stop, std::abs(psi[k]));
+    }
   }
   const double psi_stop = free_angle.back(), rate_stop = free_rate.back();
-  for (size_t k = 0; k < n; ++k) {
+  const double stop_tau = tm.stop_tau;
+  for (size_t k = 0; k < times.size(); ++k) {
     const double t = times[k];
-    if (t < t_stop) continue;
-    // The hand: rate decays exponentially, the angle settles rate_stop * tau further on.
-    const double e = std::exp(-(t - t_stop) / stop_tau);
+    if (t < tm.t_stop) continue;
+    const double e = std::exp(-(t - tm.t_stop) / stop_tau);
     psi[k] = psi_stop + rate_stop * stop_tau * (1.0 - e);
     dpsi[k] = rate_stop * e;
     ddpsi[k] = -rate_stop / stop_tau * e;
   }
+  return envelope_at_stop;
+}
 
-  // IMU synthesis.
+// The swing axis in the body at the trace's pitch and roll, the rocking axis, the IMU mounting.
+SwingFrame SwingFrameFor(const TraceSetup& setup, double rocking_beta) {
+  SwingFrame f;
   const double st = std::sin(setup.pitch_rad), ct = std::cos(setup.pitch_rad);
-  Eigen::Vector3d n_body(-st, 0.0, ct);
-  Eigen::Vector3d horizontal(ct, 0.0, st);  // in the x-z plane, perpendicular to n
-  Eigen::Vector3d lateral = Eigen::Vector3d::UnitY();  // the other horizontal direction
+  f.n_body = Eigen::Vector3d(-st, 0.0, ct);
+  f.horizontal = Eigen::Vector3d(ct, 0.0, st);  // in the x-z plane, perpendicular to n
+  f.lateral = Eigen::Vector3d::UnitY();  // the other horizontal direction
   if (setup.roll_rad != 0.0) {
     // Rolled by phi: n = Rx(-phi) (-sin theta, 0, cos theta) = (-st, sf ct, cf ct), and the two
     // horizontal directions turn with it (docs/physics.md §3.5).
     const double sf = std::sin(setup.roll_rad), cf = std::cos(setup.roll_rad);
-    n_body = Eigen::Vector3d(-st, sf * ct, cf * ct);
-    horizontal = Eigen::Vector3d(ct, sf * st, cf * st);
-    lateral = Eigen::Vector3d(0.0, cf, -sf);
+    f.n_body = Eigen::Vector3d(-st, sf * ct, cf * ct);
+    f.horizontal = Eigen::Vector3d(ct, sf * st, cf * st);
+    f.lateral = Eigen::Vector3d(0.0, cf, -sf);
   }
-  const Eigen::Vector3d rock_axis =
-      (std::cos(rocking_beta) * lateral + std::sin(rocking_beta) * horizontal).normalized();
-  const Eigen::Matrix3d imu_from_body = setup.body_from_imu.transpose();
+  f.rock_axis =
+      (std::cos(rocking_beta) * f.lateral + std::sin(rocking_beta) * f.horizontal).normalized();
+  f.imu_from_body = setup.body_from_imu.transpose();
+  return f;
+}
+
+// Gravity removed by the logger: the firmware's static down, tilted by its attitude error about
+// a random horizontal axis (a stream of its own).
+Eigen::Vector3d DownEstimateInImu(uint64_t seed, const SensorOptions& so, const SwingFrame& f,
+                                  TraceTruth* truth) {
+  Rng accel_rng(DeriveSeed(seed, "gravity_removed"));
+  truth->gravity_removal_error_rad = accel_rng.Uniform(so.gravity_removal_error_deg) * kRadPerDeg;
+  const double beta = 2.0 * kPi * accel_rng.Uniform();
+  const Eigen::Vector3d tilt_axis =
+      (std::cos(beta) * f.lateral + std::sin(beta) * f.horizontal).normalized();
+  return f.imu_from_body *
+         (Eigen::AngleAxisd(truth->gravity_removal_error_rad, tilt_axis) * f.n_body);
+}
+
+// Rocking of the body about rock_axis after the release: phi and its derivatives at t.
+void RockingAt(double t, double t_release, double rocking_amp, double rock_omega,
+               double decay_s, double* phi, double* dphi, double* ddphi) {
+  if (!(t >= t_release && rocking_amp > 0)) return;
+  const double x = t - t_release;
+  const double e = rocking_amp * std::exp(-x / decay_s);
+  const double c = 1.0 / decay_s;
+  const double s = std::sin(rock_omega * x), co = std::cos(rock_omega * x);
+  *phi = e * s;
+  *dphi = e * (rock_omega * co - c * s);
+  *ddphi = e * ((c * c - rock_omega * rock_omega) * s - 2 * c * rock_omega * co);
+}
+
+// IMU synthesis: the gyro (scale, bias, optional bias walk, white or AR(1) noise) and the
+// accelerometer (lever arm, rocking, gravity, optionally removed) at every sample, with the
+// attitude errors and rocking of the rig. Returns the bias walk at the end.
+Eigen::Vector3d SynthesizeImu(const TraceSetup& setup, const SensorOptions& so, uint64_t seed,
+                              const RandomInputs& in, const Timeline& tm, const SwingFrame& f,
+                              const std::vector<double>& times, Rng& rng, SimulatedTrace* out) {
+  const size_t n = times.size();
+  const std::vector<double>& psi = out->angle_rad;
+  const std::vector<double>& dpsi = out->rate_rad_per_s;
+  const std::vector<double>& ddpsi = out->accel_rad_per_s2;
+  const Eigen::Vector3d& n_body = f.n_body;
+  const Eigen::Vector3d& rock_axis = f.rock_axis;
+  const Eigen::Matrix3d& imu_from_body = f.imu_from_body;
   const Eigen::Vector3d& r = setup.imu_offset_in_body_m;
   const Eigen::Vector3d r_perp = r - n_body * n_body.dot(r);
   const Eigen::Vector3d n_cross_r = n_body.cross(r);
   const double g = setup.geometry.gravity_mps2;
-  const double rock_omega = 2 * kPi * rocking_hz;
+  const double rock_omega = 2 * kPi * in.rocking_hz;
   const double gyro_noise = so.gyro_noise_sigma_deg_per_s * kRadPerDeg;
   const double phi_ar = so.gyro_noise_ar1_phi;
   const double ar_innovation = std::sqrt(1.0 - phi_ar * phi_ar);
@@ -518,35 +652,18 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
   Eigen::Vector3d walk = Eigen::Vector3d::Zero();
   const bool gravity_removed = so.accelerometer && so.accel_gravity_removed;
   Eigen::Vector3d down_estimate_in_imu = Eigen::Vector3d::Zero();
-  if (gravity_removed) {
-    // The firmware's static down, tilted by its attitude error about a random horizontal axis.
-    Rng accel_rng(DeriveSeed(seed, "gravity_removed"));
-    truth.gravity_removal_error_rad = accel_rng.Uniform(so.gravity_removal_error_deg) * kRadPerDeg;
-    const double beta = 2.0 * kPi * accel_rng.Uniform();
-    const Eigen::Vector3d tilt_axis =
-        (std::cos(beta) * lateral + std::sin(beta) * horizontal).normalized();
-    down_estimate_in_imu =
-        imu_from_body * (Eigen::AngleAxisd(truth.gravity_removal_error_rad, tilt_axis) * n_body);
-  }
+  if (gravity_removed) down_estimate_in_imu = DownEstimateInImu(seed, so, f, &out->truth);
 
   out->imu.t_s = times;
   out->imu.gyro_in_imu.resize(n);
   if (so.accelerometer) out->imu.accel_in_imu.resize(n);
   for (size_t k = 0; k < n; ++k) {
-    const double t = times[k];
     double phi = 0, dphi = 0, ddphi = 0;
-    if (t >= t_release && rocking_amp > 0) {
-      const double x = t - t_release;
-      const double e = rocking_amp * std::exp(-x / so.rocking_decay_s);
-      const double c = 1.0 / so.rocking_decay_s;
-      const double s = std::sin(rock_omega * x), co = std::cos(rock_omega * x);
-      phi = e * s;
-      dphi = e * (rock_omega * co - c * s);
-      ddphi = e * ((c * c - rock_omega * rock_omega) * s - 2 * c * rock_omega * co);
-    }
+    RockingAt(times[k], tm.t_release, in.rocking_amp, rock_omega, so.rocking_decay_s, &phi, &dphi,
+              &ddphi);
     const Eigen::Vector3d omega_body = dpsi[k] * n_body + dphi * rock_axis;
     Eigen::Vector3d gyro = imu_from_body * omega_body;
-    gyro = gyro.cwiseProduct(Eigen::Vector3d::Ones() + gyro_scale) + gyro_bias;
+    gyro = gyro.cwiseProduct(Eigen::Vector3d::Ones() + in.gyro_scale) + in.gyro_bias;
     if (walk_rate > 0) {
       if (k > 0) {
         const double step = std::sqrt(times[k] - times[k - 1]);
@@ -571,68 +688,122 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
                                      hdd * n_body + ddphi * rock_axis.cross(r);
       // The body rocked by phi about rock_axis sees the down vertical rotated by -phi.
       const Eigen::Vector3d down_body = Eigen::AngleAxisd(-phi, rock_axis) * n_body;
-      Eigen::Vector3d f = imu_from_body * (a_body - g * down_body) + accel_bias;
-      if (gravity_removed) f += g * down_estimate_in_imu;
-      for (int i = 0; i < 3; ++i) f[i] += rng.Normal(so.accel_noise_sigma_mps2);
-      out->imu.accel_in_imu[k] = f;
+      Eigen::Vector3d fs = imu_from_body * (a_body - g * down_body) + in.accel_bias;
+      if (gravity_removed) fs += g * down_estimate_in_imu;
+      for (int i = 0; i < 3; ++i) fs[i] += rng.Normal(so.accel_noise_sigma_mps2);
+      out->imu.accel_in_imu[k] = fs;
     }
   }
-  // Spikes: distinct samples, the first one inside the free oscillation; on the IMU axis that
-  // carries most of the swing, replaced by +-spike_rate_rad_per_s.
-  if (so.spike_count > 0) {
-    if (static_cast<size_t>(so.spike_count) * 2 > n) {
-      return Fail(why, "sensor.spike_count = " + std::to_string(so.spike_count) +
-                           " is more than half the log's " + std::to_string(n) +
-                           " samples; lower it");
-    }
-    Rng spike_rng(DeriveSeed(seed, "spikes"));
-    const Eigen::Vector3d n_imu = imu_from_body * n_body;
-    int axis = 0;
-    n_imu.cwiseAbs().maxCoeff(&axis);
-    std::vector<bool> taken(n, false);
-    for (int i = 0; i < so.spike_count; ++i) {
-      size_t k = 0;
-      do {
-        k = i == 0 ? free_index[static_cast<size_t>(spike_rng.Uniform() * free_index.size())]
-                   : static_cast<size_t>(spike_rng.Uniform() * n);
-      } while (taken[k]);
-      taken[k] = true;
-      const double value = (spike_rng.Uniform() < 0.5 ? -1.0 : 1.0) * so.spike_rate_rad_per_s;
-      out->imu.gyro_in_imu[k][axis] = value;
-      truth.spikes.push_back({static_cast<int>(k), times[k], axis, value});
-    }
-    std::sort(truth.spikes.begin(), truth.spikes.end(),
-              [](const TraceTruth::Spike& a, const TraceTruth::Spike& b) { return a.sample < b.sample; });
-  }
+  return walk;
+}
 
-  for (size_t k = 0; k < n; ++k) {
-    if (!out->imu.gyro_in_imu[k].allFinite() ||
-        (so.accelerometer && !out->imu.accel_in_imu[k].allFinite()) || !std::isfinite(times[k])) {
+// Spikes: distinct samples, the first one inside the free oscillation; on the IMU axis that
+// carries most of the swing, replaced by +-spike_rate_rad_per_s (a stream of their own).
+bool AddSpikes(const SensorOptions& so, uint64_t seed, const SwingFrame& f,
+               const Samples& samples, SimulatedTrace* out, std::string* why) {
+  if (so.spike_count <= 0) return true;
+  const std::vector<double>& times = samples.times;
+  const std::vector<size_t>& free_index = samples.free_index;
+  const size_t n = times.size();
+  if (static_cast<size_t>(so.spike_count) * 2 > n) {
+    return Fail(why, "sensor.spike_count = " + std::to_string(so.spike_count) +
+                         " is more than half the log's " + std::to_string(n) +
+                         " samples; lower it");
+  }
+  TraceTruth& truth = out->truth;
+  Rng spike_rng(DeriveSeed(seed, "spikes"));
+  const Eigen::Vector3d n_imu = f.imu_from_body * f.n_body;
+  int axis = 0;
+  n_imu.cwiseAbs().maxCoeff(&axis);
+  std::vector<bool> taken(n, false);
+  for (int i = 0; i < so.spike_count; ++i) {
+    size_t k = 0;
+    do {
+      k = i == 0 ? free_index[static_cast<size_t>(spike_rng.Uniform() * free_index.size())]
+                 : static_cast<size_t>(spike_rng.Uniform() * n);
+    } while (taken[k]);
+    taken[k] = true;
+    const double value = (spike_rng.Uniform() < 0.5 ? -1.0 : 1.0) * so.spike_rate_rad_per_s;
+    out->imu.gyro_in_imu[k][axis] = value;
+    truth.spikes.push_back({static_cast<int>(k), times[k], axis, value});
+  }
+  std::sort(truth.spikes.begin(), truth.spikes.end(),
+            [](const TraceTruth::Spike& a, const TraceTruth::Spike& b) {
+              return a.sample < b.sample;
+            });
+  return true;
+}
+
+// Every sample finite.
+bool CheckFinite(const SensorOptions& so, const SimulatedTrace& out, std::string* why) {
+  const std::vector<double>& times = out.imu.t_s;
+  for (size_t k = 0; k < times.size(); ++k) {
+    if (!out.imu.gyro_in_imu[k].allFinite() ||
+        (so.accelerometer && !out.imu.accel_in_imu[k].allFinite()) || !std::isfinite(times[k])) {
       return Fail(why, "simulation produced a non-finite value (check the parameters)");
     }
   }
+  return true;
+}
 
-  truth.start_time_s = start_time;
-  truth.t_twist_s = t_twist;
-  truth.t_release_s = t_release;
-  truth.stopped = stopped;
-  truth.t_stop_s = t_stop;
-  truth.t_end_s = t_end;
-  truth.amplitude_rad = amplitude;
-  truth.release_rate_rad_per_s = release_rate;
-  truth.amplitude_at_stop_rad = envelope_at_stop;
-  truth.gyro_bias_rad_per_s = gyro_bias;
-  truth.gyro_bias_end_rad_per_s = gyro_bias + walk;
-  truth.softening_k = dyn.soft_k;
-  truth.gyro_scale_error = gyro_scale;
-  truth.accel_bias_mps2 = so.accelerometer ? accel_bias : Eigen::Vector3d::Zero();
-  truth.swing_axis_in_imu = imu_from_body * n_body;
-  truth.rocking_amplitude_rad = rocking_amp;
-  truth.rocking_frequency_hz = rocking_hz;
-  truth.rocking_axis_in_body = rock_axis;
-  truth.samples_nominal = n_nominal;
-  truth.samples_dropped = dropped;
-  truth.free_samples = static_cast<int>(free_index.size());
+// The truth the fit is checked against.
+void FillTruth(const TraceSetup& setup, const SensorOptions& so, const RandomInputs& in,
+               const Timeline& tm, const Samples& samples, const SwingFrame& f,
+               const TruthDynamics& dyn, double envelope_at_stop, const Eigen::Vector3d& walk,
+               TraceTruth* truth) {
+  truth->start_time_s = in.start_time;
+  truth->t_twist_s = tm.t_twist;
+  truth->t_release_s = tm.t_release;
+  truth->stopped = in.stopped;
+  truth->t_stop_s = tm.t_stop;
+  truth->t_end_s = tm.t_end;
+  truth->amplitude_rad = setup.amplitude_rad;
+  truth->release_rate_rad_per_s = in.release_rate;
+  truth->amplitude_at_stop_rad = envelope_at_stop;
+  truth->gyro_bias_rad_per_s = in.gyro_bias;
+  truth->gyro_bias_end_rad_per_s = in.gyro_bias + walk;
+  truth->softening_k = dyn.soft_k;
+  truth->gyro_scale_error = in.gyro_scale;
+  truth->accel_bias_mps2 = so.accelerometer ? in.accel_bias : Eigen::Vector3d::Zero();
+  truth->swing_axis_in_imu = f.imu_from_body * f.n_body;
+  truth->rocking_amplitude_rad = in.rocking_amp;
+  truth->rocking_frequency_hz = in.rocking_hz;
+  truth->rocking_axis_in_body = f.rock_axis;
+  truth->samples_nominal = samples.n_nominal;
+  truth->samples_dropped = samples.dropped;
+  truth->free_samples = static_cast<int>(samples.free_index.size());
+}
+
+}  // namespace
+
+bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, uint64_t seed,
+                   SimulatedTrace* out, std::string* why) {
+  if (!options.Check(why) || !setup.Check(why)) return false;
+  const SensorOptions& so = options.sensor;
+  Rng rng(seed);
+  *out = SimulatedTrace();
+  const RandomInputs in = DrawRandomInputs(setup, options, rng);
+  Timeline tm;
+  if (!MakeTimeline(in, options, &tm, why)) return false;
+  const std::vector<double> irregular = IrregularSteps(seed, so, in.start_time, tm);
+  Samples samples;
+  if (!SampleTimes(so, in.start_time, tm, irregular, rng, &samples, why)) return false;
+  if (!HandBeforeRelease(setup, in, tm, &samples, out, why)) return false;
+  TruthDynamics dyn{options.model, setup.geometry, setup.params};
+  if (!AddTruthDiscrepancies(setup, options, &dyn, why)) return false;
+  std::vector<double> free_angle, free_rate;
+  if (!IntegrateFreeSwing(setup, options, dyn, in.release_rate, samples.free_times, &free_angle,
+                          &free_rate, why)) {
+    return false;
+  }
+  const double envelope_at_stop =
+      FreeSwingAndStop(setup, dyn, tm, samples, free_angle, free_rate, out);
+  const SwingFrame frame = SwingFrameFor(setup, in.rocking_beta);
+  const Eigen::Vector3d walk =
+      SynthesizeImu(setup, so, seed, in, tm, frame, samples.times, rng, out);
+  if (!AddSpikes(so, seed, frame, samples, out, why)) return false;
+  if (!CheckFinite(so, *out, why)) return false;
+  FillTruth(setup, so, in, tm, samples, frame, dyn, envelope_at_stop, walk, &out->truth);
   return true;
 }
 
