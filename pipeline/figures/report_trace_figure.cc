@@ -46,9 +46,9 @@ void Envelope(const std::vector<double>& t, const std::vector<double>& v, size_t
 
 }  // namespace
 
-bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
-                            DisplayUnits units, const std::string& path, int width_px,
-                            int height_px, std::string* why) {
+bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title, DisplayUnits units,
+                            const std::string& path, int width_px, int height_px,
+                            std::string* why) {
   // Top: measured and fitted rate at ~250 points (the noise is invisible at this scale; it shows
   // in the residual panel). Bottom: the residual's min/max envelope over 150 buckets.
   std::vector<PLFLT> tm, ym, tf, yf, tr, yr;
@@ -79,46 +79,50 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
   std::snprintf(label, sizeof(label), "I#dtotal#u = %.5f #(2233) %.1e %s (%s)",
                 InertiaToDisplay(fit.params.inertia_kg_m2, units),
                 InertiaToDisplay(fit.inertia_stat_std_kg_m2, units),
-                units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d", ToString(fit.model));
+                units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d",
+                ToString(fit.model));
   const std::string top_title = label;
   std::snprintf(label, sizeof(label), "residual: rms = %.2f noise", fit.rms_over_noise);
   const std::string bottom_title = label;
   FigureOptions figure;
   figure.width_px = width_px;
   figure.height_px = height_px;
-  return WriteFigure(path, figure, [&] {
-    pladv(0);
-    plschr(0, 0.8);
-    plvpor(0.1, 0.97, 0.42, 0.9);
-    plwind(0, t_end, -y_max, y_max);
-    plcol0(1);
-    plbox("bct", 0, 0, "bcntv", 0, 0);
-    pllab("", "deg/s", top_title.c_str());
-    // The fit first (wide, light blue), the measured rate on top of it (thin, dark): where the
-    // two agree the measured line shows inside the fit's band (issue 18).
-    plscol0(9, 150, 185, 235);
-    plcol0(9);
-    plwidth(4.0);
-    plline(static_cast<PLINT>(tf.size()), tf.data(), yf.data());
-    plscol0(15, 0, 0, 0);
-    plcol0(15);
-    plwidth(1.0);
-    plline(static_cast<PLINT>(tm.size()), tm.data(), ym.data());
-    plscol0(15, 170, 170, 170);
-    plvpor(0.1, 0.97, 0.1, 0.32);
-    plwind(0, t_end, -r_max, r_max);
-    plcol0(1);
-    plbox("bcnt", 0, 0, "bcntv", 0, 0);
-    pllab("s", "deg/s", bottom_title.c_str());
-    plcol0(15);
-    plline(static_cast<PLINT>(tr.size()), tr.data(), yr.data());
-    plscol0(10, 200, 60, 40);
-    plcol0(10);
-    for (double level : {noise, -noise}) {
-      PLFLT xs[2] = {0, t_end}, ys[2] = {level, level};
-      plline(2, xs, ys);  // solid: PLplot draws a dashed line as one path per dash
-    }
-  }, why);
+  return WriteFigure(
+      path, figure,
+      [&] {
+        pladv(0);
+        plschr(0, 0.8);
+        plvpor(0.1, 0.97, 0.42, 0.9);
+        plwind(0, t_end, -y_max, y_max);
+        plcol0(1);
+        plbox("bct", 0, 0, "bcntv", 0, 0);
+        pllab("", "deg/s", top_title.c_str());
+        // The fit first (wide, light blue), the measured rate on top of it (thin, dark): where the
+        // two agree the measured line shows inside the fit's band (issue 18).
+        plscol0(9, 150, 185, 235);
+        plcol0(9);
+        plwidth(4.0);
+        plline(static_cast<PLINT>(tf.size()), tf.data(), yf.data());
+        plscol0(15, 0, 0, 0);
+        plcol0(15);
+        plwidth(1.0);
+        plline(static_cast<PLINT>(tm.size()), tm.data(), ym.data());
+        plscol0(15, 170, 170, 170);
+        plvpor(0.1, 0.97, 0.1, 0.32);
+        plwind(0, t_end, -r_max, r_max);
+        plcol0(1);
+        plbox("bcnt", 0, 0, "bcntv", 0, 0);
+        pllab("s", "deg/s", bottom_title.c_str());
+        plcol0(15);
+        plline(static_cast<PLINT>(tr.size()), tr.data(), yr.data());
+        plscol0(10, 200, 60, 40);
+        plcol0(10);
+        for (double level : {noise, -noise}) {
+          PLFLT xs[2] = {0, t_end}, ys[2] = {level, level};
+          plline(2, xs, ys);  // solid: PLplot draws a dashed line as one path per dash
+        }
+      },
+      why);
 }
 
 }  // namespace bifilar

@@ -14,8 +14,7 @@ namespace bifilar {
 // Needs the series (TraceFitOptions::keep_series). `title` is not drawn (the file name is in the
 // report's caption). Returns false with *why when there is nothing to draw or the file cannot be
 // written.
-bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
-                            DisplayUnits units, const std::string& path, int width_px,
-                            int height_px, std::string* why);
+bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title, DisplayUnits units,
+                            const std::string& path, int width_px, int height_px, std::string* why);
 
 }  // namespace bifilar

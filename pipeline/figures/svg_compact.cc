@@ -29,8 +29,9 @@ std::string SimplifySvgNumbers(const std::string& svg) {
   const size_t n = svg.size();
   auto digit = [&](size_t i) { return i < n && svg[i] >= '0' && svg[i] <= '9'; };
   for (size_t i = 0; i < n;) {
-    const bool starts = digit(i) && (i == 0 || !(std::isalnum(static_cast<unsigned char>(svg[i - 1])) ||
-                                                 svg[i - 1] == '.' || svg[i - 1] == '_'));
+    const bool starts =
+        digit(i) && (i == 0 || !(std::isalnum(static_cast<unsigned char>(svg[i - 1])) ||
+                                 svg[i - 1] == '.' || svg[i - 1] == '_'));
     if (!starts) {
       out += svg[i++];
       continue;
@@ -48,7 +49,8 @@ std::string SimplifySvgNumbers(const std::string& svg) {
         char buffer[64];
         std::snprintf(buffer, sizeof(buffer), "%.1f", value);
         std::string text = buffer;
-        if (text.size() > 2 && text.compare(text.size() - 2, 2, ".0") == 0) text.resize(text.size() - 2);
+        if (text.size() > 2 && text.compare(text.size() - 2, 2, ".0") == 0)
+          text.resize(text.size() - 2);
         if (negative && text == "0") out.pop_back();  // "-0.04" -> "0", not "-0"
         out += text;
         i = k;
@@ -59,8 +61,8 @@ std::string SimplifySvgNumbers(const std::string& svg) {
     out.append(svg, i, j - i);
     i = j;
   }
-  for (const char* redundant : {"stroke-opacity:1;", "fill-opacity:1;", "stroke-miterlimit:10;",
-                                "fill-rule:nonzero;"}) {
+  for (const char* redundant :
+       {"stroke-opacity:1;", "fill-opacity:1;", "stroke-miterlimit:10;", "fill-rule:nonzero;"}) {
     out = ReplaceAll(out, redundant, "");
   }
   return out;
@@ -94,7 +96,8 @@ std::string CompactPolyline(const std::string& tag) {
     const size_t num = tr_at + std::string(" transform=\"matrix(1,0,0,-1,0,").size();
     char* stop = nullptr;
     flip_height = std::strtod(tag.c_str() + num, &stop);
-    if (stop == nullptr || std::string(stop, std::min<size_t>(2, std::strlen(stop))) != ")\"") return tag;
+    if (stop == nullptr || std::string(stop, std::min<size_t>(2, std::strlen(stop))) != ")\"")
+      return tag;
     tr_end = static_cast<size_t>(stop - tag.c_str()) + 2;
   } else if (tag.find(" transform=") != std::string::npos) {
     return tag;
@@ -134,7 +137,8 @@ std::string CompactSvgPaths(const std::string& svg) {
   std::string out;
   out.reserve(svg.size());
   size_t at = 0;
-  for (size_t start = svg.find("<path ", at); start != std::string::npos; start = svg.find("<path ", at)) {
+  for (size_t start = svg.find("<path ", at); start != std::string::npos;
+       start = svg.find("<path ", at)) {
     const size_t end = svg.find('>', start);
     if (end == std::string::npos) break;
     out.append(svg, at, start - at);
@@ -220,7 +224,8 @@ std::string ShareSvgGlyphs(const std::string& html) {
     if (found == by_content.end()) {
       const std::string shared_id = "sg" + std::to_string(by_content.size());
       found = by_content.emplace(key, shared_id).first;
-      shared += symbol.substr(0, id_at) + " id=\"" + shared_id + "\"" + symbol.substr(id_end + 1) + "\n";
+      shared +=
+          symbol.substr(0, id_at) + " id=\"" + shared_id + "\"" + symbol.substr(id_end + 1) + "\n";
     }
     renamed[id] = found->second;
     body.append(html, at, start - at);
@@ -241,8 +246,9 @@ std::string ShareSvgGlyphs(const std::string& html) {
     at = id_end;
   }
   out.append(body, at, std::string::npos);
-  const std::string defs = "<svg width=\"0\" height=\"0\" style=\"position:absolute\" aria-hidden=\"true\"><defs>\n" +
-                           shared + "</defs></svg>\n";
+  const std::string defs =
+      "<svg width=\"0\" height=\"0\" style=\"position:absolute\" aria-hidden=\"true\"><defs>\n" +
+      shared + "</defs></svg>\n";
   const size_t close = out.rfind("</body>");
   out.insert(close == std::string::npos ? out.size() : close, defs);
   return out;
