@@ -90,6 +90,140 @@ void MeanAndStandardError(const std::vector<double>& values, const std::vector<d
       values.size() >= 2 ? std::max(SampleStd(values) / std::sqrt(n), fit_sem) : fit_sem;
 }
 
+namespace {
+
+// A given rig inertia (rig.inertia a value or a table) does not depend on k: looked up once, at
+// rig.calibration.rig_pitch_deg. NaN for a tare rig (measured in every round).
+void GivenRigInertia(const CampaignConfig& config, double* rig_given, double* rig_given_std) {
+  *rig_given = NAN;
+  *rig_given_std = NAN;
+  if (config.rig_inertia.kind == RigInertiaSpec::Kind::kTare) return;
+  std::string why;
+  if (!RigInertiaAt(config, NAN, NAN, config.calibration.rig_pitch_deg, rig_given, rig_given_std,
+                    &why)) {
+    throw UserError("rig.calibration: rig inertia at rig_pitch_deg " +
+                    Format("%g", config.calibration.rig_pitch_deg) + " deg: " + why);
+  }
+}
+
+// One round's records into *out: the reference swings (every one must be ok), their mean
+// inertia with its standard error and scatter, and the rig's inertia (the tare logs' mean, or the
+// given one).
+void ReadReferenceSwings(const std::vector<TraceRecord>& records, bool from_tare,
+                         double rig_given, double rig_given_std, RigCalibrationResult* out) {
+  std::vector<double> swing, swing_std, tare, tare_std;
+  out->logs.clear();
+  for (const TraceRecord& r : records) {
+    if (!r.cache_key.empty()) out->cache_keys.push_back(r.cache_key);
+    if (r.role == TraceRole::kCalibration) {
+      if (!r.ok()) {
+        throw UserError("rig.calibration: reference swing " + Described(r) +
+                        "; the campaign stops before any aircraft trace is fitted with an "
+                        "unknown geometry: fix this log (e.g. a fit.windows entry) or remove it "
+                        "from rig.calibration.logs");
+      }
+      out->logs.push_back(r.file);
+      swing.push_back(r.inertia_total_kg_m2);
+      swing_std.push_back(r.inertia_total_std_kg_m2);
+    } else if (r.role == TraceRole::kTare && r.ok()) {
+      tare.push_back(r.inertia_total_kg_m2);
+      tare_std.push_back(r.inertia_total_std_kg_m2);
+    }
+  }
+  if (swing.empty()) throw UserError("rig.calibration.logs: no reference swing was found");
+  out->n_swings = static_cast<int>(swing.size());
+  MeanAndStandardError(swing, swing_std, &out->swings_total_kg_m2, &out->swings_total_std_kg_m2);
+  out->swings_scatter_kg_m2 = SampleStd(swing);
+  if (from_tare) {
+    if (tare.empty()) {
+      throw UserError(
+          "rig.calibration: no usable tare log (rig.inertia.tare.logs): the rig's "
+          "own inertia is needed to calibrate; the campaign stops");
+    }
+    MeanAndStandardError(tare, tare_std, &out->rig_inertia_kg_m2, &out->rig_inertia_std_kg_m2);
+  } else {
+    out->rig_inertia_kg_m2 = rig_given;
+    out->rig_inertia_std_kg_m2 = rig_given_std;
+  }
+}
+
+// The factor for the next round, k times target/fitted (*ratio), checked against the allowed
+// range.
+double FactorFromRound(const RigCalibrationSpec& spec, bool from_tare, double rig_given, double k,
+                       const RigCalibrationResult& out, double* ratio) {
+  // The reference's share of the swings' inertia, which must come out as its known inertia.
+  const double measured_reference = out.swings_total_kg_m2 - out.rig_inertia_kg_m2;
+  if (!(measured_reference > 0.0)) {
+    throw UserError(
+        Format("rig.calibration: the reference swings (I = %.6g kg m^2) are not "
+               "above the rig alone (%.6g kg m^2): check rig.calibration.logs, "
+               "reference_mass_kg and rig.inertia",
+               out.swings_total_kg_m2, out.rig_inertia_kg_m2));
+  }
+  // Tare: I_rig scales with k too, so target/fitted = I_ref / (I_swings - I_tare); given rig:
+  // (I_rig + I_ref) / I_swings.
+  *ratio = from_tare ? spec.reference_inertia_kg_m2 / measured_reference
+                     : (rig_given + spec.reference_inertia_kg_m2) / out.swings_total_kg_m2;
+  const double next = k * *ratio;
+  if (!(next >= kMinCalibrationFactor && next <= kMaxCalibrationFactor)) {
+    throw UserError(
+        Format("rig.calibration: the reference swings give an effective D^2/L %.4g times the "
+               "configured one (allowed %g to %g): not a tape-measure error. Check "
+               "reference_inertia_kg_m2 (about the swing axis, kg m^2), reference_mass_kg (kg), "
+               "rig.inertia and rig.mass_kg",
+               next, kMinCalibrationFactor, kMaxCalibrationFactor));
+  }
+  return next;
+}
+
+// The converged factor k into *out with its std (std(k)/k to first order in each input,
+// docs/method.md §15), the effective geometry, and the warnings (few swings, a large std, k far
+// from 1).
+void CalibrationUncertainty(const CampaignConfig& config, bool from_tare, double rig_given,
+                            double rig_given_std, double k, RigCalibrationResult* out) {
+  const RigCalibrationSpec& spec = config.calibration;
+  const double ref = spec.reference_inertia_kg_m2;
+  if (from_tare) {  // k = I_ref / (S - T): S - T = I_ref at convergence
+    out->rel_std_reference = spec.reference_inertia_std_kg_m2 / ref;
+    out->rel_std_swings = out->swings_total_std_kg_m2 / ref;
+    out->rel_std_rig = out->rig_inertia_std_kg_m2 / ref;
+  } else {  // k = (I_rig + I_ref) / S: S = I_rig + I_ref at convergence
+    const double total = rig_given + ref;
+    out->rel_std_reference = spec.reference_inertia_std_kg_m2 / total;
+    out->rel_std_swings = out->swings_total_std_kg_m2 / out->swings_total_kg_m2;
+    out->rel_std_rig = (std::isfinite(rig_given_std) ? rig_given_std : 0.0) / total;
+  }
+  out->factor = k;
+  out->factor_rel_std =
+      std::sqrt(out->rel_std_reference * out->rel_std_reference +
+                out->rel_std_swings * out->rel_std_swings + out->rel_std_rig * out->rel_std_rig);
+  out->factor_std = k * out->factor_rel_std;
+  out->effective_separation_m = config.filar_separation_m * std::sqrt(k);
+  out->nominal_d2_over_l_m =
+      config.filar_separation_m * config.filar_separation_m / config.filar_length_m;
+  out->effective_d2_over_l_m = k * out->nominal_d2_over_l_m;
+  out->applied = true;
+  if (out->n_swings < kRecommendedReferenceSwings) {
+    out->warnings.push_back(
+        "rig.calibration: " + std::to_string(out->n_swings) + " reference swing" +
+        (out->n_swings == 1 ? "" : "s") + "; swing the reference " +
+        std::to_string(kRecommendedReferenceSwings) +
+        "-5 times, so that their scatter is measured and enters the calibration's std");
+  }
+  if (out->factor_rel_std > 0.01) {
+    out->warnings.push_back(Format(
+        "rig.calibration: the calibration's std is %.2g %%: a heavier reference (inertia well "
+        "above the rig's), more swings or a better known reference inertia shrink it",
+        100.0 * out->factor_rel_std));
+  }
+  const std::string far = FarFromOneWarning(config, *out);
+  if (!far.empty()) out->warnings.push_back(far);
+}
+
+}  // namespace
+
+// GivenRigInertia, then rounds of fit (at factor k) -> ReadReferenceSwings -> FactorFromRound
+// until target/fitted is within kCalibrationTolerance of 1, then CalibrationUncertainty.
 RigCalibrationResult CalibrateRig(const CampaignConfig& config, const CalibrationFitFunction& fit,
                                   std::vector<TraceRecord>* records_out) {
   const RigCalibrationSpec& spec = config.calibration;
@@ -104,15 +238,8 @@ RigCalibrationResult CalibrateRig(const CampaignConfig& config, const Calibratio
   out.rig_inertia_source = from_tare                                  ? "tare"
                            : rig_kind == RigInertiaSpec::Kind::kTable ? "table"
                                                                       : "value";
-  // A given rig inertia does not depend on k: look it up once.
   double rig_given = NAN, rig_given_std = NAN;
-  if (!from_tare) {
-    std::string why;
-    if (!RigInertiaAt(config, NAN, NAN, spec.rig_pitch_deg, &rig_given, &rig_given_std, &why)) {
-      throw UserError("rig.calibration: rig inertia at rig_pitch_deg " +
-                      Format("%g", spec.rig_pitch_deg) + " deg: " + why);
-    }
-  }
+  GivenRigInertia(config, &rig_given, &rig_given_std);
 
   double k = 1.0;
   std::vector<TraceRecord> records;
@@ -123,63 +250,9 @@ RigCalibrationResult CalibrateRig(const CampaignConfig& config, const Calibratio
     trial.geometry_calibration.factor = k;
     records = fit(trial);
     out.iterations = round;
-    std::vector<double> swing, swing_std, tare, tare_std;
-    out.logs.clear();
-    for (const TraceRecord& r : records) {
-      if (!r.cache_key.empty()) out.cache_keys.push_back(r.cache_key);
-      if (r.role == TraceRole::kCalibration) {
-        if (!r.ok()) {
-          throw UserError("rig.calibration: reference swing " + Described(r) +
-                          "; the campaign stops before any aircraft trace is fitted with an "
-                          "unknown geometry: fix this log (e.g. a fit.windows entry) or remove it "
-                          "from rig.calibration.logs");
-        }
-        out.logs.push_back(r.file);
-        swing.push_back(r.inertia_total_kg_m2);
-        swing_std.push_back(r.inertia_total_std_kg_m2);
-      } else if (r.role == TraceRole::kTare && r.ok()) {
-        tare.push_back(r.inertia_total_kg_m2);
-        tare_std.push_back(r.inertia_total_std_kg_m2);
-      }
-    }
-    if (swing.empty()) throw UserError("rig.calibration.logs: no reference swing was found");
-    out.n_swings = static_cast<int>(swing.size());
-    MeanAndStandardError(swing, swing_std, &out.swings_total_kg_m2, &out.swings_total_std_kg_m2);
-    out.swings_scatter_kg_m2 = SampleStd(swing);
-    if (from_tare) {
-      if (tare.empty()) {
-        throw UserError(
-            "rig.calibration: no usable tare log (rig.inertia.tare.logs): the rig's "
-            "own inertia is needed to calibrate; the campaign stops");
-      }
-      MeanAndStandardError(tare, tare_std, &out.rig_inertia_kg_m2, &out.rig_inertia_std_kg_m2);
-    } else {
-      out.rig_inertia_kg_m2 = rig_given;
-      out.rig_inertia_std_kg_m2 = rig_given_std;
-    }
-    // The reference's share of the swings' inertia, which must come out as its known inertia.
-    const double measured_reference = out.swings_total_kg_m2 - out.rig_inertia_kg_m2;
-    if (!(measured_reference > 0.0)) {
-      throw UserError(
-          Format("rig.calibration: the reference swings (I = %.6g kg m^2) are not "
-                 "above the rig alone (%.6g kg m^2): check rig.calibration.logs, "
-                 "reference_mass_kg and rig.inertia",
-                 out.swings_total_kg_m2, out.rig_inertia_kg_m2));
-    }
-    // Tare: I_rig scales with k too, so target/fitted = I_ref / (I_swings - I_tare); given rig:
-    // (I_rig + I_ref) / I_swings.
-    const double ratio = from_tare
-                             ? spec.reference_inertia_kg_m2 / measured_reference
-                             : (rig_given + spec.reference_inertia_kg_m2) / out.swings_total_kg_m2;
-    const double next = k * ratio;
-    if (!(next >= kMinCalibrationFactor && next <= kMaxCalibrationFactor)) {
-      throw UserError(
-          Format("rig.calibration: the reference swings give an effective D^2/L %.4g times the "
-                 "configured one (allowed %g to %g): not a tape-measure error. Check "
-                 "reference_inertia_kg_m2 (about the swing axis, kg m^2), reference_mass_kg (kg), "
-                 "rig.inertia and rig.mass_kg",
-                 next, kMinCalibrationFactor, kMaxCalibrationFactor));
-    }
+    ReadReferenceSwings(records, from_tare, rig_given, rig_given_std, &out);
+    double ratio = NAN;
+    const double next = FactorFromRound(spec, from_tare, rig_given, k, out, &ratio);
     if (std::abs(ratio - 1.0) <= kCalibrationTolerance) {
       converged = true;  // the records are those of k: keep k
     } else {
@@ -191,44 +264,7 @@ RigCalibrationResult CalibrateRig(const CampaignConfig& config, const Calibratio
                     std::to_string(kCalibrationMaxIterations) + " rounds (last factor " +
                     Format("%.8g", k) + ")");
   }
-
-  // std(k)/k to first order in each input (docs/method.md §15).
-  const double ref = spec.reference_inertia_kg_m2;
-  if (from_tare) {  // k = I_ref / (S - T): S - T = I_ref at convergence
-    out.rel_std_reference = spec.reference_inertia_std_kg_m2 / ref;
-    out.rel_std_swings = out.swings_total_std_kg_m2 / ref;
-    out.rel_std_rig = out.rig_inertia_std_kg_m2 / ref;
-  } else {  // k = (I_rig + I_ref) / S: S = I_rig + I_ref at convergence
-    const double total = rig_given + ref;
-    out.rel_std_reference = spec.reference_inertia_std_kg_m2 / total;
-    out.rel_std_swings = out.swings_total_std_kg_m2 / out.swings_total_kg_m2;
-    out.rel_std_rig = (std::isfinite(rig_given_std) ? rig_given_std : 0.0) / total;
-  }
-  out.factor = k;
-  out.factor_rel_std =
-      std::sqrt(out.rel_std_reference * out.rel_std_reference +
-                out.rel_std_swings * out.rel_std_swings + out.rel_std_rig * out.rel_std_rig);
-  out.factor_std = k * out.factor_rel_std;
-  out.effective_separation_m = config.filar_separation_m * std::sqrt(k);
-  out.nominal_d2_over_l_m =
-      config.filar_separation_m * config.filar_separation_m / config.filar_length_m;
-  out.effective_d2_over_l_m = k * out.nominal_d2_over_l_m;
-  out.applied = true;
-  if (out.n_swings < kRecommendedReferenceSwings) {
-    out.warnings.push_back(
-        "rig.calibration: " + std::to_string(out.n_swings) + " reference swing" +
-        (out.n_swings == 1 ? "" : "s") + "; swing the reference " +
-        std::to_string(kRecommendedReferenceSwings) +
-        "-5 times, so that their scatter is measured and enters the calibration's std");
-  }
-  if (out.factor_rel_std > 0.01) {
-    out.warnings.push_back(Format(
-        "rig.calibration: the calibration's std is %.2g %%: a heavier reference (inertia well "
-        "above the rig's), more swings or a better known reference inertia shrink it",
-        100.0 * out.factor_rel_std));
-  }
-  const std::string far = FarFromOneWarning(config, out);
-  if (!far.empty()) out.warnings.push_back(far);
+  CalibrationUncertainty(config, from_tare, rig_given, rig_given_std, k, &out);
   if (records_out) *records_out = std::move(records);
   return out;
 }

@@ -171,16 +171,8 @@ std::string Format(const char* fmt, double a) {
   return buffer;
 }
 
-}  // namespace
-
-FormatGuess GuessCsvFormat(const std::string& text) {
-  FormatGuess guess;
-  const std::vector<std::string> lines = HeadLines(text, 400);
-  if (lines.empty()) {
-    guess.why = "no header line";
-    return guess;
-  }
-  // Delimiter: the one that splits the header into the most cells, consistently with row 2.
+// Delimiter: the one that splits the header into the most cells, consistently with row 2.
+char GuessDelimiter(const std::vector<std::string>& lines) {
   char delim = ',';
   size_t best = 1;
   for (char d : {',', ';', '\t', ' '}) {
@@ -190,22 +182,26 @@ FormatGuess GuessCsvFormat(const std::string& text) {
       delim = d;
     }
   }
-  guess.format.delimiter = delim;
-  const std::vector<std::string> header = SplitLine(lines[0], delim);
-  std::vector<ColumnName> names;
-  for (const std::string& h : header) names.push_back(Normalise(h));
-  // Numeric rows below the header, column by column.
-  std::vector<std::vector<double>> columns(header.size());
+  return delim;
+}
+
+// Numeric rows below the header, column by column (up to the first row of another width).
+std::vector<std::vector<double>> NumericColumns(const std::vector<std::string>& lines, char delim,
+                                                size_t width) {
+  std::vector<std::vector<double>> columns(width);
   for (size_t r = 1; r < lines.size(); ++r) {
     const std::vector<std::string> cells = SplitLine(lines[r], delim);
-    if (cells.size() != header.size()) break;
+    if (cells.size() != width) break;
     for (size_t c = 0; c < cells.size(); ++c) {
       double v = 0;
       if (IsNumber(cells[c], &v)) columns[c].push_back(v);
     }
   }
+  return columns;
+}
 
-  // Time column: a known name, else the first whose name holds "time".
+// Time column: a known name, else the first whose name holds "time"; -1 when none.
+int GuessTimeColumn(const std::vector<ColumnName>& names) {
   int time = -1;
   for (const char* n : {"t", "time", "times", "ts", "timestamp", "timeus", "timems",
                         "timestampus", "timestampms", "sec", "seconds", "elapsed"}) {
@@ -216,6 +212,102 @@ FormatGuess GuessCsvFormat(const std::string& text) {
   for (size_t i = 0; i < names.size() && time < 0; ++i) {
     if (names[i].bare.find("time") != std::string::npos) time = static_cast<int>(i);
   }
+  return time;
+}
+
+// Time unit: from the name (`tname`, normalised), else from the median step of the first rows.
+void GuessTimeUnit(const std::string& tname, const std::vector<double>& tc, FormatGuess* guess) {
+  std::vector<double> steps;
+  for (size_t i = 1; i < tc.size(); ++i) {
+    if (tc[i] > tc[i - 1]) steps.push_back(tc[i] - tc[i - 1]);
+  }
+  const double step = Median(steps);
+  std::string time_why;
+  if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "us") == 0) {
+    guess->format.time_unit = TimeUnit::kMicroseconds;
+    time_why = "from its name";
+  } else if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "ms") == 0) {
+    guess->format.time_unit = TimeUnit::kMilliseconds;
+    time_why = "from its name";
+  } else if (std::isfinite(step)) {
+    // IMU logs are sampled at 1 Hz - 2 kHz: a median step above 0.5 s is not seconds.
+    guess->format.time_unit = step < 0.5     ? TimeUnit::kSeconds
+                              : step < 500.0 ? TimeUnit::kMilliseconds
+                                             : TimeUnit::kMicroseconds;
+    time_why = Format("from its median step, %.4g", step);
+  } else {
+    time_why = "default, no steps to judge by";
+  }
+  guess->guesses.push_back("time column '" + guess->format.time_column + "' in " +
+                           ToString(guess->format.time_unit) + " (" + time_why + ")");
+}
+
+// Gyro unit: from the names, else from the size of the readings.
+void GuessGyroUnit(const std::vector<ColumnName>& names, const std::array<int, 3>& gyro,
+                   const std::vector<std::vector<double>>& columns, FormatGuess* guess) {
+  std::string hint;
+  for (int a = 0; a < 3; ++a) {
+    if (!names[gyro[a]].unit_hint.empty()) hint = names[gyro[a]].unit_hint;
+  }
+  std::vector<double> magnitudes;
+  for (int a = 0; a < 3; ++a) {
+    for (double v : columns[gyro[a]]) magnitudes.push_back(std::fabs(v));
+  }
+  std::sort(magnitudes.begin(), magnitudes.end());
+  const double p99 = magnitudes.empty() ? NAN : magnitudes[magnitudes.size() * 99 / 100];
+  std::string gyro_why;
+  if (!hint.empty()) {
+    ParseRateUnit(hint, &guess->format.gyro_unit);
+    guess->gyro_unit_from_names = true;
+    gyro_why = "from the column names";
+  } else if (std::isfinite(p99)) {
+    guess->format.gyro_unit = p99 > kDegPerSGuessAbove ? RateUnit::kDegPerS : RateUnit::kRadPerS;
+    gyro_why = Format("from the readings: 99th percentile of |rate| %.3g", p99) +
+               (p99 > kDegPerSGuessAbove ? " is no pendulum in rad/s" : "");
+  } else {
+    gyro_why = "default";
+  }
+  guess->guesses.push_back("gyro columns " + guess->format.gyro_columns[0] + ", " +
+                           guess->format.gyro_columns[1] + ", " + guess->format.gyro_columns[2] +
+                           " in " + ToString(guess->format.gyro_unit) + " (" + gyro_why + ")");
+}
+
+// Accelerometer unit: gravity reads ~9.8 in m/s^2, ~1 in g.
+void GuessAccelUnit(const std::array<int, 3>& accel,
+                    const std::vector<std::vector<double>>& columns, FormatGuess* guess) {
+  std::vector<double> norms;
+  const size_t n = std::min({columns[accel[0]].size(), columns[accel[1]].size(),
+                             columns[accel[2]].size()});
+  for (size_t i = 0; i < n; ++i) {
+    norms.push_back(std::hypot(columns[accel[0]][i], columns[accel[1]][i], columns[accel[2]][i]));
+  }
+  const double norm = Median(norms);
+  guess->format.accel_unit =
+      std::isfinite(norm) && norm < 3.0 ? AccelUnit::kStandardGravity : AccelUnit::kMetresPerS2;
+  guess->guesses.push_back("accelerometer columns " + guess->format.accel_columns[0] + ", " +
+                           guess->format.accel_columns[1] + ", " + guess->format.accel_columns[2] +
+                           " in " + ToString(guess->format.accel_unit) +
+                           (std::isfinite(norm) ? Format(" (median |f| %.3g)", norm) : ""));
+}
+
+}  // namespace
+
+// GuessDelimiter -> NumericColumns -> GuessTimeColumn (and the gyro and accelerometer triplets)
+// -> GuessTimeUnit -> GuessGyroUnit -> GuessAccelUnit.
+FormatGuess GuessCsvFormat(const std::string& text) {
+  FormatGuess guess;
+  const std::vector<std::string> lines = HeadLines(text, 400);
+  if (lines.empty()) {
+    guess.why = "no header line";
+    return guess;
+  }
+  const char delim = GuessDelimiter(lines);
+  guess.format.delimiter = delim;
+  const std::vector<std::string> header = SplitLine(lines[0], delim);
+  std::vector<ColumnName> names;
+  for (const std::string& h : header) names.push_back(Normalise(h));
+  const std::vector<std::vector<double>> columns = NumericColumns(lines, delim, header.size());
+  const int time = GuessTimeColumn(names);
   const std::array<int, 3> gyro = FindTriplet(
       names, {"g", "gyro", "gyr", "w", "omega", "rate", "gyrorad", "angvel", "angularvelocity",
               "angularrate", "gyroscope", "bodyrate", "wb"});
@@ -238,75 +330,10 @@ FormatGuess GuessCsvFormat(const std::string& text) {
   } else {
     guess.format.accel_columns = {"", "", ""};
   }
-
-  // Time unit: from the name, else from the median step of the first rows.
-  std::vector<double> steps;
-  const std::vector<double>& tc = columns[time];
-  for (size_t i = 1; i < tc.size(); ++i) {
-    if (tc[i] > tc[i - 1]) steps.push_back(tc[i] - tc[i - 1]);
-  }
-  const double step = Median(steps);
-  const std::string& tname = names[time].bare;
-  std::string time_why;
-  if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "us") == 0) {
-    guess.format.time_unit = TimeUnit::kMicroseconds;
-    time_why = "from its name";
-  } else if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "ms") == 0) {
-    guess.format.time_unit = TimeUnit::kMilliseconds;
-    time_why = "from its name";
-  } else if (std::isfinite(step)) {
-    // IMU logs are sampled at 1 Hz - 2 kHz: a median step above 0.5 s is not seconds.
-    guess.format.time_unit = step < 0.5     ? TimeUnit::kSeconds
-                             : step < 500.0 ? TimeUnit::kMilliseconds
-                                            : TimeUnit::kMicroseconds;
-    time_why = Format("from its median step, %.4g", step);
-  } else {
-    time_why = "default, no steps to judge by";
-  }
-  guess.guesses.push_back("time column '" + guess.format.time_column + "' in " +
-                          ToString(guess.format.time_unit) + " (" + time_why + ")");
-
-  // Gyro unit: from the names, else from the size of the readings.
-  std::string hint;
-  for (int a = 0; a < 3; ++a) {
-    if (!names[gyro[a]].unit_hint.empty()) hint = names[gyro[a]].unit_hint;
-  }
-  std::vector<double> magnitudes;
-  for (int a = 0; a < 3; ++a) {
-    for (double v : columns[gyro[a]]) magnitudes.push_back(std::fabs(v));
-  }
-  std::sort(magnitudes.begin(), magnitudes.end());
-  const double p99 = magnitudes.empty() ? NAN : magnitudes[magnitudes.size() * 99 / 100];
-  std::string gyro_why;
-  if (!hint.empty()) {
-    ParseRateUnit(hint, &guess.format.gyro_unit);
-    guess.gyro_unit_from_names = true;
-    gyro_why = "from the column names";
-  } else if (std::isfinite(p99)) {
-    guess.format.gyro_unit = p99 > kDegPerSGuessAbove ? RateUnit::kDegPerS : RateUnit::kRadPerS;
-    gyro_why = Format("from the readings: 99th percentile of |rate| %.3g", p99) +
-               (p99 > kDegPerSGuessAbove ? " is no pendulum in rad/s" : "");
-  } else {
-    gyro_why = "default";
-  }
-  guess.guesses.push_back("gyro columns " + guess.format.gyro_columns[0] + ", " +
-                          guess.format.gyro_columns[1] + ", " + guess.format.gyro_columns[2] +
-                          " in " + ToString(guess.format.gyro_unit) + " (" + gyro_why + ")");
+  GuessTimeUnit(names[time].bare, columns[time], &guess);
+  GuessGyroUnit(names, gyro, columns, &guess);
   if (accel[0] >= 0) {
-    // Accelerometer unit: gravity reads ~9.8 in m/s^2, ~1 in g.
-    std::vector<double> norms;
-    const size_t n = std::min({columns[accel[0]].size(), columns[accel[1]].size(),
-                               columns[accel[2]].size()});
-    for (size_t i = 0; i < n; ++i) {
-      norms.push_back(std::hypot(columns[accel[0]][i], columns[accel[1]][i], columns[accel[2]][i]));
-    }
-    const double norm = Median(norms);
-    guess.format.accel_unit =
-        std::isfinite(norm) && norm < 3.0 ? AccelUnit::kStandardGravity : AccelUnit::kMetresPerS2;
-    guess.guesses.push_back("accelerometer columns " + guess.format.accel_columns[0] + ", " +
-                            guess.format.accel_columns[1] + ", " + guess.format.accel_columns[2] +
-                            " in " + ToString(guess.format.accel_unit) +
-                            (std::isfinite(norm) ? Format(" (median |f| %.3g)", norm) : ""));
+    GuessAccelUnit(accel, columns, &guess);
   } else {
     guess.guesses.push_back("no accelerometer columns (gyro-only: the swing axis from the gyro)");
   }

@@ -37,130 +37,163 @@ double Curve(const EllipseResult& r, double pitch_deg) {
   return EllipseMoment(r.a_kg_m2, r.b_kg_m2, r.c_kg_m2, pitch_deg);
 }
 
-}  // namespace
+// Everything the moment figure draws, in display units.
+struct MomentPage {
+  double k = 1.0;  // kg m^2 -> display unit
+  double x_lo = -90, x_hi = 90, y_lo = 0.0, y_hi = 0.0;
+  std::vector<double> cx, cy;        // the fitted curve
+  std::vector<double> px, py;        // the trials
+  std::vector<double> ex, elo, ehi;  // the error bars
+  bool legend_below = false;
+};
 
-bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
-                              const EllipsePlotOptions& options, std::string* why) {
-  const double k = options.unit_scale;
-  double x_lo = -90, x_hi = 90;
-  for (const auto& p : r.points) {
-    x_lo = std::min(x_lo, std::floor(p.pitch_deg / 10) * 10);
-    x_hi = std::max(x_hi, std::ceil(p.pitch_deg / 10) * 10);
+// Curve, trials, error bars (the given stds of a weighted fit, else each angle's mean +- std).
+void MomentSeries(const EllipseResult& r, MomentPage* p) {
+  const double k = p->k;
+  for (const auto& q : r.points) {
+    p->x_lo = std::min(p->x_lo, std::floor(q.pitch_deg / 10) * 10);
+    p->x_hi = std::max(p->x_hi, std::ceil(q.pitch_deg / 10) * 10);
   }
-  // Curve, trials, error bars.
-  std::vector<double> cx, cy;
   for (int i = 0; i <= 720; ++i) {
-    const double t = x_lo + (x_hi - x_lo) * i / 720.0;
-    cx.push_back(t);
-    cy.push_back(Curve(r, t) * k);
+    const double t = p->x_lo + (p->x_hi - p->x_lo) * i / 720.0;
+    p->cx.push_back(t);
+    p->cy.push_back(Curve(r, t) * k);
   }
-  std::vector<double> px, py;
-  for (const auto& p : r.points) {
-    px.push_back(p.pitch_deg);
-    py.push_back(p.inertia_kg_m2 * k);
+  for (const auto& q : r.points) {
+    p->px.push_back(q.pitch_deg);
+    p->py.push_back(q.inertia_kg_m2 * k);
   }
-  std::vector<double> ex, elo, ehi;
   if (r.weighted) {
-    for (const auto& p : r.points) {
-      ex.push_back(p.pitch_deg);
-      elo.push_back((p.inertia_kg_m2 - p.std_kg_m2) * k);
-      ehi.push_back((p.inertia_kg_m2 + p.std_kg_m2) * k);
+    for (const auto& q : r.points) {
+      p->ex.push_back(q.pitch_deg);
+      p->elo.push_back((q.inertia_kg_m2 - q.std_kg_m2) * k);
+      p->ehi.push_back((q.inertia_kg_m2 + q.std_kg_m2) * k);
     }
   } else {
     for (const auto& a : r.angles) {
       if (a.n < 2) continue;
-      ex.push_back(a.pitch_deg);
-      elo.push_back((a.mean_kg_m2 - a.std_kg_m2) * k);
-      ehi.push_back((a.mean_kg_m2 + a.std_kg_m2) * k);
+      p->ex.push_back(a.pitch_deg);
+      p->elo.push_back((a.mean_kg_m2 - a.std_kg_m2) * k);
+      p->ehi.push_back((a.mean_kg_m2 + a.std_kg_m2) * k);
     }
   }
-  double y_lo = *std::min_element(cy.begin(), cy.end());
-  double y_hi = *std::max_element(cy.begin(), cy.end());
-  for (double v : py) y_lo = std::min(y_lo, v), y_hi = std::max(y_hi, v);
-  for (double v : elo) y_lo = std::min(y_lo, v);
-  for (double v : ehi) y_hi = std::max(y_hi, v);
-  // The legend goes where the curve is not: below when the middle (0 deg) is high, else above.
-  const bool legend_below = Curve(r, 0.0) >= Curve(r, 90.0);
-  const double pad = 0.06 * (y_hi - y_lo) + 1e-12 * std::fabs(y_hi);
-  y_lo -= legend_below ? 5.5 * pad : pad;
-  y_hi += legend_below ? pad : 5.5 * pad;
-  x_lo -= 5;
-  x_hi += 5;
+}
 
+// The axes' ranges: everything drawn, with room for the legend where the curve is not (below
+// when the middle, 0 deg, is high, else above).
+void MomentAxes(const EllipseResult& r, MomentPage* p) {
+  double y_lo = *std::min_element(p->cy.begin(), p->cy.end());
+  double y_hi = *std::max_element(p->cy.begin(), p->cy.end());
+  for (double v : p->py) y_lo = std::min(y_lo, v), y_hi = std::max(y_hi, v);
+  for (double v : p->elo) y_lo = std::min(y_lo, v);
+  for (double v : p->ehi) y_hi = std::max(y_hi, v);
+  p->legend_below = Curve(r, 0.0) >= Curve(r, 90.0);
+  const double pad = 0.06 * (y_hi - y_lo) + 1e-12 * std::fabs(y_hi);
+  y_lo -= p->legend_below ? 5.5 * pad : pad;
+  y_hi += p->legend_below ? pad : 5.5 * pad;
+  p->y_lo = y_lo;
+  p->y_hi = y_hi;
+  p->x_lo -= 5;
+  p->x_hi += 5;
+}
+
+// Principal axes: theta = tau (I_zp) and tau +- 90 (I_xp), as labelled vertical lines.
+void DrawPrincipalLines(const EllipseResult& r, const MomentPage& p) {
+  std::vector<std::pair<double, std::string>> principal;
+  if (r.tau_defined) {
+    for (double t : {r.tau_deg.value - 90, r.tau_deg.value, r.tau_deg.value + 90}) {
+      if (t < p.x_lo || t > p.x_hi) continue;
+      principal.push_back({t, std::fabs(t - r.tau_deg.value) < 1 ? "z#dp#u" : "x#dp#u"});
+    }
+  }
+  plcol0(kRed);
+  pllsty(3);
+  plwidth(1.5);
+  for (const auto& [t, label] : principal) {
+    const double xs[2] = {t, t}, ys[2] = {p.y_lo, p.y_hi};
+    plline(2, xs, ys);
+    const bool right_edge = t > p.x_hi - 12;
+    const double y_text =
+        p.legend_below ? p.y_hi - 0.05 * (p.y_hi - p.y_lo) : p.y_lo + 0.06 * (p.y_hi - p.y_lo);
+    plptex(t + (right_edge ? -1.5 : 1.5), y_text, 1, 0, right_edge ? 1 : 0, label.c_str());
+  }
+  pllsty(1);
+}
+
+// Error bars and trials, then the body-axis moments: I_z at 0 deg, I_x at +-90 deg.
+void DrawTrials(const EllipseResult& r, const MomentPage& p) {
+  plcol0(kGrey);
+  if (!p.ex.empty()) plerry(static_cast<PLINT>(p.ex.size()), p.ex.data(), p.elo.data(), p.ehi.data());
+  plcol0(kBlack);
+  plssym(0, 0.9);
+  plpoin(static_cast<PLINT>(p.px.size()), p.px.data(), p.py.data(), 4);  // open circles
+  plcol0(kGreen);
+  plssym(0, 1.6);
+  std::vector<double> bx, by;
+  for (double t : {-90.0, 0.0, 90.0}) {
+    if (t < p.x_lo || t > p.x_hi) continue;
+    bx.push_back(t);
+    by.push_back(Curve(r, t) * p.k);
+  }
+  plpoin(static_cast<PLINT>(bx.size()), bx.data(), by.data(), 5);  // crosses
+  plssym(0, 1.0);
+}
+
+// Legend: trials, error bars, the fit with tau, the body-axis moments.
+void DrawMomentLegend(const EllipseResult& r, const MomentPage& p) {
+  const double k = p.k;
+  const std::string curve_text =
+      r.tau_defined ? "fit (Eq. 7), #gt = " + Fmt("%.2f", r.tau_deg.value) + " ± " +
+                          Fmt("%.2f", r.tau_deg.std) + " deg"
+                    : std::string("fit (Eq. 7), #gt undefined");
+  const std::string body_text = "body axes: I#dx#u = " + Fmt("%.4g", r.ix.value * k) +
+                                ", I#dz#u = " + Fmt("%.4g", r.iz.value * k) +
+                                ", I#dxz#u = " + Fmt("%.3g", r.ixz.value * k);
+  const char* texts[4] = {"trials", r.weighted ? "± 1 std (given)" : "angle mean ± 1 std",
+                          curve_text.c_str(), body_text.c_str()};
+  PLINT opts[4] = {PL_LEGEND_SYMBOL, PL_LEGEND_LINE, PL_LEGEND_LINE, PL_LEGEND_SYMBOL};
+  PLINT text_colors[4] = {kBlack, kBlack, kBlack, kBlack};
+  PLINT line_colors[4] = {kBlack, kGrey, kBlue, kGreen};
+  PLINT line_styles[4] = {1, 1, 2, 1};
+  PLFLT line_widths[4] = {1, 1, 2, 1};
+  PLINT symbol_colors[4] = {kBlack, kBlack, kBlack, kGreen};
+  PLFLT symbol_scales[4] = {1.2, 1, 1, 1.6};
+  PLINT symbol_numbers[4] = {1, 1, 1, 1};
+  const char* symbols[4] = {"○", "", "", "×"};
+  PLFLT lw, lh;
+  pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+           (p.legend_below ? PL_POSITION_BOTTOM : PL_POSITION_TOP) | PL_POSITION_INSIDE, 0.0,
+           0.02, 0.06, 0, kBlack, 1, 4, 1, 4, opts, 0.8, 0.8, 2.0, 0.0, text_colors, texts,
+           nullptr, nullptr, nullptr, nullptr, line_colors, line_styles, line_widths,
+           symbol_colors, symbol_scales, symbol_numbers, symbols);
+}
+
+}  // namespace
+
+// MomentSeries -> MomentAxes, then drawn: frame -> DrawPrincipalLines -> DrawFittedCurve ->
+// DrawTrials -> DrawMomentLegend.
+bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
+                              const EllipsePlotOptions& options, std::string* why) {
+  MomentPage p;
+  p.k = options.unit_scale;
+  MomentSeries(r, &p);
+  MomentAxes(r, &p);
   auto draw = [&] {
     plschr(0, 1.1);
     plcol0(kBlack);
     pladv(0);
     plvsta();
-    plwind(x_lo, x_hi, y_lo, y_hi);
+    plwind(p.x_lo, p.x_hi, p.y_lo, p.y_hi);
     plcol0(kLight);
     plbox("g", 30, 0, "g", 0, 0);
     plcol0(kBlack);
     plbox("bcnst", 30, 3, "bcnstv", 0, 0);
     pllab("pitch #gh (deg, nose up)", ("moment of inertia (" + options.unit_label + ")").c_str(),
           "Moments against pitch and the fitted ellipse of inertia");
-    // Principal axes: theta = tau (I_zp) and tau +- 90 (I_xp).
-    std::vector<std::pair<double, std::string>> principal;
-    if (r.tau_defined) {
-      for (double t : {r.tau_deg.value - 90, r.tau_deg.value, r.tau_deg.value + 90}) {
-        if (t < x_lo || t > x_hi) continue;
-        principal.push_back({t, std::fabs(t - r.tau_deg.value) < 1 ? "z#dp#u" : "x#dp#u"});
-      }
-    }
-    plcol0(kRed);
-    pllsty(3);
-    plwidth(1.5);
-    for (const auto& [t, label] : principal) {
-      const double xs[2] = {t, t}, ys[2] = {y_lo, y_hi};
-      plline(2, xs, ys);
-      const bool right_edge = t > x_hi - 12;
-      const double y_text = legend_below ? y_hi - 0.05 * (y_hi - y_lo) : y_lo + 0.06 * (y_hi - y_lo);
-      plptex(t + (right_edge ? -1.5 : 1.5), y_text, 1, 0, right_edge ? 1 : 0, label.c_str());
-    }
-    pllsty(1);
-    // Fitted curve.
-    DrawFittedCurve(cx, cy);
-    // Error bars and trials.
-    plcol0(kGrey);
-    if (!ex.empty()) plerry(static_cast<PLINT>(ex.size()), ex.data(), elo.data(), ehi.data());
-    plcol0(kBlack);
-    plssym(0, 0.9);
-    plpoin(static_cast<PLINT>(px.size()), px.data(), py.data(), 4);  // open circles
-    // Body-axis moments: I_z at 0 deg, I_x at +-90 deg.
-    plcol0(kGreen);
-    plssym(0, 1.6);
-    std::vector<double> bx, by;
-    for (double t : {-90.0, 0.0, 90.0}) {
-      if (t < x_lo || t > x_hi) continue;
-      bx.push_back(t);
-      by.push_back(Curve(r, t) * k);
-    }
-    plpoin(static_cast<PLINT>(bx.size()), bx.data(), by.data(), 5);  // crosses
-    plssym(0, 1.0);
-    // Legend.
-    const std::string curve_text =
-        r.tau_defined ? "fit (Eq. 7), #gt = " + Fmt("%.2f", r.tau_deg.value) + " ± " +
-                            Fmt("%.2f", r.tau_deg.std) + " deg"
-                      : std::string("fit (Eq. 7), #gt undefined");
-    const std::string body_text = "body axes: I#dx#u = " + Fmt("%.4g", r.ix.value * k) +
-                                  ", I#dz#u = " + Fmt("%.4g", r.iz.value * k) +
-                                  ", I#dxz#u = " + Fmt("%.3g", r.ixz.value * k);
-    const char* texts[4] = {"trials", r.weighted ? "± 1 std (given)" : "angle mean ± 1 std",
-                            curve_text.c_str(), body_text.c_str()};
-    PLINT opts[4] = {PL_LEGEND_SYMBOL, PL_LEGEND_LINE, PL_LEGEND_LINE, PL_LEGEND_SYMBOL};
-    PLINT text_colors[4] = {kBlack, kBlack, kBlack, kBlack};
-    PLINT line_colors[4] = {kBlack, kGrey, kBlue, kGreen};
-    PLINT line_styles[4] = {1, 1, 2, 1};
-    PLFLT line_widths[4] = {1, 1, 2, 1};
-    PLINT symbol_colors[4] = {kBlack, kBlack, kBlack, kGreen};
-    PLFLT symbol_scales[4] = {1.2, 1, 1, 1.6};
-    PLINT symbol_numbers[4] = {1, 1, 1, 1};
-    const char* symbols[4] = {"○", "", "", "×"};
-    PLFLT lw, lh;
-    pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-             (legend_below ? PL_POSITION_BOTTOM : PL_POSITION_TOP) | PL_POSITION_INSIDE, 0.0, 0.02, 0.06, 0, kBlack, 1, 4, 1, 4, opts, 0.8, 0.8, 2.0, 0.0, text_colors, texts, nullptr, nullptr, nullptr,
-             nullptr, line_colors, line_styles, line_widths, symbol_colors, symbol_scales,
-             symbol_numbers, symbols);
+    DrawPrincipalLines(r, p);
+    DrawFittedCurve(p.cx, p.cy);
+    DrawTrials(r, p);
+    DrawMomentLegend(r, p);
   };
   return WriteFigure(path, options.figure, draw, why);
 }

@@ -160,48 +160,53 @@ std::string DescribeStart(std::string_view text) {
   return "the bytes " + out;
 }
 
-// `owner`, when given, holds the bytes `text` views; it is released once the rows are parsed, so a
-// long log's text and its samples are not both held while the samples are finished.
-ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& format,
-              const ImuLogOptions& options, std::string* owner = nullptr) {
-  std::string why;
-  if (!format.Check(&why)) Fail(name + ": invalid IMU format: " + why);
-  if (!options.Check(&why)) Fail(name + ": invalid log options: " + why);
-
-  if (text.size() >= 3 && static_cast<unsigned char>(text[0]) == 0xEF &&
-      static_cast<unsigned char>(text[1]) == 0xBB && static_cast<unsigned char>(text[2]) == 0xBF) {
-    text.remove_prefix(3);  // UTF-8 byte-order mark
+// Strips a UTF-8 byte-order mark from *text; fails on an empty file and on binary data (any NUL
+// byte, or more than 1 % control characters in the first 64 KiB).
+void RefuseBinary(const std::string& name, const ImuFormat& format, std::string_view* text) {
+  if (text->size() >= 3 && static_cast<unsigned char>((*text)[0]) == 0xEF &&
+      static_cast<unsigned char>((*text)[1]) == 0xBB &&
+      static_cast<unsigned char>((*text)[2]) == 0xBF) {
+    text->remove_prefix(3);  // UTF-8 byte-order mark
   }
-  if (IsBlank(text) || text.find_first_not_of(" \t\r\n") == std::string_view::npos) {
+  if (IsBlank(*text) || text->find_first_not_of(" \t\r\n") == std::string_view::npos) {
     Fail(name + ": the file is empty (expected a CSV header with columns " + format.time_column +
          ", " + format.gyro_columns[0] + ", ...)");
   }
-  // Binary data: any NUL byte, or more than 1 % control characters in the first 64 KiB.
-  if (const void* nul = std::memchr(text.data(), '\0', text.size())) {
+  if (const void* nul = std::memchr(text->data(), '\0', text->size())) {
     Fail(name + ": not a text CSV file (binary data at byte " +
-         std::to_string(static_cast<const char*>(nul) - text.data()) + ")");
+         std::to_string(static_cast<const char*>(nul) - text->data()) + ")");
   }
-  {
-    const size_t n = std::min<size_t>(text.size(), 65536);
-    size_t control = 0;
-    for (size_t i = 0; i < n; ++i) {
-      const unsigned char c = text[i];
-      if (c < 32 && c != '\n' && c != '\r' && c != '\t' && c != static_cast<unsigned char>(format.delimiter)) ++control;
-    }
-    if (control * 100 > n) Fail(name + ": not a text CSV file (" + std::to_string(control) +
-                                " control characters in the first " + std::to_string(n) + " bytes)");
+  const size_t n = std::min<size_t>(text->size(), 65536);
+  size_t control = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const unsigned char c = (*text)[i];
+    if (c < 32 && c != '\n' && c != '\r' && c != '\t' && c != static_cast<unsigned char>(format.delimiter)) ++control;
   }
+  if (control * 100 > n) Fail(name + ": not a text CSV file (" + std::to_string(control) +
+                              " control characters in the first " + std::to_string(n) + " bytes)");
+}
 
-  ImuData data;
-  LineReader reader(text);
+// The columns a CSV log is read from: the needed ones (time, gyro x y z, then accel x y z when
+// read) with their names, SI scale and field index, and the header's line.
+struct CsvColumns {
+  int header_line = 0;
+  std::vector<std::string> names;
+  std::vector<double> scale;
+  std::vector<int> column;
+  bool with_accel = false;
+  int needed = 0;      // column.size()
+  int max_column = 0;  // the largest field index a data row must reach
+};
+
+// The header row: the first non-blank line that is not a comment ('#', '%' or '//' first: logger
+// metadata above the header is common), unquoted; the simulated-log mark and the comments
+// skipped become warnings of *data.
+std::vector<std::string> ReadHeaderRow(LineReader* reader, const std::string& name,
+                                       const ImuFormat& format, int* header_line, ImuData* data) {
   std::string_view line;
-  std::vector<std::string_view> fields;
-
-  // Header: the first non-blank line that is not a comment ('#', '%' or '//' first: logger
-  // metadata above the header is common).
   int comment_lines = 0;
   std::string simulated;  // the mark of `bifilar simulate` (pipeline/logs/simulated_log.h)
-  while (reader.Next(&line)) {
+  while (reader->Next(&line)) {
     const std::string_view trimmed = Trim(line);
     if (trimmed.empty()) continue;
     if (simulated.empty() && ParseSimulatedCsvMarker(trimmed, &simulated)) continue;
@@ -211,213 +216,267 @@ ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& f
     }
     break;
   }
-  const int header_line = reader.line_number();
+  *header_line = reader->line_number();
   if (IsBlank(line) || Trim(line)[0] == '#' || Trim(line)[0] == '%' || Trim(line).substr(0, 2) == "//") {
     Fail(name + ": no header row, only " + std::to_string(comment_lines) + " comment line(s)");
   }
-  if (!simulated.empty()) data.warnings.push_back(simulated);
+  if (!simulated.empty()) data->warnings.push_back(simulated);
   if (comment_lines > 0) {
-    data.warnings.push_back("skipped " + std::to_string(comment_lines) +
-                            " comment line(s) before the header");
+    data->warnings.push_back("skipped " + std::to_string(comment_lines) +
+                             " comment line(s) before the header");
   }
+  std::vector<std::string_view> fields;
   Split(line, format.delimiter, &fields);
   std::vector<std::string> header;
   for (auto f : fields) header.emplace_back(Unquote(f));
-  {
-    bool all_numeric = true;
-    double v;
-    for (auto f : fields) all_numeric = all_numeric && ParseCell(f, &v);
-    if (all_numeric) {
-      Fail(name + ":" + std::to_string(header_line) +
-           ": no header row (the first line holds numbers); expected a header naming the columns " +
-           format.time_column + ", " + format.gyro_columns[0] + ", " + format.gyro_columns[1] +
-           ", " + format.gyro_columns[2] + (format.has_accel() ? ", ..." : ""));
+  bool all_numeric = true;
+  double v;
+  for (auto f : fields) all_numeric = all_numeric && ParseCell(f, &v);
+  if (all_numeric) {
+    Fail(name + ":" + std::to_string(*header_line) +
+         ": no header row (the first line holds numbers); expected a header naming the columns " +
+         format.time_column + ", " + format.gyro_columns[0] + ", " + format.gyro_columns[1] +
+         ", " + format.gyro_columns[2] + (format.has_accel() ? ", ..." : ""));
+  }
+  return header;
+}
+
+// The index of column `col` in `header`, -1 when absent; fails when it appears twice.
+int FindColumn(const std::vector<std::string>& header, const std::string& col,
+               const std::string& name, int header_line) {
+  int found = -1;
+  for (size_t i = 0; i < header.size(); ++i) {
+    if (header[i] == col) {
+      if (found >= 0) {
+        Fail(name + ":" + std::to_string(header_line) + ": column '" + col +
+             "' appears twice in the header (columns " + std::to_string(found + 1) + " and " +
+             std::to_string(i + 1) + ")");
+      }
+      found = static_cast<int>(i);
     }
   }
+  return found;
+}
 
-  auto find_column = [&](const std::string& col) -> int {
-    int found = -1;
-    for (size_t i = 0; i < header.size(); ++i) {
-      if (header[i] == col) {
-        if (found >= 0) {
-          Fail(name + ":" + std::to_string(header_line) + ": column '" + col +
-               "' appears twice in the header (columns " + std::to_string(found + 1) + " and " +
-               std::to_string(i + 1) + ")");
-        }
-        found = static_cast<int>(i);
+// Fails on a missing column, guessing the delimiter when the header is one field.
+[[noreturn]] void MissingColumn(const std::vector<std::string>& header, const std::string& col,
+                                const std::string& name, int header_line,
+                                const ImuFormat& format) {
+  std::string hint;
+  if (header.size() == 1) {
+    for (char d : {',', ';', '\t', ' '}) {
+      if (d != format.delimiter && header[0].find(d) != std::string::npos) {
+        hint = std::string("; is the delimiter '") + (d == '\t' ? std::string("\\t") : std::string(1, d)) +
+               "' rather than '" + std::string(1, format.delimiter) + "'?";
+        break;
       }
     }
-    return found;
-  };
-  auto missing = [&](const std::string& col) {
-    std::string hint;
-    if (header.size() == 1) {
-      for (char d : {',', ';', '\t', ' '}) {
-        if (d != format.delimiter && header[0].find(d) != std::string::npos) {
-          hint = std::string("; is the delimiter '") + (d == '\t' ? std::string("\\t") : std::string(1, d)) +
-                 "' rather than '" + std::string(1, format.delimiter) + "'?";
-          break;
-        }
-      }
-    }
-    Fail(name + ":" + std::to_string(header_line) + ": missing column '" + col +
-         "' (columns found: " + ListColumns(header) + hint + ")");
-  };
-
-  std::vector<std::string> names = {format.time_column, format.gyro_columns[0],
-                                    format.gyro_columns[1], format.gyro_columns[2]};
-  std::vector<double> scale = {ToSi(format.time_unit), ToSi(format.gyro_unit),
-                               ToSi(format.gyro_unit), ToSi(format.gyro_unit)};
-  std::vector<int> column;
-  for (const auto& n : names) {
-    const int c = find_column(n);
-    if (c < 0) missing(n);
-    column.push_back(c);
   }
-  bool with_accel = false;
+  Fail(name + ":" + std::to_string(header_line) + ": missing column '" + col +
+       "' (columns found: " + ListColumns(header) + hint + ")");
+}
+
+// The header row and the columns the format names in it (accelerometer columns absent altogether:
+// gyro-only with a warning, unless options.require_accel).
+CsvColumns ParseHeader(LineReader* reader, const std::string& name, const ImuFormat& format,
+                       const ImuLogOptions& options, ImuData* data) {
+  CsvColumns c;
+  const std::vector<std::string> header =
+      ReadHeaderRow(reader, name, format, &c.header_line, data);
+  c.names = {format.time_column, format.gyro_columns[0], format.gyro_columns[1],
+             format.gyro_columns[2]};
+  c.scale = {ToSi(format.time_unit), ToSi(format.gyro_unit), ToSi(format.gyro_unit),
+             ToSi(format.gyro_unit)};
+  for (const auto& n : c.names) {
+    const int col = FindColumn(header, n, name, c.header_line);
+    if (col < 0) MissingColumn(header, n, name, c.header_line, format);
+    c.column.push_back(col);
+  }
   if (format.has_accel()) {
     int present = 0;
     std::array<int, 3> accel_col;
     for (int k = 0; k < 3; ++k) {
-      accel_col[k] = find_column(format.accel_columns[k]);
+      accel_col[k] = FindColumn(header, format.accel_columns[k], name, c.header_line);
       present += accel_col[k] >= 0;
     }
     if (present == 0 && !options.require_accel) {
-      data.warnings.push_back("no accelerometer columns (" + format.accel_columns[0] + ", " +
-                              format.accel_columns[1] + ", " + format.accel_columns[2] +
-                              ") in the file; read as gyro-only");
+      data->warnings.push_back("no accelerometer columns (" + format.accel_columns[0] + ", " +
+                               format.accel_columns[1] + ", " + format.accel_columns[2] +
+                               ") in the file; read as gyro-only");
     } else {
       for (int k = 0; k < 3; ++k) {
-        if (accel_col[k] < 0) missing(format.accel_columns[k]);
-        names.push_back(format.accel_columns[k]);
-        scale.push_back(ToSi(format.accel_unit));
-        column.push_back(accel_col[k]);
+        if (accel_col[k] < 0) MissingColumn(header, format.accel_columns[k], name, c.header_line, format);
+        c.names.push_back(format.accel_columns[k]);
+        c.scale.push_back(ToSi(format.accel_unit));
+        c.column.push_back(accel_col[k]);
       }
-      with_accel = true;
+      c.with_accel = true;
     }
   }
-  const int needed = static_cast<int>(column.size());
-  int max_column = 0;
-  for (int c : column) max_column = std::max(max_column, c);
+  c.needed = static_cast<int>(c.column.size());
+  for (int col : c.column) c.max_column = std::max(c.max_column, col);
+  return c;
+}
 
-  // Rows. The time series ends at a break that is not followed by a row continuing it (a later
-  // time): real loggers append footers (a blank line, then summary rows with text, or whose time
-  // is numeric again but jumps back). A blank line followed by a non-numeric row always ends it.
-  // A non-numeric row followed by a row that continues the time series is corruption inside the
-  // data: an error.
-  std::vector<double> values;  // row-major, `needed` per row, SI
+// One data row's needed cells into row[] (raw units). Returns the error of a row that is not
+// numeric (too few fields, a cell not a number), "" for a numeric one; *non_finite_message says
+// when a numeric row holds NaN, an infinity or a reading no sensor gives (imu_log.h).
+std::string ReadRowCells(const std::vector<std::string_view>& fields, std::string_view line,
+                         int line_number, const CsvColumns& c, const std::string& name,
+                         double* row, std::string* non_finite_message) {
+  if (static_cast<int>(fields.size()) <= c.max_column) {
+    int k = 0;
+    while (c.column[k] < static_cast<int>(fields.size())) ++k;
+    return name + ":" + std::to_string(line_number) + ": the row has only " +
+           std::to_string(fields.size()) + " field(s); column '" + c.names[k] + "' is field " +
+           std::to_string(c.column[k] + 1) + " ('" + Printable(Trim(line)) + "')";
+  }
+  bool non_finite = false;
+  for (int k = 0; k < c.needed; ++k) {
+    const std::string_view cell = fields[c.column[k]];
+    if (!ParseCell(cell, &row[k])) {
+      return name + ":" + std::to_string(line_number) + ":" + std::to_string(c.column[k] + 1) +
+             ": column '" + c.names[k] + "' holds '" + Printable(Trim(cell)) +
+             "', which is not a number";
+    }
+    if (!std::isfinite(row[k]) && !non_finite) {
+      non_finite = true;
+      *non_finite_message = name + ":" + std::to_string(line_number) + ":" +
+                            std::to_string(c.column[k] + 1) + ": column '" + c.names[k] +
+                            "' holds '" + Printable(Trim(cell)) +
+                            "'; NaN and infinite values are not allowed";
+    } else if (k != kTime && !non_finite) {
+      // A reading no sensor gives (imu_log.h): an error like NaN, if the row is data.
+      const bool gyro = k <= 3;
+      const double bound = gyro ? kMaxGyroRateRadPerS : kMaxAccelMps2;
+      if (std::abs(row[k] * c.scale[k]) > bound) {
+        non_finite = true;
+        *non_finite_message = name + ":" + std::to_string(line_number) + ":" +
+                              std::to_string(c.column[k] + 1) + ": column '" + c.names[k] +
+                              "' holds '" + Printable(Trim(cell)) + "' = " +
+                              FormatNumber(row[k] * c.scale[k]) +
+                              (gyro ? " rad/s, beyond any gyro (|rate| <= 1e4 rad/s)"
+                                    : " m/s^2, beyond any accelerometer (|f| <= 1e5 m/s^2)") +
+                              ": a corrupt value, or the wrong unit or column";
+      }
+    }
+  }
+  return "";
+}
+
+// The data rows read: the samples (row-major, `needed` per row, SI) with their lines, and how the
+// time series ended.
+struct CsvRows {
+  std::vector<double> values;
   std::vector<int> row_line;
-  values.reserve(text.size() / 8);
-  row_line.reserve(text.size() / 48);
   std::string first_bad;
-  int bad_rows = 0, first_bad_line = 0, first_blank_line = 0, lines_after_end = 0;
+  int bad_rows = 0, first_bad_line = 0, lines_after_end = 0;
   int end_line = 0;  // line of the break that ended the time series (0: the file's end)
   std::string end_reason;
+};
+
+// Rows. The time series ends at a break that is not followed by a row continuing it (a later
+// time): real loggers append footers (a blank line, then summary rows with text, or whose time
+// is numeric again but jumps back). A blank line followed by a non-numeric row always ends it.
+// A non-numeric row followed by a row that continues the time series is corruption inside the
+// data: an error.
+CsvRows ParseRows(LineReader* reader, size_t text_size, const CsvColumns& c,
+                  const std::string& name, const ImuFormat& format) {
+  CsvRows r;
+  const int needed = c.needed;
+  r.values.reserve(text_size / 8);
+  r.row_line.reserve(text_size / 48);
+  int first_blank_line = 0;
+  std::string_view line;
+  std::vector<std::string_view> fields;
   double row[7];
-  while (reader.Next(&line)) {
+  while (reader->Next(&line)) {
     if (IsBlank(line)) {
-      if (first_blank_line == 0 && !row_line.empty()) first_blank_line = reader.line_number();
+      if (first_blank_line == 0 && !r.row_line.empty()) first_blank_line = reader->line_number();
       continue;
     }
     Split(line, format.delimiter, &fields);
-    std::string bad;
-    bool non_finite = false;
     std::string non_finite_message;
-    if (static_cast<int>(fields.size()) <= max_column) {
-      int k = 0;
-      while (column[k] < static_cast<int>(fields.size())) ++k;
-      bad = name + ":" + std::to_string(reader.line_number()) + ": the row has only " +
-            std::to_string(fields.size()) + " field(s); column '" + names[k] + "' is field " +
-            std::to_string(column[k] + 1) + " ('" + Printable(Trim(line)) + "')";
-    } else {
-      for (int k = 0; k < needed; ++k) {
-        const std::string_view cell = fields[column[k]];
-        if (!ParseCell(cell, &row[k])) {
-          bad = name + ":" + std::to_string(reader.line_number()) + ":" +
-                std::to_string(column[k] + 1) + ": column '" + names[k] + "' holds '" +
-                Printable(Trim(cell)) + "', which is not a number";
-          break;
-        }
-        if (!std::isfinite(row[k]) && !non_finite) {
-          non_finite = true;
-          non_finite_message = name + ":" + std::to_string(reader.line_number()) + ":" +
-                               std::to_string(column[k] + 1) + ": column '" + names[k] +
-                               "' holds '" + Printable(Trim(cell)) +
-                               "'; NaN and infinite values are not allowed";
-        } else if (k != kTime && !non_finite) {
-          // A reading no sensor gives (imu_log.h): an error like NaN, if the row is data.
-          const bool gyro = k <= 3;
-          const double bound = gyro ? kMaxGyroRateRadPerS : kMaxAccelMps2;
-          if (std::abs(row[k] * scale[k]) > bound) {
-            non_finite = true;
-            non_finite_message = name + ":" + std::to_string(reader.line_number()) + ":" +
-                                 std::to_string(column[k] + 1) + ": column '" + names[k] +
-                                 "' holds '" + Printable(Trim(cell)) + "' = " +
-                                 FormatNumber(row[k] * scale[k]) +
-                                 (gyro ? " rad/s, beyond any gyro (|rate| <= 1e4 rad/s)"
-                                       : " m/s^2, beyond any accelerometer (|f| <= 1e5 m/s^2)") +
-                                 ": a corrupt value, or the wrong unit or column";
-          }
-        }
-      }
-    }
+    const std::string bad =
+        ReadRowCells(fields, line, reader->line_number(), c, name, row, &non_finite_message);
     if (!bad.empty()) {
-      if (bad_rows == 0) {
-        first_bad = bad;
-        first_bad_line = reader.line_number();
+      if (r.bad_rows == 0) {
+        r.first_bad = bad;
+        r.first_bad_line = reader->line_number();
       }
-      ++bad_rows;
-      if (first_blank_line > 0 && first_blank_line < first_bad_line) {
+      ++r.bad_rows;
+      if (first_blank_line > 0 && first_blank_line < r.first_bad_line) {
         // A blank line, then a non-numeric row: a footer. The time series ended at the blank.
-        end_line = first_blank_line;
-        end_reason = "a blank line, then a non-numeric row";
-        lines_after_end = bad_rows + CountNonBlankLinesLeft(&reader);
+        r.end_line = first_blank_line;
+        r.end_reason = "a blank line, then a non-numeric row";
+        r.lines_after_end = r.bad_rows + CountNonBlankLinesLeft(reader);
         break;
       }
       continue;
     }
     // A numeric row after a break: does it continue the time series?
-    const bool after_break = bad_rows > 0 || first_blank_line > 0;
-    const bool continues = row_line.empty() || row[kTime] * scale[kTime] >
-                                                   values[(row_line.size() - 1) * needed + kTime];
+    const bool after_break = r.bad_rows > 0 || first_blank_line > 0;
+    const bool continues = r.row_line.empty() ||
+                           row[kTime] * c.scale[kTime] >
+                               r.values[(r.row_line.size() - 1) * needed + kTime];
     if (after_break && !continues) {
-      end_line = bad_rows > 0 && (first_blank_line == 0 || first_bad_line < first_blank_line)
-                     ? first_bad_line
-                     : first_blank_line;
-      end_reason = end_line == first_bad_line && bad_rows > 0
-                       ? "a non-numeric row, then rows whose time does not continue it"
-                       : "a blank line, then rows whose time does not continue it";
-      lines_after_end = 1 + bad_rows + CountNonBlankLinesLeft(&reader);
+      r.end_line = r.bad_rows > 0 && (first_blank_line == 0 || r.first_bad_line < first_blank_line)
+                       ? r.first_bad_line
+                       : first_blank_line;
+      r.end_reason = r.end_line == r.first_bad_line && r.bad_rows > 0
+                         ? "a non-numeric row, then rows whose time does not continue it"
+                         : "a blank line, then rows whose time does not continue it";
+      r.lines_after_end = 1 + r.bad_rows + CountNonBlankLinesLeft(reader);
       break;
     }
-    if (bad_rows > 0) Fail(first_bad);  // a bad cell with the time series going on after it
-    if (non_finite) Fail(non_finite_message);
+    if (r.bad_rows > 0) Fail(r.first_bad);  // a bad cell with the time series going on after it
+    if (!non_finite_message.empty()) Fail(non_finite_message);
     first_blank_line = 0;
-    for (int k = 0; k < needed; ++k) values.push_back(row[k] * scale[k]);
-    row_line.push_back(reader.line_number());
+    for (int k = 0; k < needed; ++k) r.values.push_back(row[k] * c.scale[k]);
+    r.row_line.push_back(reader->line_number());
   }
-  if (owner != nullptr) std::string().swap(*owner);  // `text` and `line` are not used below
-  const size_t rows = row_line.size();
-  if (rows == 0) {
-    if (bad_rows > 0) {
+  return r;
+}
+
+// Fails when no data row was read; else warns of the rows after the time series' end.
+void CheckRowsEnd(const CsvRows& r, int header_line, const std::string& name, ImuData* data) {
+  if (r.row_line.empty()) {
+    if (r.bad_rows > 0) {
       Fail(name + ": no numeric data rows after the header (line " + std::to_string(header_line) +
-           "): " + std::to_string(bad_rows) + " row(s), none of them numbers (a footer only, or "
-           "the wrong columns?); the first: " + first_bad);
+           "): " + std::to_string(r.bad_rows) + " row(s), none of them numbers (a footer only, or "
+           "the wrong columns?); the first: " + r.first_bad);
     }
     Fail(name + ":" + std::to_string(header_line) + ": header only, no data rows");
   }
-  if (end_line > 0) {
-    data.warnings.push_back("the time series ends at line " + std::to_string(end_line) + " (" +
-                            end_reason + "); " +
-                            std::to_string(lines_after_end) +
-                            " row(s) after it (a footer?) are ignored");
-  } else if (bad_rows > 0) {
-    data.warnings.push_back("skipped " + std::to_string(bad_rows) +
-                            " trailing non-numeric row(s) from line " +
-                            std::to_string(first_bad_line) + " (" + first_bad + ")");
+  if (r.end_line > 0) {
+    data->warnings.push_back("the time series ends at line " + std::to_string(r.end_line) + " (" +
+                             r.end_reason + "); " +
+                             std::to_string(r.lines_after_end) +
+                             " row(s) after it (a footer?) are ignored");
+  } else if (r.bad_rows > 0) {
+    data->warnings.push_back("skipped " + std::to_string(r.bad_rows) +
+                             " trailing non-numeric row(s) from line " +
+                             std::to_string(r.first_bad_line) + " (" + r.first_bad + ")");
   }
+}
 
-  return FinishImuLog(name, options, values, needed, row_line, scale, with_accel, std::move(data));
+// `owner`, when given, holds the bytes `text` views; it is released once the rows are parsed, so a
+// long log's text and its samples are not both held while the samples are finished.
+// RefuseBinary -> ParseHeader -> ParseRows -> CheckRowsEnd -> FinishImuLog.
+ImuData Parse(std::string_view text, const std::string& name, const ImuFormat& format,
+              const ImuLogOptions& options, std::string* owner = nullptr) {
+  std::string why;
+  if (!format.Check(&why)) Fail(name + ": invalid IMU format: " + why);
+  if (!options.Check(&why)) Fail(name + ": invalid log options: " + why);
+  RefuseBinary(name, format, &text);
+  ImuData data;
+  LineReader reader(text);
+  const CsvColumns columns = ParseHeader(&reader, name, format, options, &data);
+  CsvRows rows = ParseRows(&reader, text.size(), columns, name, format);
+  if (owner != nullptr) std::string().swap(*owner);  // `text` is not used below
+  CheckRowsEnd(rows, columns.header_line, name, &data);
+  return FinishImuLog(name, options, rows.values, columns.needed, rows.row_line, columns.scale,
+                      columns.with_accel, std::move(data));
 }
 
 // The log's text: the file (bounded_read.h: a regular file within the cap), decompressed when

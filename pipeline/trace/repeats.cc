@@ -94,21 +94,10 @@ void AddCorrectionStd(TraceRecord* r) {
   UpdateTotalUncertainty(r);
 }
 
-void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
-  std::vector<TraceRecord*> used;
-  for (int i : group->members) {
-    if (Usable((*records)[i])) used.push_back(&(*records)[i]);
-  }
-  group->n_used = static_cast<int>(used.size());
-  if (used.size() < 2) {
-    group->note = std::to_string(used.size()) + " usable repeat(s) of " +
-                  std::to_string(group->members.size()) + ": nothing to combine";
-    for (TraceRecord* r : used) AddCorrectionStd(r);
-    return;
-  }
-  // The error of the correction's c moves a log by I A_i^2 dc: its part I Abar^2 dc moves every
-  // repeat of the set-up together (the set-up mean's std gets it), the rest I (A_i^2 - Abar^2) dc
-  // moves the repeats against each other and counts in their scatter (s below).
+// The error of the correction's c moves a log by I A_i^2 dc: its part I Abar^2 dc moves every
+// repeat of the set-up together (the set-up mean's std gets it), the rest I (A_i^2 - Abar^2) dc
+// moves the repeats against each other and counts in their scatter. Abar^2 over the corrected.
+double MeanSquaredCorrectionAmplitude(const std::vector<TraceRecord*>& used) {
   double a2bar = 0.0;
   int corrected = 0;
   for (const TraceRecord* r : used) {
@@ -117,60 +106,84 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
     ++corrected;
   }
   if (corrected > 0) a2bar /= corrected;
-  std::vector<double> s, before, after;
+  return a2bar;
+}
+
+// Per used log: its std with the differential part of the correction's std (*s), its inertia
+// before (*before) and after (*after) the amplitude correction.
+void RepeatValues(const std::vector<TraceRecord*>& used, double a2bar, std::vector<double>* s,
+                  std::vector<double>* before, std::vector<double>* after) {
   for (const TraceRecord* r : used) {
     double differential = 0.0;
     const double a2 = r->amplitude_correction_from_deg * r->amplitude_correction_from_deg;
     if (std::isfinite(r->amplitude_correction_kg_m2) && a2 > 0.0)
       differential = r->amplitude_correction_std_kg_m2 * std::abs(a2 - a2bar) / a2;
-    s.push_back(std::hypot(r->inertia_total_std_kg_m2, differential));
-    before.push_back(Uncorrected(*r));
-    after.push_back(r->inertia_total_kg_m2);
+    s->push_back(std::hypot(r->inertia_total_std_kg_m2, differential));
+    before->push_back(Uncorrected(*r));
+    after->push_back(r->inertia_total_kg_m2);
   }
-  // The scatter before (per-log stds) and after the amplitude correction.
-  {
-    std::vector<double> s_before;
-    for (const TraceRecord* r : used) s_before.push_back(r->inertia_total_std_kg_m2);
-    Scatter(before, s_before, &group->spread_before_percent, &group->q_before);
-    double q_after = 0.0;
-    Scatter(after, s, &group->spread_after_percent, &q_after);
-    double plain_before = 0.0;
-    for (double v : before) plain_before += v / before.size();
-    group->max_abs_z_before = 0.0;
-    for (size_t i = 0; i < before.size(); ++i) {
-      group->max_abs_z_before =
-          std::max(group->max_abs_z_before, std::abs(before[i] - plain_before) / s_before[i]);
-    }
+}
+
+// The scatter before (per-log stds) and after the amplitude correction.
+void ScatterBeforeAndAfter(const std::vector<TraceRecord*>& used,
+                           const std::vector<double>& before, const std::vector<double>& after,
+                           const std::vector<double>& s, RepeatGroup* group) {
+  std::vector<double> s_before;
+  for (const TraceRecord* r : used) s_before.push_back(r->inertia_total_std_kg_m2);
+  Scatter(before, s_before, &group->spread_before_percent, &group->q_before);
+  double q_after = 0.0;
+  Scatter(after, s, &group->spread_after_percent, &q_after);
+  double plain_before = 0.0;
+  for (double v : before) plain_before += v / before.size();
+  group->max_abs_z_before = 0.0;
+  for (size_t i = 0; i < before.size(); ++i) {
+    group->max_abs_z_before =
+        std::max(group->max_abs_z_before, std::abs(before[i] - plain_before) / s_before[i]);
   }
-  // DerSimonian-Laird: Q about the fixed-effect mean, tau^2 = max(0, (Q - (k - 1)) / c).
+}
+
+// DerSimonian-Laird: Q about the fixed-effect mean, tau^2 = max(0, (Q - (k - 1)) / c). Sets the
+// group's plain mean, Q and tau; returns tau^2.
+double DerSimonianLaird(const std::vector<double>& after, const std::vector<double>& s,
+                        RepeatGroup* group) {
   double sw = 0.0, sw2 = 0.0, swy = 0.0, plain = 0.0;
-  for (size_t i = 0; i < used.size(); ++i) {
+  for (size_t i = 0; i < after.size(); ++i) {
     const double w = 1.0 / (s[i] * s[i]);
     sw += w;
     sw2 += w * w;
     swy += w * after[i];
     plain += after[i];
   }
-  const double k = static_cast<double>(used.size());
+  const double k = static_cast<double>(after.size());
   const double fixed_mean = swy / sw;
   group->plain_mean_kg_m2 = plain / k;
   double q = 0.0;
-  for (size_t i = 0; i < used.size(); ++i) q += std::pow((after[i] - fixed_mean) / s[i], 2);
+  for (size_t i = 0; i < after.size(); ++i) q += std::pow((after[i] - fixed_mean) / s[i], 2);
   group->q = q;
   const double tau2 = std::max(0.0, (q - (k - 1.0)) / (sw - sw2 / sw));
   group->tau_kg_m2 = std::sqrt(tau2);
-  // The trend is judged on the per-log stds and values before the correction and tau (which
-  // would absorb it).
-  {
-    std::vector<TraceRecord> uncorrected;
-    for (const TraceRecord* r : used) {
-      uncorrected.push_back(*r);
-      uncorrected.back().inertia_total_kg_m2 = Uncorrected(*r);
-    }
-    std::vector<const TraceRecord*> pointers;
-    for (const TraceRecord& r : uncorrected) pointers.push_back(&r);
-    AmplitudeTrendAcrossRepeats(pointers, group->plain_mean_kg_m2, group);
+  return tau2;
+}
+
+// The trend is judged on the per-log stds and values before the correction and tau (which
+// would absorb it).
+void TrendBeforeCorrection(const std::vector<TraceRecord*>& used, RepeatGroup* group) {
+  std::vector<TraceRecord> uncorrected;
+  for (const TraceRecord* r : used) {
+    uncorrected.push_back(*r);
+    uncorrected.back().inertia_total_kg_m2 = Uncorrected(*r);
   }
+  std::vector<const TraceRecord*> pointers;
+  for (const TraceRecord& r : uncorrected) pointers.push_back(&r);
+  AmplitudeTrendAcrossRepeats(pointers, group->plain_mean_kg_m2, group);
+}
+
+// The random-effects mean (weights 1 / (s_i^2 + tau^2)) and its std with the common part of the
+// correction's std; every used log gets tau and its correction's std in its own std, and a
+// warning when the repeats scatter beyond their stds.
+void RandomEffectsMean(const std::vector<TraceRecord*>& used, const std::vector<double>& after,
+                       const std::vector<double>& s, double a2bar, double tau2,
+                       RepeatGroup* group) {
   double sw_re = 0.0, swy_re = 0.0, swc = 0.0;
   for (size_t i = 0; i < used.size(); ++i) {
     const double s_re = std::hypot(s[i], group->tau_kg_m2);
@@ -199,15 +212,20 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
       std::snprintf(text, sizeof(text),
                     "the %d repeats of %s scatter beyond their own stds (Q = %.1f on %d dof): "
                     "a between-repeat std of %.3g kg m^2 (%.2f %%) is added to this log's std",
-                    group->n_used, group->name.c_str(), q, group->n_used - 1, group->tau_kg_m2,
-                    100.0 * group->tau_kg_m2 / group->plain_mean_kg_m2);
+                    group->n_used, group->name.c_str(), group->q, group->n_used - 1,
+                    group->tau_kg_m2, 100.0 * group->tau_kg_m2 / group->plain_mean_kg_m2);
       r.warnings.push_back(text);
       r.flags.push_back("repeat_scatter");
     }
   }
   group->correction_std_kg_m2 = swc / sw_re;
   group->mean_std_kg_m2 = std::hypot(1.0 / std::sqrt(sw_re), group->correction_std_kg_m2);
-  // The common-mode terms do not average out over repeats: their mean fraction of I.
+}
+
+// The common-mode terms do not average out over repeats: their mean fraction of I, and the
+// group's total std.
+void CommonModeStd(const std::vector<TraceRecord*>& used, RepeatGroup* group) {
+  const double k = static_cast<double>(used.size());
   double common_fraction = 0.0;
   for (const TraceRecord* r : used) {
     const TotalUncertainty total = ComposeTotalUncertainty(*r);
@@ -215,6 +233,31 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
   }
   group->common_mode_std_kg_m2 = common_fraction * group->mean_kg_m2;
   group->total_std_kg_m2 = std::hypot(group->mean_std_kg_m2, group->common_mode_std_kg_m2);
+}
+
+// The usable repeats of one set-up: MeanSquaredCorrectionAmplitude -> RepeatValues ->
+// ScatterBeforeAndAfter -> DerSimonianLaird -> TrendBeforeCorrection -> RandomEffectsMean ->
+// CommonModeStd.
+void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
+  std::vector<TraceRecord*> used;
+  for (int i : group->members) {
+    if (Usable((*records)[i])) used.push_back(&(*records)[i]);
+  }
+  group->n_used = static_cast<int>(used.size());
+  if (used.size() < 2) {
+    group->note = std::to_string(used.size()) + " usable repeat(s) of " +
+                  std::to_string(group->members.size()) + ": nothing to combine";
+    for (TraceRecord* r : used) AddCorrectionStd(r);
+    return;
+  }
+  const double a2bar = MeanSquaredCorrectionAmplitude(used);
+  std::vector<double> s, before, after;
+  RepeatValues(used, a2bar, &s, &before, &after);
+  ScatterBeforeAndAfter(used, before, after, s, group);
+  const double tau2 = DerSimonianLaird(after, s, group);
+  TrendBeforeCorrection(used, group);
+  RandomEffectsMean(used, after, s, a2bar, tau2, group);
+  CommonModeStd(used, group);
 }
 
 // The pooled amplitude coefficient over the groups' usable members, applied to every usable

@@ -19,10 +19,10 @@
 #include "pipeline/config/plausibility.h"
 #include "pipeline/figures/figure.h"
 #include "pipeline/figures/sweep_plot.h"
+#include "pipeline/figures/report_trace_figure.h"
 #include "pipeline/figures/trace_plot.h"
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/records/total_uncertainty.h"
-#include <plplot.h>
 
 
 namespace bifilar {
@@ -56,116 +56,6 @@ std::string Renamed(const std::string& message, const std::string& path, const s
   if (message.rfind(path, 0) == 0) return name + message.substr(path.size());
   if (message.find(name) != std::string::npos) return message;
   return name + ": " + message;
-}
-
-// Min/max envelope of v over `buckets` equal index ranges, as a zigzag polyline (2 points per
-// bucket, in time order): what a line of every sample looks like at thumbnail size, for a fraction
-// of the drawing cost.
-void Envelope(const std::vector<double>& t, const std::vector<double>& v, size_t buckets,
-              double scale, std::vector<PLFLT>* x, std::vector<PLFLT>* y) {
-  const size_t n = t.size();
-  x->clear();
-  y->clear();
-  if (n == 0) return;
-  if (n <= 2 * buckets) {
-    for (size_t i = 0; i < n; ++i) {
-      x->push_back(t[i] - t[0]);
-      y->push_back(scale * v[i]);
-    }
-    return;
-  }
-  for (size_t b = 0; b < buckets; ++b) {
-    const size_t lo = b * n / buckets, hi = (b + 1) * n / buckets;
-    size_t i_min = lo, i_max = lo;
-    for (size_t i = lo; i < hi; ++i) {
-      if (v[i] < v[i_min]) i_min = i;
-      if (v[i] > v[i_max]) i_max = i;
-    }
-    const size_t first = std::min(i_min, i_max), second = std::max(i_min, i_max);
-    x->push_back(t[first] - t[0]);
-    y->push_back(scale * v[first]);
-    x->push_back(t[second] - t[0]);
-    y->push_back(scale * v[second]);
-  }
-}
-
-// The report's fit-and-residual thumbnail: the fit (wide blue) and the measured rate (dark, on top),
-// the residual envelope with the +-noise band beneath. Lines only (pipeline/figures/trace_plot.h
-// draws a symbol per sample, ~0.1 s per trace; this is a few ms), so a campaign of 60 traces stays
-// fast.
-bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
-                            DisplayUnits units, const std::string& path, int width_px,
-                            int height_px, std::string* why) {
-  // Top: measured and fitted rate at ~250 points (the noise is invisible at this scale; it shows
-  // in the residual panel). Bottom: the residual's min/max envelope over 150 buckets.
-  std::vector<PLFLT> tm, ym, tf, yf, tr, yr;
-  const size_t stride = std::max<size_t>(1, fit.t_s.size() / 250);
-  for (size_t i = 0; i < fit.t_s.size(); i += stride) {
-    tm.push_back(fit.t_s[i] - fit.t_s[0]);
-    ym.push_back(kDegPerRad * fit.measured_rate_rad_per_s[i]);
-    yf.push_back(kDegPerRad * fit.fitted_rate_rad_per_s[i]);
-  }
-  tf = tm;
-  Envelope(fit.t_s, fit.residual_rad_per_s, 150, -kDegPerRad, &tr, &yr);  // measured - fitted
-  if (tm.size() < 2) {
-    *why = "nothing to plot";
-    return false;
-  }
-  const double t_end = tm.back();
-  double y_max = 0.0, r_max = 0.0;
-  for (double v : ym) y_max = std::max(y_max, std::abs(v));
-  for (double v : yr) r_max = std::max(r_max, std::abs(v));
-  const double noise = kDegPerRad * fit.noise_rad_per_s;
-  r_max = std::max(r_max, 2.5 * noise) * 1.1;
-  y_max = std::max(y_max, 1e-6) * 1.1;
-  char label[256];
-  // Short labels: the SVG embeds an outline of every distinct glyph (the file name is in the
-  // report's caption).
-  (void)title;
-  // In the config's units, as every table of the report (I total: rig included).
-  std::snprintf(label, sizeof(label), "I#dtotal#u = %.5f #(2233) %.1e %s (%s)",
-                InertiaToDisplay(fit.params.inertia_kg_m2, units),
-                InertiaToDisplay(fit.inertia_stat_std_kg_m2, units),
-                units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d", ToString(fit.model));
-  const std::string top_title = label;
-  std::snprintf(label, sizeof(label), "residual: rms = %.2f noise", fit.rms_over_noise);
-  const std::string bottom_title = label;
-  FigureOptions figure;
-  figure.width_px = width_px;
-  figure.height_px = height_px;
-  return WriteFigure(path, figure, [&] {
-    pladv(0);
-    plschr(0, 0.8);
-    plvpor(0.1, 0.97, 0.42, 0.9);
-    plwind(0, t_end, -y_max, y_max);
-    plcol0(1);
-    plbox("bct", 0, 0, "bcntv", 0, 0);
-    pllab("", "deg/s", top_title.c_str());
-    // The fit first (wide, light blue), the measured rate on top of it (thin, dark): where the
-    // two agree the measured line shows inside the fit's band (issue 18).
-    plscol0(9, 150, 185, 235);
-    plcol0(9);
-    plwidth(4.0);
-    plline(static_cast<PLINT>(tf.size()), tf.data(), yf.data());
-    plscol0(15, 0, 0, 0);
-    plcol0(15);
-    plwidth(1.0);
-    plline(static_cast<PLINT>(tm.size()), tm.data(), ym.data());
-    plscol0(15, 170, 170, 170);
-    plvpor(0.1, 0.97, 0.1, 0.32);
-    plwind(0, t_end, -r_max, r_max);
-    plcol0(1);
-    plbox("bcnt", 0, 0, "bcntv", 0, 0);
-    pllab("s", "deg/s", bottom_title.c_str());
-    plcol0(15);
-    plline(static_cast<PLINT>(tr.size()), tr.data(), yr.data());
-    plscol0(10, 200, 60, 40);
-    plcol0(10);
-    for (double level : {noise, -noise}) {
-      PLFLT xs[2] = {0, t_end}, ys[2] = {level, level};
-      plline(2, xs, ys);  // solid: PLplot draws a dashed line as one path per dash
-    }
-  }, why);
 }
 
 TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, const ImuData& data,
@@ -258,200 +148,204 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
   return ProcessData(config, path, data, options, std::move(record), nullptr);
 }
 
-TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, const ImuData& raw,
-                        const TraceProcessOptions& options, TraceRecord record,
-                        TraceFitResult* fit_out) {
-  const std::string& name = record.file;
-  auto fail = [&](TraceStatus status, const std::string& message) {
-    record.status = status;
-    record.message = Renamed(message, path, name);
-    return record;
-  };
-  std::string why;
-  record.warnings = raw.warnings;
+// Marks `record` failed with `message` (the log's path in it becomes the record's name); false.
+bool Fail(TraceRecord* record, TraceStatus status, const std::string& message,
+          const std::string& path) {
+  record->status = status;
+  record->message = Renamed(message, path, record->file);
+  return false;
+}
 
-  // 1b. Isolated glitch samples (fit/glitch.h, `fit.glitch`) are dropped before anything looks at
-  // the data.
+// 1b. Isolated glitch samples (fit/glitch.h, `fit.glitch`) are dropped before anything looks at
+// the data: the raw log when there are none, else *cleaned (filled here).
+const ImuData& DropRawGlitches(const CampaignConfig& config, const ImuData& raw, ImuData* cleaned,
+                               TraceRecord* record) {
   const std::vector<size_t> glitches = FindGyroGlitches(raw, config.fit.glitch.Options());
-  ImuData cleaned;
-  if (!glitches.empty()) {
-    record.warnings.push_back(DescribeGlitches(raw, glitches));
-    cleaned = WithoutSamples(raw, glitches);
-  }
-  const ImuData& data = glitches.empty() ? raw : cleaned;
+  if (glitches.empty()) return raw;
+  record->warnings.push_back(DescribeGlitches(raw, glitches));
+  *cleaned = WithoutSamples(raw, glitches);
+  return *cleaned;
+}
 
-  // 2. Swing axis (and the pitch, from the accelerometer at rest).
-  std::optional<std::array<double, 2>> override_s =
-      options.window_s ? options.window_s : ConfigWindowFor(config, path);
-  if (override_s) {
+// 2. Swing axis (and the pitch, from the accelerometer at rest), inside the window override
+// (*override_s: the CLI's, else the config's for this log, clamped to the log) when there is one.
+bool FindSwingAxis(const CampaignConfig& config, const std::string& path, const ImuData& data,
+                   const TraceProcessOptions& options,
+                   std::optional<std::array<double, 2>>* override_s, SwingAxis* axis,
+                   TraceRecord* record) {
+  const std::string& name = record->file;
+  *override_s = options.window_s ? options.window_s : ConfigWindowFor(config, path);
+  if (*override_s) {
     std::string clamped;
-    const std::string outside = WindowOutsideLog(data, &*override_s, options.window_s.has_value(),
+    const std::string outside = WindowOutsideLog(data, &**override_s, options.window_s.has_value(),
                                                  config.imu.format.time_unit, &clamped);
-    if (!outside.empty()) return fail(TraceStatus::kError, name + ": " + outside);
-    if (!clamped.empty()) record.warnings.push_back(clamped);
+    if (!outside.empty()) return Fail(record, TraceStatus::kError, name + ": " + outside, path);
+    if (!clamped.empty()) record->warnings.push_back(clamped);
   }
-  const SwingAxisOptions axis_options = SwingAxisOptionsFor(config.imu);
   std::optional<std::pair<double, double>> axis_window;
-  if (override_s) axis_window = std::make_pair((*override_s)[0], (*override_s)[1]);
-  SwingAxis axis;
-  if (!EstimateSwingAxis(data, axis_options, axis_window, &axis, &why)) {
-    return fail(TraceStatus::kError, why);
+  if (*override_s) axis_window = std::make_pair((**override_s)[0], (**override_s)[1]);
+  std::string why;
+  if (!EstimateSwingAxis(data, SwingAxisOptionsFor(config.imu), axis_window, axis, &why)) {
+    return Fail(record, TraceStatus::kError, why, path);
   }
-  for (const std::string& w : axis.warnings) record.warnings.push_back(w);
+  for (const std::string& w : axis->warnings) record->warnings.push_back(w);
+  return true;
+}
 
-  // 3. Free-oscillation window.
+// 3. Free-oscillation window (the override when given), the pitch measured over it when no rest
+// was seen, the measured period and the small-angle inertia (the hand calculation `inspect`
+// prints).
+bool FindWindowAndPitch(const CampaignConfig& config, const std::string& path, const ImuData& data,
+                        const TraceProcessOptions& options,
+                        const std::optional<std::array<double, 2>>& override_s, SwingAxis* axis,
+                        FreeOscillationWindow* window, TraceRecord* record) {
+  const std::string& name = record->file;
   WindowOptions window_options;
   window_options.min_periods = config.fit.quality.min_periods;
-  const FreeOscillationWindow window =
-      override_s ? ApplyWindowOverride(data.t_s, axis.rate_rad_per_s, (*override_s)[0],
-                                       (*override_s)[1], window_options, name)
-                 : FindFreeOscillationWindow(data.t_s, axis.rate_rad_per_s, window_options, name);
-  if (!window.IsUsable()) {
+  *window = override_s ? ApplyWindowOverride(data.t_s, axis->rate_rad_per_s, (*override_s)[0],
+                                              (*override_s)[1], window_options, name)
+                       : FindFreeOscillationWindow(data.t_s, axis->rate_rad_per_s, window_options,
+                                                   name);
+  if (!window->IsUsable()) {
     // Time in s declared ms (or the reverse) puts every period 1000 times outside the range.
     const std::string hint =
         !override_s && config.imu.format.container != LogContainer::kUlog &&
-                window.message.find("no oscillation found") != std::string::npos
-            ? TimeUnitHint(data.t_s, axis.rate_rad_per_s, window_options,
+                window->message.find("no oscillation found") != std::string::npos
+            ? TimeUnitHint(data.t_s, axis->rate_rad_per_s, window_options,
                            config.imu.format.time_unit)
             : "";
-    return fail(window.status == WindowStatus::kError ? TraceStatus::kError : TraceStatus::kRejected,
-                window.message + hint);
+    return Fail(record,
+                window->status == WindowStatus::kError ? TraceStatus::kError
+                                                       : TraceStatus::kRejected,
+                window->message + hint, path);
   }
   // No rest seen: the accelerometer averaged over the window still gives the pitch.
-  if (!axis.pitch_measured_deg && data.has_accel() && !axis.accel_ignored && !axis_window) {
+  if (!axis->pitch_measured_deg && data.has_accel() && !axis->accel_ignored && !override_s) {
     SwingAxis again;
-    if (EstimateSwingAxis(data, axis_options, std::make_pair(window.t0_s, window.t1_s), &again,
-                          &why)) {
-      axis.pitch_measured_deg = again.pitch_measured_deg;
-      axis.roll_measured_deg = again.roll_measured_deg;
+    std::string why;
+    if (EstimateSwingAxis(data, SwingAxisOptionsFor(config.imu),
+                          std::make_pair(window->t0_s, window->t1_s), &again, &why)) {
+      axis->pitch_measured_deg = again.pitch_measured_deg;
+      axis->roll_measured_deg = again.roll_measured_deg;
     }
   }
-  record.pitch_measured_deg = axis.pitch_measured_deg;
-  if (axis.pitch_measured_deg) record.roll_measured_deg = axis.roll_measured_deg;
-  for (int k = 0; k < 3; ++k) record.swing_axis_in_imu[k] = axis.axis_in_imu[k];
-  // The measured period and the small-angle inertia (the hand calculation `inspect` prints).
-  if (window.period_s > 0.0) {
-    record.period_s = window.period_s;
-    record.frequency_hz = 1.0 / window.period_s;
-    record.small_angle_inertia_total_kg_m2 =
-        InertiaFromSmallAnglePeriod(GeometryForRole(config, options.role), window.period_s);
+  record->pitch_measured_deg = axis->pitch_measured_deg;
+  if (axis->pitch_measured_deg) record->roll_measured_deg = axis->roll_measured_deg;
+  for (int k = 0; k < 3; ++k) record->swing_axis_in_imu[k] = axis->axis_in_imu[k];
+  if (window->period_s > 0.0) {
+    record->period_s = window->period_s;
+    record->frequency_hz = 1.0 / window->period_s;
+    record->small_angle_inertia_total_kg_m2 =
+        InertiaFromSmallAnglePeriod(GeometryForRole(config, options.role), window->period_s);
   }
+  return true;
+}
 
-  // 4. Amplitude band.
+// The amplitude band of the config (fit.min/max_amplitude_deg, fit.quality.min_periods).
+AmplitudeBandOptions AmplitudeBandOptionsFor(const CampaignConfig& config) {
   AmplitudeBandOptions band_options;
   band_options.max_amplitude_deg = config.fit.max_amplitude_deg.value_or(kDefaultMaxAmplitudeDeg);
   band_options.min_amplitude_deg = config.fit.min_amplitude_deg.value_or(0.0);
   band_options.min_periods = config.fit.quality.min_periods;
-  record.amplitude_band_deg = {band_options.min_amplitude_deg, band_options.max_amplitude_deg};
-  const AmplitudeBand band =
-      TrimToAmplitudeBand(data.t_s, axis.rate_rad_per_s, window, band_options, name);
-  record.window_s = {window.t0_s, window.t1_s};
+  return band_options;
+}
+
+// 4. Amplitude band: the window trimmed to the config's band of swing amplitude.
+bool ChooseAmplitudeBand(const CampaignConfig& config, const std::string& path,
+                         const ImuData& data, const SwingAxis& axis,
+                         const FreeOscillationWindow& window, AmplitudeBand* band,
+                         TraceRecord* record) {
+  const AmplitudeBandOptions band_options = AmplitudeBandOptionsFor(config);
+  record->amplitude_band_deg = {band_options.min_amplitude_deg, band_options.max_amplitude_deg};
+  *band = TrimToAmplitudeBand(data.t_s, axis.rate_rad_per_s, window, band_options, record->file);
+  record->window_s = {window.t0_s, window.t1_s};
   // A swing beyond 180 deg (deg/s read as rad/s): a hint on a rejection, a warning on a fit.
   double largest_deg = 0.0, smallest_deg = INFINITY;
-  for (const AngleExtreme& e : band.extremes) {
+  for (const AngleExtreme& e : band->extremes) {
     largest_deg = std::max(largest_deg, e.amplitude_deg);
     smallest_deg = std::min(smallest_deg, e.amplitude_deg);
   }
   const std::string impossible =
       ImpossibleAmplitude(largest_deg, smallest_deg, config.imu.format.gyro_unit);
-  if (!band.IsUsable()) {
-    return fail(band.status == WindowStatus::kError ? TraceStatus::kError : TraceStatus::kRejected,
-                band.message + (impossible.empty() ? "" : "; " + impossible));
+  if (!band->IsUsable()) {
+    return Fail(record,
+                band->status == WindowStatus::kError ? TraceStatus::kError
+                                                     : TraceStatus::kRejected,
+                band->message + (impossible.empty() ? "" : "; " + impossible), path);
   }
-  if (!impossible.empty()) record.warnings.push_back(impossible);
-  record.window_s = {band.t0_s, band.t1_s};
+  if (!impossible.empty()) record->warnings.push_back(impossible);
+  record->window_s = {band->t0_s, band->t1_s};
+  return true;
+}
 
-  // 5. Fit.
+// 5a. The fit's input: the band's samples, or their block means when the log is dense
+// (fit/block_mean.h, *series says which), the secondary motion and the role's geometry.
+TraceFitInput MakeFitInput(const CampaignConfig& config, const TraceProcessOptions& options,
+                           const ImuData& data, const SwingAxis& axis,
+                           const FreeOscillationWindow& window, const AmplitudeBand& band,
+                           const std::string& name, FitSeries* series) {
   TraceFitInput input;
-  // The band's samples, or their block means when the log is dense (fit/block_mean.h).
-  FitSeries series = MakeFitSeries(data.t_s, axis.rate_rad_per_s, band.first_index,
-                                   band.last_index, window.period_s,
-                                   window.noise_from_rest ? window.noise_sigma_rad_per_s : 0.0,
-                                   window.rest_end_s);
-  input.t_s = std::move(series.t_s);
-  input.rate_rad_per_s = std::move(series.rate_rad_per_s);
-  input.noise_rad_per_s = series.noise_rad_per_s;
+  *series = MakeFitSeries(data.t_s, axis.rate_rad_per_s, band.first_index, band.last_index,
+                          window.period_s,
+                          window.noise_from_rest ? window.noise_sigma_rad_per_s : 0.0,
+                          window.rest_end_s);
+  input.t_s = std::move(series->t_s);
+  input.rate_rad_per_s = std::move(series->rate_rad_per_s);
+  input.noise_rad_per_s = series->noise_rad_per_s;
   input.secondary_motion_ratio =
       SecondaryMotionRatio(data, axis.axis_in_imu, band.t0_s, band.t1_s);
   input.geometry = GeometryForRole(config, options.role);
   input.label = name;
-  TraceFitOptions fit_options;
-  fit_options.model = config.fit.model;
-  fit_options.integrator = fit_options.integrator.WithMethod(config.fit.integrator);
-  const QualityThresholds& q = config.fit.quality;
-  fit_options.max_rms_over_noise = q.max_rms_over_noise;
-  fit_options.max_residual_autocorr = q.max_residual_autocorr;
-  fit_options.whiteness_lags = q.whiteness_lags;
-  fit_options.max_secondary_motion_ratio = q.max_secondary_motion_ratio;
-  fit_options.reject_secondary_motion_ratio = q.reject_secondary_motion_ratio;
-  fit_options.reject_residual_fraction = q.reject_residual_fraction;
-  fit_options.amplitude_sweep = config.fit.sweep.enabled;
-  fit_options.sweep_min_cycles_per_band = config.fit.sweep.min_cycles_per_band;
-  fit_options.sweep_max_bands = config.fit.sweep.max_bands;
-  fit_options.sweep_trend_z = config.fit.sweep.trend_z;
-  fit_options.min_periods = q.min_periods;
-  fit_options.max_amplitude_deg = band_options.max_amplitude_deg;
-  fit_options.min_amplitude_deg = std::min(fit_options.min_amplitude_deg, band_options.min_amplitude_deg);
-  // A calibrated geometry absorbs L, D and g (docs/physics.md §2.6): their terms are replaced by
-  // the calibration's own (added below). Without rig.uncertainties the budget counts the assumed
-  // +-1 mm on L and D (pipeline/records/total_uncertainty.h), unless the rig is calibrated.
-  const bool calibrated = config.geometry_calibration.applied;
-  const RigUncertainties uncertainties = config.uncertainties.InEffect();
-  fit_options.filar_length_std_m = calibrated ? 0.0 : uncertainties.filar_length_std_m;
-  fit_options.filar_separation_std_m = calibrated ? 0.0 : uncertainties.filar_separation_std_m;
-  fit_options.mass_std_kg = options.role == TraceRole::kAircraft
-                                ? std::hypot(uncertainties.mass_std_kg,
-                                             config.aircraft_mass_std_kg)
-                                : uncertainties.mass_std_kg;
-  fit_options.gravity_std_mps2 = calibrated ? 0.0 : uncertainties.gravity_std_mps2;
-  fit_options.gyro_scale_std = config.imu.gyro_scale_std;
-  // The residual series is kept for the second glitch pass below (and dropped after it when
-  // neither a figure nor the caller wants it).
-  const bool keep_series = !options.figure_paths.empty() || fit_out != nullptr;
-  fit_options.keep_series = true;
-  fit_options.interrupt = options.interrupt;
-  TraceFitResult fit = FitTrace(input, fit_options);
-  // 5b. Glitches too small for the raw-series test (below half the swing) but isolated and far
-  // outside the fit's residual noise: the same test on the residual series (fit/glitch.h), whose
-  // noise is the gyro's, not the swing's. Dropped, and the window fitted again.
-  if (fit.HasFit() && fit.residual_rad_per_s.size() == input.t_s.size()) {
-    const std::vector<size_t> more = FindGlitches(fit.t_s, fit.residual_rad_per_s,
-                                                     config.fit.glitch.Options());
-    if (!more.empty()) {
-      double largest = 0.0;
-      for (size_t k : more) largest = std::max(largest, std::abs(fit.residual_rad_per_s[k]));
-      char text[160];
-      std::snprintf(text, sizeof(text), "%zu glitch sample%s ignored (isolated readings off the "
-                    "fit by up to %.3g rad/s) at t =", more.size(), more.size() == 1 ? "" : "s",
-                    largest);
-      std::string warning = text;
-      for (size_t i = 0; i < more.size() && i < 5; ++i) {
-        std::snprintf(text, sizeof(text), "%s %.6g", i ? "," : "", input.t_s[more[i]]);
-        warning += text;
-      }
-      record.warnings.push_back(warning + (more.size() > 5 ? ", ... s" : " s"));
-      std::vector<double> t, rate;
-      size_t next = 0;
-      for (size_t k = 0; k < input.t_s.size(); ++k) {
-        if (next < more.size() && more[next] == k) {
-          ++next;
-          continue;
-        }
-        t.push_back(input.t_s[k]);
-        rate.push_back(input.rate_rad_per_s[k]);
-      }
-      input.t_s = std::move(t);
-      input.rate_rad_per_s = std::move(rate);
-      fit = FitTrace(input, fit_options);
-    }
-  }
-  if (!keep_series) {
-    fit.t_s.clear();
-    fit.measured_rate_rad_per_s.clear();
-    fit.fitted_rate_rad_per_s.clear();
-    fit.residual_rad_per_s.clear();
-  }
+  return input;
+}
 
+// 5b. The fit, then glitches too small for the raw-series test (below half the swing) but
+// isolated and far outside the fit's residual noise: the same test on the residual series
+// (fit/glitch.h), whose noise is the gyro's, not the swing's. Dropped (*input loses them, a
+// warning names them), and the window fitted again.
+TraceFitResult FitWithResidualGlitchPass(const CampaignConfig& config,
+                                         const TraceFitOptions& fit_options, TraceFitInput* input,
+                                         TraceRecord* record) {
+  TraceFitResult fit = FitTrace(*input, fit_options);
+  if (!fit.HasFit() || fit.residual_rad_per_s.size() != input->t_s.size()) return fit;
+  const std::vector<size_t> more =
+      FindGlitches(fit.t_s, fit.residual_rad_per_s, config.fit.glitch.Options());
+  if (more.empty()) return fit;
+  double largest = 0.0;
+  for (size_t k : more) largest = std::max(largest, std::abs(fit.residual_rad_per_s[k]));
+  char text[160];
+  std::snprintf(text, sizeof(text), "%zu glitch sample%s ignored (isolated readings off the "
+                "fit by up to %.3g rad/s) at t =", more.size(), more.size() == 1 ? "" : "s",
+                largest);
+  std::string warning = text;
+  for (size_t i = 0; i < more.size() && i < 5; ++i) {
+    std::snprintf(text, sizeof(text), "%s %.6g", i ? "," : "", input->t_s[more[i]]);
+    warning += text;
+  }
+  record->warnings.push_back(warning + (more.size() > 5 ? ", ... s" : " s"));
+  std::vector<double> t, rate;
+  size_t next = 0;
+  for (size_t k = 0; k < input->t_s.size(); ++k) {
+    if (next < more.size() && more[next] == k) {
+      ++next;
+      continue;
+    }
+    t.push_back(input->t_s[k]);
+    rate.push_back(input->rate_rad_per_s[k]);
+  }
+  input->t_s = std::move(t);
+  input->rate_rad_per_s = std::move(rate);
+  return FitTrace(*input, fit_options);
+}
+
+// The fit's numbers into the record, with its uncertainty budget (plus the calibration's term
+// when the geometry is calibrated), its flags, warnings and the record's message.
+void FillRecordFromFit(const CampaignConfig& config, const std::string& path,
+                       const TraceFitResult& fit, const TraceFitInput& input,
+                       const FitSeries& series, TraceRecord* record_out) {
+  TraceRecord& record = *record_out;
+  const std::string& name = record.file;
+  const bool calibrated = config.geometry_calibration.applied;
   record.status = fit.status == TraceFitStatus::kOk         ? TraceStatus::kOk
                   : fit.status == TraceFitStatus::kRejected ? TraceStatus::kRejected
                                                             : TraceStatus::kError;
@@ -472,7 +366,8 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   }
   record.model = ToString(fit.model);
   record.iterations = fit.iterations;
-  record.secondary_motion_ratio = input.secondary_motion_ratio >= 0.0 ? input.secondary_motion_ratio : NAN;
+  record.secondary_motion_ratio =
+      input.secondary_motion_ratio >= 0.0 ? input.secondary_motion_ratio : NAN;
   if (fit.HasFit()) {
     record.inertia_total_kg_m2 = fit.params.inertia_kg_m2;
     record.inertia_total_std_kg_m2 =
@@ -519,10 +414,25 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                                                        " more warnings)"
                                                  : "");
   }
+}
 
-  if (fit_out) *fit_out = fit;
+// A figure that could not be written: flagged and warned; one that was: listed in the record.
+void NoteFigure(bool drawn, const std::string& figure_path, const std::string& why,
+                TraceRecord* record) {
+  if (!drawn) {
+    record->flags.push_back("figure_failed");
+    record->warnings.push_back("figure " + figure_path + " could not be written: " + why);
+  } else {
+    record->figures.push_back(figure_path);
+  }
+}
 
-  // 6. Figure (only of a fit that ran).
+// 6. Fit-and-residual figure (only of a fit that ran), 7. I against amplitude (only when the
+// sweep was evaluated: no figure, and no link, without).
+void WriteTraceFigures(const CampaignConfig& config, const TraceProcessOptions& options,
+                       const TraceFitResult& fit, TraceRecord* record) {
+  const std::string& name = record->file;
+  std::string why;
   for (const std::string& figure_path : options.figure_paths) {
     if (fit.t_s.empty()) break;
     bool drawn = false;
@@ -539,37 +449,64 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
           config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
       drawn = WriteTraceFitFigure(fit, figure_path, figure_options, &why);
     }
-    if (!drawn) {
-      record.flags.push_back("figure_failed");
-      record.warnings.push_back("figure " + figure_path + " could not be written: " + why);
-    } else {
-      record.figures.push_back(figure_path);
-    }
+    NoteFigure(drawn, figure_path, why, record);
   }
-  // 7. I against amplitude (only when the sweep was evaluated: no figure, and no link, without).
-  if (fit.HasFit() && fit.sweep.evaluated) {
-    SweepPlotOptions sweep_options;
-    sweep_options.title = name;
-    sweep_options.unit_scale = InertiaToDisplay(1.0, config.units);
-    sweep_options.unit_label =
-        config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
-    sweep_options.figure.width_px = options.figure_width_px;
-    sweep_options.figure.height_px = options.figure_height_px;
-    sweep_options.compact = options.compact_figure;  // the report explains it in the caption
-    for (const std::string& figure_path : options.sweep_figure_paths) {
-      if (WriteAmplitudeSweepFigure(fit.sweep, record.inertia_total_kg_m2,
-                                    record.inertia_total_std_kg_m2, figure_path, sweep_options,
-                                    &why)) {
-        record.figures.push_back(figure_path);
-      } else {
-        record.flags.push_back("figure_failed");
-        record.warnings.push_back("figure " + figure_path + " could not be written: " + why);
-      }
-    }
+  if (!fit.HasFit() || !fit.sweep.evaluated) return;
+  SweepPlotOptions sweep_options;
+  sweep_options.title = name;
+  sweep_options.unit_scale = InertiaToDisplay(1.0, config.units);
+  sweep_options.unit_label = config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+  sweep_options.figure.width_px = options.figure_width_px;
+  sweep_options.figure.height_px = options.figure_height_px;
+  sweep_options.compact = options.compact_figure;  // the report explains it in the caption
+  for (const std::string& figure_path : options.sweep_figure_paths) {
+    const bool drawn =
+        WriteAmplitudeSweepFigure(fit.sweep, record->inertia_total_kg_m2,
+                                  record->inertia_total_std_kg_m2, figure_path, sweep_options,
+                                  &why);
+    NoteFigure(drawn, figure_path, why, record);
   }
-  return record;
 }
 
+// One log in memory -> its record: DropRawGlitches -> FindSwingAxis -> FindWindowAndPitch ->
+// ChooseAmplitudeBand -> MakeFitInput -> FitWithResidualGlitchPass (TraceFitOptionsFor) ->
+// FillRecordFromFit -> WriteTraceFigures. A failing step leaves the record failed.
+TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, const ImuData& raw,
+                        const TraceProcessOptions& options, TraceRecord record,
+                        TraceFitResult* fit_out) {
+  record.warnings = raw.warnings;
+  ImuData cleaned;
+  const ImuData& data = DropRawGlitches(config, raw, &cleaned, &record);
+  std::optional<std::array<double, 2>> override_s;
+  SwingAxis axis;
+  if (!FindSwingAxis(config, path, data, options, &override_s, &axis, &record)) return record;
+  FreeOscillationWindow window;
+  if (!FindWindowAndPitch(config, path, data, options, override_s, &axis, &window, &record)) {
+    return record;
+  }
+  AmplitudeBand band;
+  if (!ChooseAmplitudeBand(config, path, data, axis, window, &band, &record)) return record;
+
+  // 5. Fit. The residual series is kept for the second glitch pass (and dropped after it when
+  // neither a figure nor the caller wants it).
+  FitSeries series;
+  TraceFitInput input = MakeFitInput(config, options, data, axis, window, band, record.file,
+                                     &series);
+  TraceFitOptions fit_options = TraceFitOptionsFor(config, options.role);
+  fit_options.keep_series = true;
+  fit_options.interrupt = options.interrupt;
+  TraceFitResult fit = FitWithResidualGlitchPass(config, fit_options, &input, &record);
+  if (options.figure_paths.empty() && fit_out == nullptr) {
+    fit.t_s.clear();
+    fit.measured_rate_rad_per_s.clear();
+    fit.fitted_rate_rad_per_s.clear();
+    fit.residual_rad_per_s.clear();
+  }
+  FillRecordFromFit(config, path, fit, input, series, &record);
+  if (fit_out) *fit_out = fit;
+  WriteTraceFigures(config, options, fit, &record);
+  return record;
+}
 
 // Runs process(record) on a fresh record of `path`, timed; an exception becomes an error record.
 template <typename Process>
@@ -610,6 +547,43 @@ TraceRecord ProcessTraceData(const CampaignConfig& config, const ImuData& data,
   return Guarded(config, path, options, [&](const TraceRecord& record) {
     return ProcessData(config, path, data, options, record, fit);
   });
+}
+
+TraceFitOptions TraceFitOptionsFor(const CampaignConfig& config, TraceRole role) {
+  TraceFitOptions fit_options;
+  fit_options.model = config.fit.model;
+  fit_options.integrator = fit_options.integrator.WithMethod(config.fit.integrator);
+  const QualityThresholds& q = config.fit.quality;
+  fit_options.max_rms_over_noise = q.max_rms_over_noise;
+  fit_options.max_residual_autocorr = q.max_residual_autocorr;
+  fit_options.whiteness_lags = q.whiteness_lags;
+  fit_options.max_secondary_motion_ratio = q.max_secondary_motion_ratio;
+  fit_options.reject_secondary_motion_ratio = q.reject_secondary_motion_ratio;
+  fit_options.reject_residual_fraction = q.reject_residual_fraction;
+  fit_options.amplitude_sweep = config.fit.sweep.enabled;
+  fit_options.sweep_min_cycles_per_band = config.fit.sweep.min_cycles_per_band;
+  fit_options.sweep_max_bands = config.fit.sweep.max_bands;
+  fit_options.sweep_trend_z = config.fit.sweep.trend_z;
+  fit_options.min_periods = q.min_periods;
+  const AmplitudeBandOptions band_options = AmplitudeBandOptionsFor(config);
+  fit_options.max_amplitude_deg = band_options.max_amplitude_deg;
+  fit_options.min_amplitude_deg =
+      std::min(fit_options.min_amplitude_deg, band_options.min_amplitude_deg);
+  // A calibrated geometry absorbs L, D and g (docs/physics.md §2.6): their terms are replaced by
+  // the calibration's own (added to the record's budget). Without rig.uncertainties the budget
+  // counts the assumed +-1 mm on L and D (pipeline/records/total_uncertainty.h), unless the rig
+  // is calibrated.
+  const bool calibrated = config.geometry_calibration.applied;
+  const RigUncertainties uncertainties = config.uncertainties.InEffect();
+  fit_options.filar_length_std_m = calibrated ? 0.0 : uncertainties.filar_length_std_m;
+  fit_options.filar_separation_std_m = calibrated ? 0.0 : uncertainties.filar_separation_std_m;
+  fit_options.mass_std_kg = role == TraceRole::kAircraft
+                                ? std::hypot(uncertainties.mass_std_kg,
+                                             config.aircraft_mass_std_kg)
+                                : uncertainties.mass_std_kg;
+  fit_options.gravity_std_mps2 = calibrated ? 0.0 : uncertainties.gravity_std_mps2;
+  fit_options.gyro_scale_std = config.imu.gyro_scale_std;
+  return fit_options;
 }
 
 SwingAxisOptions SwingAxisOptionsFor(const ImuConfig& imu) {

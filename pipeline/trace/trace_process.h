@@ -72,4 +72,10 @@ std::string CanonicalLogPath(const std::string& path);
 // The swing-axis settings of the config's `imu` section (auto or fixed axis, mounting).
 SwingAxisOptions SwingAxisOptionsFor(const ImuConfig& imu);
 
+// The trace fit's settings of the config for a trace of `role`: model, integrator, quality
+// thresholds, amplitude sweep and band, and the input uncertainties of the budget (none for L, D
+// and g when the geometry is calibrated; the aircraft's mass std added for an aircraft trace).
+// keep_series and interrupt are left at their defaults.
+TraceFitOptions TraceFitOptionsFor(const CampaignConfig& config, TraceRole role);
+
 }  // namespace bifilar

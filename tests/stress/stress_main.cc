@@ -1023,10 +1023,8 @@ int RunHostileInputCases(const Args& args, Workspace& w, int first_case_no, Fail
   return c - first_case_no;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  Args args;
+// The command line into *args; false (after a message) when it is wrong.
+bool ParseArgs(int argc, char** argv, Args* args) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -1036,22 +1034,250 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--binary") args.binary = next();
-    else if (a == "--source") args.source = next();
-    else if (a == "--seed") args.seed = std::stoull(next());
-    else if (a == "--cases") args.cases = std::stoi(next());
-    else if (a == "--run-timeout-s") args.run_timeout_s = std::stod(next());
-    else if (a == "--keep") args.keep = true;
+    if (a == "--binary") args->binary = next();
+    else if (a == "--source") args->source = next();
+    else if (a == "--seed") args->seed = std::stoull(next());
+    else if (a == "--cases") args->cases = std::stoi(next());
+    else if (a == "--run-timeout-s") args->run_timeout_s = std::stod(next());
+    else if (a == "--keep") args->keep = true;
     else {
       std::cerr << "usage: bifilar_stress --binary BIFILAR --source REPO [--seed N] [--cases N] "
                    "[--run-timeout-s S] [--keep]\n";
-      return 2;
+      return false;
     }
   }
-  if (args.binary.empty() || args.source.empty()) {
+  if (args->binary.empty() || args->source.empty()) {
     std::cerr << "bifilar_stress: --binary and --source are required\n";
-    return 2;
+    return false;
   }
+  return true;
+}
+
+// Real logs (optional): the Crazyflie logs beside the repository, with their config written.
+std::vector<std::string> RealLogs(const Args& args, const Workspace& w) {
+  const std::string crazyflie = args.source + "/../shared/data/crazyflie";
+  std::vector<std::string> real_logs;
+  if (fs::is_directory(crazyflie)) {
+    for (const auto& e : fs::directory_iterator(crazyflie)) {
+      if (e.path().extension() == ".csv") real_logs.push_back(e.path().string());
+    }
+    std::sort(real_logs.begin(), real_logs.end());
+    WriteFile(w.dir + "/crazyflie.yaml",
+              "gravity_mps2: 9.8066\n"
+              "rig: {filar_length_m: 0.594, filar_separation_m: 0.030, mass_kg: 0.0343}\n"
+              "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [wx, wy, wz], unit: rad/s}\n"
+              "  swing_axis: [0, 0, 1]\n");
+  }
+  return real_logs;
+}
+
+// What every random case gets: the run's settings, the workspace, its case number, the random
+// stream and where failures go.
+struct CaseContext {
+  const Args& args;
+  Workspace& w;
+  int c;
+  std::mt19937_64& rng;
+  Failures* failures;
+  std::string prefix;  // of the runs' output files
+};
+
+// 1-3 logs mutated: a bad log is an error row, never the end of the run.
+std::string CaseLogMutation(CaseContext& x) {
+  const std::string kind = "log mutation";
+  std::string what;
+  const int k = Uniform(x.rng, 1, 3);
+  std::vector<std::string> paths;
+  for (const auto& [path, text] : x.w.pristine) paths.push_back(path);
+  for (int i = 0; i < k; ++i) {
+    const std::string& path = Pick(paths, x.rng);
+    std::string how;
+    WriteFile(path, MutateLog(ReadFile(path), x.rng, &how));
+    what += fs::path(path).filename().string() + ": " + how + "; ";
+  }
+  const Outcome o = Wait(Start(ProcessArgv(x.args, x.w, false), x.prefix), x.args.run_timeout_s);
+  CheckRun(o, x.w, x.c, kind + " (" + what + ")", x.failures);
+  if (o.exit_code == 2) {  // a bad log is an error row, never the end of the run
+    x.failures->Add(x.c, kind + " (" + what + ")", "exit 2 for a bad log:\n" + o.err);
+  }
+  x.w.RestoreLogs();
+  return kind;
+}
+
+// The config mutated.
+std::string CaseConfigMutation(CaseContext& x) {
+  const std::string kind = "config mutation";
+  std::string what;
+  WriteFile(x.w.config_path, MutateConfig(x.w.config_text, x.rng, &what));
+  CheckRun(Wait(Start(ProcessArgv(x.args, x.w, false), x.prefix), x.args.run_timeout_s), x.w, x.c,
+           kind + " (" + what + ")", x.failures);
+  x.w.RestoreConfig();
+  return kind;
+}
+
+// 1-4 cache entries tampered with: the run refits them and gives the baseline.
+std::string CaseCacheTampering(CaseContext& x) {
+  const std::string kind = "cache tampering";
+  std::string what;
+  const int k = Uniform(x.rng, 1, 4);
+  for (int i = 0; i < k; ++i) what += TamperCache(x.w, x.rng) + "; ";
+  const Outcome o = Wait(Start(ProcessArgv(x.args, x.w, false), x.prefix), x.args.run_timeout_s);
+  CheckRun(o, x.w, x.c, kind + " (" + what + ")", x.failures);
+  if (o.exit_code == 0) {
+    CheckBaseline(x.w, x.c, kind + " (" + what + ")", x.failures);
+  } else {
+    x.failures->Add(x.c, kind + " (" + what + ")",
+                    "exit " + std::to_string(o.exit_code) + "\n" + o.err);
+  }
+  return kind;
+}
+
+// A run killed at a random time (up to 1.2 forced runs), then `report` on what it left, then a
+// rerun that must give the baseline.
+std::string CaseKill(CaseContext& x, double forced_s) {
+  const std::string kind = "kill -9";
+  const Args& args = x.args;
+  const bool force = Uniform(x.rng, 0, 1) == 1;
+  const double at_s = std::uniform_real_distribution<double>(0.0, 1.2 * forced_s)(x.rng);
+  const std::string what = (force ? "--force, " : "") + std::to_string(at_s) + " s";
+  const Outcome killed =
+      Wait(Start(ProcessArgv(args, x.w, force), x.prefix), args.run_timeout_s, at_s);
+  CheckRun(killed, x.w, x.c, kind + " (" + what + ")", x.failures);
+  // `report` on what the kill left: a page from a consistent set, or a refusal naming it.
+  const bool mixed = !bifilar::CheckOutputSet(x.w.out, false).empty();
+  const Outcome report = Wait(Start({args.binary, "report", x.w.out}, x.prefix), args.run_timeout_s);
+  CheckOutside(report, x.c, kind + " then report (" + what + ")", x.failures);
+  if (report.signal || report.timed_out || (report.exit_code != 0 && report.exit_code != 2) ||
+      (mixed && report.exit_code != 2) ||
+      (report.exit_code == 2 && report.err.find("error") == std::string::npos)) {
+    x.failures->Add(x.c, kind + " then report (" + what + ")",
+                    std::string(mixed ? "mixed set, " : "") + "report exit " +
+                        std::to_string(report.exit_code) + "\n" + report.err);
+  }
+  const Outcome rerun = Wait(Start(ProcessArgv(args, x.w, false), x.prefix), args.run_timeout_s);
+  CheckRun(rerun, x.w, x.c, kind + " then rerun (" + what + ")", x.failures);
+  if (rerun.exit_code == 0) {
+    CheckBaseline(x.w, x.c, kind + " then rerun (" + what + ")", x.failures);
+  } else {
+    x.failures->Add(x.c, kind + " then rerun (" + what + ")",
+                    "rerun exit " + std::to_string(rerun.exit_code) + "\n" + rerun.err);
+  }
+  return kind;
+}
+
+// Two runs at once: one succeeds, the other succeeds too or is refused for the lock.
+std::string CaseConcurrentRuns(CaseContext& x) {
+  const std::string kind = "two concurrent runs";
+  const Args& args = x.args;
+  const bool force_a = Uniform(x.rng, 0, 1), force_b = Uniform(x.rng, 0, 1);
+  const Process a = Start(ProcessArgv(args, x.w, force_a), x.prefix + "_a");
+  const Process b = Start(ProcessArgv(args, x.w, force_b), x.prefix + "_b");
+  const Outcome oa = Wait(a, args.run_timeout_s), ob = Wait(b, args.run_timeout_s);
+  CheckRun(oa, x.w, x.c, kind + " (first)", x.failures);
+  CheckRun(ob, x.w, x.c, kind + " (second)", x.failures);
+  int ok = 0;
+  for (const Outcome* o : {&oa, &ob}) {
+    if (o->exit_code == 0) ++ok;
+    else if (!(o->exit_code == 2 && o->err.find("in use by another bifilar run") != std::string::npos)) {
+      x.failures->Add(x.c, kind, "a run neither succeeded nor was refused for the lock: exit " +
+                                     std::to_string(o->exit_code) + "\n" + o->err);
+    }
+  }
+  if (ok == 0) x.failures->Add(x.c, kind, "neither run succeeded");
+  CheckRun(Wait(Start(ProcessArgv(args, x.w, false), x.prefix), args.run_timeout_s), x.w, x.c,
+           kind + " then rerun", x.failures);
+  CheckBaseline(x.w, x.c, kind, x.failures);
+  return kind;
+}
+
+// A user's file in figures/ or cache/: the run refuses the folder and keeps the file.
+std::string CaseUserFileInOutput(CaseContext& x) {
+  const std::string kind = "user file in figures/";
+  const std::string path = x.w.out + "/" + (Uniform(x.rng, 0, 1) ? "figures" : "cache") +
+                           "/user_" + std::to_string(x.c) + ".png";
+  WriteFile(path, "mine");
+  const Outcome o = Wait(Start(ProcessArgv(x.args, x.w, Uniform(x.rng, 0, 1)), x.prefix),
+                         x.args.run_timeout_s);
+  CheckRun(o, x.w, x.c, kind, x.failures);
+  if (o.exit_code != 2 || o.err.find("did not write") == std::string::npos) {
+    x.failures->Add(x.c, kind, "a folder holding a user's file was used: exit " +
+                                   std::to_string(o.exit_code));
+  }
+  if (ReadFile(path) != "mine") x.failures->Add(x.c, kind, "the user's file was removed: " + path);
+  fs::remove(path);
+  return kind;
+}
+
+// A real log mutated, through `fit --json`: no hang, crash or non-finite number.
+std::string CaseRealLogMutation(CaseContext& x, const std::vector<std::string>& real_logs) {
+  const std::string kind = "real log mutation";
+  std::string what;
+  const std::string& source = Pick(real_logs, x.rng);
+  const std::string path = x.w.dir + "/real/" + fs::path(source).filename().string();
+  WriteFile(path, MutateLog(CrazyflieSeries(ReadFile(source)), x.rng, &what));
+  const Outcome o =
+      Wait(Start({x.args.binary, "fit", x.w.dir + "/crazyflie.yaml", path, "--json"}, x.prefix),
+           x.args.run_timeout_s);
+  const std::string label = kind + " (" + fs::path(source).filename().string() + ": " + what + ")";
+  if (o.timed_out) x.failures->Add(x.c, label, "no answer within the bound: a hang");
+  if (o.signal) {
+    x.failures->Add(x.c, label, "crashed with signal " + std::to_string(o.signal) + "\n" + o.err);
+  }
+  CheckOutside(o, x.c, label, x.failures);
+  if (!o.timed_out && !o.signal && (o.exit_code < 0 || o.exit_code > 2)) {
+    x.failures->Add(x.c, label, "exit code " + std::to_string(o.exit_code));
+  }
+  if (o.exit_code == 0 || o.exit_code == 1) {
+    const std::string bad = NonFiniteIn(o.out, false);
+    if (!bad.empty()) x.failures->Add(x.c, label, "fit --json: " + bad);
+  }
+  fs::remove(path);
+  return kind;
+}
+
+// One random case, its family drawn from `rng` (25 % log, 15 % config, 15 % cache, 20 % kill,
+// 12 % concurrent, 5 % user file, the rest real logs or a plain rerun); returns its kind.
+std::string RunRandomCase(CaseContext& x, double forced_s,
+                          const std::vector<std::string>& real_logs) {
+  const int roll = Uniform(x.rng, 0, 99);
+  if (roll < 25) return CaseLogMutation(x);
+  if (roll < 40) return CaseConfigMutation(x);
+  if (roll < 55) return CaseCacheTampering(x);
+  if (roll < 75) return CaseKill(x, forced_s);
+  if (roll < 87) return CaseConcurrentRuns(x);
+  if (roll < 92) return CaseUserFileInOutput(x);
+  if (!real_logs.empty()) return CaseRealLogMutation(x, real_logs);
+  const std::string kind = "rerun";
+  CheckRun(Wait(Start(ProcessArgv(x.args, x.w, false), x.prefix), x.args.run_timeout_s), x.w, x.c,
+           kind, x.failures);
+  return kind;
+}
+
+// The summary line (cases per kind, failures); the workspace removed unless --keep. The exit
+// code: 0 when nothing failed.
+int Summarize(const Args& args, const Workspace& w, Clock::time_point start, double forced_s,
+              const std::map<std::string, int>& kinds_run, const Failures& failures) {
+  const double total_s = std::chrono::duration<double>(Clock::now() - start).count();
+  std::cout << "bifilar_stress: seed " << args.seed << ", " << args.cases << " cases in "
+            << total_s << " s (one forced run " << forced_s << " s):";
+  for (const auto& [kind, n] : kinds_run) std::cout << " " << kind << " " << n << ";";
+  std::cout << " failures " << failures.count << "\n";
+  if (!args.keep) {
+    std::error_code ec;
+    fs::remove_all(w.dir, ec);
+  } else {
+    std::cout << "workspace kept: " << w.dir << "\n";
+  }
+  return failures.count == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+// ParseArgs -> the baseline run -> RealLogs -> per case: OutsideOutCase (every tenth) or
+// RunRandomCase -> RunHostileInputCases -> Summarize.
+int main(int argc, char** argv) {
+  Args args;
+  if (!ParseArgs(argc, argv, &args)) return 2;
   const Clock::time_point start = Clock::now();
   Workspace w = MakeWorkspace(args);
   const Sentinel sentinel{w.dir, {w.out, w.harness}};
@@ -1071,21 +1297,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   const double forced_s = base.seconds;
-
-  // Real logs (optional).
-  const std::string crazyflie = args.source + "/../shared/data/crazyflie";
-  std::vector<std::string> real_logs;
-  if (fs::is_directory(crazyflie)) {
-    for (const auto& e : fs::directory_iterator(crazyflie)) {
-      if (e.path().extension() == ".csv") real_logs.push_back(e.path().string());
-    }
-    std::sort(real_logs.begin(), real_logs.end());
-    WriteFile(w.dir + "/crazyflie.yaml",
-              "gravity_mps2: 9.8066\n"
-              "rig: {filar_length_m: 0.594, filar_separation_m: 0.030, mass_kg: 0.0343}\n"
-              "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [wx, wy, wz], unit: rad/s}\n"
-              "  swing_axis: [0, 0, 1]\n");
-  }
+  const std::vector<std::string> real_logs = RealLogs(args, w);
 
   std::map<std::string, int> kinds_run;
   for (int c = 1; c <= args.cases; ++c) {
@@ -1093,139 +1305,10 @@ int main(int argc, char** argv) {
       ++kinds_run[OutsideOutCase(args, w, c, rng_outside, &failures)];
       continue;
     }
-    const int roll = Uniform(rng, 0, 99);
-    std::string kind, what;
-    const std::string prefix = w.harness + "/run";
-    if (roll < 25) {
-      kind = "log mutation";
-      const int k = Uniform(rng, 1, 3);
-      std::vector<std::string> paths;
-      for (const auto& [path, text] : w.pristine) paths.push_back(path);
-      for (int i = 0; i < k; ++i) {
-        const std::string& path = Pick(paths, rng);
-        std::string how;
-        WriteFile(path, MutateLog(ReadFile(path), rng, &how));
-        what += fs::path(path).filename().string() + ": " + how + "; ";
-      }
-      const Outcome o = Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s);
-      CheckRun(o, w, c, kind + " (" + what + ")", &failures);
-      if (o.exit_code == 2) {  // a bad log is an error row, never the end of the run
-        failures.Add(c, kind + " (" + what + ")", "exit 2 for a bad log:\n" + o.err);
-      }
-      w.RestoreLogs();
-    } else if (roll < 40) {
-      kind = "config mutation";
-      WriteFile(w.config_path, MutateConfig(w.config_text, rng, &what));
-      CheckRun(Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s), w, c,
-               kind + " (" + what + ")", &failures);
-      w.RestoreConfig();
-    } else if (roll < 55) {
-      kind = "cache tampering";
-      const int k = Uniform(rng, 1, 4);
-      for (int i = 0; i < k; ++i) what += TamperCache(w, rng) + "; ";
-      const Outcome o = Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s);
-      CheckRun(o, w, c, kind + " (" + what + ")", &failures);
-      if (o.exit_code == 0) {
-        CheckBaseline(w, c, kind + " (" + what + ")", &failures);
-      } else {
-        failures.Add(c, kind + " (" + what + ")", "exit " + std::to_string(o.exit_code) + "\n" + o.err);
-      }
-    } else if (roll < 75) {
-      kind = "kill -9";
-      const bool force = Uniform(rng, 0, 1) == 1;
-      const double at_s = std::uniform_real_distribution<double>(0.0, 1.2 * forced_s)(rng);
-      what = (force ? "--force, " : "") + std::to_string(at_s) + " s";
-      const Outcome killed =
-          Wait(Start(ProcessArgv(args, w, force), prefix), args.run_timeout_s, at_s);
-      CheckRun(killed, w, c, kind + " (" + what + ")", &failures);
-      // `report` on what the kill left: a page from a consistent set, or a refusal naming it.
-      const bool mixed = !bifilar::CheckOutputSet(w.out, false).empty();
-      const Outcome report = Wait(Start({args.binary, "report", w.out}, prefix), args.run_timeout_s);
-      CheckOutside(report, c, kind + " then report (" + what + ")", &failures);
-      if (report.signal || report.timed_out || (report.exit_code != 0 && report.exit_code != 2) ||
-          (mixed && report.exit_code != 2) ||
-          (report.exit_code == 2 && report.err.find("error") == std::string::npos)) {
-        failures.Add(c, kind + " then report (" + what + ")",
-                     std::string(mixed ? "mixed set, " : "") + "report exit " +
-                         std::to_string(report.exit_code) + "\n" + report.err);
-      }
-      const Outcome rerun = Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s);
-      CheckRun(rerun, w, c, kind + " then rerun (" + what + ")", &failures);
-      if (rerun.exit_code == 0) {
-        CheckBaseline(w, c, kind + " then rerun (" + what + ")", &failures);
-      } else {
-        failures.Add(c, kind + " then rerun (" + what + ")",
-                     "rerun exit " + std::to_string(rerun.exit_code) + "\n" + rerun.err);
-      }
-    } else if (roll < 87) {
-      kind = "two concurrent runs";
-      const bool force_a = Uniform(rng, 0, 1), force_b = Uniform(rng, 0, 1);
-      const Process a = Start(ProcessArgv(args, w, force_a), prefix + "_a");
-      const Process b = Start(ProcessArgv(args, w, force_b), prefix + "_b");
-      const Outcome oa = Wait(a, args.run_timeout_s), ob = Wait(b, args.run_timeout_s);
-      CheckRun(oa, w, c, kind + " (first)", &failures);
-      CheckRun(ob, w, c, kind + " (second)", &failures);
-      int ok = 0;
-      for (const Outcome* o : {&oa, &ob}) {
-        if (o->exit_code == 0) ++ok;
-        else if (!(o->exit_code == 2 && o->err.find("in use by another bifilar run") != std::string::npos)) {
-          failures.Add(c, kind, "a run neither succeeded nor was refused for the lock: exit " +
-                                    std::to_string(o->exit_code) + "\n" + o->err);
-        }
-      }
-      if (ok == 0) failures.Add(c, kind, "neither run succeeded");
-      CheckRun(Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s), w, c,
-               kind + " then rerun", &failures);
-      CheckBaseline(w, c, kind, &failures);
-    } else if (roll < 92) {
-      kind = "user file in figures/";
-      const std::string path = w.out + "/" + (Uniform(rng, 0, 1) ? "figures" : "cache") +
-                               "/user_" + std::to_string(c) + ".png";
-      WriteFile(path, "mine");
-      const Outcome o = Wait(Start(ProcessArgv(args, w, Uniform(rng, 0, 1)), prefix), args.run_timeout_s);
-      CheckRun(o, w, c, kind, &failures);
-      if (o.exit_code != 2 || o.err.find("did not write") == std::string::npos) {
-        failures.Add(c, kind, "a folder holding a user's file was used: exit " + std::to_string(o.exit_code));
-      }
-      if (ReadFile(path) != "mine") failures.Add(c, kind, "the user's file was removed: " + path);
-      fs::remove(path);
-    } else if (!real_logs.empty()) {
-      kind = "real log mutation";
-      const std::string& source = Pick(real_logs, rng);
-      const std::string path = w.dir + "/real/" + fs::path(source).filename().string();
-      WriteFile(path, MutateLog(CrazyflieSeries(ReadFile(source)), rng, &what));
-      const Outcome o = Wait(Start({args.binary, "fit", w.dir + "/crazyflie.yaml", path, "--json"}, prefix),
-                             args.run_timeout_s);
-      const std::string label = kind + " (" + fs::path(source).filename().string() + ": " + what + ")";
-      if (o.timed_out) failures.Add(c, label, "no answer within the bound: a hang");
-      if (o.signal) failures.Add(c, label, "crashed with signal " + std::to_string(o.signal) + "\n" + o.err);
-      CheckOutside(o, c, label, &failures);
-      if (!o.timed_out && !o.signal && (o.exit_code < 0 || o.exit_code > 2)) {
-        failures.Add(c, label, "exit code " + std::to_string(o.exit_code));
-      }
-      if (o.exit_code == 0 || o.exit_code == 1) {
-        const std::string bad = NonFiniteIn(o.out, false);
-        if (!bad.empty()) failures.Add(c, label, "fit --json: " + bad);
-      }
-      fs::remove(path);
-    } else {
-      kind = "rerun";
-      CheckRun(Wait(Start(ProcessArgv(args, w, false), prefix), args.run_timeout_s), w, c, kind, &failures);
-    }
-    ++kinds_run[kind];
+    CaseContext x{args, w, c, rng, &failures, w.harness + "/run"};
+    ++kinds_run[RunRandomCase(x, forced_s, real_logs)];
   }
   kinds_run["hostile input (bounded reads)"] =
       RunHostileInputCases(args, w, args.cases + 1, &failures);
-  const double total_s = std::chrono::duration<double>(Clock::now() - start).count();
-  std::cout << "bifilar_stress: seed " << args.seed << ", " << args.cases << " cases in "
-            << total_s << " s (one forced run " << forced_s << " s):";
-  for (const auto& [kind, n] : kinds_run) std::cout << " " << kind << " " << n << ";";
-  std::cout << " failures " << failures.count << "\n";
-  if (!args.keep) {
-    std::error_code ec;
-    fs::remove_all(w.dir, ec);
-  } else {
-    std::cout << "workspace kept: " << w.dir << "\n";
-  }
-  return failures.count == 0 ? 0 : 1;
+  return Summarize(args, w, start, forced_s, kinds_run, failures);
 }
