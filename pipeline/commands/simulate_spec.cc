@@ -785,6 +785,27 @@ double DefaultTimeJitterSigmaS(double sample_rate_hz) {
   return 0.1 / sample_rate_hz < fallback ? 0.1 / sample_rate_hz : fallback;
 }
 
+void ApplySimulateOverrides(const SimulateOverrides& o, bool single_trace,
+                            SimulateSpec* spec) {
+  if (o.seed) spec->seed = *o.seed;
+  if (o.no_accel) spec->options.sensor.accelerometer = false;
+  if (o.duration_s) spec->options.timeline.free_s = {*o.duration_s, *o.duration_s};
+  if (!single_trace) {
+    if (o.length_m) spec->campaign.filar_length_m = *o.length_m;
+    if (o.separation_m) spec->campaign.filar_separation_m = *o.separation_m;
+    if (o.gravity_mps2) spec->campaign.gravity_mps2 = *o.gravity_mps2;
+    return;
+  }
+  TraceRequest& t = spec->trace;
+  if (o.inertia_kg_m2) t.inertia_kg_m2 = *o.inertia_kg_m2;
+  if (o.mass_kg) t.mass_kg = *o.mass_kg;
+  if (o.length_m) t.filar_length_m = *o.length_m;
+  if (o.separation_m) t.filar_separation_m = *o.separation_m;
+  if (o.gravity_mps2) t.gravity_mps2 = *o.gravity_mps2;
+  if (o.amplitude_deg) t.amplitude_deg = *o.amplitude_deg;
+  if (o.pitch_deg) t.pitch_deg = *o.pitch_deg;
+}
+
 void SetSampleRateFromFlag(SimulateSpec* spec, double rate_hz) {
   if (!(rate_hz > 0 && rate_hz <= 100000)) {
     throw UserError("--sample-rate-hz = " + Num(rate_hz) + " is out of range; allowed (0, 100000]");

@@ -56,6 +56,22 @@ double DefaultTimeJitterSigmaS(double sample_rate_hz);
 // longer fits the new rate, throws UserError naming the flag, the spec key and what to change.
 void SetSampleRateFromFlag(SimulateSpec* spec, double sample_rate_hz);
 
+// The settings `bifilar simulate` (flags) and Python's bifilar.simulate (keywords) lay over a
+// spec; unset ones keep the spec's value. The callers check the values and name them in their own
+// words (a flag or a keyword) before calling ApplySimulateOverrides.
+struct SimulateOverrides {
+  std::optional<uint64_t> seed;
+  std::optional<double> inertia_kg_m2, mass_kg, length_m, separation_m, gravity_mps2,
+      amplitude_deg, pitch_deg, duration_s;
+  bool no_accel = false;  // write no accelerometer columns
+};
+
+// Lays the overrides over the spec: the seed, --no-accel, the free-oscillation duration and the
+// geometry (L, D, g), into the campaign (`single_trace` false) or into spec.trace with the
+// trace's own inertia, mass, amplitude and pitch (`single_trace` true). Checks nothing.
+void ApplySimulateOverrides(const SimulateOverrides& overrides, bool single_trace,
+                            SimulateSpec* spec);
+
 // Refuses an output target that `simulate` must not write through: anything but a regular file
 // or nothing (a device such as /dev/null, a FIFO, a socket, a folder, also behind a symlink), or
 // a path below an existing non-folder. `what` names the option in the message ("--trace").
