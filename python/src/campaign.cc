@@ -35,6 +35,7 @@
 #include "fit/window.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/commands/log_inspect.h"
+#include "pipeline/commands/process_command.h"
 #include "pipeline/commands/simulate_spec.h"
 #include "pipeline/config/config.h"
 #include "pipeline/logs/imu_log.h"
@@ -69,26 +70,25 @@ py::object ProcessCore(const std::string& config_path, const std::optional<std::
   const bool has_callback = !progress_callback.is_none();
   std::thread worker([&] {
     try {
-      const CampaignConfig config = LoadCampaignConfig(config_path);
-      CampaignOptions options;  // as `bifilar process`
-      options.out_dir =
-          out ? *out : (std::filesystem::path(config.folder) / "out").string();
-      options.jobs = jobs.value_or(0);
-      options.force = force;
-      options.figures = figures;
-      options.write_report = figures;
-      options.progress = progress_bar ? &std::cerr : nullptr;
-      options.progress_bar = progress_bar;
-      options.cancel = &cancel;
+      ProcessCommandOptions options;  // as `bifilar process`
+      options.config_path = config_path;
+      options.out_dir = out;
+      options.campaign.jobs = jobs.value_or(0);
+      options.campaign.force = force;
+      options.campaign.figures = figures;
+      options.campaign.write_report = figures;
+      options.campaign.progress = progress_bar ? &std::cerr : nullptr;
+      options.campaign.progress_bar = progress_bar;
+      options.campaign.cancel = &cancel;
       if (has_callback) {
-        options.on_progress = [&](int done, int total, const std::string& line) {
+        options.campaign.on_progress = [&](int done, int total, const std::string& line) {
           const std::lock_guard<std::mutex> lock(events_mutex);
           events.push_back({done, total, line});
         };
       }
-      RunCampaign(config, options);
+      const ProcessCommandResult run = RunProcess(options);
       // The file just written, so that the two can never differ.
-      const std::string path = (std::filesystem::path(options.out_dir) / "results.json").string();
+      const std::string path = (std::filesystem::path(run.out_dir) / "results.json").string();
       results = nlohmann::json::parse(ReadRegularFileOrThrow(path, OutputFileCap()));
     } catch (...) {
       error = std::current_exception();
