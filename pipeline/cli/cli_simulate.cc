@@ -15,13 +15,6 @@
 namespace bifilar {
 namespace {
 
-struct SimulateArgs {
-  std::string spec_file, out_dir, trace_csv, truth_json, model;
-  SimulateOverrides o;  // --seed, --inertia-kg-m2, ..., --duration-s, --no-accel
-  std::optional<double> sample_rate;
-  bool force = false;  // replace files that exist (issue 23: never without being told)
-};
-
 // CLI11 2.1 binds plain values; an option given on the command line fills the std::optional.
 struct RawArgs {
   std::string seed;
@@ -37,62 +30,10 @@ std::optional<T> Given(const CLI::Option* option, T value) {
   return option->count() > 0 ? std::optional<T>(value) : std::nullopt;
 }
 
-void Run(const SimulateArgs& a, int* exit_code) {
-  const SimulateOverrides& o = a.o;
-  auto positive = [](const std::optional<double>& v, const char* flag) {
-    if (v && !(*v > 0)) {
-      throw UserError(std::string(flag) + " = " + std::to_string(*v) + " is out of range; allowed > 0");
-    }
-  };
-  positive(o.duration_s, "--duration-s");
-  positive(a.sample_rate, "--sample-rate-hz");
-  positive(o.inertia_kg_m2, "--inertia-kg-m2");
-  positive(o.mass_kg, "--mass-kg");
-  positive(o.length_m, "-L/--filar-length-m");
-  positive(o.separation_m, "-D/--filar-separation-m");
-  positive(o.gravity_mps2, "--gravity-mps2");
-  SimulateSpec spec = a.spec_file.empty() ? ParseSimulateSpec("{}", "<defaults>")
-                                          : ReadSimulateSpec(a.spec_file);
-  if (a.spec_file.empty()) spec.file.clear();
-  if (!a.model.empty() && !ParsePendulumModel(a.model, &spec.options.model)) {
-    throw UserError("--model: unknown model '" + a.model + "'; allowed full, jardin, linear");
-  }
-  if (a.sample_rate) SetSampleRateFromFlag(&spec, *a.sample_rate);
-  if (!a.trace_csv.empty()) {
-    if (!a.out_dir.empty()) throw UserError("give either --trace FILE.csv or --out DIR, not both");
-    if (spec.has_campaign) {
-      throw UserError(a.spec_file + ": has campaign sections (aircraft, rig, campaign); simulate "
-                      "it with --out DIR, or use a spec without them with --trace");
-    }
-    ApplySimulateOverrides(o, true, &spec);
-    std::string why;
-    if (!spec.options.Check(&why)) throw UserError(why);
-    const SimulateRunSummary summary = RunSimulateTrace(spec, a.trace_csv, a.truth_json, a.force);
-    std::cout << "wrote " << a.trace_csv << ": " << summary.BriefReport() << "\n";
-    *exit_code = 0;
-    return;
-  }
-  if (a.out_dir.empty()) {
-    throw UserError("nothing to do: give SPEC.yaml --out DIR (campaign) or --trace FILE.csv "
-                    "(one trace); see bifilar simulate --help");
-  }
-  if (a.spec_file.empty()) throw UserError("--out DIR needs a campaign spec file SPEC.yaml");
-  if (o.inertia_kg_m2 || o.mass_kg || o.amplitude_deg || o.pitch_deg || !a.truth_json.empty()) {
-    throw UserError("--inertia-kg-m2, --mass-kg, --amplitude-deg, --pitch-deg and --truth apply to "
-                    "--trace only; a campaign takes them from the spec");
-  }
-  ApplySimulateOverrides(o, false, &spec);
-  std::string why;
-  if (!spec.campaign.Check(&why) || !spec.options.Check(&why)) throw UserError(why);
-  const SimulateRunSummary summary = RunSimulateCampaign(spec, a.out_dir, a.force);
-  std::cout << "wrote " << a.out_dir << ": " << summary.BriefReport() << "\n";
-  *exit_code = 0;
-}
-
 }  // namespace
 
 void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
-  auto args = std::make_shared<SimulateArgs>();
+  auto args = std::make_shared<SimulateCommandOptions>();
   auto raw = std::make_shared<RawArgs>();
   auto* sub = app.add_subcommand(
       "simulate",
@@ -127,7 +68,7 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
                 "overwrite files that exist (--trace, --truth, or the logs and truth.json of "
                 "--out); without it simulate refuses, naming the file");
   sub->callback([args, raw, exit_code] {
-    SimulateArgs& a = *args;
+    SimulateCommandOptions& a = *args;
     if (raw->o_seed->count() > 0) {
       a.o.seed = ParseSeed(raw->seed, "--seed", std::numeric_limits<uint64_t>::max());
     }
@@ -140,7 +81,9 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
     a.o.pitch_deg = Given(raw->o_pitch, raw->pitch);
     a.o.duration_s = Given(raw->o_duration, raw->duration);
     a.sample_rate = Given(raw->o_sample_rate, raw->sample_rate);
-    Run(a, exit_code);
+    const SimulateCommandResult result = RunSimulate(a);
+    std::cout << "wrote " << result.written << ": " << result.summary.BriefReport() << "\n";
+    *exit_code = 0;
   });
 }
 

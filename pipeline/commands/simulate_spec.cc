@@ -806,6 +806,53 @@ void ApplySimulateOverrides(const SimulateOverrides& o, bool single_trace,
   if (o.pitch_deg) t.pitch_deg = *o.pitch_deg;
 }
 
+SimulateCommandResult RunSimulate(const SimulateCommandOptions& a) {
+  const SimulateOverrides& o = a.o;
+  auto positive = [](const std::optional<double>& v, const char* flag) {
+    if (v && !(*v > 0)) {
+      throw UserError(std::string(flag) + " = " + std::to_string(*v) + " is out of range; allowed > 0");
+    }
+  };
+  positive(o.duration_s, "--duration-s");
+  positive(a.sample_rate, "--sample-rate-hz");
+  positive(o.inertia_kg_m2, "--inertia-kg-m2");
+  positive(o.mass_kg, "--mass-kg");
+  positive(o.length_m, "-L/--filar-length-m");
+  positive(o.separation_m, "-D/--filar-separation-m");
+  positive(o.gravity_mps2, "--gravity-mps2");
+  SimulateSpec spec = a.spec_file.empty() ? ParseSimulateSpec("{}", "<defaults>")
+                                          : ReadSimulateSpec(a.spec_file);
+  if (a.spec_file.empty()) spec.file.clear();
+  if (!a.model.empty() && !ParsePendulumModel(a.model, &spec.options.model)) {
+    throw UserError("--model: unknown model '" + a.model + "'; allowed full, jardin, linear");
+  }
+  if (a.sample_rate) SetSampleRateFromFlag(&spec, *a.sample_rate);
+  if (!a.trace_csv.empty()) {
+    if (!a.out_dir.empty()) throw UserError("give either --trace FILE.csv or --out DIR, not both");
+    if (spec.has_campaign) {
+      throw UserError(a.spec_file + ": has campaign sections (aircraft, rig, campaign); simulate "
+                      "it with --out DIR, or use a spec without them with --trace");
+    }
+    ApplySimulateOverrides(o, true, &spec);
+    std::string why;
+    if (!spec.options.Check(&why)) throw UserError(why);
+    return {RunSimulateTrace(spec, a.trace_csv, a.truth_json, a.force), a.trace_csv};
+  }
+  if (a.out_dir.empty()) {
+    throw UserError("nothing to do: give SPEC.yaml --out DIR (campaign) or --trace FILE.csv "
+                    "(one trace); see bifilar simulate --help");
+  }
+  if (a.spec_file.empty()) throw UserError("--out DIR needs a campaign spec file SPEC.yaml");
+  if (o.inertia_kg_m2 || o.mass_kg || o.amplitude_deg || o.pitch_deg || !a.truth_json.empty()) {
+    throw UserError("--inertia-kg-m2, --mass-kg, --amplitude-deg, --pitch-deg and --truth apply to "
+                    "--trace only; a campaign takes them from the spec");
+  }
+  ApplySimulateOverrides(o, false, &spec);
+  std::string why;
+  if (!spec.campaign.Check(&why) || !spec.options.Check(&why)) throw UserError(why);
+  return {RunSimulateCampaign(spec, a.out_dir, a.force), a.out_dir};
+}
+
 void SetSampleRateFromFlag(SimulateSpec* spec, double rate_hz) {
   if (!(rate_hz > 0 && rate_hz <= 100000)) {
     throw UserError("--sample-rate-hz = " + Num(rate_hz) + " is out of range; allowed (0, 100000]");

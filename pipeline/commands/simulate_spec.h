@@ -110,6 +110,28 @@ SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::stri
 SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string& csv_path,
                                     const std::string& truth_path = "", bool force = false);
 
+// `bifilar simulate`: a campaign (spec_file + out_dir) or one trace (trace_csv), with the
+// command line's settings over the spec's. Messages name the flags (--trace, --out, ...).
+struct SimulateCommandOptions {
+  std::string spec_file;   // "" : the defaults (a trace only)
+  std::string out_dir;     // campaign output folder
+  std::string trace_csv;   // one trace into this file (CSV, or ULog when it ends in .ulg)
+  std::string truth_json;  // the trace's truth file ("" : beside it)
+  std::string model;       // "" : the spec's
+  SimulateOverrides o;     // --seed, --inertia-kg-m2, ..., --duration-s, --no-accel
+  std::optional<double> sample_rate;  // --sample-rate-hz (SetSampleRateFromFlag)
+  bool force = false;  // replace files that exist (issue 23: never without being told)
+};
+
+struct SimulateCommandResult {
+  SimulateRunSummary summary;
+  std::string written;  // the trace file or the campaign folder
+};
+
+// Checks the settings, merges them into the spec and runs RunSimulateTrace or
+// RunSimulateCampaign. Throws UserError naming the flag or the spec key.
+SimulateCommandResult RunSimulate(const SimulateCommandOptions& options);
+
 // The truth JSON text of a campaign / a single trace (what the Run functions write).
 std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<CampaignTrace>& traces);
 
