@@ -186,7 +186,9 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     if (!json) {
       options.on_calibration = [](const RigCalibrationResult& calibration) {
         std::cout << calibration.BriefReport() << std::endl;
-        for (const std::string& w : calibration.warnings) std::cout << "warning: " << w << std::endl;
+        for (const std::string& w : calibration.warnings) {
+          std::cout << "warning: " << w << std::endl;
+        }
       };
       options.on_identical_log = [](const std::string& w) {
         std::cout << "warning: " << w << std::endl;

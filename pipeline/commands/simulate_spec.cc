@@ -810,7 +810,8 @@ SimulateCommandResult RunSimulate(const SimulateCommandOptions& a) {
   const SimulateOverrides& o = a.o;
   auto positive = [](const std::optional<double>& v, const char* flag) {
     if (v && !(*v > 0)) {
-      throw UserError(std::string(flag) + " = " + std::to_string(*v) + " is out of range; allowed > 0");
+      throw UserError(std::string(flag) + " = " + std::to_string(*v) +
+                      " is out of range; allowed > 0");
     }
   };
   positive(o.duration_s, "--duration-s");
