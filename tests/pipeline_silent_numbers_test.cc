@@ -206,7 +206,7 @@ TEST(SilentNumbers, NonPhysicalEllipseIsAWarningAndExitOne) {
   EllipseCommandOptions options;
   options.table_path = table;
   options.fit.bootstrap_replicates = 0;
-  EXPECT_EQ(RunEllipseCommand(options, out), 1) << out.str();
+  EXPECT_EQ(RunEllipse(options, out), 1) << out.str();
   EXPECT_TRUE(Contains(out.str(), "warning: non-physical result")) << out.str();
   EXPECT_TRUE(Contains(out.str(), "point 12 at pitch 30 deg")) << out.str();
   std::string cli;
@@ -215,7 +215,7 @@ TEST(SilentNumbers, NonPhysicalEllipseIsAWarningAndExitOne) {
   text.replace(text.find("30,1000.000000"), 14, "30,2.750000");
   WriteFile(table, text);
   std::ostringstream clean;
-  EXPECT_EQ(RunEllipseCommand(options, clean), 0) << clean.str();
+  EXPECT_EQ(RunEllipse(options, clean), 0) << clean.str();
   EXPECT_FALSE(Contains(clean.str(), "non-physical")) << clean.str();
 }
 

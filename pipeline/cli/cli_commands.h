@@ -11,6 +11,7 @@
 
 #include "base/units.h"
 #include "base/user_error.h"
+#include "pipeline/commands/tensor_plan_command.h"
 
 namespace bifilar {
 
@@ -31,11 +32,14 @@ void RegisterExportCommand(CLI::App& app, int* exit_code);    // `export`
 
 // `plan --tensor` (pipeline/cli/cli_plan_tensor.cc): its options on the `plan` subcommand, whether
 // it was asked for (throws UserError when a tensor-only option comes without --tensor), and the
-// run, given the options it shares with the pitch-plane plan.
+// typed options of RunTensorPlan (pipeline/commands/tensor_plan_command.h), given the options it
+// shares with the pitch-plane plan.
 struct TensorPlanCli;
 std::shared_ptr<TensorPlanCli> AddTensorPlanOptions(CLI::App* plan);
 bool TensorPlanRequested(const TensorPlanCli& tensor_plan);
-int RunTensorPlanFromCli(const TensorPlanCli& tensor_plan, const CLI::App& plan, int trials,
-                         double sigma, double ixz, bool ixz_given, DisplayUnits units, bool json);
+TensorPlanCommandOptions TensorPlanOptionsFromCli(const TensorPlanCli& tensor_plan,
+                                                  const CLI::App& plan, int trials, double sigma,
+                                                  double ixz, bool ixz_given, DisplayUnits units,
+                                                  bool json);
 
 }  // namespace bifilar

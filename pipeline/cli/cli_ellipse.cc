@@ -1,5 +1,5 @@
-// `bifilar ellipse TABLE.csv` and `bifilar plan`: parse options, call RunEllipseCommand /
-// RunPlanCommand (pipeline/commands/ellipse_command.h).
+// `bifilar ellipse TABLE.csv` and `bifilar plan`: parse options, call RunEllipse /
+// RunPlan (pipeline/commands/ellipse_command.h).
 #include <cmath>
 #include <iostream>
 #include <limits>
@@ -8,6 +8,7 @@
 #include <fast_float/fast_float.h>
 
 #include "pipeline/cli/cli_commands.h"
+#include "pipeline/commands/tensor_plan_command.h"
 #include "pipeline/commands/ellipse_command.h"
 
 namespace bifilar {
@@ -100,7 +101,7 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
       throw UserError("--covariance must be auto, points, angle_means or absolute, got '" +
                       *covariance + "'");
     }
-    *exit_code = RunEllipseCommand(*opts, std::cout);
+    *exit_code = RunEllipse(*opts, std::cout);
   });
 
   // plan
@@ -138,9 +139,11 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
                   exit_code] {
     plan_opts->units = Units(*plan_units);
     if (TensorPlanRequested(*tensor_plan)) {
-      *exit_code = RunTensorPlanFromCli(*tensor_plan, *plan, plan_opts->trials_per_angle,
-                                        plan_opts->sigma, *ixz, ixz_option->count() > 0,
-                                        plan_opts->units, plan_opts->json);
+      *exit_code = RunTensorPlan(
+          TensorPlanOptionsFromCli(*tensor_plan, *plan, plan_opts->trials_per_angle,
+                                   plan_opts->sigma, *ixz, ixz_option->count() > 0,
+                                   plan_opts->units, plan_opts->json),
+          std::cout);
       return;
     }
     if (angles->empty()) throw UserError("plan: --angles is required (or --tensor)");
@@ -156,7 +159,7 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
     plan_opts->ix = *ix;
     plan_opts->iz = *iz;
     plan_opts->ixz = *ixz;
-    *exit_code = RunPlanCommand(*plan_opts, std::cout);
+    *exit_code = RunPlan(*plan_opts, std::cout);
   });
 }
 

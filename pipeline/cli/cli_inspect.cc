@@ -8,9 +8,9 @@
 #include <filesystem>
 #include <iostream>
 
-#include "base/atomic_file.h"
 #include "base/units.h"
 #include "pipeline/cli/cli_commands.h"
+#include "pipeline/commands/inspect_command.h"
 #include "pipeline/commands/log_inspect.h"
 #include "pipeline/config/config.h"
 #include "pipeline/config/config_template.h"
@@ -33,8 +33,7 @@ double AskNumber(const std::string& question) {
 
 void RegisterInspectCommand(CLI::App& app, int* exit_code) {
   struct Args {
-    std::vector<std::string> logs;
-    std::string config;
+    InspectCommandOptions options;
     bool json = false;
   };
   auto args = std::make_shared<Args>();
@@ -42,44 +41,30 @@ void RegisterInspectCommand(CLI::App& app, int* exit_code) {
       "inspect",
       "Look at logs before fitting: format, columns or ULog topics, sample rate, the swing's "
       "window, axis, amplitude and period (and with --config the small-angle inertia)");
-  sub->add_option("logs", args->logs, "logs: CSV (.csv, .csv.gz) or PX4 ULog (.ulg)")->required();
-  sub->add_option("--config", args->config,
+  sub->add_option("logs", args->options.logs, "logs: CSV (.csv, .csv.gz) or PX4 ULog (.ulg)")
+      ->required();
+  sub->add_option("--config", args->options.config_path,
                   "config (YAML) giving the log format and the rig; without it the time and gyro "
                   "columns and units are guessed, and the guesses printed");
   sub->add_flag("--json", args->json, "print a JSON array of reports instead of text");
   sub->callback([args, exit_code] {
-    std::optional<CampaignConfig> config;
-    if (!args->config.empty()) {
-      ConfigLoadOptions load;
-      load.require_runs = false;
-      config = LoadCampaignConfig(args->config, load);
-    }
-    nlohmann::json all = nlohmann::json::array();
-    int bad = 0;
-    for (const std::string& log : args->logs) {
-      const InspectReport report = InspectLog(log, config ? &*config : nullptr);
-      if (!report.is_log() || !report.error.empty()) ++bad;
-      if (args->json) {
-        all.push_back(InspectReportToJson(report));
-      } else {
+    InspectCommandOptions options = args->options;
+    if (!args->json) {
+      options.on_report = [](const InspectReport& report) {
         std::cout << InspectReportText(report) << std::flush;
-      }
+      };
     }
+    const InspectCommandResult result = RunInspect(options);
     if (args->json) {
-      std::cout << all.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+      std::cout << result.json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+                << std::endl;
     }
-    *exit_code = bad > 0 ? 1 : 0;
+    *exit_code = result.ExitCode();
   });
 }
 
 void RegisterInitCommand(CLI::App& app, int* exit_code) {
-  struct Args {
-    std::string path = "bifilar.yaml";
-    std::string log, rig;
-    double gravity_mps2 = kStandardGravityMps2;
-    bool force = false;
-  };
-  auto args = std::make_shared<Args>();
+  auto args = std::make_shared<InitCommandOptions>();
   auto* sub = app.add_subcommand("init", "Write a commented starting config for your rig");
   sub->add_option("path", args->path, "config file to write (default bifilar.yaml)");
   sub->add_option("--log", args->log,
@@ -95,39 +80,18 @@ void RegisterInitCommand(CLI::App& app, int* exit_code) {
   sub->add_option("--gravity", args->gravity_mps2, gravity_help)->check(FiniteNumber());
   sub->add_flag("--force", args->force, "overwrite PATH if it exists");
   sub->callback([args, exit_code] {
-    RefuseToReplace(args->path, "init", args->force);  // base/atomic_file.h
-    StartingConfigOptions options;
-    options.gravity_mps2 = args->gravity_mps2;
-    {
-      std::string why;  // the config's own bound and message (pipeline/config/config.h)
-      if (!CheckGravity(args->gravity_mps2, false, &why)) throw UserError("init: --gravity: " + why);
-    }
-    if (!args->rig.empty()) {
-      std::string why;
-      if (!ParseRigSpec(args->rig, &options, &why)) throw UserError(why);
-    } else if (isatty(STDIN_FILENO)) {
+    InitCommandOptions options = *args;
+    options.ask_rig = [](StartingConfigOptions* rig) {
+      if (!isatty(STDIN_FILENO)) return false;
       std::cout << "The rig (SI units; see configs/README.md):\n";
-      options.filar_length_m = AskNumber("  wire length L, pivot to rig (m): ");
-      options.filar_separation_m = AskNumber("  wire separation D (m): ");
-      options.mass_kg = AskNumber("  everything that hangs, rig + aircraft (kg): ");
-      std::string why;
-      if (!options.Check(&why)) throw UserError("init: " + why);
-    } else {
-      throw UserError("init: give the rig with --rig L,D,MASS (m, m, kg), e.g. --rig "
-                      "0.594,0.030,0.0343, or run it on a terminal to be asked");
-    }
-    if (!args->log.empty()) {
-      const InspectReport report = InspectLog(args->log, nullptr);
-      if (!report.is_log()) {
-        throw UserError("init: --log " + (report.error.empty() ? args->log : report.error));
-      }
-      options.format = report.format;
-      options.ulog = report.kind == "ulog";
-      options.format_source = args->log;
-      for (const std::string& g : report.guesses) std::cout << "guessed: " << g << "\n";
-    }
-    WriteFileAtomically(args->path, CheckedStartingConfigText(options, args->path));
-    std::cout << "wrote " << args->path << "; next: bifilar fit " << args->path << " LOG\n";
+      rig->filar_length_m = AskNumber("  wire length L, pivot to rig (m): ");
+      rig->filar_separation_m = AskNumber("  wire separation D (m): ");
+      rig->mass_kg = AskNumber("  everything that hangs, rig + aircraft (kg): ");
+      return true;
+    };
+    options.on_guess = [](const std::string& g) { std::cout << "guessed: " << g << "\n"; };
+    const std::string path = RunInit(options);
+    std::cout << "wrote " << path << "; next: bifilar fit " << path << " LOG\n";
     *exit_code = 0;
   });
 }

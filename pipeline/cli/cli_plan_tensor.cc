@@ -1,5 +1,5 @@
 // `bifilar plan --tensor`: the options of the tensor plan on the `plan` subcommand (registered by
-// RegisterEllipseCommands), parsed into TensorPlanCommandOptions and run by RunTensorPlanCommand
+// RegisterEllipseCommands), parsed into TensorPlanCommandOptions and run by RunTensorPlan
 // (pipeline/commands/tensor_plan_command.h).
 #include <fast_float/fast_float.h>
 
@@ -106,8 +106,9 @@ bool TensorPlanRequested(const TensorPlanCli& t) {
   return false;
 }
 
-int RunTensorPlanFromCli(const TensorPlanCli& t, const CLI::App& plan, int trials, double sigma,
-                         double ixz, bool ixz_given, DisplayUnits units, bool json) {
+TensorPlanCommandOptions TensorPlanOptionsFromCli(const TensorPlanCli& t, const CLI::App& plan,
+                                                  int trials, double sigma, double ixz,
+                                                  bool ixz_given, DisplayUnits units, bool json) {
   for (const char* name : {"--angles", "--ix", "--iz"}) {
     if (plan.count(name) > 0) {
       throw UserError(std::string("plan --tensor: ") + name +
@@ -144,7 +145,7 @@ int RunTensorPlanFromCli(const TensorPlanCli& t, const CLI::App& plan, int trial
              t.iyz};
   o.units = units;
   o.json = json;
-  return RunTensorPlanCommand(o, std::cout);
+  return o;
 }
 
 }  // namespace bifilar

@@ -1,13 +1,13 @@
 // `bifilar process CONFIG [--out DIR] [--jobs N] [--force]` and `bifilar report DIR`.
 #include <unistd.h>
 
-#include <filesystem>
 #include <iostream>
 
 #include "base/interrupt.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/campaign/campaign_summary.h"
 #include "pipeline/cli/cli_commands.h"
+#include "pipeline/commands/process_command.h"
 #include "pipeline/config/config.h"
 #include "pipeline/report/report.h"
 
@@ -40,31 +40,28 @@ void RegisterProcessCommands(CLI::App& app, int* exit_code) {
   process->add_option("--runs-root", args->runs_root,
                       "folder of the aircraft logs, instead of the config's runs.root");
   process->callback([args, exit_code] {
-    ConfigLoadOptions load;
-    load.runs_root = args->runs_root;
-    CampaignConfig config = LoadCampaignConfig(args->config, load);
-    if (!args->integrator.empty()) ParseIntegratorMethod(args->integrator, &config.fit.integrator);
-    CampaignOptions options;
-    options.out_dir = args->out.empty()
-                          ? (std::filesystem::path(config.folder) / "out").string()
-                          : args->out;
-    options.jobs = args->jobs;
-    options.force = args->force;
-    options.progress = &std::cerr;
-    options.progress_bar = isatty(2) != 0;
-    InstallInterruptHandler();
-    options.cancel = &ProcessInterruptFlag();
-    CampaignResult result;
+    ProcessCommandOptions options;
+    options.config_path = args->config;
+    options.runs_root = args->runs_root;
+    options.integrator = args->integrator;
+    if (!args->out.empty()) options.out_dir = args->out;
+    options.campaign.jobs = args->jobs;
+    options.campaign.force = args->force;
+    options.campaign.progress = &std::cerr;
+    options.campaign.progress_bar = isatty(2) != 0;
+    options.handle_interrupt = true;
+    ProcessCommandResult result;
     try {
-      result = RunCampaign(config, options);
+      result = RunProcess(options);
     } catch (const CampaignInterrupted& e) {
       std::cerr << "bifilar: " << e.what() << "\n";
       *exit_code = kInterruptedExitCode;
       return;
     }
-    PrintCampaignSummary(config, result, std::cout);
-    std::cout << "Wrote " << options.out_dir << "/{results.json, traces.csv, angles.csv, report.html}\n";
-    *exit_code = result.summary.exit_code;
+    PrintCampaignSummary(result.config, result.campaign, std::cout);
+    std::cout << "Wrote " << result.out_dir
+              << "/{results.json, traces.csv, angles.csv, report.html}\n";
+    *exit_code = result.campaign.summary.exit_code;
   });
 
   auto* report = app.add_subcommand("report", "Rebuild DIR/report.html from DIR/results.json");

@@ -15,15 +15,6 @@
 namespace bifilar {
 namespace {
 
-struct SimulateArgs {
-  std::string spec_file, out_dir, trace_csv, truth_json, model;
-  std::optional<uint64_t> seed;
-  std::optional<double> inertia, mass, length, separation, gravity, amplitude, pitch, duration;
-  std::optional<double> sample_rate;
-  bool no_accel = false;
-  bool force = false;  // replace files that exist (issue 23: never without being told)
-};
-
 // CLI11 2.1 binds plain values; an option given on the command line fills the std::optional.
 struct RawArgs {
   std::string seed;
@@ -39,74 +30,10 @@ std::optional<T> Given(const CLI::Option* option, T value) {
   return option->count() > 0 ? std::optional<T>(value) : std::nullopt;
 }
 
-void Run(const SimulateArgs& a, int* exit_code) {
-  auto positive = [](const std::optional<double>& v, const char* flag) {
-    if (v && !(*v > 0)) {
-      throw UserError(std::string(flag) + " = " + std::to_string(*v) + " is out of range; allowed > 0");
-    }
-  };
-  positive(a.duration, "--duration-s");
-  positive(a.sample_rate, "--sample-rate-hz");
-  positive(a.inertia, "--inertia-kg-m2");
-  positive(a.mass, "--mass-kg");
-  positive(a.length, "-L/--filar-length-m");
-  positive(a.separation, "-D/--filar-separation-m");
-  positive(a.gravity, "--gravity-mps2");
-  SimulateSpec spec = a.spec_file.empty() ? ParseSimulateSpec("{}", "<defaults>")
-                                          : ReadSimulateSpec(a.spec_file);
-  if (a.spec_file.empty()) spec.file.clear();
-  if (a.seed) spec.seed = *a.seed;
-  if (!a.model.empty() && !ParsePendulumModel(a.model, &spec.options.model)) {
-    throw UserError("--model: unknown model '" + a.model + "'; allowed full, jardin, linear");
-  }
-  if (a.sample_rate) SetSampleRateFromFlag(&spec, *a.sample_rate);
-  if (a.no_accel) spec.options.sensor.accelerometer = false;
-  if (!a.trace_csv.empty()) {
-    if (!a.out_dir.empty()) throw UserError("give either --trace FILE.csv or --out DIR, not both");
-    if (spec.has_campaign) {
-      throw UserError(a.spec_file + ": has campaign sections (aircraft, rig, campaign); simulate "
-                      "it with --out DIR, or use a spec without them with --trace");
-    }
-    TraceRequest& t = spec.trace;
-    if (a.inertia) t.inertia_kg_m2 = *a.inertia;
-    if (a.mass) t.mass_kg = *a.mass;
-    if (a.length) t.filar_length_m = *a.length;
-    if (a.separation) t.filar_separation_m = *a.separation;
-    if (a.gravity) t.gravity_mps2 = *a.gravity;
-    if (a.amplitude) t.amplitude_deg = *a.amplitude;
-    if (a.pitch) t.pitch_deg = *a.pitch;
-    if (a.duration) spec.options.timeline.free_s = {*a.duration, *a.duration};
-    std::string why;
-    if (!spec.options.Check(&why)) throw UserError(why);
-    const SimulateRunSummary summary = RunSimulateTrace(spec, a.trace_csv, a.truth_json, a.force);
-    std::cout << "wrote " << a.trace_csv << ": " << summary.BriefReport() << "\n";
-    *exit_code = 0;
-    return;
-  }
-  if (a.out_dir.empty()) {
-    throw UserError("nothing to do: give SPEC.yaml --out DIR (campaign) or --trace FILE.csv "
-                    "(one trace); see bifilar simulate --help");
-  }
-  if (a.spec_file.empty()) throw UserError("--out DIR needs a campaign spec file SPEC.yaml");
-  if (a.inertia || a.mass || a.amplitude || a.pitch || !a.truth_json.empty()) {
-    throw UserError("--inertia-kg-m2, --mass-kg, --amplitude-deg, --pitch-deg and --truth apply to "
-                    "--trace only; a campaign takes them from the spec");
-  }
-  if (a.length) spec.campaign.filar_length_m = *a.length;
-  if (a.separation) spec.campaign.filar_separation_m = *a.separation;
-  if (a.gravity) spec.campaign.gravity_mps2 = *a.gravity;
-  if (a.duration) spec.options.timeline.free_s = {*a.duration, *a.duration};
-  std::string why;
-  if (!spec.campaign.Check(&why) || !spec.options.Check(&why)) throw UserError(why);
-  const SimulateRunSummary summary = RunSimulateCampaign(spec, a.out_dir, a.force);
-  std::cout << "wrote " << a.out_dir << ": " << summary.BriefReport() << "\n";
-  *exit_code = 0;
-}
-
 }  // namespace
 
 void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
-  auto args = std::make_shared<SimulateArgs>();
+  auto args = std::make_shared<SimulateCommandOptions>();
   auto raw = std::make_shared<RawArgs>();
   auto* sub = app.add_subcommand(
       "simulate",
@@ -136,25 +63,27 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
     option->check(FiniteNumber());
   }
   sub->add_option("--model", args->model, "truth model: full (default), jardin, linear");
-  sub->add_flag("--no-accel", args->no_accel, "write no accelerometer columns");
+  sub->add_flag("--no-accel", args->o.no_accel, "write no accelerometer columns");
   sub->add_flag("--force", args->force,
                 "overwrite files that exist (--trace, --truth, or the logs and truth.json of "
                 "--out); without it simulate refuses, naming the file");
   sub->callback([args, raw, exit_code] {
-    SimulateArgs& a = *args;
+    SimulateCommandOptions& a = *args;
     if (raw->o_seed->count() > 0) {
-      a.seed = ParseSeed(raw->seed, "--seed", std::numeric_limits<uint64_t>::max());
+      a.o.seed = ParseSeed(raw->seed, "--seed", std::numeric_limits<uint64_t>::max());
     }
-    a.inertia = Given(raw->o_inertia, raw->inertia);
-    a.mass = Given(raw->o_mass, raw->mass);
-    a.length = Given(raw->o_length, raw->length);
-    a.separation = Given(raw->o_separation, raw->separation);
-    a.gravity = Given(raw->o_gravity, raw->gravity);
-    a.amplitude = Given(raw->o_amplitude, raw->amplitude);
-    a.pitch = Given(raw->o_pitch, raw->pitch);
-    a.duration = Given(raw->o_duration, raw->duration);
+    a.o.inertia_kg_m2 = Given(raw->o_inertia, raw->inertia);
+    a.o.mass_kg = Given(raw->o_mass, raw->mass);
+    a.o.length_m = Given(raw->o_length, raw->length);
+    a.o.separation_m = Given(raw->o_separation, raw->separation);
+    a.o.gravity_mps2 = Given(raw->o_gravity, raw->gravity);
+    a.o.amplitude_deg = Given(raw->o_amplitude, raw->amplitude);
+    a.o.pitch_deg = Given(raw->o_pitch, raw->pitch);
+    a.o.duration_s = Given(raw->o_duration, raw->duration);
     a.sample_rate = Given(raw->o_sample_rate, raw->sample_rate);
-    Run(a, exit_code);
+    const SimulateCommandResult result = RunSimulate(a);
+    std::cout << "wrote " << result.written << ": " << result.summary.BriefReport() << "\n";
+    *exit_code = 0;
   });
 }
 

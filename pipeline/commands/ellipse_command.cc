@@ -169,7 +169,7 @@ std::vector<std::string> WriteEllipsePlots(const EllipseResult& result, DisplayU
   return written;
 }
 
-int RunEllipseCommand(const EllipseCommandOptions& options, std::ostream& out) {
+int RunEllipse(const EllipseCommandOptions& options, std::ostream& out) {
   std::string why;
   if (!options.fit.Check(&why)) throw UserError("ellipse options: " + why);
   const std::vector<EllipsePoint> points = ReadEllipseTable(options.table_path, options.units);
@@ -189,7 +189,7 @@ int RunEllipseCommand(const EllipseCommandOptions& options, std::ostream& out) {
   return result.physical ? 0 : 1;  // a non-physical tensor is printed with its warning, exit 1
 }
 
-int RunPlanCommand(const PlanCommandOptions& options, std::ostream& out) {
+int RunPlan(const PlanCommandOptions& options, std::ostream& out) {
   const double to_si = InertiaToSi(options.units);
   EllipsePlanOptions plan_options;
   plan_options.pitch_deg = options.pitch_deg;

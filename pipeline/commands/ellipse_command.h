@@ -22,7 +22,7 @@ struct EllipseCommandOptions {
 
 // Reads the table, fits, prints to `out`, writes figures. Returns the exit code (0). Throws
 // UserError on bad input (file, column, value, options) with a message naming it.
-int RunEllipseCommand(const EllipseCommandOptions& options, std::ostream& out);
+int RunEllipse(const EllipseCommandOptions& options, std::ostream& out);
 
 // Human-readable report of a fit in the given units (the three fits side by side, Table 1 and
 // Table 2, NACA comparison, outliers, warnings).
@@ -46,6 +46,6 @@ struct PlanCommandOptions {
 };
 
 // Predicts the standard errors of a design; prints them. Returns 0; throws UserError.
-int RunPlanCommand(const PlanCommandOptions& options, std::ostream& out);
+int RunPlan(const PlanCommandOptions& options, std::ostream& out);
 
 }  // namespace bifilar

@@ -302,27 +302,27 @@ void ReadGeometry(YamlMap map, std::optional<double>* length, std::optional<doub
   map.Finish();
 }
 
-SimulateSpec ParseSpec(YamlMap root) {
-  SimulateSpec spec;
-  spec.file = root.file();
-  const double inf = INFINITY;
-  {
-    const YAML::Node seed = root.Optional("seed");
-    if (root.Given(seed, "seed", "an integer")) {
-      unsigned long long value = 0;
-      if (!seed.IsScalar() || (!seed.Scalar().empty() && seed.Scalar()[0] == '-') ||
-          !YAML::convert<unsigned long long>::decode(seed, value)) {
-        throw UserError(root.Where(seed) + ": 'seed' must be an integer in [0, " +
-                        std::to_string(std::numeric_limits<uint64_t>::max()) + "]");
-      }
-      spec.seed = value;
+// `seed`: a non-negative integer that fits 64 bits.
+void ReadSeed(YamlMap& root, SimulateSpec* spec) {
+  const YAML::Node seed = root.Optional("seed");
+  if (root.Given(seed, "seed", "an integer")) {
+    unsigned long long value = 0;
+    if (!seed.IsScalar() || (!seed.Scalar().empty() && seed.Scalar()[0] == '-') ||
+        !YAML::convert<unsigned long long>::decode(seed, value)) {
+      throw UserError(root.Where(seed) + ": 'seed' must be an integer in [0, " +
+                      std::to_string(std::numeric_limits<uint64_t>::max()) + "]");
     }
+    spec->seed = value;
   }
+}
+
+// `model` and `integrator`: the pendulum model and the ODE solver of the simulation.
+void ReadModelAndIntegrator(YamlMap& root, SimulateSpec* spec) {
   {
     const YAML::Node model = root.Optional("model");
     if (model.IsDefined() && !model.IsNull()) {
       const std::string name = root.AsString(model, "model");
-      if (!ParsePendulumModel(name, &spec.options.model)) {
+      if (!ParsePendulumModel(name, &spec->options.model)) {
         throw UserError(root.Where(model) + ": unknown model '" + name +
                         "' for 'model'; allowed full, jardin, linear");
       }
@@ -332,188 +332,239 @@ SimulateSpec ParseSpec(YamlMap root) {
     const YAML::Node method = root.Optional("integrator");
     if (method.IsDefined() && !method.IsNull()) {
       const std::string name = root.AsString(method, "integrator");
-      if (!ParseIntegratorMethod(name, &spec.options.integrator.method)) {
+      if (!ParseIntegratorMethod(name, &spec->options.integrator.method)) {
         throw UserError(root.Where(method) + ": unknown integrator '" + name +
                         "' for 'integrator'; allowed cvodes (default), rk853");
       }
     }
   }
+}
+
+// The `geometry` section's values (ReadGeometry).
+struct SpecGeometry {
   std::optional<double> length, separation, true_length, true_separation;
   double gravity = kStandardGravityMps2;
-  ReadGeometry(Section(root, "geometry"), &length, &separation, &gravity, &true_length,
-               &true_separation);
+};
+
+// `swing`: amplitudes, damping and the departures from the ideal model.
+void ReadSwing(YamlMap swing, SimulateSpec* spec) {
+  const double inf = INFINITY;
+  CampaignSpec& c = spec->campaign;
+  c.amplitude_deg = ReadRange(swing, "amplitude_deg", c.amplitude_deg, 0, true, 85);
+  spec->options.negative_amplitude_probability =
+      ReadValue(swing, "negative_amplitude_probability",
+                spec->options.negative_amplitude_probability, 0, false, 1);
+  c.drag_coeff_kg_m2 = ReadRange(swing, "drag_coeff_kg_m2", c.drag_coeff_kg_m2, 0, false, inf);
+  c.viscous_coeff_kg_m2_per_s =
+      ReadRange(swing, "viscous_coeff_kg_m2_per_s", c.viscous_coeff_kg_m2_per_s, 0, false, inf);
+  spec->options.sway_coupling_at_60deg =
+      ReadValue(swing, "sway_coupling_percent_at_60deg", 0.0, 0, false, 50) / 100.0;
+  spec->options.softening_at_30deg =
+      ReadValue(swing, "softening_percent_at_30deg", 0.0, 0, false, 50) / 100.0;
+  spec->options.softening_exponent =
+      ReadValue(swing, "softening_exponent", spec->options.softening_exponent, 1, false, 4);
+  swing.Finish();
+}
+
+// `aircraft`: mass and inertia tensor of the simulated aircraft.
+void ReadAircraft(YamlMap aircraft, const std::string& file, AircraftTruth* a) {
+  a->mass_kg = aircraft.RequiredDouble("mass_kg");
+  a->mass_kg = ReadValue(aircraft, "mass_kg", 0, 0, true, 1e6);
+  a->ix_kg_m2 = ReadInertia(aircraft, "ix", true, 0, true);
+  a->iz_kg_m2 = ReadInertia(aircraft, "iz", true, 0, true);
+  a->ixz_kg_m2 = ReadInertia(aircraft, "ixz", true, -1e9, false);
+  // The rest of the tensor (campaigns that roll): optional, 0 when absent.
+  a->iy_kg_m2 = ReadInertia(aircraft, "iy", false, 0, false);
+  a->ixy_kg_m2 = ReadInertia(aircraft, "ixy", false, -1e9, false);
+  a->iyz_kg_m2 = ReadInertia(aircraft, "iyz", false, -1e9, false);
+  aircraft.Finish();
+  std::string why;
+  if (!a->Check(&why)) throw UserError(file + ": aircraft: " + why);
+}
+
+// `rig.inertia_by_pitch_kg_m2` (a mapping pitch_deg: inertia) or `rig.inertia_kg_m2`.
+void ReadRigInertia(YamlMap& rig, CampaignSpec* c) {
+  const bool has_table = rig.Has("inertia_by_pitch_kg_m2");
+  if (has_table) {
+    const YAML::Node table = rig.Optional("inertia_by_pitch_kg_m2");
+    if (!table.IsMap()) {
+      throw UserError(rig.Where(table) + ": '" + rig.KeyPath("inertia_by_pitch_kg_m2") +
+                      "' must be a mapping pitch_deg: inertia_kg_m2");
+    }
+    for (const auto& item : table) {
+      const double pitch = rig.AsDouble(item.first, "inertia_by_pitch_kg_m2 (pitch)");
+      const double inertia = rig.AsDouble(item.second, "inertia_by_pitch_kg_m2");
+      if (!(inertia > 0)) {
+        throw UserError(rig.Where(item.second) + ": '" + rig.KeyPath("inertia_by_pitch_kg_m2") +
+                        "' at " + Num(pitch) + " deg = " + Num(inertia) +
+                        " is out of range; allowed (0, inf)");
+      }
+      c->rig.inertia_by_pitch_kg_m2.emplace_back(pitch, inertia);
+    }
+    if (rig.Has("inertia_kg_m2")) {
+      throw UserError(rig.Where(rig.Optional("inertia_kg_m2")) + ": give either '" +
+                      rig.KeyPath("inertia_kg_m2") + "' or '" +
+                      rig.KeyPath("inertia_by_pitch_kg_m2") + "', not both");
+    }
+    rig.Optional("inertia_kg_m2");
+  } else {
+    rig.Optional("inertia_by_pitch_kg_m2");
+    c->rig.inertia_kg_m2 = rig.RequiredDouble("inertia_kg_m2");
+    c->rig.inertia_kg_m2 = ReadValue(rig, "inertia_kg_m2", 0, 0, true, 1e9);
+  }
+}
+
+// `rig`: mass, inertia, tare logs and the IMU's place on the rig.
+void ReadRig(YamlMap rig, CampaignSpec* c) {
+  c->rig.mass_kg = rig.RequiredDouble("mass_kg");
+  c->rig.mass_kg = ReadValue(rig, "mass_kg", 0, 0, true, 1e6);
+  c->rig.imu_mass_kg = ReadValue(rig, "imu_mass_kg", 0.0, 0, false, 1e3);
+  ReadRigInertia(rig, c);
+  c->tare_logs = static_cast<int>(ReadValue(rig, "tare_logs", 0, 0, false, 1000));
+  c->tare_pitch_deg = ReadValue(rig, "tare_pitch_deg", 0, -90, false, 90);
+  c->tare_damping_scale = ReadValue(rig, "tare_damping_scale", c->tare_damping_scale, 0, false, 1);
+  c->rig.imu_offset_in_body_m =
+      ReadVector3(rig, "imu_offset_m", Eigen::Vector3d(0.15, 0.10, -0.05));
+  const Eigen::Vector3d rpy = ReadVector3(rig, "imu_mounting_rpy_deg", Eigen::Vector3d::Zero());
+  c->rig.body_from_imu = MountingFromRollPitchYawDeg(rpy[0], rpy[1], rpy[2]);
+  rig.Finish();
+}
+
+// `campaign`: the attitudes (pitch_deg, or attitudes_deg for a tensor campaign) and trials.
+void ReadCampaignPlan(YamlMap campaign, CampaignSpec* c) {
+  // attitudes_deg: [[roll, pitch], ...] (a tensor campaign) instead of pitch_deg.
+  const YAML::Node attitudes = campaign.Optional("attitudes_deg");
+  if (attitudes.IsDefined() && !attitudes.IsNull()) {
+    if (!attitudes.IsSequence() || attitudes.size() == 0) {
+      throw UserError(campaign.Where(attitudes) + ": '" + campaign.KeyPath("attitudes_deg") +
+                      "' must be a list of [roll_deg, pitch_deg] pairs");
+    }
+    for (const auto& item : attitudes) {
+      if (!item.IsSequence() || item.size() != 2) {
+        throw UserError(campaign.Where(item) + ": '" + campaign.KeyPath("attitudes_deg") +
+                        "' entries are [roll_deg, pitch_deg] pairs");
+      }
+      const double roll = campaign.AsDouble(item[0], "attitudes_deg");
+      const double pitch = campaign.AsDouble(item[1], "attitudes_deg");
+      if (roll < -180 || roll > 180 || pitch < -90 || pitch > 90) {
+        throw UserError(campaign.Where(item) + ": '" + campaign.KeyPath("attitudes_deg") +
+                        "' has roll " + Num(roll) + ", pitch " + Num(pitch) +
+                        "; allowed roll [-180, 180], pitch [-90, 90]");
+      }
+      c->attitudes_deg.push_back({roll, pitch});
+    }
+  }
+  const YAML::Node pitch_node =
+      c->attitudes_deg.empty() ? campaign.Required("pitch_deg") : campaign.Optional("pitch_deg");
+  c->pitch_deg = campaign.OptionalDoubleList("pitch_deg", {});
+  for (double p : c->pitch_deg) {
+    if (p < -90 || p > 90) {
+      throw UserError(campaign.Where(pitch_node) + ": '" + campaign.KeyPath("pitch_deg") +
+                      "' has " + Num(p) + "; allowed [-90, 90]");
+    }
+  }
+  c->trials_per_pitch =
+      static_cast<int>(ReadValue(campaign, "trials_per_pitch", 3, 1, false, 1000));
+  c->pitch_error_sigma_deg =
+      ReadValue(campaign, "pitch_error_sigma_deg", c->pitch_error_sigma_deg, 0, false, 10);
+  c->roll_error_sigma_deg =
+      ReadValue(campaign, "roll_error_sigma_deg", c->pitch_error_sigma_deg, 0, false, 10);
+  campaign.Finish();
+}
+
+// `calibration`: reference swings for rig.calibration (a reference object on the rig).
+void ReadCalibration(YamlMap& root, CampaignSpec* c) {
+  YamlMap calibration = Section(root, "calibration");
+  if (root.Has("calibration")) {
+    c->calibration_logs = static_cast<int>(ReadValue(calibration, "logs", 3, 1, false, 1000));
+    c->reference_inertia_kg_m2 = ReadInertia(calibration, "reference_inertia", true, 0, true);
+    c->reference_mass_kg = calibration.RequiredDouble("reference_mass_kg");
+    c->reference_mass_kg = ReadValue(calibration, "reference_mass_kg", 0, 0, true, 1e6);
+    c->calibration_amplitude_deg =
+        ReadRange(calibration, "amplitude_deg", c->amplitude_deg, 0, true, 75);
+  }
+  calibration.Finish();
+}
+
+// A campaign (`aircraft`, `rig`, `campaign`, optional `calibration`), when any of them is given.
+void ReadCampaignSections(YamlMap& root, const SpecGeometry& g, SimulateSpec* spec) {
+  CampaignSpec& c = spec->campaign;
+  const bool has_aircraft = root.Has("aircraft"), has_rig = root.Has("rig"),
+             has_campaign = root.Has("campaign");
+  spec->has_campaign = has_aircraft || has_rig || has_campaign;
+  if (spec->has_campaign) {
+    YamlMap aircraft = Section(root, "aircraft");
+    if (!has_aircraft) root.Required("aircraft");
+    ReadAircraft(aircraft, spec->file, &c.aircraft);
+    YamlMap rig = Section(root, "rig");
+    if (!has_rig) root.Required("rig");
+    ReadRig(rig, &c);
+    YamlMap campaign = Section(root, "campaign");
+    if (!has_campaign) root.Required("campaign");
+    ReadCampaignPlan(campaign, &c);
+
+    if (!g.length || !g.separation) {
+      throw UserError(spec->file +
+                      ": missing required key 'geometry.filar_length_m' or "
+                      "'geometry.filar_separation_m' (a campaign needs both)");
+    }
+    c.filar_length_m = *g.length;
+    c.filar_separation_m = *g.separation;
+    c.gravity_mps2 = g.gravity;
+    c.true_filar_length_m = g.true_length.value_or(0.0);
+    c.true_filar_separation_m = g.true_separation.value_or(0.0);
+    ReadCalibration(root, &c);
+    std::string why;
+    if (!c.Check(&why)) throw UserError(spec->file + ": " + why);
+  } else if (g.true_length || g.true_separation || root.Has("calibration")) {
+    throw UserError(spec->file +
+                    ": 'geometry.true_filar_*' and 'calibration' describe a "
+                    "campaign's rig: they need the 'aircraft', 'rig' and 'campaign' sections");
+  }
+}
+
+// `trace`: one simulated log (`bifilar simulate` without a campaign).
+void ReadTraceSection(YamlMap trace, TraceRequest* request) {
+  TraceRequest& t = *request;
+  const double inf = INFINITY;
+  t.inertia_kg_m2 = ReadOptionalValue(trace, "inertia_kg_m2", 0, true, 1e9);
+  t.mass_kg = ReadOptionalValue(trace, "mass_kg", 0, true, 1e6);
+  t.pitch_deg = ReadValue(trace, "pitch_deg", t.pitch_deg, -90, false, 90);
+  const YAML::Node amp = trace.Optional("amplitude_deg");
+  t.amplitude_deg = ReadValue(trace, "amplitude_deg", t.amplitude_deg, -85, false, 85);
+  if (t.amplitude_deg == 0) {
+    throw UserError(trace.Where(amp) +
+                    ": 'trace.amplitude_deg' must not be 0; allowed "
+                    "0 < |amplitude| <= 85");
+  }
+  t.drag_coeff_kg_m2 = ReadValue(trace, "drag_coeff_kg_m2", t.drag_coeff_kg_m2, 0, false, inf);
+  t.viscous_coeff_kg_m2_per_s =
+      ReadValue(trace, "viscous_coeff_kg_m2_per_s", t.viscous_coeff_kg_m2_per_s, 0, false, inf);
+  t.imu_offset_m = ReadVector3(trace, "imu_offset_m", t.imu_offset_m);
+  t.imu_mounting_rpy_deg = ReadVector3(trace, "imu_mounting_rpy_deg", t.imu_mounting_rpy_deg);
+  trace.Finish();
+}
+
+SimulateSpec ParseSpec(YamlMap root) {
+  SimulateSpec spec;
+  spec.file = root.file();
+  ReadSeed(root, &spec);
+  ReadModelAndIntegrator(root, &spec);
+  SpecGeometry g;
+  ReadGeometry(Section(root, "geometry"), &g.length, &g.separation, &g.gravity, &g.true_length,
+               &g.true_separation);
   ReadFormat(Section(root, "format"), &spec);
   ReadTimeline(Section(root, "timeline"), &spec.options.timeline);
   ReadSensor(Section(root, "sensor"), &spec.options.sensor, &spec.time_jitter_given);
-
-  CampaignSpec& c = spec.campaign;
-  {
-    YamlMap swing = Section(root, "swing");
-    c.amplitude_deg = ReadRange(swing, "amplitude_deg", c.amplitude_deg, 0, true, 85);
-    spec.options.negative_amplitude_probability =
-        ReadValue(swing, "negative_amplitude_probability",
-                  spec.options.negative_amplitude_probability, 0, false, 1);
-    c.drag_coeff_kg_m2 = ReadRange(swing, "drag_coeff_kg_m2", c.drag_coeff_kg_m2, 0, false, inf);
-    c.viscous_coeff_kg_m2_per_s =
-        ReadRange(swing, "viscous_coeff_kg_m2_per_s", c.viscous_coeff_kg_m2_per_s, 0, false, inf);
-    spec.options.sway_coupling_at_60deg =
-        ReadValue(swing, "sway_coupling_percent_at_60deg", 0.0, 0, false, 50) / 100.0;
-    spec.options.softening_at_30deg =
-        ReadValue(swing, "softening_percent_at_30deg", 0.0, 0, false, 50) / 100.0;
-    spec.options.softening_exponent =
-        ReadValue(swing, "softening_exponent", spec.options.softening_exponent, 1, false, 4);
-    swing.Finish();
-  }
-
-  const bool has_aircraft = root.Has("aircraft"), has_rig = root.Has("rig"),
-             has_campaign = root.Has("campaign");
-  spec.has_campaign = has_aircraft || has_rig || has_campaign;
-  if (spec.has_campaign) {
-    YamlMap aircraft = Section(root, "aircraft");
-    if (!has_aircraft) root.Required("aircraft");
-    c.aircraft.mass_kg = aircraft.RequiredDouble("mass_kg");
-    c.aircraft.mass_kg = ReadValue(aircraft, "mass_kg", 0, 0, true, 1e6);
-    c.aircraft.ix_kg_m2 = ReadInertia(aircraft, "ix", true, 0, true);
-    c.aircraft.iz_kg_m2 = ReadInertia(aircraft, "iz", true, 0, true);
-    c.aircraft.ixz_kg_m2 = ReadInertia(aircraft, "ixz", true, -1e9, false);
-    // The rest of the tensor (campaigns that roll): optional, 0 when absent.
-    c.aircraft.iy_kg_m2 = ReadInertia(aircraft, "iy", false, 0, false);
-    c.aircraft.ixy_kg_m2 = ReadInertia(aircraft, "ixy", false, -1e9, false);
-    c.aircraft.iyz_kg_m2 = ReadInertia(aircraft, "iyz", false, -1e9, false);
-    aircraft.Finish();
-    std::string why;
-    if (!c.aircraft.Check(&why)) throw UserError(spec.file + ": aircraft: " + why);
-
-    YamlMap rig = Section(root, "rig");
-    if (!has_rig) root.Required("rig");
-    c.rig.mass_kg = rig.RequiredDouble("mass_kg");
-    c.rig.mass_kg = ReadValue(rig, "mass_kg", 0, 0, true, 1e6);
-    c.rig.imu_mass_kg = ReadValue(rig, "imu_mass_kg", 0.0, 0, false, 1e3);
-    const bool has_table = rig.Has("inertia_by_pitch_kg_m2");
-    if (has_table) {
-      const YAML::Node table = rig.Optional("inertia_by_pitch_kg_m2");
-      if (!table.IsMap()) {
-        throw UserError(rig.Where(table) + ": '" + rig.KeyPath("inertia_by_pitch_kg_m2") +
-                        "' must be a mapping pitch_deg: inertia_kg_m2");
-      }
-      for (const auto& item : table) {
-        const double pitch = rig.AsDouble(item.first, "inertia_by_pitch_kg_m2 (pitch)");
-        const double inertia = rig.AsDouble(item.second, "inertia_by_pitch_kg_m2");
-        if (!(inertia > 0)) {
-          throw UserError(rig.Where(item.second) + ": '" + rig.KeyPath("inertia_by_pitch_kg_m2") +
-                          "' at " + Num(pitch) + " deg = " + Num(inertia) +
-                          " is out of range; allowed (0, inf)");
-        }
-        c.rig.inertia_by_pitch_kg_m2.emplace_back(pitch, inertia);
-      }
-      if (rig.Has("inertia_kg_m2")) {
-        throw UserError(rig.Where(rig.Optional("inertia_kg_m2")) + ": give either '" +
-                        rig.KeyPath("inertia_kg_m2") + "' or '" +
-                        rig.KeyPath("inertia_by_pitch_kg_m2") + "', not both");
-      }
-      rig.Optional("inertia_kg_m2");
-    } else {
-      rig.Optional("inertia_by_pitch_kg_m2");
-      c.rig.inertia_kg_m2 = rig.RequiredDouble("inertia_kg_m2");
-      c.rig.inertia_kg_m2 = ReadValue(rig, "inertia_kg_m2", 0, 0, true, 1e9);
-    }
-    c.tare_logs = static_cast<int>(ReadValue(rig, "tare_logs", 0, 0, false, 1000));
-    c.tare_pitch_deg = ReadValue(rig, "tare_pitch_deg", 0, -90, false, 90);
-    c.tare_damping_scale = ReadValue(rig, "tare_damping_scale", c.tare_damping_scale, 0, false, 1);
-    c.rig.imu_offset_in_body_m = ReadVector3(rig, "imu_offset_m", Eigen::Vector3d(0.15, 0.10, -0.05));
-    const Eigen::Vector3d rpy = ReadVector3(rig, "imu_mounting_rpy_deg", Eigen::Vector3d::Zero());
-    c.rig.body_from_imu = MountingFromRollPitchYawDeg(rpy[0], rpy[1], rpy[2]);
-    rig.Finish();
-
-    YamlMap campaign = Section(root, "campaign");
-    if (!has_campaign) root.Required("campaign");
-    // attitudes_deg: [[roll, pitch], ...] (a tensor campaign) instead of pitch_deg.
-    const YAML::Node attitudes = campaign.Optional("attitudes_deg");
-    if (attitudes.IsDefined() && !attitudes.IsNull()) {
-      if (!attitudes.IsSequence() || attitudes.size() == 0) {
-        throw UserError(campaign.Where(attitudes) + ": '" + campaign.KeyPath("attitudes_deg") +
-                        "' must be a list of [roll_deg, pitch_deg] pairs");
-      }
-      for (const auto& item : attitudes) {
-        if (!item.IsSequence() || item.size() != 2) {
-          throw UserError(campaign.Where(item) + ": '" + campaign.KeyPath("attitudes_deg") +
-                          "' entries are [roll_deg, pitch_deg] pairs");
-        }
-        const double roll = campaign.AsDouble(item[0], "attitudes_deg");
-        const double pitch = campaign.AsDouble(item[1], "attitudes_deg");
-        if (roll < -180 || roll > 180 || pitch < -90 || pitch > 90) {
-          throw UserError(campaign.Where(item) + ": '" + campaign.KeyPath("attitudes_deg") +
-                          "' has roll " + Num(roll) + ", pitch " + Num(pitch) +
-                          "; allowed roll [-180, 180], pitch [-90, 90]");
-        }
-        c.attitudes_deg.push_back({roll, pitch});
-      }
-    }
-    const YAML::Node pitch_node =
-        c.attitudes_deg.empty() ? campaign.Required("pitch_deg") : campaign.Optional("pitch_deg");
-    c.pitch_deg = campaign.OptionalDoubleList("pitch_deg", {});
-    for (double p : c.pitch_deg) {
-      if (p < -90 || p > 90) {
-        throw UserError(campaign.Where(pitch_node) + ": '" + campaign.KeyPath("pitch_deg") +
-                        "' has " + Num(p) + "; allowed [-90, 90]");
-      }
-    }
-    c.trials_per_pitch = static_cast<int>(ReadValue(campaign, "trials_per_pitch", 3, 1, false, 1000));
-    c.pitch_error_sigma_deg =
-        ReadValue(campaign, "pitch_error_sigma_deg", c.pitch_error_sigma_deg, 0, false, 10);
-    c.roll_error_sigma_deg =
-        ReadValue(campaign, "roll_error_sigma_deg", c.pitch_error_sigma_deg, 0, false, 10);
-    campaign.Finish();
-
-    if (!length || !separation) {
-      throw UserError(spec.file + ": missing required key 'geometry.filar_length_m' or "
-                      "'geometry.filar_separation_m' (a campaign needs both)");
-    }
-    c.filar_length_m = *length;
-    c.filar_separation_m = *separation;
-    c.gravity_mps2 = gravity;
-    c.true_filar_length_m = true_length.value_or(0.0);
-    c.true_filar_separation_m = true_separation.value_or(0.0);
-    // `calibration`: reference swings for rig.calibration (a reference object on the rig).
-    YamlMap calibration = Section(root, "calibration");
-    if (root.Has("calibration")) {
-      c.calibration_logs = static_cast<int>(ReadValue(calibration, "logs", 3, 1, false, 1000));
-      c.reference_inertia_kg_m2 = ReadInertia(calibration, "reference_inertia", true, 0, true);
-      c.reference_mass_kg = calibration.RequiredDouble("reference_mass_kg");
-      c.reference_mass_kg = ReadValue(calibration, "reference_mass_kg", 0, 0, true, 1e6);
-      c.calibration_amplitude_deg =
-          ReadRange(calibration, "amplitude_deg", c.amplitude_deg, 0, true, 75);
-    }
-    calibration.Finish();
-    if (!c.Check(&why)) throw UserError(spec.file + ": " + why);
-  } else if (true_length || true_separation || root.Has("calibration")) {
-    throw UserError(spec.file + ": 'geometry.true_filar_*' and 'calibration' describe a campaign's "
-                    "rig: they need the 'aircraft', 'rig' and 'campaign' sections");
-  }
+  ReadSwing(Section(root, "swing"), &spec);
+  ReadCampaignSections(root, g, &spec);
 
   spec.has_trace = root.Has("trace");
   TraceRequest& t = spec.trace;
-  t.filar_length_m = length;
-  t.filar_separation_m = separation;
-  t.gravity_mps2 = gravity;
-  {
-    YamlMap trace = Section(root, "trace");
-    t.inertia_kg_m2 = ReadOptionalValue(trace, "inertia_kg_m2", 0, true, 1e9);
-    t.mass_kg = ReadOptionalValue(trace, "mass_kg", 0, true, 1e6);
-    t.pitch_deg = ReadValue(trace, "pitch_deg", t.pitch_deg, -90, false, 90);
-    const YAML::Node amp = trace.Optional("amplitude_deg");
-    t.amplitude_deg = ReadValue(trace, "amplitude_deg", t.amplitude_deg, -85, false, 85);
-    if (t.amplitude_deg == 0) {
-      throw UserError(trace.Where(amp) + ": 'trace.amplitude_deg' must not be 0; allowed "
-                      "0 < |amplitude| <= 85");
-    }
-    t.drag_coeff_kg_m2 = ReadValue(trace, "drag_coeff_kg_m2", t.drag_coeff_kg_m2, 0, false, inf);
-    t.viscous_coeff_kg_m2_per_s =
-        ReadValue(trace, "viscous_coeff_kg_m2_per_s", t.viscous_coeff_kg_m2_per_s, 0, false, inf);
-    t.imu_offset_m = ReadVector3(trace, "imu_offset_m", t.imu_offset_m);
-    t.imu_mounting_rpy_deg = ReadVector3(trace, "imu_mounting_rpy_deg", t.imu_mounting_rpy_deg);
-    trace.Finish();
-  }
+  t.filar_length_m = g.length;
+  t.filar_separation_m = g.separation;
+  t.gravity_mps2 = g.gravity;
+  ReadTraceSection(Section(root, "trace"), &t);
   root.Finish();
   std::string why;
   if (!spec.options.Check(&why)) throw UserError(spec.file + ": " + why);
@@ -732,6 +783,75 @@ void WriteTrace(const std::string& path, const SimulatedTrace& trace, const Simu
 double DefaultTimeJitterSigmaS(double sample_rate_hz) {
   const double fallback = SensorOptions().time_jitter_sigma_s;  // 1 ms
   return 0.1 / sample_rate_hz < fallback ? 0.1 / sample_rate_hz : fallback;
+}
+
+void ApplySimulateOverrides(const SimulateOverrides& o, bool single_trace,
+                            SimulateSpec* spec) {
+  if (o.seed) spec->seed = *o.seed;
+  if (o.no_accel) spec->options.sensor.accelerometer = false;
+  if (o.duration_s) spec->options.timeline.free_s = {*o.duration_s, *o.duration_s};
+  if (!single_trace) {
+    if (o.length_m) spec->campaign.filar_length_m = *o.length_m;
+    if (o.separation_m) spec->campaign.filar_separation_m = *o.separation_m;
+    if (o.gravity_mps2) spec->campaign.gravity_mps2 = *o.gravity_mps2;
+    return;
+  }
+  TraceRequest& t = spec->trace;
+  if (o.inertia_kg_m2) t.inertia_kg_m2 = *o.inertia_kg_m2;
+  if (o.mass_kg) t.mass_kg = *o.mass_kg;
+  if (o.length_m) t.filar_length_m = *o.length_m;
+  if (o.separation_m) t.filar_separation_m = *o.separation_m;
+  if (o.gravity_mps2) t.gravity_mps2 = *o.gravity_mps2;
+  if (o.amplitude_deg) t.amplitude_deg = *o.amplitude_deg;
+  if (o.pitch_deg) t.pitch_deg = *o.pitch_deg;
+}
+
+SimulateCommandResult RunSimulate(const SimulateCommandOptions& a) {
+  const SimulateOverrides& o = a.o;
+  auto positive = [](const std::optional<double>& v, const char* flag) {
+    if (v && !(*v > 0)) {
+      throw UserError(std::string(flag) + " = " + std::to_string(*v) +
+                      " is out of range; allowed > 0");
+    }
+  };
+  positive(o.duration_s, "--duration-s");
+  positive(a.sample_rate, "--sample-rate-hz");
+  positive(o.inertia_kg_m2, "--inertia-kg-m2");
+  positive(o.mass_kg, "--mass-kg");
+  positive(o.length_m, "-L/--filar-length-m");
+  positive(o.separation_m, "-D/--filar-separation-m");
+  positive(o.gravity_mps2, "--gravity-mps2");
+  SimulateSpec spec = a.spec_file.empty() ? ParseSimulateSpec("{}", "<defaults>")
+                                          : ReadSimulateSpec(a.spec_file);
+  if (a.spec_file.empty()) spec.file.clear();
+  if (!a.model.empty() && !ParsePendulumModel(a.model, &spec.options.model)) {
+    throw UserError("--model: unknown model '" + a.model + "'; allowed full, jardin, linear");
+  }
+  if (a.sample_rate) SetSampleRateFromFlag(&spec, *a.sample_rate);
+  if (!a.trace_csv.empty()) {
+    if (!a.out_dir.empty()) throw UserError("give either --trace FILE.csv or --out DIR, not both");
+    if (spec.has_campaign) {
+      throw UserError(a.spec_file + ": has campaign sections (aircraft, rig, campaign); simulate "
+                      "it with --out DIR, or use a spec without them with --trace");
+    }
+    ApplySimulateOverrides(o, true, &spec);
+    std::string why;
+    if (!spec.options.Check(&why)) throw UserError(why);
+    return {RunSimulateTrace(spec, a.trace_csv, a.truth_json, a.force), a.trace_csv};
+  }
+  if (a.out_dir.empty()) {
+    throw UserError("nothing to do: give SPEC.yaml --out DIR (campaign) or --trace FILE.csv "
+                    "(one trace); see bifilar simulate --help");
+  }
+  if (a.spec_file.empty()) throw UserError("--out DIR needs a campaign spec file SPEC.yaml");
+  if (o.inertia_kg_m2 || o.mass_kg || o.amplitude_deg || o.pitch_deg || !a.truth_json.empty()) {
+    throw UserError("--inertia-kg-m2, --mass-kg, --amplitude-deg, --pitch-deg and --truth apply to "
+                    "--trace only; a campaign takes them from the spec");
+  }
+  ApplySimulateOverrides(o, false, &spec);
+  std::string why;
+  if (!spec.campaign.Check(&why) || !spec.options.Check(&why)) throw UserError(why);
+  return {RunSimulateCampaign(spec, a.out_dir, a.force), a.out_dir};
 }
 
 void SetSampleRateFromFlag(SimulateSpec* spec, double rate_hz) {

@@ -56,6 +56,22 @@ double DefaultTimeJitterSigmaS(double sample_rate_hz);
 // longer fits the new rate, throws UserError naming the flag, the spec key and what to change.
 void SetSampleRateFromFlag(SimulateSpec* spec, double sample_rate_hz);
 
+// The settings `bifilar simulate` (flags) and Python's bifilar.simulate (keywords) lay over a
+// spec; unset ones keep the spec's value. The callers check the values and name them in their own
+// words (a flag or a keyword) before calling ApplySimulateOverrides.
+struct SimulateOverrides {
+  std::optional<uint64_t> seed;
+  std::optional<double> inertia_kg_m2, mass_kg, length_m, separation_m, gravity_mps2,
+      amplitude_deg, pitch_deg, duration_s;
+  bool no_accel = false;  // write no accelerometer columns
+};
+
+// Lays the overrides over the spec: the seed, --no-accel, the free-oscillation duration and the
+// geometry (L, D, g), into the campaign (`single_trace` false) or into spec.trace with the
+// trace's own inertia, mass, amplitude and pitch (`single_trace` true). Checks nothing.
+void ApplySimulateOverrides(const SimulateOverrides& overrides, bool single_trace,
+                            SimulateSpec* spec);
+
 // Refuses an output target that `simulate` must not write through: anything but a regular file
 // or nothing (a device such as /dev/null, a FIFO, a socket, a folder, also behind a symlink), or
 // a path below an existing non-folder. `what` names the option in the message ("--trace").
@@ -93,6 +109,28 @@ SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::stri
 // simulated, with its seed (pipeline/logs/simulated_log.h).
 SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string& csv_path,
                                     const std::string& truth_path = "", bool force = false);
+
+// `bifilar simulate`: a campaign (spec_file + out_dir) or one trace (trace_csv), with the
+// command line's settings over the spec's. Messages name the flags (--trace, --out, ...).
+struct SimulateCommandOptions {
+  std::string spec_file;   // "" : the defaults (a trace only)
+  std::string out_dir;     // campaign output folder
+  std::string trace_csv;   // one trace into this file (CSV, or ULog when it ends in .ulg)
+  std::string truth_json;  // the trace's truth file ("" : beside it)
+  std::string model;       // "" : the spec's
+  SimulateOverrides o;     // --seed, --inertia-kg-m2, ..., --duration-s, --no-accel
+  std::optional<double> sample_rate;  // --sample-rate-hz (SetSampleRateFromFlag)
+  bool force = false;  // replace files that exist (issue 23: never without being told)
+};
+
+struct SimulateCommandResult {
+  SimulateRunSummary summary;
+  std::string written;  // the trace file or the campaign folder
+};
+
+// Checks the settings, merges them into the spec and runs RunSimulateTrace or
+// RunSimulateCampaign. Throws UserError naming the flag or the spec key.
+SimulateCommandResult RunSimulate(const SimulateCommandOptions& options);
 
 // The truth JSON text of a campaign / a single trace (what the Run functions write).
 std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<CampaignTrace>& traces);

@@ -95,7 +95,7 @@ json TensorPlanToJson(const TensorPlan& p, const TensorPlanOptions& o) {
   return j;
 }
 
-int RunTensorPlanCommand(const TensorPlanCommandOptions& options, std::ostream& out) {
+int RunTensorPlan(const TensorPlanCommandOptions& options, std::ostream& out) {
   const double to_si = InertiaToSi(options.units);
   TensorPlanOptions o = options.plan;
   o.sigma_kg_m2 = options.sigma * to_si;

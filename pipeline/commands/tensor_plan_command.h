@@ -16,7 +16,7 @@ namespace bifilar {
 struct TensorPlanCommandOptions {
   // Rig range, grid, orientations, trials, sigma_relative and attitude_std_deg as in
   // TensorPlanOptions; its SI fields (sigma_kg_m2, guess_kg_m2, target_std_kg_m2) are set by
-  // RunTensorPlanCommand from the values below, which are in `units`.
+  // RunTensorPlan from the values below, which are in `units`.
   TensorPlanOptions plan;
   double sigma = 0.0;  // per-swing std, absolute, in `units` (>= 0)
   std::array<double, kTensorPlanComponents> guess = {0, 0, 0, 0, 0, 0};  // in `units`
@@ -29,7 +29,7 @@ struct TensorPlanCommandOptions {
 };
 
 // Plans and prints. Returns 0; throws UserError naming the option on bad input.
-int RunTensorPlanCommand(const TensorPlanCommandOptions& options, std::ostream& out);
+int RunTensorPlan(const TensorPlanCommandOptions& options, std::ostream& out);
 
 // JSON form (SI): rig, orientations, components {Ixx: {observable, std_kg_m2,
 // floor_std_kg_m2, trials_needed}, ...}, unobservable, rank, condition_number, warnings, ...

@@ -1,0 +1,65 @@
+// The use cases of `bifilar inspect` and `bifilar init` (pipeline/commands/inspect_command.h).
+#include "pipeline/commands/inspect_command.h"
+
+#include <optional>
+
+#include "base/atomic_file.h"
+#include "base/user_error.h"
+#include "pipeline/config/config.h"
+
+namespace bifilar {
+
+InspectCommandResult RunInspect(const InspectCommandOptions& options) {
+  InspectCommandResult result;
+  std::optional<CampaignConfig> config;
+  if (!options.config_path.empty()) {
+    ConfigLoadOptions load;
+    load.require_runs = false;
+    config = LoadCampaignConfig(options.config_path, load);
+  }
+  result.json = nlohmann::json::array();
+  for (const std::string& log : options.logs) {
+    result.reports.push_back(InspectLog(log, config ? &*config : nullptr));
+    const InspectReport& report = result.reports.back();
+    if (!report.is_log() || !report.error.empty()) ++result.n_bad;
+    result.json.push_back(InspectReportToJson(report));
+    if (options.on_report) options.on_report(report);
+  }
+  return result;
+}
+
+std::string RunInit(const InitCommandOptions& o) {
+  RefuseToReplace(o.path, "init", o.force);  // base/atomic_file.h
+  StartingConfigOptions options;
+  options.gravity_mps2 = o.gravity_mps2;
+  {
+    std::string why;  // the config's own bound and message (pipeline/config/config.h)
+    if (!CheckGravity(o.gravity_mps2, false, &why)) throw UserError("init: --gravity: " + why);
+  }
+  if (!o.rig.empty()) {
+    std::string why;
+    if (!ParseRigSpec(o.rig, &options, &why)) throw UserError(why);
+  } else if (o.ask_rig && o.ask_rig(&options)) {
+    std::string why;
+    if (!options.Check(&why)) throw UserError("init: " + why);
+  } else {
+    throw UserError("init: give the rig with --rig L,D,MASS (m, m, kg), e.g. --rig "
+                    "0.594,0.030,0.0343, or run it on a terminal to be asked");
+  }
+  if (!o.log.empty()) {
+    const InspectReport report = InspectLog(o.log, nullptr);
+    if (!report.is_log()) {
+      throw UserError("init: --log " + (report.error.empty() ? o.log : report.error));
+    }
+    options.format = report.format;
+    options.ulog = report.kind == "ulog";
+    options.format_source = o.log;
+    if (o.on_guess) {
+      for (const std::string& g : report.guesses) o.on_guess(g);
+    }
+  }
+  WriteFileAtomically(o.path, CheckedStartingConfigText(options, o.path));
+  return o.path;
+}
+
+}  // namespace bifilar
