@@ -228,7 +228,7 @@ TEST(PendulumModel, RigGeometryCheck) {
   for (double length : {0.8, 0.5}) {
     RigGeometry g = TestGeometry();
     g.filar_length_m = length;
-    ExpectRigError(g, "must be > filar_separation_m (D) so the wires never go slack");
+    ExpectRigError(g, "filar_separation_m (D) = 0.8 m is not below filar_length_m (L)");
   }
   RigGeometry g = TestGeometry();
   g.filar_length_m = 0.5;

@@ -243,10 +243,10 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
   sub->add_option("logs", args->logs, "IMU logs: CSV (optionally .gz) or PX4 ULog (.ulg)")->required();
   sub->add_flag("--json", args->json, "print a JSON array of trace records instead of lines");
   sub->add_option("--model", args->model, "full (default), jardin or linear")
-      ->check(CLI::IsMember({"full", "jardin", "linear"}));
+      ->check(CLI::IsMember(PendulumModelNames()));
   sub->add_option("--integrator", args->integrator,
                   "ODE solver of the fit: rk853 (default) or cvodes; overrides fit.integrator")
-      ->check(CLI::IsMember({"rk853", "cvodes"}));
+      ->check(CLI::IsMember(IntegratorMethodNames()));
   sub->add_option("--window", args->window, "fit only T0:T1 (s, the log's own time)");
   sub->add_option("--max-amplitude", args->max_amplitude_deg,
                   "upper end of the amplitude band (deg)")

@@ -838,15 +838,16 @@ void ReadFitGlitch(YamlMap& fit, GlitchConfig* g) {
 // `fit`: model, integrator, windows, amplitude limits, quality, sweep, glitch; then
 // FitConfig::Check.
 void ReadFit(YamlMap fit, FitConfig* out) {
-  const std::string model = fit.OptionalString("model", "full");
+  // Defaults: FitConfig's own (full, rk853), named through the enums' tables.
+  const std::string model = fit.OptionalString("model", ToString(out->model));
   if (!ParsePendulumModel(model, &out->model)) {
-    throw UserError(fit.Where(fit.Optional("model")) +
-                    ": 'fit.model' must be full, jardin or linear, not '" + model + "'");
+    throw UserError(fit.Where(fit.Optional("model")) + ": 'fit.model' must be " +
+                    PendulumModelAllowedValues() + ", not '" + model + "'");
   }
-  const std::string integrator = fit.OptionalString("integrator", "rk853");
+  const std::string integrator = fit.OptionalString("integrator", ToString(out->integrator));
   if (!ParseIntegratorMethod(integrator, &out->integrator)) {
-    throw UserError(fit.Where(fit.Optional("integrator")) +
-                    ": 'fit.integrator' must be rk853 or cvodes, not '" + integrator + "'");
+    throw UserError(fit.Where(fit.Optional("integrator")) + ": 'fit.integrator' must be " +
+                    IntegratorMethodAllowedValues() + ", not '" + integrator + "'");
   }
   ReadFitWindows(fit, out);
   if (fit.Has("max_amplitude_deg")) out->max_amplitude_deg = fit.RequiredDouble("max_amplitude_deg");
