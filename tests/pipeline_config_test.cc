@@ -125,7 +125,7 @@ TEST(Config, ReadsEveryKey) {
   EXPECT_DOUBLE_EQ(c.fit.quality.min_periods, 3.0);
   EXPECT_EQ(c.ellipse.bootstrap, 100);
   EXPECT_EQ(c.ellipse.seed, 7u);
-  EXPECT_EQ(c.ellipse.covariance, "points");
+  EXPECT_EQ(c.ellipse.covariance, EllipseCovariance::kPointResiduals);
   EXPECT_NE(c.text.find("filar_length_m: 2.4"), std::string::npos);
   // The window override is found from the absolute log path.
   EXPECT_TRUE(ConfigWindowFor(c, dir + "/logs/pitch_10/trial_1.csv").has_value());
@@ -259,7 +259,7 @@ TEST(Config, CountsAndRangesAreBoundedAtLoad) {
   ExpectError(yaml + "fit: {max_amplitude_deg: 179.9}\n", {"fit.max_amplitude_deg"});
   ExpectError(yaml + "fit: {max_amplitude_deg: 20, min_amplitude_deg: 25}\n",
               {"fit.min_amplitude_deg"});
-  ExpectError(yaml + "fit: {quality: {whiteness_lags: 100000000}}\n", {"whiteness_lags in [1, 1000]"});
+  ExpectError(yaml + "fit: {quality: {whiteness_lags: 100000000}}\n", {"'fit.quality.whiteness_lags' must be in [1, 1000], got 100000000"});
   // Check() holds the same ranges for a config built in code.
   CampaignConfig config;
   std::string why;
