@@ -233,7 +233,7 @@ TEST(PendulumModel, RigGeometryCheck) {
   RigGeometry g = TestGeometry();
   g.filar_length_m = 0.5;
   ASSERT_FALSE(g.Check(&why));
-  EXPECT_NE(why.find("L = 0.5 m, D = 0.8 m"), std::string::npos) << why;
+  EXPECT_NE(why.find("filar_separation_m (D) = 0.8 m is not below filar_length_m (L) = 0.5 m"), std::string::npos) << why;
 }
 
 TEST(PendulumModel, PendulumParamsCheck) {

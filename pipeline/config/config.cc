@@ -773,6 +773,8 @@ void ReadAircraftAndGravity(YamlMap& root, const std::string& path,
     const std::string why = ImplausibleValue("aircraft.mass_kg", "mass", config->aircraft_mass_kg,
                                              0.0, kMaxMassKg);
     if (!why.empty()) throw UserError(aircraft.Where(aircraft.Optional("mass_kg")) + ": " + why);
+    const YAML::Node std_node = aircraft.Optional("mass_std_kg");
+    config->aircraft_mass_std_given = std_node.IsDefined() && !std_node.IsNull();
     config->aircraft_mass_std_kg = NonNegative(aircraft, "mass_std_kg", 0.0);
   } else if (options.require_runs && config->rig_inertia_given) {
     throw UserError(path + ": missing required key 'aircraft' (or leave out 'rig.inertia' too: "

@@ -234,6 +234,7 @@ struct CampaignConfig {
   RigUncertainties uncertainties;
   double aircraft_mass_kg = 0.0;      // aircraft mass (kg); 0 when only tare logs are fitted
   double aircraft_mass_std_kg = 0.0;  // its standard uncertainty (kg)
+  bool aircraft_mass_std_given = false;  // aircraft.mass_std_kg written in the config
   // Local gravity (m/s^2); in [9.76, 9.84] (Earth) unless
   double gravity_mps2 = kStandardGravityMps2;
   bool gravity_off_earth = false;     // `gravity_off_earth: true`: then in (0, 100]
