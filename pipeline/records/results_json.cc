@@ -322,7 +322,7 @@ TraceRecord TraceRecordFromJson(const json& j) {
   TraceRecord r;
   r.file = GetString(j, "file");
   if (!ParseTraceStatus(GetString(j, "status"), &r.status)) {
-    throw UserError("trace record: bad 'status'");
+    throw UserError("trace record: bad 'status' (allowed " + TraceStatusAllowedValues() + ")");
   }
   r.message = GetString(j, "message");
   r.inertia_total_kg_m2 = GetNumber(j, "inertia_total_kg_m2");
@@ -395,7 +395,7 @@ TraceRecord TraceRecordFromJson(const json& j) {
   }
   if (auto it = j.find("amplitude_sweep"); it != j.end() && it->is_object()) r.sweep = SweepFromJson(*it);
   if (j.contains("role") && !ParseTraceRole(GetString(j, "role"), &r.role)) {
-    throw UserError("trace record: bad 'role'");
+    throw UserError("trace record: bad 'role' (allowed " + TraceRoleAllowedValues() + ")");
   }
   r.content_hash = GetString(j, "content_hash");
   r.cache_key = GetString(j, "cache_key");
