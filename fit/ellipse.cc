@@ -4,6 +4,7 @@
 // ellipse_diagnostics.cc; ellipse_steps.h lists them.
 #include "fit/ellipse.h"
 
+#include "base/enum_names.h"
 #include "fit/ellipse_steps.h"
 #include "fit/solver_logging.h"
 
@@ -273,6 +274,11 @@ bool PrepareData(const std::vector<EllipsePoint>& points, const EllipseOptions& 
 // The rest of this file is the public face and the procedure: its steps by their names.
 using namespace ellipse;
 
+// Every mode, in the order of the names table below (config, --covariance, JSON).
+constexpr EllipseCovariance kEllipseCovariances[] = {
+    EllipseCovariance::kAuto, EllipseCovariance::kPointResiduals, EllipseCovariance::kAngleMeans,
+    EllipseCovariance::kAbsolute};
+
 const char* EllipseCovarianceName(EllipseCovariance mode) {
   switch (mode) {
     case EllipseCovariance::kAuto: return "auto";
@@ -284,14 +290,19 @@ const char* EllipseCovarianceName(EllipseCovariance mode) {
 }
 
 bool ParseEllipseCovariance(const std::string& name, EllipseCovariance* mode) {
-  for (EllipseCovariance m : {EllipseCovariance::kAuto, EllipseCovariance::kPointResiduals,
-                              EllipseCovariance::kAngleMeans, EllipseCovariance::kAbsolute}) {
+  for (EllipseCovariance m : kEllipseCovariances) {
     if (name == EllipseCovarianceName(m)) {
       *mode = m;
       return true;
     }
   }
   return false;
+}
+
+std::string EllipseCovarianceAllowedValues() {
+  std::vector<std::string> names;
+  for (EllipseCovariance m : kEllipseCovariances) names.push_back(EllipseCovarianceName(m));
+  return JoinAllowedValues(names);
 }
 
 bool EllipseOptions::Check(std::string* why) const {

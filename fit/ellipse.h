@@ -50,6 +50,8 @@ enum class EllipseCovariance {
 const char* EllipseCovarianceName(EllipseCovariance mode);
 // Parses "auto", "points", "angle_means", "absolute"; false if unknown.
 bool ParseEllipseCovariance(const std::string& name, EllipseCovariance* mode);
+// The allowed values for messages and help: "auto, points, angle_means or absolute".
+std::string EllipseCovarianceAllowedValues();
 
 // Limits of EllipseOptions::bootstrap_replicates (besides 0 = off). Fewer than 100 replicates
 // cannot place a 95 % percentile; 100000 puts the Monte Carlo error of the 2.5 % quantile far

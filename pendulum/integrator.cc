@@ -29,6 +29,7 @@
 #include <sundials/sundials_context.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
+#include "base/enum_names.h"
 #include "pendulum/dop853.h"
 
 namespace bifilar {
@@ -74,26 +75,47 @@ struct AugmentedRhs {
 
 }  // namespace
 
+namespace {
+
+// The one table of integrators (Ceres types.h style): config `integrator`, --integrator, JSON.
+struct IntegratorMethodRow {
+  IntegratorMethod method;
+  const char* name;
+};
+constexpr IntegratorMethodRow kIntegratorMethodTable[] = {
+    {IntegratorMethod::kRungeKutta, "rk853"},
+    {IntegratorMethod::kCvodes, "cvodes"},
+};
+
+}  // namespace
+
 const char* ToString(IntegratorMethod method) {
-  switch (method) {
-    case IntegratorMethod::kRungeKutta:
-      return "rk853";
-    case IntegratorMethod::kCvodes:
-      return "cvodes";
+  for (const IntegratorMethodRow& row : kIntegratorMethodTable) {
+    if (row.method == method) return row.name;
   }
   return "unknown";
 }
 
 bool ParseIntegratorMethod(const std::string& name, IntegratorMethod* method) {
-  if (name == "rk853") {
-    *method = IntegratorMethod::kRungeKutta;
-  } else if (name == "cvodes") {
-    *method = IntegratorMethod::kCvodes;
-  } else {
-    return false;
+  for (const IntegratorMethodRow& row : kIntegratorMethodTable) {
+    if (name == row.name) {
+      *method = row.method;
+      return true;
+    }
   }
-  return true;
+  return false;
 }
+
+const std::vector<std::string>& IntegratorMethodNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const IntegratorMethodRow& row : kIntegratorMethodTable) out.push_back(row.name);
+    return out;
+  }();
+  return names;
+}
+
+std::string IntegratorMethodAllowedValues() { return JoinAllowedValues(IntegratorMethodNames()); }
 
 bool IntegratorOptions::Check(std::string* why) const {
   if (!std::isfinite(rel_tol) || !(rel_tol > 0.0) || !(rel_tol <= 1e-2)) {

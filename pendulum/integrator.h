@@ -32,6 +32,10 @@ enum class IntegratorMethod {
 // "rk853", "cvodes".
 const char* ToString(IntegratorMethod method);
 bool ParseIntegratorMethod(const std::string& name, IntegratorMethod* method);
+// The names in table order, for CLI choices: {"rk853", "cvodes"}.
+const std::vector<std::string>& IntegratorMethodNames();
+// The allowed values for messages and help: "rk853 or cvodes".
+std::string IntegratorMethodAllowedValues();
 
 struct IntegratorOptions {
   // Local error tolerances per step, for the state and (same values) the sensitivities. With

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "base/enum_names.h"
 #include "base/units.h"
 
 namespace bifilar {
@@ -65,29 +66,55 @@ std::string Num(double v) {
 
 }  // namespace
 
+namespace {
+
+// The one table of pendulum models (Ceres types.h style): config `model`, --model, JSON.
+struct PendulumModelRow {
+  PendulumModel model;
+  const char* name;
+};
+constexpr PendulumModelRow kPendulumModelTable[] = {
+    {PendulumModel::kFull, "full"},
+    {PendulumModel::kJardin, "jardin"},
+    {PendulumModel::kLinear, "linear"},
+};
+
+}  // namespace
+
 const char* ToString(PendulumModel model) {
-  switch (model) {
-    case PendulumModel::kFull:
-      return "full";
-    case PendulumModel::kJardin:
-      return "jardin";
-    case PendulumModel::kLinear:
-      return "linear";
+  for (const PendulumModelRow& row : kPendulumModelTable) {
+    if (row.model == model) return row.name;
   }
   return "unknown";
 }
 
 bool ParsePendulumModel(const std::string& name, PendulumModel* model) {
-  if (name == "full") {
-    *model = PendulumModel::kFull;
-  } else if (name == "jardin") {
-    *model = PendulumModel::kJardin;
-  } else if (name == "linear") {
-    *model = PendulumModel::kLinear;
-  } else {
-    return false;
+  for (const PendulumModelRow& row : kPendulumModelTable) {
+    if (name == row.name) {
+      *model = row.model;
+      return true;
+    }
   }
-  return true;
+  return false;
+}
+
+const std::vector<std::string>& PendulumModelNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const PendulumModelRow& row : kPendulumModelTable) out.push_back(row.name);
+    return out;
+  }();
+  return names;
+}
+
+std::string PendulumModelAllowedValues() { return JoinAllowedValues(PendulumModelNames()); }
+
+bool CheckSeparationBelowLength(double filar_length_m, double filar_separation_m,
+                                std::string* why) {
+  if (filar_length_m > filar_separation_m) return true;
+  return Fail(why, "filar_separation_m (D) = " + Num(filar_separation_m) +
+                       " m is not below filar_length_m (L) = " + Num(filar_length_m) +
+                       " m (the wires would go slack); allowed D < L");
 }
 
 bool RigGeometry::Check(std::string* why) const {
@@ -98,11 +125,7 @@ bool RigGeometry::Check(std::string* why) const {
     return Fail(why, "filar_separation_m (D) must be finite and > 0 m, got " +
                          Num(filar_separation_m));
   }
-  if (!(filar_length_m > filar_separation_m)) {
-    return Fail(why, "filar_length_m (L) must be > filar_separation_m (D) so the wires never go "
-                     "slack, got L = " + Num(filar_length_m) + " m, D = " +
-                         Num(filar_separation_m) + " m");
-  }
+  if (!CheckSeparationBelowLength(filar_length_m, filar_separation_m, why)) return false;
   if (!std::isfinite(mass_kg) || !(mass_kg > 0.0)) {
     return Fail(why, "mass_kg (m) must be finite and > 0 kg, got " + Num(mass_kg));
   }

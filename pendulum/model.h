@@ -11,6 +11,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "base/units.h"
 
@@ -22,6 +23,10 @@ enum class PendulumModel { kFull, kJardin, kLinear };
 const char* ToString(PendulumModel model);
 // Parses the names above; returns false (and leaves *model unchanged) for anything else.
 bool ParsePendulumModel(const std::string& name, PendulumModel* model);
+// The names in table order, for CLI choices: {"full", "jardin", "linear"}.
+const std::vector<std::string>& PendulumModelNames();
+// The allowed values for messages and help: "full, jardin or linear".
+std::string PendulumModelAllowedValues();
 
 // Suspension geometry and the suspended mass.
 struct RigGeometry {
@@ -33,6 +38,13 @@ struct RigGeometry {
   // True when every field is finite and in range; otherwise names the field and the range.
   bool Check(std::string* why) const;
 };
+
+// L > D, the one check of it and its one message (the config, the simulator and RigGeometry all
+// use it): true when filar_length_m > filar_separation_m; otherwise *why (if not null) says
+// "filar_separation_m (D) = .. m is not below filar_length_m (L) = .. m (the wires would go
+// slack); allowed D < L". Callers prefix their file, line and key. NaN fails.
+bool CheckSeparationBelowLength(double filar_length_m, double filar_separation_m,
+                                std::string* why);
 
 // The unknowns of one swing that enter the equation of motion.
 struct PendulumParams {

@@ -260,11 +260,7 @@ bool TraceSetup::Check(std::string* why) const {
                   1e9, why)) {
     return false;
   }
-  if (!(g.filar_length_m > g.filar_separation_m)) {
-    return Fail(why, "filar_length_m (L) = " + Num(g.filar_length_m) +
-                         " must be greater than filar_separation_m (D) = " +
-                         Num(g.filar_separation_m) + " (the wires would go slack); allowed L > D");
-  }
+  if (!CheckSeparationBelowLength(g.filar_length_m, g.filar_separation_m, why)) return false;
   if (!std::isfinite(pitch_rad) || std::abs(pitch_rad) > kPi / 2 + 1e-9) {
     return Fail(why, "pitch = " + Num(pitch_rad / kRadPerDeg) +
                          " deg is out of range; allowed [-90, 90]");
@@ -909,11 +905,7 @@ bool CampaignSpec::Check(std::string* why) const {
       !CheckValue(gravity_mps2, "gravity_mps2", 0.0, true, 100.0, why)) {
     return false;
   }
-  if (!(filar_length_m > filar_separation_m)) {
-    return Fail(why, "filar_length_m (L) = " + Num(filar_length_m) +
-                         " must be greater than filar_separation_m (D) = " +
-                         Num(filar_separation_m) + " (the wires would go slack); allowed L > D");
-  }
+  if (!CheckSeparationBelowLength(filar_length_m, filar_separation_m, why)) return false;
   if (!(TrueLengthM() > TrueSeparationM()) || !(true_filar_length_m >= 0.0) ||
       !(true_filar_separation_m >= 0.0) || !std::isfinite(true_filar_length_m) ||
       !std::isfinite(true_filar_separation_m)) {

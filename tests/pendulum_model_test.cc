@@ -6,10 +6,12 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "base/units.h"
+#include "pendulum/integrator.h"
 
 namespace bifilar {
 namespace {
@@ -228,12 +230,12 @@ TEST(PendulumModel, RigGeometryCheck) {
   for (double length : {0.8, 0.5}) {
     RigGeometry g = TestGeometry();
     g.filar_length_m = length;
-    ExpectRigError(g, "must be > filar_separation_m (D) so the wires never go slack");
+    ExpectRigError(g, "filar_separation_m (D) = 0.8 m is not below filar_length_m (L)");
   }
   RigGeometry g = TestGeometry();
   g.filar_length_m = 0.5;
   ASSERT_FALSE(g.Check(&why));
-  EXPECT_NE(why.find("L = 0.5 m, D = 0.8 m"), std::string::npos) << why;
+  EXPECT_NE(why.find("filar_separation_m (D) = 0.8 m is not below filar_length_m (L) = 0.5 m"), std::string::npos) << why;
 }
 
 TEST(PendulumModel, PendulumParamsCheck) {
@@ -262,6 +264,38 @@ TEST(PendulumModel, PendulumParamsCheck) {
               std::string::npos)
         << why;
   }
+}
+
+// One table per enumeration: every name parses back to its value, the CLI choices and the
+// allowed-values text come from the same table.
+TEST(EnumTables, PendulumModelAndIntegratorNamesRoundTrip) {
+  EXPECT_EQ(PendulumModelNames(), (std::vector<std::string>{"full", "jardin", "linear"}));
+  for (const std::string& name : PendulumModelNames()) {
+    PendulumModel model = PendulumModel::kFull;
+    ASSERT_TRUE(ParsePendulumModel(name, &model)) << name;
+    EXPECT_EQ(ToString(model), name);
+  }
+  EXPECT_EQ(PendulumModelAllowedValues(), "full, jardin or linear");
+  EXPECT_EQ(IntegratorMethodNames(), (std::vector<std::string>{"rk853", "cvodes"}));
+  for (const std::string& name : IntegratorMethodNames()) {
+    IntegratorMethod method = IntegratorMethod::kRungeKutta;
+    ASSERT_TRUE(ParseIntegratorMethod(name, &method)) << name;
+    EXPECT_EQ(ToString(method), name);
+  }
+  EXPECT_EQ(IntegratorMethodAllowedValues(), "rk853 or cvodes");
+  PendulumModel model = PendulumModel::kLinear;
+  EXPECT_FALSE(ParsePendulumModel("Full", &model));
+  EXPECT_EQ(model, PendulumModel::kLinear);
+}
+
+// L > D: one check, one message, NaN refused.
+TEST(EnumTables, SeparationBelowLengthIsOneCheck) {
+  std::string why;
+  EXPECT_TRUE(CheckSeparationBelowLength(2.0, 1.0, &why));
+  EXPECT_FALSE(CheckSeparationBelowLength(1.0, 1.0, &why));
+  EXPECT_EQ(why, "filar_separation_m (D) = 1 m is not below filar_length_m (L) = 1 m (the wires "
+                 "would go slack); allowed D < L");
+  EXPECT_FALSE(CheckSeparationBelowLength(NAN, 1.0, nullptr));
 }
 
 }  // namespace

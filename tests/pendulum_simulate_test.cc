@@ -264,7 +264,7 @@ TEST(Simulate, BadInputNamesTheParameter) {
   };
   const std::vector<Case> cases = {
       {"filar_length_m", [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_length_m = -1; }},
-      {"filar_length_m (L) = 1.5 must be greater than filar_separation_m",
+      {"filar_separation_m (D) = 1.8 m is not below filar_length_m (L) = 1.5 m",
        [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_length_m = 1.5; }},
       {"filar_separation_m", [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_separation_m = 0; }},
       {"mass_kg", [](TraceSetup* s, SimulationOptions*) { s->geometry.mass_kg = 0; }},

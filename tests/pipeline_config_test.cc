@@ -125,7 +125,7 @@ TEST(Config, ReadsEveryKey) {
   EXPECT_DOUBLE_EQ(c.fit.quality.min_periods, 3.0);
   EXPECT_EQ(c.ellipse.bootstrap, 100);
   EXPECT_EQ(c.ellipse.seed, 7u);
-  EXPECT_EQ(c.ellipse.covariance, "points");
+  EXPECT_EQ(c.ellipse.covariance, EllipseCovariance::kPointResiduals);
   EXPECT_NE(c.text.find("filar_length_m: 2.4"), std::string::npos);
   // The window override is found from the absolute log path.
   EXPECT_TRUE(ConfigWindowFor(c, dir + "/logs/pitch_10/trial_1.csv").has_value());
@@ -259,7 +259,14 @@ TEST(Config, CountsAndRangesAreBoundedAtLoad) {
   ExpectError(yaml + "fit: {max_amplitude_deg: 179.9}\n", {"fit.max_amplitude_deg"});
   ExpectError(yaml + "fit: {max_amplitude_deg: 20, min_amplitude_deg: 25}\n",
               {"fit.min_amplitude_deg"});
-  ExpectError(yaml + "fit: {quality: {whiteness_lags: 100000000}}\n", {"whiteness_lags in [1, 1000]"});
+  ExpectError(yaml + "fit: {quality: {whiteness_lags: 100000000}}\n", {"'fit.quality.whiteness_lags' must be in [1, 1000], got 100000000"});
+  // Nested keys: the line of the key itself, found through the field -> key table.
+  ExpectError(yaml + "fit:\n  amplitude_sweep:\n    max_bands: 50\n",
+              {"'fit.amplitude_sweep.max_bands' must be in [2, 20], got 50", ":10:"});
+  ExpectError(yaml + "fit:\n  quality:\n    reject_residual_fraction: 0\n",
+              {"'fit.quality.reject_residual_fraction' must be in (0, 1], got 0", ":10:"});
+  ExpectError(yaml + "ellipse: {covariance: magic}\n",
+              {"'ellipse.covariance' must be auto, points, angle_means or absolute, not 'magic'"});
   // Check() holds the same ranges for a config built in code.
   CampaignConfig config;
   std::string why;
@@ -298,6 +305,33 @@ TEST(Config, DuplicateKeysDocumentsAndTablePitchesNameBothLines) {
   ExpectError(buffer, {":8:", "duplicate key 'rig.inertia.table.0' (first at line 7)"});
   std::snprintf(buffer, sizeof(buffer), table, "0.0");
   ExpectError(buffer, {":8:", "pitch 0.0 deg twice", ":7:"});
+}
+
+// Every bound lives in the options struct's Check (a config built in code is checked for the
+// quality, sweep and glitch ranges too), reported as field, value and bound; the config layer
+// maps the field to its YAML key and line.
+TEST(ConfigCheck, FailureNamesFieldValueAndBound) {
+  FitConfig fit;
+  CheckFailure failure;
+  EXPECT_TRUE(fit.Check(&failure));
+  fit.sweep.max_bands = 50;
+  ASSERT_FALSE(fit.Check(&failure));
+  EXPECT_EQ(failure.field, "sweep.max_bands");
+  EXPECT_EQ(failure.value, 50);
+  EXPECT_EQ(failure.allowed, "in [2, 20]");
+  std::string why;
+  ASSERT_FALSE(fit.Check(&why));
+  EXPECT_EQ(why, "'fit.amplitude_sweep.max_bands' must be in [2, 20], got 50");
+  fit = FitConfig();
+  fit.quality.reject_residual_fraction = 1.5;
+  ASSERT_FALSE(fit.Check(&failure));
+  EXPECT_EQ(failure.field, "quality.reject_residual_fraction");
+  EllipseConfig ellipse;
+  ellipse.confidence = 1.0;
+  ASSERT_FALSE(ellipse.Check(&failure));
+  EXPECT_EQ(failure.field, "confidence");
+  ASSERT_FALSE(ellipse.Check(&why));
+  EXPECT_EQ(why, "'ellipse.confidence' must be in (0, 1), got 1");
 }
 
 }  // namespace

@@ -259,6 +259,34 @@ TEST(ExportRead, PlanarResultsExportIxxIzzIxzAndNameWhatIsMissing) {
   EXPECT_THROW(ReadExportInertia(ReadFile(path), path, o), UserError);
 }
 
+// results.json's `aircraft` (written by ResultsToJson) is the mass export uses; the stored
+// config is read only for files written before that key (the test above: the committed sample).
+TEST(ExportRead, MassFromTheResultsAircraftSectionBeforeTheStoredConfig) {
+  json j = json::parse(TensorResults(kExample, kExampleStd));
+  j["aircraft"] = {{"mass_kg", 2.5}, {"mass_std_kg", 0.02}};  // differs from the config's 1.25
+  ExportOptions o;
+  o.results_path = "r.json";
+  ExportInertia in = ReadExportInertia(j.dump(), "r.json", o);
+  EXPECT_EQ(in.mass_kg, 2.5);
+  EXPECT_EQ(in.mass_std_kg, 0.02);
+  EXPECT_EQ(in.mass_source, "config aircraft.mass_kg");
+  // No std given in the config: null, read as unknown.
+  j["aircraft"]["mass_std_kg"] = nullptr;
+  in = ReadExportInertia(j.dump(), "r.json", o);
+  EXPECT_EQ(in.mass_kg, 2.5);
+  EXPECT_TRUE(std::isnan(in.mass_std_kg));
+  // No aircraft in the campaign: null, no mass (the stored config is not consulted).
+  j["aircraft"] = nullptr;
+  in = ReadExportInertia(j.dump(), "r.json", o);
+  EXPECT_TRUE(std::isnan(in.mass_kg));
+  EXPECT_TRUE(in.mass_source.empty());
+  // A file without the key: the stored config, as before.
+  j.erase("aircraft");
+  in = ReadExportInertia(j.dump(), "r.json", o);
+  EXPECT_EQ(in.mass_kg, 1.25);
+  EXPECT_EQ(in.mass_std_kg, 0.01);
+}
+
 TEST(ExportRead, ThreeAxisTensorNamesTheMissingProducts) {
   const double nan = NAN;
   ExportOptions o;

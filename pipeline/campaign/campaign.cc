@@ -636,7 +636,7 @@ EllipseOptions MakeEllipseOptions(const CampaignConfig& config, double rig_std_k
   o.bootstrap_replicates = config.ellipse.bootstrap;
   o.seed = config.ellipse.seed;
   o.confidence = config.ellipse.confidence;
-  ParseEllipseCovariance(config.ellipse.covariance, &o.covariance);
+  o.covariance = config.ellipse.covariance;
   const double rig_std = config.rig_inertia.kind == RigInertiaSpec::Kind::kTare
                              ? rig_std_kg_m2
                              : config.rig_inertia.inertia_std_kg_m2;

@@ -33,7 +33,7 @@ TensorOptions MakeTensorOptions(const CampaignConfig& config, const CampaignResu
   o.bootstrap_replicates = config.ellipse.bootstrap;
   o.seed = config.ellipse.seed;
   o.confidence = config.ellipse.confidence;
-  ParseEllipseCovariance(config.ellipse.covariance, &o.covariance);
+  o.covariance = config.ellipse.covariance;
   o.common_offset_std_kg_m2 = RigCommonStd(config, result);
   return o;
 }

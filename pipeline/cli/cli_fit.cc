@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pendulum/integrator.h"
+#include "pendulum/model.h"
 #include "pipeline/cli/cli_commands.h"
 #include "pipeline/commands/fit_command.h"
 #include "pipeline/config/config.h"
@@ -156,10 +158,10 @@ void AddFitOptions(CLI::App* sub, FitCli* args) {
   sub->add_option("logs", o.logs, "IMU logs: CSV (optionally .gz) or PX4 ULog (.ulg)")->required();
   sub->add_flag("--json", args->json, "print a JSON array of trace records instead of lines");
   sub->add_option("--model", o.model, "full (default), jardin or linear")
-      ->check(CLI::IsMember({"full", "jardin", "linear"}));
+      ->check(CLI::IsMember(PendulumModelNames()));
   sub->add_option("--integrator", o.integrator,
                   "ODE solver of the fit: rk853 (default) or cvodes; overrides fit.integrator")
-      ->check(CLI::IsMember({"rk853", "cvodes"}));
+      ->check(CLI::IsMember(IntegratorMethodNames()));
   sub->add_option("--window", o.window, "fit only T0:T1 (s, the log's own time)");
   sub->add_option("--max-amplitude", o.max_amplitude_deg, "upper end of the amplitude band (deg)")
       ->check(FiniteNumber())

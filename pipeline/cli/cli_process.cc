@@ -36,7 +36,7 @@ void RegisterProcessCommands(CLI::App& app, int* exit_code) {
   process->add_flag("--force", args->force, "ignore the cache and refit every log");
   process->add_option("--integrator", args->integrator,
                       "ODE solver of the fits: rk853 or cvodes; overrides fit.integrator")
-      ->check(CLI::IsMember({"rk853", "cvodes"}));
+      ->check(CLI::IsMember(IntegratorMethodNames()));
   process->add_option("--runs-root", args->runs_root,
                       "folder of the aircraft logs, instead of the config's runs.root");
   process->callback([args, exit_code] {

@@ -11,6 +11,7 @@
 
 #include "base/hash.h"
 #include "base/interrupt.h"
+#include "base/json_number.h"
 #include "base/user_error.h"
 #include "fit/window.h"
 #include "pipeline/campaign/calibration.h"
@@ -89,49 +90,47 @@ std::vector<std::string> FigureStems(const std::vector<std::string>& logs) {
 namespace {
 
 nlohmann::json RepeatGroupsToJson(const std::vector<RepeatGroup>& groups) {
-  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
   nlohmann::json out = nlohmann::json::array();
   for (const RepeatGroup& g : groups) {
     out.push_back({{"name", g.name},
                    {"members", g.members},
                    {"n_used", g.n_used},
-                   {"mean_kg_m2", number(g.mean_kg_m2)},
-                   {"mean_std_kg_m2", number(g.mean_std_kg_m2)},
-                   {"plain_mean_kg_m2", number(g.plain_mean_kg_m2)},
-                   {"q", number(g.q)},
-                   {"tau_kg_m2", number(g.tau_kg_m2)},
-                   {"max_abs_z", number(g.max_abs_z)},
+                   {"mean_kg_m2", JsonNumber(g.mean_kg_m2)},
+                   {"mean_std_kg_m2", JsonNumber(g.mean_std_kg_m2)},
+                   {"plain_mean_kg_m2", JsonNumber(g.plain_mean_kg_m2)},
+                   {"q", JsonNumber(g.q)},
+                   {"tau_kg_m2", JsonNumber(g.tau_kg_m2)},
+                   {"max_abs_z", JsonNumber(g.max_abs_z)},
                    {"amplitude_trend_percent_per_10deg",
-                    number(g.amplitude_trend_percent_per_10deg)},
-                   {"amplitude_trend_z", number(g.amplitude_trend_z)},
-                   {"spread_before_percent", number(g.spread_before_percent)},
-                   {"spread_after_percent", number(g.spread_after_percent)},
-                   {"q_before", number(g.q_before)},
-                   {"max_abs_z_before", number(g.max_abs_z_before)},
-                   {"correction_std_kg_m2", number(g.correction_std_kg_m2)},
-                   {"common_mode_std_kg_m2", number(g.common_mode_std_kg_m2)},
-                   {"total_std_kg_m2", number(g.total_std_kg_m2)},
+                    JsonNumber(g.amplitude_trend_percent_per_10deg)},
+                   {"amplitude_trend_z", JsonNumber(g.amplitude_trend_z)},
+                   {"spread_before_percent", JsonNumber(g.spread_before_percent)},
+                   {"spread_after_percent", JsonNumber(g.spread_after_percent)},
+                   {"q_before", JsonNumber(g.q_before)},
+                   {"max_abs_z_before", JsonNumber(g.max_abs_z_before)},
+                   {"correction_std_kg_m2", JsonNumber(g.correction_std_kg_m2)},
+                   {"common_mode_std_kg_m2", JsonNumber(g.common_mode_std_kg_m2)},
+                   {"total_std_kg_m2", JsonNumber(g.total_std_kg_m2)},
                    {"note", g.note}});
   }
   return out;
 }
 
 nlohmann::json AmplitudeCorrectionToJson(const RepeatsAmplitudeCorrection& c) {
-  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
   return {{"applied", c.applied},
           {"model", "I_0 (1 + c A^2)"},
           {"to_amplitude_deg", 0.0},
-          {"coeff_per_deg2", number(c.coeff_per_deg2)},
-          {"coeff_std_per_deg2", number(c.coeff_std_per_deg2)},
-          {"z", number(c.z)},
-          {"birge", number(c.birge)},
-          {"scatter_percent", number(c.scatter_percent)},
+          {"coeff_per_deg2", JsonNumber(c.coeff_per_deg2)},
+          {"coeff_std_per_deg2", JsonNumber(c.coeff_std_per_deg2)},
+          {"z", JsonNumber(c.z)},
+          {"birge", JsonNumber(c.birge)},
+          {"scatter_percent", JsonNumber(c.scatter_percent)},
           {"dof", c.dof},
           {"n_logs", c.n_logs},
           {"n_groups", c.n_groups},
           {"n_corrected", c.n_corrected},
           {"n_low_band_kept", c.n_low_band_kept},
-          {"amplitude_range_deg", {number(c.amplitude_min_deg), number(c.amplitude_max_deg)}},
+          {"amplitude_range_deg", {JsonNumber(c.amplitude_min_deg), JsonNumber(c.amplitude_max_deg)}},
           {"note", c.note}};
 }
 

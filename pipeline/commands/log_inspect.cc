@@ -9,6 +9,7 @@
 
 #include "base/bounded_read.h"
 #include "base/gzip.h"
+#include "base/json_number.h"
 #include "base/units.h"
 #include "base/user_error.h"
 #include "fit/swing_axis.h"
@@ -685,7 +686,6 @@ std::string InspectReportText(const InspectReport& r) {
 }
 
 nlohmann::json InspectReportToJson(const InspectReport& r) {
-  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
   nlohmann::json j;
   j["file"] = r.file;
   j["kind"] = r.kind;
@@ -696,7 +696,7 @@ nlohmann::json InspectReportToJson(const InspectReport& r) {
     topics.push_back({{"topic", t.topic},
                       {"multi_id", t.multi_id},
                       {"samples", t.samples},
-                      {"rate_hz", number(t.rate_hz)}});
+                      {"rate_hz", JsonNumber(t.rate_hz)}});
   }
   j["topics"] = topics;
   if (r.is_log()) {
@@ -722,12 +722,12 @@ nlohmann::json InspectReportToJson(const InspectReport& r) {
     j["format"] = format;
   }
   j["samples"] = r.samples;
-  j["duration_s"] = number(r.duration_s);
-  j["rate_mean_hz"] = number(r.rate_mean_hz);
-  j["step_median_s"] = number(r.step_median_s);
-  j["step_jitter_s"] = number(r.step_jitter_s);
+  j["duration_s"] = JsonNumber(r.duration_s);
+  j["rate_mean_hz"] = JsonNumber(r.rate_mean_hz);
+  j["step_median_s"] = JsonNumber(r.step_median_s);
+  j["step_jitter_s"] = JsonNumber(r.step_jitter_s);
   j["dropouts"] = r.dropouts;
-  j["longest_gap_s"] = number(r.longest_gap_s);
+  j["longest_gap_s"] = JsonNumber(r.longest_gap_s);
   j["has_accel"] = r.has_accel;
   j["swing_axis_in_imu"] = r.swing_axis_source.empty()
                                ? nlohmann::json()
@@ -737,16 +737,16 @@ nlohmann::json InspectReportToJson(const InspectReport& r) {
   j["pitch_measured_deg"] = r.pitch_measured_deg ? nlohmann::json(*r.pitch_measured_deg)
                                                  : nlohmann::json();
   j["window_status"] = r.window_status;
-  j["window_s"] = {number(r.window_s[0]), number(r.window_s[1])};
+  j["window_s"] = {JsonNumber(r.window_s[0]), JsonNumber(r.window_s[1])};
   j["window_end"] = r.window_end;
-  j["release_s"] = number(r.release_s);
-  j["period_s"] = number(r.period_s);
-  j["frequency_hz"] = number(r.frequency_hz);
-  j["cycles"] = number(r.cycles);
-  j["amplitude_deg"] = {number(r.amplitude_deg[0]), number(r.amplitude_deg[1])};
-  j["noise_rad_per_s"] = number(r.noise_rad_per_s);
-  j["small_angle_inertia_kg_m2"] = number(r.small_angle_inertia_kg_m2);
-  j["mass_used_kg"] = number(r.mass_used_kg);
+  j["release_s"] = JsonNumber(r.release_s);
+  j["period_s"] = JsonNumber(r.period_s);
+  j["frequency_hz"] = JsonNumber(r.frequency_hz);
+  j["cycles"] = JsonNumber(r.cycles);
+  j["amplitude_deg"] = {JsonNumber(r.amplitude_deg[0]), JsonNumber(r.amplitude_deg[1])};
+  j["noise_rad_per_s"] = JsonNumber(r.noise_rad_per_s);
+  j["small_angle_inertia_kg_m2"] = JsonNumber(r.small_angle_inertia_kg_m2);
+  j["mass_used_kg"] = JsonNumber(r.mass_used_kg);
   j["warnings"] = r.warnings;
   j["error"] = r.error;
   return j;

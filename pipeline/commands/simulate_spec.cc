@@ -294,10 +294,11 @@ void ReadGeometry(YamlMap map, std::optional<double>* length, std::optional<doub
   *true_length = ReadOptionalValue(map, "true_filar_length_m", 0, true, 1000);
   *true_separation = ReadOptionalValue(map, "true_filar_separation_m", 0, true, 1000);
   (void)inf;
-  if (length->has_value() && separation->has_value() && !(**length > **separation)) {
-    throw UserError(map.Where(length_node) + ": '" + map.KeyPath("filar_length_m") + "' = " +
-                    Num(**length) + " must be greater than '" + map.KeyPath("filar_separation_m") +
-                    "' = " + Num(**separation) + " (the wires would go slack); allowed L > D > 0");
+  std::string why;
+  if (length->has_value() && separation->has_value() &&
+      !CheckSeparationBelowLength(**length, **separation, &why)) {
+    throw UserError(map.Where(length_node) + ": '" + map.KeyPath("filar_separation_m") + "': " +
+                    why);
   }
   map.Finish();
 }
@@ -324,7 +325,7 @@ void ReadModelAndIntegrator(YamlMap& root, SimulateSpec* spec) {
       const std::string name = root.AsString(model, "model");
       if (!ParsePendulumModel(name, &spec->options.model)) {
         throw UserError(root.Where(model) + ": unknown model '" + name +
-                        "' for 'model'; allowed full, jardin, linear");
+                        "' for 'model'; allowed " + PendulumModelAllowedValues());
       }
     }
   }
@@ -334,7 +335,9 @@ void ReadModelAndIntegrator(YamlMap& root, SimulateSpec* spec) {
       const std::string name = root.AsString(method, "integrator");
       if (!ParseIntegratorMethod(name, &spec->options.integrator.method)) {
         throw UserError(root.Where(method) + ": unknown integrator '" + name +
-                        "' for 'integrator'; allowed cvodes (default), rk853");
+                        "' for 'integrator'; allowed " +
+                        IntegratorMethodAllowedValues() + " (default " +
+                        ToString(spec.options.integrator.method) + ")");
       }
     }
   }

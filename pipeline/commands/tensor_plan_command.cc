@@ -6,14 +6,13 @@
 #include <cstdio>
 #include <string>
 
+#include "base/json_number.h"
 #include "base/user_error.h"
 
 namespace bifilar {
 namespace {
 
 using nlohmann::json;
-
-json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 std::string Fmt(const char* format, double v) {
   char buf[64];
@@ -57,17 +56,17 @@ json TensorPlanToJson(const TensorPlan& p, const TensorPlanOptions& o) {
   j["n_candidates"] = p.n_candidates;
   j["n_points"] = p.n_points;
   j["rank"] = p.rank;
-  j["condition_number"] = Num(p.condition_number);
-  j["log_det_information"] = Num(p.log_det_information);
+  j["condition_number"] = JsonNumber(p.condition_number);
+  j["log_det_information"] = JsonNumber(p.log_det_information);
   j["exchange_sweeps"] = p.exchange_sweeps;
   json orientations = json::array();
   for (const TensorPlanOrientation& x : p.orientations) {
     orientations.push_back({{"roll_deg", x.roll_deg},
                             {"pitch_deg", x.pitch_deg},
                             {"axis_in_body", x.axis_in_body},
-                            {"inertia_kg_m2", Num(x.inertia_kg_m2)},
-                            {"swing_std_kg_m2", Num(x.swing_std_kg_m2)},
-                            {"mean_std_kg_m2", Num(x.mean_std_kg_m2)}});
+                            {"inertia_kg_m2", JsonNumber(x.inertia_kg_m2)},
+                            {"swing_std_kg_m2", JsonNumber(x.swing_std_kg_m2)},
+                            {"mean_std_kg_m2", JsonNumber(x.mean_std_kg_m2)}});
   }
   j["orientations"] = orientations;
   json components;
@@ -75,8 +74,8 @@ json TensorPlanToJson(const TensorPlan& p, const TensorPlanOptions& o) {
     const bool obs = p.observable[k];
     components[TensorPlanComponentName(k)] = {
         {"observable", obs},
-        {"std_kg_m2", obs ? Num(p.std_kg_m2[k]) : json(nullptr)},
-        {"floor_std_kg_m2", obs ? Num(p.floor_std_kg_m2[k]) : json(nullptr)},
+        {"std_kg_m2", obs ? JsonNumber(p.std_kg_m2[k]) : json(nullptr)},
+        {"floor_std_kg_m2", obs ? JsonNumber(p.floor_std_kg_m2[k]) : json(nullptr)},
         {"trials_needed", obs && o.target_std_kg_m2 > 0 && p.trials_needed[k] > 0
                               ? json(p.trials_needed[k])
                               : json(nullptr)}};

@@ -3,6 +3,7 @@
 #include "base/units.h"
 #include "fit/ellipse.h"
 
+#include <cassert>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -478,94 +479,196 @@ bool GlitchConfig::IsDefault() const {
 
 namespace {
 
-// The first `fit.glitch` value outside its range: its key (below fit.glitch) and the message.
-bool CheckGlitch(const GlitchConfig& g, std::string* key, std::string* why) {
-  char buffer[200];
-  auto fail = [&](const char* name, const char* range, double value) {
-    *key = name;
-    std::snprintf(buffer, sizeof(buffer), "'fit.glitch.%s' must be in %s, got %g", name, range, value);
-    *why = buffer;
-    return false;
-  };
-  char range[64];
-  std::snprintf(range, sizeof(range), "[%g, %g]", kMinGlitchSigmas, kMaxGlitchSigmas);
+// A number as users write it: integers exactly, others with %g.
+std::string BoundNum(double value) {
+  char buffer[64];
+  if (std::isfinite(value) && value == std::floor(value) && std::fabs(value) < 1e15) {
+    std::snprintf(buffer, sizeof(buffer), "%.0f", value);
+  } else {
+    std::snprintf(buffer, sizeof(buffer), "%g", value);
+  }
+  return buffer;
+}
+
+// "[lo, hi]", "(lo, hi]", ...
+std::string Interval(char open, double lo, double hi, char close) {
+  return std::string(1, open) + BoundNum(lo) + ", " + BoundNum(hi) + std::string(1, close);
+}
+
+bool Fail(CheckFailure* failure, const char* field, double value, const std::string& allowed) {
+  if (failure != nullptr) *failure = CheckFailure{field, value, allowed};
+  return false;
+}
+
+// The one map from an options field to its YAML key: `section` below the struct's own section
+// (empty: directly in it), then `key`. Every field a Check can name has a row.
+struct FieldKey {
+  const char* field;
+  const char* section;
+  const char* key;
+};
+constexpr FieldKey kFitFieldKeys[] = {
+    {"max_amplitude_deg", "", "max_amplitude_deg"},
+    {"min_amplitude_deg", "", "min_amplitude_deg"},
+    {"quality.max_rms_over_noise", "quality", "max_rms_over_noise"},
+    {"quality.max_residual_autocorr", "quality", "max_residual_autocorr"},
+    {"quality.whiteness_lags", "quality", "whiteness_lags"},
+    {"quality.max_secondary_motion_ratio", "quality", "max_secondary_motion_ratio"},
+    {"quality.reject_secondary_motion_ratio", "quality", "reject_secondary_motion_ratio"},
+    {"quality.reject_residual_fraction", "quality", "reject_residual_fraction"},
+    {"quality.min_periods", "quality", "min_periods"},
+    {"sweep.min_cycles_per_band", "amplitude_sweep", "min_cycles_per_band"},
+    {"sweep.max_bands", "amplitude_sweep", "max_bands"},
+    {"sweep.trend_z", "amplitude_sweep", "trend_z"},
+    {"glitch.threshold_sigmas", "glitch", "threshold_sigmas"},
+    {"glitch.range_factor", "glitch", "range_factor"},
+    {"glitch.excursion_fraction", "glitch", "excursion_fraction"},
+    {"glitch.max_fraction", "glitch", "max_fraction"},
+};
+constexpr FieldKey kEllipseFieldKeys[] = {
+    {"bootstrap", "", "bootstrap"},
+    {"confidence", "", "confidence"},
+    {"min_angles", "", "min_angles"},
+};
+
+template <size_t N>
+const FieldKey& KeyOf(const FieldKey (&table)[N], const std::string& field) {
+  for (const FieldKey& row : table) {
+    if (field == row.field) return row;
+  }
+  assert(false && "a Check names a field that has no row in its FieldKey table");
+  return table[0];
+}
+
+// "fit.quality.whiteness_lags", from the struct's own section ("fit") and the field's row.
+std::string YamlKeyPath(const std::string& root, const FieldKey& key) {
+  return root + "." + (key.section[0] != '\0' ? std::string(key.section) + "." : "") + key.key;
+}
+
+std::string FailureMessage(const std::string& root, const FieldKey& key, const CheckFailure& f) {
+  return "'" + YamlKeyPath(root, key) + "' must be " + f.allowed + ", got " + BoundNum(f.value);
+}
+
+// The node to name in an error: the key's value, else its section, else the struct's section.
+YAML::Node FailureNode(YamlMap& map, const FieldKey& key) {
+  if (key.section[0] == '\0') return map.Optional(key.key);
+  const YAML::Node section = map.Optional(key.section);
+  if (section.IsDefined() && section.IsMap() && section[key.key].IsDefined()) {
+    return section[key.key];
+  }
+  return section;
+}
+
+bool CheckGlitch(const GlitchConfig& g, CheckFailure* failure) {
   if (!(g.threshold_sigmas >= kMinGlitchSigmas && g.threshold_sigmas <= kMaxGlitchSigmas)) {
-    return fail("threshold_sigmas", range, g.threshold_sigmas);
+    return Fail(failure, "glitch.threshold_sigmas", g.threshold_sigmas,
+                "in " + Interval('[', kMinGlitchSigmas, kMaxGlitchSigmas, ']'));
   }
-  std::snprintf(range, sizeof(range), "[%g, %g]", kMinGlitchRange, kMaxGlitchRange);
   if (!(g.range_factor >= kMinGlitchRange && g.range_factor <= kMaxGlitchRange)) {
-    return fail("range_factor", range, g.range_factor);
+    return Fail(failure, "glitch.range_factor", g.range_factor,
+                "in " + Interval('[', kMinGlitchRange, kMaxGlitchRange, ']'));
   }
-  std::snprintf(range, sizeof(range), "[0, %g]", kMaxGlitchExcursion);
   if (!(g.excursion_fraction >= 0.0 && g.excursion_fraction <= kMaxGlitchExcursion)) {
-    return fail("excursion_fraction", range, g.excursion_fraction);
+    return Fail(failure, "glitch.excursion_fraction", g.excursion_fraction,
+                "in " + Interval('[', 0, kMaxGlitchExcursion, ']'));
   }
-  std::snprintf(range, sizeof(range), "(0, %g]", kMaxGlitchFraction);
   if (!(g.max_fraction > 0.0 && g.max_fraction <= kMaxGlitchFraction)) {
-    return fail("max_fraction", range, g.max_fraction);
+    return Fail(failure, "glitch.max_fraction", g.max_fraction,
+                "in " + Interval('(', 0, kMaxGlitchFraction, ']'));
+  }
+  return true;
+}
+
+bool CheckQuality(const QualityThresholds& q, CheckFailure* failure) {
+  if (!(q.max_rms_over_noise > 1.0) || !std::isfinite(q.max_rms_over_noise)) {
+    return Fail(failure, "quality.max_rms_over_noise", q.max_rms_over_noise, "finite and > 1");
+  }
+  if (!(q.max_residual_autocorr > 0.0 && q.max_residual_autocorr < 1.0)) {
+    return Fail(failure, "quality.max_residual_autocorr", q.max_residual_autocorr,
+                "in (0, 1)");
+  }
+  if (q.whiteness_lags < 1 || q.whiteness_lags > kMaxWhitenessLags) {
+    return Fail(failure, "quality.whiteness_lags", q.whiteness_lags,
+                "in " + Interval('[', 1, kMaxWhitenessLags, ']'));
+  }
+  if (!(q.max_secondary_motion_ratio >= 0.0) || !std::isfinite(q.max_secondary_motion_ratio)) {
+    return Fail(failure, "quality.max_secondary_motion_ratio", q.max_secondary_motion_ratio,
+                "finite and >= 0");
+  }
+  if (!(q.reject_secondary_motion_ratio >= q.max_secondary_motion_ratio)) {
+    return Fail(failure, "quality.reject_secondary_motion_ratio",
+                q.reject_secondary_motion_ratio,
+                ">= max_secondary_motion_ratio = " + BoundNum(q.max_secondary_motion_ratio));
+  }
+  if (!(q.reject_residual_fraction > 0.0 && q.reject_residual_fraction <= 1.0)) {
+    return Fail(failure, "quality.reject_residual_fraction", q.reject_residual_fraction,
+                "in (0, 1]");
+  }
+  if (!(q.min_periods >= 2.0 && q.min_periods <= kMaxMinPeriods)) {
+    return Fail(failure, "quality.min_periods", q.min_periods,
+                "in " + Interval('[', 2, kMaxMinPeriods, ']'));
+  }
+  return true;
+}
+
+bool CheckSweep(const SweepConfig& sw, CheckFailure* failure) {
+  if (!(sw.min_cycles_per_band >= 1.0 && sw.min_cycles_per_band <= 1000.0)) {
+    return Fail(failure, "sweep.min_cycles_per_band", sw.min_cycles_per_band, "in [1, 1000]");
+  }
+  if (sw.max_bands < 2 || sw.max_bands > 20) {
+    return Fail(failure, "sweep.max_bands", sw.max_bands, "in [2, 20]");
+  }
+  if (!(sw.trend_z > 0.0 && sw.trend_z < 1000.0)) {
+    return Fail(failure, "sweep.trend_z", sw.trend_z, "in (0, 1000)");
   }
   return true;
 }
 
 }  // namespace
 
-bool FitConfig::Check(std::string* why) const {
-  char buffer[200];
+bool FitConfig::Check(CheckFailure* failure) const {
   const double max_deg = max_amplitude_deg.value_or(kMaxMaxAmplitudeDeg);
   if (max_amplitude_deg && !(*max_amplitude_deg >= kMinMaxAmplitudeDeg &&
                              *max_amplitude_deg <= kMaxMaxAmplitudeDeg)) {
-    std::snprintf(buffer, sizeof(buffer), "'fit.max_amplitude_deg' must be in [%g, %g] deg, got %g",
-                  kMinMaxAmplitudeDeg, kMaxMaxAmplitudeDeg, *max_amplitude_deg);
-    *why = buffer;
-    return false;
+    return Fail(failure, "max_amplitude_deg", *max_amplitude_deg,
+                "in " + Interval('[', kMinMaxAmplitudeDeg, kMaxMaxAmplitudeDeg, ']') + " deg");
   }
   if (min_amplitude_deg && !(*min_amplitude_deg >= 0.0 && *min_amplitude_deg < max_deg)) {
-    std::snprintf(buffer, sizeof(buffer),
-                  "'fit.min_amplitude_deg' must be in [0, max_amplitude_deg = %g) deg, got %g",
-                  max_deg, *min_amplitude_deg);
-    *why = buffer;
-    return false;
+    return Fail(failure, "min_amplitude_deg", *min_amplitude_deg,
+                "in [0, max_amplitude_deg = " + BoundNum(max_deg) + ") deg");
   }
-  const QualityThresholds& q = quality;
-  if (!(q.max_rms_over_noise > 1.0) || !(q.max_residual_autocorr > 0.0) ||
-      !(q.max_residual_autocorr < 1.0) || q.whiteness_lags < 1 ||
-      q.whiteness_lags > kMaxWhitenessLags || !(q.max_secondary_motion_ratio >= 0.0) ||
-      !std::isfinite(q.max_secondary_motion_ratio) || !std::isfinite(q.max_rms_over_noise) ||
-      !(q.min_periods >= 2.0 && q.min_periods <= kMaxMinPeriods)) {
-    std::snprintf(buffer, sizeof(buffer),
-                  "'fit.quality' out of range (max_rms_over_noise > 1, 0 < max_residual_autocorr "
-                  "< 1, whiteness_lags in [1, %d], max_secondary_motion_ratio >= 0, min_periods "
-                  "in [2, %g])", kMaxWhitenessLags, kMaxMinPeriods);
-    *why = buffer;
-    return false;
+  return CheckQuality(quality, failure) && CheckSweep(sweep, failure) &&
+         CheckGlitch(glitch, failure);
+}
+
+bool FitConfig::Check(std::string* why) const {
+  CheckFailure failure;
+  if (Check(&failure)) return true;
+  *why = FailureMessage("fit", KeyOf(kFitFieldKeys, failure.field), failure);
+  return false;
+}
+
+bool EllipseConfig::Check(CheckFailure* failure) const {
+  if (bootstrap != 0 &&
+      !(bootstrap >= kMinBootstrapReplicates && bootstrap <= kMaxBootstrapReplicates)) {
+    return Fail(failure, "bootstrap", bootstrap,
+                "0 (off) or in " +
+                    Interval('[', kMinBootstrapReplicates, kMaxBootstrapReplicates, ']'));
   }
-  std::string key;
-  return CheckGlitch(glitch, &key, why);
+  if (!(confidence > 0.0 && confidence < 1.0)) {
+    return Fail(failure, "confidence", confidence, "in (0, 1)");
+  }
+  if (min_angles < 3 || min_angles > kMaxMinAngles) {
+    return Fail(failure, "min_angles", min_angles, "in " + Interval('[', 3, kMaxMinAngles, ']'));
+  }
+  return true;
 }
 
 bool EllipseConfig::Check(std::string* why) const {
-  if (bootstrap != 0 &&
-      !(bootstrap >= kMinBootstrapReplicates && bootstrap <= kMaxBootstrapReplicates)) {
-    *why = "'ellipse.bootstrap' must be 0 (off) or in [" +
-           std::to_string(kMinBootstrapReplicates) + ", " +
-           std::to_string(kMaxBootstrapReplicates) + "], got " + std::to_string(bootstrap);
-    return false;
-  }
-  if (!(confidence > 0.0 && confidence < 1.0)) {
-    *why = "'ellipse.confidence' must be in (0, 1)";
-    return false;
-  }
-  if (min_angles < 3 || min_angles > kMaxMinAngles) {
-    *why = "'ellipse.min_angles' must be in [3, " + std::to_string(kMaxMinAngles) + "], got " +
-           std::to_string(min_angles);
-    return false;
-  }
-  if (covariance != "auto" && covariance != "points" && covariance != "angle_means" &&
-      covariance != "absolute") {
-    *why = "'ellipse.covariance' must be auto, points, angle_means or absolute";
-    return false;
-  }
-  return true;
+  CheckFailure failure;
+  if (Check(&failure)) return true;
+  *why = FailureMessage("ellipse", KeyOf(kEllipseFieldKeys, failure.field), failure);
+  return false;
 }
 
 namespace {
@@ -670,6 +773,8 @@ void ReadAircraftAndGravity(YamlMap& root, const std::string& path,
     const std::string why = ImplausibleValue("aircraft.mass_kg", "mass", config->aircraft_mass_kg,
                                              0.0, kMaxMassKg);
     if (!why.empty()) throw UserError(aircraft.Where(aircraft.Optional("mass_kg")) + ": " + why);
+    const YAML::Node std_node = aircraft.Optional("mass_std_kg");
+    config->aircraft_mass_std_given = std_node.IsDefined() && !std_node.IsNull();
     config->aircraft_mass_std_kg = NonNegative(aircraft, "mass_std_kg", 0.0);
   } else if (options.require_runs && config->rig_inertia_given) {
     throw UserError(path + ": missing required key 'aircraft' (or leave out 'rig.inertia' too: "
@@ -776,7 +881,7 @@ void ReadFitWindows(YamlMap& fit, FitConfig* out) {
   }
 }
 
-// `fit.quality`: the thresholds of the quality checks, each in its range.
+// `fit.quality`: the thresholds of the quality checks (ranges: FitConfig::Check, in ReadFit).
 void ReadFitQuality(YamlMap& fit, QualityThresholds* q) {
   YamlMap quality = Sub(fit, "quality");
   q->max_rms_over_noise = quality.OptionalDouble("max_rms_over_noise", q->max_rms_over_noise);
@@ -791,38 +896,20 @@ void ReadFitQuality(YamlMap& fit, QualityThresholds* q) {
                                                 q->max_secondary_motion_ratio));
   q->reject_residual_fraction =
       quality.OptionalDouble("reject_residual_fraction", q->reject_residual_fraction);
-  if (!(q->max_rms_over_noise > 1.0) || !(q->max_residual_autocorr > 0.0) ||
-      !(q->max_residual_autocorr < 1.0) || q->whiteness_lags < 1 ||
-      !(q->max_secondary_motion_ratio >= 0.0) || !(q->min_periods >= 2.0) ||
-      !(q->reject_secondary_motion_ratio >= q->max_secondary_motion_ratio) ||
-      !(q->reject_residual_fraction > 0.0 && q->reject_residual_fraction <= 1.0)) {
-    throw UserError(quality.Where(fit.Optional("quality")) +
-                    ": 'fit.quality' out of range (max_rms_over_noise > 1, "
-                    "0 < max_residual_autocorr < 1, whiteness_lags >= 1, "
-                    "max_secondary_motion_ratio >= 0, min_periods >= 2, "
-                    "reject_secondary_motion_ratio >= max_secondary_motion_ratio, "
-                    "0 < reject_residual_fraction <= 1)");
-  }
   quality.Finish();
 }
 
-// `fit.amplitude_sweep`: I against amplitude band.
+// `fit.amplitude_sweep`: I against amplitude band (ranges: FitConfig::Check).
 void ReadFitSweep(YamlMap& fit, SweepConfig* sw) {
   YamlMap sweep = Sub(fit, "amplitude_sweep");
   sw->enabled = sweep.OptionalBool("enabled", sw->enabled);
   sw->min_cycles_per_band = sweep.OptionalDouble("min_cycles_per_band", sw->min_cycles_per_band);
   sw->max_bands = sweep.OptionalInt("max_bands", sw->max_bands);
   sw->trend_z = sweep.OptionalDouble("trend_z", sw->trend_z);
-  if (!(sw->min_cycles_per_band >= 1.0 && sw->min_cycles_per_band <= 1000.0) ||
-      sw->max_bands < 2 || sw->max_bands > 20 || !(sw->trend_z > 0.0 && sw->trend_z < 1000.0)) {
-    throw UserError(sweep.Where(fit.Optional("amplitude_sweep")) +
-                    ": 'fit.amplitude_sweep' out of range (min_cycles_per_band in [1, 1000], "
-                    "max_bands in [2, 20], trend_z in (0, 1000))");
-  }
   sweep.Finish();
 }
 
-// `fit.glitch`: the single-sample glitch detector, each value in its range (error at its line).
+// `fit.glitch`: the single-sample glitch detector (ranges: FitConfig::Check, error at the line).
 void ReadFitGlitch(YamlMap& fit, GlitchConfig* g) {
   YamlMap glitch = Sub(fit, "glitch");
   g->enabled = glitch.OptionalBool("enabled", g->enabled);
@@ -830,23 +917,22 @@ void ReadFitGlitch(YamlMap& fit, GlitchConfig* g) {
   g->range_factor = glitch.OptionalDouble("range_factor", g->range_factor);
   g->excursion_fraction = glitch.OptionalDouble("excursion_fraction", g->excursion_fraction);
   g->max_fraction = glitch.OptionalDouble("max_fraction", g->max_fraction);
-  std::string key, why;
-  if (!CheckGlitch(*g, &key, &why)) throw UserError(glitch.Where(glitch.Optional(key)) + ": " + why);
   glitch.Finish();
 }
 
 // `fit`: model, integrator, windows, amplitude limits, quality, sweep, glitch; then
 // FitConfig::Check.
 void ReadFit(YamlMap fit, FitConfig* out) {
-  const std::string model = fit.OptionalString("model", "full");
+  // Defaults: FitConfig's own (full, rk853), named through the enums' tables.
+  const std::string model = fit.OptionalString("model", ToString(out->model));
   if (!ParsePendulumModel(model, &out->model)) {
-    throw UserError(fit.Where(fit.Optional("model")) +
-                    ": 'fit.model' must be full, jardin or linear, not '" + model + "'");
+    throw UserError(fit.Where(fit.Optional("model")) + ": 'fit.model' must be " +
+                    PendulumModelAllowedValues() + ", not '" + model + "'");
   }
-  const std::string integrator = fit.OptionalString("integrator", "rk853");
+  const std::string integrator = fit.OptionalString("integrator", ToString(out->integrator));
   if (!ParseIntegratorMethod(integrator, &out->integrator)) {
-    throw UserError(fit.Where(fit.Optional("integrator")) +
-                    ": 'fit.integrator' must be rk853 or cvodes, not '" + integrator + "'");
+    throw UserError(fit.Where(fit.Optional("integrator")) + ": 'fit.integrator' must be " +
+                    IntegratorMethodAllowedValues() + ", not '" + integrator + "'");
   }
   ReadFitWindows(fit, out);
   if (fit.Has("max_amplitude_deg")) out->max_amplitude_deg = fit.RequiredDouble("max_amplitude_deg");
@@ -854,12 +940,11 @@ void ReadFit(YamlMap fit, FitConfig* out) {
   ReadFitQuality(fit, &out->quality);
   ReadFitSweep(fit, &out->sweep);
   ReadFitGlitch(fit, &out->glitch);
-  std::string why;
-  if (!out->Check(&why)) {
-    const char* key = why.find("max_amplitude") != std::string::npos ? "max_amplitude_deg"
-                      : why.find("min_amplitude") != std::string::npos ? "min_amplitude_deg"
-                                                                       : "quality";
-    throw UserError(fit.Where(fit.Optional(key)) + ": " + why);
+  CheckFailure failure;
+  if (!out->Check(&failure)) {
+    const FieldKey& key = KeyOf(kFitFieldKeys, failure.field);
+    throw UserError(fit.Where(FailureNode(fit, key)) + ": " +
+                    FailureMessage("fit", key, failure));
   }
   fit.Finish();
 }
@@ -870,15 +955,18 @@ void ReadEllipse(YamlMap ellipse, EllipseConfig* e) {
   e->seed = static_cast<unsigned>(
       ellipse.OptionalIntIn("seed", e->seed, 0, std::numeric_limits<unsigned>::max()));
   e->confidence = ellipse.OptionalDouble("confidence", e->confidence);
-  e->covariance = ellipse.OptionalString("covariance", e->covariance);
+  const std::string covariance =
+      ellipse.OptionalString("covariance", EllipseCovarianceName(e->covariance));
+  if (!ParseEllipseCovariance(covariance, &e->covariance)) {
+    throw UserError(ellipse.Where(ellipse.Optional("covariance")) + ": 'ellipse.covariance' must be " +
+                    EllipseCovarianceAllowedValues() + ", not '" + covariance + "'");
+  }
   e->min_angles = ellipse.OptionalInt("min_angles", e->min_angles);
-  std::string why;
-  if (!e->Check(&why)) {
-    const char* key = why.find("bootstrap") != std::string::npos    ? "bootstrap"
-                      : why.find("confidence") != std::string::npos ? "confidence"
-                      : why.find("min_angles") != std::string::npos ? "min_angles"
-                                                                    : "covariance";
-    throw UserError(ellipse.Where(ellipse.Optional(key)) + ": " + why);
+  CheckFailure failure;
+  if (!e->Check(&failure)) {
+    const FieldKey& key = KeyOf(kEllipseFieldKeys, failure.field);
+    throw UserError(ellipse.Where(FailureNode(ellipse, key)) + ": " +
+                    FailureMessage("ellipse", key, failure));
   }
   ellipse.Finish();
 }

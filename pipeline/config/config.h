@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "base/units.h"
+#include "fit/ellipse.h"
 #include "fit/glitch.h"
 #include "pendulum/integrator.h"
 #include "pendulum/model.h"
@@ -146,6 +147,15 @@ constexpr double kMinGlitchRange = 1, kMaxGlitchRange = 100;     // fit.glitch.r
 constexpr double kMaxGlitchExcursion = 10;                       // fit.glitch.excursion_fraction
 constexpr double kMaxGlitchFraction = 0.1;                       // fit.glitch.max_fraction
 
+// A value outside its bound (Ceres OPTION_GE, COLMAP CHECK_OPTION_*): the options field, its
+// value and what is allowed. The config layer maps `field` to its YAML key with a table
+// (config.cc), never by reading text.
+struct CheckFailure {
+  std::string field;    // the options struct's field, e.g. "quality.whiteness_lags"
+  double value = 0.0;   // its value
+  std::string allowed;  // the bound, e.g. "in [1, 1000]", "0 (off) or in [100, 100000]"
+};
+
 struct FitConfig {
   PendulumModel model = PendulumModel::kFull;  // `fit.model`: full | jardin | linear
   // `fit.integrator`: rk853 (default) | cvodes; the fit's ODE solver (pendulum/integrator.h).
@@ -159,7 +169,11 @@ struct FitConfig {
   SweepConfig sweep;
   GlitchConfig glitch;
 
-  bool Check(std::string* why) const;  // amplitude band, quality, glitch ranges; *why names the key
+  // Every bound of the fields above (amplitude band, quality, sweep, glitch): the first field
+  // outside its bound in *failure.
+  bool Check(CheckFailure* failure) const;
+  // The same; *why = "'fit.<YAML key>' must be <allowed>, got <value>".
+  bool Check(std::string* why) const;
 };
 
 // Options of the ellipse fit (fit/ellipse.h EllipseOptions, same defaults).
@@ -181,10 +195,12 @@ struct EllipseConfig {
   int bootstrap = 2000;           // parametric bootstrap replicates (0 = covariance intervals)
   unsigned seed = 1;              // seed of the bootstrap
   double confidence = 0.95;       // confidence level of the intervals, in (0, 1)
-  std::string covariance = "auto";  // auto | points | angle_means | absolute
-  int min_angles = 3;             // distinct pitch angles needed to fit the ellipse; >= 3
+  // auto | points | angle_means | absolute (fit/ellipse.h, parsed once when the config is read)
+  EllipseCovariance covariance = EllipseCovariance::kAuto;
+  int min_angles = 3;             // distinct pitch angles needed to fit the ellipse; [3, 1000]
 
-  bool Check(std::string* why) const;  // the ranges above; *why names the key
+  bool Check(CheckFailure* failure) const;  // the ranges above: the first field outside them
+  bool Check(std::string* why) const;  // the same; *why = "'ellipse.<key>' must be .., got .."
 };
 
 // `limits`: size caps of the logs (MB = 1e6 bytes), README "Input size limits". The other
@@ -218,6 +234,7 @@ struct CampaignConfig {
   RigUncertainties uncertainties;
   double aircraft_mass_kg = 0.0;      // aircraft mass (kg); 0 when only tare logs are fitted
   double aircraft_mass_std_kg = 0.0;  // its standard uncertainty (kg)
+  bool aircraft_mass_std_given = false;  // aircraft.mass_std_kg written in the config
   // Local gravity (m/s^2); in [9.76, 9.84] (Earth) unless
   double gravity_mps2 = kStandardGravityMps2;
   bool gravity_off_earth = false;     // `gravity_off_earth: true`: then in (0, 100]

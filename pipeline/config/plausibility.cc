@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "base/units.h"
+#include "pendulum/model.h"
 
 namespace bifilar {
 namespace {
@@ -83,12 +84,11 @@ std::string ImplausibleRigInertia(const std::string& key, double inertia_kg_m2, 
 }
 
 std::string SeparationNotBelowLength(double filar_length_m, double filar_separation_m) {
-  if (filar_length_m > filar_separation_m) return "";
+  std::string why;
+  if (CheckSeparationBelowLength(filar_length_m, filar_separation_m, &why)) return "";
   const auto fits = [&](double si) { return si >= kMinFilarSeparationM && si < filar_length_m; };
   const std::string hint = Suggestion(kLengthUnits, filar_separation_m, fits);
-  return "'rig.filar_separation_m': D = " + Num(filar_separation_m) +
-         " m is not below the wire length rig.filar_length_m L = " + Num(filar_length_m) +
-         " m (the wires would go slack)" + (hint.empty() ? "" : hint);
+  return "'rig.filar_separation_m': " + why + (hint.empty() ? "" : hint);
 }
 
 std::vector<std::string> FitPlausibilityWarnings(double inertia_kg_m2, double mass_kg,

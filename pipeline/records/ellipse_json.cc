@@ -2,28 +2,28 @@
 
 #include <cmath>
 
+#include "base/json_number.h"
+
 namespace bifilar {
 namespace {
 
 using nlohmann::json;
 
-json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
 void PutEstimate(json* j, const std::string& key, const EllipseEstimate& e) {
   const bool ok = e.defined;
-  (*j)[key] = ok ? Num(e.value) : json(nullptr);
-  (*j)[key + "_std"] = ok ? Num(e.std) : json(nullptr);
-  (*j)[key + "_ci95"] = ok ? json::array({Num(e.ci_lo), Num(e.ci_hi)}) : json(nullptr);
+  (*j)[key] = ok ? JsonNumber(e.value) : json(nullptr);
+  (*j)[key + "_std"] = ok ? JsonNumber(e.std) : json(nullptr);
+  (*j)[key + "_ci95"] = ok ? json::array({JsonNumber(e.ci_lo), JsonNumber(e.ci_hi)}) : json(nullptr);
 }
 
 json ParametersToJson(const EllipseParameters& p, bool tau_defined) {
   json j;
-  j["Ix_kg_m2"] = Num(p.ix_kg_m2);
-  j["Iz_kg_m2"] = Num(p.iz_kg_m2);
-  j["Ixz_kg_m2"] = Num(p.ixz_kg_m2);
-  j["tau_deg"] = tau_defined ? Num(p.tau_deg) : json(nullptr);
-  j["Ixp_kg_m2"] = tau_defined ? Num(p.ixp_kg_m2) : json(nullptr);
-  j["Izp_kg_m2"] = tau_defined ? Num(p.izp_kg_m2) : json(nullptr);
+  j["Ix_kg_m2"] = JsonNumber(p.ix_kg_m2);
+  j["Iz_kg_m2"] = JsonNumber(p.iz_kg_m2);
+  j["Ixz_kg_m2"] = JsonNumber(p.ixz_kg_m2);
+  j["tau_deg"] = tau_defined ? JsonNumber(p.tau_deg) : json(nullptr);
+  j["Ixp_kg_m2"] = tau_defined ? JsonNumber(p.ixp_kg_m2) : json(nullptr);
+  j["Izp_kg_m2"] = tau_defined ? JsonNumber(p.izp_kg_m2) : json(nullptr);
   return j;
 }
 
@@ -36,9 +36,9 @@ json SolverToJson(const EllipseSolverSummary& s, bool tau_defined) {
   j["message"] = s.message;
   j["iterations"] = s.iterations;
   j["restarts"] = s.restarts;
-  j["initial_cost"] = Num(s.initial_cost);
-  j["final_cost"] = Num(s.final_cost);
-  j["time_s"] = Num(s.time_s);
+  j["initial_cost"] = JsonNumber(s.initial_cost);
+  j["final_cost"] = JsonNumber(s.final_cost);
+  j["time_s"] = JsonNumber(s.time_s);
   j["parameters"] = ParametersToJson(s.parameters, tau_defined);
   j["std"] = s.has_std ? ParametersToJson(s.std, tau_defined) : json(nullptr);
   return j;
@@ -46,11 +46,11 @@ json SolverToJson(const EllipseSolverSummary& s, bool tau_defined) {
 
 json ResidualToJson(const EllipseResidual& e) {
   return {{"index", e.index},
-          {"pitch_deg", Num(e.pitch_deg)},
-          {"inertia_kg_m2", Num(e.inertia_kg_m2)},
-          {"fitted_kg_m2", Num(e.fitted_kg_m2)},
-          {"residual_kg_m2", Num(e.residual_kg_m2)},
-          {"studentized", Num(e.studentized)},
+          {"pitch_deg", JsonNumber(e.pitch_deg)},
+          {"inertia_kg_m2", JsonNumber(e.inertia_kg_m2)},
+          {"fitted_kg_m2", JsonNumber(e.fitted_kg_m2)},
+          {"residual_kg_m2", JsonNumber(e.residual_kg_m2)},
+          {"studentized", JsonNumber(e.studentized)},
           {"outlier", e.outlier}};
 }
 
@@ -80,46 +80,46 @@ json EllipseResultToJson(const EllipseResult& r, bool with_residuals) {
   PutEstimate(&j, "tau_deg", r.tau_deg);
   PutEstimate(&j, "Ixp_kg_m2", r.ixp);
   PutEstimate(&j, "Izp_kg_m2", r.izp);
-  j["rmse_kg_m2"] = Num(r.rmse_kg_m2);
+  j["rmse_kg_m2"] = JsonNumber(r.rmse_kg_m2);
   j["n_points"] = r.n_points;
   j["n_angles"] = r.n_angles;
   j["weighted"] = r.weighted;
   j["tau_defined"] = r.tau_defined;
-  j["circle_chi2"] = Num(r.circle_chi2);
+  j["circle_chi2"] = JsonNumber(r.circle_chi2);
   j["covariance"] = EllipseCovarianceName(r.covariance_used);
-  j["variance_factor"] = Num(r.variance_factor);
-  j["dof"] = Num(r.dof);  // null when the std were trusted as absolute (normal quantiles)
-  j["reduced_chi2"] = Num(r.reduced_chi2);
+  j["variance_factor"] = JsonNumber(r.variance_factor);
+  j["dof"] = JsonNumber(r.dof);  // null when the std were trusted as absolute (normal quantiles)
+  j["reduced_chi2"] = JsonNumber(r.reduced_chi2);
   j["confidence_interval_method"] =
       r.bootstrap_replicates > 0 ? "parametric_bootstrap_percentile" : "t_quantile";
   j["bootstrap_replicates"] = r.bootstrap_replicates;
-  j["coefficients_kg_m2"] = {{"A", Num(r.a_kg_m2)}, {"B", Num(r.b_kg_m2)}, {"C", Num(r.c_kg_m2)}};
+  j["coefficients_kg_m2"] = {{"A", JsonNumber(r.a_kg_m2)}, {"B", JsonNumber(r.b_kg_m2)}, {"C", JsonNumber(r.c_kg_m2)}};
   json cov = json::array();
-  for (const auto& row : r.cov_abc) cov.push_back({Num(row[0]), Num(row[1]), Num(row[2])});
+  for (const auto& row : r.cov_abc) cov.push_back({JsonNumber(row[0]), JsonNumber(row[1]), JsonNumber(row[2])});
   j["cov_abc_kg2_m4"] = cov;
   j["fits"] = {{"linear_ls", SolverToJson(r.linear, r.tau_defined)},
                {"nelder_mead", SolverToJson(r.nelder_mead, r.tau_defined)},
                {"ceres", SolverToJson(r.ceres, r.tau_defined)}};
-  j["table1"] = {{"mean_angle_std_kg_m2", Num(r.table1.mean_angle_std_kg_m2)},
-                 {"mean_cov_percent", Num(r.table1.mean_cov_percent)},
-                 {"rmse_kg_m2", Num(r.table1.rmse_kg_m2)},
+  j["table1"] = {{"mean_angle_std_kg_m2", JsonNumber(r.table1.mean_angle_std_kg_m2)},
+                 {"mean_cov_percent", JsonNumber(r.table1.mean_cov_percent)},
+                 {"rmse_kg_m2", JsonNumber(r.table1.rmse_kg_m2)},
                  {"n_angles_with_trials", r.table1.n_angles_with_trials}};
   if (r.table1.n_angles_with_trials == 0) {
     j["table1"]["mean_angle_std_kg_m2"] = nullptr;
     j["table1"]["mean_cov_percent"] = nullptr;
   }
-  j["table2"] = {{"Ixz_kg_m2", Num(r.ixz.value)},
-                 {"tau_deg", r.tau_defined ? Num(r.tau_deg.value) : json(nullptr)},
-                 {"Iz_kg_m2", Num(r.iz.value)},
-                 {"Ix_kg_m2", Num(r.ix.value)}};
+  j["table2"] = {{"Ixz_kg_m2", JsonNumber(r.ixz.value)},
+                 {"tau_deg", r.tau_defined ? JsonNumber(r.tau_deg.value) : json(nullptr)},
+                 {"Iz_kg_m2", JsonNumber(r.iz.value)},
+                 {"Ix_kg_m2", JsonNumber(r.ix.value)}};
   json angles = json::array();
   for (const auto& a : r.angles) {
-    angles.push_back({{"pitch_deg", Num(a.pitch_deg)},
+    angles.push_back({{"pitch_deg", JsonNumber(a.pitch_deg)},
                       {"n", a.n},
-                      {"mean_kg_m2", Num(a.mean_kg_m2)},
-                      {"std_kg_m2", a.n > 1 ? Num(a.std_kg_m2) : json(nullptr)},
-                      {"cov_percent", a.n > 1 ? Num(a.cov_percent) : json(nullptr)},
-                      {"fitted_kg_m2", Num(a.fitted_kg_m2)}});
+                      {"mean_kg_m2", JsonNumber(a.mean_kg_m2)},
+                      {"std_kg_m2", a.n > 1 ? JsonNumber(a.std_kg_m2) : json(nullptr)},
+                      {"cov_percent", a.n > 1 ? JsonNumber(a.cov_percent) : json(nullptr)},
+                      {"fitted_kg_m2", JsonNumber(a.fitted_kg_m2)}});
   }
   j["angles"] = angles;
   json residuals = json::array();
@@ -132,15 +132,15 @@ json EllipseResultToJson(const EllipseResult& r, bool with_residuals) {
   j["outliers"] = outliers;
   json naca = json::array();
   for (const auto& e : r.naca) {
-    naca.push_back({{"pitch_deg", Num(e.pitch_deg)},
-                    {"phi_deg", Num(e.phi_deg)},
-                    {"I_phi_kg_m2", Num(e.i_phi_kg_m2)},
-                    {"Ixz_kg_m2", Num(e.ixz_kg_m2)},
-                    {"Ixz_std_kg_m2", Num(e.ixz_std_kg_m2)}});
+    naca.push_back({{"pitch_deg", JsonNumber(e.pitch_deg)},
+                    {"phi_deg", JsonNumber(e.phi_deg)},
+                    {"I_phi_kg_m2", JsonNumber(e.i_phi_kg_m2)},
+                    {"Ixz_kg_m2", JsonNumber(e.ixz_kg_m2)},
+                    {"Ixz_std_kg_m2", JsonNumber(e.ixz_std_kg_m2)}});
   }
   j["naca"] = naca;
   j["warnings"] = r.warnings;
-  j["time_s"] = Num(r.time_s);
+  j["time_s"] = JsonNumber(r.time_s);
   return j;
 }
 

@@ -5,19 +5,20 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <thread>
 
+#include "base/json_number.h"
 #include "base/user_error.h"
 #include "base/version.h"
+#include "pipeline/records/results_aircraft.h"
 #include "pipeline/records/total_uncertainty.h"
 
 namespace bifilar {
 namespace {
 
 using nlohmann::json;
-
-json Number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
 json Pair(const std::array<double, 2>& v) {
   if (!std::isfinite(v[0]) || !std::isfinite(v[1])) return json(nullptr);
@@ -65,26 +66,26 @@ json SweepToJson(const AmplitudeSweep& s) {
   for (const AmplitudeSweepBand& b : s.bands) {
     bands.push_back({{"window_s", json::array({b.t0_s, b.t1_s})},
                      {"samples", b.num_samples},
-                     {"cycles", Number(b.cycles)},
-                     {"amplitude_deg", json::array({Number(b.amplitude_start_deg),
-                                                    Number(b.amplitude_end_deg)})},
-                     {"amplitude_mean_deg", Number(b.amplitude_mean_deg)},
-                     {"inertia_kg_m2", b.ok ? Number(b.inertia_kg_m2) : json(nullptr)},
-                     {"inertia_std_kg_m2", b.ok ? Number(b.inertia_std_kg_m2) : json(nullptr)},
+                     {"cycles", JsonNumber(b.cycles)},
+                     {"amplitude_deg", json::array({JsonNumber(b.amplitude_start_deg),
+                                                    JsonNumber(b.amplitude_end_deg)})},
+                     {"amplitude_mean_deg", JsonNumber(b.amplitude_mean_deg)},
+                     {"inertia_kg_m2", b.ok ? JsonNumber(b.inertia_kg_m2) : json(nullptr)},
+                     {"inertia_std_kg_m2", b.ok ? JsonNumber(b.inertia_std_kg_m2) : json(nullptr)},
                      {"ok", b.ok}});
   }
   json j = {{"evaluated", s.evaluated}, {"note", s.note}, {"bands", bands}, {"low_band", s.low_band}};
   if (s.evaluated) {
-    j["trend_exponent"] = Number(s.trend_exponent);
-    j["trend_coeff_per_deg_p"] = Number(s.trend_coeff);
-    j["trend_coeff_std_per_deg_p"] = Number(s.trend_coeff_std);
-    j["trend_z"] = Number(s.trend_z);
-    j["trend_chi2"] = Number(s.trend_chi2);
+    j["trend_exponent"] = JsonNumber(s.trend_exponent);
+    j["trend_coeff_per_deg_p"] = JsonNumber(s.trend_coeff);
+    j["trend_coeff_std_per_deg_p"] = JsonNumber(s.trend_coeff_std);
+    j["trend_z"] = JsonNumber(s.trend_z);
+    j["trend_chi2"] = JsonNumber(s.trend_chi2);
     j["trend_dof"] = s.trend_dof;
-    j["trend_scale"] = Number(s.trend_scale);
-    j["std_scale"] = Number(s.std_scale);
-    j["trend_percent_per_10deg"] = Number(s.trend_percent_per_10deg);
-    j["inertia_zero_amplitude_kg_m2"] = Number(s.inertia_zero_amplitude_kg_m2);
+    j["trend_scale"] = JsonNumber(s.trend_scale);
+    j["std_scale"] = JsonNumber(s.std_scale);
+    j["trend_percent_per_10deg"] = JsonNumber(s.trend_percent_per_10deg);
+    j["inertia_zero_amplitude_kg_m2"] = JsonNumber(s.inertia_zero_amplitude_kg_m2);
     j["trend_detected"] = s.trend_detected;
   }
   return j;
@@ -203,18 +204,18 @@ void AddTotalUncertainty(const TraceRecord& r, json* u) {
   json terms = json::array();
   for (const UncertaintyTerm& t : total.terms) {
     json term = {{"name", t.name},
-                 {"std_kg_m2", fitted ? Number(t.std_kg_m2) : json(nullptr)},
+                 {"std_kg_m2", fitted ? JsonNumber(t.std_kg_m2) : json(nullptr)},
                  {"kind", t.common_mode ? "common_mode" : "per_log"}};
     if (t.assumed) term["assumed"] = true;
     terms.push_back(term);
   }
   (*u)["terms"] = terms;
-  (*u)["stat_kg_m2"] = fitted ? Number(total.stat_std_kg_m2) : json(nullptr);
-  (*u)["common_mode_kg_m2"] = fitted ? Number(total.common_mode_std_kg_m2) : json(nullptr);
-  (*u)["total_kg_m2"] = Number(r.inertia_total_std_total_kg_m2);
+  (*u)["stat_kg_m2"] = fitted ? JsonNumber(total.stat_std_kg_m2) : json(nullptr);
+  (*u)["common_mode_kg_m2"] = fitted ? JsonNumber(total.common_mode_std_kg_m2) : json(nullptr);
+  (*u)["total_kg_m2"] = JsonNumber(r.inertia_total_std_total_kg_m2);
   (*u)["total_percent"] =
       fitted && r.inertia_total_kg_m2 > 0.0
-          ? Number(100.0 * r.inertia_total_std_total_kg_m2 / r.inertia_total_kg_m2)
+          ? JsonNumber(100.0 * r.inertia_total_std_total_kg_m2 / r.inertia_total_kg_m2)
           : json(nullptr);
   (*u)["configured_inputs_assumed"] = r.budget_assumed;
   (*u)["assumed_inputs"] = r.budget_assumed
@@ -245,27 +246,27 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
   j["file"] = r.file;
   j["status"] = ToString(r.status);
   j["message"] = r.message;
-  j["inertia_total_kg_m2"] = Number(r.inertia_total_kg_m2);
-  j["inertia_total_std_kg_m2"] = Number(r.inertia_total_std_kg_m2);
-  j["drag_coeff_kg_m2"] = Number(r.drag_coeff_kg_m2);
-  j["viscous_coeff_kg_m2_per_s"] = Number(r.viscous_coeff_kg_m2_per_s);
+  j["inertia_total_kg_m2"] = JsonNumber(r.inertia_total_kg_m2);
+  j["inertia_total_std_kg_m2"] = JsonNumber(r.inertia_total_std_kg_m2);
+  j["drag_coeff_kg_m2"] = JsonNumber(r.drag_coeff_kg_m2);
+  j["viscous_coeff_kg_m2_per_s"] = JsonNumber(r.viscous_coeff_kg_m2_per_s);
   j["window_s"] = Pair(r.window_s);
   j["amplitude_deg"] = Pair(r.amplitude_deg);
   j["amplitude_band_deg"] = Pair(r.amplitude_band_deg);
-  j["period_s"] = Number(r.period_s);
-  j["frequency_hz"] = Number(r.frequency_hz);
-  j["small_angle_inertia_total_kg_m2"] = Number(r.small_angle_inertia_total_kg_m2);
-  j["bias_rad_per_s"] = Number(r.bias_rad_per_s);
-  j["residual_rms_rad_per_s"] = Number(r.residual_rms_rad_per_s);
-  j["noise_rms_rad_per_s"] = Number(r.noise_rms_rad_per_s);
-  j["pitch_measured_deg"] = r.pitch_measured_deg ? Number(*r.pitch_measured_deg) : json(nullptr);
-  j["roll_measured_deg"] = r.roll_measured_deg ? Number(*r.roll_measured_deg) : json(nullptr);
+  j["period_s"] = JsonNumber(r.period_s);
+  j["frequency_hz"] = JsonNumber(r.frequency_hz);
+  j["small_angle_inertia_total_kg_m2"] = JsonNumber(r.small_angle_inertia_total_kg_m2);
+  j["bias_rad_per_s"] = JsonNumber(r.bias_rad_per_s);
+  j["residual_rms_rad_per_s"] = JsonNumber(r.residual_rms_rad_per_s);
+  j["noise_rms_rad_per_s"] = JsonNumber(r.noise_rms_rad_per_s);
+  j["pitch_measured_deg"] = r.pitch_measured_deg ? JsonNumber(*r.pitch_measured_deg) : json(nullptr);
+  j["roll_measured_deg"] = r.roll_measured_deg ? JsonNumber(*r.roll_measured_deg) : json(nullptr);
   j["model"] = r.model;
   j["iterations"] = r.iterations;
   j["fit_seconds"] = r.fit_seconds;
   json budget = json::object();
-  for (const BudgetTerm& term : r.budget) budget[term.name + "_kg_m2"] = Number(term.std_kg_m2);
-  budget["total_kg_m2"] = Number(r.budget_total_std_kg_m2);
+  for (const BudgetTerm& term : r.budget) budget[term.name + "_kg_m2"] = JsonNumber(term.std_kg_m2);
+  budget["total_kg_m2"] = JsonNumber(r.budget_total_std_kg_m2);
   j["budget"] = budget;
   j["flags"] = r.flags;
   j["warnings"] = r.warnings;
@@ -276,26 +277,26 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
                                ? json::array({r.swing_axis_in_imu[0], r.swing_axis_in_imu[1],
                                               r.swing_axis_in_imu[2]})
                                : json(nullptr);
-  j["secondary_motion_ratio"] = Number(r.secondary_motion_ratio);
-  j["rms_over_noise"] = Number(r.rms_over_noise);
-  j["residual_autocorrelation"] = {{"lag1", Number(r.residual_autocorr_lag1)},
-                                   {"ar1_phi", Number(r.residual_ar1_phi)},
-                                   {"prewhitened_max", Number(r.prewhitened_autocorr_max)}};
-  j["inertia_window_kg_m2"] = Number(r.inertia_window_kg_m2);
+  j["secondary_motion_ratio"] = JsonNumber(r.secondary_motion_ratio);
+  j["rms_over_noise"] = JsonNumber(r.rms_over_noise);
+  j["residual_autocorrelation"] = {{"lag1", JsonNumber(r.residual_autocorr_lag1)},
+                                   {"ar1_phi", JsonNumber(r.residual_ar1_phi)},
+                                   {"prewhitened_max", JsonNumber(r.prewhitened_autocorr_max)}};
+  j["inertia_window_kg_m2"] = JsonNumber(r.inertia_window_kg_m2);
   j["inertia_source"] = r.inertia_source;
-  j["uncertainty"] = {{"statistical_kg_m2", Number(r.inertia_stat_std_kg_m2)},
-                      {"iid_kg_m2", Number(r.inertia_iid_std_kg_m2)},
+  j["uncertainty"] = {{"statistical_kg_m2", JsonNumber(r.inertia_stat_std_kg_m2)},
+                      {"iid_kg_m2", JsonNumber(r.inertia_iid_std_kg_m2)},
                       {"hac_bandwidth", r.hac_bandwidth},
-                      {"model_inadequacy_kg_m2", Number(r.model_inadequacy_std_kg_m2)}};
+                      {"model_inadequacy_kg_m2", JsonNumber(r.model_inadequacy_std_kg_m2)}};
   if (std::isfinite(r.repeat_scatter_std_kg_m2))
     j["uncertainty"]["repeat_scatter_kg_m2"] = r.repeat_scatter_std_kg_m2;
   if (std::isfinite(r.amplitude_correction_kg_m2)) {
-    j["amplitude_correction"] = {{"correction_kg_m2", Number(r.amplitude_correction_kg_m2)},
-                                 {"std_kg_m2", Number(r.amplitude_correction_std_kg_m2)},
-                                 {"from_amplitude_deg", Number(r.amplitude_correction_from_deg)},
+    j["amplitude_correction"] = {{"correction_kg_m2", JsonNumber(r.amplitude_correction_kg_m2)},
+                                 {"std_kg_m2", JsonNumber(r.amplitude_correction_std_kg_m2)},
+                                 {"from_amplitude_deg", JsonNumber(r.amplitude_correction_from_deg)},
                                  {"to_amplitude_deg", 0.0}};
   }
-  j["inertia_total_std_total_kg_m2"] = Number(r.inertia_total_std_total_kg_m2);
+  j["inertia_total_std_total_kg_m2"] = JsonNumber(r.inertia_total_std_total_kg_m2);
   AddTotalUncertainty(r, &j["uncertainty"]);
   j["amplitude_sweep"] = SweepToJson(r.sweep);
   if (campaign_fields) {
@@ -303,15 +304,15 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
     j["content_hash"] = r.content_hash;
     j["cache_key"] = r.cache_key;
     j["from_cache"] = r.from_cache;
-    j["pitch_nominal_deg"] = r.pitch_nominal_deg ? Number(*r.pitch_nominal_deg) : json(nullptr);
-    j["pitch_used_deg"] = Number(r.pitch_used_deg);
-    j["roll_nominal_deg"] = r.roll_nominal_deg ? Number(*r.roll_nominal_deg) : json(nullptr);
-    j["roll_used_deg"] = Number(r.roll_used_deg);
-    j["rig_inertia_kg_m2"] = Number(r.rig_inertia_kg_m2);
-    j["inertia_kg_m2"] = Number(r.inertia_kg_m2);
-    j["inertia_std_kg_m2"] = Number(r.inertia_std_kg_m2);
-    j["inertia_std_total_kg_m2"] = Number(r.inertia_std_total_kg_m2);
-    j["aircraft_scale_std_kg_m2"] = Number(r.aircraft_scale_std_kg_m2);
+    j["pitch_nominal_deg"] = r.pitch_nominal_deg ? JsonNumber(*r.pitch_nominal_deg) : json(nullptr);
+    j["pitch_used_deg"] = JsonNumber(r.pitch_used_deg);
+    j["roll_nominal_deg"] = r.roll_nominal_deg ? JsonNumber(*r.roll_nominal_deg) : json(nullptr);
+    j["roll_used_deg"] = JsonNumber(r.roll_used_deg);
+    j["rig_inertia_kg_m2"] = JsonNumber(r.rig_inertia_kg_m2);
+    j["inertia_kg_m2"] = JsonNumber(r.inertia_kg_m2);
+    j["inertia_std_kg_m2"] = JsonNumber(r.inertia_std_kg_m2);
+    j["inertia_std_total_kg_m2"] = JsonNumber(r.inertia_std_total_kg_m2);
+    j["aircraft_scale_std_kg_m2"] = JsonNumber(r.aircraft_scale_std_kg_m2);
   }
   return j;
 }
@@ -321,7 +322,7 @@ TraceRecord TraceRecordFromJson(const json& j) {
   TraceRecord r;
   r.file = GetString(j, "file");
   if (!ParseTraceStatus(GetString(j, "status"), &r.status)) {
-    throw UserError("trace record: bad 'status'");
+    throw UserError("trace record: bad 'status' (allowed " + TraceStatusAllowedValues() + ")");
   }
   r.message = GetString(j, "message");
   r.inertia_total_kg_m2 = GetNumber(j, "inertia_total_kg_m2");
@@ -394,7 +395,7 @@ TraceRecord TraceRecordFromJson(const json& j) {
   }
   if (auto it = j.find("amplitude_sweep"); it != j.end() && it->is_object()) r.sweep = SweepFromJson(*it);
   if (j.contains("role") && !ParseTraceRole(GetString(j, "role"), &r.role)) {
-    throw UserError("trace record: bad 'role'");
+    throw UserError("trace record: bad 'role' (allowed " + TraceRoleAllowedValues() + ")");
   }
   r.content_hash = GetString(j, "content_hash");
   r.cache_key = GetString(j, "cache_key");
@@ -417,31 +418,46 @@ TraceRecord TraceRecordFromJson(const json& j) {
 
 json CalibrationToJson(const RigCalibrationResult& c) {
   return {{"applied", c.applied},
-          {"factor", Number(c.factor)},
-          {"factor_std", Number(c.factor_std)},
-          {"factor_relative_std", Number(c.factor_rel_std)},
-          {"relative_std_parts", {{"reference_inertia", Number(c.rel_std_reference)},
-                                  {"reference_swings", Number(c.rel_std_swings)},
-                                  {"rig_inertia", Number(c.rel_std_rig)}}},
-          {"nominal", {{"filar_length_m", Number(c.filar_length_m)},
-                       {"filar_separation_m", Number(c.nominal_separation_m)},
-                       {"d2_over_l_m", Number(c.nominal_d2_over_l_m)}}},
-          {"effective", {{"filar_length_m", Number(c.filar_length_m)},
-                         {"filar_separation_m", Number(c.effective_separation_m)},
-                         {"d2_over_l_m", Number(c.effective_d2_over_l_m)}}},
-          {"reference", {{"inertia_kg_m2", Number(c.reference_inertia_kg_m2)},
-                         {"inertia_std_kg_m2", Number(c.reference_inertia_std_kg_m2)},
-                         {"mass_kg", Number(c.reference_mass_kg)}}},
+          {"factor", JsonNumber(c.factor)},
+          {"factor_std", JsonNumber(c.factor_std)},
+          {"factor_relative_std", JsonNumber(c.factor_rel_std)},
+          {"relative_std_parts", {{"reference_inertia", JsonNumber(c.rel_std_reference)},
+                                  {"reference_swings", JsonNumber(c.rel_std_swings)},
+                                  {"rig_inertia", JsonNumber(c.rel_std_rig)}}},
+          {"nominal", {{"filar_length_m", JsonNumber(c.filar_length_m)},
+                       {"filar_separation_m", JsonNumber(c.nominal_separation_m)},
+                       {"d2_over_l_m", JsonNumber(c.nominal_d2_over_l_m)}}},
+          {"effective", {{"filar_length_m", JsonNumber(c.filar_length_m)},
+                         {"filar_separation_m", JsonNumber(c.effective_separation_m)},
+                         {"d2_over_l_m", JsonNumber(c.effective_d2_over_l_m)}}},
+          {"reference", {{"inertia_kg_m2", JsonNumber(c.reference_inertia_kg_m2)},
+                         {"inertia_std_kg_m2", JsonNumber(c.reference_inertia_std_kg_m2)},
+                         {"mass_kg", JsonNumber(c.reference_mass_kg)}}},
           {"swings", {{"n", c.n_swings},
                       {"logs", c.logs},
-                      {"total_mean_kg_m2", Number(c.swings_total_kg_m2)},
-                      {"total_standard_error_kg_m2", Number(c.swings_total_std_kg_m2)},
-                      {"scatter_kg_m2", Number(c.swings_scatter_kg_m2)}}},
+                      {"total_mean_kg_m2", JsonNumber(c.swings_total_kg_m2)},
+                      {"total_standard_error_kg_m2", JsonNumber(c.swings_total_std_kg_m2)},
+                      {"scatter_kg_m2", JsonNumber(c.swings_scatter_kg_m2)}}},
           {"rig_inertia", {{"source", c.rig_inertia_source},
-                           {"inertia_kg_m2", Number(c.rig_inertia_kg_m2)},
-                           {"inertia_std_kg_m2", Number(c.rig_inertia_std_kg_m2)}}},
+                           {"inertia_kg_m2", JsonNumber(c.rig_inertia_kg_m2)},
+                           {"inertia_std_kg_m2", JsonNumber(c.rig_inertia_std_kg_m2)}}},
           {"iterations", c.iterations},
           {"warnings", c.warnings}};
+}
+
+bool AircraftMassFromResultsJson(const json& results, double* mass_kg, double* mass_std_kg) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  *mass_kg = nan;
+  *mass_std_kg = nan;
+  if (!results.is_object() || !results.contains("aircraft")) return false;
+  const json& aircraft = results["aircraft"];
+  if (!aircraft.is_object()) return true;
+  const auto number = [&aircraft, nan](const char* key) {
+    return aircraft.contains(key) && aircraft[key].is_number() ? aircraft[key].get<double>() : nan;
+  };
+  *mass_kg = number("mass_kg");
+  *mass_std_kg = number("mass_std_kg");
+  return true;
 }
 
 json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
@@ -454,6 +470,13 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
       std::filesystem::path(config.file).lexically_relative(std::filesystem::current_path(ec)).string();
   j["config_file"] = !relative.empty() && relative.rfind("..", 0) != 0 ? relative : config.file;
   j["config"] = config.text;
+  // The aircraft's mass, for export (not measured by the bifilar; from the config).
+  j["aircraft"] = config.aircraft_mass_kg > 0
+                      ? json{{"mass_kg", JsonNumber(config.aircraft_mass_kg)},
+                             {"mass_std_kg", config.aircraft_mass_std_given
+                                                 ? JsonNumber(config.aircraft_mass_std_kg)
+                                                 : json(nullptr)}}
+                      : json(nullptr);
   j["units"] = ToString(config.units);
   j["pitch_source"] = ToString(config.runs.pitch_source);
   // The fit settings in effect: the config's, with the command line's overrides (--integrator),
@@ -493,36 +516,36 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
                           : config.rig_inertia.kind == RigInertiaSpec::Kind::kValue   ? "value"
                           : config.rig_inertia.kind == RigInertiaSpec::Kind::kTable ? "table"
                                                                                     : "tare";
-  rig["inertia_kg_m2"] = Number(result.rig_inertia_kg_m2);
-  rig["inertia_std_kg_m2"] = Number(result.rig_inertia_std_kg_m2);
+  rig["inertia_kg_m2"] = JsonNumber(result.rig_inertia_kg_m2);
+  rig["inertia_std_kg_m2"] = JsonNumber(result.rig_inertia_std_kg_m2);
   rig["tare_n"] = result.rig_tare_n;
   j["rig"] = rig;
   json table1;
-  table1["raw_sigma_kg_m2"] = Number(result.raw_sigma_kg_m2);
-  table1["cv_percent"] = Number(result.cv_percent);
-  table1["regression_rmse_kg_m2"] = Number(result.regression_rmse_kg_m2);
+  table1["raw_sigma_kg_m2"] = JsonNumber(result.raw_sigma_kg_m2);
+  table1["cv_percent"] = JsonNumber(result.cv_percent);
+  table1["regression_rmse_kg_m2"] = JsonNumber(result.regression_rmse_kg_m2);
   j["table1"] = table1;
-  j["systematic_relative_std"] = Number(result.systematic_relative_std);
+  j["systematic_relative_std"] = JsonNumber(result.systematic_relative_std);
   // rig.calibration: the effective geometry of every fit; its relative std is the `calibration`
   // term of each trace's budget (and so inside systematic_relative_std). null without one.
   j["calibration"] = result.calibration ? CalibrationToJson(*result.calibration) : json(nullptr);
   // Table 2's total (pipeline/records/total_uncertainty.h): each moment's std and the common-mode
   // scale fraction in quadrature; tau has no scale term.
-  json total = {{"common_mode_relative_std", Number(result.common_mode_relative_std)},
+  json total = {{"common_mode_relative_std", JsonNumber(result.common_mode_relative_std)},
                 {"configured_inputs_assumed", result.common_mode_assumed},
                 {"note", result.assumed_inputs_note}};
   if (result.ellipse_fit) {
     const EllipseResult& e = *result.ellipse_fit;
     const double rel = result.common_mode_relative_std;
     auto moment = [&](const EllipseEstimate& est) {
-      return est.defined ? Number(WithCommonModeScale(est.value, est.std, rel)) : json(nullptr);
+      return est.defined ? JsonNumber(WithCommonModeScale(est.value, est.std, rel)) : json(nullptr);
     };
     total["Ix_kg_m2"] = moment(e.ix);
     total["Iz_kg_m2"] = moment(e.iz);
     total["Ixz_kg_m2"] = moment(e.ixz);
     total["Ixp_kg_m2"] = moment(e.ixp);
     total["Izp_kg_m2"] = moment(e.izp);
-    total["tau_deg"] = e.tau_deg.defined ? Number(e.tau_deg.std) : json(nullptr);
+    total["tau_deg"] = e.tau_deg.defined ? JsonNumber(e.tau_deg.std) : json(nullptr);
   }
   j["total_uncertainty"] = total;
   json traces = json::array();
@@ -530,16 +553,16 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   j["traces"] = traces;
   json angles = json::array();
   for (const AngleStats& a : result.angles) {
-    angles.push_back({{"pitch_deg", Number(a.pitch_deg)},
+    angles.push_back({{"pitch_deg", JsonNumber(a.pitch_deg)},
                       {"n", a.n},
-                      {"inertia_mean_kg_m2", Number(a.inertia_mean_kg_m2)},
-                      {"inertia_std_kg_m2", Number(a.inertia_std_kg_m2)},
-                      {"inertia_sem_kg_m2", Number(a.inertia_sem_kg_m2)},
-                      {"cv_percent", Number(a.cv_percent)},
-                      {"fit_std_mean_kg_m2", Number(a.fit_std_mean_kg_m2)},
-                      {"common_mode_std_kg_m2", Number(a.common_mode_std_kg_m2)},
-                      {"inertia_std_total_kg_m2", Number(a.inertia_std_total_kg_m2)},
-                      {"roll_deg", Number(a.roll_deg)}});
+                      {"inertia_mean_kg_m2", JsonNumber(a.inertia_mean_kg_m2)},
+                      {"inertia_std_kg_m2", JsonNumber(a.inertia_std_kg_m2)},
+                      {"inertia_sem_kg_m2", JsonNumber(a.inertia_sem_kg_m2)},
+                      {"cv_percent", JsonNumber(a.cv_percent)},
+                      {"fit_std_mean_kg_m2", JsonNumber(a.fit_std_mean_kg_m2)},
+                      {"common_mode_std_kg_m2", JsonNumber(a.common_mode_std_kg_m2)},
+                      {"inertia_std_total_kg_m2", JsonNumber(a.inertia_std_total_kg_m2)},
+                      {"roll_deg", JsonNumber(a.roll_deg)}});
   }
   j["angles"] = angles;
   j["ellipse"] = result.ellipse;

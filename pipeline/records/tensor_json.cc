@@ -2,12 +2,12 @@
 
 #include <cmath>
 
+#include "base/json_number.h"
+
 namespace bifilar {
 namespace {
 
 using nlohmann::json;
-
-json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 json Vector3(const std::array<double, 3>& v) {
   if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) return nullptr;
@@ -16,9 +16,9 @@ json Vector3(const std::array<double, 3>& v) {
 
 void PutEstimate(json* j, const std::string& key, const TensorEstimate& e) {
   const bool ok = e.observable && std::isfinite(e.value);
-  (*j)[key] = ok ? Num(e.value) : json(nullptr);
-  (*j)[key + "_std"] = ok ? Num(e.std) : json(nullptr);
-  (*j)[key + "_ci95"] = ok ? json::array({Num(e.ci_lo), Num(e.ci_hi)}) : json(nullptr);
+  (*j)[key] = ok ? JsonNumber(e.value) : json(nullptr);
+  (*j)[key + "_std"] = ok ? JsonNumber(e.std) : json(nullptr);
+  (*j)[key + "_ci95"] = ok ? json::array({JsonNumber(e.ci_lo), JsonNumber(e.ci_hi)}) : json(nullptr);
 }
 
 json ComponentsOrder() {
@@ -38,8 +38,151 @@ void PutCommon(const TensorJsonContext& c, json* j) {
   (*j)["convention"] = kConvention;
   (*j)["components_order"] = ComponentsOrder();
   (*j)["confidence"] = c.confidence;
-  (*j)["rig_common_offset_std_kg_m2"] = Num(c.common_offset_std_kg_m2);
-  (*j)["systematic_relative_std"] = Num(c.systematic_relative_std);
+  (*j)["rig_common_offset_std_kg_m2"] = JsonNumber(c.common_offset_std_kg_m2);
+  (*j)["systematic_relative_std"] = JsonNumber(c.systematic_relative_std);
+}
+
+// The components, which are observable, and their covariance.
+void PutComponents(const TensorResult& r, json* j) {
+  for (int k = 0; k < kTensorComponents; ++k) {
+    PutEstimate(j, std::string(TensorComponentName(k)) + "_kg_m2", r.components[k]);
+  }
+  json observable = json::object();
+  for (int k = 0; k < kTensorComponents; ++k) {
+    observable[TensorComponentName(k)] = r.components[k].observable;
+  }
+  (*j)["observable"] = observable;
+  (*j)["unobservable"] = r.unobservable;
+  (*j)["observable_combinations"] = r.observable_combinations;
+  json cov = json::array();
+  for (int k = 0; k < kTensorComponents; ++k) {
+    json row = json::array();
+    for (int l = 0; l < kTensorComponents; ++l) row.push_back(JsonNumber(r.covariance[k][l]));
+    cov.push_back(row);
+  }
+  (*j)["covariance_kg2_m4"] = cov;
+}
+
+// The tensor matrix, principal moments, axes and angles; null when the fit is not full.
+void PutPrincipal(const TensorResult& r, json* j) {
+  if (r.full) {
+    const auto& v = r.components;
+    (*j)["tensor_kg_m2"] =
+        json::array({json::array({v[kIxx].value, -v[kIxy].value, -v[kIxz].value}),
+                     json::array({-v[kIxy].value, v[kIyy].value, -v[kIyz].value}),
+                     json::array({-v[kIxz].value, -v[kIyz].value, v[kIzz].value})});
+    json moments = json::array(), stds = json::array(), cis = json::array(), axes = json::array(),
+         axes_std = json::array();
+    for (int k = 0; k < 3; ++k) {
+      moments.push_back(JsonNumber(r.principal_moments[k].value));
+      stds.push_back(JsonNumber(r.principal_moments[k].std));
+      cis.push_back(json::array({JsonNumber(r.principal_moments[k].ci_lo),
+                                 JsonNumber(r.principal_moments[k].ci_hi)}));
+      axes.push_back(Vector3(r.principal_axes[k]));
+      axes_std.push_back(JsonNumber(r.principal_axes_std_deg[k]));
+    }
+    (*j)["principal_moments_kg_m2"] = moments;
+    (*j)["principal_moments_kg_m2_std"] = stds;
+    (*j)["principal_moments_kg_m2_ci95"] = cis;
+    (*j)["principal_axes"] = axes;
+    (*j)["principal_axes_std_deg"] = axes_std;
+    (*j)["principal_euler_deg"] = {{"roll", JsonNumber(r.euler_deg[0].value)},
+                                   {"pitch", JsonNumber(r.euler_deg[1].value)},
+                                   {"yaw", JsonNumber(r.euler_deg[2].value)},
+                                   {"roll_std", JsonNumber(r.euler_deg[0].std)},
+                                   {"pitch_std", JsonNumber(r.euler_deg[1].std)},
+                                   {"yaw_std", JsonNumber(r.euler_deg[2].std)},
+                                   {"convention",
+                                    "body_from_principal = Rz(yaw) Ry(pitch) Rx(roll), each "
+                                    "principal axis matched to the nearest body axis"}};
+    const auto& matched = r.principal_moments_matched_kg_m2;
+    (*j)["principal_moments_matched_kg_m2"] = {{"x", JsonNumber(matched[0])},
+                                               {"y", JsonNumber(matched[1])},
+                                               {"z", JsonNumber(matched[2])}};
+  } else {
+    (*j)["tensor_kg_m2"] = nullptr;
+    (*j)["principal_moments_kg_m2"] = nullptr;
+    (*j)["principal_moments_kg_m2_std"] = nullptr;
+    (*j)["principal_moments_kg_m2_ci95"] = nullptr;
+    (*j)["principal_axes"] = nullptr;
+    (*j)["principal_axes_std_deg"] = nullptr;
+    (*j)["principal_euler_deg"] = nullptr;
+    (*j)["principal_moments_matched_kg_m2"] = nullptr;
+  }
+}
+
+// The design (rank, condition, singular values, counts) and the scatter model of the fit.
+void PutDesignAndScatter(const TensorResult& r, json* j) {
+  (*j)["rank"] = r.rank;
+  (*j)["condition_number"] = JsonNumber(r.condition_number);
+  json sv = json::array();
+  for (double s : r.design_singular_values) sv.push_back(JsonNumber(s));
+  (*j)["design_singular_values"] = sv;
+  (*j)["n_points"] = r.n_points;
+  (*j)["n_orientations"] = r.n_orientations;
+  (*j)["weighted"] = r.weighted;
+  (*j)["attitude_scatter_deg"] = JsonNumber(r.attitude_scatter_deg);
+  (*j)["relative_scatter"] = JsonNumber(r.relative_scatter);
+  (*j)["covariance"] = EllipseCovarianceName(r.covariance_used);
+  (*j)["variance_factor"] = JsonNumber(r.variance_factor);
+  (*j)["dof"] = JsonNumber(r.dof);
+  (*j)["reduced_chi2"] = JsonNumber(r.reduced_chi2);
+  (*j)["rmse_kg_m2"] = JsonNumber(r.rmse_kg_m2);
+  (*j)["bootstrap_replicates"] = r.bootstrap_replicates;
+}
+
+// One entry per point: measured, fitted, residual, with its file and attitude when known.
+json ResidualsJson(const TensorResult& r, const TensorJsonContext& c) {
+  json residuals = json::array();
+  for (const TensorPointResidual& p : r.residuals) {
+    json e = {{"index", p.index},
+              {"orientation", p.orientation},
+              {"inertia_kg_m2", JsonNumber(p.inertia_kg_m2)},
+              {"fitted_kg_m2", JsonNumber(p.fitted_kg_m2)},
+              {"residual_kg_m2", JsonNumber(p.residual_kg_m2)},
+              {"studentized", JsonNumber(p.studentized)},
+              {"outlier", p.outlier}};
+    if (p.index < static_cast<int>(c.points.size())) {
+      const TensorJsonContext::Point& q = c.points[p.index];
+      e["file"] = q.file;
+      e["roll_deg"] = JsonNumber(q.roll_deg);
+      e["pitch_deg"] = JsonNumber(q.pitch_deg);
+    }
+    residuals.push_back(e);
+  }
+  return residuals;
+}
+
+// One entry per orientation group: axis, mean, fit, residual, with its attitude when known.
+json OrientationsJson(const TensorResult& r, const TensorJsonContext& c) {
+  json orientations = json::array();
+  for (size_t g = 0; g < r.orientations.size(); ++g) {
+    const TensorOrientation& o = r.orientations[g];
+    json e = {{"axis_in_body", Vector3(o.nominal_in_body)},
+              {"n", static_cast<int>(o.members.size())},
+              {"mean_kg_m2", JsonNumber(o.mean_kg_m2)},
+              {"fitted_kg_m2", JsonNumber(o.fitted_kg_m2)},
+              {"residual_kg_m2", JsonNumber(o.residual_kg_m2)},
+              {"residual_std_kg_m2", JsonNumber(o.residual_std_kg_m2)},
+              {"z", JsonNumber(o.z)},
+              {"scatter_kg_m2", JsonNumber(o.scatter_kg_m2)}};
+    if (g < c.orientations.size()) {
+      e["roll_deg"] = JsonNumber(c.orientations[g].roll_deg);
+      e["pitch_deg"] = JsonNumber(c.orientations[g].pitch_deg);
+    }
+    orientations.push_back(e);
+  }
+  return orientations;
+}
+
+json SolverJson(const TensorResult& r) {
+  return {{"method", r.ceres.method},
+          {"converged", r.ceres.converged},
+          {"message", r.ceres.message},
+          {"iterations", r.ceres.iterations},
+          {"initial_cost", JsonNumber(r.ceres.initial_cost)},
+          {"final_cost", JsonNumber(r.ceres.final_cost)},
+          {"time_s", JsonNumber(r.ceres.time_s)}};
 }
 
 }  // namespace
@@ -48,127 +191,16 @@ json TensorResultToJson(const TensorResult& r, const TensorJsonContext& c) {
   json j;
   PutCommon(c, &j);
   j["source"] = "tensor_fit";
-  for (int k = 0; k < kTensorComponents; ++k) {
-    PutEstimate(&j, std::string(TensorComponentName(k)) + "_kg_m2", r.components[k]);
-  }
-  json observable = json::object();
-  for (int k = 0; k < kTensorComponents; ++k) {
-    observable[TensorComponentName(k)] = r.components[k].observable;
-  }
-  j["observable"] = observable;
-  j["unobservable"] = r.unobservable;
-  j["observable_combinations"] = r.observable_combinations;
-  json cov = json::array();
-  for (int k = 0; k < kTensorComponents; ++k) {
-    json row = json::array();
-    for (int l = 0; l < kTensorComponents; ++l) row.push_back(Num(r.covariance[k][l]));
-    cov.push_back(row);
-  }
-  j["covariance_kg2_m4"] = cov;
-  if (r.full) {
-    const auto& v = r.components;
-    j["tensor_kg_m2"] = json::array({json::array({v[kIxx].value, -v[kIxy].value, -v[kIxz].value}),
-                                     json::array({-v[kIxy].value, v[kIyy].value, -v[kIyz].value}),
-                                     json::array({-v[kIxz].value, -v[kIyz].value, v[kIzz].value})});
-    json moments = json::array(), stds = json::array(), cis = json::array(), axes = json::array(),
-         axes_std = json::array();
-    for (int k = 0; k < 3; ++k) {
-      moments.push_back(Num(r.principal_moments[k].value));
-      stds.push_back(Num(r.principal_moments[k].std));
-      cis.push_back(json::array({Num(r.principal_moments[k].ci_lo), Num(r.principal_moments[k].ci_hi)}));
-      axes.push_back(Vector3(r.principal_axes[k]));
-      axes_std.push_back(Num(r.principal_axes_std_deg[k]));
-    }
-    j["principal_moments_kg_m2"] = moments;
-    j["principal_moments_kg_m2_std"] = stds;
-    j["principal_moments_kg_m2_ci95"] = cis;
-    j["principal_axes"] = axes;
-    j["principal_axes_std_deg"] = axes_std;
-    j["principal_euler_deg"] = {{"roll", Num(r.euler_deg[0].value)},
-                                {"pitch", Num(r.euler_deg[1].value)},
-                                {"yaw", Num(r.euler_deg[2].value)},
-                                {"roll_std", Num(r.euler_deg[0].std)},
-                                {"pitch_std", Num(r.euler_deg[1].std)},
-                                {"yaw_std", Num(r.euler_deg[2].std)},
-                                {"convention",
-                                 "body_from_principal = Rz(yaw) Ry(pitch) Rx(roll), each "
-                                 "principal axis matched to the nearest body axis"}};
-    j["principal_moments_matched_kg_m2"] = {{"x", Num(r.principal_moments_matched_kg_m2[0])},
-                                            {"y", Num(r.principal_moments_matched_kg_m2[1])},
-                                            {"z", Num(r.principal_moments_matched_kg_m2[2])}};
-  } else {
-    j["tensor_kg_m2"] = nullptr;
-    j["principal_moments_kg_m2"] = nullptr;
-    j["principal_moments_kg_m2_std"] = nullptr;
-    j["principal_moments_kg_m2_ci95"] = nullptr;
-    j["principal_axes"] = nullptr;
-    j["principal_axes_std_deg"] = nullptr;
-    j["principal_euler_deg"] = nullptr;
-    j["principal_moments_matched_kg_m2"] = nullptr;
-  }
-  j["rank"] = r.rank;
-  j["condition_number"] = Num(r.condition_number);
-  json sv = json::array();
-  for (double s : r.design_singular_values) sv.push_back(Num(s));
-  j["design_singular_values"] = sv;
-  j["n_points"] = r.n_points;
-  j["n_orientations"] = r.n_orientations;
-  j["weighted"] = r.weighted;
-  j["attitude_scatter_deg"] = Num(r.attitude_scatter_deg);
-  j["relative_scatter"] = Num(r.relative_scatter);
-  j["covariance"] = EllipseCovarianceName(r.covariance_used);
-  j["variance_factor"] = Num(r.variance_factor);
-  j["dof"] = Num(r.dof);
-  j["reduced_chi2"] = Num(r.reduced_chi2);
-  j["rmse_kg_m2"] = Num(r.rmse_kg_m2);
-  j["bootstrap_replicates"] = r.bootstrap_replicates;
-  json residuals = json::array();
-  for (const TensorPointResidual& p : r.residuals) {
-    json e = {{"index", p.index},
-              {"orientation", p.orientation},
-              {"inertia_kg_m2", Num(p.inertia_kg_m2)},
-              {"fitted_kg_m2", Num(p.fitted_kg_m2)},
-              {"residual_kg_m2", Num(p.residual_kg_m2)},
-              {"studentized", Num(p.studentized)},
-              {"outlier", p.outlier}};
-    if (p.index < static_cast<int>(c.points.size())) {
-      const TensorJsonContext::Point& q = c.points[p.index];
-      e["file"] = q.file;
-      e["roll_deg"] = Num(q.roll_deg);
-      e["pitch_deg"] = Num(q.pitch_deg);
-    }
-    residuals.push_back(e);
-  }
-  j["residuals"] = residuals;
+  PutComponents(r, &j);
+  PutPrincipal(r, &j);
+  PutDesignAndScatter(r, &j);
+  j["residuals"] = ResidualsJson(r, c);
   j["n_outliers"] = r.n_outliers;
-  json orientations = json::array();
-  for (size_t g = 0; g < r.orientations.size(); ++g) {
-    const TensorOrientation& o = r.orientations[g];
-    json e = {{"axis_in_body", Vector3(o.nominal_in_body)},
-              {"n", static_cast<int>(o.members.size())},
-              {"mean_kg_m2", Num(o.mean_kg_m2)},
-              {"fitted_kg_m2", Num(o.fitted_kg_m2)},
-              {"residual_kg_m2", Num(o.residual_kg_m2)},
-              {"residual_std_kg_m2", Num(o.residual_std_kg_m2)},
-              {"z", Num(o.z)},
-              {"scatter_kg_m2", Num(o.scatter_kg_m2)}};
-    if (g < c.orientations.size()) {
-      e["roll_deg"] = Num(c.orientations[g].roll_deg);
-      e["pitch_deg"] = Num(c.orientations[g].pitch_deg);
-    }
-    orientations.push_back(e);
-  }
-  j["orientations"] = orientations;
-  j["solver"] = {{"method", r.ceres.method},
-                 {"converged", r.ceres.converged},
-                 {"message", r.ceres.message},
-                 {"iterations", r.ceres.iterations},
-                 {"initial_cost", Num(r.ceres.initial_cost)},
-                 {"final_cost", Num(r.ceres.final_cost)},
-                 {"time_s", Num(r.ceres.time_s)}};
-  j["closed_form_max_relative_difference"] = Num(r.closed_form_max_relative_difference);
+  j["orientations"] = OrientationsJson(r, c);
+  j["solver"] = SolverJson(r);
+  j["closed_form_max_relative_difference"] = JsonNumber(r.closed_form_max_relative_difference);
   j["warnings"] = r.warnings;
-  j["time_s"] = Num(r.time_s);
+  j["time_s"] = JsonNumber(r.time_s);
   return j;
 }
 
@@ -204,35 +236,35 @@ json PlanarTensorJson(const EllipseResult& e, const TensorJsonContext& c) {
       double v = 0.0;
       for (int p = 0; p < 3; ++p)
         for (int q = 0; q < 3; ++q) v += m[a][p] * e.cov_abc[p][q] * m[b][q];
-      cov[index[a]][index[b]] = Num(v);
+      cov[index[a]][index[b]] = JsonNumber(v);
     }
   }
   j["covariance_kg2_m4"] = cov;
   j["tensor_kg_m2"] = nullptr;
   j["principal_moments_kg_m2"] = nullptr;
   j["principal_axes"] = nullptr;
-  j["principal_in_plane"] = {{"tau_deg", e.tau_defined ? Num(e.tau_deg.value) : json(nullptr)},
-                             {"Ixp_kg_m2", e.tau_defined ? Num(e.ixp.value) : json(nullptr)},
-                             {"Izp_kg_m2", e.tau_defined ? Num(e.izp.value) : json(nullptr)},
+  j["principal_in_plane"] = {{"tau_deg", e.tau_defined ? JsonNumber(e.tau_deg.value) : json(nullptr)},
+                             {"Ixp_kg_m2", e.tau_defined ? JsonNumber(e.ixp.value) : json(nullptr)},
+                             {"Izp_kg_m2", e.tau_defined ? JsonNumber(e.izp.value) : json(nullptr)},
                              {"note", "principal axes of the x-z plane, see the ellipse section"}};
   j["rank"] = 3;
   j["n_points"] = e.n_points;
   j["n_orientations"] = e.n_angles;
   j["covariance"] = EllipseCovarianceName(e.covariance_used);
-  j["variance_factor"] = Num(e.variance_factor);
-  j["dof"] = Num(e.dof);
-  j["rmse_kg_m2"] = Num(e.rmse_kg_m2);
+  j["variance_factor"] = JsonNumber(e.variance_factor);
+  j["dof"] = JsonNumber(e.dof);
+  j["rmse_kg_m2"] = JsonNumber(e.rmse_kg_m2);
   j["bootstrap_replicates"] = e.bootstrap_replicates;
   json residuals = json::array();
   for (const EllipseResidual& p : e.residuals) {
     json r = {{"index", p.index},
-              {"inertia_kg_m2", Num(p.inertia_kg_m2)},
-              {"fitted_kg_m2", Num(p.fitted_kg_m2)},
-              {"residual_kg_m2", Num(p.residual_kg_m2)},
-              {"studentized", Num(p.studentized)},
+              {"inertia_kg_m2", JsonNumber(p.inertia_kg_m2)},
+              {"fitted_kg_m2", JsonNumber(p.fitted_kg_m2)},
+              {"residual_kg_m2", JsonNumber(p.residual_kg_m2)},
+              {"studentized", JsonNumber(p.studentized)},
               {"outlier", p.outlier},
               {"roll_deg", 0.0},
-              {"pitch_deg", Num(p.pitch_deg)}};
+              {"pitch_deg", JsonNumber(p.pitch_deg)}};
     if (p.index < static_cast<int>(c.points.size())) r["file"] = c.points[p.index].file;
     residuals.push_back(r);
   }
@@ -241,13 +273,13 @@ json PlanarTensorJson(const EllipseResult& e, const TensorJsonContext& c) {
   for (const EllipseAngleStats& a : e.angles) {
     const std::array<double, 3> n = DownInBodyFromAttitude(0.0, a.pitch_deg);
     orientations.push_back({{"roll_deg", 0.0},
-                            {"pitch_deg", Num(a.pitch_deg)},
+                            {"pitch_deg", JsonNumber(a.pitch_deg)},
                             {"axis_in_body", Vector3(n)},
                             {"n", a.n},
-                            {"mean_kg_m2", Num(a.mean_kg_m2)},
-                            {"fitted_kg_m2", Num(a.fitted_kg_m2)},
-                            {"residual_kg_m2", Num(a.mean_kg_m2 - a.fitted_kg_m2)},
-                            {"scatter_kg_m2", Num(a.std_kg_m2)}});
+                            {"mean_kg_m2", JsonNumber(a.mean_kg_m2)},
+                            {"fitted_kg_m2", JsonNumber(a.fitted_kg_m2)},
+                            {"residual_kg_m2", JsonNumber(a.mean_kg_m2 - a.fitted_kg_m2)},
+                            {"scatter_kg_m2", JsonNumber(a.std_kg_m2)}});
   }
   j["orientations"] = orientations;
   j["warnings"] = json::array(

@@ -1,39 +1,75 @@
 #include "pipeline/records/trace_record.h"
 
+#include <vector>
+
+#include "base/enum_names.h"
+
 namespace bifilar {
 
+namespace {
+
+// The one table of each enumeration (Ceres types.h style): results.json, the cache, reports.
+struct TraceStatusRow {
+  TraceStatus status;
+  const char* name;
+};
+constexpr TraceStatusRow kTraceStatusTable[] = {
+    {TraceStatus::kOk, "ok"}, {TraceStatus::kRejected, "rejected"}, {TraceStatus::kError, "error"}};
+
+struct TraceRoleRow {
+  TraceRole role;
+  const char* name;
+};
+constexpr TraceRoleRow kTraceRoleTable[] = {{TraceRole::kAircraft, "aircraft"},
+                                            {TraceRole::kTare, "tare"},
+                                            {TraceRole::kCalibration, "calibration"}};
+
+}  // namespace
+
 const char* ToString(TraceStatus status) {
-  switch (status) {
-    case TraceStatus::kOk: return "ok";
-    case TraceStatus::kRejected: return "rejected";
-    case TraceStatus::kError: return "error";
+  for (const TraceStatusRow& row : kTraceStatusTable) {
+    if (row.status == status) return row.name;
   }
   return "error";
 }
 
 bool ParseTraceStatus(const std::string& name, TraceStatus* status) {
-  if (name == "ok") *status = TraceStatus::kOk;
-  else if (name == "rejected") *status = TraceStatus::kRejected;
-  else if (name == "error") *status = TraceStatus::kError;
-  else return false;
-  return true;
+  for (const TraceStatusRow& row : kTraceStatusTable) {
+    if (name == row.name) {
+      *status = row.status;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string TraceStatusAllowedValues() {
+  std::vector<std::string> names;
+  for (const TraceStatusRow& row : kTraceStatusTable) names.push_back(row.name);
+  return JoinAllowedValues(names);
 }
 
 const char* ToString(TraceRole role) {
-  switch (role) {
-    case TraceRole::kAircraft: return "aircraft";
-    case TraceRole::kTare: return "tare";
-    case TraceRole::kCalibration: return "calibration";
+  for (const TraceRoleRow& row : kTraceRoleTable) {
+    if (row.role == role) return row.name;
   }
   return "aircraft";
 }
 
 bool ParseTraceRole(const std::string& name, TraceRole* role) {
-  if (name == "aircraft") *role = TraceRole::kAircraft;
-  else if (name == "tare") *role = TraceRole::kTare;
-  else if (name == "calibration") *role = TraceRole::kCalibration;
-  else return false;
-  return true;
+  for (const TraceRoleRow& row : kTraceRoleTable) {
+    if (name == row.name) {
+      *role = row.role;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string TraceRoleAllowedValues() {
+  std::vector<std::string> names;
+  for (const TraceRoleRow& row : kTraceRoleTable) names.push_back(row.name);
+  return JoinAllowedValues(names);
 }
 
 RigGeometry GeometryForRole(const CampaignConfig& config, TraceRole role) {

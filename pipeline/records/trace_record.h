@@ -18,12 +18,14 @@ namespace bifilar {
 enum class TraceStatus { kOk, kRejected, kError };
 const char* ToString(TraceStatus status);  // "ok", "rejected", "error"
 bool ParseTraceStatus(const std::string& name, TraceStatus* status);
+std::string TraceStatusAllowedValues();      // "ok, rejected or error"
 
 // An aircraft run, a tare log of the rig alone, or a reference swing of rig.calibration (rig +
 // reference object).
 enum class TraceRole { kAircraft, kTare, kCalibration };
 const char* ToString(TraceRole role);        // "aircraft", "tare", "calibration"
 bool ParseTraceRole(const std::string& name, TraceRole* role);
+std::string TraceRoleAllowedValues();        // "aircraft, tare or calibration"
 
 // One term of the systematic uncertainty budget of I (issue 3 item 7).
 struct BudgetTerm {

@@ -14,6 +14,7 @@
 #include "base/bounded_read.h"
 #include "base/json_error.h"
 #include "base/user_error.h"
+#include "pipeline/records/results_aircraft.h"
 #include "pipeline/store/output_set.h"
 
 namespace bifilar {
@@ -381,10 +382,18 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
       in.source[k] = "symmetric";
     }
   }
-  // Mass: the option, else the config stored in results.json.
+  // Mass: the option, else results.json's `aircraft` (written from the config), else (files
+  // written before that key) the config stored in results.json.
+  double stored_mass_kg = kNaN, stored_mass_std_kg = kNaN;
   if (!std::isnan(options.mass_kg)) {
     in.mass_kg = options.mass_kg;
     in.mass_source = "--mass-kg";
+  } else if (AircraftMassFromResultsJson(j, &stored_mass_kg, &stored_mass_std_kg)) {
+    if (!std::isnan(stored_mass_kg)) {
+      in.mass_kg = stored_mass_kg;
+      in.mass_std_kg = stored_mass_std_kg;
+      in.mass_source = "config aircraft.mass_kg";
+    }
   } else if (j.contains("config") && j["config"].is_string()) {
     try {
       const YAML::Node config = YAML::Load(j["config"].get<std::string>());

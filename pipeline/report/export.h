@@ -24,7 +24,7 @@
 //   and what every version reads) <ixy> etc. are the matrix elements, -integral x y dm in that
 //   frame: ixy = +I_xy, ixz = -I_xz, iyz = +I_yz of the body products. The attribute is written
 //   explicitly so the file reads the same in versions before and after it existed.
-// - Mass: aircraft.mass_kg from the config stored in results.json (or --mass-kg); CG: the origin
+// - Mass: results.json `aircraft.mass_kg` (older files: the stored config; or --mass-kg); CG: the origin
 //   of the link (URDF/SDF) or of the structural frame (JSBSim). The bifilar measures neither the
 //   mass nor the CG: the files say so, and the CG must be moved to where it was measured.
 #pragma once
