@@ -337,7 +337,7 @@ void ReadModelAndIntegrator(YamlMap& root, SimulateSpec* spec) {
         throw UserError(root.Where(method) + ": unknown integrator '" + name +
                         "' for 'integrator'; allowed " +
                         IntegratorMethodAllowedValues() + " (default " +
-                        ToString(spec.options.integrator.method) + ")");
+                        ToString(spec->options.integrator.method) + ")");
       }
     }
   }
