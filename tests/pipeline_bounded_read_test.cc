@@ -29,16 +29,7 @@ bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
-// The message of the UserError `f` throws ("" when it throws none).
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const UserError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test_support::ErrorOf;
 
 const InputCap kTenBytes{10, "test file", "raise the test's cap"};
 

@@ -26,15 +26,7 @@ bool Contains(const std::string& s, const std::string& part) {
   return s.find(part) != std::string::npos;
 }
 
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const UserError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test_support::ErrorOf;
 
 // A topic `top` whose format nests `levels` types: top -> n1 -> ... -> n<levels-1>, the last
 // holding scalars; one sample of it.

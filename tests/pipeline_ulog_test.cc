@@ -48,15 +48,7 @@ std::string TempDir() {
 }
 
 // The UserError message of `f()`, or "" when it does not throw.
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const UserError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test_support::ErrorOf;
 
 ImuFormat Topic(const std::string& topic, int multi_id = 0) {
   ImuFormat format;

@@ -16,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/user_error.h"
 #include "pipeline/config/config.h"
 
 namespace bifilar {
@@ -164,6 +165,17 @@ inline RealData FindRealData(const std::string& relative, std::string* path, std
     if (bifilar_real_data_found != ::bifilar::test_support::RealData::kFound)             \
       FAIL() << bifilar_real_data_why;                                                    \
   } while (false)
+
+// The message of the UserError `f` throws ("" when it throws none).
+template <typename F>
+std::string ErrorOf(F f) {
+  try {
+    f();
+  } catch (const UserError& e) {
+    return e.what();
+  }
+  return "";
+}
 
 }  // namespace test_support
 }  // namespace bifilar
