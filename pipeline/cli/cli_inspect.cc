@@ -6,7 +6,10 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <array>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "base/units.h"
 #include "pipeline/cli/cli_commands.h"
@@ -63,6 +66,26 @@ void RegisterInspectCommand(CLI::App& app, int* exit_code) {
   });
 }
 
+// "--gyro X,Y,Z": three column names.
+std::array<std::string, 3> GyroColumnsFromFlag(const std::string& text) {
+  std::vector<std::string> names;
+  std::string cell;
+  for (char c : text + ",") {
+    if (c != ',') {
+      cell += c;
+      continue;
+    }
+    const size_t b = cell.find_first_not_of(" \t"), e = cell.find_last_not_of(" \t");
+    names.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
+    cell.clear();
+  }
+  if (names.size() != 3 || names[0].empty() || names[1].empty() || names[2].empty()) {
+    throw UserError("init: --gyro takes three column names X,Y,Z (the IMU's x, y, z axes), got '" +
+                    text + "'");
+  }
+  return {names[0], names[1], names[2]};
+}
+
 void RegisterInitCommand(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<InitCommandOptions>();
   auto* sub = app.add_subcommand("init", "Write a commented starting config for your rig");
@@ -73,14 +96,22 @@ void RegisterInitCommand(CLI::App& app, int* exit_code) {
   sub->add_option("--rig", args->rig,
                   "L,D,MASS: wire length (m), wire separation (m), suspended mass (kg); asked on "
                   "a terminal when not given");
+  auto gyro = std::make_shared<std::string>();
+  sub->add_option("--time", args->columns.time,
+                  "with --log: the log's time column, when the guess misses it (its unit is "
+                  "still guessed from the steps)");
+  sub->add_option("--gyro", *gyro,
+                  "with --log: the log's gyro columns X,Y,Z (IMU axes), when the guess misses "
+                  "them (their unit is still guessed from the readings)");
   char gravity_help[160];
   std::snprintf(gravity_help, sizeof(gravity_help),
                 "local gravity (m/s^2) in [%g, %g], the range a config accepts; default 9.80665",
                 kMinEarthGravityMps2, kMaxEarthGravityMps2);
   sub->add_option("--gravity", args->gravity_mps2, gravity_help)->check(FiniteNumber());
   sub->add_flag("--force", args->force, "overwrite PATH if it exists");
-  sub->callback([args, exit_code] {
+  sub->callback([args, gyro, exit_code] {
     InitCommandOptions options = *args;
+    if (!gyro->empty()) options.columns.gyro = GyroColumnsFromFlag(*gyro);
     options.ask_rig = [](StartingConfigOptions* rig) {
       if (!isatty(STDIN_FILENO)) return false;
       std::cout << "The rig (SI units; see configs/README.md):\n";

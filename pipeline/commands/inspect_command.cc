@@ -46,8 +46,12 @@ std::string RunInit(const InitCommandOptions& o) {
     throw UserError("init: give the rig with --rig L,D,MASS (m, m, kg), e.g. --rig "
                     "0.594,0.030,0.0343, or run it on a terminal to be asked");
   }
+  const bool columns_named = !o.columns.time.empty() || !o.columns.gyro[0].empty();
+  if (columns_named && o.log.empty()) {
+    throw UserError("init: --time and --gyro name columns of a log: give the log with --log");
+  }
   if (!o.log.empty()) {
-    const InspectReport report = InspectLog(o.log, nullptr);
+    const InspectReport report = InspectLog(o.log, nullptr, o.columns);
     if (!report.is_log()) {
       throw UserError("init: --log " + (report.error.empty() ? o.log : report.error));
     }

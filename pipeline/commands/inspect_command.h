@@ -34,6 +34,7 @@ InspectCommandResult RunInspect(const InspectCommandOptions& options);
 struct InitCommandOptions {
   std::string path = "bifilar.yaml";  // config file to write
   std::string log;                    // "" or a log whose format is filled in (as inspect guesses)
+  ColumnChoice columns;               // with `log`: its time and gyro columns, named (not guessed)
   std::string rig;                    // "L,D,MASS" (m, m, kg); "": ask_rig
   double gravity_mps2 = kStandardGravityMps2;
   bool force = false;                 // overwrite `path` if it exists

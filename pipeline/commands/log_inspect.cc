@@ -98,7 +98,8 @@ std::vector<std::string> HeadLines(const std::string& text, size_t max_lines) {
 // "gyrox", plus the unit it names, if any.
 struct ColumnName {
   std::string bare;
-  std::string unit_hint;  // "deg/s", "rad/s", "ms", "us", "s", ""
+  std::string unit_hint;  // "deg/s", "rad/s", ""
+  std::string bracket;    // the text in brackets, without digits: "ms" of "Time [ms]"
 };
 
 ColumnName Normalise(const std::string& name) {
@@ -121,6 +122,7 @@ ColumnName Normalise(const std::string& name) {
     if (depth > 0 && !std::isdigit(static_cast<unsigned char>(c))) continue;
     if (std::isalnum(static_cast<unsigned char>(c))) out.bare += c;
   }
+  out.bracket = Trim(inside);
   const std::string all = lower;
   if (all.find("deg") != std::string::npos || all.find("dps") != std::string::npos) {
     out.unit_hint = "deg/s";
@@ -130,23 +132,38 @@ ColumnName Normalise(const std::string& name) {
   return out;
 }
 
-// Column triplets named prefix + {x,y,z} or prefix + {0,1,2}: the index of each axis, or -1.
+// The index of the column whose normalised name is `bare`, or -1.
+int ColumnIndex(const std::vector<ColumnName>& names, const std::string& bare) {
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (names[i].bare == bare) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+// Column triplets named word + axis ("gyrox", "gyro0", "gyro1") or axis + word ("xgyro"): the
+// index of each axis, or -1. `named` lists whole triplets tried after them, such as the body
+// rates p, q, r.
 std::array<int, 3> FindTriplet(const std::vector<ColumnName>& names,
-                               const std::vector<std::string>& prefixes) {
-  static const char* kSuffixes[][3] = {{"x", "y", "z"}, {"0", "1", "2"}, {"1", "2", "3"}};
-  for (const std::string& prefix : prefixes) {
-    for (const auto& suffix : kSuffixes) {
-      std::array<int, 3> idx = {-1, -1, -1};
-      for (int a = 0; a < 3; ++a) {
-        for (size_t i = 0; i < names.size(); ++i) {
-          if (names[i].bare == prefix + suffix[a]) {
-            idx[a] = static_cast<int>(i);
-            break;
-          }
-        }
-      }
-      if (idx[0] >= 0 && idx[1] >= 0 && idx[2] >= 0) return idx;
+                               const std::vector<std::string>& words,
+                               const std::vector<std::array<const char*, 3>>& named = {}) {
+  static const char* kAxes[][3] = {{"x", "y", "z"}, {"0", "1", "2"}, {"1", "2", "3"}};
+  auto all_three = [&](auto&& name_of) {
+    std::array<int, 3> idx;
+    for (int a = 0; a < 3; ++a) idx[a] = ColumnIndex(names, name_of(a));
+    return idx;
+  };
+  auto found = [](const std::array<int, 3>& idx) { return idx[0] >= 0 && idx[1] >= 0 && idx[2] >= 0; };
+  for (const std::string& word : words) {
+    for (const auto& axes : kAxes) {
+      const std::array<int, 3> after = all_three([&](int a) { return word + axes[a]; });
+      if (found(after)) return after;
     }
+    const std::array<int, 3> before = all_three([&](int a) { return kAxes[0][a] + word; });
+    if (found(before)) return before;
+  }
+  for (const auto& triplet : named) {
+    const std::array<int, 3> idx = all_three([&](int a) { return std::string(triplet[a]); });
+    if (found(idx)) return idx;
   }
   return {-1, -1, -1};
 }
@@ -217,14 +234,21 @@ int GuessTimeColumn(const std::vector<ColumnName>& names) {
 }
 
 // Time unit: from the name (`tname`, normalised), else from the median step of the first rows.
-void GuessTimeUnit(const std::string& tname, const std::vector<double>& tc, FormatGuess* guess) {
+void GuessTimeUnit(const ColumnName& name, const std::vector<double>& tc, FormatGuess* guess) {
+  const std::string& tname = name.bare;
   std::vector<double> steps;
   for (size_t i = 1; i < tc.size(); ++i) {
     if (tc[i] > tc[i - 1]) steps.push_back(tc[i] - tc[i - 1]);
   }
   const double step = Median(steps);
   std::string time_why;
-  if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "us") == 0) {
+  const std::string& unit = name.bracket;
+  if (unit == "s" || unit == "sec" || unit == "ms" || unit == "us" || unit == "\u00b5s") {
+    guess->format.time_unit = unit == "ms"   ? TimeUnit::kMilliseconds
+                              : unit == "us" || unit == "\u00b5s" ? TimeUnit::kMicroseconds
+                                                                : TimeUnit::kSeconds;
+    time_why = "from its name";
+  } else if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "us") == 0) {
     guess->format.time_unit = TimeUnit::kMicroseconds;
     time_why = "from its name";
   } else if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "ms") == 0) {
@@ -293,9 +317,52 @@ void GuessAccelUnit(const std::array<int, 3>& accel,
 
 }  // namespace
 
+namespace {
+
+// The index of the header cell named `name` (case and surrounding blanks aside), or -1.
+int HeaderIndex(const std::vector<std::string>& header, const std::string& name) {
+  for (size_t i = 0; i < header.size(); ++i) {
+    if (Lower(Trim(header[i])) == Lower(Trim(name))) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+// The columns the user named (ColumnChoice) are in the header; otherwise false and why.
+bool ChosenColumnsPresent(const std::vector<std::string>& header, const ColumnChoice& choice,
+                          std::string* why) {
+  std::vector<std::string> wanted;
+  if (!choice.time.empty()) wanted.push_back(choice.time);
+  for (const std::string& g : choice.gyro) {
+    if (!g.empty()) wanted.push_back(g);
+  }
+  std::string list;
+  for (const std::string& h : header) list += (list.empty() ? "" : ", ") + h;
+  for (const std::string& w : wanted) {
+    if (HeaderIndex(header, w) < 0) {
+      *why = "no column '" + w + "' among the " + std::to_string(header.size()) +
+             " column(s) of the first line: " + Abbreviated(list, 400);
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+std::string UnrecognisedColumnsMessage(const std::vector<std::string>& header,
+                                       const std::string& what) {
+  std::string list;
+  for (const std::string& h : header) list += (list.empty() ? "" : ", ") + h;
+  return "no " + what + " recognised among the " + std::to_string(header.size()) +
+         " column(s) of the first line: " + Abbreviated(list, 400) +
+         ". Name them in the config (imu.time: {column: T, unit: s|ms|us}, imu.gyro: {columns: "
+         "[X, Y, Z], unit: rad/s|deg/s}), or let bifilar write that config: bifilar init --log "
+         "LOG --time T --gyro X,Y,Z --rig L,D,MASS (units are still guessed from the data)";
+}
+
 // GuessDelimiter -> NumericColumns -> GuessTimeColumn (and the gyro and accelerometer triplets)
 // -> GuessTimeUnit -> GuessGyroUnit -> GuessAccelUnit.
-FormatGuess GuessCsvFormat(const std::string& text) {
+FormatGuess GuessCsvFormat(const std::string& text, const ColumnChoice& choice) {
   FormatGuess guess;
   const std::vector<std::string> lines = HeadLines(text, 400);
   if (lines.empty()) {
@@ -308,19 +375,22 @@ FormatGuess GuessCsvFormat(const std::string& text) {
   std::vector<ColumnName> names;
   for (const std::string& h : header) names.push_back(Normalise(h));
   const std::vector<std::vector<double>> columns = NumericColumns(lines, delim, header.size());
-  const int time = GuessTimeColumn(names);
-  const std::array<int, 3> gyro = FindTriplet(
-      names, {"g", "gyro", "gyr", "w", "omega", "rate", "gyrorad", "angvel", "angularvelocity",
-              "angularrate", "gyroscope", "bodyrate", "wb"});
+  if (!ChosenColumnsPresent(header, choice, &guess.why)) return guess;
+  const int time = choice.time.empty() ? GuessTimeColumn(names) : HeaderIndex(header, choice.time);
+  const std::array<int, 3> gyro =
+      choice.gyro[0].empty()
+          ? FindTriplet(names,
+                        {"g", "gyro", "gyr", "w", "omega", "rate", "gyrorad", "angvel",
+                         "angularvelocity", "angularrate", "gyroscope", "bodyrate", "wb"},
+                        {{"p", "q", "r"}, {"rollrate", "pitchrate", "yawrate"}})
+          : std::array<int, 3>{HeaderIndex(header, choice.gyro[0]),
+                               HeaderIndex(header, choice.gyro[1]),
+                               HeaderIndex(header, choice.gyro[2])};
   const std::array<int, 3> accel = FindTriplet(
       names, {"a", "acc", "accel", "accelerometer", "accelerometerms2", "acceleration", "f",
               "specificforce", "linacc"});
   if (time < 0 || gyro[0] < 0) {
-    std::string list;
-    for (const std::string& h : header) list += (list.empty() ? "" : ", ") + h;
-    guess.why = std::string(time < 0 ? "no time column" : "no gyro columns") +
-                " recognised among the " + std::to_string(header.size()) +
-                " column(s) of the first line: " + Abbreviated(list);
+    guess.why = UnrecognisedColumnsMessage(header, time < 0 ? "time column" : "gyro columns");
     return guess;
   }
   guess.found = true;
@@ -331,7 +401,7 @@ FormatGuess GuessCsvFormat(const std::string& text) {
   } else {
     guess.format.accel_columns = {"", "", ""};
   }
-  GuessTimeUnit(names[time].bare, columns[time], &guess);
+  GuessTimeUnit(names[time], columns[time], &guess);
   GuessGyroUnit(names, gyro, columns, &guess);
   if (accel[0] >= 0) {
     GuessAccelUnit(accel, columns, &guess);
@@ -520,7 +590,8 @@ void SwingAndWindow(const ImuData& data, const CampaignConfig* config, InspectRe
 
 }  // namespace
 
-InspectReport InspectLog(const std::string& path, const CampaignConfig* config) {
+InspectReport InspectLog(const std::string& path, const CampaignConfig* config,
+                         const ColumnChoice& choice) {
   InspectReport report;
   report.file = path;
   std::error_code ec;
@@ -578,7 +649,7 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config) 
       data = ReadUlogImu(bytes, path, report.format, log_options);
     } else {
       const std::string kind = ClassifyText(bytes);
-      const FormatGuess guess = GuessCsvFormat(bytes);
+      const FormatGuess guess = GuessCsvFormat(bytes, choice);
       const std::vector<std::string> head = HeadLines(bytes, 1);
       if (!head.empty()) {
         for (const std::string& c : SplitLine(head[0], guess.format.delimiter)) {

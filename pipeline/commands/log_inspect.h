@@ -88,12 +88,30 @@ struct InspectReport {
   std::string error;                  // why the series could not be read or searched; "" if fine
 };
 
-// Guesses the format of a CSV text from its header and first rows.
-FormatGuess GuessCsvFormat(const std::string& text);
+// Columns the user names (`bifilar init --time COL --gyro X,Y,Z`) instead of the guess; their
+// units are still guessed from the data. Empty: guess.
+struct ColumnChoice {
+  std::string time;
+  std::array<std::string, 3> gyro;
+};
+
+// Guesses the format of a CSV text from its header and first rows. Recognised, ignoring case,
+// separators and a unit in brackets: time as t, time, timestamp, TimeUS, TimeMS, "Time [ms]"
+// (or any name holding "time"); gyro and accelerometer triplets as word + axis (GyroX, gyr_x,
+// gyro[0], AngVelX) or axis + word (xGyro, ZGyro, xAcc), and the body rates p, q, r or
+// roll_rate, pitch_rate, yaw_rate. `choice` names columns instead.
+FormatGuess GuessCsvFormat(const std::string& text, const ColumnChoice& choice = {});
+
+// The message when no time or gyro columns are found (`what`): the columns, the config keys to
+// write, and the `bifilar init` command that writes them.
+std::string UnrecognisedColumnsMessage(const std::vector<std::string>& header,
+                                       const std::string& what);
 
 // Reads and looks at `path`. `config` (optional) gives the format and the rig for the
-// small-angle inertia. Never throws on bad input: what went wrong is in kind/error.
-InspectReport InspectLog(const std::string& path, const CampaignConfig* config);
+// small-angle inertia; `choice` names CSV columns instead of guessing them. Never throws on bad
+// input: what went wrong is in kind/error.
+InspectReport InspectLog(const std::string& path, const CampaignConfig* config,
+                         const ColumnChoice& choice = {});
 
 // The console form (several lines) and the JSON form of a report.
 std::string InspectReportText(const InspectReport& report);
