@@ -307,7 +307,8 @@ RigCandidate Evaluate(const RigPlanOptions& o, const std::string& label, double 
   const TraceFitResult r = FitTrace(in, FitOptionsFor(o, true));
   if (!r.HasFit()) {
     throw UserError("plan --rig: the simulated swing on L " + Fmt("%.3g", l) + " m, D " +
-                    Fmt("%.3g", d) + " m did not fit: " + r.message);
+                    Fmt("%.3g", d) + " m did not fit (--gyro-noise, --imu-rate): " +
+                    r.message);
   }
   const double i = r.params.inertia_kg_m2;
   c.terms.statistical = r.inertia_stat_std_kg_m2 / i;
@@ -430,9 +431,13 @@ void Alternatives(const RigPlanOptions& o, const GridModel& m, double inertia, R
                        {"narrower D", std::max(o.min_separation_m, 0.75 * d0), l0}};
   for (const Try& t : tries) {
     if ((t.d == d0 && t.l == l0) || !m.Feasible(t.d, t.l)) continue;
-    plan->alternatives.push_back(Evaluate(o, t.label, t.d, t.l, inertia,
-                                          plan->release_amplitude_deg, m.SwingS(m.Period(t.d, t.l)),
-                                          target));
+    try {
+      plan->alternatives.push_back(Evaluate(o, t.label, t.d, t.l, inertia,
+                                            plan->release_amplitude_deg,
+                                            m.SwingS(m.Period(t.d, t.l)), target));
+    } catch (const UserError&) {
+      // an alternative whose swing the noise drowns is no alternative: left out
+    }
   }
 }
 
