@@ -2,11 +2,11 @@
 // logs reproduces the ~3.3 % its fits report, the fixed-wing meets 1 %, the written config loads,
 // bad input names the flag, impossible constraints are an answer, and a small Monte-Carlo run
 // confirms the predicted std (the large run: scripts/rig_plan_mc.sh).
-#include <cmath>
-#include <string>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "base/user_error.h"
 #include "pipeline/commands/rig_plan.h"
@@ -81,6 +81,36 @@ TEST(RigPlan, QuadrotorReproducesTheFitsAndSaysWhatMeetsOnePercent) {
   EXPECT_NEAR(p.recommended.period_s, 2.23, 0.05);
   EXPECT_GT(p.release_amplitude_deg, 3.0);
   EXPECT_LE(p.release_amplitude_deg, 30.0);
+}
+
+// The real logs of that rig (4 repeats about body x), fitted with --repeats and the same stds:
+// the total `bifilar fit` reports and the plan's agree to 5 % of each other (the fit's total
+// carries the measured between-repeat and amplitude-correction terms instead of the planned 0.25
+// %).
+TEST(RigPlan, QuadrotorPlanMatchesTheFitOfTheRealLogs) {
+  BIFILAR_REAL_DATA(data, "crazyflie");
+  TempDir dir("rig_plan_real");
+  const std::string config = WriteFile(
+      dir.path + "/q.yaml",
+      "gravity_mps2: 9.8066\n"
+      "rig: {filar_length_m: 0.594, filar_separation_m: 0.030, mass_kg: 0.0343,\n"
+      "      uncertainties: {filar_length_std_m: 0.0005, filar_separation_std_m: 0.0005,\n"
+      "                      mass_std_kg: 0.0000343}}\n"
+      "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [wx, wy, wz], unit: rad/s}\n"
+      "  accel: null\n");
+  const test_support::CliRun r =
+      Bifilar(dir, "fit " + config + " " + data + "/BaseModel_Ixx_Log-1.csv " + data +
+                       "/BaseModel_Ixx_Log-2.csv " + data + "/BaseModel_Ixx_Log-3.csv " + data +
+                       "/BaseModel_Ixx_Log-4.csv --repeats");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const size_t line = r.out.find("\nrepeats ");
+  ASSERT_NE(line, std::string::npos) << r.out;
+  const size_t at = r.out.find("(total, ", line);
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const double fit_total_percent = std::stod(r.out.substr(at + 8));
+  const RigPlan p = RunRigPlan(Quadrotor());
+  EXPECT_NEAR(p.best_std_percent / fit_total_percent, 1.0, 0.05)
+      << "fit " << fit_total_percent << " %, plan " << p.best_std_percent << " %";
 }
 
 TEST(RigPlan, FixedWingMeetsOnePercentAtTheWidestSeparation) {
@@ -205,8 +235,9 @@ TEST(RigPlan, CommandLineJsonAndFlagErrors) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("binding: --max-separation"), std::string::npos) << r.out;
   EXPECT_TRUE(std::filesystem::file_size(dir.path + "/plan.png") > 1000);
-  r = Bifilar(dir, "plan --rig --mass -1 --inertia 1e-5 --max-length 0.5 --max-separation 0.03 "
-                   "--target-percent 1");
+  r = Bifilar(dir,
+              "plan --rig --mass -1 --inertia 1e-5 --max-length 0.5 --max-separation 0.03 "
+              "--target-percent 1");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--mass"), std::string::npos) << r.err;
   r = Bifilar(dir, "plan --mass 1");

@@ -307,8 +307,7 @@ RigCandidate Evaluate(const RigPlanOptions& o, const std::string& label, double 
   const TraceFitResult r = FitTrace(in, FitOptionsFor(o, true));
   if (!r.HasFit()) {
     throw UserError("plan --rig: the simulated swing on L " + Fmt("%.3g", l) + " m, D " +
-                    Fmt("%.3g", d) + " m did not fit (--gyro-noise, --imu-rate): " +
-                    r.message);
+                    Fmt("%.3g", d) + " m did not fit (--gyro-noise, --imu-rate): " + r.message);
   }
   const double i = r.params.inertia_kg_m2;
   c.terms.statistical = r.inertia_stat_std_kg_m2 / i;
