@@ -169,6 +169,14 @@ TEST(RigPlan, ImpossibleConstraintsAreAnAnswer) {
   EXPECT_EQ(p.binding, "--min-period");
   EXPECT_NE(p.advice.find("period"), std::string::npos);
   EXPECT_GT(p.best_std_percent, 0.0);
+  // An empty period range.
+  o = Quadrotor();
+  o.min_period_s = 3.0;
+  o.max_period_s = 2.0;
+  p = RunRigPlan(o);
+  EXPECT_FALSE(p.target_met);
+  EXPECT_EQ(p.binding, "--min-period");
+  EXPECT_NE(p.advice.find("empty"), std::string::npos) << p.advice;
 }
 
 TEST(RigPlan, WrittenConfigLoadsWithTheRigAndItsUncertainties) {

@@ -459,13 +459,18 @@ RigPlan RunRigPlan(const RigPlanOptions& options) {
   GridPoint best = SearchGrid(model, &plan.grid);
   if (!best.found) {  // the period range excludes every rig: say which end binds
     const double t_fast = model.Period(o.max_separation_m, o.min_length_m);
-    plan.binding = t_fast > o.max_period_s ? "--max-period" : "--min-period";
-    plan.advice =
-        "no rig within --min-length..--max-length and --min-separation.."
-        "--max-separation swings with a period in [" +
-        Fmt("%g", o.min_period_s) + ", " + Fmt("%g", o.max_period_s) +
-        "] s; the periods possible span " + Fmt("%.3g", t_fast) + " to " +
-        Fmt("%.3g", model.Period(o.min_separation_m, o.max_length_m)) + " s";
+    plan.binding = o.min_period_s > o.max_period_s ? "--min-period"
+                   : t_fast > o.max_period_s       ? "--max-period"
+                                                   : "--min-period";
+    plan.advice = o.min_period_s > o.max_period_s
+                      ? "the period range is empty (--min-period " + Fmt("%g", o.min_period_s) +
+                            " s above --max-period " + Fmt("%g", o.max_period_s) + " s)"
+                      : "no rig within --min-length..--max-length and --min-separation.."
+                        "--max-separation swings with a period in [" +
+                            Fmt("%g", o.min_period_s) + ", " + Fmt("%g", o.max_period_s) +
+                            "] s; the periods possible span " + Fmt("%.3g", t_fast) + " to " +
+                            Fmt("%.3g", model.Period(o.min_separation_m, o.max_length_m)) + " s";
+    plan.advice += "; the rig shown is the widest D on the longest L";
     best = {o.max_separation_m, o.max_length_m, 0.0, true};  // evaluated anyway, marked
   }
   plan.swing_s = model.SwingS(model.Period(best.d, best.l));
