@@ -126,6 +126,19 @@ TEST(RigPlan, FixedWingMeetsOnePercentAtTheWidestSeparation) {
   EXPECT_FALSE(p.alternatives.empty());
 }
 
+// A radius of gyration instead of the inertia: I = (mass + cradle) r^2, the same plan.
+TEST(RigPlan, RadiusOfGyrationGivesTheSameRig) {
+  RigPlanOptions o = Quadrotor();
+  o.inertia_kg_m2 = NAN;
+  o.radius_of_gyration_m = std::sqrt(1.6e-5 / 0.0343);
+  const RigPlan p = RunRigPlan(o);
+  EXPECT_NEAR(p.options.inertia_kg_m2, 1.6e-5, 1e-12);
+  EXPECT_NEAR(p.best_std_percent, RunRigPlan(Quadrotor()).best_std_percent, 1e-9);
+  o.inertia_kg_m2 = 1.6e-5;  // both: an error naming them
+  EXPECT_NE(test_support::ErrorOf([&] { RunRigPlan(o); }).find("--radius-of-gyration"),
+            std::string::npos);
+}
+
 TEST(RigPlan, NonPhysicalValuesNameTheFlag) {
   const auto expect_error = [](RigPlanOptions o, const std::string& flag) {
     try {

@@ -33,6 +33,9 @@ std::shared_ptr<RigPlanCli> AddRigPlanOptions(CLI::App* plan) {
   only(plan->add_option("--inertia", o.inertia_kg_m2,
                         "with --rig: the expected inertia of all that swings, kg m^2 (the low "
                         "end with --inertia-max)"));
+  only(plan->add_option("--radius-of-gyration", o.radius_of_gyration_m,
+                        "with --rig: instead of --inertia, the radius of gyration r, m: I = "
+                        "(mass + cradle) r^2"));
   only(plan->add_option("--inertia-max", o.inertia_max_kg_m2,
                         "with --rig: upper end of the expected inertia, kg m^2"));
   only(plan->add_option("--max-length", o.max_length_m, "with --rig: the longest L, m"));

@@ -15,6 +15,7 @@
 #include "pendulum/integrator.h"
 #include "pendulum/model.h"
 #include "pendulum/simulate.h"
+#include "pipeline/campaign/calibration.h"
 
 namespace bifilar {
 namespace {
@@ -53,6 +54,22 @@ double RigPlanTerms::Total() const {
 double RigPlanTerms::SingleSwing() const { return std::hypot(Common(), statistical); }
 
 bool RigPlanOptions::Check(std::string* why) const {
+  if (std::isnan(inertia_kg_m2) == std::isnan(radius_of_gyration_m)) {
+    *why = "plan --rig: give --inertia or --radius-of-gyration (exactly one)";
+    return false;
+  }
+  if (!std::isnan(radius_of_gyration_m)) {
+    if (!(radius_of_gyration_m > 0.0 && radius_of_gyration_m < 100.0)) {
+      *why = "plan --rig: --radius-of-gyration must be in (0, 100) m, got " +
+             Fmt("%g", radius_of_gyration_m);
+      return false;
+    }
+    RigPlanOptions with_inertia = *this;
+    with_inertia.inertia_kg_m2 =
+        (mass_kg + cradle_mass_kg) * radius_of_gyration_m * radius_of_gyration_m;
+    with_inertia.radius_of_gyration_m = NAN;
+    return with_inertia.Check(why);
+  }
   struct Bound {
     const char* flag;
     double value;
@@ -348,6 +365,7 @@ ReferenceBar DesignReference(double inertia, double mass) {
   bar.mass_kg = mass;
   bar.inertia_kg_m2 = mass * (a * a + b * b) / 12.0;
   bar.tolerance_m = kBarToleranceM;
+  bar.swings = kRecommendedReferenceSwings;
   const double s2 = a * a + b * b;
   const double da = 2.0 * a * kBarToleranceM / s2, db = 2.0 * b * kBarToleranceM / s2;
   bar.inertia_rel_std = std::sqrt(da * da + db * db + kBarWeighingRelStd * kBarWeighingRelStd);
@@ -450,6 +468,9 @@ RigPlan RunRigPlan(const RigPlanOptions& options) {
   plan.options = options;
   RigPlanOptions& o = plan.options;
   if (std::isnan(o.mass_std_kg)) o.mass_std_kg = 1e-3 * SuspendedMass(o);
+  if (!std::isnan(o.radius_of_gyration_m)) {
+    o.inertia_kg_m2 = SuspendedMass(o) * o.radius_of_gyration_m * o.radius_of_gyration_m;
+  }
   // A range of inertia: planned at its low end (the shortest period; the relative L, D, m, g
   // terms do not depend on I); the period range must hold at both ends (GridModel::Feasible).
   const double inertia = o.inertia_kg_m2;

@@ -27,6 +27,8 @@ struct RigPlanOptions {
   double cradle_mass_kg = 0.0;     // --cradle-mass: cradle + IMU (kg); >= 0, default 0 (thread)
   double inertia_kg_m2 = NAN;      // --inertia: aircraft (+ cradle) about the swing axis; > 0
   double inertia_max_kg_m2 = NAN;  // --inertia-max: upper end of a range (NaN: one value)
+  // --radius-of-gyration: instead of --inertia, I = (mass + cradle) r^2 (m); NaN: not given.
+  double radius_of_gyration_m = NAN;
   // Constraints.
   double max_length_m = NAN;       // --max-length: the longest L the ceiling allows (m), required
   double max_separation_m = NAN;   // --max-separation: the widest D the airframe allows, required
@@ -90,7 +92,7 @@ struct ReferenceBar {
   double inertia_kg_m2 = 0.0;
   double tolerance_m = 5e-5;     // machining tolerance assumed on a and b (m)
   double inertia_rel_std = 0.0;  // from the drawing and the weighing
-  int swings = 3;
+  int swings = 3;                // reference swings (kRecommendedReferenceSwings)
 };
 
 struct RigMonteCarlo {
