@@ -85,8 +85,7 @@ bool RigPlanRequested(const RigPlanCli& r) {
 }
 
 int RunRigPlanCli(const RigPlanCli& r, const CLI::App& plan, bool json) {
-  for (const char* name :
-       {"--mass", "--inertia", "--max-length", "--max-separation", "--target-percent"}) {
+  for (const char* name : {"--mass", "--max-length", "--max-separation", "--target-percent"}) {
     if (plan.count(name) == 0) throw UserError(std::string("plan --rig: ") + name + " is required");
   }
   for (const char* name : {"--angles", "--sigma", "--tensor"}) {
