@@ -230,19 +230,28 @@ GridPoint SearchGrid(const GridModel& m, RigPlanGrid* grid) {
 
 // The smallest D (then the shortest L) meeting `target` with max-length and max-separation lifted
 // to the plausibility bounds (20 m, 5 m); the period range and the other constraints kept.
+// Found on a geometric grid, then D refined by bisection at that L.
 GridPoint RelaxedForTarget(const GridModel& m, double target) {
-  GridPoint out;
+  const auto meets = [&](double d, double l) {
+    if (!m.Feasible(d, l)) return false;
+    RigPlanTerms t = m.Terms(d, l, kMinRepeats);
+    t.repeats = RepeatsFor(t, target);
+    return t.Total() <= target;
+  };
   const std::vector<double> ds = Axis(m.o.min_separation_m, kMaxRelaxedSeparationM, true);
   const std::vector<double> ls = Axis(m.o.min_length_m, kMaxRelaxedLengthM, true);
-  for (double d : ds) {
+  for (size_t i = 0; i < ds.size(); ++i) {
     for (double l : ls) {
-      if (!m.Feasible(d, l)) continue;
-      RigPlanTerms t = m.Terms(d, l, kMinRepeats);
-      t.repeats = RepeatsFor(t, target);
-      if (t.Total() <= target) return {d, l, t.Total(), true};
+      if (!meets(ds[i], l)) continue;
+      double lo = i > 0 ? ds[i - 1] : ds[i], hi = ds[i];
+      for (int k = 0; k < 40 && hi - lo > 1e-5 * hi; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (meets(mid, l) ? hi : lo) = mid;
+      }
+      return {hi, l, 0.0, true};
     }
   }
-  return out;
+  return GridPoint();
 }
 
 // --- The release amplitude.
