@@ -42,4 +42,11 @@ TensorPlanCommandOptions TensorPlanOptionsFromCli(const TensorPlanCli& tensor_pl
                                                   double ixz, bool ixz_given, DisplayUnits units,
                                                   bool json);
 
+// `plan --rig` (pipeline/cli/cli_plan_rig.cc): its options on the `plan` subcommand, whether it
+// was asked for (throws UserError when a rig-only option comes without --rig), and the run.
+struct RigPlanCli;
+std::shared_ptr<RigPlanCli> AddRigPlanOptions(CLI::App* plan);
+bool RigPlanRequested(const RigPlanCli& rig_plan);
+int RunRigPlanCli(const RigPlanCli& rig_plan, const CLI::App& plan, bool json);
+
 }  // namespace bifilar

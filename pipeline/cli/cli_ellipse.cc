@@ -137,8 +137,14 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
   plan->add_flag("--json", plan_opts->json, "print JSON (SI)");
   // `plan --tensor`: pipeline/cli/cli_plan_tensor.cc
   auto tensor_plan = AddTensorPlanOptions(plan);
-  plan->callback([plan, plan_opts, angles, plan_units, ix, iz, ixz, ixz_option, tensor_plan] {
+  auto rig_plan = AddRigPlanOptions(plan);  // `plan --rig`: pipeline/cli/cli_plan_rig.cc
+  plan->callback([plan, plan_opts, angles, plan_units, ix, iz, ixz, ixz_option, tensor_plan,
+                  rig_plan, exit_code] {
     plan_opts->units = Units(*plan_units);
+    if (RigPlanRequested(*rig_plan)) {
+      *exit_code = RunRigPlanCli(*rig_plan, *plan, plan_opts->json);
+      return;
+    }
     if (TensorPlanRequested(*tensor_plan)) {
       const TensorPlanCommandOptions tensor_opts = TensorPlanOptionsFromCli(
           *tensor_plan, *plan, plan_opts->trials_per_angle, plan_opts->sigma, *ixz,

@@ -1,0 +1,543 @@
+// `bifilar plan --rig`: the search over (D, L), the evaluation of the chosen rig with the trace
+// fit, the release amplitude, the reference object and the Monte-Carlo check (rig_plan.h).
+#include "pipeline/commands/rig_plan.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+
+#include "base/user_error.h"
+#include "fit/trace_fit.h"
+#include "fit/trace_synth.h"
+#include "pendulum/integrator.h"
+#include "pendulum/model.h"
+#include "pendulum/simulate.h"
+#include "pipeline/campaign/calibration.h"
+
+namespace bifilar {
+namespace {
+
+constexpr int kGridSteps = 60;  // grid points per axis of the search and the figure
+constexpr int kMinRepeats = 3, kMaxRepeats = 10;
+constexpr double kMinReleaseDeg = 3.0, kMaxReleaseDeg = 30.0;
+constexpr double kMinSwingS = 30.0, kMaxSwingS = 300.0;
+constexpr double kMaxRelaxedSeparationM = 5.0, kMaxRelaxedLengthM = 20.0;  // plausibility bounds
+constexpr double kMaxSeparationOverLength = 0.9;  // keep the wires from splaying past ~64 deg
+// Machined reference bar: tolerance on length and width, and the weighing (fraction).
+constexpr double kBarToleranceM = 5e-5, kBarWeighingRelStd = 2e-4;
+
+std::string Fmt(const char* format, double v) {
+  char b[96];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
+bool Bad(double v) { return !std::isfinite(v); }
+
+double SuspendedMass(const RigPlanOptions& o) { return o.mass_kg + o.cradle_mass_kg; }
+
+}  // namespace
+
+double RigPlanTerms::Common() const {
+  return std::sqrt(filar_length * filar_length + filar_separation * filar_separation + mass * mass +
+                   gravity * gravity + calibration * calibration);
+}
+
+double RigPlanTerms::Total() const {
+  const double per_log = PerLog() / std::sqrt(static_cast<double>(std::max(1, repeats)));
+  return std::hypot(Common(), per_log);
+}
+
+double RigPlanTerms::SingleSwing() const { return std::hypot(Common(), statistical); }
+
+bool RigPlanOptions::Check(std::string* why) const {
+  if (std::isnan(inertia_kg_m2) == std::isnan(radius_of_gyration_m)) {
+    *why = "plan --rig: give --inertia or --radius-of-gyration (exactly one)";
+    return false;
+  }
+  if (!std::isnan(radius_of_gyration_m)) {
+    if (!(radius_of_gyration_m > 0.0 && radius_of_gyration_m < 100.0)) {
+      *why = "plan --rig: --radius-of-gyration must be in (0, 100) m, got " +
+             Fmt("%g", radius_of_gyration_m);
+      return false;
+    }
+    RigPlanOptions with_inertia = *this;
+    with_inertia.inertia_kg_m2 =
+        (mass_kg + cradle_mass_kg) * radius_of_gyration_m * radius_of_gyration_m;
+    with_inertia.radius_of_gyration_m = NAN;
+    return with_inertia.Check(why);
+  }
+  struct Bound {
+    const char* flag;
+    double value;
+    bool ok;
+    const char* allowed;
+  };
+  const Bound bounds[] = {
+      {"--mass", mass_kg, mass_kg > 0.0, "> 0 kg"},
+      {"--cradle-mass", cradle_mass_kg, cradle_mass_kg >= 0.0, ">= 0 kg"},
+      {"--inertia", inertia_kg_m2, inertia_kg_m2 > 0.0, "> 0 kg m^2"},
+      {"--inertia-max", inertia_max_kg_m2,
+       std::isnan(inertia_max_kg_m2) || inertia_max_kg_m2 >= inertia_kg_m2, ">= --inertia"},
+      {"--max-length", max_length_m, max_length_m > 0.0 && max_length_m <= kMaxRelaxedLengthM,
+       "in (0, 20] m"},
+      {"--max-separation", max_separation_m, max_separation_m > 0.0, "> 0 m"},
+      {"--max-separation", max_separation_m, max_separation_m < max_length_m,
+       "below --max-length (D >= L: the wires would go slack)"},
+      {"--min-length", min_length_m, min_length_m > 0.0 && min_length_m <= max_length_m,
+       "in (0, --max-length]"},
+      {"--min-separation", min_separation_m,
+       min_separation_m > 0.0 && min_separation_m <= max_separation_m, "in (0, --max-separation]"},
+      {"--min-period", min_period_s, min_period_s > 0.0, "> 0 s"},
+      {"--max-period", max_period_s, max_period_s > 0.0, "> 0 s"},
+      {"--length-std", length_std_m, length_std_m >= 0.0 && length_std_m < max_length_m,
+       ">= 0 and below --max-length"},
+      {"--separation-std", separation_std_m,
+       separation_std_m >= 0.0 && separation_std_m < max_separation_m,
+       ">= 0 and below --max-separation"},
+      {"--mass-std", mass_std_kg,
+       std::isnan(mass_std_kg) || (mass_std_kg >= 0.0 && mass_std_kg < mass_kg + cradle_mass_kg),
+       ">= 0 and below the suspended mass"},
+      {"--gravity", gravity_mps2, gravity_mps2 > 0.0 && gravity_mps2 <= 100.0, "in (0, 100] m/s^2"},
+      {"--gravity-std", gravity_std_mps2,
+       gravity_std_mps2 >= 0.0 && gravity_std_mps2 < gravity_mps2, ">= 0 and below --gravity"},
+      {"--imu-rate", imu_rate_hz, imu_rate_hz >= 5.0 && imu_rate_hz <= 10000.0, "in [5, 10000] Hz"},
+      {"--gyro-noise", gyro_noise_deg_per_s, gyro_noise_deg_per_s > 0.0, "> 0 deg/s"},
+      {"--repeat-scatter", repeat_scatter_percent, repeat_scatter_percent >= 0.0, ">= 0 %"},
+      {"--rig-departure", rig_departure_percent,
+       rig_departure_percent >= 0.0 && rig_departure_percent <= 50.0, "in [0, 50] %"},
+      {"--target-percent", target_percent, target_percent > 0.0 && target_percent < 100.0,
+       "in (0, 100) %"},
+  };
+  for (const Bound& b : bounds) {
+    // NaN fails every comparison; an optional NaN (not given) passes its own test above.
+    if (!b.ok || (Bad(b.value) && !std::isnan(b.value))) {
+      *why = std::string("plan --rig: ") + b.flag + " must be " + b.allowed + ", got " +
+             Fmt("%g", b.value);
+      return false;
+    }
+  }
+  if (!(decay_periods > 1.0)) {
+    *why = "plan --rig: the decay (periods) must be > 1, got " + Fmt("%g", decay_periods);
+    return false;
+  }
+  if (monte_carlo_swings < 0 || monte_carlo_swings > 100000) {
+    *why = "plan --rig: --monte-carlo must be in [0, 100000]";
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+// --- The first-order model of the grid (docs/physics.md §5).
+
+struct GridModel {
+  const RigPlanOptions& o;
+  double inertia_kg_m2;
+  double amplitude_rad;
+
+  double Period(double d, double l) const {
+    RigGeometry g{l, d, SuspendedMass(o), o.gravity_mps2};
+    return SmallAnglePeriod(g, inertia_kg_m2);
+  }
+  double SwingS(double period_s) const {
+    return std::clamp(o.decay_periods * period_s, kMinSwingS, kMaxSwingS);
+  }
+  // Cramer-Rao bound of the relative std of I from one swing: rate a(t) = A w e^{-lt} cos(w t),
+  // white noise sigma at rate fs: var(w) = 2 sigma^2 / (fs (W2 - W1^2/W0)), W_k = int a^2 t^k dt
+  // over the swing; I ~ w^-2, so sigma_I / I = 2 sigma_w / w.
+  double Statistical(double period_s) const {
+    const double w = 2.0 * kPi / period_s, lambda = 1.0 / (o.decay_periods * period_s);
+    const double tw = SwingS(period_s), a = amplitude_rad * w;
+    const int n = 400;
+    double w0 = 0, w1 = 0, w2 = 0;
+    for (int k = 0; k < n; ++k) {
+      const double t = (k + 0.5) * tw / n, e = a * a * std::exp(-2.0 * lambda * t) * tw / n;
+      w0 += e;
+      w1 += e * t;
+      w2 += e * t * t;
+    }
+    const double sigma = o.gyro_noise_deg_per_s * kRadPerDeg;
+    const double var_w = 2.0 * sigma * sigma / (o.imu_rate_hz * (w2 - w1 * w1 / w0));
+    return 2.0 * std::sqrt(var_w) / w;
+  }
+  RigPlanTerms Terms(double d, double l, int repeats) const {
+    RigPlanTerms t;
+    t.statistical = Statistical(Period(d, l));
+    t.between_repeat = o.repeat_scatter_percent / 100.0;
+    t.filar_length = o.length_std_m / l;
+    t.filar_separation = 2.0 * o.separation_std_m / d;
+    t.mass = o.mass_std_kg / SuspendedMass(o);
+    t.gravity = o.gravity_std_mps2 / o.gravity_mps2;
+    t.repeats = repeats;
+    return t;
+  }
+  // Inside the constraints: D well below L and the period of both ends of the inertia range
+  // within [min_period, max_period].
+  bool Feasible(double d, double l) const {
+    const double t = Period(d, l);
+    const double t_hi =
+        std::isnan(o.inertia_max_kg_m2) ? t : t * std::sqrt(o.inertia_max_kg_m2 / inertia_kg_m2);
+    return d <= kMaxSeparationOverLength * l && t >= o.min_period_s && t_hi <= o.max_period_s;
+  }
+};
+
+// The fewest repeats (kMinRepeats..kMaxRepeats) that bring the total to the target;
+// kMinRepeats when none does (more repeats then buy little against the common-mode terms).
+int RepeatsFor(RigPlanTerms t, double target) {
+  for (int n = kMinRepeats; n <= kMaxRepeats; ++n) {
+    t.repeats = n;
+    if (t.Total() <= target) return n;
+  }
+  return kMinRepeats;
+}
+
+struct GridPoint {
+  double d = NAN, l = NAN, total = INFINITY;
+  bool found = false;
+};
+
+// Linear axis from lo to hi, or geometric when `geometric`.
+std::vector<double> Axis(double lo, double hi, bool geometric) {
+  std::vector<double> v(kGridSteps);
+  for (int i = 0; i < kGridSteps; ++i) {
+    const double f = static_cast<double>(i) / (kGridSteps - 1);
+    v[i] = geometric ? lo * std::pow(hi / lo, f) : lo + (hi - lo) * f;
+  }
+  return v;
+}
+
+// The grid of the figure and the best feasible point (the lowest total).
+GridPoint SearchGrid(const GridModel& m, RigPlanGrid* grid) {
+  grid->separation_m = Axis(m.o.min_separation_m, m.o.max_separation_m, false);
+  grid->length_m = Axis(m.o.min_length_m, m.o.max_length_m, false);
+  GridPoint best;
+  for (double d : grid->separation_m) {
+    for (double l : grid->length_m) {
+      const double total = m.Terms(d, l, kMinRepeats).Total();
+      const bool ok = m.Feasible(d, l);
+      grid->total_percent.push_back(100.0 * total);
+      grid->feasible.push_back(ok ? 1 : 0);
+      if (ok && total < best.total) best = {d, l, total, true};
+    }
+  }
+  return best;
+}
+
+// The smallest D (then the shortest L) meeting `target` with max-length and max-separation lifted
+// to the plausibility bounds (20 m, 5 m); the period range and the other constraints kept.
+// Found on a geometric grid, then D refined by bisection at that L.
+GridPoint RelaxedForTarget(const GridModel& m, double target) {
+  const auto meets = [&](double d, double l) {
+    if (!m.Feasible(d, l)) return false;
+    RigPlanTerms t = m.Terms(d, l, kMinRepeats);
+    t.repeats = RepeatsFor(t, target);
+    return t.Total() <= target;
+  };
+  const std::vector<double> ds = Axis(m.o.min_separation_m, kMaxRelaxedSeparationM, true);
+  const std::vector<double> ls = Axis(m.o.min_length_m, kMaxRelaxedLengthM, true);
+  for (size_t i = 0; i < ds.size(); ++i) {
+    for (double l : ls) {
+      if (!meets(ds[i], l)) continue;
+      double lo = i > 0 ? ds[i - 1] : ds[i], hi = ds[i];
+      for (int k = 0; k < 40 && hi - lo > 1e-5 * hi; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (meets(mid, l) ? hi : lo) = mid;
+      }
+      return {hi, l, 0.0, true};
+    }
+  }
+  return GridPoint();
+}
+
+// --- The release amplitude.
+
+// The largest release (deg) at which a rig that departs from the model like the simulator's
+// non-ideal preset (restoring torque x (1 - k psi^2), `rig_departure` at 30 deg,
+// pendulum/simulate.h) moves I by at most `fraction` of the target.
+double ReleaseAmplitudeDeg(const RigPlanOptions& o, double fraction) {
+  if (o.rig_departure_percent <= 0.0) return kMaxReleaseDeg;
+  const double k = SofteningCoefficient(o.rig_departure_percent / 100.0, 2.0);
+  const double allowed = fraction * o.target_percent / 100.0;
+  double lo = kMinReleaseDeg;
+  for (double a = kMinReleaseDeg; a <= kMaxReleaseDeg + 1e-9; a += 0.5) {
+    if (ApparentInertiaExcess(k, 2.0, a * kRadPerDeg) <= allowed) lo = a;
+  }
+  return lo;
+}
+
+// The full model's period at release amplitude A (undamped), from the integrator: the time for
+// the rate to come back to zero, twice. NaN if the integration fails.
+double FullModelPeriod(const RigGeometry& g, double inertia, double amplitude_rad) {
+  const double t0 = SmallAnglePeriod(g, inertia);
+  std::vector<double> t(4001);
+  for (size_t k = 0; k < t.size(); ++k) t[k] = 0.75 * t0 * k / (t.size() - 1);
+  PendulumIntegrator integ(PendulumModel::kFull, g);
+  Trajectory traj;
+  std::string why;
+  if (!integ.Integrate({inertia, 0.0, 0.0}, amplitude_rad, 0.0, t, false, &traj, &why)) return NAN;
+  for (size_t k = t.size() / 3; k + 1 < t.size(); ++k) {  // angle crosses -A: rate sign change
+    const double r0 = traj.rate_rad_per_s[k], r1 = traj.rate_rad_per_s[k + 1];
+    if (r0 < 0.0 && r1 >= 0.0) return 2.0 * (t[k] + (t[k + 1] - t[k]) * (-r0) / (r1 - r0));
+  }
+  return NAN;
+}
+
+// --- One rig evaluated with the project's fit.
+
+TraceFitOptions FitOptionsFor(const RigPlanOptions& o, bool with_budget) {
+  TraceFitOptions f;
+  f.keep_series = false;
+  if (with_budget) {
+    f.filar_length_std_m = o.length_std_m;
+    f.filar_separation_std_m = o.separation_std_m;
+    f.mass_std_kg = o.mass_std_kg;
+    f.gravity_std_mps2 = o.gravity_std_mps2;
+  }
+  return f;
+}
+
+SyntheticTraceOptions SwingFor(const RigPlanOptions& o, const RigGeometry& g, double inertia,
+                               double amplitude_deg, double swing_s, uint64_t seed) {
+  SyntheticTraceOptions s;
+  s.geometry = g;
+  s.params.inertia_kg_m2 = inertia;
+  const double period = SmallAnglePeriod(g, inertia);
+  // Amplitude ~ exp(-t / (decay_periods T)): C = 2 I / (decay_periods T).
+  s.params.viscous_coeff_kg_m2_per_s = 2.0 * inertia / (o.decay_periods * period);
+  s.amplitude_deg = amplitude_deg;
+  s.duration_s = swing_s;
+  s.sample_rate_hz = o.imu_rate_hz;
+  s.noise_deg_per_s = o.gyro_noise_deg_per_s;
+  s.seed = seed;
+  return s;
+}
+
+RigCandidate Evaluate(const RigPlanOptions& o, const std::string& label, double d, double l,
+                      double inertia, double amplitude_deg, double swing_s, double target) {
+  RigCandidate c;
+  c.label = label;
+  c.separation_m = d;
+  c.length_m = l;
+  const RigGeometry g{l, d, SuspendedMass(o), o.gravity_mps2};
+  c.period_s = FullModelPeriod(g, inertia, amplitude_deg * kRadPerDeg);
+  TraceFitInput in;
+  if (!MakeSyntheticTrace(SwingFor(o, g, inertia, amplitude_deg, swing_s, o.seed), &in)) {
+    throw UserError("plan --rig: the swing on L " + Fmt("%.3g", l) + " m, D " + Fmt("%.3g", d) +
+                    " m could not be simulated");
+  }
+  const TraceFitResult r = FitTrace(in, FitOptionsFor(o, true));
+  if (!r.HasFit()) {
+    throw UserError("plan --rig: the simulated swing on L " + Fmt("%.3g", l) + " m, D " +
+                    Fmt("%.3g", d) + " m did not fit (--gyro-noise, --imu-rate): " + r.message);
+  }
+  const double i = r.params.inertia_kg_m2;
+  c.terms.statistical = r.inertia_stat_std_kg_m2 / i;
+  c.terms.between_repeat = o.repeat_scatter_percent / 100.0;
+  for (const UncertaintyContribution& b : r.budget) {
+    const double rel = b.contribution_kg_m2 / i;
+    if (b.name == "filar_length") c.terms.filar_length = rel;
+    if (b.name == "filar_separation") c.terms.filar_separation = rel;
+    if (b.name == "mass") c.terms.mass = rel;
+    if (b.name == "gravity") c.terms.gravity = rel;
+  }
+  c.terms.repeats = RepeatsFor(c.terms, target);
+  return c;
+}
+
+// --- The reference object.
+
+// A flat bar, swung flat and centred: I = M (a^2 + b^2) / 12 with b = a / 8, of the aircraft's
+// inertia and mass; aluminium when that gives a bar at least 3 mm thick and no thicker than it
+// is wide, else steel. Its inertia's std from the machining tolerance of a and b and the weighing.
+ReferenceBar DesignReference(double inertia, double mass) {
+  ReferenceBar bar;
+  const double a = std::sqrt(12.0 * inertia / mass / (1.0 + 1.0 / 64.0)), b = a / 8.0;
+  struct Material {
+    const char* name;
+    double density;
+  };
+  const Material materials[] = {{"aluminium", 2700.0}, {"steel", 7850.0}};
+  for (const Material& m : materials) {
+    const double t = mass / (m.density * a * b);
+    bar.material = m.name;
+    bar.density_kg_m3 = m.density;
+    bar.thickness_m = t;
+    if (t >= 0.003 && t <= b) break;
+  }
+  bar.length_m = a;
+  bar.width_m = b;
+  bar.mass_kg = mass;
+  bar.inertia_kg_m2 = mass * (a * a + b * b) / 12.0;
+  bar.tolerance_m = kBarToleranceM;
+  bar.swings = kRecommendedReferenceSwings;
+  const double s2 = a * a + b * b;
+  const double da = 2.0 * a * kBarToleranceM / s2, db = 2.0 * b * kBarToleranceM / s2;
+  bar.inertia_rel_std = std::sqrt(da * da + db * db + kBarWeighingRelStd * kBarWeighingRelStd);
+  return bar;
+}
+
+// The recommended rig with the reference object: L, D and g replaced by the calibration's
+// relative std (docs/method.md §15, given rig inertia): the bar's own and its swings' mean
+// (per-log std / sqrt(swings), the reference's inertia close to the aircraft's).
+RigPlanTerms Calibrated(const RigPlanTerms& t, const ReferenceBar& bar, double target) {
+  RigPlanTerms c = t;
+  c.filar_length = c.filar_separation = c.gravity = 0.0;
+  c.calibration =
+      std::hypot(bar.inertia_rel_std, t.PerLog() / std::sqrt(static_cast<double>(bar.swings)));
+  c.repeats = RepeatsFor(c, target);
+  return c;
+}
+
+// --- Monte-Carlo: swings on the recommended rig, L, D, m drawn, fitted with the nominal ones.
+
+RigMonteCarlo MonteCarlo(const RigPlan& plan, double inertia) {
+  const RigPlanOptions& o = plan.options;
+  RigMonteCarlo mc;
+  mc.swings = o.monte_carlo_swings;
+  mc.predicted_rel_std = plan.recommended.terms.SingleSwing();
+  const RigGeometry nominal{plan.recommended.length_m, plan.recommended.separation_m,
+                            SuspendedMass(o), o.gravity_mps2};
+  std::mt19937_64 rng(o.seed + 12345);
+  std::normal_distribution<double> z(0.0, 1.0);
+  std::vector<double> errors;
+  for (int k = 0; k < mc.swings; ++k) {
+    RigGeometry truth = nominal;
+    truth.filar_length_m += o.length_std_m * z(rng);
+    truth.filar_separation_m += o.separation_std_m * z(rng);
+    truth.mass_kg += o.mass_std_kg * z(rng);
+    truth.gravity_mps2 += o.gravity_std_mps2 * z(rng);
+    TraceFitInput in;
+    if (!MakeSyntheticTrace(SwingFor(o, truth, inertia, plan.release_amplitude_deg, plan.swing_s,
+                                     o.seed + 1000 + k),
+                            &in)) {
+      continue;
+    }
+    in.geometry = nominal;  // the fit knows only the measured rig
+    const TraceFitResult r = FitTrace(in, FitOptionsFor(o, false));
+    if (r.HasFit()) errors.push_back(r.params.inertia_kg_m2 / inertia - 1.0);
+  }
+  mc.usable = static_cast<int>(errors.size());
+  if (mc.usable >= 2) {
+    double mean = 0, ss = 0;
+    for (double e : errors) mean += e / errors.size();
+    for (double e : errors) ss += (e - mean) * (e - mean);
+    mc.scatter_rel_std = std::sqrt(ss / (errors.size() - 1));
+    mc.ratio = mc.scatter_rel_std / mc.predicted_rel_std;
+  }
+  return mc;
+}
+
+// The constraint that binds: the flag behind the largest term at the recommended rig.
+std::string BindingFlag(const RigPlanTerms& t) {
+  const double per_log = t.PerLog() / std::sqrt(static_cast<double>(t.repeats));
+  const std::pair<double, const char*> terms[] = {
+      {t.filar_separation, "--max-separation"},
+      {t.filar_length, "--max-length"},
+      {t.mass, "--mass-std"},
+      {t.gravity, "--gravity-std"},
+      {per_log, t.statistical > t.between_repeat ? "--gyro-noise" : "--repeat-scatter"}};
+  return std::max_element(std::begin(terms), std::end(terms))->second;
+}
+
+void Alternatives(const RigPlanOptions& o, const GridModel& m, double inertia, RigPlan* plan) {
+  const double target = o.target_percent / 100.0, d0 = plan->recommended.separation_m,
+               l0 = plan->recommended.length_m;
+  struct Try {
+    const char* label;
+    double d, l;
+  };
+  // Around the choice: a shorter and a longer wire, a narrower separation.
+  const Try tries[] = {{"shorter L", d0, std::max(o.min_length_m, 0.75 * l0)},
+                       {"longer L", d0, std::min(o.max_length_m, 1.25 * l0)},
+                       {"narrower D", std::max(o.min_separation_m, 0.75 * d0), l0}};
+  for (const Try& t : tries) {
+    if ((t.d == d0 && t.l == l0) || !m.Feasible(t.d, t.l)) continue;
+    try {
+      plan->alternatives.push_back(Evaluate(o, t.label, t.d, t.l, inertia,
+                                            plan->release_amplitude_deg,
+                                            m.SwingS(m.Period(t.d, t.l)), target));
+    } catch (const UserError&) {
+      // an alternative whose swing the noise drowns is no alternative: left out
+    }
+  }
+}
+
+}  // namespace
+
+RigPlan RunRigPlan(const RigPlanOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string why;
+  if (!options.Check(&why)) throw UserError(why);
+  RigPlan plan;
+  plan.options = options;
+  RigPlanOptions& o = plan.options;
+  if (std::isnan(o.mass_std_kg)) o.mass_std_kg = 1e-3 * SuspendedMass(o);
+  if (!std::isnan(o.radius_of_gyration_m)) {
+    o.inertia_kg_m2 = SuspendedMass(o) * o.radius_of_gyration_m * o.radius_of_gyration_m;
+  }
+  // A range of inertia: planned at its low end (the shortest period; the relative L, D, m, g
+  // terms do not depend on I); the period range must hold at both ends (GridModel::Feasible).
+  const double inertia = o.inertia_kg_m2;
+  const double target = o.target_percent / 100.0;
+  plan.release_amplitude_deg = ReleaseAmplitudeDeg(o, plan.departure_fraction_of_target);
+  const GridModel model{o, inertia, plan.release_amplitude_deg * kRadPerDeg};
+  GridPoint best = SearchGrid(model, &plan.grid);
+  if (!best.found) {  // the period range excludes every rig: say which end binds
+    const double t_fast = model.Period(o.max_separation_m, o.min_length_m);
+    plan.binding = o.min_period_s > o.max_period_s ? "--min-period"
+                   : t_fast > o.max_period_s       ? "--max-period"
+                                                   : "--min-period";
+    plan.advice = o.min_period_s > o.max_period_s
+                      ? "the period range is empty (--min-period " + Fmt("%g", o.min_period_s) +
+                            " s above --max-period " + Fmt("%g", o.max_period_s) + " s)"
+                      : "no rig within --min-length..--max-length and --min-separation.."
+                        "--max-separation swings with a period in [" +
+                            Fmt("%g", o.min_period_s) + ", " + Fmt("%g", o.max_period_s) +
+                            "] s; the periods possible span " + Fmt("%.3g", t_fast) + " to " +
+                            Fmt("%.3g", model.Period(o.min_separation_m, o.max_length_m)) + " s";
+    plan.advice += "; the rig shown is the widest D on the longest L";
+    best = {o.max_separation_m, o.max_length_m, 0.0, true};  // evaluated anyway, marked
+  }
+  plan.swing_s = model.SwingS(model.Period(best.d, best.l));
+  plan.recommended = Evaluate(o, "recommended", best.d, best.l, inertia, plan.release_amplitude_deg,
+                              plan.swing_s, target);
+  const RigGeometry g{best.l, best.d, SuspendedMass(o), o.gravity_mps2};
+  plan.small_angle_excess_percent =
+      100.0 * (std::pow(plan.recommended.period_s / SmallAnglePeriod(g, inertia), 2) - 1.0);
+  plan.best_std_percent = 100.0 * plan.recommended.terms.Total();
+  if (plan.binding.empty()) {
+    plan.target_met = plan.recommended.terms.Total() <= target;
+    if (!plan.target_met) plan.binding = BindingFlag(plan.recommended.terms);
+  }
+  Alternatives(o, model, inertia, &plan);
+  const GridPoint relaxed = RelaxedForTarget(model, target);
+  if (relaxed.found) {
+    plan.separation_for_target_m = relaxed.d;
+    plan.length_for_target_m = relaxed.l;
+  }
+  plan.reference = DesignReference(inertia, o.mass_kg);
+  plan.calibrated = Calibrated(plan.recommended.terms, plan.reference, target);
+  plan.reference.needed = !plan.target_met;
+  if (!plan.target_met && plan.advice.empty()) {
+    plan.advice = plan.calibrated.Total() <= target
+                      ? "a reference object (below) brings it to " +
+                            Fmt("%.2f", 100.0 * plan.calibrated.Total()) + " %"
+                      : "even a reference object leaves " +
+                            Fmt("%.2f", 100.0 * plan.calibrated.Total()) + " %";
+    if (relaxed.found) {
+      plan.advice += "; without one, D >= " + Fmt("%.3f", relaxed.d) + " m on L " +
+                     Fmt("%.3f", relaxed.l) + " m meets the target";
+    }
+  }
+  if (o.monte_carlo_swings > 0) plan.monte_carlo = MonteCarlo(plan, inertia);
+  plan.plan_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return plan;
+}
+
+}  // namespace bifilar
