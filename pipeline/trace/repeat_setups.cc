@@ -208,7 +208,8 @@ void Decide(const std::vector<const TraceRecord*>& records, SetupSplit* out) {
   (void)records;
 }
 
-std::string Names(const std::vector<int>& which, const std::vector<std::string>& names) {
+std::string Names(std::vector<int> which, const std::vector<std::string>& names) {
+  std::sort(which.begin(), which.end());
   std::string out;
   for (size_t k = 0; k < which.size(); ++k) {
     out += (k ? ", " : "") + names[which[k]];
@@ -280,7 +281,7 @@ std::string TwoSetupsText(const SetupSplit& split, const std::vector<std::string
   if (!split.two_setups) return "";
   char text[640];
   std::snprintf(text, sizeof(text),
-                "looks like two set-ups, not one: %s at I = %.5g +- %.2g kg m^2 and %s at "
+                "two set-ups, not one: %s at I = %.5g +- %.2g kg m^2 and %s at "
                 "I = %.5g +- %.2g kg m^2, %.1f %% apart (%.0f sigma, Q = %.0f on %d dof)",
                 Names(split.clusters[0], names).c_str(), split.mean_kg_m2[0],
                 split.mean_std_kg_m2[0], Names(split.clusters[1], names).c_str(),

@@ -75,7 +75,7 @@ bool PooledOwnTrend(const std::vector<const TraceRecord*>& records, double* coef
 // (a caller that corrected them for amplitude passes the uncorrected ones).
 SetupSplit TestTwoSetups(const std::vector<const TraceRecord*>& records);
 
-// "looks like two set-ups, not one: a, b at I = ...; c, d at I = ... (...)" with each log named
+// "two set-ups, not one: a, b at I = ... and c, d at I = ... (...)" with each log named
 // by `names` (same order as the records given to TestTwoSetups); "" unless two_setups.
 std::string TwoSetupsText(const SetupSplit& split, const std::vector<std::string>& names);
 

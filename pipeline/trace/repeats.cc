@@ -170,7 +170,7 @@ void TrendBeforeCorrection(const std::vector<TraceRecord*>& used, RepeatGroup* g
 
 // The two-set-up finding, as the end of the scatter warning ("" for one set-up).
 std::string SetupsSentence(const RepeatGroup& g) {
-  return g.setups_text.empty() ? "" : "; they " + g.setups_text;
+  return g.setups_text.empty() ? "" : "; they look like " + g.setups_text;
 }
 
 // The random-effects mean (weights 1 / (s_i^2 + tau^2)) and its std with the common part of the
@@ -327,10 +327,12 @@ RepeatsAmplitudeCorrection CorrectAmplitude(const std::vector<RepeatGroup>& grou
   }
   PooledAmplitudeTrend pooled;
   if (!FitPooledAmplitudeTrend(points, &pooled)) {
-    out.note = "the repeats do not vary in amplitude enough to measure how I depends on it "
-               "(needs 2 or more repeats of a set-up at different amplitudes, and 1 degree of "
-               "freedom beyond the fit)";
-    if (out.n_groups_two_setups > 0) {
+    out.note = points.empty() && out.n_groups_two_setups > 0
+                   ? "every group of repeats looks like two set-ups, whose spread is not amplitude"
+                   : "the repeats do not vary in amplitude enough to measure how I depends on it "
+                     "(needs 2 or more repeats of a set-up at different amplitudes, and 1 degree "
+                     "of freedom beyond the fit)";
+    if (!points.empty() && out.n_groups_two_setups > 0) {
       out.note += "; " + std::to_string(out.n_groups_two_setups) +
                   " group(s) left out: they look like two set-ups";
     }
