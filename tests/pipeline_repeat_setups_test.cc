@@ -201,5 +201,37 @@ TEST(RepeatSetups, NoFalseTwoSetupsOnIdealGroups) {
   EXPECT_EQ(two, 0);
 }
 
+// A campaign does the same for the logs of one attitude; a runs.table `group` column that puts
+// each hanging in its own group silences it (2 logs per group are not tested).
+TEST(RepeatSetups, CampaignWarnsPerAttitudeAndHonoursTheGroupColumn) {
+  const TempDir dir("bifilar_setups_campaign");
+  Simulate(dir, "p_1.csv", 0.100, 41, 20);
+  Simulate(dir, "p_2.csv", 0.100, 42, 12);
+  Simulate(dir, "p_3.csv", 0.110, 43, 18);
+  Simulate(dir, "p_4.csv", 0.110, 44, 14);
+  const std::string config =
+      "rig: {filar_length_m: 1.5, filar_separation_m: 0.5, mass_kg: 3}\n"
+      "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [gx, gy, gz], unit: rad/s}\n"
+      "  accel: {columns: [ax, ay, az], unit: m/s^2}\n"
+      "runs: {root: ., table: runs.csv}\n";
+  WriteFile(dir.path + "/campaign.yaml", config);
+  WriteFile(dir.path + "/runs.csv",
+            "path,pitch_deg\np_1.csv,0\np_2.csv,0\np_3.csv,0\np_4.csv,0\n");
+  const test_support::CliRun one =
+      test_support::Bifilar(dir, "process " + dir.path + "/campaign.yaml --out " + dir.path + "/out1");
+  EXPECT_NE(one.out.find("Warning: the 4 logs at roll 0, pitch 0 deg look like two set-ups, not "
+                         "one: p_1.csv, p_2.csv at I = "),
+            std::string::npos)
+      << one.out << one.err;
+  EXPECT_NE(test_support::ReadFile(dir.path + "/out1/results.json").find("look like two set-ups"),
+            std::string::npos);
+  WriteFile(dir.path + "/runs.csv", "path,pitch_deg,group\np_1.csv,0,A\np_2.csv,0,A\n"
+                                    "p_3.csv,0,B\np_4.csv,0,B\n");
+  const test_support::CliRun two =
+      test_support::Bifilar(dir, "process " + dir.path + "/campaign.yaml --out " + dir.path + "/out2");
+  EXPECT_EQ(two.out.find("two set-ups"), std::string::npos) << two.out;
+  EXPECT_NE(two.out.find("Traces: 4 ok"), std::string::npos) << two.out << two.err;
+}
+
 }  // namespace
 }  // namespace bifilar

@@ -532,7 +532,9 @@ void WarnIfTwoSetups(const std::vector<RunFile>& runs, CampaignResult* result) {
     std::snprintf(where, sizeof(where), "the %zu logs at roll %g, pitch %g deg%s look like ",
                   members.size(), std::get<0>(key), std::get<1>(key),
                   std::get<2>(key).empty() ? "" : (" of group '" + std::get<2>(key) + "'").c_str());
-    const std::string text = where + TwoSetupsText(split, names);
+    const std::string text = where + TwoSetupsText(split, names) +
+                             ". Check the hanging; if it changed, name each set-up in a group "
+                             "column of runs.table";
     result->setup_warnings.push_back(text);
     for (int i : members) traces[i].warnings.push_back(text);
   }

@@ -281,8 +281,8 @@ std::string TwoSetupsText(const SetupSplit& split, const std::vector<std::string
   if (!split.two_setups) return "";
   char text[640];
   std::snprintf(text, sizeof(text),
-                "two set-ups, not one: %s at I = %.5g +- %.2g kg m^2 and %s at "
-                "I = %.5g +- %.2g kg m^2, %.1f %% apart (%.0f sigma, Q = %.0f on %d dof)",
+                "two set-ups, not one: %s at I = %#.5g +- %.2g kg m^2 and %s at "
+                "I = %#.5g +- %.2g kg m^2, %.1f %% apart (%.0f sigma, Q = %.0f on %d dof)",
                 Names(split.clusters[0], names).c_str(), split.mean_kg_m2[0],
                 split.mean_std_kg_m2[0], Names(split.clusters[1], names).c_str(),
                 split.mean_kg_m2[1], split.mean_std_kg_m2[1], split.gap_percent, split.gap_z,
@@ -296,7 +296,7 @@ std::string TwoSetupsText(const SetupSplit& split, const std::vector<std::string
   } else {
     std::snprintf(text, sizeof(text),
                   "; not the release amplitude (RMS %.1f and %.1f deg): the logs' own I(A) trends "
-                  "allow at most %.2f %% between them",
+                  "allow at most %.2g %% between them",
                   split.amplitude_rms_deg[0], split.amplitude_rms_deg[1],
                   split.amplitude_allows_percent);
   }
@@ -312,7 +312,7 @@ std::string TwoSetupsText(const SetupSplit& split, const std::vector<std::string
                   split.axes_differ ? ": a different hanging" : ", as within a cluster");
     out += text;
   }
-  return out + ". Fit each set-up as its own group (--group-by, or a runs table's group column)";
+  return out;
 }
 
 }  // namespace bifilar

@@ -170,7 +170,10 @@ void TrendBeforeCorrection(const std::vector<TraceRecord*>& used, RepeatGroup* g
 
 // The two-set-up finding, as the end of the scatter warning ("" for one set-up).
 std::string SetupsSentence(const RepeatGroup& g) {
-  return g.setups_text.empty() ? "" : "; they look like " + g.setups_text;
+  return g.setups_text.empty() ? ""
+                               : "; they look like " + g.setups_text +
+                                     ". Fit each set-up as its own group (--group-by, or "
+                                     "--runs-table with a group column)";
 }
 
 // The random-effects mean (weights 1 / (s_i^2 + tau^2)) and its std with the common part of the
