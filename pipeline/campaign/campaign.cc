@@ -512,7 +512,10 @@ void WarnIfTwoSetups(const std::vector<RunFile>& runs, CampaignResult* result) {
   std::map<std::tuple<double, double, std::string>, std::vector<int>> groups;
   for (size_t i = 0; i < traces.size(); ++i) {
     const TraceRecord& r = traces[i];
-    if (r.role != TraceRole::kAircraft || !r.ok() || !(r.inertia_total_std_kg_m2 > 0.0)) continue;
+    if (r.role != TraceRole::kAircraft || !r.ok() || !std::isfinite(r.inertia_total_kg_m2) ||
+        !std::isfinite(r.inertia_total_std_kg_m2) || !(r.inertia_total_std_kg_m2 > 0.0)) {
+      continue;
+    }
     const double pitch =
         r.pitch_nominal_deg ? *r.pitch_nominal_deg : std::round(r.pitch_used_deg * 2.0) / 2.0;
     const double roll = r.pitch_nominal_deg ? r.roll_nominal_deg.value_or(0.0)
