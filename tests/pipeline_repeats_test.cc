@@ -227,8 +227,13 @@ TEST(Repeats, QuadrotorRepeatsAreWithinTheirStd) {
   EXPECT_GT(correction.z, 3.0);
   int logs = 0, beyond = 0;
   double spread_before = 0.0, spread_after = 0.0, q_before = 0.0, q_after = 0.0;
+  // Issue 26: the pooled coefficient agrees with the logs' own I(A) trends, and no set-up looks
+  // like two (pipeline/trace/repeat_setups.h).
+  EXPECT_FALSE(correction.contradicts_own);
+  EXPECT_LT(std::abs(correction.own_z), 3.0);
   for (const RepeatGroup& g : groups) {
     EXPECT_EQ(g.n_used, 4);
+    EXPECT_FALSE(g.setups.two_setups) << g.name << ": " << g.setups_text;
     EXPECT_LE(g.max_abs_z, 2.5) << g.name;
     spread_before += g.spread_before_percent / groups.size();
     spread_after += g.spread_after_percent / groups.size();

@@ -12,6 +12,7 @@
 #include <ostream>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include "base/bounded_read.h"
@@ -33,6 +34,7 @@
 #include "pipeline/report/report.h"
 #include "pipeline/store/cache.h"
 #include "pipeline/store/output_set.h"
+#include "pipeline/trace/repeat_setups.h"
 
 namespace bifilar {
 namespace {
@@ -502,6 +504,45 @@ void SubtractRig(const CampaignConfig& config, const TareEstimate& tare,
 
 // ---- Step 4: group ----------------------------------------------------------------------------
 
+// The logs of one attitude (and of one group of runs.table's `group` column, when it has one)
+// are repeats of one set-up: when they look like two (pipeline/trace/repeat_setups.h), each gets
+// a warning naming the clusters, and the campaign says it once. Numbers are not changed.
+void WarnIfTwoSetups(const std::vector<RunFile>& runs, CampaignResult* result) {
+  std::vector<TraceRecord>& traces = result->traces;
+  std::map<std::tuple<double, double, std::string>, std::vector<int>> groups;
+  for (size_t i = 0; i < traces.size(); ++i) {
+    const TraceRecord& r = traces[i];
+    if (r.role != TraceRole::kAircraft || !r.ok() || !std::isfinite(r.inertia_total_kg_m2) ||
+        !std::isfinite(r.inertia_total_std_kg_m2) || !(r.inertia_total_std_kg_m2 > 0.0)) {
+      continue;
+    }
+    const double pitch =
+        r.pitch_nominal_deg ? *r.pitch_nominal_deg : std::round(r.pitch_used_deg * 2.0) / 2.0;
+    const double roll = r.pitch_nominal_deg ? r.roll_nominal_deg.value_or(0.0)
+                                            : std::round(r.roll_used_deg * 2.0) / 2.0;
+    groups[{roll, pitch, i < runs.size() ? runs[i].group : ""}].push_back(static_cast<int>(i));
+  }
+  for (const auto& [key, members] : groups) {
+    std::vector<const TraceRecord*> records;
+    std::vector<std::string> names;
+    for (int i : members) {
+      records.push_back(&traces[i]);
+      names.push_back(traces[i].file);
+    }
+    const SetupSplit split = TestTwoSetups(records);
+    if (!split.two_setups) continue;
+    char where[160];
+    std::snprintf(where, sizeof(where), "the %zu logs at roll %g, pitch %g deg%s look like ",
+                  members.size(), std::get<0>(key), std::get<1>(key),
+                  std::get<2>(key).empty() ? "" : (" of group '" + std::get<2>(key) + "'").c_str());
+    const std::string text = where + TwoSetupsText(split, names) +
+                             ". Check the hanging; if it changed, name each set-up in a group "
+                             "column of runs.table";
+    result->setup_warnings.push_back(text);
+    for (int i : members) traces[i].warnings.push_back(text);
+  }
+}
+
 void CountStatuses(const std::vector<TraceRecord>& traces, CampaignSummary* summary) {
   for (const TraceRecord& r : traces) {
     ++summary->n_traces;
@@ -768,6 +809,7 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   const TareEstimate tare = EstimateTare(&result.traces);
   SetRigInertia(config, tare, &result);
   SubtractRig(config, tare, &result.traces);
+  WarnIfTwoSetups(inputs.runs, &result);
   // 4. Group: counts, per-angle statistics, the systematic uncertainty.
   CountStatuses(result.traces, &result.summary);
   result.angles = GroupByAngle(result.traces);

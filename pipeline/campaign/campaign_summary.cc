@@ -104,6 +104,7 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     }
     out << "  " << ToString(r.status) << ": " << r.message << "\n";
   }
+  for (const std::string& w : result.setup_warnings) out << "Warning: " << w << "\n";
   if (!result.assumed_inputs_note.empty()) out << result.assumed_inputs_note << "\n";
   if (rig_unknown > 0) {
     out << "  error: " << rig_unknown << " aircraft trace" << (rig_unknown == 1 ? "" : "s")

@@ -221,6 +221,7 @@ std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
   std::string line;
   int line_no = 0;
   int path_col = -1, pitch_col = -1, roll_col = -1;  // roll_deg is optional (0 when absent)
+  int group_col = -1;                                 // group is optional
   while (std::getline(in, line)) {
     ++line_no;
     // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
@@ -233,6 +234,7 @@ std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
         if (cells[i] == "path" || cells[i] == "file") path_col = static_cast<int>(i);
         if (cells[i] == "pitch_deg") pitch_col = static_cast<int>(i);
         if (cells[i] == "roll_deg") roll_col = static_cast<int>(i);
+        if (cells[i] == "group") group_col = static_cast<int>(i);
       }
       if (path_col < 0 || pitch_col < 0) {
         throw UserError(config.runs.table + ":" + std::to_string(line_no) +
@@ -244,6 +246,7 @@ std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
     const std::string rel = static_cast<int>(cells.size()) > path_col ? cells[path_col] : "";
     run.path = ResolvePath(config.runs.root, rel);
     run.display = Display(config, run.path);
+    if (group_col >= 0 && static_cast<int>(cells.size()) > group_col) run.group = cells[group_col];
     double pitch = 0.0, roll = 0.0;
     if (rel.empty()) {
       run.display = config.runs.table + ":" + std::to_string(line_no);
@@ -427,6 +430,77 @@ std::vector<RunFile> DiscoverRuns(const CampaignConfig& config) {
     runs.insert(runs.end(), reference.begin(), reference.end());
   }
   return OncePerPath(std::move(runs));
+}
+
+RunsTableGroups ReadRunsTableGroups(const std::string& table) {
+  std::istringstream in(ReadRegularFileOrThrow(table, TableCap("runs table (--runs-table)")));
+  RunsTableGroups out;
+  std::string line;
+  int line_no = 0, path_col = -1, group_col = -1, pitch_col = -1, roll_col = -1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line_no == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
+    const size_t first = line.find_first_not_of(" \r\t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const std::vector<std::string> cells = SplitCsvLine(line);
+    const auto cell = [&](int col) {
+      return col >= 0 && col < static_cast<int>(cells.size()) ? cells[col] : std::string();
+    };
+    if (path_col < 0) {
+      for (size_t i = 0; i < cells.size(); ++i) {
+        if (cells[i] == "path" || cells[i] == "file") path_col = static_cast<int>(i);
+        if (cells[i] == "group") group_col = static_cast<int>(i);
+        if (cells[i] == "pitch_deg") pitch_col = static_cast<int>(i);
+        if (cells[i] == "roll_deg") roll_col = static_cast<int>(i);
+      }
+      if (path_col < 0 || (group_col < 0 && pitch_col < 0)) {
+        throw UserError(table + ":" + std::to_string(line_no) +
+                        ": a runs table needs a header with a 'path' column and a 'group' column "
+                        "(or the attitude: 'pitch_deg', optionally 'roll_deg')");
+      }
+      out.source = table + (group_col >= 0 ? " (its group column)" : " (its roll_deg and pitch_deg)");
+      continue;
+    }
+    std::string group = cell(group_col);
+    if (group_col < 0) {
+      double pitch = 0.0, roll = 0.0;
+      if (!ParsePitchText(cell(pitch_col), &pitch) ||
+          (roll_col >= 0 && !ParsePitchText(cell(roll_col), &roll))) {
+        throw UserError(table + ":" + std::to_string(line_no) + ": the attitude of '" +
+                        cell(path_col) + "' is not a number in [-180, 180] (pitch_deg, roll_deg)");
+      }
+      char text[64];
+      std::snprintf(text, sizeof(text), "roll %g pitch %g", roll, pitch);
+      group = text;
+    }
+    if (cell(path_col).empty()) {
+      throw UserError(table + ":" + std::to_string(line_no) + ": empty path in runs table");
+    }
+    out.paths.push_back(cell(path_col));
+    out.groups.push_back(group);
+  }
+  if (path_col < 0) throw UserError(table + ": runs table is empty: expected a header 'path,group'");
+  return out;
+}
+
+std::vector<std::string> GroupsOfLogs(const std::vector<std::string>& logs,
+                                      const RunsTableGroups& table) {
+  std::vector<std::string> groups;
+  for (const std::string& log : logs) {
+    const std::vector<std::string> parts = SplitPath(fs::path(log).lexically_normal().string());
+    std::string group;
+    size_t longest = 0;
+    for (size_t r = 0; r < table.paths.size(); ++r) {
+      const std::vector<std::string> row = SplitPath(fs::path(table.paths[r]).lexically_normal().string());
+      if (row.empty() || row.size() > parts.size() || row.size() <= longest) continue;
+      if (std::equal(row.begin(), row.end(), parts.end() - row.size())) {
+        longest = row.size();
+        group = table.groups[r];
+      }
+    }
+    groups.push_back(group);
+  }
+  return groups;
 }
 
 }  // namespace bifilar

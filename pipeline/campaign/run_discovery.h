@@ -23,6 +23,7 @@ struct RunFile {
   std::optional<double> pitch_nominal_deg;  // from the path pattern or the table
   std::optional<double> roll_nominal_deg;   // {roll_deg} in the pattern, roll_deg in the table
   std::string error;                        // non-empty: becomes an error row
+  std::string group;  // runs.table's optional `group` column: the set-up it names ("" none)
 };
 
 // Aircraft runs (runs.pattern or runs.table), then tare logs, then the reference swings of
@@ -36,5 +37,22 @@ std::vector<RunFile> DiscoverRuns(const CampaignConfig& config);
 // nothing.
 std::vector<RunFile> DiscoverListedLogs(const CampaignConfig& config,
                                         const std::vector<std::string>& patterns, TraceRole role);
+
+// A runs table read for the groups it names (`fit --repeats --runs-table FILE`): each row's
+// path (column `path` or `file`) and its group: the `group` column, else the attitude of its
+// `roll_deg` and `pitch_deg` columns ("roll 90 pitch 0"), as `process` groups them. Throws
+// UserError naming the file and line (no path column, neither group nor pitch_deg).
+struct RunsTableGroups {
+  std::string source;               // "FILE (its group column)" or "(its roll_deg/pitch_deg)"
+  std::vector<std::string> paths;   // as written in the table
+  std::vector<std::string> groups;  // one per row
+};
+RunsTableGroups ReadRunsTableGroups(const std::string& table);
+
+// For each log, the group of the table row naming it, "" when no row does: a row names a log
+// when the row's path, folder by folder, is the end of the log's path (the table's paths are
+// relative to runs.root, the logs are given as they are found).
+std::vector<std::string> GroupsOfLogs(const std::vector<std::string>& logs,
+                                      const RunsTableGroups& table);
 
 }  // namespace bifilar

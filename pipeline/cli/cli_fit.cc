@@ -171,7 +171,14 @@ void AddFitOptions(CLI::App* sub, FitCli* args) {
                   "amplitude) DIR/<log>_sweep.svg and .png when the trace has one");
   sub->add_flag("--repeats", o.repeats,
                 "combine repeats: logs whose paths differ only in the last number of the file "
-                "name are swings of one set-up; their scatter beyond their stds is added to each");
+                "name (case ignored) are swings of one set-up; their scatter beyond their stds "
+                "is added to each; a group that looks like two set-ups is named");
+  sub->add_option("--group-by", o.group_by,
+                  "with --repeats: a regular expression for the part of each file name that names "
+                  "the set-up (its first group, else the whole match; case ignored)");
+  sub->add_option("--runs-table", o.runs_table,
+                  "with --repeats: a CSV naming each log's group (columns path and group; or "
+                  "pitch_deg/roll_deg: one group per attitude, as `process` does)");
 }
 
 }  // namespace
@@ -195,6 +202,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       options.on_identical_log = [](const std::string& w) {
         std::cout << "warning: " << w << std::endl;
       };
+      options.on_groups = [](const std::string& groups) { std::cout << groups << std::endl; };
       // Without --repeats each line is printed as soon as its log is fitted.
       if (!repeats) {
         options.on_record = [](const TraceRecord& r, const CampaignConfig& config) {

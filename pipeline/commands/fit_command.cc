@@ -16,6 +16,7 @@
 #include "fit/window.h"
 #include "pipeline/campaign/calibration.h"
 #include "pipeline/campaign/campaign_inputs.h"
+#include "pipeline/campaign/run_discovery.h"
 #include "pipeline/records/results_json.h"
 #include "pipeline/trace/trace_process.h"
 
@@ -89,6 +90,30 @@ std::vector<std::string> FigureStems(const std::vector<std::string>& logs) {
 
 namespace {
 
+nlohmann::json SetupSplitToJson(const SetupSplit& s, const std::string& text) {
+  nlohmann::json j = {{"tested", s.tested}, {"two_setups", s.two_setups}, {"note", s.note},
+                      {"q", JsonNumber(s.q)}, {"q_z", JsonNumber(s.q_z)}};
+  if (!s.tested) return j;
+  j["clusters"] = {s.clusters[0], s.clusters[1]};
+  j["mean_kg_m2"] = {JsonNumber(s.mean_kg_m2[0]), JsonNumber(s.mean_kg_m2[1])};
+  j["mean_std_kg_m2"] = {JsonNumber(s.mean_std_kg_m2[0]), JsonNumber(s.mean_std_kg_m2[1])};
+  j["amplitude_rms_deg"] = {JsonNumber(s.amplitude_rms_deg[0]), JsonNumber(s.amplitude_rms_deg[1])};
+  j["gap_percent"] = JsonNumber(s.gap_percent);
+  j["gap_z"] = JsonNumber(s.gap_z);
+  j["separation"] = JsonNumber(s.separation);
+  j["amplitudes_interleave"] = s.amplitudes_interleave;
+  j["own_trend_logs"] = s.n_own;
+  j["own_coeff_per_deg2"] = JsonNumber(s.own_coeff_per_deg2);
+  j["own_coeff_std_per_deg2"] = JsonNumber(s.own_coeff_std_per_deg2);
+  j["amplitude_allows_percent"] = JsonNumber(s.amplitude_allows_percent);
+  j["gap_z_beyond_amplitude"] = JsonNumber(s.gap_z_beyond_amplitude);
+  j["axis_angle_deg"] = JsonNumber(s.axis_angle_deg);
+  j["axis_spread_deg"] = JsonNumber(s.axis_spread_deg);
+  j["axes_differ"] = s.axes_differ;
+  j["text"] = text;
+  return j;
+}
+
 nlohmann::json RepeatGroupsToJson(const std::vector<RepeatGroup>& groups) {
   nlohmann::json out = nlohmann::json::array();
   for (const RepeatGroup& g : groups) {
@@ -111,7 +136,11 @@ nlohmann::json RepeatGroupsToJson(const std::vector<RepeatGroup>& groups) {
                    {"correction_std_kg_m2", JsonNumber(g.correction_std_kg_m2)},
                    {"common_mode_std_kg_m2", JsonNumber(g.common_mode_std_kg_m2)},
                    {"total_std_kg_m2", JsonNumber(g.total_std_kg_m2)},
-                   {"note", g.note}});
+                   {"note", g.note},
+                   {"max_abs_z_own", JsonNumber(g.max_abs_z_own)},
+                   {"alone", g.alone},
+                   {"trend_contradicts_own_trends", g.trend_contradicts_own},
+                   {"setups", SetupSplitToJson(g.setups, g.setups_text)}});
   }
   return out;
 }
@@ -131,7 +160,13 @@ nlohmann::json AmplitudeCorrectionToJson(const RepeatsAmplitudeCorrection& c) {
           {"n_corrected", c.n_corrected},
           {"n_low_band_kept", c.n_low_band_kept},
           {"amplitude_range_deg", {JsonNumber(c.amplitude_min_deg), JsonNumber(c.amplitude_max_deg)}},
-          {"note", c.note}};
+          {"note", c.note},
+          {"own_coeff_per_deg2", JsonNumber(c.own_coeff_per_deg2)},
+          {"own_coeff_std_per_deg2", JsonNumber(c.own_coeff_std_per_deg2)},
+          {"own_trend_logs", c.n_own},
+          {"own_z", JsonNumber(c.own_z)},
+          {"contradicts_own_trends", c.contradicts_own},
+          {"groups_two_setups", c.n_groups_two_setups}};
 }
 
 // The config with the command line's overrides; checks them and fit.windows before any fit.
@@ -236,6 +271,27 @@ nlohmann::json FitResultJson(const FitCommandOptions& o, const FitCommandResult&
   return out;
 }
 
+// --group-by and --runs-table (with --repeats, not both): how the logs are grouped.
+RepeatGroupingOptions GroupingOptions(const FitCommandOptions& o,
+                                      const std::vector<std::string>& logs) {
+  if (!o.repeats && (!o.group_by.empty() || !o.runs_table.empty())) {
+    throw UserError(std::string(o.group_by.empty() ? "--runs-table" : "--group-by") +
+                    " groups repeats: it needs --repeats");
+  }
+  if (!o.group_by.empty() && !o.runs_table.empty()) {
+    throw UserError("--group-by and --runs-table both say how to group the repeats: give one");
+  }
+  RepeatGroupingOptions grouping;
+  grouping.group_by = o.group_by;
+  if (!o.runs_table.empty()) {
+    const RunsTableGroups table = ReadRunsTableGroups(o.runs_table);
+    grouping.named = GroupsOfLogs(logs, table);
+    grouping.named_source = table.source;
+    grouping.named_rows = table.paths;
+  }
+  return grouping;
+}
+
 }  // namespace
 
 int FitCommandResult::ExitCode() const {
@@ -246,6 +302,7 @@ int FitCommandResult::ExitCode() const {
 FitCommandResult RunFit(const FitCommandOptions& options) {
   FitCommandResult result;
   result.config = LoadFitConfig(options);
+  if (!options.repeats) GroupingOptions(options, {});  // --group-by without --repeats: refused
   const TraceProcessOptions trace_options = BaseTraceOptions(options);
   CalibrateIfConfigured(options, &result);
   // --repeats: identical data is one repeat; the copies are named and dropped before fitting.
@@ -257,10 +314,19 @@ FitCommandResult RunFit(const FitCommandOptions& options) {
   if (options.on_identical_log) {
     for (const std::string& w : result.distinct.warnings) options.on_identical_log(w);
   }
+  if (options.repeats) {  // the groups before any fit: a wrong grouping is seen at once
+    result.grouping = GroupingOptions(options, result.distinct.kept);
+    result.groups = GroupRepeats(result.distinct.kept, result.grouping);
+    if (options.on_groups) {
+      options.on_groups(RepeatGroupsText(result.groups, result.distinct.kept, result.grouping));
+    }
+  }
   FitLogs(options, trace_options, &result);
-  if (result.interrupted) return result;
+  if (result.interrupted) {
+    result.groups.clear();
+    return result;
+  }
   if (options.repeats) {
-    result.groups = GroupRepeats(result.distinct.kept);
     result.correction = CombineRepeats(&result.groups, &result.records);
   }
   result.json = FitResultJson(options, result);

@@ -23,6 +23,12 @@ struct FitCommandOptions {
   std::string config_path;         // YAML: rig geometry, masses, IMU format (configs/README.md)
   std::vector<std::string> logs;   // CSV (optionally .gz) or PX4 ULog (.ulg)
   bool repeats = false;            // combine repeats (GroupRepeats, CombineRepeats)
+  // --repeats: the part of each file name that names the set-up (a regular expression, case
+  // ignored; RepeatGroupingOptions::group_by); "" groups by file name.
+  std::string group_by;
+  // --repeats: a runs table naming each log's group (its `group` column, else its attitude;
+  // pipeline/campaign/run_discovery.h ReadRunsTableGroups); "" none. Not with group_by.
+  std::string runs_table;
   std::string model;               // "" (the config's), "full", "jardin" or "linear"
   std::string integrator;          // "" (the config's), "rk853" or "cvodes"
   std::string window;              // "" or "T0:T1" (s, the log's own time)
@@ -34,6 +40,8 @@ struct FitCommandOptions {
   // Told as the run goes (the CLI prints them at once); any may be empty.
   std::function<void(const RigCalibrationResult&)> on_calibration;  // before any fit
   std::function<void(const std::string&)> on_identical_log;  // a dropped copy (--repeats)
+  // --repeats: the groups made (RepeatGroupsText), before any fit.
+  std::function<void(const std::string&)> on_groups;
   // Each record once fitted, with the config it was fitted with (its display units).
   std::function<void(const TraceRecord&, const CampaignConfig&)> on_record;
 };
@@ -43,7 +51,8 @@ struct FitCommandResult {
   std::optional<RigCalibrationResult> calibration;  // when rig.calibration is enabled
   DistinctLogs distinct;                            // the logs fitted, and dropped copies
   std::vector<TraceRecord> records;                 // one per fitted log, in order
-  std::vector<RepeatGroup> groups;                  // --repeats
+  std::vector<RepeatGroup> groups;                  // --repeats (members index distinct.kept)
+  RepeatGroupingOptions grouping;                   // --repeats: how they were made
   RepeatsAmplitudeCorrection correction;            // --repeats
   int n_failed = 0;                                 // records not ok
   // Ctrl-C: `records` holds the logs fitted before it; groups, correction and json are empty.

@@ -82,6 +82,9 @@ struct CampaignResult {
   double common_mode_relative_std = NAN;
   bool common_mode_assumed = false;  // it holds the assumed +-1 mm on L and D
   std::string assumed_inputs_note;   // AssumedInputsSummary of the traces ("" when none)
+  // Attitudes whose logs look like two set-ups (pipeline/trace/repeat_setups.h), one sentence
+  // each; also a warning on each of their traces.
+  std::vector<std::string> setup_warnings;
   // Table 1 of the paper (kg m^2): mean of per-angle std, mean CV (%), regression RMSE.
   double raw_sigma_kg_m2 = NAN, cv_percent = NAN, regression_rmse_kg_m2 = NAN;
   CampaignSummary summary;

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <string>
 
 #include "fit/amplitude_trend.h"
 #include "pipeline/records/total_uncertainty.h"
@@ -14,31 +15,9 @@
 namespace bifilar {
 namespace {
 
-// "logs/BaseModel_Ixx_Log-3.csv" -> "logs/BaseModel_Ixx_Log-*.csv": the last run of digits in
-// the file name (not the folders) becomes '*'.
-std::string RepeatKey(const std::string& path) {
-  const size_t name_start = path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1;
-  size_t end = path.size();
-  while (end > name_start && !std::isdigit(static_cast<unsigned char>(path[end - 1]))) --end;
-  if (end == name_start) return path;
-  size_t begin = end;
-  while (begin > name_start && std::isdigit(static_cast<unsigned char>(path[begin - 1]))) --begin;
-  return path.substr(0, begin) + "*" + path.substr(end);
-}
-
 bool Usable(const TraceRecord& r) {
   return r.ok() && std::isfinite(r.inertia_total_kg_m2) && std::isfinite(r.inertia_total_std_kg_m2) &&
          r.inertia_total_std_kg_m2 > 0.0;
-}
-
-// Mean squared amplitude (deg^2) of the part of the log the result comes from.
-double ResultAmplitudeSquared(const TraceRecord& r) {
-  if (r.inertia_source == "low_amplitude_band" && r.sweep.low_band >= 0 &&
-      r.sweep.low_band < static_cast<int>(r.sweep.bands.size())) {
-    const double a = r.sweep.bands[r.sweep.low_band].amplitude_mean_deg;
-    return a * a;
-  }
-  return 0.5 * (r.amplitude_deg[0] * r.amplitude_deg[0] + r.amplitude_deg[1] * r.amplitude_deg[1]);
 }
 
 // I against each used member's result amplitude across the repeats (fit/amplitude_trend.h, on
@@ -59,6 +38,17 @@ void AmplitudeTrendAcrossRepeats(const std::vector<const TraceRecord*>& used, do
   }
   group->amplitude_trend_percent_per_10deg = trend.percent_per_10deg;
   group->amplitude_trend_z = trend.coeff_std_per_deg2 > 0.0 ? trend.z : NAN;
+  // The members' own I(A) trends, at the same amplitudes: a trend across the repeats beyond 3
+  // sigma of theirs is not amplitude.
+  double own = 0.0, own_std = 0.0;
+  int n_own = 0;
+  if (!PooledOwnTrend(used, &own, &own_std, &n_own)) return;
+  const double per_10deg = 1000.0 * (trend.amplitude_max_deg + trend.amplitude_min_deg);
+  group->own_trend_percent_per_10deg = own * per_10deg;
+  group->own_trend_std_percent_per_10deg = own_std * per_10deg;
+  group->trend_contradicts_own =
+      trend.coeff_std_per_deg2 > 0.0 &&
+      std::abs(trend.coeff_per_deg2 - own) > 3.0 * std::hypot(trend.coeff_std_per_deg2, own_std);
 }
 
 // The value a record had before the amplitude correction.
@@ -178,6 +168,14 @@ void TrendBeforeCorrection(const std::vector<TraceRecord*>& used, RepeatGroup* g
   AmplitudeTrendAcrossRepeats(pointers, group->plain_mean_kg_m2, group);
 }
 
+// The two-set-up finding, as the end of the scatter warning ("" for one set-up).
+std::string SetupsSentence(const RepeatGroup& g) {
+  return g.setups_text.empty() ? ""
+                               : "; they look like " + g.setups_text +
+                                     ". Fit each set-up as its own group (--group-by, or "
+                                     "--runs-table with a group column)";
+}
+
 // The random-effects mean (weights 1 / (s_i^2 + tau^2)) and its std with the common part of the
 // correction's std; every used log gets tau and its correction's std in its own std, and a
 // warning when the repeats scatter beyond their stds.
@@ -192,6 +190,7 @@ void RandomEffectsMean(const std::vector<TraceRecord*>& used, const std::vector<
   }
   group->mean_kg_m2 = swy_re / sw_re;
   group->max_abs_z = 0.0;
+  group->max_abs_z_own = 0.0;
   for (size_t i = 0; i < used.size(); ++i) {
     TraceRecord& r = *used[i];
     const double s_re = std::hypot(s[i], group->tau_kg_m2);
@@ -203,6 +202,7 @@ void RandomEffectsMean(const std::vector<TraceRecord*>& used, const std::vector<
     // Against the set-up's value, the random-effects mean (a plain mean would be pulled by an
     // imprecise log, a lowest-band result with its large std).
     group->max_abs_z = std::max(group->max_abs_z, std::abs(after[i] - group->mean_kg_m2) / s_re);
+    group->max_abs_z_own = std::max(group->max_abs_z_own, std::abs(after[i] - group->mean_kg_m2) / s[i]);
     // The log's own std: its per-log std, tau and the whole std of its correction.
     r.repeat_scatter_std_kg_m2 = group->tau_kg_m2;
     r.inertia_total_std_kg_m2 = std::hypot(r.inertia_total_std_kg_m2, group->tau_kg_m2);
@@ -214,7 +214,7 @@ void RandomEffectsMean(const std::vector<TraceRecord*>& used, const std::vector<
                     "a between-repeat std of %.3g kg m^2 (%.2f %%) is added to this log's std",
                     group->n_used, group->name.c_str(), group->q, group->n_used - 1,
                     group->tau_kg_m2, 100.0 * group->tau_kg_m2 / group->plain_mean_kg_m2);
-      r.warnings.push_back(text);
+      r.warnings.push_back(text + SetupsSentence(*group));
       r.flags.push_back("repeat_scatter");
     }
   }
@@ -246,7 +246,8 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
   group->n_used = static_cast<int>(used.size());
   if (used.size() < 2) {
     group->note = std::to_string(used.size()) + " usable repeat(s) of " +
-                  std::to_string(group->members.size()) + ": nothing to combine";
+                  std::to_string(group->members.size()) + ": nothing to combine" +
+                  (group->alone.empty() ? "" : " (a group of one: " + group->alone + ")");
     for (TraceRecord* r : used) AddCorrectionStd(r);
     return;
   }
@@ -260,29 +261,87 @@ void Combine(RepeatGroup* group, std::vector<TraceRecord>* records) {
   CommonModeStd(used, group);
 }
 
+// One set-up or two (repeat_setups.h), on the usable members as fitted; the clusters as
+// indices into the records, the finding as text naming the logs.
+void TestSetups(const std::vector<TraceRecord>& records, RepeatGroup* group) {
+  std::vector<const TraceRecord*> used;
+  std::vector<int> index;
+  std::vector<std::string> names;
+  for (int i : group->members) {
+    if (!Usable(records[i])) continue;
+    used.push_back(&records[i]);
+    index.push_back(i);
+    const std::string& file = records[i].file;
+    names.push_back(file.substr(file.find_last_of('/') == std::string::npos ? 0 : file.find_last_of('/') + 1));
+  }
+  group->setups = TestTwoSetups(used);
+  group->setups_text = TwoSetupsText(group->setups, names);
+  for (std::vector<int>& c : group->setups.clusters) {
+    for (int& i : c) i = index[i];
+  }
+}
+
 // The pooled amplitude coefficient over the groups' usable members, applied to every usable
 // record: I_0 = I / (1 + c A^2), std I_0 A^2 std(c) / (1 + c A^2) (to first order).
+// The pooled coefficient against the logs' own I(A) trends (the logs of the pooled fit): beyond
+// 3 sigma the spread between repeats is not amplitude. True when it contradicts them.
+bool ContradictsOwnTrends(const std::vector<const TraceRecord*>& fitted,
+                          const PooledAmplitudeTrend& pooled, RepeatsAmplitudeCorrection* out) {
+  if (!PooledOwnTrend(fitted, &out->own_coeff_per_deg2, &out->own_coeff_std_per_deg2, &out->n_own))
+    return false;
+  out->own_z = (pooled.coeff_per_deg2 - out->own_coeff_per_deg2) /
+               std::hypot(pooled.coeff_std_per_deg2, out->own_coeff_std_per_deg2);
+  if (!(std::abs(out->own_z) > 3.0)) return false;
+  char text[480];
+  std::snprintf(text, sizeof(text),
+                "the repeats' differences do not follow their release amplitudes as the logs' own "
+                "I(A) trends do (those trends, pooled over %d logs: c = %.3g +- %.2g per deg^2, "
+                "%+.2f %% at 20 deg); the repeats differ for another reason (a changed set-up?)",
+                out->n_own, out->own_coeff_per_deg2, out->own_coeff_std_per_deg2,
+                100.0 * out->own_coeff_per_deg2 * 400.0);
+  out->note = text;
+  out->contradicts_own = true;
+  return true;
+}
+
 RepeatsAmplitudeCorrection CorrectAmplitude(const std::vector<RepeatGroup>& groups,
                                             std::vector<TraceRecord>* records) {
   RepeatsAmplitudeCorrection out;
   std::vector<std::vector<AmplitudePoint>> points;
+  std::vector<const TraceRecord*> fitted;
   for (const RepeatGroup& g : groups) {
+    if (g.setups.two_setups) {  // its spread is not amplitude
+      ++out.n_groups_two_setups;
+      continue;
+    }
     std::vector<AmplitudePoint> group_points;
+    std::vector<const TraceRecord*> group_records;
     for (int i : g.members) {
       const TraceRecord& r = (*records)[i];
       const double a2 = ResultAmplitudeSquared(r);
       if (!Usable(r) || !std::isfinite(a2)) continue;
       group_points.push_back({std::sqrt(a2), r.inertia_total_kg_m2, r.inertia_total_std_kg_m2});
+      group_records.push_back(&r);
     }
-    if (group_points.size() >= 2) points.push_back(group_points);
+    if (group_points.size() >= 2) {
+      points.push_back(group_points);
+      fitted.insert(fitted.end(), group_records.begin(), group_records.end());
+    }
   }
   PooledAmplitudeTrend pooled;
   if (!FitPooledAmplitudeTrend(points, &pooled)) {
-    out.note = "the repeats do not vary in amplitude enough to measure how I depends on it "
-               "(needs 2 or more repeats of a set-up at different amplitudes, and 1 degree of "
-               "freedom beyond the fit)";
+    out.note = points.empty() && out.n_groups_two_setups > 0
+                   ? "every group of repeats looks like two set-ups, whose spread is not amplitude"
+                   : "the repeats do not vary in amplitude enough to measure how I depends on it "
+                     "(needs 2 or more repeats of a set-up at different amplitudes, and 1 degree "
+                     "of freedom beyond the fit)";
+    if (!points.empty() && out.n_groups_two_setups > 0) {
+      out.note += "; " + std::to_string(out.n_groups_two_setups) +
+                  " group(s) left out: they look like two set-ups";
+    }
     return out;
   }
+  if (ContradictsOwnTrends(fitted, pooled, &out)) return out;
   out.coeff_per_deg2 = pooled.coeff_per_deg2;
   out.coeff_std_per_deg2 = pooled.coeff_std_per_deg2;
   out.z = pooled.z;
@@ -325,21 +384,6 @@ RepeatsAmplitudeCorrection CorrectAmplitude(const std::vector<RepeatGroup>& grou
 bool IsRepeatScatterWarning(const std::string& warning) {
   return warning.rfind("the ", 0) == 0 &&
          warning.find(" scatter beyond their own stds (Q = ") != std::string::npos;
-}
-
-std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths) {
-  std::vector<RepeatGroup> groups;
-  std::map<std::string, size_t> index;
-  for (size_t i = 0; i < paths.size(); ++i) {
-    const std::string key = RepeatKey(paths[i]);
-    auto [it, inserted] = index.emplace(key, groups.size());
-    if (inserted) {
-      groups.emplace_back();
-      groups.back().name = key;
-    }
-    groups[it->second].members.push_back(static_cast<int>(i));
-  }
-  return groups;
 }
 
 namespace {
@@ -406,10 +450,33 @@ DistinctLogs DropIdenticalLogs(const std::vector<std::string>& paths) {
 
 RepeatsAmplitudeCorrection CombineRepeats(std::vector<RepeatGroup>* groups,
                                           std::vector<TraceRecord>* records) {
+  for (RepeatGroup& g : *groups) TestSetups(*records, &g);
   const RepeatsAmplitudeCorrection correction = CorrectAmplitude(*groups, records);
   for (RepeatGroup& g : *groups) Combine(&g, records);
   return correction;
 }
+
+namespace {
+
+// How far the logs lie from the mean: with a between-repeat std added, that std is named in the
+// same sentence, and the per-log stds' figure beside it.
+std::string WithinSigmaText(const RepeatGroup& g) {
+  char text[320];
+  if (g.tau_kg_m2 > 0.0) {
+    std::snprintf(text, sizeof(text),
+                  "between-repeat std %.2g kg m^2 = %.2f %% added to each log; with it every log "
+                  "is within %.1f sigma of the mean, %.1f sigma on the per-log stds alone",
+                  g.tau_kg_m2, 100.0 * g.tau_kg_m2 / g.plain_mean_kg_m2, g.max_abs_z,
+                  g.max_abs_z_own);
+  } else {
+    std::snprintf(text, sizeof(text),
+                  "no between-repeat std needed; every log within %.1f sigma (stat) of the mean",
+                  g.max_abs_z);
+  }
+  return text;
+}
+
+}  // namespace
 
 std::string RepeatGroupLine(const RepeatGroup& g) {
   char buffer[640];
@@ -418,17 +485,23 @@ std::string RepeatGroupLine(const RepeatGroup& g) {
     return buffer;
   }
   std::snprintf(buffer, sizeof(buffer),
-                "repeats %s: I = %s (random-effects mean of %d; Q = %.1f on %d "
-                "dof; between-repeat std %.2g kg m^2 = %.2f %% added to each log; every log within "
-                "%.1f sigma (stat) of the mean)",
+                "repeats %s: I = %s (random-effects mean of %d; Q = %.1f on %d dof; %s)",
                 g.name.c_str(),
                 StatAndTotal(g.mean_kg_m2, g.mean_std_kg_m2,
                              std::isfinite(g.total_std_kg_m2) ? g.total_std_kg_m2 : NAN, "kg m^2")
                     .c_str(),
-                g.n_used, g.q, g.n_used - 1,
-                g.tau_kg_m2, 100.0 * g.tau_kg_m2 / g.plain_mean_kg_m2, g.max_abs_z);
+                g.n_used, g.q, g.n_used - 1, WithinSigmaText(g).c_str());
   std::string line = buffer;
-  if (std::isfinite(g.amplitude_trend_z)) {
+  if (g.setups.two_setups) {
+    line += "\n    the mean above is of two set-ups, not one (the warning below names them)";
+  } else if (g.trend_contradicts_own) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "\n    across the repeats I does not follow the release amplitude as each log's "
+                  "own I(A) does (own trends %+.2g +- %.2g %% per 10 deg): the repeats differ for "
+                  "another reason than amplitude",
+                  g.own_trend_percent_per_10deg, g.own_trend_std_percent_per_10deg);
+    line += buffer;
+  } else if (std::isfinite(g.amplitude_trend_z)) {
     std::snprintf(buffer, sizeof(buffer),
                   "\n    across the repeats I changes by %+.2g %% per 10 deg of amplitude (z = %.1f)%s",
                   g.amplitude_trend_percent_per_10deg, g.amplitude_trend_z,

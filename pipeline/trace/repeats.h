@@ -16,7 +16,9 @@
 // set-up mean's std, not the scatter between repeats). The scatter is reported before and after.
 //
 // `bifilar fit --repeats` groups the logs whose paths differ only in the last number of the
-// file name (`BaseModel_Ixx_Log-1.csv` ... `-4.csv`; `pitch_10/trial_1.csv` ... `trial_5.csv`).
+// file name, case ignored (`BaseModel_Ixx_Log-1.csv` ... `-4.csv`; `pitch_10/trial_1.csv` ...
+// `trial_5.csv`), or as --group-by or a runs table says (RepeatGroupingOptions). A group whose
+// repeats disagree far beyond their stds is tested for two set-ups (repeat_setups.h).
 // docs/method.md, "Repeats".
 #ifndef BIFILAR_PIPELINE_REPEATS_H_
 #define BIFILAR_PIPELINE_REPEATS_H_
@@ -26,6 +28,7 @@
 #include <vector>
 
 #include "pipeline/records/trace_record.h"
+#include "pipeline/trace/repeat_setups.h"
 
 namespace bifilar {
 
@@ -64,14 +67,49 @@ struct RepeatGroup {
   double common_mode_std_kg_m2 = NAN;
   double total_std_kg_m2 = NAN;
   std::string note;          // why nothing was combined (fewer than 2 usable members)
+  // A group of one: why no other log joined it, and the nearest name that almost matched.
+  std::string alone;
+  // Largest |I_i - mean_kg_m2| / per-log std, without tau (the between-repeat std).
+  double max_abs_z_own = NAN;
+  // One set-up or two (pipeline/trace/repeat_setups.h), on the values before the amplitude
+  // correction; cluster indices are into the records given to CombineRepeats.
+  SetupSplit setups;
+  std::string setups_text;  // TwoSetupsText with the logs' file names ("" for one set-up)
+  // The members' own I(A) trends (as an A^2 coefficient) disagree with the trend across the
+  // repeats beyond 3 sigma: the repeats differ for another reason than their amplitude.
+  bool trend_contradicts_own = false;
+  double own_trend_percent_per_10deg = NAN, own_trend_std_percent_per_10deg = NAN;
 };
 
-// Groups `paths` by the path with its last number in the file name removed; a path without a
-// number is a group of its own.
+// How logs are grouped into set-ups: by default, paths that differ only in the last number of
+// the file name, ignoring case; `group_by` (a regular expression, case ignored) names the part of
+// each file name (of the path, when the expression holds a '/') that names the set-up: its first
+// capture group, else the whole match; `named` (one entry per path, "" for a path it does not
+// name: a runs table's group column, or its attitude) names groups explicitly. `named` wins over
+// `group_by`.
+struct RepeatGroupingOptions {
+  std::string group_by;
+  std::vector<std::string> named;
+  std::string named_source;            // the table, for the messages ("runs.csv (group column)")
+  std::vector<std::string> named_rows;  // the table's paths, for the nearest name of a lost log
+};
+
+// Throws UserError when group_by is not a regular expression.
+std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths,
+                                      const RepeatGroupingOptions& options);
+
+// The groups made, for the console before any combining: the rule, then one line per group with
+// its logs' file names, or why it is alone and the nearest name.
+std::string RepeatGroupsText(const std::vector<RepeatGroup>& groups,
+                             const std::vector<std::string>& paths,
+                             const RepeatGroupingOptions& options);
+
 // True for the warning CombineRepeats puts on each member of a group whose repeats scatter
 // beyond their stds (the same text on every member: `fit --repeats` prints it once).
 bool IsRepeatScatterWarning(const std::string& warning);
 
+// Groups `paths` by the path with its last number in the file name removed, ignoring case; a
+// path without a number is a group of its own (the default RepeatGroupingOptions).
 std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths);
 
 // One swing is one repeat: a log given twice (the same file under one or two names) or a
@@ -109,10 +147,20 @@ struct RepeatsAmplitudeCorrection {
   int n_low_band_kept = 0;
   double amplitude_min_deg = NAN, amplitude_max_deg = NAN;
   std::string note;                 // why it was not applied (the fields above may be set)
+  // The logs' own I(A) trends pooled (PooledOwnTrend, over the logs of the pooled fit), and the
+  // pooled coefficient's z against them. Beyond 3 sigma the spread between repeats is not their
+  // amplitude: nothing is corrected, and the coefficient fields above stay NaN.
+  double own_coeff_per_deg2 = NAN, own_coeff_std_per_deg2 = NAN;
+  int n_own = 0;
+  double own_z = NAN;
+  bool contradicts_own = false;
+  int n_groups_two_setups = 0;      // groups left out of the pooled fit: they look like two set-ups
 };
 
-// Combines each group's usable members (status ok, finite I, std > 0). First the amplitude
-// correction: c pooled over the groups with >= 2 usable members; every usable record whose result
+// Combines each group's usable members (status ok, finite I, std > 0). First the set-up test of
+// each group (TestTwoSetups on the values as fitted): a group that looks like two set-ups is
+// left out of the pooled amplitude fit, and its scatter warning says so, naming the clusters.
+// Then the amplitude correction: c pooled over the groups with >= 2 usable members; every usable record whose result
 // is not already a low-amplitude band gets amplitude_correction_* set, the correction subtracted
 // from inertia_total_kg_m2. Then per group:
 // the statistics, and for every used member repeat_scatter_std_kg_m2 = tau, tau and the

@@ -1,0 +1,185 @@
+// Grouping logs into set-ups (pipeline/trace/repeats.h, RepeatGroupingOptions).
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <regex>
+
+#include "base/user_error.h"
+#include "pipeline/trace/repeats.h"
+
+namespace bifilar {
+namespace {
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string FileName(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// "logs/BaseModel_Ixx_Log-3.csv" -> "logs/BaseModel_Ixx_Log-*.csv": the last run of digits in
+// the file name (not the folders) becomes '*'.
+std::string RepeatKey(const std::string& path) {
+  const size_t name_start = path.size() - FileName(path).size();
+  size_t end = path.size();
+  while (end > name_start && !std::isdigit(static_cast<unsigned char>(path[end - 1]))) --end;
+  if (end == name_start) return path;
+  size_t begin = end;
+  while (begin > name_start && std::isdigit(static_cast<unsigned char>(path[begin - 1]))) --begin;
+  return path.substr(0, begin) + "*" + path.substr(end);
+}
+
+// Edit distance (insertions, deletions, substitutions), case ignored.
+size_t Distance(const std::string& a_in, const std::string& b_in) {
+  const std::string a = Lower(a_in), b = Lower(b_in);
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1] ? 1 : 0)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// Each path's key (what names its set-up; "" when it names none) and, for a key-less path, why.
+struct Keys {
+  std::vector<std::string> key, why_none;
+};
+
+Keys KeysOf(const std::vector<std::string>& paths, const RepeatGroupingOptions& o) {
+  Keys k;
+  std::regex re;
+  if (o.named.empty() && !o.group_by.empty()) {
+    try {
+      re = std::regex(o.group_by, std::regex::ECMAScript | std::regex::icase);
+    } catch (const std::regex_error& e) {
+      throw UserError("--group-by '" + o.group_by + "': not a regular expression (" + e.what() + ")");
+    }
+  }
+  for (size_t i = 0; i < paths.size(); ++i) {
+    std::string key, why;
+    if (!o.named.empty()) {
+      key = i < o.named.size() ? o.named[i] : "";
+      if (key.empty()) why = "not in " + o.named_source;
+    } else if (!o.group_by.empty()) {
+      const std::string target = o.group_by.find('/') != std::string::npos ? paths[i] : FileName(paths[i]);
+      std::smatch m;
+      if (std::regex_search(target, m, re)) key = m.size() > 1 && m[1].matched ? m[1].str() : m[0].str();
+      if (key.empty()) why = "its name does not match --group-by '" + o.group_by + "'";
+    } else {
+      key = RepeatKey(paths[i]);
+    }
+    k.key.push_back(key);
+    k.why_none.push_back(why);
+  }
+  return k;
+}
+
+// Why a group of one is alone, and the nearest name that almost matched: another log's key, or
+// (a log a table does not name) the table's nearest row.
+std::string AloneText(const std::vector<std::string>& paths, const Keys& k, size_t i,
+                      const RepeatGroupingOptions& o) {
+  std::string why = k.why_none[i];
+  if (why.empty()) {
+    if (!o.named.empty()) {
+      why = "the only log of group '" + k.key[i] + "' in " + o.named_source;
+    } else if (!o.group_by.empty()) {
+      why = "no other log's name gives '" + k.key[i] + "' for --group-by '" + o.group_by + "'";
+    } else if (k.key[i] == paths[i]) {
+      why = "its file name holds no number to count repeats by";
+    } else {
+      why = "no other log's name differs from it only in its last number (case ignored)";
+    }
+  }
+  std::string nearest;
+  size_t best = std::string::npos;
+  if (!o.named.empty() && k.key[i].empty()) {
+    for (const std::string& row : o.named_rows) {
+      const size_t d = Distance(FileName(row), FileName(paths[i]));
+      if (d < best) {
+        best = d;
+        nearest = row + " (a row of the table, " + std::to_string(d) + " character(s) apart)";
+      }
+    }
+  } else {
+    for (size_t j = 0; j < paths.size(); ++j) {
+      if (j == i) continue;
+      const bool by_key = !k.key[i].empty() && !k.key[j].empty();
+      const size_t d = by_key ? Distance(FileName(k.key[i]), FileName(k.key[j]))
+                              : Distance(FileName(paths[i]), FileName(paths[j]));
+      if (d < best) {
+        best = d;
+        nearest = paths[j] + " (" +
+                  (!o.named.empty() ? "group '" + k.key[j] + "', "
+                   : !o.group_by.empty() && !k.key[j].empty() ? "'" + k.key[j] + "', "
+                                                              : std::string()) +
+                  std::to_string(d) + " character(s) apart" +
+                  (o.named.empty() && o.group_by.empty() && by_key ? " besides the number" : "") + ")";
+      }
+    }
+  }
+  return why + (nearest.empty() ? "; the only log given" : "; nearest: " + nearest);
+}
+
+std::string Rule(const RepeatGroupingOptions& o) {
+  if (!o.named.empty()) return "as " + o.named_source + " names them";
+  if (!o.group_by.empty()) {
+    return "by --group-by '" + o.group_by + "' (the part of each name it matches; case ignored)";
+  }
+  return "by file name (names that differ only in their last number; case ignored)";
+}
+
+}  // namespace
+
+std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths,
+                                      const RepeatGroupingOptions& options) {
+  const Keys k = KeysOf(paths, options);
+  std::vector<RepeatGroup> groups;
+  std::map<std::string, size_t> index;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    // A log without a key is a group of its own, named by its path.
+    const std::string lookup = k.key[i].empty() ? "\n" + std::to_string(i) : Lower(k.key[i]);
+    auto [it, inserted] = index.emplace(lookup, groups.size());
+    if (inserted) {
+      groups.emplace_back();
+      groups.back().name = k.key[i].empty() ? paths[i] : k.key[i];
+    }
+    groups[it->second].members.push_back(static_cast<int>(i));
+  }
+  for (RepeatGroup& g : groups) {
+    if (g.members.size() == 1) g.alone = AloneText(paths, k, g.members[0], options);
+  }
+  return groups;
+}
+
+std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths) {
+  return GroupRepeats(paths, RepeatGroupingOptions());
+}
+
+std::string RepeatGroupsText(const std::vector<RepeatGroup>& groups,
+                             const std::vector<std::string>& paths,
+                             const RepeatGroupingOptions& options) {
+  std::string text = "repeats: " + std::to_string(paths.size()) + " log(s) in " +
+                     std::to_string(groups.size()) + " group(s), " + Rule(options) + ":";
+  for (const RepeatGroup& g : groups) {
+    text += "\n  " + g.name + ": ";
+    if (!g.alone.empty()) {
+      text += FileName(paths[g.members[0]]) + " alone: " + g.alone;
+      continue;
+    }
+    for (size_t k = 0; k < g.members.size(); ++k) {
+      text += (k ? ", " : "") + FileName(paths[g.members[k]]);
+    }
+  }
+  return text;
+}
+
+}  // namespace bifilar
