@@ -249,5 +249,54 @@ TEST(ColumnNaming, UnguessableColumnsAreNamedByInitFlags) {
   EXPECT_NE(two.err.find("--gyro takes three column names"), std::string::npos) << two.err;
 }
 
+// A header and five rows of small readings (time steps of 0.01).
+std::string SmallCsv(const std::string& header) {
+  const size_t width = std::count(header.begin(), header.end(), ',') + 1;
+  std::string text = header + "\n";
+  for (int r = 0; r < 5; ++r) {
+    text += std::to_string(0.01 * r);
+    for (size_t c = 1; c < width; ++c) text += "," + std::to_string(0.1 * ((r + c) % 3) - 0.1);
+    text += "\n";
+  }
+  return text;
+}
+
+// What the guess must not take: p without q and r, a pressure column, numbered columns with a
+// fourth beside them (motor speeds w1..w4, a quaternion q0..q3).
+TEST(ColumnNaming, NoFalsePositives) {
+  using Gyro = std::array<std::string, 3>;
+  struct Case {
+    std::string header;
+    bool found;
+    Gyro gyro;
+    Gyro accel;
+  };
+  const std::vector<Case> cases = {
+      {"time,p,alt,gyro_x,gyro_y,gyro_z", true, {"gyro_x", "gyro_y", "gyro_z"}, {"", "", ""}},
+      {"time,p,temp,baro_alt", false, {}, {}},
+      {"time,pressure,q,r", false, {}, {}},
+      {"time,pressure,p,q,r", true, {"p", "q", "r"}, {"", "", ""}},
+      {"t,p,q,r,w1,w2,w3,w4", true, {"p", "q", "r"}, {"", "", ""}},
+      {"t,q0,q1,q2,q3,roll_rate,pitch_rate,yaw_rate", true,
+       {"roll_rate", "pitch_rate", "yaw_rate"}, {"", "", ""}},
+      {"t,gx,gy,gz,a1,a2,a3,a4", true, {"gx", "gy", "gz"}, {"", "", ""}},
+      {"Time,xGyro,yGyro,ZGyro,xAcc,yAcc,zAcc,Pressure", true, {"xGyro", "yGyro", "ZGyro"},
+       {"xAcc", "yAcc", "zAcc"}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.header);
+    const FormatGuess guess = GuessCsvFormat(SmallCsv(c.header));
+    ASSERT_EQ(guess.found, c.found) << guess.why;
+    if (!c.found) {
+      EXPECT_NE(guess.why.find("imu.gyro"), std::string::npos) << guess.why;
+      EXPECT_NE(guess.why.find(c.header.substr(c.header.rfind(',') + 1)), std::string::npos)
+          << guess.why;
+      continue;
+    }
+    EXPECT_EQ(guess.format.gyro_columns, c.gyro);
+    EXPECT_EQ(guess.format.accel_columns, c.accel);
+  }
+}
+
 }  // namespace
 }  // namespace bifilar

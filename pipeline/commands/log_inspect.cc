@@ -156,7 +156,11 @@ std::array<int, 3> FindTriplet(const std::vector<ColumnName>& names,
   for (const std::string& word : words) {
     for (const auto& axes : kAxes) {
       const std::array<int, 3> after = all_three([&](int a) { return word + axes[a]; });
-      if (found(after)) return after;
+      // Numbered columns with a fourth one beside them (w1..w4 motor speeds, q0..q3 a
+      // quaternion) are no triplet.
+      const bool numbered = std::isdigit(static_cast<unsigned char>(axes[0][0]));
+      const std::string fourth = word + std::to_string(axes[2][0] - '0' + 1);
+      if (found(after) && !(numbered && ColumnIndex(names, fourth) >= 0)) return after;
     }
     const std::array<int, 3> before = all_three([&](int a) { return kAxes[0][a] + word; });
     if (found(before)) return before;
