@@ -144,6 +144,17 @@ TEST(InspectLog, SaysWhatAFileIsWhenItIsNotALog) {
   EXPECT_NE(text.error.find("a, b, c"), std::string::npos) << text.error;  // what it found
 }
 
+// A log whose gyro never moves: the swing-axis error is said once ("swing axis: ..."), not with
+// its prefix doubled.
+TEST(InspectLog, ConstantGyroSaysSwingAxisOnce) {
+  TempDir dir;
+  std::string text = "t,gx,gy,gz\n";
+  for (int i = 0; i < 200; ++i) text += std::to_string(0.01 * i) + ",0.001,0.002,0.003\n";
+  const InspectReport report = InspectLog(WriteFile(dir.path + "/still.csv", text), nullptr);
+  EXPECT_NE(report.error.find("swing axis: "), std::string::npos) << report.error;
+  EXPECT_EQ(report.error.find("swing axis: swing axis"), std::string::npos) << report.error;
+}
+
 TEST(InspectLog, RealUlogListsTopicsWithRates) {
   BIFILAR_REAL_DATA(path, "px4/sample_log_small.ulg");
   const InspectReport r = InspectLog(path, nullptr);

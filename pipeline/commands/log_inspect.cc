@@ -536,7 +536,7 @@ void SwingAndWindow(const ImuData& data, const CampaignConfig* config, InspectRe
   std::string why;
   if (!EstimateSwingAxis(data, axis_options, std::nullopt, &axis, &why)) {
     if (!data.has_accel()) {
-      report->error = "swing axis: " + why;
+      report->error = why;  // EstimateSwingAxis says "swing axis: ..."
       return;
     }
     // An accelerometer that does not read gravity: look at the gyro alone, and say so.
@@ -544,7 +544,7 @@ void SwingAndWindow(const ImuData& data, const CampaignConfig* config, InspectRe
     gyro_only.accel_in_imu.clear();
     report->warnings.push_back("accelerometer ignored: " + why);
     if (!EstimateSwingAxis(gyro_only, axis_options, std::nullopt, &axis, &why)) {
-      report->error = "swing axis: " + why;
+      report->error = why;  // EstimateSwingAxis says "swing axis: ..."
       return;
     }
   }
