@@ -88,7 +88,7 @@ void WarnResidualAboveNoise(const TraceFitInput& input, const TraceFitOptions& o
                             Findings* findings) {
   std::vector<double> fitted_rate = solution.trajectory.rate_rad_per_s;
   const ResidualShape shape = ClassifyResidual(input.t_s, minimum.residuals, fitted_rate, rho1);
-  const std::string level = "residual RMS " + Fmt("%.2f", solution.rms_over_noise) + "x the noise";
+  const std::string level = "residual " + Fmt("%.3g", solution.rms_over_noise) + "x noise";
   const std::string detail =
       " The residual RMS " + Fmt("%.3g", solution.residual_rms_rad_per_s) + " rad/s is " +
       Fmt("%.2f", solution.rms_over_noise) + "x the noise estimate (warning above " +
@@ -102,23 +102,21 @@ void WarnResidualAboveNoise(const TraceFitInput& input, const TraceFitOptions& o
     case ResidualShape::Cause::kGlitch:
       findings->Warn("rms_above_noise",
                      level + " from a step or spike near t = " + Fmt("%.2f", shape.glitch_t_s) +
-                         " s (a glitch in the log): fit the part before or after it "
-                         "(fit.windows or --window), or lower fit.glitch's thresholds." + detail);
+                         " s (a glitch): fit the part before or after it (fit.windows or "
+                         "--window), or lower fit.glitch's thresholds." + detail);
       findings->flags.push_back("residual_glitch");
       return;
     case ResidualShape::Cause::kModel:
       findings->Warn("rms_above_noise",
                      level + ", coherent (rho_1 " + Fmt("%.2f", rho1) +
-                         ") and largest at large amplitude: the rig departs from the model; "
-                         "swing lower, or set fit.max_amplitude_deg (--max-amplitude)." +
-                         detail);
+                         "), growing with amplitude: the rig departs from the model; swing "
+                         "lower or set fit.max_amplitude_deg (--max-amplitude)." + detail);
       findings->flags.push_back("residual_model");
       return;
     case ResidualShape::Cause::kNoise:
       findings->Warn("rms_above_noise",
-                     level + ", white and even across the swing (noise): the gyro is noisier "
-                             "in the swing than the noise estimate; if that is expected, raise "
-                             "fit.quality.max_rms_over_noise." + detail);
+                     level + ", white and even (noise): if the gyro is this noisy in the "
+                             "swing, raise fit.quality.max_rms_over_noise." + detail);
       findings->flags.push_back("residual_noise");
       return;
   }
