@@ -34,7 +34,10 @@ namespace {
 // well the model follows the data. No fit (an error, or rejected before fitting): status only.
 std::string ResultLine(const TraceRecord& r, DisplayUnits units) {
   if (r.status == TraceStatus::kError || !std::isfinite(r.inertia_total_kg_m2)) {
-    return r.file + ": " + ToString(r.status);
+    const std::string prefix = r.file + ": ";
+    const std::string message = SiTextInDisplayUnits(
+        r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message, units);
+    return prefix + ToString(r.status) + (message.empty() ? "" : ": " + message);
   }
   const double scale = InertiaToDisplay(1.0, units);
   char buffer[512];
@@ -119,7 +122,8 @@ std::string WarningLines(const TraceRecord& r, DisplayUnits units, bool* folded)
   std::string lines;
   // Messages name the file already; the line under it does not repeat it.
   const std::string prefix = r.file + ": ";
-  if (!r.ok() && !r.message.empty()) {
+  if (!r.ok() && !r.message.empty() && std::isfinite(r.inertia_total_kg_m2) &&
+      r.status != TraceStatus::kError) {  // with no fit, the message is on the result line
     const std::string message = SiTextInDisplayUnits(
         r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message, units);
     lines += "\n    " + std::string(ToString(r.status)) + ": " + message;
@@ -150,7 +154,7 @@ const char kFoldedNote[] =
 
 // --repeats without --json: the records, then the amplitude correction and each group. The
 // between-repeat (Q) warning is the same on every member: said once, under its group.
-void PrintRepeats(const FitCommandResult& result, bool* folded) {
+void PrintRepeats(const FitCommandResult& result, bool* folded) {  // *folded: as HumanLine
   std::vector<std::string> scatter_warnings;
   for (const TraceRecord& r : result.records) {
     TraceRecord shown = r;
@@ -177,9 +181,7 @@ void PrintRepeats(const FitCommandResult& result, bool* folded) {
       const std::string per_log = "this log's std";
       const size_t at = text.find(per_log);
       if (at != std::string::npos) text.replace(at, per_log.size(), "each log's std");
-      const std::string summary = WarningSummary(text);
-      if (summary.size() < text.size()) *folded = true;
-      std::cout << "    warning: " << summary << std::endl;
+      std::cout << "    warning: " << text << std::endl;  // once per group: in full
     }
   }
 }
