@@ -322,7 +322,9 @@ TraceFitResult FitWithResidualGlitchPass(const CampaignConfig& config,
     std::snprintf(text, sizeof(text), "%s %.6g", i ? "," : "", input->t_s[more[i]]);
     warning += text;
   }
-  record->warnings.push_back(warning + (more.size() > 5 ? ", ... s" : " s"));
+  record->warnings.push_back(warning + (more.size() > 5 ? ", ... s" : " s") +
+                             "; nothing to do unless they were real motion (fit.glitch sets the "
+                             "thresholds)");
   std::vector<double> t, rate;
   size_t next = 0;
   for (size_t k = 0; k < input->t_s.size(); ++k) {
