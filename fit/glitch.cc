@@ -172,7 +172,7 @@ std::string DescribeGlitches(const ImuData& data, const std::vector<size_t>& ind
     text += buf;
   }
   if (shown < indices.size()) text += ", ...";
-  return text + " s";
+  return text + " s; nothing to do unless they were real motion (fit.glitch sets the thresholds)";
 }
 
 }  // namespace bifilar

@@ -251,8 +251,8 @@ std::string AccelNotGravityMessage(const ImuData& data, IndexPair range,
   } else {
     std::snprintf(buf, sizeof(buf),
                   "the accelerometer reads %.3g g (%.3g m/s^2) %s: neither gravity (1 g "
-                  "+- %.0f %%) nor removed gravity; check imu.accel.columns and "
-                  "imu.accel.unit",
+                  "+- %.0f %%) nor removed gravity (a small reading across the swing axis, left "
+                  "when the logger removes gravity); check imu.accel.columns and imu.accel.unit",
                   g_read, f_mean.norm(), where, 100.0 * tol);
   }
   const std::string text = buf;

@@ -189,7 +189,8 @@ TraceFitResult AssembleResult(const TraceFitInput& input, const TraceFitOptions&
   result.prewhitened_autocorr_max = whiteness.prewhitened_autocorr_max;
   result.ljung_box_q = whiteness.ljung_box_q;
 
-  for (const Findings* f : {&stat.findings, &budget.findings, &rule.findings, &quality.findings})
+  // The most important first: the amplitude rule, the quality warnings, then the uncertainty's.
+  for (const Findings* f : {&rule.findings, &quality.findings, &stat.findings, &budget.findings})
     Append(*f, &result);
 
   // Never NaN in the output.

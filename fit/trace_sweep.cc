@@ -177,22 +177,25 @@ SweepRule ApplySweepRule(const AmplitudeSweep& sweep, const Solution& solution,
   rule.inertia_source = "low_amplitude_band";
   rule.model_inadequacy_std_kg_m2 =
       std::abs(sweep.TrendAt(low->amplitude_mean_deg) - sweep.TrendAt(0.0));
+  // The first sentence is the warning's one-line summary with its action (the console and the
+  // report show it; the rest is the detail).
   rule.findings.Warn(
       "amplitude_trend",
-      "I depends on the amplitude beyond its statistical error (" +
-          Fmt("%+.3g", sweep.trend_percent_per_10deg) + " % per 10 deg between " +
+      "I changes with amplitude (" + Fmt("%+.3g", sweep.trend_percent_per_10deg) +
+          " % per 10 deg, z = " + Fmt("%.1f", sweep.trend_z) +
+          "): the rig departs from the model; swing lower, or set fit.max_amplitude_deg "
+          "(--max-amplitude). I depends on the amplitude beyond its statistical error between " +
           Fmt("%.1f", sweep.bands.back().amplitude_mean_deg) + " and " +
-          Fmt("%.1f", sweep.bands.front().amplitude_mean_deg) + " deg, z = " +
-          Fmt("%.1f", sweep.trend_z) + ", I_0 (1 + c A^" + Fmt("%g", sweep.trend_exponent) +
-          ") fits best): the rig departs from the ideal model; I is taken from the "
-          "lowest-amplitude band (" + Fmt("%.1f", low->amplitude_mean_deg) + " deg)" +
+          Fmt("%.1f", sweep.bands.front().amplitude_mean_deg) + " deg (I_0 (1 + c A^" +
+          Fmt("%g", sweep.trend_exponent) +
+          ") fits best); I is taken from the lowest-amplitude band (" +
+          Fmt("%.1f", low->amplitude_mean_deg) + " deg)" +
           (sweep.std_scale > 1.0
                ? ", its std scaled by " + Fmt("%.2g", sweep.std_scale) +
                      " for the bands' scatter about the trend,"
                : std::string()) +
           " with a model-inadequacy std of " + Fmt("%.2g", rule.model_inadequacy_std_kg_m2) +
-          " kg m^2 (the trend's change from that amplitude to zero). Swing at smaller amplitude, "
-          "or set fit.max_amplitude_deg");
+          " kg m^2 (the trend's change from that amplitude to zero).");
   return rule;
 }
 

@@ -25,61 +25,76 @@
 namespace bifilar {
 namespace {
 
-// The record's console line, inertias (I, K_D, C and the small-angle I) in the config's units.
-std::string HumanLine(const TraceRecord& r, DisplayUnits units) {
-  char buffer[1024];
-  // Messages name the file already; say it once at the start of the line.
-  const std::string prefix = r.file + ": ";
-  std::string message = SiTextInDisplayUnits(
-      r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message, units);
-  // The assumed +-1 mm on L and D is said once for the run (AssumedInputsSummary), not per log.
-  if (IsAssumedInputsWarning(message)) message.clear();
-  // No fit to show (an error, or rejected before fitting): status and reason only, never NaN.
+// Console output of one record (issue 25 item 5): one result line of at most ~160 characters,
+// indented detail lines (the fit's settings and solver, the period and the hand calculation,
+// I(A)), then one line per warning, the most important first (the record's order), each shown by
+// its one-line summary (WarningSummary); *folded is set when a summary shortens a warning.
+
+// "FILE: ok  I = ... kg m^2  amplitude A0 -> A1 deg  rms/noise R": status, the result, and how
+// well the model follows the data. No fit (an error, or rejected before fitting): status only.
+std::string ResultLine(const TraceRecord& r, DisplayUnits units) {
   if (r.status == TraceStatus::kError || !std::isfinite(r.inertia_total_kg_m2)) {
-    return prefix + ToString(r.status) + ": " + message;
+    const std::string prefix = r.file + ": ";
+    const std::string message = SiTextInDisplayUnits(
+        r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message, units);
+    return prefix + ToString(r.status) + (message.empty() ? "" : ": " + message);
   }
   const double scale = InertiaToDisplay(1.0, units);
-  const char* unit = InertiaUnitName(units);
-  std::snprintf(buffer, sizeof(buffer),
-                "%s: %s  I = %s  K_D %.3g  C %.3g  "
-                "window [%.2f, %.2f] s  amplitude %.1f -> %.1f deg  rms/noise %.2f  %d it  %.0f ms",
+  char buffer[512];
+  std::snprintf(buffer, sizeof(buffer), "%s: %s  I = %s  amplitude %.1f -> %.1f deg  rms/noise %.2f",
                 r.file.c_str(), ToString(r.status),
                 StatAndTotal(scale * r.inertia_total_kg_m2, scale * r.inertia_total_std_kg_m2,
-                             scale * r.inertia_total_std_total_kg_m2, unit)
+                             scale * r.inertia_total_std_total_kg_m2, InertiaUnitName(units))
                     .c_str(),
-                scale * r.drag_coeff_kg_m2,
-                scale * r.viscous_coeff_kg_m2_per_s, r.window_s[0], r.window_s[1], r.amplitude_deg[0],
-                r.amplitude_deg[1], r.residual_rms_rad_per_s / r.noise_rms_rad_per_s, r.iterations,
-                1e3 * r.fit_seconds);
-  std::string line = buffer;
-  if (r.pitch_measured_deg) {
-    std::snprintf(buffer, sizeof(buffer), "  pitch %.2f deg", *r.pitch_measured_deg);
-    line += buffer;
+                r.amplitude_deg[0], r.amplitude_deg[1],
+                r.residual_rms_rad_per_s / r.noise_rms_rad_per_s);
+  return buffer;
+}
+
+// The indented lines under the result: the fit (window, damping, solver), the measured period with
+// the small-angle hand calculation, I against amplitude, the amplitude correction of --repeats,
+// block means.
+std::string DetailLines(const TraceRecord& r, DisplayUnits units) {
+  const double scale = InertiaToDisplay(1.0, units);
+  const char* unit = InertiaUnitName(units);
+  char buffer[512];
+  std::string lines;
+  if (std::isfinite(r.inertia_total_kg_m2)) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "\n    fit: window [%.2f, %.2f] s  K_D %.3g  C %.3g  %d it  %.0f ms", r.window_s[0],
+                  r.window_s[1], scale * r.drag_coeff_kg_m2, scale * r.viscous_coeff_kg_m2_per_s,
+                  r.iterations, 1e3 * r.fit_seconds);
+    lines += buffer;
+    if (r.pitch_measured_deg) {
+      std::snprintf(buffer, sizeof(buffer), "  pitch %.2f deg", *r.pitch_measured_deg);
+      lines += buffer;
+    }
   }
-  if (!message.empty()) line += "  (" + message + ")";
-  // The measured period and the hand calculation beside the nonlinear fit.
+  // The measured period and the hand calculation beside the nonlinear fit: over the whole free
+  // oscillation, with no amplitude or damping correction.
   if (std::isfinite(r.period_s)) {
     std::snprintf(buffer, sizeof(buffer),
-                  "\n    period %.4f s (%.4f Hz), small-angle I = m g D^2 T^2 / (16 pi^2 L) = %.5g %s",
+                  "\n    period %.4f s (%.4f Hz), small-angle I = m g D^2 T^2 / (16 pi^2 L) = %.5g %s "
+                  "(whole free swing)",
                   r.period_s, r.frequency_hz, scale * r.small_angle_inertia_total_kg_m2, unit);
-    line += buffer;
+    lines += buffer;
   }
-  // I against amplitude (the ideal model is flat), and every warning on its own line.
+  // I against amplitude (the ideal model is flat).
   if (!r.sweep.bands.empty()) {
     AmplitudeSweep shown = r.sweep;  // the bands' I in the display units
     for (AmplitudeSweepBand& b : shown.bands) {
       b.inertia_kg_m2 *= scale;
       b.inertia_std_kg_m2 *= scale;
     }
-    line += "\n    I(A): " + SweepSummary(shown);
+    lines += "\n    I(A): " + SweepSummary(shown);
     if (r.sweep.evaluated) {
       std::snprintf(buffer, sizeof(buffer), "  trend %+.3g %% per 10 deg (as A^%g, z = %.1f)%s",
                     r.sweep.trend_percent_per_10deg, r.sweep.trend_exponent, r.sweep.trend_z,
                     r.sweep.trend_detected ? ": the rig departs from the model" : "");
-      line += buffer;
+      lines += buffer;
     }
   } else if (!r.sweep.note.empty()) {
-    line += "\n    I(A): no sweep (" + r.sweep.note + ")";
+    lines += "\n    I(A): no sweep (" + r.sweep.note + ")";
   }
   if (std::isfinite(r.amplitude_correction_kg_m2)) {
     const double before = r.inertia_total_kg_m2 + r.amplitude_correction_kg_m2;
@@ -89,31 +104,57 @@ std::string HumanLine(const TraceRecord& r, DisplayUnits units) {
                   before, r.inertia_total_kg_m2, -100.0 * r.amplitude_correction_kg_m2 / before,
                   100.0 * r.amplitude_correction_std_kg_m2 / before,
                   r.amplitude_correction_from_deg);
-    line += buffer;
+    lines += buffer;
   }
   for (const std::string& flag : r.flags) {
     if (flag.rfind("block_means_of_", 0) == 0) {
-      line += "\n    note: a dense log; the fit used means of " +
-              flag.substr(std::string("block_means_of_").size(), flag.find("_samples") - 15) +
-              " consecutive samples (docs/method.md, section 6)";
+      lines += "\n    note: a dense log; the fit used means of " +
+               flag.substr(std::string("block_means_of_").size(), flag.find("_samples") - 15) +
+               " consecutive samples (docs/method.md, section 6)";
     }
   }
+  return lines;
+}
+
+// "    warning: SUMMARY", one line per warning (the assumed +-1 mm on L and D is said once for the
+// run, AssumedInputsSummary); a rejection or error first, as "    rejected: REASON".
+std::string WarningLines(const TraceRecord& r, DisplayUnits units, bool* folded) {
+  std::string lines;
+  // Messages name the file already; the line under it does not repeat it.
+  const std::string prefix = r.file + ": ";
+  if (!r.ok() && !r.message.empty() && std::isfinite(r.inertia_total_kg_m2) &&
+      r.status != TraceStatus::kError) {  // with no fit, the message is on the result line
+    const std::string message = SiTextInDisplayUnits(
+        r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message, units);
+    lines += "\n    " + std::string(ToString(r.status)) + ": " + message;
+  }
   for (const std::string& w : r.warnings) {
+    if (IsAssumedInputsWarning(w)) continue;
     const std::string shown = SiTextInDisplayUnits(w, units);
-    if (message.find(shown) == std::string::npos && !IsAssumedInputsWarning(w))
-      line += "\n    warning: " + shown;
+    const std::string summary = WarningSummary(shown);
+    if (summary.size() < shown.size()) *folded = true;
+    lines += "\n    warning: " + summary;
   }
   // --plot: which files are this log's figures (a name may carry a hash: FigureStems).
   if (!r.figures.empty()) {
-    line += "\n    figures:";
-    for (const std::string& f : r.figures) line += " " + f;
+    lines += "\n    figures:";
+    for (const std::string& f : r.figures) lines += " " + f;
   }
-  return line;
+  return lines;
 }
+
+std::string HumanLine(const TraceRecord& r, DisplayUnits units, bool* folded) {
+  return ResultLine(r, units) + DetailLines(r, units) + WarningLines(r, units, folded);
+}
+
+// Said once after the records when a warning was shown shortened.
+const char kFoldedNote[] =
+    "(warnings shown by their first sentence, which says what to do; `bifilar fit --json` prints "
+    "them in full)";
 
 // --repeats without --json: the records, then the amplitude correction and each group. The
 // between-repeat (Q) warning is the same on every member: said once, under its group.
-void PrintRepeats(const FitCommandResult& result) {
+void PrintRepeats(const FitCommandResult& result, bool* folded) {  // *folded: as HumanLine
   std::vector<std::string> scatter_warnings;
   for (const TraceRecord& r : result.records) {
     TraceRecord shown = r;
@@ -128,7 +169,7 @@ void PrintRepeats(const FitCommandResult& result) {
         shown.warnings.push_back(w);
       }
     }
-    std::cout << HumanLine(shown, result.config.units) << std::endl;
+    std::cout << HumanLine(shown, result.config.units, folded) << std::endl;
   }
   std::cout << AmplitudeCorrectionLine(result.correction) << std::endl;
   for (const RepeatGroup& g : result.groups) {
@@ -140,7 +181,7 @@ void PrintRepeats(const FitCommandResult& result) {
       const std::string per_log = "this log's std";
       const size_t at = text.find(per_log);
       if (at != std::string::npos) text.replace(at, per_log.size(), "each log's std");
-      std::cout << "    warning: " << text << std::endl;
+      std::cout << "    warning: " << text << std::endl;  // once per group: in full
     }
   }
 }
@@ -192,6 +233,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     FitCommandOptions options = args->options;
     const bool json = args->json, repeats = options.repeats;
     options.handle_interrupt = true;
+    auto folded = std::make_shared<bool>(false);  // a warning was shown by its summary
     if (!json) {
       options.on_calibration = [](const RigCalibrationResult& calibration) {
         std::cout << calibration.BriefReport() << std::endl;
@@ -205,8 +247,8 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       options.on_groups = [](const std::string& groups) { std::cout << groups << std::endl; };
       // Without --repeats each line is printed as soon as its log is fitted.
       if (!repeats) {
-        options.on_record = [](const TraceRecord& r, const CampaignConfig& config) {
-          std::cout << HumanLine(r, config.units) << std::endl;
+        options.on_record = [folded](const TraceRecord& r, const CampaignConfig& config) {
+          std::cout << HumanLine(r, config.units, folded.get()) << std::endl;
         };
       }
     }
@@ -214,7 +256,7 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
     if (result.interrupted) {
       if (json || repeats) {
         for (const TraceRecord& r : result.records) {
-          std::cout << HumanLine(r, result.config.units) << std::endl;
+          std::cout << HumanLine(r, result.config.units, folded.get()) << std::endl;
         }
       }
       std::cerr << "bifilar: interrupted: " << result.records.size() << " of "
@@ -227,8 +269,9 @@ void RegisterFitCommand(CLI::App& app, int* exit_code) {
       std::cout << result.json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
                 << std::endl;
     } else if (repeats) {
-      PrintRepeats(result);
+      PrintRepeats(result, folded.get());
     }
+    if (*folded && !json) std::cout << kFoldedNote << std::endl;
     // Once for the run: what the assumed +-1 mm on L and D adds (--json records carry it).
     const std::string assumed = AssumedInputsSummary(result.records);
     if (!assumed.empty() && !json) std::cout << assumed << std::endl;

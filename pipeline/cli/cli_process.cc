@@ -9,9 +9,43 @@
 #include "pipeline/cli/cli_commands.h"
 #include "pipeline/commands/process_command.h"
 #include "pipeline/config/config.h"
+#include "pipeline/records/total_uncertainty.h"
+#include "pipeline/records/trace_record.h"
 #include "pipeline/report/report.h"
 
 namespace bifilar {
+namespace {
+
+// The traces' warnings after the summary (issue 25 item 5), in the traces' order: each trace that
+// raised one, then one line per warning by its summary (WarningSummary), the most important first.
+// The assumed +-1 mm on L and D is said once in the summary. At most kShownTraces traces; the rest
+// and the full texts are named where to find them.
+void PrintTraceWarnings(const CampaignResult& campaign, DisplayUnits units, std::ostream& out) {
+  constexpr int kShownTraces = 20;
+  int warned = 0, shown = 0;
+  std::string block;
+  for (const TraceRecord& r : campaign.traces) {
+    std::string lines;
+    for (const std::string& w : r.warnings) {
+      if (!IsAssumedInputsWarning(w))
+        lines += "    warning: " + WarningSummary(SiTextInDisplayUnits(w, units)) + "\n";
+    }
+    if (lines.empty()) continue;
+    if (++warned > kShownTraces) continue;
+    ++shown;
+    block += "  " + r.file + " (" + ToString(r.status) + "):\n" + lines;
+  }
+  if (warned == 0) return;
+  out << "Warnings of " << warned << " trace" << (warned == 1 ? "" : "s")
+      << " (first sentence of each; full texts in results.json and report.html, section Warnings):\n"
+      << block;
+  if (warned > shown) {
+    out << "  ... and " << warned - shown << " more traces with warnings (report.html, section "
+        << "Warnings)\n";
+  }
+}
+
+}  // namespace
 
 void RegisterProcessCommands(CLI::App& app, int* exit_code) {
   struct Args {
@@ -59,6 +93,7 @@ void RegisterProcessCommands(CLI::App& app, int* exit_code) {
       return;
     }
     PrintCampaignSummary(result.config, result.campaign, std::cout);
+    PrintTraceWarnings(result.campaign, result.config.units, std::cout);
     std::cout << "Wrote " << result.out_dir
               << "/{results.json, traces.csv, angles.csv, report.html}\n";
     *exit_code = result.campaign.summary.exit_code;

@@ -751,7 +751,8 @@ std::string InspectReportText(const InspectReport& r) {
   if (std::isfinite(r.small_angle_inertia_kg_m2)) {
     std::snprintf(line, sizeof(line),
                   "  small-angle inertia m g D^2 T^2 / (16 pi^2 L) = %#.5g kg m^2 (m = %.4g kg; "
-                  "the nonlinear fit, `bifilar fit`, corrects it for amplitude and damping)\n",
+                  "a whole-log estimate from the mean period, not the result: `bifilar fit` "
+                  "gives I)\n",
                   r.small_angle_inertia_kg_m2, r.mass_used_kg);
     out << line;
   }

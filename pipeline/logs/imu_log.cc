@@ -452,7 +452,8 @@ void CheckRowsEnd(const CsvRows& r, int header_line, const std::string& name, Im
     data->warnings.push_back("the time series ends at line " + std::to_string(r.end_line) + " (" +
                              r.end_reason + "); " +
                              std::to_string(r.lines_after_end) +
-                             " row(s) after it (a footer?) are ignored");
+                             " row(s) after it (a footer?) are ignored; if they are data, "
+                             "fix the row");
   } else if (r.bad_rows > 0) {
     data->warnings.push_back("skipped " + std::to_string(r.bad_rows) +
                              " trailing non-numeric row(s) from line " +

@@ -1,5 +1,6 @@
 #include "pipeline/records/trace_record.h"
 
+#include <cctype>
 #include <vector>
 
 #include "base/enum_names.h"
@@ -25,6 +26,21 @@ constexpr TraceRoleRow kTraceRoleTable[] = {{TraceRole::kAircraft, "aircraft"},
                                             {TraceRole::kCalibration, "calibration"}};
 
 }  // namespace
+
+std::string WarningSummary(const std::string& warning, size_t max_chars) {
+  std::string summary = warning;
+  for (size_t k = 0; k + 2 < warning.size(); ++k) {
+    if ((warning[k] == '.' || warning[k] == '?') && warning[k + 1] == ' ' &&
+        std::isupper(static_cast<unsigned char>(warning[k + 2]))) {
+      summary = warning.substr(0, warning[k] == '.' ? k : k + 1);
+      break;
+    }
+  }
+  if (summary.size() <= max_chars || max_chars < 8) return summary;
+  size_t cut = summary.rfind(' ', max_chars - 4);
+  if (cut == std::string::npos || cut < max_chars / 2) cut = max_chars - 4;
+  return summary.substr(0, cut) + " ...";
+}
 
 const char* ToString(TraceStatus status) {
   for (const TraceStatusRow& row : kTraceStatusTable) {

@@ -128,6 +128,13 @@ struct TraceRecord {
   bool ok() const { return status == TraceStatus::kOk; }
 };
 
+// A warning's one-line summary. Warnings (TraceRecord::warnings, TraceFitResult::warnings) state
+// the finding and what to do in their first sentence and give the detail after it: the summary
+// is that first sentence (up to ". " or "? " before a capital letter), cut at a word to at most
+// max_chars with " ..." when longer. The console and the report show it; the full text is in
+// results.json, `bifilar fit --json` and the report's expanded warning.
+std::string WarningSummary(const std::string& warning, size_t max_chars = 160);
+
 // The geometry (L, D, suspended mass, g) a trace of `role` is fitted with.
 RigGeometry GeometryForRole(const CampaignConfig& config, TraceRole role);
 

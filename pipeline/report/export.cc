@@ -402,7 +402,10 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
       const auto scalar = [&aircraft](const char* key) {
         return aircraft[key].IsDefined() && aircraft[key].IsScalar();
       };
-      if (aircraft.IsMap() && scalar("mass_kg")) {
+      // An absent section or key gives an invalid node, which throws on IsMap()/IsScalar():
+      // IsDefined first, so a config without aircraft.mass_std_kg (or without aircraft) is read
+      // without a warning.
+      if (aircraft.IsDefined() && aircraft.IsMap() && scalar("mass_kg")) {
         in.mass_kg = aircraft["mass_kg"].as<double>();
         in.mass_source = "config aircraft.mass_kg";
         if (scalar("mass_std_kg")) in.mass_std_kg = aircraft["mass_std_kg"].as<double>();

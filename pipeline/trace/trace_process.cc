@@ -322,7 +322,9 @@ TraceFitResult FitWithResidualGlitchPass(const CampaignConfig& config,
     std::snprintf(text, sizeof(text), "%s %.6g", i ? "," : "", input->t_s[more[i]]);
     warning += text;
   }
-  record->warnings.push_back(warning + (more.size() > 5 ? ", ... s" : " s"));
+  record->warnings.push_back(warning + (more.size() > 5 ? ", ... s" : " s") +
+                             "; nothing to do unless they were real motion (fit.glitch sets the "
+                             "thresholds)");
   std::vector<double> t, rate;
   size_t next = 0;
   for (size_t k = 0; k < input->t_s.size(); ++k) {
@@ -356,7 +358,10 @@ void FillRecordFromFit(const CampaignConfig& config, const std::string& path,
     std::snprintf(flag, sizeof(flag), "block_means_of_%.0f_samples", series.samples_per_point);
     record.flags.push_back(flag);
   }
-  for (const std::string& w : fit.warnings) record.warnings.push_back(w);
+  // The most important first: values no real rig gives (units), the fit's warnings (in their
+  // own order), then what reading the log and finding the window noted.
+  const std::vector<std::string> data_warnings = std::move(record.warnings);
+  record.warnings.clear();
   if (fit.HasFit()) {  // an amplitude or radius of gyration no real rig gives: units (issue 16)
     for (const std::string& w : FitPlausibilityWarnings(
              fit.params.inertia_kg_m2, input.geometry.mass_kg, input.geometry.filar_separation_m,
@@ -364,6 +369,8 @@ void FillRecordFromFit(const CampaignConfig& config, const std::string& path,
       record.warnings.push_back(w);
     }
   }
+  for (const std::string& w : fit.warnings) record.warnings.push_back(w);
+  for (const std::string& w : data_warnings) record.warnings.push_back(w);
   record.model = ToString(fit.model);
   record.iterations = fit.iterations;
   record.secondary_motion_ratio =
@@ -408,11 +415,14 @@ void FillRecordFromFit(const CampaignConfig& config, const std::string& path,
       record.warnings.push_back(AssumedInputsWarning(record));
     }
   }
+  // An ok record's message names its first warning by its summary and how many more there are
+  // (every one is in `warnings`; the console prints each on its own line).
   if (record.status == TraceStatus::kOk && !record.warnings.empty()) {
-    record.message = name + ": " + record.warnings.front() +
-                     (record.warnings.size() > 1 ? " (+" + std::to_string(record.warnings.size() - 1) +
-                                                       " more warnings)"
-                                                 : "");
+    const size_t more = record.warnings.size() - 1;
+    record.message = name + ": " + WarningSummary(record.warnings.front()) +
+                     (more > 0 ? " (and " + std::to_string(more) + " more warning" +
+                                     (more == 1 ? "" : "s") + " in the record's warnings)"
+                               : "");
   }
 }
 
