@@ -185,7 +185,8 @@ class Parser {
  private:
   // The length of a message of `type` at `pos` when it is a whole message followed by another
   // header (or the end of the file); 0 otherwise.
-  size_t WholeMessageAt(size_t pos);
+  // `in_sync`: the message before ended here.
+  size_t WholeMessageAt(size_t pos, bool in_sync);
   void OnMessage(size_t pos, const DataflashFormat& f);
   void OnFmt(size_t pos, const unsigned char* body);
   void OnFmtu(const DataflashFormat& f, const unsigned char* body);
@@ -207,13 +208,14 @@ class Parser {
   size_t first_skip_at_ = 0, first_skip_bytes_ = 0;
   std::string tail_;  // what the cut tail was, when the log ends inside a message
   bool simulated_noted_ = false;
+  std::set<int> confirmed_ = {kDataflashFmtType};  // types seen followed by another message
   // The request's field indices in the format last used (by its FMT byte offset).
   uint64_t request_format_at_ = UINT64_MAX;
   std::vector<int> request_index_;
   int request_instance_index_ = -1;
 };
 
-size_t Parser::WholeMessageAt(size_t pos) {
+size_t Parser::WholeMessageAt(size_t pos, bool in_sync) {
   const auto it = out_.formats.find(data_[pos + 2]);
   if (it == out_.formats.end()) return 0;
   const size_t length = static_cast<size_t>(it->second.length);
@@ -222,11 +224,15 @@ size_t Parser::WholeMessageAt(size_t pos) {
   const size_t left = size_ - next;
   const bool followed = left == 0 || (data_[next] == kDataflashHead1 &&
                                       (left == 1 || data_[next + 1] == kDataflashHead2));
-  if (!followed) {
-    ++out_.misframed[it->first];
-    return 0;
+  if (followed) {
+    confirmed_.insert(it->first);
+    return length;
   }
-  return length;
+  // Garbage after a message: kept when the reader is in step and the type's length has been
+  // seen to frame the messages before (else a wrong FMT length would be read as data).
+  if (in_sync && confirmed_.count(it->first)) return length;
+  ++out_.misframed[it->first];
+  return 0;
 }
 
 DataflashContents Parser::Run() {
@@ -235,7 +241,7 @@ DataflashContents Parser::Run() {
   while (pos < size_) {
     if (size_ - pos >= kHeader && data_[pos] == kDataflashHead1 &&
         data_[pos + 1] == kDataflashHead2) {
-      const size_t length = WholeMessageAt(pos);
+      const size_t length = WholeMessageAt(pos, !skipping);
       if (length > 0) {
         if (skipping) NoteSkipped(skip_start, pos, false);
         skipping = false;

@@ -12,9 +12,10 @@
 // it has no use for are skipped by their FMT length; FMT may redefine a type; bytes that are not
 // a message (bad sync bytes, garbage between messages) are skipped up to the next header of a
 // defined type that is followed by another header, and a log cut mid-message is read to its last
-// whole message: both with a warning saying how many bytes were skipped and where. A message is
-// only taken when the bytes after it start another message (or end the file), so a wrong FMT
-// length is found rather than read as data.
+// whole message: both with a warning saying how many bytes were skipped and where. After
+// skipped bytes, a message is only taken when the bytes after it start another message (or end
+// the file), and a type's messages are only taken unchecked once its length has framed one that
+// way: so a wrong FMT length is found rather than read as data.
 //
 // Bad input is a UserError naming the file and what was found, never a crash: not DataFlash (no
 // message anywhere), no IMU message (the messages found are listed), an FMT of the IMU message
