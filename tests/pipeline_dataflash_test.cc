@@ -295,8 +295,10 @@ TEST(DataflashReader, LogCutMidMessageIsReadToTheLastWholeMessage) {
   const ImuData d = ReadDataflashImu(cut, "cut.bin");
   EXPECT_EQ(d.size(), 49u);
   ASSERT_FALSE(d.warnings.empty());
-  EXPECT_TRUE(Contains(d.warnings[0], "the log ends inside a IMU message")) << d.warnings[0];
-  EXPECT_TRUE(Contains(d.warnings[0], "skipped 34 byte(s)")) << d.warnings[0];
+  EXPECT_EQ(d.warnings[0], "the log ends inside a IMU message at byte " +
+                               std::to_string(whole.size() - 54) +
+                               " (34 of its 54 bytes): the logger stopped mid-write; read to the "
+                               "last whole message");
 }
 
 TEST(DataflashReader, BadInputIsAnErrorNamingTheFileAndWhatWasFound) {
@@ -380,6 +382,28 @@ TEST(DataflashReader, RandomDamageNeverCrashes) {
   }
   EXPECT_GT(read, 100);
   EXPECT_EQ(read + refused, 300);
+}
+
+TEST(DataflashConfig, InstanceKey) {
+  TempDir dir("bifilar_dataflash_config");
+  const std::string rig = "rig: {filar_length_m: 2.0, filar_separation_m: 1.0, mass_kg: 6}\n";
+  const CampaignConfig plain = test_support::LoadFitConfig(WriteFile(dir.path + "/a.yaml", rig));
+  EXPECT_EQ(plain.LogOptions().dataflash_instance, -1);
+  const CampaignConfig one = test_support::LoadFitConfig(
+      WriteFile(dir.path + "/b.yaml", rig + "imu:\n  dataflash: {instance: 1}\n"));
+  EXPECT_EQ(one.LogOptions().dataflash_instance, 1);
+  for (const std::string& bad : {std::string("imu:\n  dataflash: {instance: 256}\n"),
+                                 std::string("imu:\n  dataflash: {instance: -1}\n"),
+                                 std::string("imu:\n  dataflash: {instanse: 1}\n")}) {
+    const std::string path = WriteFile(dir.path + "/c.yaml", rig + bad);
+    try {
+      test_support::LoadFitConfig(path);
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const UserError& e) {
+      EXPECT_TRUE(Contains(e.what(), "c.yaml")) << e.what();
+      EXPECT_TRUE(Contains(e.what(), "instan")) << e.what();
+    }
+  }
 }
 
 // The simulated swing written by `bifilar simulate --trace x.bin`, and the same samples as CSV

@@ -207,6 +207,7 @@ class Parser {
   long skipped_runs_ = 0;
   size_t first_skip_at_ = 0, first_skip_bytes_ = 0;
   std::string tail_;  // what the cut tail was, when the log ends inside a message
+  size_t tail_bytes_ = 0;
   bool simulated_noted_ = false;
   std::set<int> confirmed_ = {kDataflashFmtType};  // types seen followed by another message
   // The request's field indices in the format last used (by its FMT byte offset).
@@ -273,31 +274,35 @@ DataflashContents Parser::Run() {
   }
   if (skipped_runs_ > 0) {
     out_.warnings.push_back(
-        "skipped " + std::to_string(out_.skipped_bytes) +
-        " byte(s) that are not part of a whole "
-        "message, in " +
+        "skipped " + std::to_string(out_.skipped_bytes - tail_bytes_) +
+        " byte(s) that are not "
+        "part of a whole message, in " +
         std::to_string(skipped_runs_) + " place(s) (the first " +
         std::to_string(first_skip_bytes_) + " byte(s) at byte " + std::to_string(first_skip_at_) +
-        "): bad sync bytes or garbage between messages; reading went on at the next message" +
-        tail_);
+        "): bad sync bytes or garbage between messages; reading went on at the next message");
   }
+  if (!tail_.empty()) out_.warnings.push_back(tail_);
   return std::move(out_);
 }
 
 void Parser::NoteSkipped(size_t start, size_t end, bool at_end) {
   out_.skipped_bytes += end - start;
-  if (skipped_runs_++ == 0) {
-    first_skip_at_ = start;
-    first_skip_bytes_ = end - start;
-  }
   if (at_end && end - start >= kHeader && data_[start] == kDataflashHead1 &&
       data_[start + 1] == kDataflashHead2) {
     const auto it = out_.formats.find(data_[start + 2]);
     if (it != out_.formats.end() && static_cast<size_t>(it->second.length) > end - start) {
-      tail_ = "; the log ends inside a " + Printable(it->second.name) + " message at byte " +
+      tail_bytes_ = end - start;
+      tail_ = "the log ends inside a " + Printable(it->second.name) + " message at byte " +
               std::to_string(start) + " (" + std::to_string(end - start) + " of its " +
-              std::to_string(it->second.length) + " bytes): the logger stopped mid-write";
+              std::to_string(it->second.length) +
+              " bytes): the logger stopped mid-write; read "
+              "to the last whole message";
+      return;
     }
+  }
+  if (skipped_runs_++ == 0) {
+    first_skip_at_ = start;
+    first_skip_bytes_ = end - start;
   }
 }
 
