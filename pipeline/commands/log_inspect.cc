@@ -668,7 +668,12 @@ std::string InspectReportText(const InspectReport& r) {
       if (m.rate_hz() > 0) out << Format("  %8.1f Hz", m.rate_hz());
       if (!m.instances.empty()) {
         out << "  instances (" << m.instance_field << "):";
-        for (const auto& [instance, count] : m.instances) out << " " << instance << " (" << count << ")";
+        const double span_s = m.last_time_s - m.first_time_s;
+        for (const auto& [instance, count] : m.instances) {
+          out << " " << instance << " (" << count;
+          if (span_s > 0 && count > 1) out << Format(", %.1f Hz", (count - 1) / span_s);
+          out << ")";
+        }
       }
       out << "\n";
     }

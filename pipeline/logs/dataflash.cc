@@ -152,6 +152,17 @@ void Layout(DataflashFormat* f) {
   }
   f->problem.clear();
   f->decodable = true;
+  f->time_index = f->instance_index = -1;
+  for (size_t i = 0; i < f->labels.size(); ++i) {
+    const char c = f->format[i];
+    const bool number = !IsStringChar(c) && c != 'a';
+    if (f->time_index < 0 && number && (f->labels[i] == "TimeUS" || f->labels[i] == "TimeMS")) {
+      f->time_index = static_cast<int>(i);
+    }
+    if (f->instance_index < 0 && number && (f->labels[i] == "I" || f->labels[i] == "Instance")) {
+      f->instance_index = static_cast<int>(i);
+    }
+  }
 }
 
 int LabelIndex(const DataflashFormat& f, const std::string& label) {
@@ -209,7 +220,9 @@ class Parser {
   std::string tail_;  // what the cut tail was, when the log ends inside a message
   size_t tail_bytes_ = 0;
   bool simulated_noted_ = false;
-  std::set<int> confirmed_ = {kDataflashFmtType};  // types seen followed by another message
+  std::set<int> confirmed_ = {kDataflashFmtType};
+  std::vector<int> slot_by_type_ =
+      std::vector<int>(256, -1);  // into out_.messages  // types seen followed by another message
   // The request's field indices in the format last used (by its FMT byte offset).
   uint64_t request_format_at_ = UINT64_MAX;
   std::vector<int> request_index_;
@@ -355,6 +368,7 @@ void Parser::OnFmt(size_t pos, const unsigned char* body) {
     return;  // the same definition again (a log restarted): keep its FMTU
   }
   out_.formats[f.type] = f;
+  slot_by_type_[f.type] = -1;  // its name may have changed
 }
 
 void Parser::OnFmtu(const DataflashFormat& f, const unsigned char* body) {
@@ -399,33 +413,27 @@ void Parser::OnMsg(const DataflashFormat& f, const unsigned char* body) {
 
 // The count, time span and instances of a message name.
 void Parser::Count(const DataflashFormat& f, const unsigned char* body) {
-  auto [it, added] = message_index_.emplace(f.name, out_.messages.size());
-  if (added) {
-    DataflashMessageInfo info;
-    info.name = f.name;
-    out_.messages.push_back(info);
-  }
-  DataflashMessageInfo& info = out_.messages[it->second];
-  ++info.count;
-  if (!f.decodable || f.labels.empty()) return;
-  int time_at = -1, instance_at = -1;
-  for (size_t i = 0; i < f.labels.size(); ++i) {
-    if (time_at < 0 && (f.labels[i] == "TimeUS" || f.labels[i] == "TimeMS"))
-      time_at = static_cast<int>(i);
-    if (instance_at < 0 && (f.labels[i] == "I" || f.labels[i] == "Instance") &&
-        !IsStringChar(f.format[i]) && f.format[i] != 'a') {
-      instance_at = static_cast<int>(i);
+  int& slot = slot_by_type_[f.type];
+  if (slot < 0) {
+    auto [it, added] = message_index_.emplace(f.name, out_.messages.size());
+    if (added) {
+      DataflashMessageInfo info;
+      info.name = f.name;
+      out_.messages.push_back(info);
     }
+    slot = static_cast<int>(it->second);
   }
-  if (time_at >= 0 && !IsStringChar(f.format[time_at]) && f.format[time_at] != 'a') {
-    const double t = DecodeNumber(body + f.offsets[time_at], f.format[time_at]) *
-                     (f.labels[time_at] == "TimeUS" ? 1e-6 : 1e-3);
+  DataflashMessageInfo& info = out_.messages[slot];
+  ++info.count;
+  if (f.time_index >= 0) {
+    const double t = DecodeNumber(body + f.offsets[f.time_index], f.format[f.time_index]) *
+                     (f.labels[f.time_index] == "TimeUS" ? 1e-6 : 1e-3);
     if (info.count == 1 || !std::isfinite(info.first_time_s)) info.first_time_s = t;
     info.last_time_s = t;
   }
-  if (instance_at >= 0) {
-    info.instance_field = f.labels[instance_at];
-    const double v = DecodeNumber(body + f.offsets[instance_at], f.format[instance_at]);
+  if (f.instance_index >= 0) {
+    if (info.instance_field.empty()) info.instance_field = f.labels[f.instance_index];
+    const double v = DecodeNumber(body + f.offsets[f.instance_index], f.format[f.instance_index]);
     if (std::isfinite(v) && std::abs(v) < 1e6) ++info.instances[static_cast<int>(v)];
   }
 }

@@ -60,6 +60,8 @@ struct DataflashFormat {
   bool decodable = false;
   std::string problem;
   std::vector<int> offsets;  // of each field in the message body (after the header)
+  // When decodable: the numeric TimeUS/TimeMS and I/Instance fields (-1: none).
+  int time_index = -1, instance_index = -1;
 };
 
 // What a log holds of one message name.
