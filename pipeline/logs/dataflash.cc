@@ -624,6 +624,42 @@ ImuSource ChooseSource(const std::vector<ImuSource>& sources, int instance,
                   " (imu.dataflash.instance) in the log; its instances are: " + list);
 }
 
+// The rows FinishImuLog takes (t, gyro x y z, then accel x y z when `with_accel`), each value
+// finite and within a sensor's range (imu_log_options.h), else an error naming the message.
+void PackRows(const SourceSeries& gyro, const std::vector<double>& accel, bool with_accel,
+              const std::string& name, const std::string& what, std::vector<double>* values_out,
+              std::vector<int>* row_number_out) {
+  const size_t rows = gyro.t_s.size();
+  const int needed = with_accel ? 7 : 4;
+  std::vector<double>& values = *values_out;
+  values.resize(rows * needed);
+  std::vector<int>& row_number = *row_number_out;
+  row_number.resize(rows);
+  for (size_t r = 0; r < rows; ++r) {
+    double* v = &values[r * needed];
+    v[0] = gyro.t_s[r];
+    for (int a = 0; a < 3; ++a) v[1 + a] = gyro.xyz[3 * r + a];
+    if (with_accel)
+      for (int a = 0; a < 3; ++a) v[4 + a] = accel[3 * r + a];
+    for (int k = 0; k < needed; ++k) {
+      const double bound = k == 0 ? INFINITY : (k <= 3 ? kMaxGyroRateRadPerS : kMaxAccelMps2);
+      if (!std::isfinite(v[k]) || std::abs(v[k]) > bound) {
+        char value[32];
+        std::snprintf(value, sizeof(value), "%g", v[k]);
+        throw UserError(name + ": message " + std::to_string(r + 1) + " of " + what + " has " +
+                        (k == 0   ? "time"
+                         : k <= 3 ? "a gyro rate"
+                                  : "a specific force") +
+                        " = " + value +
+                        (k == 0   ? ""
+                         : k <= 3 ? " rad/s (|rate| <= 1e4 rad/s expected)"
+                                  : " m/s^2 (|f| <= 1e5 m/s^2 expected)"));
+      }
+    }
+    row_number[r] = static_cast<int>(std::min<size_t>(r + 1, 2147483647));
+  }
+}
+
 }  // namespace
 
 double DataflashMessageInfo::rate_hz() const {
@@ -758,31 +794,9 @@ ImuData ReadDataflashImu(std::string_view bytes, const std::string& name,
   const size_t rows = gyro.t_s.size();
   if (rows == 0) throw UserError(name + ": no " + what + " messages could be read");
   const int needed = with_accel ? 7 : 4;
-  std::vector<double> values(rows * needed);
-  std::vector<int> row_number(rows);
-  for (size_t r = 0; r < rows; ++r) {
-    double* v = &values[r * needed];
-    v[0] = gyro.t_s[r];
-    for (int a = 0; a < 3; ++a) v[1 + a] = gyro.xyz[3 * r + a];
-    if (with_accel)
-      for (int a = 0; a < 3; ++a) v[4 + a] = accel[3 * r + a];
-    for (int k = 0; k < needed; ++k) {
-      const double bound = k == 0 ? INFINITY : (k <= 3 ? kMaxGyroRateRadPerS : kMaxAccelMps2);
-      if (!std::isfinite(v[k]) || std::abs(v[k]) > bound) {
-        char value[32];
-        std::snprintf(value, sizeof(value), "%g", v[k]);
-        throw UserError(name + ": message " + std::to_string(r + 1) + " of " + what + " has " +
-                        (k == 0   ? "time"
-                         : k <= 3 ? "a gyro rate"
-                                  : "a specific force") +
-                        " = " + value +
-                        (k == 0   ? ""
-                         : k <= 3 ? " rad/s (|rate| <= 1e4 rad/s expected)"
-                                  : " m/s^2 (|f| <= 1e5 m/s^2 expected)"));
-      }
-    }
-    row_number[r] = static_cast<int>(std::min<size_t>(r + 1, 2147483647));
-  }
+  std::vector<double> values;
+  std::vector<int> row_number;
+  PackRows(gyro, accel, with_accel, name, what, &values, &row_number);
   ImuData data;
   data.warnings = log.warnings;
   if (sources.size() > 1 && options.dataflash_instance < 0) {
