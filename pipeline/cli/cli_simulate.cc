@@ -43,7 +43,7 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
   sub->add_option("spec", args->spec_file, "simulation spec (YAML); see configs/simulate_prandtl_d.yaml")
       ->check(CLI::ExistingFile);
   sub->add_option("--out", args->out_dir, "campaign output folder (pitch_*/trial_*.csv, tare/, truth.json)");
-  sub->add_option("--trace", args->trace_csv, "simulate one trace into this file: CSV, or PX4 ULog when it ends in .ulg");
+  sub->add_option("--trace", args->trace_csv, "simulate one trace into this file: CSV, PX4 ULog when it ends in .ulg, ArduPilot DataFlash when it ends in .bin");
   sub->add_option("--truth", args->truth_json, "truth JSON of --trace (default OUT.truth.json)");
   raw->o_seed = sub->add_option("--seed", raw->seed,
                                 "random seed, an integer in [0, 2^64 - 1] (overrides the spec's "

@@ -458,6 +458,27 @@ void ReadUlogTopics(const std::string& bytes, const std::string& name, InspectRe
   for (const std::string& w : contents.warnings) report->warnings.push_back(w);
 }
 
+// An ArduPilot DataFlash log (pipeline/logs/dataflash.h): every message with its count, rate and
+// instances, then the IMU series of the configured instance (or the lowest).
+ImuData ReadDataflashLog(const std::string& bytes, const std::string& path,
+                         const CampaignConfig* config, ImuLogOptions options,
+                         InspectReport* report) {
+  report->kind = "dataflash";
+  const DataflashContents contents = ParseDataflash(bytes, path);
+  report->messages = contents.messages;
+  if (config != nullptr) {
+    report->format = config->imu.format;
+    report->format_from_config = true;
+    options.dataflash_instance = config->imu.dataflash_instance;
+  }
+  ImuData data = ReadDataflashImu(bytes, path, options);
+  if (!report->format_from_config) {
+    report->guesses.push_back("ArduPilot DataFlash log: gyro in rad/s and accelerometer in m/s^2 "
+                              "as ArduPilot logs them (FMTU units checked)");
+  }
+  return data;
+}
+
 // The first topic with an IMU among those with known defaults.
 bool GuessUlogFormat(InspectReport* report) {
   for (const char* topic : {"sensor_combined", "vehicle_angular_velocity", "sensor_gyro"}) {
@@ -635,7 +656,10 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config,
   }
   try {
     ImuData data;
-    if (LooksLikeUlog(bytes)) {
+    if (LooksLikeDataflash(bytes) ||
+        (NamedLikeDataflash(path) && ClassifyText(bytes) == "binary")) {
+      data = ReadDataflashLog(bytes, path, config, log_options, &report);
+    } else if (LooksLikeUlog(bytes)) {
       report.kind = "ulog";
       ReadUlogTopics(bytes, path, &report);
       if (config != nullptr) {
@@ -711,6 +735,24 @@ std::string InspectReportText(const InspectReport& r) {
       out << "\n";
     }
   }
+  if (!r.messages.empty()) {
+    out << "  messages (" << r.messages.size() << "):\n";
+    for (const DataflashMessageInfo& m : r.messages) {
+      std::snprintf(line, sizeof(line), "    %-6s %8ld", m.name.c_str(), m.count);
+      out << line;
+      if (m.rate_hz() > 0) out << Format("  %8.1f Hz", m.rate_hz());
+      if (!m.instances.empty()) {
+        out << "  instances (" << m.instance_field << "):";
+        const double span_s = m.last_time_s - m.first_time_s;
+        for (const auto& [instance, count] : m.instances) {
+          out << " " << instance << " (" << count;
+          if (span_s > 0 && count > 1) out << Format(", %.1f Hz", (count - 1) / span_s);
+          out << ")";
+        }
+      }
+      out << "\n";
+    }
+  }
   if (r.is_log()) {
     if (r.format_from_config) {
       out << "  format: from the config\n";
@@ -775,6 +817,17 @@ nlohmann::json InspectReportToJson(const InspectReport& r) {
                       {"rate_hz", JsonNumber(t.rate_hz)}});
   }
   j["topics"] = topics;
+  nlohmann::json messages = nlohmann::json::array();
+  for (const DataflashMessageInfo& m : r.messages) {
+    nlohmann::json instances = nlohmann::json::object();
+    for (const auto& [instance, count] : m.instances) instances[std::to_string(instance)] = count;
+    messages.push_back({{"name", m.name},
+                        {"count", m.count},
+                        {"rate_hz", JsonNumber(m.rate_hz())},
+                        {"instance_field", m.instance_field},
+                        {"instances", instances}});
+  }
+  j["messages"] = messages;
   if (r.is_log()) {
     nlohmann::json format;
     format["from_config"] = r.format_from_config;
@@ -791,7 +844,7 @@ nlohmann::json InspectReportToJson(const InspectReport& r) {
         format["accel_columns"] = nullptr;
       }
       format["delimiter"] = std::string(1, r.format.delimiter);
-    } else {
+    } else if (r.kind == "ulog") {
       format["ulog_topic"] = r.format.ulog.topic;
       format["ulog_multi_id"] = r.format.ulog.multi_id;
     }

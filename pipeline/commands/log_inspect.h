@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/config/config.h"
+#include "pipeline/logs/dataflash.h"
 #include "pipeline/logs/imu_format.h"
 
 namespace bifilar {
@@ -45,13 +46,14 @@ struct FormatGuess {
 // What `inspect` found in one file. Numbers that do not apply are NaN (null in JSON).
 struct InspectReport {
   std::string file;
-  // "csv", "ulog", or what the file is instead: "missing", "folder", "empty", "binary",
+  // "csv", "ulog", "dataflash" (ArduPilot .bin), or what the file is instead: "missing", "folder", "empty", "binary",
   // "config" (a YAML config), "text" (text that is not a table of numbers).
   std::string kind;
-  bool is_log() const { return kind == "csv" || kind == "ulog"; }
+  bool is_log() const { return kind == "csv" || kind == "ulog" || kind == "dataflash"; }
   bool compressed = false;                 // gzip around the log
   std::vector<std::string> columns;        // CSV header
   std::vector<UlogTopicInfo> topics;       // ULog subscriptions
+  std::vector<DataflashMessageInfo> messages;  // DataFlash messages: counts, rates, instances
   bool format_from_config = false;         // the format came from --config, not a guess
   std::vector<std::string> guesses;        // what was guessed without a config, and why
   ImuFormat format;                        // the format used to read the series

@@ -17,6 +17,8 @@
 #include "base/version.h"
 #include "pipeline/config/yaml_reader.h"
 #include "pipeline/logs/simulated_log.h"
+#include "pipeline/logs/dataflash.h"
+#include "pipeline/logs/dataflash_writer.h"
 #include "pipeline/logs/ulog_writer.h"
 
 namespace bifilar {
@@ -764,9 +766,15 @@ std::string Footer(const SimulatedTrace& trace, const ImuFormat& format, const s
 }
 
 // Every log simulate writes carries the mark of a simulated log with its seed
-// (pipeline/logs/simulated_log.h): the CSV's first line, or a ULog information message.
+// (pipeline/logs/simulated_log.h): the CSV's first line, a ULog information message, or a
+// DataFlash MSG message.
 void WriteTrace(const std::string& path, const SimulatedTrace& trace, const SimulateSpec& spec) {
   const std::string origin = SimulatedLogOrigin(spec.seed);
+  if (NamedLikeDataflash(path)) {  // pipeline/logs/dataflash_writer.h
+    ImuData imu = trace.imu;
+    if (!spec.options.sensor.accelerometer) imu.accel_in_imu.clear();
+    return WriteImuDataflash(path, imu, origin);
+  }
   if (spec.ulog || path.find(".ulg") != std::string::npos) {  // pipeline/logs/ulog_writer.h
     ImuData imu = trace.imu;
     if (!spec.options.sensor.accelerometer) imu.accel_in_imu.clear();

@@ -126,7 +126,7 @@ struct SimulateSettingNames {
 struct SimulateCommandOptions {
   std::string spec_file;   // "" : the defaults (a trace only)
   std::string out_dir;     // campaign output folder
-  std::string trace_csv;   // one trace into this file (CSV, or ULog when it ends in .ulg)
+  std::string trace_csv;   // one trace into this file (CSV; ULog for .ulg; DataFlash for .bin)
   std::string truth_json;  // the trace's truth file ("" : beside it)
   std::string model;       // "" : the spec's
   SimulateOverrides o;     // --seed, --inertia-kg-m2, ..., --duration-s, --no-accel

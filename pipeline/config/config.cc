@@ -215,6 +215,17 @@ void ReadImuMounting(YamlMap& imu, ImuConfig* out) {
 // `imu`: columns and units, then how the IMU hangs.
 void ReadImu(YamlMap imu, ImuConfig* out) {
   ReadImuColumns(imu, out);
+  {
+    YamlMap dataflash = Sub(imu, "dataflash");  // pipeline/logs/dataflash.h
+    const YAML::Node node = dataflash.Optional("instance");
+    out->dataflash_instance = dataflash.OptionalInt("instance", -1);
+    if (dataflash.Has("instance") && (out->dataflash_instance < 0 || out->dataflash_instance > 255)) {
+      throw UserError(dataflash.Where(node) + ": 'imu.dataflash.instance' must be in [0, 255] (the "
+                      "IMU instance of an ArduPilot log; leave it out for the lowest), not " +
+                      std::to_string(out->dataflash_instance));
+    }
+    dataflash.Finish();
+  }
   ReadImuMounting(imu, out);
   imu.Finish();
 }
@@ -999,6 +1010,12 @@ InputLimits ReadLimits(YamlMap limits) {
 }
 
 }  // namespace
+
+ImuLogOptions CampaignConfig::LogOptions() const {
+  ImuLogOptions options = limits.LogOptions();
+  options.dataflash_instance = imu.dataflash_instance;
+  return options;
+}
 
 ImuLogOptions InputLimits::LogOptions() const {
   ImuLogOptions options;

@@ -95,6 +95,9 @@ struct ImuConfig {
   Eigen::Vector3d swing_axis_in_imu = Eigen::Vector3d::UnitZ();  // fixed axis (unit) otherwise
   // Rotation taking IMU-frame vectors to body axes (x fwd, y right, z down); default identity.
   Eigen::Matrix3d imu_to_body = Eigen::Matrix3d::Identity();
+  // `imu.dataflash.instance`: the IMU instance of ArduPilot DataFlash logs (the `I` field; 0, 1,
+  // 2 for IMU, IMU2, IMU3 in older logs); [0, 255], default -1: the lowest in the log.
+  int dataflash_instance = -1;
 };
 
 // Where the aircraft logs are and how their pitch is known.
@@ -248,6 +251,8 @@ struct CampaignConfig {
   // Geometry of an aircraft trace (mass = aircraft + rig), of a tare trace (rig alone) and of a
   // reference swing (rig + reference), with the calibrated separation when one is applied.
   RigGeometry AircraftGeometry() const;
+  // The log reader's options: limits.LogOptions() and imu.dataflash.instance.
+  ImuLogOptions LogOptions() const;
   RigGeometry TareGeometry() const;
   RigGeometry CalibrationGeometry() const;
   double EffectiveSeparationM() const;  // D sqrt(geometry_calibration.factor)

@@ -17,6 +17,7 @@
 
 #include "base/gzip.h"
 #include "base/user_error.h"
+#include "pipeline/logs/dataflash.h"
 #include "pipeline/logs/imu_log_finish.h"
 #include "pipeline/logs/simulated_log.h"
 #include "pipeline/logs/ulog.h"
@@ -142,6 +143,12 @@ bool NamedLikeUlog(const std::string& path) {
            lower.compare(lower.size() - suffix.size(), suffix.size(), suffix) == 0;
   };
   return ends_with(".ulg") || ends_with(".ulg.gz");
+}
+
+// ArduPilot DataFlash (pipeline/logs/dataflash.h) with imu.format auto: a file that starts with
+// the FMT header. A .bin that does not is tried by ReadBin.
+bool UseDataflashReader(std::string_view text, const ImuFormat& format) {
+  return format.container == LogContainer::kAuto && LooksLikeDataflash(text);
 }
 
 // The first bytes of `text` for a message: printable ASCII quoted, anything else as hex.
@@ -501,6 +508,7 @@ std::string ReadWholeFile(const std::string& path, const ImuLogOptions& options)
 ImuData ReadImuLogFromString(const std::string& text, const std::string& name,
                              const ImuFormat& format, const ImuLogOptions& options) {
   if (UseUlogReader(text, format)) return ReadUlogImu(text, name, format, options);
+  if (UseDataflashReader(text, format)) return ReadDataflashImu(text, name, options);
   return Parse(text, name, format, options);
 }
 
@@ -508,6 +516,22 @@ ImuData ReadImuLog(const std::string& path, const ImuFormat& format,
                    const ImuLogOptions& options) {
   std::string text = ReadWholeFile(path, options);
   if (UseUlogReader(text, format)) return ReadUlogImu(text, path, format, options);
+  if (UseDataflashReader(text, format)) return ReadDataflashImu(text, path, options);
+  // A .bin that does not start with a DataFlash header: the DataFlash reader skips leading
+  // garbage to the first message; a text file named .bin is read as CSV; anything else is the
+  // DataFlash reader's error (it names what it found).
+  if (format.container == LogContainer::kAuto && NamedLikeDataflash(path)) {
+    try {
+      return ReadDataflashImu(text, path, options);
+    } catch (const UserError& e) {
+      if (text.empty() || std::memchr(text.data(), '\0', text.size()) != nullptr) throw;
+      try {
+        return Parse(text, path, format, options);
+      } catch (const UserError& csv) {
+        Fail(std::string(e.what()) + "; nor is it a CSV log (" + csv.what() + ")");
+      }
+    }
+  }
   // A .ulg without the ULog magic is read as CSV (a CSV named .ulg still works); when that fails
   // too, say so rather than "missing column 't'", which points at the wrong problem.
   if (NamedLikeUlog(path)) {

@@ -15,6 +15,10 @@ bool ImuLogOptions::Check(std::string* why) const {
     *why = "max_file_bytes and max_decompressed_bytes must be at least 1";
     return false;
   }
+  if (dataflash_instance < -1 || dataflash_instance > 255) {
+    *why = "dataflash_instance must be in [0, 255] (or -1: the lowest in the log)";
+    return false;
+  }
   return true;
 }
 

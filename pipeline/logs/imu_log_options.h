@@ -1,5 +1,6 @@
 // The options of reading an IMU log and the physical bounds of a reading: shared by the CSV
-// reader (pipeline/logs/imu_log.h), the ULog reader (pipeline/logs/ulog.h) and their common last
+// reader (pipeline/logs/imu_log.h), the ULog reader (pipeline/logs/ulog.h), the DataFlash reader
+// (pipeline/logs/dataflash.h) and their common last
 // step (pipeline/logs/imu_log_finish.h), so none of them includes another for them.
 #pragma once
 
@@ -35,6 +36,10 @@ struct ImuLogOptions {
   // refused whatever the caps.
   uint64_t max_file_bytes = static_cast<uint64_t>(kDefaultMaxLogMb * 1e6);
   uint64_t max_decompressed_bytes = static_cast<uint64_t>(kDefaultMaxDecompressedLogMb * 1e6);
+  // ArduPilot DataFlash logs (pipeline/logs/dataflash.h): the IMU instance read (the `I` field of
+  // IMU/GYR, or 0, 1, 2 for IMU, IMU2, IMU3 in older logs); the config's imu.dataflash.instance.
+  // In [-1, 255]; default -1: the lowest instance in the log.
+  int dataflash_instance = -1;
 
   bool Check(std::string* why) const;
 };

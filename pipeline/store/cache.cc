@@ -71,6 +71,7 @@ std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
       << f.ulog.time_field << ',' << f.ulog.gyro_fields[0] << ',' << f.ulog.gyro_fields[1] << ','
       << f.ulog.gyro_fields[2] << ',' << f.ulog.accel_fields[0] << ',' << f.ulog.accel_fields[1] << ','
       << f.ulog.accel_fields[2] << ';';
+  if (config.imu.dataflash_instance >= 0) out << "dataflash=" << config.imu.dataflash_instance << ';';
   out << "axis=" << (config.imu.swing_axis_auto ? "auto" : "fixed") << ';';
   for (int i = 0; i < 3; ++i) Put(out, "n", config.imu.swing_axis_in_imu[i]);
   for (int i = 0; i < 9; ++i) Put(out, "R", config.imu.imu_to_body(i / 3, i % 3));

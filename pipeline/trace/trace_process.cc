@@ -142,7 +142,7 @@ TraceRecord Process(const CampaignConfig& config, const std::string& path,
   // 1. Read.
   ImuData data;
   std::string why;
-  if (!TryReadImuLog(path, config.imu.format, config.limits.LogOptions(), &data, &why)) {
+  if (!TryReadImuLog(path, config.imu.format, config.LogOptions(), &data, &why)) {
     return fail(TraceStatus::kError, why);
   }
   return ProcessData(config, path, data, options, std::move(record), nullptr);

@@ -75,7 +75,7 @@ py::dict ReadLogCore(const std::string& path, const std::optional<std::string>& 
   std::optional<std::array<double, 2>> window;
   {
     py::gil_scoped_release release;
-    data = ReadImuLog(path, config.imu.format, config.limits.LogOptions());
+    data = ReadImuLog(path, config.imu.format, config.LogOptions());
     // Step 2 of ProcessTrace (pipeline/trace/trace_process.cc): the swing axis with the config's
     // settings, over the config's window for this file when it has one (matched as
     // `bifilar fit` matches it, on the path as given).

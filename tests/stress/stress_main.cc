@@ -11,7 +11,8 @@
 // manifest entry with "../", an absolute path or a symbolic link out of OUT; the lock replaced
 // by a link, hard link or FIFO; `--out` inside the logs.
 // Then, once each, hostile inputs that must stop quickly with a clear message
-// (issue 15): a FIFO and a symlink to /dev/urandom among the logs, /dev/zero as the config, a
+// (issue 15; issue 26: ArduPilot DataFlash logs that are not DataFlash, empty, without IMU, with a
+// bad FMT, and damaged copies): a FIFO and a symlink to /dev/urandom among the logs, /dev/zero as the config, a
 // multi-member gzip log (the baseline's ellipse), a gzip bomb, a FIFO as results.json and as a
 // cache entry (process and report), a YAML alias bomb; (issue 23) simulate, init and export
 // aimed at a user's file, a log, the campaign's results or a link to /proc/self/fd/1.
@@ -55,6 +56,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/gzip.h"
+#include "pipeline/logs/dataflash_writer.h"
 #include "pipeline/store/cache.h"
 #include "pipeline/store/output_set.h"
 
@@ -1008,6 +1010,79 @@ void CaseNoOverwrite(const Args& args, const Workspace& w, int case_no, Failures
   w.RestoreLogs();
 }
 
+// Issue 26: ArduPilot DataFlash logs (.bin) that are not what they claim: not DataFlash, empty,
+// no IMU message, an FMT that makes the IMU longer than its messages or too short for its format.
+// `fit` ends (exit 1) with an error naming the file and what was found; then `inspect` over 40
+// randomly damaged copies of a simulated .bin (cut, bytes flipped, garbage inserted, the FMTs
+// damaged) only has to end without a crash or hang.
+void CaseDataflash(const Args& args, const Workspace& w, int case_no, std::mt19937_64& rng,
+                   Failures* failures) {
+  using bifilar::DataflashPayload;
+  using bifilar::DataflashWriter;
+  const std::string dir = w.harness + "/dataflash";
+  fs::create_directories(dir);
+  const char* imu_format = "QBffffffIIfBBHH";
+  const char* imu_labels = "TimeUS,I,GyrX,GyrY,GyrZ,AccX,AccY,AccZ,EG,EA,T,GH,AH,GHz,AHz";
+  auto imu_log = [&](int length) {
+    DataflashWriter d;
+    d.Format(48, "IMU", imu_format, imu_labels, length);
+    for (int k = 0; k < 50; ++k) {
+      DataflashPayload p;
+      p.U64(10000 * k).U8(0).F32(0.1f).F32(0).F32(0).F32(0).F32(0).F32(-9.8f);
+      p.U32(0).U32(0).F32(25.0f).U8(1).U8(1).U16(1000).U16(1000);
+      d.Message(48, p.str());
+    }
+    return d.bytes();
+  };
+  std::string noise(5000, '\0');
+  for (char& c : noise) c = static_cast<char>(rng() % 160);  // never a3 95: no message
+  DataflashWriter no_imu;
+  no_imu.Format(91, "MSG", "QZ", "TimeUS,Message");
+  no_imu.Message(91, DataflashPayload().U64(1).Text("ArduPlane V4.5.0", 64).str());
+  struct Bad {
+    std::string file, bytes, message;
+  };
+  const std::vector<Bad> bad = {
+      {"noise.bin", noise, "noise.bin: error: not an ArduPilot DataFlash log: no message found"},
+      {"empty.bin", "", "empty.bin: error: the file is empty (expected an ArduPilot DataFlash log)"},
+      {"no_imu.bin", no_imu.bytes(), "no_imu.bin: error: an ArduPilot DataFlash log without IMU"},
+      {"long_fmt.bin", imu_log(120), "long_fmt.bin: error: the FMT of IMU (type 48, byte 89) cannot be read: it defines the message as 120 bytes"},
+      {"short_fmt.bin", imu_log(20), "short_fmt.bin: error: the FMT of IMU (type 48, byte 89) cannot be read: its length 20 is too short for its format"},
+  };
+  for (const Bad& b : bad) {
+    WriteFile(dir + "/" + b.file, b.bytes);
+    const Outcome o = Wait(Start({args.binary, "fit", w.config_path, dir + "/" + b.file},
+                                 w.harness + "/hostile"),
+                           args.run_timeout_s);
+    ExpectStop(o, case_no, "DataFlash " + b.file, {1}, o.out + o.err, b.message, failures);
+  }
+  const std::string sim = dir + "/sim.bin";
+  fs::remove(sim);
+  const Outcome made = Wait(Start({args.binary, "simulate", "--trace", sim, "--inertia-kg-m2",
+                                   "0.4", "--mass-kg", "6", "-L", "2", "-D", "1", "--duration-s",
+                                   "20", "--seed", "26"},
+                                  w.harness + "/hostile"),
+                            args.run_timeout_s);
+  ExpectStop(made, case_no, "DataFlash simulate", {0}, made.out, "wrote", failures);
+  const std::string clean = ReadFile(sim);
+  if (clean.empty()) return;
+  std::vector<std::string> argv = {args.binary, "inspect"};
+  for (int k = 0; k < 40; ++k) {
+    std::string bytes = clean;
+    switch (k % 4) {
+      case 0: bytes.resize(rng() % bytes.size()); break;
+      case 1: for (int i = 0; i < 30; ++i) bytes[rng() % bytes.size()] = static_cast<char>(rng()); break;
+      case 2: bytes.insert(rng() % bytes.size(), std::string(1 + rng() % 500, static_cast<char>(rng()))); break;
+      default: for (int i = 0; i < 3; ++i) bytes[rng() % 900] = static_cast<char>(rng()); break;
+    }
+    const std::string path = dir + "/damaged_" + std::to_string(k) + ".bin";
+    WriteFile(path, bytes);
+    argv.push_back(path);
+  }
+  const Outcome o = Wait(Start(argv, w.harness + "/hostile"), args.run_timeout_s);
+  ExpectStop(o, case_no, "DataFlash damaged copies (inspect)", {0, 1}, o.out, "dataflash", failures);
+}
+
 // Runs the cases above once each; returns how many ran.
 int RunHostileInputCases(const Args& args, Workspace& w, int first_case_no, Failures* failures) {
   int c = first_case_no;
@@ -1020,6 +1095,8 @@ int RunHostileInputCases(const Args& args, Workspace& w, int first_case_no, Fail
   CaseFifoInOutput(args, w, c++, /*cache_entry=*/true, failures);
   CaseAliasBomb(args, w, c++, failures);
   CaseNoOverwrite(args, w, c++, failures);
+  std::mt19937_64 rng(26);
+  CaseDataflash(args, w, c++, rng, failures);
   return c - first_case_no;
 }
 
