@@ -10,11 +10,17 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pipeline/records/results_reader.h"
+
 namespace bifilar {
 
-// The page for the results document `results` (ResultsToJson); figures are read from
-// `out_dir`/figures/. A missing figure is shown as a note, never an error.
+// The page for the results document `results` (ResultsToJson), read through ResultsReader;
+// figures are read from `out_dir`/figures/. A missing figure is shown as a note, never an error.
 std::string BuildReportHtml(const nlohmann::json& results, const std::string& out_dir);
+
+// Every results.json key that BuildReportHtml reads for `results` (for the test that each is one
+// the writer writes).
+KeyLog ReportKeysRead(const nlohmann::json& results, const std::string& out_dir);
 
 // `bifilar report DIR`: rebuilds DIR/report.html from DIR/results.json (written atomically).
 // Throws UserError when DIR or its results.json is missing or unreadable.

@@ -1,0 +1,113 @@
+#include "pipeline/records/results_reader.h"
+
+#include <cmath>
+
+namespace bifilar {
+namespace {
+
+using nlohmann::json;
+
+const json& Null() {
+  static const json kNull(nullptr);
+  return kNull;
+}
+
+void Collect(const json& j, const std::string& path, KeyLog* out) {
+  if (j.is_object()) {
+    for (const auto& [key, value] : j.items()) {
+      const std::string child = path.empty() ? key : path + "." + key;
+      out->insert(child);
+      Collect(value, child, out);
+    }
+  } else if (j.is_array()) {
+    for (const json& element : j) Collect(element, path + "[]", out);
+  }
+}
+
+}  // namespace
+
+ResultsReader::ResultsReader(const json& node, KeyLog* log, std::string path)
+    : node_(&node), log_(log), path_(std::move(path)) {}
+
+const json* ResultsReader::At(const char* key) const {
+  if (log_ != nullptr) log_->insert(path_.empty() ? key : path_ + "." + key);
+  if (!node_->is_object()) return nullptr;
+  const auto it = node_->find(key);
+  return it == node_->end() || it->is_null() ? nullptr : &*it;
+}
+
+bool ResultsReader::Has(const char* key) const { return At(key) != nullptr; }
+
+double ResultsReader::Num(const char* key) const {
+  const json* v = At(key);
+  return v != nullptr && v->is_number() ? v->get<double>() : NAN;
+}
+
+std::string ResultsReader::Str(const char* key) const {
+  const json* v = At(key);
+  return v != nullptr && v->is_string() ? v->get<std::string>() : std::string();
+}
+
+bool ResultsReader::Bool(const char* key, bool fallback) const {
+  const json* v = At(key);
+  return v != nullptr && v->is_boolean() ? v->get<bool>() : fallback;
+}
+
+int ResultsReader::Int(const char* key, int fallback) const {
+  const json* v = At(key);
+  return v != nullptr && v->is_number_integer() ? v->get<int>() : fallback;
+}
+
+ResultsReader ResultsReader::Get(const char* key) const {
+  const json* v = At(key);
+  return ResultsReader(v != nullptr ? *v : Null(), log_, path_.empty() ? key : path_ + "." + key);
+}
+
+std::vector<ResultsReader> ResultsReader::Items(const char* key) const {
+  std::vector<ResultsReader> out;
+  const json* v = At(key);
+  if (v == nullptr || !v->is_array()) return out;
+  const std::string path = (path_.empty() ? key : path_ + "." + key) + "[]";
+  for (const json& element : *v) out.emplace_back(element, log_, path);
+  return out;
+}
+
+std::vector<double> ResultsReader::Nums(const char* key) const {
+  std::vector<double> out;
+  const json* v = At(key);
+  if (v == nullptr || !v->is_array()) return out;
+  for (const json& element : *v) out.push_back(element.is_number() ? element.get<double>() : NAN);
+  return out;
+}
+
+std::vector<std::string> ResultsReader::Strs(const char* key) const {
+  std::vector<std::string> out;
+  const json* v = At(key);
+  if (v == nullptr || !v->is_array()) return out;
+  for (const json& element : *v) {
+    if (element.is_string()) out.push_back(element.get<std::string>());
+  }
+  return out;
+}
+
+std::vector<std::vector<double>> ResultsReader::Rows(const char* key) const {
+  std::vector<std::vector<double>> out;
+  const json* v = At(key);
+  if (v == nullptr || !v->is_array()) return out;
+  for (const json& row : *v) {
+    std::vector<double> values;
+    if (row.is_array()) {
+      for (const json& x : row) values.push_back(x.is_number() ? x.get<double>() : NAN);
+    }
+    out.push_back(values);
+  }
+  return out;
+}
+
+KeyLog KeyPaths(const json& document) {
+  KeyLog out;
+  Collect(document, "", &out);
+  return out;
+}
+
+}  // namespace bifilar
