@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -82,30 +83,46 @@ std::string DisplayStatus(const R& t) {
   return status == "ok" && !TraceWarnings(t).empty() ? "ok (warned)" : status;
 }
 
-// A warning's one line: its first sentence (up to the first ". " or "; "), at most ~160
-// characters. The one place to swap for a structured warning's own summary.
+// A warning's clauses, split at ". " and "; ".
+std::vector<std::string> Clauses(const std::string& text) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = std::min(text.find(". ", start), text.find("; ", start));
+    if (end == std::string::npos) end = text.size();
+    out.push_back(text.substr(start, end - start));
+    start = end + 2;
+  }
+  return out;
+}
+
+// A warning's one line: its first clause (shortened at " (" or ": " when over 100 characters),
+// at most 160 characters. The one place to swap for a structured warning's own summary.
 std::string WarningSummary(const std::string& text) {
-  size_t end = std::string::npos;
-  for (const char* stop : {". ", "; "}) end = std::min(end, text.find(stop));
-  std::string line = text.substr(0, end);
-  constexpr size_t kMax = 160;
+  const std::vector<std::string> clauses = Clauses(text);
+  std::string line = clauses.empty() ? text : clauses.front();
+  constexpr size_t kLong = 100, kMax = 160;
+  if (line.size() > kLong) line = line.substr(0, std::min(line.find(" ("), line.find(": ")));
   if (line.size() > kMax) line = line.substr(0, kMax - 3) + "...";
   return line;
 }
 
-// The advice a warning gives: its clause that tells what to do ("raise ...", "set ...", "swing
-// ...", "check ...", ...), "" when it has none.
+// The clause of a warning that says what to do (it starts with a verb: "raise ...", "swing
+// ...", "set ..."), "" when it has none.
 std::string WarningAction(const std::string& text) {
-  for (const char* verb : {"; raise ", "; lower ", "; set ", "; swing ", "; check ", "; give ",
-                           "; rerun ", "; use ", "; add ", "; remove ", "; release ", "; hang "}) {
-    const size_t at = text.find(verb);
-    if (at != std::string::npos) {
-      std::string action = text.substr(at + 2);
-      const size_t end = action.find(". ");
-      return action.substr(0, end);
+  static const char* const kVerbs[] = {"raise", "lower", "set", "swing", "check", "give", "rerun",
+                                       "use", "add", "remove", "release", "hang", "fix", "measure",
+                                       "increase", "decrease", "shorten", "lengthen", "reprocess",
+                                       "replace", "move", "weigh", "repeat"};
+  std::string action;
+  for (const std::string& clause : Clauses(text)) {
+    std::string word = clause.substr(0, clause.find(' '));
+    std::transform(word.begin(), word.end(), word.begin(), ::tolower);
+    for (const char* verb : kVerbs) {
+      if (word == verb) action = clause;
     }
   }
-  return "";
+  return action;
 }
 
 struct Units {
@@ -381,8 +398,12 @@ void WriteNotes(const std::vector<std::string>& warnings, const Units& u, std::o
 void WriteOutliers(const ReportPage& p, std::ostream& h) {
   std::string names;
   int n = 0;
+  // A planar campaign's outliers are the ellipse's (the points its warning counts), named
+  // through the tensor section's per-point files; a tensor campaign's are its own.
+  std::set<int> planar_outliers;
+  for (const R& o : p.ellipse.Items("outliers")) planar_outliers.insert(o.Int("index", -1));
   for (const R& r : p.tensor.Items("residuals")) {
-    if (!r.Bool("outlier")) continue;
+    if (p.Planar() ? planar_outliers.count(r.Int("index", -1)) == 0 : !r.Bool("outlier")) continue;
     ++n;
     names += (names.empty() ? "" : ", ") + Escape(r.Str("file")) + " (roll " +
              Fmt(r.Num("roll_deg"), "%.1f") + ", pitch " + Fmt(r.Num("pitch_deg"), "%.1f") +
