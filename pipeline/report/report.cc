@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -167,6 +168,9 @@ Estimate GetEstimate(const R& section, const std::string& key) {
   return e;
 }
 
+// The first line of a figure that the report has compacted (CompactSvg) and stored in its place.
+constexpr const char* kCompactMark = "<!-- bifilar: compact svg for report.html -->\n";
+
 // A figure file as page content: an SVG inline (its ids prefixed, so the glyph and clip ids that
 // every cairo SVG names alike do not collide; a third smaller than base64), a PNG as a base64
 // data URI.
@@ -180,10 +184,22 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
   }
   const std::string ext = fs::path(name).extension().string();
   if (ext == ".svg") {
-    const size_t start = bytes.find("<svg");
-    if (start == std::string::npos) return "<p class=\"note\">(figure " + Escape(name) + " unreadable)</p>";
     const std::string prefix = "f" + std::to_string((*counter)++) + "-";
-    std::string svg = PrefixSvgIds(CompactSvg(bytes.substr(start)), prefix);
+    std::string svg;
+    if (bytes.compare(0, std::strlen(kCompactMark), kCompactMark) == 0) {
+      svg = bytes.substr(std::strlen(kCompactMark));  // compacted by an earlier report
+    } else {
+      const size_t start = bytes.find("<svg");
+      if (start == std::string::npos) return "<p class=\"note\">(figure " + Escape(name) + " unreadable)</p>";
+      svg = CompactSvg(bytes.substr(start));
+      // The figure's name is keyed by its content, so its compact form serves every later report:
+      // stored in its place (atomically; best effort, a read-only folder only costs the time).
+      try {
+        WriteFileAtomically(path, kCompactMark + svg);
+      } catch (const std::exception&) {
+      }
+    }
+    svg = PrefixSvgIds(svg, prefix);
     svg.replace(0, 4, "<svg class=\"" + css_class + "\" role=\"img\" aria-label=\"" + Escape(alt) + "\"");
     return svg;
   }
