@@ -16,6 +16,7 @@
 #include "fit/tensor.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/records/results_reader.h"
+#include "pipeline/report/export.h"
 #include "pipeline/report/report.h"
 #include "test_support.h"
 
@@ -203,6 +204,13 @@ TEST(ReportKinds, EveryKeyTheReportReadsIsWritten) {
     const KeyLog w = KeyPaths(p.results), r = ReportKeysRead(p.results, p.out);
     written.insert(w.begin(), w.end());
     read.insert(r.begin(), r.end());
+    // export reads through the same reader
+    ExportOptions options;
+    options.results_path = p.out + "/results.json";
+    KeyLog exported;
+    ReadExportInertia(p.results.dump(), "results.json", options, &exported);
+    EXPECT_TRUE(exported.count("tensor.Ixx_kg_m2") == 1) << "export read no tensor";
+    read.insert(exported.begin(), exported.end());
   }
   // Written only with a rig calibration (pipeline/records/results_json.cc CalibrationToJson):
   // the campaigns above have none, so the report reads none of them.

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "base/user_error.h"
+
 namespace bifilar {
 namespace {
 
@@ -41,6 +43,18 @@ bool ResultsReader::Has(const char* key) const { return At(key) != nullptr; }
 double ResultsReader::Num(const char* key) const {
   const json* v = At(key);
   return v != nullptr && v->is_number() ? v->get<double>() : NAN;
+}
+
+double ResultsReader::NumOrNull(const char* key, const std::string& file) const {
+  const json* v = At(key);
+  if (v == nullptr) return NAN;
+  const std::string where = path_.empty() ? key : path_ + "." + key;
+  if (!v->is_number()) {
+    throw UserError(file + ": " + where + " is not a number (" + std::string(v->type_name()) + ")");
+  }
+  const double value = v->get<double>();
+  if (!std::isfinite(value)) throw UserError(file + ": " + where + " is not finite");
+  return value;
 }
 
 std::string ResultsReader::Str(const char* key) const {

@@ -26,6 +26,9 @@ class ResultsReader {
   bool IsObject() const { return node_->is_object(); }
   bool Has(const char* key) const;                 // present and not null
   double Num(const char* key) const;               // NaN unless a number
+  // A number or null/missing (NaN); anything else, or a non-finite number, throws UserError
+  // "`file`: PATH.KEY is not a number (TYPE)" (export, which must not write a wrong file).
+  double NumOrNull(const char* key, const std::string& file) const;
   std::string Str(const char* key) const;          // "" unless text
   bool Bool(const char* key, bool fallback = false) const;
   int Int(const char* key, int fallback = 0) const;
