@@ -1,10 +1,11 @@
 // The one reader of results.json (the document ResultsToJson writes, pipeline/records/
 // results_json.h, with its ellipse_json.h and tensor_json.h sections), shared by the report and
-// export. A ResultsReader is a typed view of one node: a missing key, null or a value of another
-// type reads as NaN / "" / the fallback, never an exception, so a results file of an older version
-// still gives a page. Every key read can be logged (`KeyLog`), and tests/pipeline_results_reader_
-// test.cc checks that each key the report and export read is one the writer writes for some kind
-// of campaign: reading a key the writer never writes is caught there.
+// export. A ResultsReader is a typed view of one node: a missing key or null reads as NaN / "" /
+// the fallback (a results file of an older version still gives a page); a value of another type
+// throws UserError naming its key path ("traces[].window_s[] is not a number (string)"). Every
+// key read can be logged (`KeyLog`), and tests/pipeline_report_kinds_test.cc checks that each key
+// the report and export read is one the writer writes for some kind of campaign: reading a key
+// the writer never writes is caught there.
 #pragma once
 
 #include <set>
@@ -42,6 +43,7 @@ class ResultsReader {
 
  private:
   const nlohmann::json* At(const char* key) const;
+  std::string Where(const char* key) const;
   const nlohmann::json* node_;
   KeyLog* log_;
   std::string path_;

@@ -308,7 +308,15 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
                     "); export reads the results.json written by `bifilar process`");
   }
   const ResultsReader results(j, keys_read);
-  if (results.Str("program") != "bifilar") {
+  // A key of the wrong type is named with the file (the reader names the key).
+  const auto named = [&name](const auto& read) {
+    try {
+      return read();
+    } catch (const UserError& e) {
+      throw UserError(name + ": " + e.what());
+    }
+  };
+  if (!j.is_object() || named([&] { return results.Str("program"); }) != "bifilar") {
     throw UserError(name +
                     ": not a results.json written by bifilar (no \"program\": "
                     "\"bifilar\"); export reads the results.json of `bifilar process`");
@@ -379,14 +387,14 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
     in.mass_source = "--mass-kg";
   } else if (j.contains("aircraft")) {  // null: the config gave no mass
     const ResultsReader aircraft = results.Get("aircraft");
-    stored_mass_kg = aircraft.Num("mass_kg");
-    stored_mass_std_kg = aircraft.Num("mass_std_kg");
+    stored_mass_kg = named([&] { return aircraft.Num("mass_kg"); });
+    stored_mass_std_kg = named([&] { return aircraft.Num("mass_std_kg"); });
     if (!std::isnan(stored_mass_kg)) {
       in.mass_kg = stored_mass_kg;
       in.mass_std_kg = stored_mass_std_kg;
       in.mass_source = "config aircraft.mass_kg";
     }
-  } else if (!results.Str("config").empty()) {  // written before `aircraft` existed
+  } else if (!named([&] { return results.Str("config"); }).empty()) {  // written before `aircraft` existed
     try {
       const YAML::Node config = YAML::Load(results.Str("config"));
       const YAML::Node aircraft = config.IsMap() ? config["aircraft"] : YAML::Node();

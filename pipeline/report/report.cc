@@ -150,14 +150,13 @@ std::string InDisplayUnits(const Units& u, const std::string& text) {
 // An estimate of the ellipse or tensor JSON: KEY, KEY_std, KEY_ci95 [lo, hi]; null when
 // undefined.
 struct Estimate {
-  bool present = false, defined = false;
+  bool defined = false;
   double value = NAN, std = NAN, lo = NAN, hi = NAN;
 };
 Estimate GetEstimate(const R& section, const std::string& key) {
   Estimate e;
   if (!section.IsObject()) return e;
   e.value = section.Num(key.c_str());
-  e.present = true;
   e.defined = std::isfinite(e.value);
   e.std = section.Num((key + "_std").c_str());
   const std::vector<double> ci = section.Nums((key + "_ci95").c_str());
@@ -381,14 +380,20 @@ void WriteHeader(const ReportPage& p, std::ostream& h) {
     << " error); fits reused from cache: " << summary.Int("n_reused") << ".</p>\n";
   // Simulated logs say so in their warnings (pipeline/logs/simulated_log.h): the page says it first.
   int simulated = 0;
+  std::string mark;  // the first log's own words, once for the page
   for (const TraceRow& row : p.traces) {
     bool marked = false;
-    for (const std::string& w : row.t.Strs("warnings")) marked = marked || IsSimulatedLogWarning(w);
+    for (const std::string& w : row.t.Strs("warnings")) {
+      if (!IsSimulatedLogWarning(w)) continue;
+      marked = true;
+      if (mark.empty()) mark = w;
+    }
     simulated += marked ? 1 : 0;
   }
   if (simulated > 0) {
     h << "<p class=\"warn\">Simulated data: " << simulated << " of the " << p.traces.size()
-      << " logs were written by <code>bifilar simulate</code>, not measured.</p>\n";
+      << " logs were written by <code>bifilar simulate</code>, not measured (" << Escape(mark)
+      << ").</p>\n";
   }
   WriteHeadline(p, h);
 }
@@ -613,13 +618,7 @@ void WriteOrientations(const ReportPage& p, std::ostream& h) {
     const std::vector<double> axis = o.Nums("axis_in_body");
     std::string axis_text = "&ndash;";
     if (axis.size() == 3) {
-      axis_text = "(" + Fmt(axis[0] + 0.0, "%.3f") + ", " + Fmt(axis[1] + 0.0, "%.3f") + ", " +
-                  Fmt(axis[2] + 0.0, "%.3f") + ")";
-      for (const char* minus_zero : {"-0.000"}) {
-        for (size_t at = axis_text.find(minus_zero); at != std::string::npos; at = axis_text.find(minus_zero)) {
-          axis_text.erase(at, 1);
-        }
-      }
+      axis_text = "(" + Fixed(axis[0], 3) + ", " + Fixed(axis[1], 3) + ", " + Fixed(axis[2], 3) + ")";
     }
     const double z = o.Num("z"), scatter = o.Num("scatter_kg_m2");
     const double d_std = scatter > 0 ? scatter : std::fabs(o.Num("residual_kg_m2"));
@@ -951,6 +950,9 @@ void RunReport(const std::string& out_dir) {
     html = BuildReportHtml(results, out_dir);
   } catch (const json::exception& e) {  // a field of the wrong type: name the file, not json
     throw UserError(path + ": not a results file bifilar can read (" + DescribeJsonError(e) +
+                    "); rerun `bifilar process` to rewrite it");
+  } catch (const UserError& e) {  // ResultsReader: a key of the wrong type, named
+    throw UserError(path + ": not a results file bifilar can read (" + e.what() +
                     "); rerun `bifilar process` to rewrite it");
   }
   WriteFileAtomically((fs::path(out_dir) / "report.html").string(),
