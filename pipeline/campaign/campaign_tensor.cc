@@ -109,7 +109,7 @@ void FitCampaignTensor(const CampaignConfig& config, const std::string& figures_
     p.inertia_kg_m2 = r.inertia_kg_m2;
     p.std_kg_m2 = r.inertia_total_std_kg_m2;  // the rig's std is the common offset
     points.push_back(p);
-    context.points.push_back({r.file, r.roll_used_deg, r.pitch_used_deg});
+    context.points.push_back({r.file, r.roll_used_deg, r.pitch_used_deg, p.std_kg_m2});
   }
   if (points.empty()) {
     summary.tensor_message = "tensor not fitted: no usable aircraft trace";
@@ -186,6 +186,14 @@ void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& resu
                   "docs/method.md)\n", 100.0 * t.relative_scatter);
     out << line;
   }
+  std::vector<std::pair<std::string, double>> logs;
+  if (result.tensor.is_object() && result.tensor.contains("scatter_logs")) {
+    for (const nlohmann::json& l : result.tensor["scatter_logs"]) {
+      logs.emplace_back(l.value("file", std::string("?")), l.value("residual_over_std", 0.0));
+    }
+  }
+  const std::string scatter_logs = ScatterLogsText(logs);
+  if (!scatter_logs.empty()) out << "  (" << scatter_logs << ")\n";
   if (t.full) {
     out << "Principal moments (ascending) and axes in body axes (x, y, z):\n";
     for (int k = 0; k < 3; ++k) {

@@ -12,7 +12,6 @@
 #include "base/json_number.h"
 #include "base/user_error.h"
 #include "base/version.h"
-#include "pipeline/records/results_aircraft.h"
 #include "pipeline/records/total_uncertainty.h"
 
 namespace bifilar {
@@ -443,21 +442,6 @@ json CalibrationToJson(const RigCalibrationResult& c) {
                            {"inertia_std_kg_m2", JsonNumber(c.rig_inertia_std_kg_m2)}}},
           {"iterations", c.iterations},
           {"warnings", c.warnings}};
-}
-
-bool AircraftMassFromResultsJson(const json& results, double* mass_kg, double* mass_std_kg) {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  *mass_kg = nan;
-  *mass_std_kg = nan;
-  if (!results.is_object() || !results.contains("aircraft")) return false;
-  const json& aircraft = results["aircraft"];
-  if (!aircraft.is_object()) return true;
-  const auto number = [&aircraft, nan](const char* key) {
-    return aircraft.contains(key) && aircraft[key].is_number() ? aircraft[key].get<double>() : nan;
-  };
-  *mass_kg = number("mass_kg");
-  *mass_std_kg = number("mass_std_kg");
-  return true;
 }
 
 json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {

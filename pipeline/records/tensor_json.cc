@@ -1,6 +1,8 @@
 #include "pipeline/records/tensor_json.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "base/json_number.h"
 
@@ -187,6 +189,38 @@ json SolverJson(const TensorResult& r) {
 
 }  // namespace
 
+json TensorScatterLogs(const TensorResult& r, const TensorJsonContext& c) {
+  json out = json::array();
+  if (!(r.relative_scatter > 0) && !(r.attitude_scatter_deg > 0)) return out;
+  // A log is behind the scatter when its residual is beyond 2 of its own stds.
+  constexpr double kBeyondStds = 2.0;
+  std::vector<std::pair<double, std::string>> logs;
+  for (const TensorPointResidual& p : r.residuals) {
+    if (p.index >= static_cast<int>(c.points.size())) continue;
+    const TensorJsonContext::Point& q = c.points[p.index];
+    const double ratio = p.residual_kg_m2 / q.std_kg_m2;
+    if (std::isfinite(ratio) && std::fabs(ratio) > kBeyondStds) logs.emplace_back(ratio, q.file);
+  }
+  std::stable_sort(logs.begin(), logs.end(), [](const auto& a, const auto& b) {
+    return std::fabs(a.first) > std::fabs(b.first);
+  });
+  for (const auto& [ratio, file] : logs) out.push_back({{"file", file}, {"residual_over_std", ratio}});
+  return out;
+}
+
+std::string ScatterLogsText(const std::vector<std::pair<std::string, double>>& logs) {
+  if (logs.empty()) return "";
+  constexpr size_t kNamed = 4;
+  std::string out = "the logs behind the scatter, residual over their own std: ";
+  char ratio[32];
+  for (size_t i = 0; i < logs.size() && i < kNamed; ++i) {
+    std::snprintf(ratio, sizeof(ratio), " %+.1f", logs[i].second);
+    out += (i ? ", " : "") + logs[i].first + ratio;
+  }
+  if (logs.size() > kNamed) out += ", and " + std::to_string(logs.size() - kNamed) + " more";
+  return out;
+}
+
 json TensorResultToJson(const TensorResult& r, const TensorJsonContext& c) {
   json j;
   PutCommon(c, &j);
@@ -200,6 +234,7 @@ json TensorResultToJson(const TensorResult& r, const TensorJsonContext& c) {
   j["solver"] = SolverJson(r);
   j["closed_form_max_relative_difference"] = JsonNumber(r.closed_form_max_relative_difference);
   j["warnings"] = r.warnings;
+  j["scatter_logs"] = TensorScatterLogs(r, c);
   j["time_s"] = JsonNumber(r.time_s);
   return j;
 }

@@ -24,6 +24,7 @@ struct TensorJsonContext {
   struct Point {
     std::string file;
     double roll_deg = NAN, pitch_deg = NAN;  // the attitude used for its axis
+    double std_kg_m2 = NAN;                  // the log's own std (names the logs of a scatter)
   };
   std::vector<Point> points;        // one per fitted point, same order
   struct Orientation {
@@ -40,7 +41,14 @@ struct TensorJsonContext {
 // principal_moments_matched_kg_m2 {x, y, z}, rank, condition_number, design_singular_values,
 // n_points, n_orientations, covariance, variance_factor, dof, reduced_chi2, rmse_kg_m2,
 // bootstrap_replicates, confidence, residuals (per point), orientations (per orientation, the
-// per-orientation residuals), solver, closed_form_max_relative_difference, warnings.
+// per-orientation residuals), solver, closed_form_max_relative_difference, warnings;
+// scatter_logs: when the moments scatter beyond their logs' stds (relative_scatter or
+// attitude_scatter_deg > 0), the logs behind it, {file, residual_over_std}, largest first.
+nlohmann::json TensorScatterLogs(const TensorResult& result, const TensorJsonContext& context);
+
+// The scatter_logs in one line, as the console and the report show them: "the logs behind the
+// scatter, residual over their own std: a.csv +5.2, b.csv -3.1, and 2 more"; "" for none.
+std::string ScatterLogsText(const std::vector<std::pair<std::string, double>>& logs);
 nlohmann::json TensorResultToJson(const TensorResult& result, const TensorJsonContext& context);
 
 // The tensor section of a planar x-z campaign: the ellipse's I_x, I_z, I_xz (the same numbers)

@@ -14,7 +14,7 @@
 #include "base/bounded_read.h"
 #include "base/json_error.h"
 #include "base/user_error.h"
-#include "pipeline/records/results_aircraft.h"
+#include "pipeline/records/results_reader.h"
 #include "pipeline/store/output_set.h"
 
 namespace bifilar {
@@ -52,19 +52,6 @@ std::string CsvField(const std::string& s) {
   std::string q = "\"";
   for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
   return q + "\"";
-}
-
-// A number or null at j[key]; anything else is an error naming the key.
-double NumberOrNull(const json& j, const std::string& key, const std::string& where,
-                    const std::string& name) {
-  if (!j.contains(key) || j[key].is_null()) return kNaN;
-  if (!j[key].is_number()) {
-    throw UserError(name + ": " + where + "." + key + " is not a number (" +
-                    std::string(j[key].type_name()) + ")");
-  }
-  const double v = j[key].get<double>();
-  if (!std::isfinite(v)) throw UserError(name + ": " + where + "." + key + " is not finite");
-  return v;
 }
 
 // The elements written for URDF/SDF in `frame` (ixx iyy izz ixy ixz iyz).
@@ -310,7 +297,7 @@ std::vector<std::string> ExportInertia::Missing() const {
 }
 
 ExportInertia ReadExportInertia(const std::string& text, const std::string& name,
-                                const ExportOptions& options) {
+                                const ExportOptions& options, KeyLog* keys_read) {
   std::string why;
   if (!options.Check(&why)) throw UserError("export: " + why);
   json j;
@@ -320,7 +307,16 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
     throw UserError(name + ": not valid JSON (" + DescribeJsonError(e) +
                     "); export reads the results.json written by `bifilar process`");
   }
-  if (!j.is_object() || !j.contains("program") || j["program"] != "bifilar") {
+  const ResultsReader results(j, keys_read);
+  // A key of the wrong type is named with the file (the reader names the key).
+  const auto named = [&name](const auto& read) {
+    try {
+      return read();
+    } catch (const UserError& e) {
+      throw UserError(name + ": " + e.what());
+    }
+  };
+  if (!j.is_object() || named([&] { return results.Str("program"); }) != "bifilar") {
     throw UserError(name +
                     ": not a results.json written by bifilar (no \"program\": "
                     "\"bifilar\"); export reads the results.json of `bifilar process`");
@@ -330,28 +326,29 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
   in.value_kg_m2.fill(kNaN);
   in.std_kg_m2.fill(kNaN);
   in.source.fill("missing");
-  // The tensor section (issue 17) when it holds a number, else the ellipse's I_x, I_z, I_xz.
+  // The tensor section (issue 17) when it holds a number, else the ellipse's I_x, I_z, I_xz; read
+  // through the one results.json reader (pipeline/records/results_reader.h).
   bool found = false;
-  if (j.contains("tensor") && j["tensor"].is_object()) {
-    const json& t = j["tensor"];
+  const ResultsReader tensor = results.Get("tensor");
+  if (tensor.IsObject()) {
     for (int k = 0; k < 6; ++k) {
       const std::string key = std::string(ExportComponentName(k)) + "_kg_m2";
-      in.value_kg_m2[k] = NumberOrNull(t, key, "tensor", name);
+      in.value_kg_m2[k] = tensor.NumOrNull(key.c_str(), name);
       if (std::isnan(in.value_kg_m2[k])) continue;
-      in.std_kg_m2[k] = NumberOrNull(t, key + "_std", "tensor", name);
+      in.std_kg_m2[k] = tensor.NumOrNull((key + "_std").c_str(), name);
       in.source[k] = "measured";
       found = true;
     }
     if (found) in.section = "tensor";
   }
-  if (!found && j.contains("ellipse") && j["ellipse"].is_object()) {
-    const json& e = j["ellipse"];
+  const ResultsReader ellipse = results.Get("ellipse");
+  if (!found && ellipse.IsObject()) {
     const std::pair<int, const char*> keys[] = {
         {kIxx, "Ix_kg_m2"}, {kIzz, "Iz_kg_m2"}, {kIxz, "Ixz_kg_m2"}};
     for (const auto& [k, key] : keys) {
-      in.value_kg_m2[k] = NumberOrNull(e, key, "ellipse", name);
+      in.value_kg_m2[k] = ellipse.NumOrNull(key, name);
       if (std::isnan(in.value_kg_m2[k])) continue;
-      in.std_kg_m2[k] = NumberOrNull(e, std::string(key) + "_std", "ellipse", name);
+      in.std_kg_m2[k] = ellipse.NumOrNull((std::string(key) + "_std").c_str(), name);
       in.source[k] = "measured";
       found = true;
     }
@@ -388,15 +385,18 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
   if (!std::isnan(options.mass_kg)) {
     in.mass_kg = options.mass_kg;
     in.mass_source = "--mass-kg";
-  } else if (AircraftMassFromResultsJson(j, &stored_mass_kg, &stored_mass_std_kg)) {
+  } else if (j.contains("aircraft")) {  // null: the config gave no mass
+    const ResultsReader aircraft = results.Get("aircraft");
+    stored_mass_kg = named([&] { return aircraft.Num("mass_kg"); });
+    stored_mass_std_kg = named([&] { return aircraft.Num("mass_std_kg"); });
     if (!std::isnan(stored_mass_kg)) {
       in.mass_kg = stored_mass_kg;
       in.mass_std_kg = stored_mass_std_kg;
       in.mass_source = "config aircraft.mass_kg";
     }
-  } else if (j.contains("config") && j["config"].is_string()) {
+  } else if (!named([&] { return results.Str("config"); }).empty()) {  // written before `aircraft` existed
     try {
-      const YAML::Node config = YAML::Load(j["config"].get<std::string>());
+      const YAML::Node config = YAML::Load(results.Str("config"));
       const YAML::Node aircraft = config.IsMap() ? config["aircraft"] : YAML::Node();
       // A key that is absent gives an invalid node, whose IsScalar() throws: IsDefined first.
       const auto scalar = [&aircraft](const char* key) {

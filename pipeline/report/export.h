@@ -36,6 +36,8 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/records/results_reader.h"
+
 namespace bifilar {
 
 enum class ExportFormat { kUrdf, kSdf, kJsbsim, kCsv };
@@ -104,8 +106,10 @@ const char* ExportComponentName(int component);  // "Ixx", ..., "Iyz"
 // components from the options. Throws UserError naming the file on: text that is not JSON, a
 // document bifilar did not write, no `tensor` or `ellipse` section with a number, a --set of a
 // measured or unknown component.
+// Reads through ResultsReader (pipeline/records/results_reader.h); `keys_read`, when given,
+// receives every key read (the test that each is one the writer writes).
 ExportInertia ReadExportInertia(const std::string& text, const std::string& name,
-                                const ExportOptions& options);
+                                const ExportOptions& options, KeyLog* keys_read = nullptr);
 
 // The text of each format (see the table above). URDF, SDF and JSBSim throw UserError when a
 // component or the mass is missing, naming them and how to supply them; the CSV leaves them empty.

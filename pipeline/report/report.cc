@@ -1,8 +1,11 @@
 #include "pipeline/report/report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -14,6 +17,8 @@
 #include "base/user_error.h"
 #include "pipeline/figures/svg_compact.h"
 #include "pipeline/logs/simulated_log.h"
+#include "pipeline/records/results_reader.h"
+#include "pipeline/records/tensor_json.h"
 #include "pipeline/records/total_uncertainty.h"
 #include "pipeline/store/output_set.h"
 
@@ -22,6 +27,7 @@ namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
+using R = ResultsReader;
 
 std::string Escape(const std::string& text) {
   std::string out;
@@ -38,40 +44,86 @@ std::string Escape(const std::string& text) {
   return out;
 }
 
-double Num(const json& j, const char* key) {
-  if (!j.is_object()) return NAN;
-  auto it = j.find(key);
-  return it != j.end() && it->is_number() ? it->get<double>() : NAN;
-}
-
-std::string Str(const json& j, const char* key) {
-  if (!j.is_object()) return "";
-  auto it = j.find(key);
-  return it != j.end() && it->is_string() ? it->get<std::string>() : "";
-}
-
-// Trace `t`'s warnings as the report shows them: every warning of the record except the assumed
-// +-1 mm on L and D, which Table 2 states once for the campaign.
-std::vector<std::string> TraceWarnings(const json& t) {
-  std::vector<std::string> out;
-  if (!t.is_object() || !t.contains("warnings") || !t["warnings"].is_array()) return out;
-  for (const auto& w : t["warnings"]) {
-    if (w.is_string() && !IsAssumedInputsWarning(w.get<std::string>())) out.push_back(w.get<std::string>());
-  }
-  return out;
-}
-
-// The status a reader sees: "ok (warned)" for an ok trace with warnings, else the record's.
-std::string DisplayStatus(const json& t) {
-  const std::string status = Str(t, "status");
-  return status == "ok" && !TraceWarnings(t).empty() ? "ok (warned)" : status;
-}
-
 std::string Fmt(double value, const char* format = "%.4f") {
   if (!std::isfinite(value)) return "&ndash;";
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), format, value);
   return buffer;
+}
+
+// The decimals that show `std` to two significant digits (0 to 12), in fixed notation.
+int DecimalsFor(double std) {
+  if (!(std::isfinite(std) && std > 0)) return 4;
+  const int decimals = 1 - static_cast<int>(std::floor(std::log10(std)));
+  return std::clamp(decimals, 0, 12);
+}
+
+// `value` with `decimals` decimals, fixed notation (never e-notation), no "-0".
+std::string Fixed(double value, int decimals) {
+  if (!std::isfinite(value)) return "&ndash;";
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
+  std::string out = buffer;
+  if (out.find_first_not_of("-0.") == std::string::npos && out[0] == '-') out.erase(0, 1);
+  return out;
+}
+
+// Trace `t`'s warnings as the report lists them: not the assumed +-1 mm on L and D (Table 2
+// states it once) nor the simulated-log mark (the page says it once, at the top).
+std::vector<std::string> TraceWarnings(const R& t) {
+  std::vector<std::string> out;
+  for (const std::string& w : t.Strs("warnings")) {
+    if (!IsAssumedInputsWarning(w) && !IsSimulatedLogWarning(w)) out.push_back(w);
+  }
+  return out;
+}
+
+// The status a reader sees: "ok (warned)" for an ok trace with warnings, else the record's.
+std::string DisplayStatus(const R& t) {
+  const std::string status = t.Str("status");
+  return status == "ok" && !TraceWarnings(t).empty() ? "ok (warned)" : status;
+}
+
+// A warning's clauses, split at ". " and "; ".
+std::vector<std::string> Clauses(const std::string& text) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = std::min(text.find(". ", start), text.find("; ", start));
+    if (end == std::string::npos) end = text.size();
+    out.push_back(text.substr(start, end - start));
+    start = end + 2;
+  }
+  return out;
+}
+
+// A warning's one line: its first clause (shortened at " (" or ": " when over 100 characters),
+// at most 160 characters. The one place to swap for a structured warning's own summary.
+std::string WarningSummary(const std::string& text) {
+  const std::vector<std::string> clauses = Clauses(text);
+  std::string line = clauses.empty() ? text : clauses.front();
+  constexpr size_t kLong = 100, kMax = 160;
+  if (line.size() > kLong) line = line.substr(0, std::min(line.find(" ("), line.find(": ")));
+  if (line.size() > kMax) line = line.substr(0, kMax - 3) + "...";
+  return line;
+}
+
+// The clause of a warning that says what to do (it starts with a verb: "raise ...", "swing
+// ...", "set ..."), "" when it has none.
+std::string WarningAction(const std::string& text) {
+  static const char* const kVerbs[] = {"raise", "lower", "set", "swing", "check", "give", "rerun",
+                                       "use", "add", "remove", "release", "hang", "fix", "measure",
+                                       "increase", "decrease", "shorten", "lengthen", "reprocess",
+                                       "replace", "move", "weigh", "repeat"};
+  std::string action;
+  for (const std::string& clause : Clauses(text)) {
+    std::string word = clause.substr(0, clause.find(' '));
+    std::transform(word.begin(), word.end(), word.begin(), ::tolower);
+    for (const char* verb : kVerbs) {
+      if (word == verb) action = clause;
+    }
+  }
+  return action;
 }
 
 struct Units {
@@ -81,6 +133,13 @@ struct Units {
   std::string Inertia(double kg_m2, const char* format = "%.4f") const {
     return Fmt(kg_m2 * scale, format);
   }
+  // A moment and its std in display units, each to the digits the std supports.
+  std::string Value(double kg_m2, double std_kg_m2) const {
+    return Fixed(kg_m2 * scale, DecimalsFor(std_kg_m2 * scale));
+  }
+  std::string Std(double std_kg_m2) const {
+    return Fixed(std_kg_m2 * scale, DecimalsFor(std_kg_m2 * scale));
+  }
 };
 
 // A message or warning as the page shows it: in the page's units (the fit writes them in SI).
@@ -88,26 +147,28 @@ std::string InDisplayUnits(const Units& u, const std::string& text) {
   return SiTextInDisplayUnits(text, u.imperial ? DisplayUnits::kImperial : DisplayUnits::kSi);
 }
 
-// An estimate of the ellipse JSON (pipeline/records/ellipse_json.h): KEY, KEY_std, KEY_ci95 [lo,
-// hi]; null when undefined (tau, I_xp, I_zp when I_x ~ I_z).
+// An estimate of the ellipse or tensor JSON: KEY, KEY_std, KEY_ci95 [lo, hi]; null when
+// undefined.
 struct Estimate {
-  bool present = false, defined = false;
+  bool defined = false;
   double value = NAN, std = NAN, lo = NAN, hi = NAN;
 };
-Estimate GetEstimate(const json& ellipse, const std::string& key) {
+Estimate GetEstimate(const R& section, const std::string& key) {
   Estimate e;
-  if (!ellipse.is_object() || !ellipse.contains(key)) return e;
-  e.present = true;
-  e.defined = ellipse[key].is_number();
-  e.value = Num(ellipse, key.c_str());
-  e.std = Num(ellipse, (key + "_std").c_str());
-  const json ci = ellipse.value(key + "_ci95", json(nullptr));
-  if (ci.is_array() && ci.size() == 2 && ci[0].is_number() && ci[1].is_number()) {
-    e.lo = ci[0].get<double>();
-    e.hi = ci[1].get<double>();
+  if (!section.IsObject()) return e;
+  e.value = section.Num(key.c_str());
+  e.defined = std::isfinite(e.value);
+  e.std = section.Num((key + "_std").c_str());
+  const std::vector<double> ci = section.Nums((key + "_ci95").c_str());
+  if (ci.size() == 2) {
+    e.lo = ci[0];
+    e.hi = ci[1];
   }
   return e;
 }
+
+// The first line of a figure that the report has compacted (CompactSvg) and stored in its place.
+constexpr const char* kCompactMark = "<!-- bifilar: compact svg for report.html -->\n";
 
 // A figure file as page content: an SVG inline (its ids prefixed, so the glyph and clip ids that
 // every cairo SVG names alike do not collide; a third smaller than base64), a PNG as a base64
@@ -122,10 +183,22 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
   }
   const std::string ext = fs::path(name).extension().string();
   if (ext == ".svg") {
-    const size_t start = bytes.find("<svg");
-    if (start == std::string::npos) return "<p class=\"note\">(figure " + Escape(name) + " unreadable)</p>";
     const std::string prefix = "f" + std::to_string((*counter)++) + "-";
-    std::string svg = PrefixSvgIds(CompactSvg(bytes.substr(start)), prefix);
+    std::string svg;
+    if (bytes.compare(0, std::strlen(kCompactMark), kCompactMark) == 0) {
+      svg = bytes.substr(std::strlen(kCompactMark));  // compacted by an earlier report
+    } else {
+      const size_t start = bytes.find("<svg");
+      if (start == std::string::npos) return "<p class=\"note\">(figure " + Escape(name) + " unreadable)</p>";
+      svg = CompactSvg(bytes.substr(start));
+      // The figure's name is keyed by its content, so its compact form serves every later report:
+      // stored in its place (atomically; best effort, a read-only folder only costs the time).
+      try {
+        WriteFileAtomically(path, kCompactMark + svg);
+      } catch (const std::exception&) {
+      }
+    }
+    svg = PrefixSvgIds(svg, prefix);
     svg.replace(0, 4, "<svg class=\"" + css_class + "\" role=\"img\" aria-label=\"" + Escape(alt) + "\"");
     return svg;
   }
@@ -134,26 +207,25 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
 }
 
 // The amplitude-sweep figure beside trace `t`'s fit figure (I against amplitude,
-// pipeline/figures/sweep_plot.h), or a note saying why there is none: a trace without a sweep gets
-// no figure and no link.
-std::string SweepFigure(const json& t, const std::string& out_dir, int* counter) {
-  const std::string name = Str(t, "sweep_figure"), file = Escape(Str(t, "file"));
-  const json sweep = t.contains("amplitude_sweep") ? t["amplitude_sweep"] : json::object();
+// pipeline/figures/sweep_plot.h), or a note saying why there is none.
+std::string SweepFigure(const R& t, const std::string& out_dir, int* counter) {
+  const std::string name = t.Str("sweep_figure"), file = Escape(t.Str("file"));
+  const R sweep = t.Get("amplitude_sweep");
   if (name.empty()) {
-    const std::string note = Str(sweep, "note");
+    const std::string note = sweep.Str("note");
     return "<figure><p class=\"note\">" + file + ": no amplitude sweep" +
            (note.empty() ? std::string() : " (" + Escape(note) + ")") + ".</p></figure>\n";
   }
   // The compact figure has no legend: the caption is its legend.
-  const bool trend = sweep.is_object() && sweep.value("trend_detected", false);
-  const std::string alt = "I against amplitude, " + Str(t, "file");
+  const bool trend = sweep.Bool("trend_detected");
+  const double exponent = sweep.Num("trend_exponent");
+  const std::string alt = "I against amplitude, " + t.Str("file");
   return "<figure>" + Figure(out_dir, name, alt, "sweep", counter) + "<figcaption>" + file +
          " &middot; I against amplitude, flat for the ideal model: each band &plusmn; 1&sigma; "
          "over its amplitude range; blue, the result &plusmn; 1&sigma;" +
          (trend ? "; red, the trend I<sub>0</sub>(1 + c A<sup>" +
-                      Fmt(sweep.value("trend_exponent", 2.0), "%g") +
-                      "</sup>) and a ring on the band the "
-                  "result is taken from"
+                      Fmt(std::isfinite(exponent) ? exponent : 2.0, "%g") +
+                      "</sup>) and a ring on the band the result is taken from"
                 : "") +
          "</figcaption></figure>\n";
 }
@@ -161,99 +233,224 @@ std::string SweepFigure(const json& t, const std::string& out_dir, int* counter)
 const char* kStyle = R"(
 body { font-family: sans-serif; margin: 2em auto; max-width: 1100px; color: #222; }
 h1 { font-size: 1.6em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: .2em; margin-top: 2em; }
+.scroll { overflow-x: auto; max-width: 100%; }
 table { border-collapse: collapse; margin: .5em 0 1em; font-size: .9em; }
 th, td { border: 1px solid #ccc; padding: .25em .6em; text-align: right; }
-th { background: #f2f2f2; } td.l, th.l { text-align: left; }
+td { white-space: nowrap; }
+th { background: #f2f2f2; } td.l, th.l { text-align: left; } td.w { white-space: normal; }
 tr.rejected td { background: #fff4e0; } tr.warned td { background: #fffbe0; } tr.error td { background: #fde8e8; }
 .note { color: #666; font-style: italic; }
+.result { font-size: 1.1em; background: #f4f8ff; border: 1px solid #c8d8f0; padding: .6em .9em; }
 img.fig, svg.fig { max-width: 100%; height: auto; border: 1px solid #ddd; }
 .traces { display: flex; flex-wrap: wrap; gap: 10px; }
 .traces figure { margin: 0; width: 540px; }
 .traces img, .traces svg { width: 540px; height: auto; border: 1px solid #ddd; }
 figcaption { font-size: .8em; color: #444; }
+details summary { cursor: pointer; } details p { margin: .3em 0 .3em 1.2em; color: #444; }
 pre { background: #f7f7f7; padding: .8em; overflow-x: auto; font-size: .85em; }
-.ok { color: #1a7f37; } .bad { color: #b42318; }
+.ok { color: #1a7f37; } .bad { color: #b42318; } .warn { color: #8a5a00; }
 )";
 
-// What every section reads: the results document, its parts, the units, and the number of
-// figures embedded so far (the inline SVGs' id prefixes).
+// Tables wider than the text column scroll inside their own box.
+const char* kScrollOpen = "<div class=\"scroll\">";
+const char* kScrollClose = "</div>\n";
+
+// The kind of campaign, from its tensor section (pipeline/records/tensor_json.h): planar pitch
+// (the paper's ellipse), a full tensor, a partial one, or three separate axes (moments only).
+enum class CampaignKind { kPlanar, kFullTensor, kPartialTensor, kSeparateAxes };
+
+// One trace in the order of the tables: by roll, pitch (numerically), then file.
+struct TraceRow {
+  R t;
+  double roll = 0.0, pitch = NAN;
+};
+
+// What every section reads: the results document, its parts, the units, the campaign kind, and
+// the number of figures embedded so far (the inline SVGs' id prefixes).
 struct ReportPage {
-  ReportPage(const json& results_in, const std::string& out_dir_in)
-      : results(results_in), out_dir(out_dir_in) {
-    if (Str(results, "units") == "imperial") {
+  ReportPage(const json& results_in, const std::string& out_dir_in, KeyLog* log)
+      : results(results_in, log), out_dir(out_dir_in) {
+    if (results.Str("units") == "imperial") {
       u.imperial = true;
       u.scale = kSlugFt2PerKgM2;
       u.name = "slug ft<sup>2</sup>";
     }
+    const std::string mode = tensor.Str("mode");
+    const R observable = tensor.Get("observable");
+    const bool products = observable.Bool("Ixy") || observable.Bool("Ixz") || observable.Bool("Iyz");
+    kind = mode == "full_3d"   ? CampaignKind::kFullTensor
+           : mode == "partial" ? (products ? CampaignKind::kPartialTensor : CampaignKind::kSeparateAxes)
+                               : CampaignKind::kPlanar;
+    for (const R& t : results.Items("traces")) {
+      TraceRow row{t};
+      const double roll = t.Num("roll_used_deg");
+      row.roll = std::isfinite(roll) ? roll : 0.0;
+      row.pitch = t.Num("pitch_used_deg");
+      if (row.roll != 0.0) rolls = true;
+      traces.push_back(row);
+    }
+    std::stable_sort(traces.begin(), traces.end(), [](const TraceRow& a, const TraceRow& b) {
+      const double pa = std::isfinite(a.pitch) ? a.pitch : 1e9, pb = std::isfinite(b.pitch) ? b.pitch : 1e9;
+      if (a.roll != b.roll) return a.roll < b.roll;
+      if (pa != pb) return pa < pb;
+      return a.t.Str("file") < b.t.Str("file");
+    });
+    // A campaign whose tensor fit failed is still not planar when its logs roll.
+    if (kind == CampaignKind::kPlanar && rolls) kind = CampaignKind::kPartialTensor;
   }
-  json Part(const char* key, const json& fallback) const {
-    return results.contains(key) ? results[key] : fallback;
-  }
-  const json& results;
+  bool Planar() const { return kind == CampaignKind::kPlanar; }
+  R results;
   const std::string& out_dir;
   Units u;
-  const json summary = Part("summary", json::object());
-  const json ellipse = Part("ellipse", json(nullptr));
-  const json traces = Part("traces", json::array());
-  const json angles = Part("angles", json::array());
-  const json figures = Part("figures", json::object());
+  const R summary = results.Get("summary");
+  const R ellipse = results.Get("ellipse");
+  const R tensor = results.Get("tensor");
+  const R figures = results.Get("figures");
+  std::vector<TraceRow> traces;
+  bool rolls = false;
+  CampaignKind kind = CampaignKind::kPlanar;
   int figures_drawn = 0;
 };
 
-// Title, version, config and the trace counts.
+const char* KindName(CampaignKind kind) {
+  switch (kind) {
+    case CampaignKind::kPlanar: return "planar pitch (the ellipse of inertia in the x-z plane)";
+    case CampaignKind::kFullTensor: return "full inertia tensor (swings about axes in every plane)";
+    case CampaignKind::kPartialTensor: return "partial inertia tensor";
+    case CampaignKind::kSeparateAxes: return "separate axes (one moment per body axis)";
+  }
+  return "";
+}
+
+// The main result in one box at the top: the moments with their total std.
+void WriteHeadline(const ReportPage& p, std::ostream& h) {
+  const Units& u = p.u;
+  std::string items;
+  const auto add = [&](const std::string& label, const Estimate& e, double total) {
+    if (!e.defined) return;
+    const double shown_std = std::isfinite(total) ? total : e.std;
+    items += (items.empty() ? "" : ", ") + label + " = " + u.Value(e.value, shown_std) +
+             " &plusmn; " + u.Std(shown_std);
+  };
+  if (p.Planar()) {
+    if (!p.ellipse.IsObject()) {
+      h << "<p class=\"bad\">" << Escape(p.summary.Str("ellipse_message")) << "</p>\n";
+      return;
+    }
+    const R total = p.results.Get("total_uncertainty");
+    for (const auto& [key, label] : {std::make_pair("Ix_kg_m2", "I<sub>x</sub>"),
+                                     std::make_pair("Iz_kg_m2", "I<sub>z</sub>"),
+                                     std::make_pair("Ixz_kg_m2", "I<sub>xz</sub>")}) {
+      add(label, GetEstimate(p.ellipse, key), total.Num(key));
+    }
+    h << "<p class=\"result\">Result: " << items << " " << u.name
+      << " (&plusmn; total std; Table 2).</p>\n";
+    return;
+  }
+  if (!p.tensor.IsObject()) {
+    h << "<p class=\"bad\">" << Escape(p.summary.Str("tensor_message")) << "</p>\n";
+    return;
+  }
+  for (const char* name : {"Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"}) {
+    add(std::string("I<sub>") + (name + 1) + "</sub>", GetEstimate(p.tensor, std::string(name) + "_kg_m2"),
+        NAN);
+  }
+  h << "<p class=\"result\">Result: " << items << " " << u.name
+    << " (&plusmn; stat std; inertia tensor below).</p>\n";
+}
+
+// Title, version, config, the campaign kind and the trace counts, then the main result.
 void WriteHeader(const ReportPage& p, std::ostream& h) {
-  const json& summary = p.summary;
+  const R& summary = p.summary;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
     << "<title>bifilar report</title><style>" << kStyle << "</style></head><body>\n";
   h << "<h1>Mass properties from bifilar pendulum swings</h1>\n";
-  h << "<p>bifilar " << Escape(Str(p.results, "version")) << " &middot; config <code>"
-    << Escape(Str(p.results, "config_file")) << "</code> &middot; pitch source "
-    << Escape(Str(p.results, "pitch_source"));
+  h << "<p>bifilar " << Escape(p.results.Str("version")) << " &middot; config <code>"
+    << Escape(p.results.Str("config_file")) << "</code> &middot; campaign: " << KindName(p.kind)
+    << " &middot; attitude source " << Escape(p.results.Str("pitch_source"));
   // The fit's model and ODE solver (fit.integrator or --integrator), and glitch removal when off.
-  const json settings = p.results.is_object() ? p.results.value("fit_settings", json::object())
-                                              : json::object();
-  if (settings.is_object() && settings.contains("integrator")) {
-    h << " &middot; fit model " << Escape(Str(settings, "model")) << ", integrator <code>"
-      << Escape(Str(settings, "integrator")) << "</code>";
-    const json glitch = settings.value("glitch", json::object());
-    if (glitch.is_object() && !glitch.value("enabled", true)) h << ", glitch removal off";
+  const R settings = p.results.Get("fit_settings");
+  if (settings.Has("integrator")) {
+    h << " &middot; fit model " << Escape(settings.Str("model")) << ", integrator <code>"
+      << Escape(settings.Str("integrator")) << "</code>";
+    if (!settings.Get("glitch").Bool("enabled", true)) h << ", glitch removal off";
   }
-  h << ". Traces: " << summary.value("n_traces", 0)
-    << " (<span class=\"ok\">" << summary.value("n_ok", 0) << " ok</span>, "
-    << summary.value("n_rejected", 0) << " rejected, " << summary.value("n_error", 0)
-    << " error); fits reused from cache: " << summary.value("n_reused", 0) << ".</p>\n";
+  h << ". Traces: " << summary.Int("n_traces") << " (<span class=\"ok\">" << summary.Int("n_ok")
+    << " ok</span>, " << summary.Int("n_rejected") << " rejected, " << summary.Int("n_error")
+    << " error); fits reused from cache: " << summary.Int("n_reused") << ".</p>\n";
   // Simulated logs say so in their warnings (pipeline/logs/simulated_log.h): the page says it first.
   int simulated = 0;
-  for (const auto& t : p.traces) {
+  std::string mark;  // the first log's own words, once for the page
+  for (const TraceRow& row : p.traces) {
     bool marked = false;
-    if (t.is_object() && t.contains("warnings") && t["warnings"].is_array()) {
-      for (const auto& w : t["warnings"]) {
-        marked = marked || (w.is_string() && IsSimulatedLogWarning(w.get<std::string>()));
-      }
+    for (const std::string& w : row.t.Strs("warnings")) {
+      if (!IsSimulatedLogWarning(w)) continue;
+      marked = true;
+      if (mark.empty()) mark = w;
     }
     simulated += marked ? 1 : 0;
   }
   if (simulated > 0) {
-    h << "<p class=\"bad\">Simulated data: " << simulated << " of the " << p.traces.size()
-      << " logs were written by <code>bifilar simulate</code>, not measured (see Warnings).</p>\n";
+    h << "<p class=\"warn\">Simulated data: " << simulated << " of the " << p.traces.size()
+      << " logs were written by <code>bifilar simulate</code>, not measured (" << Escape(mark)
+      << ").</p>\n";
+  }
+  WriteHeadline(p, h);
+}
+
+// One warning as a line with the action, the full text on click.
+std::string WarningItem(const Units& u, const std::string& warning) {
+  const std::string text = InDisplayUnits(u, warning);
+  const std::string line = WarningSummary(text), action = WarningAction(text);
+  std::string summary = Escape(line);
+  if (!action.empty() && line.find(action) == std::string::npos) {
+    summary += " &rarr; <b>" + Escape(action) + "</b>";
+  }
+  if (line.size() == text.size()) return "<p>" + summary + "</p>";  // nothing more to expand
+  return "<details><summary>" + summary + "</summary><p>" + Escape(text) + "</p></details>";
+}
+
+// A section's own warnings: one line each, the full text on click.
+void WriteNotes(const std::vector<std::string>& warnings, const Units& u, std::ostream& h) {
+  for (const std::string& w : warnings) h << "<div class=\"note\">" << WarningItem(u, w) << "</div>\n";
+}
+
+// The points flagged as outliers (|studentized residual| > 3), named by their log.
+void WriteOutliers(const ReportPage& p, std::ostream& h) {
+  std::string names;
+  int n = 0;
+  // A planar campaign's outliers are the ellipse's (the points its warning counts), named
+  // through the tensor section's per-point files; a tensor campaign's are its own.
+  std::set<int> planar_outliers;
+  for (const R& o : p.ellipse.Items("outliers")) planar_outliers.insert(o.Int("index", -1));
+  for (const R& r : p.tensor.Items("residuals")) {
+    if (p.Planar() ? planar_outliers.count(r.Int("index", -1)) == 0 : !r.Bool("outlier")) continue;
+    ++n;
+    names += (names.empty() ? "" : ", ") + Escape(r.Str("file")) + " (roll " +
+             Fmt(r.Num("roll_deg"), "%.1f") + ", pitch " + Fmt(r.Num("pitch_deg"), "%.1f") +
+             ", studentized residual " + Fmt(r.Num("studentized"), "%+.2f") + ")";
+  }
+  if (n > 0) {
+    h << "<p class=\"warn\">Outlier" << (n == 1 ? "" : "s")
+      << " (|studentized residual| &gt; 3; check the log, its attitude and its fit): " << names
+      << ".</p>\n";
   }
 }
 
 // Table 2: I_x, I_z, I_xz, tau and the principal moments with std and interval, the systematic
-// share, the ellipse's warnings; or why there is no ellipse.
+// share, the ellipse's warnings and outliers. Planar campaigns only.
 void WriteTable2(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
-  const json& ellipse = p.ellipse;
+  const R& ellipse = p.ellipse;
   h << "<h2>Table 2: inertia properties</h2>\n";
-  if (!ellipse.is_object()) {
-    h << "<p class=\"bad\">"
-      << Escape(p.summary.value("ellipse_message", std::string("ellipse not fitted"))) << "</p>\n";
+  if (!ellipse.IsObject()) {
+    h << "<p class=\"bad\">" << Escape(p.summary.Str("ellipse_message")) << "</p>\n";
     return;
   }
   // The total column (results.json total_uncertainty, pipeline/records/total_uncertainty.h): the
   // std and the common-mode scale terms in quadrature.
-  const json total = p.Part("total_uncertainty", json::object());
-  h << "<table><tr><th class=\"l\">quantity</th><th>value</th><th>std (stat)</th>"
+  const R total = p.results.Get("total_uncertainty");
+  h << kScrollOpen << "<table><tr><th class=\"l\">quantity</th><th>value</th><th>std (stat)</th>"
        "<th>std (total)</th><th>interval (stat)</th><th class=\"l\">unit</th></tr>\n";
   struct Row { const char* key; const char* label; bool angle; };
   for (const Row& row : {Row{"Ix_kg_m2", "I<sub>x</sub>", false}, Row{"Iz_kg_m2", "I<sub>z</sub>", false},
@@ -261,25 +458,23 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
                          Row{"Ixp_kg_m2", "I<sub>xp</sub> (principal)", false},
                          Row{"Izp_kg_m2", "I<sub>zp</sub> (principal)", false}}) {
     const Estimate e = GetEstimate(ellipse, row.key);
-    if (!e.present) continue;
     h << "<tr><td class=\"l\">" << row.label << "</td>";
-    const double e_total = Num(total, row.key);
+    const double e_total = total.Num(row.key);
     if (!e.defined) {
       h << "<td colspan=\"4\">ill-defined (I<sub>x</sub> &asymp; I<sub>z</sub>)</td>";
-    } else if (row.angle) {
-      h << "<td>" << Fmt(e.value) << "</td><td>" << Fmt(e.std) << "</td><td>" << Fmt(e_total)
-        << "</td><td>[" << Fmt(e.lo) << ", " << Fmt(e.hi) << "]</td>";
     } else {
-      h << "<td>" << u.Inertia(e.value) << "</td><td>" << u.Inertia(e.std) << "</td><td>"
-        << u.Inertia(e_total) << "</td><td>[" << u.Inertia(e.lo) << ", " << u.Inertia(e.hi)
-        << "]</td>";
+      const double scale = row.angle ? 1.0 : u.scale;
+      const int d = DecimalsFor(e.std * scale);
+      h << "<td>" << Fixed(e.value * scale, d) << "</td><td>" << Fixed(e.std * scale, d)
+        << "</td><td>" << Fixed(e_total * scale, DecimalsFor(e_total * scale)) << "</td><td>["
+        << Fixed(e.lo * scale, d) << ", " << Fixed(e.hi * scale, d) << "]</td>";
     }
     h << "<td class=\"l\">" << (row.angle ? "deg" : u.name) << "</td></tr>\n";
   }
-  h << "</table>\n";
-  const bool calibrated = p.Part("calibration", json(nullptr)).is_object();
-  const double common = Num(total, "common_mode_relative_std");
-  const bool assumed = total.is_object() && total.value("configured_inputs_assumed", false);
+  h << "</table>" << kScrollClose;
+  const bool calibrated = p.results.Get("calibration").IsObject();
+  const double common = total.Num("common_mode_relative_std");
+  const bool assumed = total.Bool("configured_inputs_assumed");
   h << "<p><b>std (stat)</b>: the scatter between trials and angles, the fits' own errors and the "
        "rig inertia's offset; the interval is its 95 % bootstrap interval. <b>std (total)</b> adds "
        "in quadrature the common-mode terms, one error shared by every moment: the "
@@ -290,333 +485,370 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
                          ", g")
     << ", the masses and the gyro scale, &plusmn;" << Fmt(100.0 * common, "%.2f")
     << " % of each moment. It scales every moment alike and leaves &tau; unchanged. Read the total "
-       "when you use a number; compare trials or set-ups with the stat std.</p>\n";
-  const std::string note = Str(total, "note");
-  if (!note.empty()) h << "<p class=\"bad\">" << Escape(note) << "</p>\n";
-  if (ellipse.contains("warnings")) {
-    for (const auto& w : ellipse["warnings"]) {
-      if (w.is_string()) h << "<p class=\"note\">" << Escape(w.get<std::string>()) << "</p>\n";
-    }
-  }
+       "when you use a number; compare trials or set-ups with the stat std. Values are given to "
+       "the digits their std supports.</p>\n";
+  const std::string note = total.Str("note");
+  if (!note.empty()) h << "<p class=\"warn\">" << Escape(note) << "</p>\n";
+  WriteOutliers(p, h);
+  WriteNotes(ellipse.Strs("warnings"), u, h);
 }
 
 // rig.calibration: effective against configured geometry, the factor with its std and parts.
 void WriteCalibration(const ReportPage& p, std::ostream& h) {
-  const json c = p.Part("calibration", json(nullptr));
-  if (!c.is_object()) return;
-  const json nominal = c.value("nominal", json::object()), effective = c.value("effective", json::object());
-  const json parts = c.value("relative_std_parts", json::object());
-  const json swings = c.value("swings", json::object()), reference = c.value("reference", json::object());
+  const R c = p.results.Get("calibration");
+  if (!c.IsObject()) return;
+  const R parts = c.Get("relative_std_parts"), swings = c.Get("swings"), reference = c.Get("reference");
   h << "<h2>Rig calibration (reference object)</h2>\n<table><tr><th class=\"l\">geometry</th>"
        "<th>L (m)</th><th>D (m)</th><th>D<sup>2</sup>/L (m)</th></tr>\n";
-  for (const auto& [label, g] : {std::make_pair("configured", nominal), std::make_pair("effective", effective)}) {
-    h << "<tr><td class=\"l\">" << label << "</td><td>" << Fmt(Num(g, "filar_length_m"), "%.4f")
-      << "</td><td>" << Fmt(Num(g, "filar_separation_m"), "%.5f") << "</td><td>"
-      << Fmt(Num(g, "d2_over_l_m"), "%.6f") << "</td></tr>\n";
+  for (const char* label : {"nominal", "effective"}) {
+    const R g = c.Get(label);
+    h << "<tr><td class=\"l\">" << (std::string(label) == "nominal" ? "configured" : label)
+      << "</td><td>" << Fmt(g.Num("filar_length_m"), "%.4f") << "</td><td>"
+      << Fmt(g.Num("filar_separation_m"), "%.5f") << "</td><td>" << Fmt(g.Num("d2_over_l_m"), "%.6f")
+      << "</td></tr>\n";
   }
-  h << "</table>\n<p>Factor k = " << Fmt(Num(c, "factor"), "%.5f") << " &plusmn; "
-    << Fmt(Num(c, "factor_std"), "%.5f") << " (&plusmn;" << Fmt(100.0 * Num(c, "factor_relative_std"), "%.3f")
-    << " %, common to every moment: reference inertia " << Fmt(100.0 * Num(parts, "reference_inertia"), "%.3f")
-    << " %, reference swings " << Fmt(100.0 * Num(parts, "reference_swings"), "%.3f") << " %, rig inertia "
-    << Fmt(100.0 * Num(parts, "rig_inertia"), "%.3f") << " %), from " << swings.value("n", 0)
-    << " swing(s) of a reference of " << p.u.Inertia(Num(reference, "inertia_kg_m2"), "%.5g") << " "
-    << p.u.name << " and " << Fmt(Num(reference, "mass_kg"), "%.4g")
+  h << "</table>\n<p>Factor k = " << Fmt(c.Num("factor"), "%.5f") << " &plusmn; "
+    << Fmt(c.Num("factor_std"), "%.5f") << " (&plusmn;" << Fmt(100.0 * c.Num("factor_relative_std"), "%.3f")
+    << " %, common to every moment: reference inertia " << Fmt(100.0 * parts.Num("reference_inertia"), "%.3f")
+    << " %, reference swings " << Fmt(100.0 * parts.Num("reference_swings"), "%.3f") << " %, rig inertia "
+    << Fmt(100.0 * parts.Num("rig_inertia"), "%.3f") << " %), from " << swings.Int("n")
+    << " swing(s) of a reference of " << p.u.Inertia(reference.Num("inertia_kg_m2"), "%.5g") << " "
+    << p.u.name << " and " << Fmt(reference.Num("mass_kg"), "%.4g")
     << " kg. Every trace, tare logs included, was fitted with the effective geometry; the "
        "tape-measure uncertainties of L and D and that of g do not apply.</p>\n";
-  for (const auto& w : c.value("warnings", json::array())) {
-    if (w.is_string()) h << "<p class=\"note\">" << Escape(w.get<std::string>()) << "</p>\n";
-  }
+  WriteNotes(c.Strs("warnings"), p.u, h);
 }
 
-// The inertia tensor of a campaign that rolls (or has too few pitch angles for the ellipse):
-// the six components with std and interval (unobservable ones named), the principal moments,
-// axes and Euler angles, the principal-axes figure, the per-orientation residuals. Nothing for a
-// planar campaign (its tensor section repeats Table 2).
-void WriteTensorSection(ReportPage& p, std::ostream& h) {
-  const Units& u = p.u;
-  const json tensor = p.Part("tensor", json(nullptr));
-  if (!tensor.is_object() || Str(tensor, "mode") == "planar_xz") return;
-  h << "<h2>Inertia tensor</h2>\n<p>" << tensor.value("n_points", 0) << " moments about "
-    << tensor.value("n_orientations", 0) << " axes; design rank " << tensor.value("rank", 0)
-    << " of 6, condition number " << Fmt(Num(tensor, "condition_number"), "%.3g")
-    << "; covariance " << Escape(Str(tensor, "covariance"));
-  const double scatter = Num(tensor, "attitude_scatter_deg");
-  if (scatter > 0) h << "; attitude scatter " << Fmt(scatter, "%.2f") << " deg";
-  h << ". Products are positive (I<sub>xy</sub> = &int; x y dm); the tensor holds their negatives "
-       "(docs/physics.md &sect;3.5).</p>\n";
-  h << "<table><tr><th class=\"l\">component</th><th>value</th><th>std</th><th>interval</th>"
-       "<th class=\"l\">unit</th></tr>\n";
-  for (const char* name : {"Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"}) {
-    const Estimate e = GetEstimate(tensor, std::string(name) + "_kg_m2");
-    h << "<tr><td class=\"l\">I<sub>" << (name + 1) << "</sub></td>";
-    if (!e.defined) {
-      h << "<td colspan=\"3\">not observable from these swing axes</td>";
-    } else {
-      h << "<td>" << u.Inertia(e.value, "%.5g") << "</td><td>" << u.Inertia(e.std, "%.2g")
-        << "</td><td>[" << u.Inertia(e.lo, "%.5g") << ", " << u.Inertia(e.hi, "%.5g") << "]</td>";
-    }
-    h << "<td class=\"l\">" << u.name << "</td></tr>\n";
-  }
-  h << "</table>\n";
-  const json moments = tensor.value("principal_moments_kg_m2", json(nullptr));
-  if (moments.is_array() && moments.size() == 3) {
-    const json stds = tensor.value("principal_moments_kg_m2_std", json::array());
-    const json axes = tensor.value("principal_axes", json::array());
-    const json axes_std = tensor.value("principal_axes_std_deg", json::array());
-    h << "<table><tr><th>principal</th><th>moment</th><th>std</th><th>axis x</th><th>axis y</th>"
-         "<th>axis z</th><th>axis std (deg)</th></tr>\n";
-    for (int k = 0; k < 3; ++k) {
-      auto at = [](const json& a, int i) {
-        return a.is_array() && i < static_cast<int>(a.size()) && a[i].is_number() ? a[i].get<double>()
-                                                                                : NAN;
-      };
-      const json axis = k < static_cast<int>(axes.size()) ? axes[k] : json::array();
-      h << "<tr><td>" << k + 1 << "</td><td>" << u.Inertia(at(moments, k), "%.5g") << "</td><td>"
-        << u.Inertia(at(stds, k), "%.2g") << "</td><td>" << Fmt(at(axis, 0)) << "</td><td>"
-        << Fmt(at(axis, 1)) << "</td><td>" << Fmt(at(axis, 2)) << "</td><td>"
-        << Fmt(at(axes_std, k), "%.2f") << "</td></tr>\n";
-    }
-    h << "</table>\n";
-    const json euler = tensor.value("principal_euler_deg", json::object());
-    h << "<p>Principal axes from body axes (Z-Y-X Euler angles, each principal axis matched to the "
-         "nearest body axis): roll "
-      << Fmt(Num(euler, "roll"), "%.3f") << " &plusmn; " << Fmt(Num(euler, "roll_std"), "%.3f")
-      << ", pitch " << Fmt(Num(euler, "pitch"), "%.3f") << " &plusmn; "
-      << Fmt(Num(euler, "pitch_std"), "%.3f") << ", yaw " << Fmt(Num(euler, "yaw"), "%.3f")
-      << " &plusmn; " << Fmt(Num(euler, "yaw_std"), "%.3f") << " deg.</p>\n";
-  }
-  h << "<p>Uncertainties are statistical; the configured uncertainties add a systematic &plusmn;"
-    << Fmt(100.0 * Num(tensor, "systematic_relative_std"), "%.2f")
-    << " % that scales every component alike.</p>\n";
-  for (const auto& w : tensor.value("warnings", json::array())) {
-    if (w.is_string()) h << "<p class=\"note\">" << Escape(w.get<std::string>()) << "</p>\n";
-  }
-  if (!Str(p.figures, "tensor").empty()) {
-    h << "<h2>Principal axes and per-orientation residuals</h2>\n"
-      << Figure(p.out_dir, Str(p.figures, "tensor"),
-                "ellipsoid of inertia in three plane views and residuals", "fig", &p.figures_drawn)
-      << "\n";
-  }
-  h << "<h2>Per-orientation residuals</h2>\n<table><tr><th>#</th><th>roll (deg)</th>"
-       "<th>pitch (deg)</th><th>axis in body</th><th>logs</th><th>mean</th><th>fitted</th>"
-       "<th>residual</th><th>residual / expected</th></tr>\n";
-  int index = 0;
-  for (const auto& o : tensor.value("orientations", json::array())) {
-    const json axis = o.value("axis_in_body", json::array());
-    std::string axis_text = "&ndash;";
-    if (axis.is_array() && axis.size() == 3 && axis[0].is_number()) {
-      axis_text = "(" + Fmt(axis[0].get<double>(), "%.3f") + ", " + Fmt(axis[1].get<double>(), "%.3f") +
-                  ", " + Fmt(axis[2].get<double>(), "%.3f") + ")";
-    }
-    const double z = Num(o, "z");
-    h << "<tr><td>" << ++index << "</td><td>" << Fmt(Num(o, "roll_deg"), "%.1f") << "</td><td>"
-      << Fmt(Num(o, "pitch_deg"), "%.1f") << "</td><td>" << axis_text << "</td><td>"
-      << o.value("n", 0) << "</td><td>" << u.Inertia(Num(o, "mean_kg_m2"), "%.5g") << "</td><td>"
-      << u.Inertia(Num(o, "fitted_kg_m2"), "%.5g") << "</td><td>"
-      << u.Inertia(Num(o, "residual_kg_m2"), "%.2g") << "</td><td"
-      << (std::fabs(z) > 3 ? " class=\"bad\"" : "") << ">" << Fmt(z, "%+.2f") << "</td></tr>\n";
-  }
-  h << "</table>\n";
-}
-
-// Table 1 (data quality) and the rig line.
+// Table 1 (data quality) and the rig line. The regression RMSE is the ellipse's (planar) or the
+// tensor's.
 void WriteTable1AndRig(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
-  const json t1 = p.Part("table1", json::object());
+  const R t1 = p.results.Get("table1");
+  const double rmse = p.Planar() ? t1.Num("regression_rmse_kg_m2") : p.tensor.Num("rmse_kg_m2");
   h << "<h2>Table 1: data quality</h2>\n<table><tr><th class=\"l\">statistic</th><th>value</th>"
        "<th class=\"l\">unit</th></tr>\n";
-  h << "<tr><td class=\"l\">raw data &sigma; (mean of per-angle standard deviations)</td><td>"
-    << u.Inertia(Num(t1, "raw_sigma_kg_m2")) << "</td><td class=\"l\">" << u.name << "</td></tr>\n";
-  h << "<tr><td class=\"l\">coefficient of variation (mean per angle)</td><td>"
-    << Fmt(Num(t1, "cv_percent"), "%.4f") << "</td><td class=\"l\">%</td></tr>\n";
-  h << "<tr><td class=\"l\">regression RMSE</td><td>" << u.Inertia(Num(t1, "regression_rmse_kg_m2"))
-    << "</td><td class=\"l\">" << u.name << "</td></tr>\n</table>\n";
-  const json rig = p.Part("rig", json::object());
-  h << "<p>Rig: L = " << Fmt(Num(rig, "filar_length_m"), "%.4f") << " m, D = "
-    << Fmt(Num(rig, "filar_separation_m"), "%.4f") << " m, rig mass "
-    << Fmt(Num(rig, "mass_kg"), "%.4f") << " kg, aircraft mass "
-    << Fmt(Num(rig, "aircraft_mass_kg"), "%.4f") << " kg, g = "
-    << Fmt(Num(rig, "gravity_mps2"), "%.5f") << " m/s<sup>2</sup>. Rig inertia ("
-    << Escape(Str(rig, "inertia_source")) << "): " << u.Inertia(Num(rig, "inertia_kg_m2"), "%.5f")
-    << " &plusmn; " << u.Inertia(Num(rig, "inertia_std_kg_m2"), "%.2e") << " " << u.name;
-  if (Str(rig, "inertia_source") == "tare") h << " from " << rig.value("tare_n", 0) << " tare log(s)";
+  h << "<tr><td class=\"l\">raw data &sigma; (mean of per-" << (p.Planar() ? "angle" : "attitude")
+    << " standard deviations)</td><td>" << u.Inertia(t1.Num("raw_sigma_kg_m2"), "%.3g")
+    << "</td><td class=\"l\">" << u.name << "</td></tr>\n";
+  h << "<tr><td class=\"l\">coefficient of variation (mean per " << (p.Planar() ? "angle" : "attitude")
+    << ")</td><td>" << Fmt(t1.Num("cv_percent"), "%.3g") << "</td><td class=\"l\">%</td></tr>\n";
+  h << "<tr><td class=\"l\">regression RMSE" << (p.Planar() ? "" : " (tensor fit)") << "</td><td>"
+    << u.Inertia(rmse, "%.3g") << "</td><td class=\"l\">" << u.name << "</td></tr>\n</table>\n";
+  const R rig = p.results.Get("rig");
+  h << "<p>Rig: L = " << Fmt(rig.Num("filar_length_m"), "%.4f") << " m, D = "
+    << Fmt(rig.Num("filar_separation_m"), "%.4f") << " m, rig mass "
+    << Fmt(rig.Num("mass_kg"), "%.4f") << " kg, aircraft mass "
+    << Fmt(rig.Num("aircraft_mass_kg"), "%.4f") << " kg, g = "
+    << Fmt(rig.Num("gravity_mps2"), "%.5f") << " m/s<sup>2</sup>. Rig inertia ("
+    << Escape(rig.Str("inertia_source")) << "): "
+    << u.Value(rig.Num("inertia_kg_m2"), rig.Num("inertia_std_kg_m2")) << " &plusmn; "
+    << u.Std(rig.Num("inertia_std_kg_m2")) << " " << u.name;
+  if (rig.Str("inertia_source") == "tare") h << " from " << rig.Int("tare_n") << " tare log(s)";
   h << ".</p>\n";
   WriteCalibration(p, h);
 }
 
-// Figures 3 and 4, and the NACA Report 467 comparison of I_xz.
+// Figures 3 and 4 (those drawn), and the NACA Report 467 comparison of I_xz when it applies.
 void WriteEllipseSection(ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
-  const json& ellipse = p.ellipse;
-  h << "<h2>Figure 3: moment of inertia against pitch</h2>\n"
-    << Figure(p.out_dir, Str(p.figures, "moments"), "moments of inertia against pitch angle", "fig", &p.figures_drawn)
-    << "\n<h2>Figure 4: ellipse of inertia</h2>\n"
-    << Figure(p.out_dir, Str(p.figures, "polar"), "polar plot of the ellipse of inertia", "fig", &p.figures_drawn) << "\n";
-  h << "<h2>NACA Report 467 comparison</h2>\n";
-  if (!(ellipse.is_object() && ellipse.contains("naca") && !ellipse["naca"].empty())) {
-    h << "<p class=\"note\">No NACA 467 estimate (needs the ellipse fit and oblique angles).</p>\n";
-    return;
+  const R& ellipse = p.ellipse;
+  const std::string moments = p.figures.Str("moments"), polar = p.figures.Str("polar");
+  if (!moments.empty()) {
+    h << "<h2>Figure 3: moment of inertia against pitch</h2>\n"
+      << Figure(p.out_dir, moments, "moments of inertia against pitch angle", "fig", &p.figures_drawn) << "\n";
   }
+  if (!polar.empty()) {
+    h << "<h2>Figure 4: ellipse of inertia</h2>\n"
+      << Figure(p.out_dir, polar, "polar plot of the ellipse of inertia", "fig", &p.figures_drawn) << "\n";
+  }
+  const std::vector<R> naca = ellipse.Items("naca");
+  if (naca.empty()) return;
   const Estimate ixz = GetEstimate(ellipse, "Ixz_kg_m2");
-  h << "<p>I<sub>xz</sub> from one oblique angle (paper Eq. 1) against the multi-angle fit "
-    << u.Inertia(ixz.value) << " &plusmn; " << u.Inertia(ixz.std) << " " << u.name << ".</p>\n"
-    << "<table><tr><th>pitch (deg)</th><th>I<sub>xz</sub> NACA 467</th><th>std</th>"
+  h << "<h2>NACA Report 467 comparison</h2>\n<p>I<sub>xz</sub> from one oblique angle (paper Eq. 1) "
+       "against the multi-angle fit "
+    << u.Value(ixz.value, ixz.std) << " &plusmn; " << u.Std(ixz.std) << " " << u.name << ".</p>\n"
+    << kScrollOpen << "<table><tr><th>pitch (deg)</th><th>I<sub>xz</sub> NACA 467</th><th>std</th>"
        "<th>difference from fit</th></tr>\n";
-  for (const auto& e : ellipse["naca"]) {
-    const double v = Num(e, "Ixz_kg_m2");
-    h << "<tr><td>" << Fmt(Num(e, "pitch_deg"), "%.1f") << "</td><td>" << u.Inertia(v)
-      << "</td><td>" << u.Inertia(Num(e, "Ixz_std_kg_m2")) << "</td><td>"
-      << u.Inertia(v - ixz.value) << "</td></tr>\n";
+  for (const R& e : naca) {
+    const double v = e.Num("Ixz_kg_m2"), s = e.Num("Ixz_std_kg_m2");
+    h << "<tr><td>" << Fmt(e.Num("pitch_deg"), "%.1f") << "</td><td>" << u.Value(v, s)
+      << "</td><td>" << u.Std(s) << "</td><td>" << u.Value(v - ixz.value, s) << "</td></tr>\n";
   }
-  h << "</table>\n";
+  h << "</table>" << kScrollClose;
 }
 
+// The principal moments, axes and Euler angles of a full tensor.
+void WritePrincipal(const ReportPage& p, std::ostream& h) {
+  const Units& u = p.u;
+  const R& tensor = p.tensor;
+  const std::vector<double> moments = tensor.Nums("principal_moments_kg_m2");
+  if (moments.size() != 3) return;
+  const std::vector<double> stds = tensor.Nums("principal_moments_kg_m2_std");
+  const std::vector<double> axes_std = tensor.Nums("principal_axes_std_deg");
+  const std::vector<std::vector<double>> axes = tensor.Rows("principal_axes");
+  const auto at = [](const std::vector<double>& a, size_t i) { return i < a.size() ? a[i] : NAN; };
+  h << kScrollOpen << "<table><tr><th>principal</th><th>moment</th><th>std</th><th>axis x</th><th>axis y</th>"
+       "<th>axis z</th><th>axis std (deg)</th></tr>\n";
+  for (size_t k = 0; k < 3; ++k) {
+    h << "<tr><td>" << k + 1 << "</td><td>" << u.Value(moments[k], at(stds, k)) << "</td><td>"
+      << u.Std(at(stds, k));
+    const std::vector<double> a = k < axes.size() ? axes[k] : std::vector<double>();
+    for (size_t c = 0; c < 3; ++c) h << "</td><td>" << Fmt(at(a, c), "%+.4f");
+    h << "</td><td>" << Fmt(at(axes_std, k), "%.2f") << "</td></tr>\n";
+  }
+  h << "</table>" << kScrollClose;
+  const R euler = tensor.Get("principal_euler_deg");
+  h << "<p>Principal axes from body axes (Z-Y-X Euler angles, each principal axis matched to the "
+       "nearest body axis): roll "
+    << Fmt(euler.Num("roll"), "%.3f") << " &plusmn; " << Fmt(euler.Num("roll_std"), "%.3f")
+    << ", pitch " << Fmt(euler.Num("pitch"), "%.3f") << " &plusmn; "
+    << Fmt(euler.Num("pitch_std"), "%.3f") << ", yaw " << Fmt(euler.Num("yaw"), "%.3f")
+    << " &plusmn; " << Fmt(euler.Num("yaw_std"), "%.3f") << " deg.</p>\n";
+}
+
+// The per-orientation residuals of the tensor fit, roll and pitch of each.
+void WriteOrientations(const ReportPage& p, std::ostream& h) {
+  const Units& u = p.u;
+  h << "<h2>Per-orientation residuals</h2>\n" << kScrollOpen
+    << "<table><tr><th>#</th><th>roll (deg)</th><th>pitch (deg)</th><th>axis in body</th>"
+       "<th>logs</th><th>mean (" << u.name << ")</th><th>fitted</th><th>residual</th>"
+       "<th>residual / expected</th></tr>\n";
+  int index = 0;
+  for (const R& o : p.tensor.Items("orientations")) {
+    const std::vector<double> axis = o.Nums("axis_in_body");
+    std::string axis_text = "&ndash;";
+    if (axis.size() == 3) {
+      axis_text = "(" + Fixed(axis[0], 3) + ", " + Fixed(axis[1], 3) + ", " + Fixed(axis[2], 3) + ")";
+    }
+    const double z = o.Num("z"), scatter = o.Num("scatter_kg_m2");
+    const double d_std = scatter > 0 ? scatter : std::fabs(o.Num("residual_kg_m2"));
+    h << "<tr><td>" << ++index << "</td><td>" << Fmt(o.Num("roll_deg"), "%.1f") << "</td><td>"
+      << Fmt(o.Num("pitch_deg"), "%.1f") << "</td><td>" << axis_text << "</td><td>" << o.Int("n")
+      << "</td><td>" << u.Value(o.Num("mean_kg_m2"), d_std) << "</td><td>"
+      << u.Value(o.Num("fitted_kg_m2"), d_std) << "</td><td>"
+      << u.Value(o.Num("residual_kg_m2"), d_std) << "</td><td"
+      << (std::fabs(z) > 3 ? " class=\"bad\"" : "") << ">" << Fmt(z, "%+.2f") << "</td></tr>\n";
+  }
+  h << "</table>" << kScrollClose;
+}
+
+// The inertia tensor of a campaign that rolls: the six components with std and interval
+// (unobservable ones named), the scatter and the logs behind it, the outliers, the principal
+// moments and axes with the ellipsoid figure (a full tensor), the per-orientation residuals.
+void WriteTensorSection(ReportPage& p, std::ostream& h) {
+  const Units& u = p.u;
+  const R& tensor = p.tensor;
+  h << "<h2>Inertia tensor</h2>\n";
+  if (!tensor.IsObject()) {
+    h << "<p class=\"bad\">" << Escape(p.summary.Str("tensor_message")) << "</p>\n";
+    return;
+  }
+  h << "<p>" << tensor.Int("n_points") << " moments about " << tensor.Int("n_orientations")
+    << " axes; design rank " << tensor.Int("rank") << " of 6, condition number "
+    << Fmt(tensor.Num("condition_number"), "%.3g") << "; covariance " << Escape(tensor.Str("covariance"));
+  const double scatter = tensor.Num("attitude_scatter_deg");
+  if (scatter > 0) h << "; attitude scatter " << Fmt(scatter, "%.2f") << " deg";
+  h << ". Products are positive (I<sub>xy</sub> = &int; x y dm); the tensor holds their negatives "
+       "(docs/physics.md &sect;3.5). Values are given to the digits their std supports.</p>\n";
+  h << kScrollOpen << "<table><tr><th class=\"l\">component</th><th>value</th><th>std (stat)</th>"
+       "<th>interval (stat)</th><th class=\"l\">unit</th></tr>\n";
+  for (const char* name : {"Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"}) {
+    const Estimate e = GetEstimate(tensor, std::string(name) + "_kg_m2");
+    h << "<tr><td class=\"l\">I<sub>" << (name + 1) << "</sub></td>";
+    if (!e.defined) {
+      h << "<td colspan=\"3\" class=\"note\">not observable from these swing axes</td>";
+    } else {
+      h << "<td>" << u.Value(e.value, e.std) << "</td><td>" << u.Std(e.std) << "</td><td>["
+        << u.Value(e.lo, e.std) << ", " << u.Value(e.hi, e.std) << "]</td>";
+    }
+    h << "<td class=\"l\">" << u.name << "</td></tr>\n";
+  }
+  h << "</table>" << kScrollClose;
+  h << "<p>Uncertainties are statistical; the configured uncertainties add a systematic &plusmn;"
+    << Fmt(100.0 * tensor.Num("systematic_relative_std"), "%.2f")
+    << " % that scales every component alike.</p>\n";
+  const double relative = tensor.Num("relative_scatter");
+  std::vector<std::pair<std::string, double>> logs;
+  for (const R& l : tensor.Items("scatter_logs")) logs.emplace_back(l.Str("file"), l.Num("residual_over_std"));
+  if (relative > 0 || scatter > 0) {
+    h << "<p class=\"warn\">The moments scatter "
+      << (relative > 0 ? "by " + Fmt(100.0 * relative, "%.2f") + " %" : "as if each axis were off by " + Fmt(scatter, "%.2f") + " deg")
+      << " beyond their logs' stds; the fit is weighed by that (docs/method.md)"
+      << (logs.empty() ? "" : "; " + Escape(ScatterLogsText(logs))) << ".</p>\n";
+  }
+  WriteOutliers(p, h);
+  WriteNotes(tensor.Strs("warnings"), u, h);
+  WritePrincipal(p, h);
+  const std::string figure = p.figures.Str("tensor");
+  if (!figure.empty()) {
+    h << "<h2>Ellipsoid of inertia and per-orientation residuals</h2>\n"
+      << Figure(p.out_dir, figure, "ellipsoid of inertia in three plane views and residuals", "fig",
+                &p.figures_drawn)
+      << "\n";
+  }
+  WriteOrientations(p, h);
+}
+
+// Per-attitude statistics (roll, pitch), sorted numerically.
 void WriteAngleTable(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
-  h << "<h2>Per-angle statistics</h2>\n<table><tr><th>pitch (deg)</th><th>n</th><th>mean ("
-    << u.name << ")</th><th>std</th><th>sem</th><th>total of the mean</th><th>CV (%)</th></tr>\n";
-  for (const auto& a : p.angles) {
-    h << "<tr><td>" << Fmt(Num(a, "pitch_deg"), "%.2f") << "</td><td>" << a.value("n", 0)
-      << "</td><td>" << u.Inertia(Num(a, "inertia_mean_kg_m2")) << "</td><td>"
-      << u.Inertia(Num(a, "inertia_std_kg_m2"), "%.5f") << "</td><td>"
-      << u.Inertia(Num(a, "inertia_sem_kg_m2"), "%.5f") << "</td><td>"
-      << u.Inertia(Num(a, "inertia_std_total_kg_m2"), "%.5f") << "</td><td>"
-      << Fmt(Num(a, "cv_percent"), "%.3f") << "</td></tr>\n";
+  std::vector<R> angles = p.results.Items("angles");
+  const auto roll = [](const R& a) { const double r = a.Num("roll_deg"); return std::isfinite(r) ? r : 0.0; };
+  std::stable_sort(angles.begin(), angles.end(), [&](const R& a, const R& b) {
+    if (roll(a) != roll(b)) return roll(a) < roll(b);
+    return a.Num("pitch_deg") < b.Num("pitch_deg");
+  });
+  h << "<h2>Per-" << (p.Planar() ? "angle" : "attitude") << " statistics</h2>\n" << kScrollOpen
+    << "<table><tr><th>roll (deg)</th><th>pitch (deg)</th><th>n</th><th>mean (" << u.name
+    << ")</th><th>std</th><th>sem</th><th>total of the mean</th><th>CV (%)</th></tr>\n";
+  for (const R& a : angles) {
+    const double sem = a.Num("inertia_sem_kg_m2");
+    h << "<tr><td>" << Fmt(roll(a), "%.2f") << "</td><td>" << Fmt(a.Num("pitch_deg"), "%.2f")
+      << "</td><td>" << a.Int("n") << "</td><td>" << u.Value(a.Num("inertia_mean_kg_m2"), sem)
+      << "</td><td>" << u.Std(a.Num("inertia_std_kg_m2")) << "</td><td>" << u.Std(sem)
+      << "</td><td>" << u.Std(a.Num("inertia_std_total_kg_m2")) << "</td><td>"
+      << Fmt(a.Num("cv_percent"), "%.3f") << "</td></tr>\n";
   }
-  h << "</table>\n";
+  h << "</table>" << kScrollClose;
 }
 
 // The traces that are not ok, with the reason.
 void WriteRejectedTraces(const ReportPage& p, std::ostream& h) {
-  h << "<h2>Rejected and failed traces</h2>\n";
   int bad = 0;
   std::ostringstream rows;
-  for (const auto& t : p.traces) {
-    const std::string status = Str(t, "status");
+  for (const TraceRow& row : p.traces) {
+    const std::string status = row.t.Str("status");
     if (status == "ok") continue;
     ++bad;
-    rows << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
-         << "</td><td class=\"l\">" << Escape(status) << "</td><td class=\"l\">"
-         << Escape(InDisplayUnits(p.u, Str(t, "message"))) << "</td></tr>\n";
+    rows << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(row.t.Str("file"))
+         << "</td><td class=\"l\">" << Escape(status) << "</td><td class=\"l w\">"
+         << Escape(InDisplayUnits(p.u, row.t.Str("message"))) << "</td></tr>\n";
   }
-  if (bad == 0) {
-    h << "<p class=\"ok\">None: every trace was fitted (warnings, if any, are listed below).</p>\n";
-  } else {
-    h << "<table><tr><th class=\"l\">file</th><th class=\"l\">status</th><th class=\"l\">reason</th></tr>\n"
-      << rows.str() << "</table>\n";
-  }
+  if (bad == 0) return;  // nothing to show: the header's counts say every trace was fitted
+  h << "<h2>Rejected and failed traces</h2>\n" << kScrollOpen
+    << "<table><tr><th class=\"l\">file</th><th class=\"l\">status</th><th class=\"l\">reason</th></tr>\n"
+    << rows.str() << "</table>" << kScrollClose;
 }
 
-// Every fitted trace that raised a warning, with the warnings' text: its number is used, so the
-// reader must see why to doubt it (the traces table says "ok (warned)").
+// Every fitted trace that raised a warning: one line per warning, its full text on click.
 void WriteWarnings(const ReportPage& p, std::ostream& h) {
-  h << "<h2 id=\"warnings\">Warnings</h2>\n";
   std::ostringstream rows;
   int warned = 0;
-  for (const auto& t : p.traces) {
-    if (Str(t, "status") != "ok") continue;  // rejected and failed: the section above
-    const std::vector<std::string> warnings = TraceWarnings(t);
+  for (const TraceRow& row : p.traces) {
+    if (row.t.Str("status") != "ok") continue;  // rejected and failed: the section above
+    const std::vector<std::string> warnings = TraceWarnings(row.t);
     if (warnings.empty()) continue;
     ++warned;
-    rows << "<tr class=\"warned\"><td class=\"l\">" << Escape(Str(t, "file")) << "</td><td class=\"l\">";
-    for (size_t i = 0; i < warnings.size(); ++i) {
-      rows << (i ? "<br>" : "") << Escape(InDisplayUnits(p.u, warnings[i]));
-    }
+    rows << "<tr class=\"warned\"><td class=\"l\">" << Escape(row.t.Str("file")) << "</td><td class=\"l w\">";
+    for (const std::string& w : warnings) rows << WarningItem(p.u, w);
     rows << "</td></tr>\n";
   }
+  h << "<h2 id=\"warnings\">Warnings</h2>\n";
   if (warned == 0) {
     h << "<p class=\"ok\">None: no fitted trace raised a warning.</p>\n";
     return;
   }
-  h << "<p class=\"bad\">" << warned << " fitted trace" << (warned == 1 ? "" : "s")
+  h << "<p class=\"warn\">" << warned << " fitted trace" << (warned == 1 ? "" : "s")
     << " raised warnings. Their numbers are in every table above; read why before you trust "
-       "them.</p>\n<table class=\"warnings\"><tr><th class=\"l\">file</th><th class=\"l\">warnings</th></tr>\n"
-    << rows.str() << "</table>\n";
+       "them (click a line for the full text).</p>\n"
+    << kScrollOpen << "<table class=\"warnings\"><tr><th class=\"l\">file</th><th class=\"l\">warnings</th></tr>\n"
+    << rows.str() << "</table>" << kScrollClose;
 }
 
 // The traces table's status cell: "ok (warned)" links to the Warnings section and carries the
-// warnings' text as its tooltip.
-std::string StatusCell(const Units& u, const json& t) {
+// warnings' first lines as its tooltip.
+std::string StatusCell(const Units& u, const R& t) {
   const std::string shown = DisplayStatus(t);
   if (shown != "ok (warned)") return Escape(shown);
   std::string tip;
-  for (const std::string& w : TraceWarnings(t)) tip += (tip.empty() ? "" : "\n") + InDisplayUnits(u, w);
+  for (const std::string& w : TraceWarnings(t)) {
+    tip += (tip.empty() ? "" : "\n") + WarningSummary(InDisplayUnits(u, w));
+  }
   return "<a href=\"#warnings\" title=\"" + Escape(tip) + "\">" + Escape(shown) + "</a>";
 }
 
-// One row per trace: role, status, pitch, total and aircraft inertia, window, amplitude.
+// One row per trace, sorted by roll and pitch: role, status, attitude, total and aircraft
+// inertia, window, amplitude.
 void WriteTraceTable(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
-  h << "<h2>Traces</h2>\n<table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"
-       "<th class=\"l\">status</th><th>pitch (deg)</th><th>I total (" << u.name
+  h << "<h2>Traces</h2>\n" << kScrollOpen
+    << "<table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"
+       "<th class=\"l\">status</th><th>roll (deg)</th><th>pitch (deg)</th><th>I total (" << u.name
     << ")</th><th>std (stat)</th><th>std (total)</th><th>period (s)</th><th>I aircraft</th><th>std (stat)</th>"
-       "<th>std (total)</th><th>window (s)</th>"
-       "<th>amplitude (deg)</th><th>rms/noise</th></tr>\n";
-  for (const auto& t : p.traces) {
-    const std::string status = Str(t, "status");
+       "<th>std (total)</th><th>window (s)</th><th>amplitude (deg)</th><th>rms/noise</th></tr>\n";
+  for (const TraceRow& row : p.traces) {
+    const R& t = row.t;
+    const std::string status = t.Str("status");
     std::string window = "&ndash;", amplitude = "&ndash;";
-    if (t.contains("window_s") && t["window_s"].is_array()) {
-      window = Fmt(t["window_s"][0].get<double>(), "%.2f") + "&ndash;" +
-               Fmt(t["window_s"][1].get<double>(), "%.2f");
-    }
-    if (t.contains("amplitude_deg") && t["amplitude_deg"].is_array()) {
-      amplitude = Fmt(t["amplitude_deg"][0].get<double>(), "%.1f") + "&rarr;" +
-                  Fmt(t["amplitude_deg"][1].get<double>(), "%.1f");
-    }
-    const std::string row_class = DisplayStatus(t) == "ok (warned)" ? "warned" : status;
-    h << "<tr class=\"" << Escape(row_class) << "\"><td class=\"l\">" << Escape(Str(t, "file"))
-      << "</td><td class=\"l\">" << Escape(Str(t, "role")) << "</td><td class=\"l\">"
-      << StatusCell(u, t) << "</td><td>" << Fmt(Num(t, "pitch_used_deg"), "%.2f") << "</td><td>"
-      << u.Inertia(Num(t, "inertia_total_kg_m2"), "%.5f") << "</td><td>"
-      << u.Inertia(Num(t, "inertia_total_std_kg_m2"), "%.2e") << "</td><td>"
-      << u.Inertia(Num(t, "inertia_total_std_total_kg_m2"), "%.2e") << "</td><td>"
-      << Fmt(Num(t, "period_s"), "%.4f") << "</td><td>"
-      << u.Inertia(Num(t, "inertia_kg_m2"), "%.5f") << "</td><td>"
-      << u.Inertia(Num(t, "inertia_std_kg_m2"), "%.2e") << "</td><td>"
-      << u.Inertia(Num(t, "inertia_std_total_kg_m2"), "%.2e") << "</td><td>" << window << "</td><td>"
+    const std::vector<double> w = t.Nums("window_s"), a = t.Nums("amplitude_deg");
+    if (w.size() == 2) window = Fmt(w[0], "%.2f") + "&ndash;" + Fmt(w[1], "%.2f");
+    if (a.size() == 2) amplitude = Fmt(a[0], "%.1f") + "&rarr;" + Fmt(a[1], "%.1f");
+    const double total_std = t.Num("inertia_total_std_kg_m2"), std = t.Num("inertia_std_kg_m2");
+    const std::string row_class = DisplayStatus(t) == "ok (warned)" ? "warned"
+                                  : status == "ok"                 ? ""
+                                                                   : status;
+    h << "<tr class=\"" << Escape(row_class) << "\"><td class=\"l\">" << Escape(t.Str("file"))
+      << "</td><td class=\"l\">" << Escape(t.Str("role")) << "</td><td class=\"l\">"
+      << StatusCell(u, t) << "</td><td>" << Fmt(row.roll, "%.2f") << "</td><td>"
+      << Fmt(row.pitch, "%.2f") << "</td><td>" << u.Value(t.Num("inertia_total_kg_m2"), total_std)
+      << "</td><td>" << u.Std(total_std) << "</td><td>" << u.Std(t.Num("inertia_total_std_total_kg_m2"))
+      << "</td><td>" << Fmt(t.Num("period_s"), "%.4f") << "</td><td>"
+      << u.Value(t.Num("inertia_kg_m2"), std) << "</td><td>" << u.Std(std) << "</td><td>"
+      << u.Std(t.Num("inertia_std_total_kg_m2")) << "</td><td>" << window << "</td><td>"
       << amplitude << "</td><td>"
-      << Fmt(Num(t, "residual_rms_rad_per_s") / Num(t, "noise_rms_rad_per_s"), "%.2f")
+      << Fmt(t.Num("residual_rms_rad_per_s") / t.Num("noise_rms_rad_per_s"), "%.2f")
       << "</td></tr>\n";
   }
-  h << "</table>\n";
+  h << "</table>" << kScrollClose;
 }
 
-// A trace figure's caption after the status: period, small-angle I, and each warning in red.
-std::string TraceCaptionFacts(const ReportPage& p, const json& t) {
+// A trace figure's caption after the status: the record's I with its stds, labelled (the number
+// the tables give), period and small-angle I, and each warning's line.
+std::string TraceCaptionFacts(const ReportPage& p, const R& t) {
   std::string out;
-  const double period = Num(t, "period_s");
+  const double value = t.Num("inertia_total_kg_m2"), stat = t.Num("inertia_total_std_kg_m2");
+  const double total = t.Num("inertia_total_std_total_kg_m2");
+  if (std::isfinite(value)) {
+    out += "<br>I<sub>total</sub> = " + p.u.Value(value, stat) + " &plusmn; " + p.u.Std(stat) +
+           " (stat) &plusmn; " + p.u.Std(total) + " (total) " + p.u.name;
+  }
+  const double period = t.Num("period_s");
   if (std::isfinite(period)) {
     out += " &middot; T = " + Fmt(period, "%.4f") + " s, small-angle I = " +
-           p.u.Inertia(Num(t, "small_angle_inertia_total_kg_m2"), "%.5f") + " " + p.u.name;
+           p.u.Inertia(t.Num("small_angle_inertia_total_kg_m2"), "%.5f") + " " + p.u.name;
   }
   for (const std::string& w : TraceWarnings(t)) {
-    out += "<br><span class=\"bad\">warning: " + Escape(InDisplayUnits(p.u, w)) + "</span>";
+    out += "<br><span class=\"warn\">warning: " + Escape(WarningSummary(InDisplayUnits(p.u, w))) + "</span>";
   }
   return out;
 }
 
 // The per-trace section: every trace's figures (fit and residual) with its caption.
 void WriteTraceFigures(ReportPage& p, std::ostream& h) {
+  std::ostringstream figures;
+  for (const TraceRow& row : p.traces) {
+    const std::string fig = row.t.Str("figure");
+    if (fig.empty()) continue;
+    figures << "<figure>"
+            << Figure(p.out_dir, fig, "fit of " + row.t.Str("file"), "trace", &p.figures_drawn)
+            << "<figcaption>" << Escape(row.t.Str("file")) << " &middot; "
+            << Escape(DisplayStatus(row.t)) << TraceCaptionFacts(p, row.t) << "</figcaption></figure>\n"
+            << SweepFigure(row.t, p.out_dir, &p.figures_drawn);
+  }
+  if (figures.tellp() == 0) return;  // no figures drawn (process --no-figures): no section
   h << "<h2>Fit and residual of every trace</h2>\n<p>Left, each trace: the measured swing rate "
        "(black) over the fit (light blue), and beneath them the residual (grey) with the "
-       "&plusmn;1&sigma; noise estimate (red). Its caption gives the measured period T "
+       "&plusmn;1&sigma; noise estimate (red). Its caption gives the record's I<sub>total</sub> with "
+       "its stat and total std (the numbers of the tables), the measured period T "
        "and the small-angle inertia m g D<sup>2</sup> T<sup>2</sup> / (16 &pi;<sup>2</sup> L) of "
        "everything suspended, the hand check of the fitted I<sub>total</sub>. Right: I against "
-       "amplitude.</p>\n<div class=\"traces\">\n";
-  for (const auto& t : p.traces) {
-    const std::string fig = Str(t, "figure");
-    if (fig.empty()) continue;
-    h << "<figure>" << Figure(p.out_dir, fig, "fit of " + Str(t, "file"), "trace", &p.figures_drawn)
-      << "<figcaption>" << Escape(Str(t, "file")) << " &middot; " << Escape(DisplayStatus(t))
-      << TraceCaptionFacts(p, t) << "</figcaption></figure>\n"
-      << SweepFigure(t, p.out_dir, &p.figures_drawn);
-  }
-  h << "</div>\n";
+       "amplitude.</p>\n<div class=\"traces\">\n"
+    << figures.str() << "</div>\n";
 }
 
 // The config text used, and the end of the page.
 void WriteFooter(const ReportPage& p, std::ostream& h) {
-  h << "<h2>Config used</h2>\n<pre>" << Escape(Str(p.results, "config")) << "</pre>\n";
+  h << "<h2>Config used</h2>\n<pre>" << Escape(p.results.Str("config")) << "</pre>\n";
   h << "</body></html>\n";
 }
 
@@ -650,16 +882,23 @@ std::string Base64(const std::string& bytes) {
   return out;
 }
 
-// header -> Table 2 -> inertia tensor (campaigns that roll) -> Table 1 and rig -> ellipse figures and NACA 467 -> per-angle table ->
-// rejected traces -> warnings -> trace table -> per-trace figures -> footer.
-std::string BuildReportHtml(const json& results, const std::string& out_dir) {
-  ReportPage page(results, out_dir);
+// header (main result) -> Table 1 and rig -> planar: Table 2, Figures 3 and 4, NACA 467; a
+// campaign that rolls: the inertia tensor -> per-attitude table -> rejected traces -> warnings ->
+// trace table -> per-trace figures -> footer. The paper's order (Table 1 before Table 2); the main
+// result is first in the header's box.
+namespace {
+
+std::string BuildPage(const json& results, const std::string& out_dir, KeyLog* keys_read) {
+  ReportPage page(results, out_dir, keys_read);
   std::ostringstream h;
   WriteHeader(page, h);
-  WriteTable2(page, h);
-  WriteTensorSection(page, h);
   WriteTable1AndRig(page, h);
-  WriteEllipseSection(page, h);
+  if (page.Planar()) {
+    WriteTable2(page, h);
+    WriteEllipseSection(page, h);
+  } else {
+    WriteTensorSection(page, h);
+  }
   WriteAngleTable(page, h);
   WriteRejectedTraces(page, h);
   WriteWarnings(page, h);
@@ -667,6 +906,18 @@ std::string BuildReportHtml(const json& results, const std::string& out_dir) {
   WriteTraceFigures(page, h);
   WriteFooter(page, h);
   return ShareSvgGlyphs(ShareStyles(h.str()));
+}
+
+}  // namespace
+
+std::string BuildReportHtml(const json& results, const std::string& out_dir) {
+  return BuildPage(results, out_dir, nullptr);
+}
+
+KeyLog ReportKeysRead(const json& results, const std::string& out_dir) {
+  KeyLog keys;
+  BuildPage(results, out_dir, &keys);
+  return keys;
 }
 
 void RunReport(const std::string& out_dir) {
@@ -699,6 +950,9 @@ void RunReport(const std::string& out_dir) {
     html = BuildReportHtml(results, out_dir);
   } catch (const json::exception& e) {  // a field of the wrong type: name the file, not json
     throw UserError(path + ": not a results file bifilar can read (" + DescribeJsonError(e) +
+                    "); rerun `bifilar process` to rewrite it");
+  } catch (const UserError& e) {  // ResultsReader: a key of the wrong type, named
+    throw UserError(path + ": not a results file bifilar can read (" + e.what() +
                     "); rerun `bifilar process` to rewrite it");
   }
   WriteFileAtomically((fs::path(out_dir) / "report.html").string(),
