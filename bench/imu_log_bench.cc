@@ -9,6 +9,7 @@
 
 #include "fit/swing_axis.h"
 #include "fit/window.h"
+#include "bench/bench_support.h"
 #include "pendulum/simulate.h"
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/logs/imu_log_writer.h"
@@ -16,30 +17,7 @@
 namespace bifilar {
 namespace {
 
-// A simulated 60 s log (rest 3 s, twist 1 s, hold 1.5 s, free 54.5 s) at 100 Hz.
-const SimulatedTrace& Trace60s() {
-  static const SimulatedTrace trace = [] {
-    TraceSetup setup;
-    setup.geometry.filar_length_m = 2.0;
-    setup.geometry.filar_separation_m = 0.7;
-    setup.geometry.mass_kg = 10.0;
-    setup.params.inertia_kg_m2 = 0.8;
-    setup.params.drag_coeff_kg_m2 = 0.005;
-    setup.params.viscous_coeff_kg_m2_per_s = 0.001;
-    setup.amplitude_rad = 0.35;
-    SimulationOptions options;
-    options.timeline.rest_before_s = {3.0, 3.0};
-    options.timeline.twist_s = {1.0, 1.0};
-    options.timeline.hold_s = {1.5, 1.5};
-    options.timeline.free_s = {54.5, 54.5};
-    options.timeline.stop_probability = 0.0;
-    SimulatedTrace t;
-    std::string why;
-    if (!SimulateTrace(setup, options, 42, &t, &why)) std::abort();
-    return t;
-  }();
-  return trace;
-}
+const SimulatedTrace& Trace60s() { return BenchTrace60s(); }
 
 const std::string& CsvText() {
   static const std::string text = FormatImuLog(Trace60s().imu, ImuFormat());

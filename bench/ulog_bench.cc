@@ -9,6 +9,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "bench/bench_support.h"
 #include "pendulum/simulate.h"
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/logs/imu_log_writer.h"
@@ -19,29 +20,7 @@ namespace bifilar {
 namespace {
 
 // The simulated log of bench/imu_log_bench.cc: 60 s at 100 Hz, 7 channels.
-const ImuData& Log60s() {
-  static const ImuData imu = [] {
-    TraceSetup setup;
-    setup.geometry.filar_length_m = 2.0;
-    setup.geometry.filar_separation_m = 0.7;
-    setup.geometry.mass_kg = 10.0;
-    setup.params.inertia_kg_m2 = 0.8;
-    setup.params.drag_coeff_kg_m2 = 0.005;
-    setup.params.viscous_coeff_kg_m2_per_s = 0.001;
-    setup.amplitude_rad = 0.35;
-    SimulationOptions options;
-    options.timeline.rest_before_s = {3.0, 3.0};
-    options.timeline.twist_s = {1.0, 1.0};
-    options.timeline.hold_s = {1.5, 1.5};
-    options.timeline.free_s = {54.5, 54.5};
-    options.timeline.stop_probability = 0.0;
-    SimulatedTrace t;
-    std::string why;
-    if (!SimulateTrace(setup, options, 42, &t, &why)) std::abort();
-    return t.imu;
-  }();
-  return imu;
-}
+const ImuData& Log60s() { return BenchTrace60s().imu; }
 
 void BM_ImuLogCsvPerSample(benchmark::State& state) {
   const std::string text = FormatImuLog(Log60s(), ImuFormat());

@@ -168,6 +168,16 @@ double ApparentInertiaExcess(double k, double exponent, double amplitude_rad) {
   return x < 1.0 ? x / (1.0 - x) : std::numeric_limits<double>::infinity();
 }
 
+TimelineOptions FixedTimeline(double rest_s, double twist_s, double hold_s, double free_s) {
+  TimelineOptions t;
+  t.rest_before_s = {rest_s, rest_s};
+  t.twist_s = {twist_s, twist_s};
+  t.hold_s = {hold_s, hold_s};
+  t.free_s = {free_s, free_s};
+  t.stop_probability = 0.0;
+  return t;
+}
+
 bool TimelineOptions::Check(std::string* why) const {
   return CheckRange(rest_before_s, "timeline.rest_before_s", 0.0, false, why) &&
          CheckRange(twist_s, "timeline.twist_s", 0.0, true, why) &&

@@ -63,6 +63,10 @@ struct TimelineOptions {
   bool Check(std::string* why) const;
 };
 
+// A timeline of fixed phase durations (s) that is never stopped by hand: a trace of known
+// length, as tests and benchmarks use.
+TimelineOptions FixedTimeline(double rest_s, double twist_s, double hold_s, double free_s);
+
 // The sensor and the radio link.
 // How timestamps are spaced.
 //   kRegular: a grid at 1/sample_rate_hz with Gaussian jitter (time_jitter_sigma_s), as before.

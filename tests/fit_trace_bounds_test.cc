@@ -27,11 +27,7 @@ TraceFitInput Simulated(bool whole) {
   setup.params.viscous_coeff_kg_m2_per_s = 0.0005;
   setup.amplitude_rad = 0.35;
   SimulationOptions options;
-  options.timeline.rest_before_s = {3.0, 3.0};
-  options.timeline.twist_s = {1.0, 1.0};
-  options.timeline.hold_s = {1.5, 1.5};
-  options.timeline.free_s = {30.0, 30.0};
-  options.timeline.stop_probability = 0.0;
+  options.timeline = FixedTimeline(3.0, 1.0, 1.5, 30.0);
   SimulatedTrace trace;
   std::string why;
   EXPECT_TRUE(SimulateTrace(setup, options, 7, &trace, &why)) << why;

@@ -206,7 +206,10 @@ TEST(SilentNumbers, NonPhysicalEllipseIsAWarningAndExitOne) {
   EllipseCommandOptions options;
   options.table_path = table;
   options.fit.bootstrap_replicates = 0;
-  EXPECT_EQ(RunEllipse(options, out), 1) << out.str();
+  const EllipseCommandResult outlier = RunEllipse(options);
+  PrintEllipseCommand(options, outlier, out);
+  EXPECT_EQ(EllipseExitCode(outlier), 1) << out.str();
+  EXPECT_FALSE(outlier.fit.physical);
   EXPECT_TRUE(Contains(out.str(), "warning: non-physical result")) << out.str();
   EXPECT_TRUE(Contains(out.str(), "point 12 at pitch 30 deg")) << out.str();
   std::string cli;
@@ -215,7 +218,9 @@ TEST(SilentNumbers, NonPhysicalEllipseIsAWarningAndExitOne) {
   text.replace(text.find("30,1000.000000"), 14, "30,2.750000");
   WriteFile(table, text);
   std::ostringstream clean;
-  EXPECT_EQ(RunEllipse(options, clean), 0) << clean.str();
+  const EllipseCommandResult fixed = RunEllipse(options);
+  PrintEllipseCommand(options, fixed, clean);
+  EXPECT_EQ(EllipseExitCode(fixed), 0) << clean.str();
   EXPECT_FALSE(Contains(clean.str(), "non-physical")) << clean.str();
 }
 

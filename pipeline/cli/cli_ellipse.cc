@@ -101,7 +101,9 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
       throw UserError("--covariance must be auto, points, angle_means or absolute, got '" +
                       *covariance + "'");
     }
-    *exit_code = RunEllipse(*opts, std::cout);
+    const EllipseCommandResult result = RunEllipse(*opts);
+    PrintEllipseCommand(*opts, result, std::cout);
+    *exit_code = EllipseExitCode(result);
   });
 
   // plan
@@ -135,15 +137,13 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
   plan->add_flag("--json", plan_opts->json, "print JSON (SI)");
   // `plan --tensor`: pipeline/cli/cli_plan_tensor.cc
   auto tensor_plan = AddTensorPlanOptions(plan);
-  plan->callback([plan, plan_opts, angles, plan_units, ix, iz, ixz, ixz_option, tensor_plan,
-                  exit_code] {
+  plan->callback([plan, plan_opts, angles, plan_units, ix, iz, ixz, ixz_option, tensor_plan] {
     plan_opts->units = Units(*plan_units);
     if (TensorPlanRequested(*tensor_plan)) {
-      *exit_code = RunTensorPlan(
-          TensorPlanOptionsFromCli(*tensor_plan, *plan, plan_opts->trials_per_angle,
-                                   plan_opts->sigma, *ixz, ixz_option->count() > 0,
-                                   plan_opts->units, plan_opts->json),
-          std::cout);
+      const TensorPlanCommandOptions tensor_opts = TensorPlanOptionsFromCli(
+          *tensor_plan, *plan, plan_opts->trials_per_angle, plan_opts->sigma, *ixz,
+          ixz_option->count() > 0, plan_opts->units, plan_opts->json);
+      PrintTensorPlan(RunTensorPlan(tensor_opts), tensor_opts.units, tensor_opts.json, std::cout);
       return;
     }
     if (angles->empty()) throw UserError("plan: --angles is required (or --tensor)");
@@ -159,7 +159,7 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
     plan_opts->ix = *ix;
     plan_opts->iz = *iz;
     plan_opts->ixz = *ixz;
-    *exit_code = RunPlan(*plan_opts, std::cout);
+    PrintPlan(*plan_opts, RunPlan(*plan_opts), std::cout);
   });
 }
 

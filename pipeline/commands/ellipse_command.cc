@@ -169,27 +169,37 @@ std::vector<std::string> WriteEllipsePlots(const EllipseResult& result, DisplayU
   return written;
 }
 
-int RunEllipse(const EllipseCommandOptions& options, std::ostream& out) {
+EllipseCommandResult RunEllipse(const EllipseCommandOptions& options) {
   std::string why;
   if (!options.fit.Check(&why)) throw UserError("ellipse options: " + why);
   const std::vector<EllipsePoint> points = ReadEllipseTable(options.table_path, options.units);
-  EllipseResult result;
-  if (!FitEllipse(points, options.fit, &result, &why)) {
+  EllipseCommandResult result;
+  if (!FitEllipse(points, options.fit, &result.fit, &why)) {
     throw UserError(options.table_path + ": " + why);
   }
-  std::vector<std::string> plots;
-  if (!options.plot_dir.empty()) plots = WriteEllipsePlots(result, options.units, options.plot_dir);
-  if (options.json) {
-    WriteEllipseResultJson(result, {{"table", options.table_path}, {"figures", plots}}, out);
-  } else {
-    out << options.table_path << "\n";
-    PrintEllipseReport(result, options.units, out);
-    for (const auto& p : plots) out << "wrote " << p << "\n";
+  if (!options.plot_dir.empty()) {
+    result.figures = WriteEllipsePlots(result.fit, options.units, options.plot_dir);
   }
-  return result.physical ? 0 : 1;  // a non-physical tensor is printed with its warning, exit 1
+  return result;
 }
 
-int RunPlan(const PlanCommandOptions& options, std::ostream& out) {
+void PrintEllipseCommand(const EllipseCommandOptions& options, const EllipseCommandResult& result,
+                         std::ostream& out) {
+  if (options.json) {
+    WriteEllipseResultJson(result.fit,
+                           {{"table", options.table_path}, {"figures", result.figures}}, out);
+    return;
+  }
+  out << options.table_path << "\n";
+  PrintEllipseReport(result.fit, options.units, out);
+  for (const auto& p : result.figures) out << "wrote " << p << "\n";
+}
+
+int EllipseExitCode(const EllipseCommandResult& result) {
+  return result.fit.physical ? 0 : 1;  // a non-physical tensor is printed with its warning
+}
+
+EllipsePlan RunPlan(const PlanCommandOptions& options) {
   const double to_si = InertiaToSi(options.units);
   EllipsePlanOptions plan_options;
   plan_options.pitch_deg = options.pitch_deg;
@@ -207,11 +217,15 @@ int RunPlan(const PlanCommandOptions& options, std::ostream& out) {
   EllipsePlan plan;
   std::string why;
   if (!PlanEllipse(plan_options, &plan, &why)) throw UserError("plan: " + why);
+  return plan;
+}
+
+void PrintPlan(const PlanCommandOptions& options, const EllipsePlan& plan, std::ostream& out) {
   if (options.json) {
     out << EllipsePlanToJson(plan).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
-    return 0;
+    return;
   }
-  const double k = 1.0 / to_si;
+  const double k = 1.0 / InertiaToSi(options.units);
   const std::string u = InertiaUnitName(options.units);
   out << "Planned design: " << options.pitch_deg.size() << " angle(s) x "
       << options.trials_per_angle << " trial(s) = " << plan.n_points << " points, per-trial sigma "
@@ -230,7 +244,6 @@ int RunPlan(const PlanCommandOptions& options, std::ostream& out) {
   }
   out << "  I_x   " << Fmt("%.5g ", plan.std.ix_kg_m2 * k) << u << "\n";
   out << "  I_z   " << Fmt("%.5g ", plan.std.iz_kg_m2 * k) << u << "\n";
-  return 0;
 }
 
 }  // namespace bifilar

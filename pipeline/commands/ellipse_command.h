@@ -20,9 +20,22 @@ struct EllipseCommandOptions {
   EllipseOptions fit;                           // seed, bootstrap, covariance, ...
 };
 
-// Reads the table, fits, prints to `out`, writes figures. Returns the exit code (0). Throws
-// UserError on bad input (file, column, value, options) with a message naming it.
-int RunEllipse(const EllipseCommandOptions& options, std::ostream& out);
+struct EllipseCommandResult {
+  EllipseResult fit;                 // SI
+  std::vector<std::string> figures;  // written into options.plot_dir
+};
+
+// Reads the table, fits and writes the figures. Throws UserError on bad input (file, column,
+// value, options) with a message naming it. A non-physical tensor is a result, with its warning.
+EllipseCommandResult RunEllipse(const EllipseCommandOptions& options);
+
+// What `bifilar ellipse` prints: the JSON document (options.json) or the tables, then the
+// figures written.
+void PrintEllipseCommand(const EllipseCommandOptions& options, const EllipseCommandResult& result,
+                         std::ostream& out);
+
+// The exit code of `bifilar ellipse`: 0, or 1 for a non-physical tensor.
+int EllipseExitCode(const EllipseCommandResult& result);
 
 // Human-readable report of a fit in the given units (the three fits side by side, Table 1 and
 // Table 2, NACA comparison, outliers, warnings).
@@ -45,7 +58,11 @@ struct PlanCommandOptions {
   bool json = false;
 };
 
-// Predicts the standard errors of a design; prints them. Returns 0; throws UserError.
-int RunPlan(const PlanCommandOptions& options, std::ostream& out);
+// Predicts the standard errors of a design (SI). Throws UserError naming the option.
+EllipsePlan RunPlan(const PlanCommandOptions& options);
+
+// What `bifilar plan` prints: the JSON document (options.json) or the design and its stds in
+// options.units.
+void PrintPlan(const PlanCommandOptions& options, const EllipsePlan& plan, std::ostream& out);
 
 }  // namespace bifilar

@@ -811,71 +811,78 @@ void ApplySimulateOverrides(const SimulateOverrides& o, bool single_trace,
 
 SimulateCommandResult RunSimulate(const SimulateCommandOptions& a) {
   const SimulateOverrides& o = a.o;
-  auto positive = [](const std::optional<double>& v, const char* flag) {
-    if (v && !(*v > 0)) {
-      throw UserError(std::string(flag) + " = " + std::to_string(*v) +
-                      " is out of range; allowed > 0");
-    }
+  const SimulateSettingNames& n = a.names;
+  auto positive = [](const std::optional<double>& v, const std::string& name) {
+    if (v && !(*v > 0)) throw UserError(name + " = " + Num(*v) + " is out of range; allowed > 0");
   };
-  positive(o.duration_s, "--duration-s");
-  positive(a.sample_rate, "--sample-rate-hz");
-  positive(o.inertia_kg_m2, "--inertia-kg-m2");
-  positive(o.mass_kg, "--mass-kg");
-  positive(o.length_m, "-L/--filar-length-m");
-  positive(o.separation_m, "-D/--filar-separation-m");
-  positive(o.gravity_mps2, "--gravity-mps2");
+  positive(o.duration_s, n.duration);
+  positive(a.sample_rate, n.sample_rate);
+  positive(o.inertia_kg_m2, n.inertia);
+  positive(o.mass_kg, n.mass);
+  positive(o.length_m, n.length);
+  positive(o.separation_m, n.separation);
+  positive(o.gravity_mps2, n.gravity);
+  if (!a.trace_csv.empty() && !a.out_dir.empty()) {
+    throw UserError("give either " + n.out + " or " + n.trace + ", not both");
+  }
   SimulateSpec spec = a.spec_file.empty() ? ParseSimulateSpec("{}", "<defaults>")
                                           : ReadSimulateSpec(a.spec_file);
   if (a.spec_file.empty()) spec.file.clear();
   if (!a.model.empty() && !ParsePendulumModel(a.model, &spec.options.model)) {
-    throw UserError("--model: unknown model '" + a.model + "'; allowed full, jardin, linear");
+    throw UserError(n.model + ": unknown model '" + a.model + "'; allowed full, jardin, linear");
   }
-  if (a.sample_rate) SetSampleRateFromFlag(&spec, *a.sample_rate);
+  if (a.sample_rate) SetSampleRateFromFlag(&spec, *a.sample_rate, n.sample_rate);
   if (!a.trace_csv.empty()) {
-    if (!a.out_dir.empty()) throw UserError("give either --trace FILE.csv or --out DIR, not both");
     if (spec.has_campaign) {
       throw UserError(a.spec_file + ": has campaign sections (aircraft, rig, campaign); simulate "
-                      "it with --out DIR, or use a spec without them with --trace");
+                      "it with " + n.out + ", or use a spec without them with " + n.trace);
     }
     ApplySimulateOverrides(o, true, &spec);
+    const TraceRequest& t = spec.trace;
+    for (const auto& [value, name] : {std::make_pair(&t.inertia_kg_m2, &n.inertia),
+                                      std::make_pair(&t.mass_kg, &n.mass),
+                                      std::make_pair(&t.filar_length_m, &n.length),
+                                      std::make_pair(&t.filar_separation_m, &n.separation)}) {
+      if (!*value) throw UserError("give " + *name + " (or its spec key) for a single trace");
+    }
     std::string why;
     if (!spec.options.Check(&why)) throw UserError(why);
-    return {RunSimulateTrace(spec, a.trace_csv, a.truth_json, a.force), a.trace_csv};
+    return {RunSimulateTrace(spec, a.trace_csv, a.truth_json, a.force), a.trace_csv, spec.format};
   }
   if (a.out_dir.empty()) {
-    throw UserError("nothing to do: give SPEC.yaml --out DIR (campaign) or --trace FILE.csv "
-                    "(one trace); see bifilar simulate --help");
+    throw UserError("nothing to do: give SPEC.yaml and " + n.out + " (campaign) or " + n.trace +
+                    " (one trace); see bifilar simulate --help");
   }
-  if (a.spec_file.empty()) throw UserError("--out DIR needs a campaign spec file SPEC.yaml");
+  if (a.spec_file.empty()) throw UserError(n.out + " needs a campaign spec file SPEC.yaml");
   if (o.inertia_kg_m2 || o.mass_kg || o.amplitude_deg || o.pitch_deg || !a.truth_json.empty()) {
-    throw UserError("--inertia-kg-m2, --mass-kg, --amplitude-deg, --pitch-deg and --truth apply to "
-                    "--trace only; a campaign takes them from the spec");
+    throw UserError(n.inertia + ", " + n.mass + ", " + n.amplitude + ", " + n.pitch + " and " +
+                    n.truth + " apply to " + n.trace + " only; a campaign takes them from the spec");
   }
   ApplySimulateOverrides(o, false, &spec);
   std::string why;
   if (!spec.campaign.Check(&why) || !spec.options.Check(&why)) throw UserError(why);
-  return {RunSimulateCampaign(spec, a.out_dir, a.force), a.out_dir};
+  return {RunSimulateCampaign(spec, a.out_dir, a.force), a.out_dir, spec.format};
 }
 
-void SetSampleRateFromFlag(SimulateSpec* spec, double rate_hz) {
+void SetSampleRateFromFlag(SimulateSpec* spec, double rate_hz, const std::string& flag) {
   if (!(rate_hz > 0 && rate_hz <= 100000)) {
-    throw UserError("--sample-rate-hz = " + Num(rate_hz) + " is out of range; allowed (0, 100000]");
+    throw UserError(flag + " = " + Num(rate_hz) + " is out of range; allowed (0, 100000]");
   }
   SensorOptions& s = spec->options.sensor;
   const std::string from = spec->file.empty() ? std::string("the spec") : spec->file;
   if (!spec->time_jitter_given) {
     s.time_jitter_sigma_s = DefaultTimeJitterSigmaS(rate_hz);
   } else if (s.time_jitter_sigma_s > 1.0 / rate_hz) {
-    throw UserError("--sample-rate-hz " + Num(rate_hz) + ": 'sensor.time_jitter_sigma_s' = " +
+    throw UserError(flag + " " + Num(rate_hz) + ": 'sensor.time_jitter_sigma_s' = " +
                     Num(s.time_jitter_sigma_s) + " s in " + from +
                     " is more than one sample period at that rate (" + Num(1.0 / rate_hz) +
                     " s); lower it in the spec (or remove it: the default follows the rate), or "
-                    "lower --sample-rate-hz");
+                    "lower " + flag);
   }
   if (s.rocking_frequency_hz > rate_hz / 4) {
-    throw UserError("--sample-rate-hz " + Num(rate_hz) + ": 'sensor.rocking_frequency_hz' = " +
+    throw UserError(flag + " " + Num(rate_hz) + ": 'sensor.rocking_frequency_hz' = " +
                     Num(s.rocking_frequency_hz) + " Hz in " + from +
-                    " is above a quarter of that rate; raise --sample-rate-hz to at least " +
+                    " is above a quarter of that rate; raise " + flag + " to at least " +
                     Num(4 * s.rocking_frequency_hz) + " or lower the rocking frequency");
   }
   s.sample_rate_hz = rate_hz;

@@ -54,7 +54,8 @@ double DefaultTimeJitterSigmaS(double sample_rate_hz);
 // Sets the sample rate from the command line (`--sample-rate-hz`): checks the range, lets a
 // default jitter follow the rate (DefaultTimeJitterSigmaS) and, when a setting the spec made no
 // longer fits the new rate, throws UserError naming the flag, the spec key and what to change.
-void SetSampleRateFromFlag(SimulateSpec* spec, double sample_rate_hz);
+void SetSampleRateFromFlag(SimulateSpec* spec, double sample_rate_hz,
+                           const std::string& flag = "--sample-rate-hz");
 
 // The settings `bifilar simulate` (flags) and Python's bifilar.simulate (keywords) lay over a
 // spec; unset ones keep the spec's value. The callers check the values and name them in their own
@@ -110,8 +111,18 @@ SimulateRunSummary RunSimulateCampaign(const SimulateSpec& spec, const std::stri
 SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string& csv_path,
                                     const std::string& truth_path = "", bool force = false);
 
+// How the settings are named in RunSimulate's messages: `bifilar simulate`'s flags (the
+// defaults), or Python's keywords (python/src/simulate.cc).
+struct SimulateSettingNames {
+  std::string duration = "--duration-s", sample_rate = "--sample-rate-hz",
+              inertia = "--inertia-kg-m2", mass = "--mass-kg", length = "-L/--filar-length-m",
+              separation = "-D/--filar-separation-m", gravity = "--gravity-mps2",
+              amplitude = "--amplitude-deg", pitch = "--pitch-deg", truth = "--truth",
+              model = "--model", trace = "--trace FILE.csv", out = "--out DIR";
+};
+
 // `bifilar simulate`: a campaign (spec_file + out_dir) or one trace (trace_csv), with the
-// command line's settings over the spec's. Messages name the flags (--trace, --out, ...).
+// command line's settings over the spec's. Messages name the settings as `names` does.
 struct SimulateCommandOptions {
   std::string spec_file;   // "" : the defaults (a trace only)
   std::string out_dir;     // campaign output folder
@@ -121,11 +132,13 @@ struct SimulateCommandOptions {
   SimulateOverrides o;     // --seed, --inertia-kg-m2, ..., --duration-s, --no-accel
   std::optional<double> sample_rate;  // --sample-rate-hz (SetSampleRateFromFlag)
   bool force = false;  // replace files that exist (issue 23: never without being told)
+  SimulateSettingNames names;
 };
 
 struct SimulateCommandResult {
   SimulateRunSummary summary;
   std::string written;  // the trace file or the campaign folder
+  ImuFormat format;     // the columns and units the logs were written with
 };
 
 // Checks the settings, merges them into the spec and runs RunSimulateTrace or

@@ -94,7 +94,7 @@ json TensorPlanToJson(const TensorPlan& p, const TensorPlanOptions& o) {
   return j;
 }
 
-int RunTensorPlan(const TensorPlanCommandOptions& options, std::ostream& out) {
+TensorPlanCommandResult RunTensorPlan(const TensorPlanCommandOptions& options) {
   const double to_si = InertiaToSi(options.units);
   TensorPlanOptions o = options.plan;
   o.sigma_kg_m2 = options.sigma * to_si;
@@ -123,15 +123,22 @@ int RunTensorPlan(const TensorPlanCommandOptions& options, std::ostream& out) {
     }
     o.target_std_kg_m2 = options.target_relative * LargestPrincipal(o.guess_kg_m2);
   }
-  TensorPlan plan;
-  if (!PlanTensor(o, &plan, &why)) throw UserError("plan --tensor: " + why);
-  if (options.json) {
-    out << TensorPlanToJson(plan, o).dump(2, ' ', false, json::error_handler_t::replace) << "\n";
-    return 0;
-  }
+  TensorPlanCommandResult result;
+  if (!PlanTensor(o, &result.plan, &why)) throw UserError("plan --tensor: " + why);
+  result.options = o;
+  return result;
+}
 
-  const double k = 1.0 / to_si;
-  const std::string u = InertiaUnitName(options.units);
+void PrintTensorPlan(const TensorPlanCommandResult& result, DisplayUnits units, bool json,
+                     std::ostream& out) {
+  const TensorPlan& plan = result.plan;
+  const TensorPlanOptions& o = result.options;
+  if (json) {
+    out << TensorPlanToJson(plan, o).dump(2, ' ', false, json::error_handler_t::replace) << "\n";
+    return;
+  }
+  const double k = 1.0 / InertiaToSi(units);
+  const std::string u = InertiaUnitName(units);
   out << "Tensor plan: " << plan.orientations.size() << " orientation(s) x "
       << o.trials_per_orientation << " trial(s) = " << plan.n_points << " swings, chosen "
       << "D-optimally from " << plan.n_candidates << " distinct reachable swing axes (roll "
@@ -211,7 +218,6 @@ int RunTensorPlan(const TensorPlanCommandOptions& options, std::ostream& out) {
   out << "These stds assume independent swing noise"
       << (o.attitude_std_deg > 0 ? " and the stated attitude error" : "")
       << "; errors shared by all orientations (rig tare, calibration) add to them.\n";
-  return 0;
 }
 
 }  // namespace bifilar

@@ -28,8 +28,18 @@ struct TensorPlanCommandOptions {
   bool json = false;                       // print JSON (SI) instead of the table
 };
 
-// Plans and prints. Returns 0; throws UserError naming the option on bad input.
-int RunTensorPlan(const TensorPlanCommandOptions& options, std::ostream& out);
+struct TensorPlanCommandResult {
+  TensorPlanOptions options;  // as planned: the SI fields set from the command's values
+  TensorPlan plan;
+};
+
+// Plans. Throws UserError naming the option on bad input.
+TensorPlanCommandResult RunTensorPlan(const TensorPlanCommandOptions& options);
+
+// What `bifilar plan --tensor` prints: the JSON document (SI, `json`) or the attitudes and the
+// expected stds in `units`.
+void PrintTensorPlan(const TensorPlanCommandResult& result, DisplayUnits units, bool json,
+                     std::ostream& out);
 
 // JSON form (SI): rig, orientations, components {Ixx: {observable, std_kg_m2,
 // floor_std_kg_m2, trials_needed}, ...}, unobservable, rank, condition_number, warnings, ...

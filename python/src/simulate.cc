@@ -62,87 +62,67 @@ std::string ReadText(const std::string& path) {
   return ReadRegularFileOrThrow(path, OutputFileCap());
 }
 
-// The same checks and merging as `bifilar simulate` (pipeline/cli/cli_simulate.cc), with the
-// keyword names in the messages.
+// Python's keywords for the settings, in the messages of RunSimulate.
+SimulateSettingNames PythonNames() {
+  SimulateSettingNames n;
+  n.duration = "duration_s";
+  n.sample_rate = "sample_rate_hz";
+  n.inertia = "inertia_kg_m2";
+  n.mass = "mass_kg";
+  n.length = "length_m";
+  n.separation = "separation_m";
+  n.gravity = "g";
+  n.amplitude = "amplitude_deg";
+  n.pitch = "pitch_deg";
+  n.truth = "truth=";
+  n.model = "model=";
+  n.trace = "trace=";
+  n.out = "out=";
+  return n;
+}
+
+// `bifilar simulate` through its entry point (RunSimulate: the same checks and merging, with
+// the keyword names in the messages). Without trace= or out=, the trace goes to a temporary
+// file that is read back and removed.
 py::dict SimulateCore(const SimulateArgs& a) {
-  auto positive = [](const std::optional<double>& v, const char* name) {
-    if (v && !(*v > 0)) {
-      throw std::invalid_argument("simulate: " + std::string(name) + " = " + Num(*v) +
-                                  " is out of range; allowed > 0");
-    }
-  };
-  const SimulateOverrides& o = a.o;
-  positive(o.duration_s, "duration_s");
-  positive(a.sample_rate_hz, "sample_rate_hz");
-  positive(o.inertia_kg_m2, "inertia_kg_m2");
-  positive(o.mass_kg, "mass_kg");
-  positive(o.length_m, "length_m");
-  positive(o.separation_m, "separation_m");
-  positive(o.gravity_mps2, "g");
-  if (a.out && a.trace) throw std::invalid_argument("simulate: give either out= or trace=, not both");
+  SimulateCommandOptions options;
+  options.spec_file = a.spec.value_or("");
+  options.out_dir = a.out.value_or("");
+  options.trace_csv = a.trace.value_or("");
+  options.truth_json = a.truth.value_or("");
+  options.model = a.model.value_or("");
+  options.o = a.o;
+  options.sample_rate = a.sample_rate_hz;
+  options.force = a.force;
+  options.names = PythonNames();
+  if (a.out && a.out->empty()) throw std::invalid_argument("simulate: out= is empty");
+  if (a.trace && a.trace->empty()) throw std::invalid_argument("simulate: trace= is empty");
   SimulateRunSummary summary;
   ImuData data;  // the single trace, read back from its file
   std::string truth_text;
   {
     py::gil_scoped_release release;
-    SimulateSpec spec = a.spec ? ReadSimulateSpec(*a.spec) : ParseSimulateSpec("{}", "<defaults>");
-    if (!a.spec) spec.file.clear();
-    if (a.model && !ParsePendulumModel(*a.model, &spec.options.model)) {
-      throw std::invalid_argument("simulate: model '" + *a.model +
-                                  "': expected full, jardin or linear");
+    std::filesystem::path temp;
+    if (!a.out && !a.trace) {  // in memory: a temporary file, read back
+      std::random_device device;
+      temp = std::filesystem::temp_directory_path() /
+             ("bifilar_py_" + std::to_string(device()) + "_" + std::to_string(device()));
+      std::filesystem::create_directories(temp);
+      options.trace_csv = (temp / "trace.csv").string();
     }
-    if (a.sample_rate_hz) spec.options.sensor.sample_rate_hz = *a.sample_rate_hz;
-    std::string why;
-    if (a.out) {  // a campaign
-      if (!a.spec) throw std::invalid_argument("simulate: out= needs a campaign spec file");
-      if (o.inertia_kg_m2 || o.mass_kg || o.amplitude_deg || o.pitch_deg || a.truth) {
-        throw std::invalid_argument(
-            "simulate: inertia_kg_m2, mass_kg, amplitude_deg, pitch_deg and truth apply to a "
-            "single trace only; a campaign takes them from the spec");
-      }
-      ApplySimulateOverrides(o, false, &spec);
-      if (!spec.campaign.Check(&why) || !spec.options.Check(&why)) throw UserError(why);
-      summary = RunSimulateCampaign(spec, *a.out, a.force);
-    } else {  // one trace, into trace= or in memory (a temporary file read back)
-      if (spec.has_campaign) {
-        throw std::invalid_argument(*a.spec + ": has campaign sections (aircraft, rig, "
-                                    "campaign); simulate it with out=DIR");
-      }
-      ApplySimulateOverrides(o, true, &spec);
-      const TraceRequest& t = spec.trace;
-      for (auto [value, name] : {std::make_pair(&t.inertia_kg_m2, "inertia_kg_m2"),
-                                 std::make_pair(&t.mass_kg, "mass_kg"),
-                                 std::make_pair(&t.filar_length_m, "length_m"),
-                                 std::make_pair(&t.filar_separation_m, "separation_m")}) {
-        if (!*value) {
-          throw std::invalid_argument(std::string("simulate: give ") + name +
-                                      " (or its spec key) for a single trace");
-        }
-      }
-      if (!spec.options.Check(&why)) throw UserError(why);
-      std::filesystem::path temp;
-      std::string csv = a.trace.value_or("");
-      if (csv.empty()) {
-        std::random_device device;
-        temp = std::filesystem::temp_directory_path() /
-               ("bifilar_py_" + std::to_string(device()) + "_" + std::to_string(device()));
-        std::filesystem::create_directories(temp);
-        csv = (temp / "trace.csv").string();
-      }
-      try {
-        summary = RunSimulateTrace(spec, csv, a.truth.value_or(""), a.force);
-        data = ReadImuLog(csv, spec.format);
-      } catch (...) {
-        if (!temp.empty()) std::filesystem::remove_all(temp);
-        throw;
-      }
+    try {
+      const SimulateCommandResult run = RunSimulate(options);
+      summary = run.summary;
+      if (!a.out) data = ReadImuLog(options.trace_csv, run.format);
       truth_text = ReadText(summary.truth_path);
-      if (!temp.empty()) {
-        std::filesystem::remove_all(temp);
-        summary.truth_path.clear();
-      }
+    } catch (...) {
+      if (!temp.empty()) std::filesystem::remove_all(temp);
+      throw;
     }
-    if (truth_text.empty()) truth_text = ReadText(summary.truth_path);
+    if (!temp.empty()) {
+      std::filesystem::remove_all(temp);
+      summary.truth_path.clear();
+    }
   }
   py::dict result;
   result["samples_written"] = summary.samples_written;
