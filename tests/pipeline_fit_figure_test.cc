@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <regex>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "pendulum/model.h"
 #include "pipeline/commands/simulate_spec.h"
 #include "pipeline/config/config.h"
+#include "pipeline/figures/sweep_plot.h"
 #include "pipeline/figures/trace_plot.h"
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/trace/trace_process.h"
@@ -195,6 +197,72 @@ TEST(FitFigure, SvgIsLightAndSearchable) {
   ExpectLightSearchableSvg(f.dir.path + "/fit.svg",
                            ValueWithStd(f.fit.params.inertia_kg_m2,
                                         f.record.inertia_total_std_total_kg_m2));
+}
+
+}  // namespace
+}  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// A sweep of `bands` bands about `inertia` (kg m^2) with a 3 % per 10 deg trend.
+AmplitudeSweep SyntheticSweep(double inertia, int bands) {
+  AmplitudeSweep s;
+  s.evaluated = true;
+  s.trend_detected = true;
+  s.trend_exponent = 2.0;
+  s.trend_coeff = 3e-4;
+  s.inertia_zero_amplitude_kg_m2 = inertia;
+  s.trend_z = 12.0;
+  s.trend_percent_per_10deg = 3.0;
+  for (int j = 0; j < bands; ++j) {
+    AmplitudeSweepBand b;
+    b.amplitude_start_deg = 30.0 - 25.0 * j / bands;
+    b.amplitude_end_deg = 30.0 - 25.0 * (j + 1) / bands;
+    b.amplitude_mean_deg = 0.5 * (b.amplitude_start_deg + b.amplitude_end_deg);
+    b.inertia_kg_m2 = s.TrendAt(b.amplitude_mean_deg) * (1.0 + 1e-3 * ((j % 3) - 1));
+    b.inertia_std_kg_m2 = 2e-3 * inertia;
+    if (inertia == 0.12703) {  // flat: a narrow axis, long tick labels (0.12705)
+      b.inertia_kg_m2 = inertia * (1.0 + 2e-4 * ((j % 3) - 1));
+      b.inertia_std_kg_m2 = 1e-4 * inertia;
+    }
+    b.ok = true;
+    s.bands.push_back(b);
+  }
+  s.low_band = bands - 1;
+  return s;
+}
+
+// The sweep figure at the extremes: tiny and huge I, kg m^2 and slug ft^2, an unscaled axis
+// (0.127: issue 25 saw ".127"), 3 bands and 20; full and compact.
+TEST(FigureExtremes, SweepTickLabelsAndTextStayOnThePage) {
+  TempDir dir("bifilar_sweep_extremes");
+  int k = 0;
+  for (double inertia : {1.6e-5, 0.127, 0.12703, 0.25, 2.9, 4500.0}) {
+    for (double unit_scale : {1.0, 1.0 / 1.35581795}) {
+      for (int bands : {3, 20}) {
+        for (int page : {0, 1, 2}) {  // 800 x 500 (default), 640 x 400 compact, 1100 x 700
+          const bool compact = page == 1;
+          const AmplitudeSweep sweep = SyntheticSweep(inertia, bands);
+          SweepPlotOptions options;
+          options.title = "pitch_-10/trial_1.csv";
+          options.unit_scale = unit_scale;
+          options.unit_label = unit_scale == 1.0 ? "kg m#u2#d" : "slug ft#u2#d";
+          options.compact = compact;
+          if (compact) options.figure = {640, 400};
+          if (page == 2) options.figure = {1100, 700};  // `fit --plot`
+          const std::string path = std::string(std::getenv("FIGDIR") ? std::getenv("FIGDIR") : dir.path.c_str()) + "/s" + std::to_string(k++) + ".svg";
+          std::string why;
+          ASSERT_TRUE(WriteAmplitudeSweepFigure(sweep, sweep.bands.back().inertia_kg_m2,
+                                                2e-3 * inertia, path, options, &why))
+              << why;
+          SCOPED_TRACE("I " + std::to_string(inertia) + ", scale " + std::to_string(unit_scale) +
+                       ", " + std::to_string(bands) + " bands" + (compact ? ", compact" : ""));
+          ExpectLightSearchableSvg(path, "amplitude (deg)");
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
