@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "fit/trace_synth.h"
 #include "pendulum/model.h"
 #include "pipeline/commands/simulate_spec.h"
 #include "pipeline/config/config.h"
@@ -260,6 +261,53 @@ TEST(FigureExtremes, SweepTickLabelsAndTextStayOnThePage) {
                        ", " + std::to_string(bands) + " bands" + (compact ? ", compact" : ""));
           ExpectLightSearchableSvg(path, "amplitude (deg)");
         }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// An ideal rig (the result is the whole window's fit): the figure draws that fit, at the
+// extremes of I (a 34 g quadrotor's 1.6e-5 kg m^2, an airliner model's 4500 kg m^2), slug ft^2
+// and kg m^2, and a dense log (15 000 samples: an envelope instead of dots), each SVG light,
+// searchable and on the page.
+TEST(FigureExtremes, WindowFitFiguresAtTheExtremes) {
+  TempDir dir("bifilar_fit_extremes");
+  int k = 0;
+  for (double inertia : {1.6e-5, 1.1616, 4500.0}) {
+    for (double rate_hz : {20.0, 100.0}) {
+      SyntheticTraceOptions o;
+      o.geometry = {2.0, 0.88, 6.0 * inertia / 1.1616, 9.80665};  // same period for every I
+      o.params = {inertia, 0.004 * inertia, 0.002 * inertia};
+      o.amplitude_deg = 10.0;
+      o.duration_s = 150.0;
+      o.sample_rate_hz = rate_hz;
+      o.seed = 7;
+      TraceFitInput in;
+      ASSERT_TRUE(MakeSyntheticTrace(o, &in));
+      const TraceFitResult fit = FitTrace(in, TraceFitOptions());
+      ASSERT_TRUE(fit.HasFit()) << fit.BriefReport();
+      ASSERT_EQ(fit.inertia_source, "window");
+      TraceFigureData d;
+      std::string why;
+      ASSERT_TRUE(MakeTraceFigureData(fit, TracePlotOptions(), &d, &why)) << why;
+      EXPECT_FALSE(d.from_band);
+      EXPECT_EQ(d.t_s.size(), fit.t_s.size());
+      EXPECT_TRUE(d.whole_t_s.empty());
+      for (double unit_scale : {1.0, 1.0 / 1.35581795}) {
+        TracePlotOptions options;
+        options.title = "pitch_-10/trial_1.csv";
+        options.unit_scale = unit_scale;
+        options.unit_label = unit_scale == 1.0 ? "kg m#u2#d" : "slug ft#u2#d";
+        const std::string path = std::string(std::getenv("FIGDIR") ? std::getenv("FIGDIR") : dir.path.c_str()) + "/f" + std::to_string(k++) + ".svg";
+        ASSERT_TRUE(WriteTraceFitFigure(fit, path, options, &why)) << why;
+        SCOPED_TRACE(path);
+        ExpectLightSearchableSvg(path, "fit of the whole window");
       }
     }
   }

@@ -138,7 +138,7 @@ void Texts(const TraceFitResult& r, const TracePlotOptions& o, TraceFigureData* 
   d->residual_label =
       "measured − fit: rms " + Fmt("%.3g", d->residual_rms_deg_per_s) + " deg/s" +
       (d->rms_over_noise > 0.0
-           ? " = " + Fmt("%.2f", d->rms_over_noise) + " × gyro noise (lines: ±1, ±2 noise)"
+           ? " = " + Fmt("%.2f", d->rms_over_noise) + " × gyro noise (lines ±1, ±2)"
            : std::string()) +
       "; lag-1 autocorrelation " + Fmt("%.2f", d->autocorr_lag1);
   if (d->from_band) {
