@@ -27,6 +27,13 @@ using test_support::TempDir;
 using test_support::WriteFile;
 const std::string kSource = BIFILAR_SOURCE_DIR;
 
+// Where the figures go: the test's own folder, or BIFILAR_KEEP_FIGURES=DIR to keep them there and
+// look at them (e.g. chromium --headless --screenshot).
+std::string FigureDir(const TempDir& dir) {
+  const char* keep = std::getenv("BIFILAR_KEEP_FIGURES");
+  return keep != nullptr && *keep != '\0' ? std::string(keep) : dir.path;
+}
+
 // Mean period of v (deg/s) about `level` from its upward crossings (linear interpolation).
 double PeriodByCrossings(const std::vector<double>& t, const std::vector<double>& v, double level,
                          int* crossings) {
@@ -252,7 +259,7 @@ TEST(FigureExtremes, SweepTickLabelsAndTextStayOnThePage) {
           options.compact = compact;
           if (compact) options.figure = {640, 400};
           if (page == 2) options.figure = {1100, 700};  // `fit --plot`
-          const std::string path = std::string(std::getenv("FIGDIR") ? std::getenv("FIGDIR") : dir.path.c_str()) + "/s" + std::to_string(k++) + ".svg";
+          const std::string path = FigureDir(dir) + "/s" + std::to_string(k++) + ".svg";
           std::string why;
           ASSERT_TRUE(WriteAmplitudeSweepFigure(sweep, sweep.bands.back().inertia_kg_m2,
                                                 2e-3 * inertia, path, options, &why))
@@ -304,7 +311,7 @@ TEST(FigureExtremes, WindowFitFiguresAtTheExtremes) {
         options.title = "pitch_-10/trial_1.csv";
         options.unit_scale = unit_scale;
         options.unit_label = unit_scale == 1.0 ? "kg m#u2#d" : "slug ft#u2#d";
-        const std::string path = std::string(std::getenv("FIGDIR") ? std::getenv("FIGDIR") : dir.path.c_str()) + "/f" + std::to_string(k++) + ".svg";
+        const std::string path = FigureDir(dir) + "/f" + std::to_string(k++) + ".svg";
         ASSERT_TRUE(WriteTraceFitFigure(fit, path, options, &why)) << why;
         SCOPED_TRACE(path);
         ExpectLightSearchableSvg(path, "fit of the whole window");
