@@ -292,7 +292,8 @@ std::string FillStyle(std::map<std::string, std::string>& a) {
   std::string style = "fill=\"" + a["fill"] + "\"";
   const double opacity = a["fill-opacity"].empty() ? 1.0 : std::strtod(a["fill-opacity"].c_str(), nullptr);
   if (opacity < 1.0) style += " fill-opacity=\"" + ShortNumber(opacity) + "\"";
-  if (!a["stroke"].empty() && a["stroke"] != "none") style += " " + StrokeStyle(a);
+  if (!a["stroke"].empty() && a["stroke"] != "none")  // its outline too (no second fill=)
+    style += " " + StrokeStyle(a).substr(std::string("fill=\"none\" ").size());
   return style;
 }
 
