@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fit/trace_synth.h"
+#include "base/units.h"
 #include "pendulum/model.h"
 #include "pipeline/commands/simulate_spec.h"
 #include "pipeline/config/config.h"
@@ -188,6 +189,17 @@ void ExpectLightSearchableSvg(const std::string& path, const std::string& must_c
   std::smatch m;
   ASSERT_TRUE(std::regex_search(svg, m, std::regex("viewBox=\"0 0 ([0-9.]+) ")));
   const double width = std::stod(m[1]);
+  // Well-formed enough for a browser: no attribute twice in one element.
+  const std::regex element("<[a-z][^>]*>");
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), element);
+       it != std::sregex_iterator(); ++it) {
+    const std::string tag = it->str();
+    for (const char* attr : {" fill=\"", " stroke=\"", " d=\"", " x=\"", " y=\""}) {
+      const size_t first = tag.find(attr);
+      EXPECT_TRUE(first == std::string::npos || tag.find(attr, first + 1) == std::string::npos)
+          << path << ": " << attr << " twice in " << tag.substr(0, 120);
+    }
+  }
   const std::vector<SvgText> texts = Texts(svg);
   EXPECT_GE(texts.size(), 10u) << path;
   for (const SvgText& t : texts) {
@@ -316,6 +328,45 @@ TEST(FigureExtremes, WindowFitFiguresAtTheExtremes) {
         SCOPED_TRACE(path);
         ExpectLightSearchableSvg(path, "fit of the whole window");
       }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// The ellipse figures (moments against pitch, polar) at the extremes: 200 points of a 1.6e-5
+// kg m^2 quadrotor, and 4 points of a 4500 slug ft^2 airframe.
+TEST(FigureExtremes, EllipseFiguresStayOnThePage) {
+  TempDir dir("bifilar_ellipse_extremes");
+  std::string many = "pitch_deg,inertia,std\n", four = "pitch_deg,inertia,std\n";
+  for (int i = 0; i < 200; ++i) {
+    const double theta = -85.0 + 170.0 * i / 199.0, t = (theta - 2.0) * kPi / 180.0;
+    many += std::to_string(theta) + "," +
+            std::to_string(1.6e-5 * std::cos(t) * std::cos(t) + 2.4e-5 * std::sin(t) * std::sin(t)) +
+            ",3e-8\n";
+  }
+  for (int theta : {-60, -20, 20, 60}) {
+    const double t = (theta - 5.0) * kPi / 180.0;
+    four += std::to_string(theta) + "," +
+            std::to_string(4500.0 * std::cos(t) * std::cos(t) + 6100.0 * std::sin(t) * std::sin(t)) +
+            ",5\n";
+  }
+  WriteFile(dir.path + "/many.csv", many);
+  WriteFile(dir.path + "/four.csv", four);
+  const std::string out = FigureDir(dir);
+  for (const std::string& table : {std::string("many"), std::string("four")}) {
+    const std::string units = table == "four" ? " --units imperial --covariance absolute" : "";
+    const test_support::CliRun run =
+        test_support::Bifilar(dir, "ellipse " + dir.path + "/" + table + ".csv --bootstrap 0 --plot " +
+                                       out + "/" + table + units);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    for (const char* figure : {"/ellipse_moments.svg", "/ellipse_polar.svg"}) {
+      SCOPED_TRACE(table + figure);
+      ExpectLightSearchableSvg(out + "/" + table + figure, "llipse of inertia");
     }
   }
 }

@@ -304,8 +304,10 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
   auto draw = [&] {
     plschr(0, 0.95);
     pladv(0);
-    panel(false, 0.1, 0.48);
-    panel(true, 0.6, 0.98);
+    // Room right of each panel for PLplot's "(x10^n)" of the x axis (it was cut at the page's
+    // edge, issue 25).
+    panel(false, 0.1, 0.44);
+    panel(true, 0.6, 0.91);
     plcol0(kBlack);
     plvpor(0.0, 1.0, 0.0, 1.0);
     plwind(0, 1, 0, 1);
