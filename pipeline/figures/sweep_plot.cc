@@ -108,14 +108,12 @@ void TrendCurveAndValueAxis(const AmplitudeSweep& sweep, double inertia_kg_m2,
   p->y_hi += y_pad;
 }
 
-// Text in one size (an SVG embeds every glyph once per size) and short: the report inlines one
-// of these per trace.
+// Text short: the report inlines one of these per trace.
 void SweepTexts(const AmplitudeSweep& sweep, const SweepPlotOptions& options, SweepPage* p) {
   const std::string name = options.title.empty() ? std::string("trace") : options.title;
   const std::string trend_text = "trend z = " + Fmt("%.1f", sweep.trend_z) + ", " +
                                  Fmt("%+.2g", sweep.trend_percent_per_10deg) + " % per 10 deg";
-  // Compact: the page's caption names the trace (a file name is many distinct glyphs) and the
-  // subtitle's facts go in the title.
+  // Compact: the page's caption names the trace and the subtitle's facts go in the title.
   const std::string scatter_text =
       sweep.std_scale > 1.0 ? "bands scatter " + Fmt("%.1f", sweep.std_scale) + "× σ" : "";
   p->title =
