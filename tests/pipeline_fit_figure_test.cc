@@ -152,20 +152,22 @@ struct SvgText {
   double x = 0.0, size = 0.0;
   std::string anchor, content;
 };
+// (Scanned by hand: std::regex recurses per character and overflows the stack on a path's
+// 100 kB d attribute.)
 std::vector<SvgText> Texts(const std::string& svg) {
   std::vector<SvgText> out;
-  const std::regex text("<text([^>]*)>(.*?)</text>");
   const std::regex tag("<[^>]*>");
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), text); it != std::sregex_iterator();
-       ++it) {
+  for (size_t at = svg.find("<text"); at != std::string::npos; at = svg.find("<text", at + 1)) {
+    const size_t attrs_end = svg.find('>', at), close = svg.find("</text>", at);
+    if (attrs_end == std::string::npos || close == std::string::npos) break;
+    const std::string attrs = svg.substr(at + 5, attrs_end - at - 5);
     SvgText t;
-    const std::string attrs = (*it)[1];
     std::smatch m;
     if (std::regex_search(attrs, m, std::regex(" x=\"([-0-9.]+)\""))) t.x = std::stod(m[1]);
     if (std::regex_search(attrs, m, std::regex("font-size=\"([0-9.]+)\""))) t.size = std::stod(m[1]);
     t.anchor = std::regex_search(attrs, m, std::regex("text-anchor=\"([a-z]+)\"")) ? m[1].str()
                                                                                  : "start";
-    t.content = std::regex_replace((*it)[2].str(), tag, "");
+    t.content = std::regex_replace(svg.substr(attrs_end + 1, close - attrs_end - 1), tag, "");
     if (attrs.find("transform") == std::string::npos) out.push_back(t);  // rotated: skipped
   }
   return out;
@@ -190,10 +192,10 @@ void ExpectLightSearchableSvg(const std::string& path, const std::string& must_c
   ASSERT_TRUE(std::regex_search(svg, m, std::regex("viewBox=\"0 0 ([0-9.]+) ")));
   const double width = std::stod(m[1]);
   // Well-formed enough for a browser: no attribute twice in one element.
-  const std::regex element("<[a-z][^>]*>");
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), element);
-       it != std::sregex_iterator(); ++it) {
-    const std::string tag = it->str();
+  for (size_t at = svg.find('<'); at != std::string::npos; at = svg.find('<', at + 1)) {
+    const size_t end = svg.find('>', at);
+    if (end == std::string::npos) break;
+    const std::string tag = svg.substr(at, end + 1 - at);
     for (const char* attr : {" fill=\"", " stroke=\"", " d=\"", " x=\"", " y=\""}) {
       const size_t first = tag.find(attr);
       EXPECT_TRUE(first == std::string::npos || tag.find(attr, first + 1) == std::string::npos)
