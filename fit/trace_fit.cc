@@ -384,9 +384,16 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
   const WhitenessStats whiteness = ComputeWhiteness(minimum.residuals, options.whiteness_lags);
   const Quality quality = JudgeQuality(input, options, minimum, solution, sweep, whiteness, noise);
 
-  // 11. The result: non-finite guard, status, kept series.
-  return finish(AssembleResult(input, options, std::move(result), minimum, solution, stat, budget,
-                               sweep, rule, whiteness, quality));
+  // 11. The result: non-finite guard, status, kept series (and the band fit's, when the result
+  // is a band's).
+  result = AssembleResult(input, options, std::move(result), minimum, solution, stat, budget,
+                          sweep, rule, whiteness, quality);
+  if (options.keep_series && result.HasFit() && rule.inertia_source == "low_amplitude_band") {
+    result.band_fitted_rate_rad_per_s =
+        BandFittedRate(input, options, minimum.p.data(), cost.inertia_scale(),
+                       sweep.bands[sweep.low_band], &result.band_first_index);
+  }
+  return finish(std::move(result));
 }
 
 }  // namespace bifilar

@@ -136,6 +136,11 @@ struct AmplitudeSweepBand {
   double inertia_kg_m2 = 0.0;              // I fitted in the band (K_D, C held)
   double inertia_std_kg_m2 = 0.0;          // its statistical (HAC) std
   double residual_fraction = 0.0;          // residual RMS / swing-rate RMS of the band fit
+  // The band fit's state at t0_s and its gyro bias (K_D and C are the window fit's): what the
+  // fit figure needs to draw the band's curve (TraceFitResult::band_fitted_rate_rad_per_s).
+  double angle0_rad = 0.0;                 // psi(t0_s)
+  double rate0_rad_per_s = 0.0;            // psi'(t0_s)
+  double bias_rad_per_s = 0.0;             // b
   bool ok = false;                         // the band fit converged
 };
 
@@ -243,6 +248,12 @@ struct TraceFitResult {
   std::vector<double> measured_rate_rad_per_s;
   std::vector<double> fitted_rate_rad_per_s;
   std::vector<double> residual_rad_per_s;
+  // The fit that gave params.inertia_kg_m2 when it is a band's (inertia_source
+  // "low_amplitude_band", kept with the series): its fitted rate psi'(t_k) + b at the samples
+  // t_s[band_first_index], t_s[band_first_index + 1], ... of the window. Empty otherwise; the
+  // series above are then the result's fit.
+  size_t band_first_index = 0;
+  std::vector<double> band_fitted_rate_rad_per_s;
 
   bool IsUsable() const { return status == TraceFitStatus::kOk; }
   bool HasFit() const { return status != TraceFitStatus::kError && params.inertia_kg_m2 > 0.0; }

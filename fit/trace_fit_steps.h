@@ -217,6 +217,13 @@ AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptio
                                  const double* p, double scale, const Trajectory& traj,
                                  double period_s, SolveBudget* budget);
 
+// The fitted rate psi' + b of `band` (a band of the sweep, at its own state and I, K_D and C of
+// the window fit p) at its samples, which start at input.t_s[*first]; empty when the band is not
+// in the window or its integration fails.
+std::vector<double> BandFittedRate(const TraceFitInput& input, const TraceFitOptions& options,
+                                   const double* p, double scale, const AmplitudeSweepBand& band,
+                                   size_t* first);
+
 // I and its statistical std after the sweep's rule.
 struct SweepRule {
   double inertia_kg_m2 = 0.0;

@@ -57,6 +57,9 @@ AmplitudeSweepBand FitBand(const TraceFitInput& input, const TraceFitOptions& op
   band.amplitude_end_deg = a1;
   band.amplitude_mean_deg = 0.5 * (a0 + a1);
   band.inertia_kg_m2 = scale * q[kTraceInertia];
+  band.angle0_rad = q[kTraceAngle0];
+  band.rate0_rad_per_s = q[kTraceRate0];
+  band.bias_rad_per_s = q[kTraceBias];
   band.inertia_std_kg_m2 = stat.ok ? scale * stat.hac[0] : 0.0;
   band.ok = lm.ok && stat.ok && band.inertia_std_kg_m2 > 0.0 && std::isfinite(band.inertia_kg_m2);
   return band;
@@ -157,6 +160,31 @@ AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptio
   }
   FitTrend(options, scale, &sweep);
   return sweep;
+}
+
+std::vector<double> BandFittedRate(const TraceFitInput& input, const TraceFitOptions& options,
+                                   const double* p, double scale, const AmplitudeSweepBand& band,
+                                   size_t* first) {
+  const auto begin = std::lower_bound(input.t_s.begin(), input.t_s.end(), band.t0_s);
+  *first = static_cast<size_t>(begin - input.t_s.begin());
+  if (band.num_samples < 2 || *first + band.num_samples > input.t_s.size() ||
+      *begin != band.t0_s) {
+    return {};
+  }
+  const std::vector<double> t(begin, begin + band.num_samples);
+  const std::vector<double> rate(input.rate_rad_per_s.begin() + *first,
+                                 input.rate_rad_per_s.begin() + *first + band.num_samples);
+  TraceRateCost cost(&t, &rate, options.model, input.geometry, options.integrator, scale);
+  double q[kNumTraceParams];
+  std::copy(p, p + kNumTraceParams, q);
+  q[kTraceInertia] = band.inertia_kg_m2 / scale;
+  q[kTraceAngle0] = band.angle0_rad;
+  q[kTraceRate0] = band.rate0_rad_per_s;
+  q[kTraceBias] = band.bias_rad_per_s;
+  std::vector<double> r(t.size());
+  if (!std::isfinite(Cost(cost, q, &r))) return {};
+  for (size_t k = 0; k < r.size(); ++k) r[k] += rate[k];  // fitted = measured + (fitted - measured)
+  return r;
 }
 
 SweepRule ApplySweepRule(const AmplitudeSweep& sweep, const Solution& solution,

@@ -59,3 +59,46 @@ TEST(SvgCompact, EqualGlyphsOfTwoFiguresShareOneSymbol) {
 
 }  // namespace
 }  // namespace bifilar
+
+namespace bifilar {
+namespace {
+
+// PLplot's own svg driver (issue 25): the flip applied, polylines of one style joined in one
+// path (a one-point polyline a dot), text as UTF-8 at page coordinates, the whole-page clip
+// dropped; a second pass changes nothing.
+TEST(SvgCompact, PlplotSvgDriverOutput) {
+  const std::string svg =
+      "<?xml version=\"1.0\"?>\n<svg\n  xmlns=\"http://www.w3.org/2000/svg\"\n  width=\"100pt\"\n"
+      "  height=\"50pt\"\n  viewBox=\"0 0 100 50\"\n  >\n  <rect\n    x=\"0\"\n    y=\"0\"\n"
+      "    width=\"100\"\n    height=\"50\"\n    stroke=\"none\"\n    fill=\"#FFFFFF\"\n    />\n"
+      "  <g\n    transform=\"matrix(1 0 0 -1 0 50)\"\n    >\n"
+      "    <polyline\n      stroke-width=\"1.000000e+00\"\n      stroke=\"#000000\"\n"
+      "      stroke-opacity=\"1.000000\"\n      fill=\"none\"\n      points=\"10.00,10.00 20.04,10.00\"\n      />\n"
+      "    <polyline\n      stroke-width=\"1.000000e+00\"\n      stroke=\"#000000\"\n"
+      "      stroke-opacity=\"1.000000\"\n      fill=\"none\"\n      points=\"30.00,40.00 30.00,40.00\"\n      />\n"
+      "    <clipPath\n      id=\"text-clipping0\"\n      >\n      <polygon\n"
+      "        points=\"0.000000,0.000000 0.000000,49.99 100.000000,49.99 100.000000,0.000000\"\n"
+      "        />\n    </clipPath>\n    <g\n      clip-path=\"url(#text-clipping0)\"\n      >\n"
+      "      <text\n        dominant-baseline=\"no-change\"\n        fill=\"#000000\"\n"
+      "        fill-opacity=\"1.000000\"\n        xml:space=\"preserve\"\n        font-size=\"17\"\n"
+      "        transform=\"matrix(1.000000 0.000000 0.000000 -1.000000 50.000000 5.000000)\"\n"
+      "        text-anchor=\"middle\"\n        x=\"0.000000\"\n        y=\"6.640507\"\n"
+      "><tspan font-family=\"sans-serif\" font-style=\"normal\" font-weight=\"normal\">"
+      "&#x49;&#x20;&#xb1;&#x20;&#x3c3;&#x3c;</tspan></text>\n    </g>\n  </g>\n</svg>\n";
+  const std::string out = CompactSvg(svg);
+  EXPECT_NE(out.find("viewBox=\"0 0 100 50\""), std::string::npos) << out;
+  EXPECT_NE(out.find("width=\"100\" height=\"50\""), std::string::npos) << out;
+  // (10, 50-10) -> (20, 40): one path with the dot (30, 10) as its second sub-path.
+  EXPECT_NE(out.find("<path fill=\"none\" stroke=\"#000000\" stroke-width=\"1\" "
+                     "d=\"M10 40l10 0M30 10l0 0\"/>"),
+            std::string::npos) << out;
+  EXPECT_NE(out.find("<text x=\"50\" y=\"51.6\" font-size=\"17\" text-anchor=\"middle\" "
+                     "xml:space=\"preserve\"><tspan>I ± σ&lt;</tspan></text>"),
+            std::string::npos) << out;
+  EXPECT_EQ(out.find("clip"), std::string::npos) << out;
+  EXPECT_EQ(out.find("<polyline"), std::string::npos) << out;
+  EXPECT_EQ(CompactSvg(out), out);
+}
+
+}  // namespace
+}  // namespace bifilar

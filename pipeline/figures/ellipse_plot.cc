@@ -88,9 +88,11 @@ void MomentAxes(const EllipseResult& r, MomentPage* p) {
   for (double v : p->elo) y_lo = std::min(y_lo, v);
   for (double v : p->ehi) y_hi = std::max(y_hi, v);
   p->legend_below = Curve(r, 0.0) >= Curve(r, 90.0);
+  // The legend's 4 rows take ~0.3 of the plot's height: 9.5 pads of 0.06 leave 0.35 of it free
+  // (5.5 let the legend cover the trials near +-90 deg, issue 25).
   const double pad = 0.06 * (y_hi - y_lo) + 1e-12 * std::fabs(y_hi);
-  y_lo -= p->legend_below ? 5.5 * pad : pad;
-  y_hi += p->legend_below ? pad : 5.5 * pad;
+  y_lo -= p->legend_below ? 9.5 * pad : pad;
+  y_hi += p->legend_below ? pad : 9.5 * pad;
   p->y_lo = y_lo;
   p->y_hi = y_hi;
   p->x_lo -= 5;
@@ -302,8 +304,10 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
   auto draw = [&] {
     plschr(0, 0.95);
     pladv(0);
-    panel(false, 0.1, 0.48);
-    panel(true, 0.6, 0.98);
+    // Room right of each panel for PLplot's "(x10^n)" of the x axis (it was cut at the page's
+    // edge, issue 25).
+    panel(false, 0.1, 0.44);
+    panel(true, 0.6, 0.91);
     plcol0(kBlack);
     plvpor(0.0, 1.0, 0.0, 1.0);
     plwind(0, 1, 0, 1);

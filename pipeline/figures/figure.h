@@ -25,7 +25,8 @@ enum FigureColour {
 };
 
 // Draws `draw` (PLplot C API calls: plenv, plline, ... between plinit and plend) into `path`.
-// The device follows the extension: ".png" -> pngcairo, ".svg" -> svgcairo. The file is written
+// The device follows the extension: ".png" -> pngcairo, ".svg" -> PLplot's svg driver (text
+// stays text), compacted by CompactSvg (pipeline/figures/svg_compact.h). The file is written
 // to a temporary name and renamed. Returns false with *why set on failure.
 bool WriteFigure(const std::string& path, const FigureOptions& options,
                  const std::function<void()>& draw, std::string* why);

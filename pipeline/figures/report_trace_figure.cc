@@ -9,6 +9,7 @@
 
 #include "pendulum/model.h"
 #include "pipeline/figures/figure.h"
+#include "pipeline/figures/trace_plot.h"
 
 namespace bifilar {
 namespace {
@@ -47,19 +48,27 @@ void Envelope(const std::vector<double>& t, const std::vector<double>& v, size_t
 }  // namespace
 
 bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title, DisplayUnits units,
-                            const std::string& path, int width_px, int height_px,
-                            std::string* why) {
-  // Top: measured and fitted rate at ~250 points (the noise is invisible at this scale; it shows
-  // in the residual panel). Bottom: the residual's min/max envelope over 150 buckets.
-  std::vector<PLFLT> tm, ym, tf, yf, tr, yr;
-  const size_t stride = std::max<size_t>(1, fit.t_s.size() / 250);
-  for (size_t i = 0; i < fit.t_s.size(); i += stride) {
-    tm.push_back(fit.t_s[i] - fit.t_s[0]);
-    ym.push_back(kDegPerRad * fit.measured_rate_rad_per_s[i]);
-    yf.push_back(kDegPerRad * fit.fitted_rate_rad_per_s[i]);
+                            const std::string& path, int width_px, int height_px, std::string* why,
+                            double inertia_std_kg_m2, const std::string& std_label) {
+  (void)title;  // the file name is in the report's caption
+  // The series of the fit that gave I (trace_plot.h). Top: measured and fitted rate at ~250
+  // points (the noise is invisible at this scale; it shows in the residual panel). Bottom: the
+  // residual's min/max envelope over 150 buckets.
+  TracePlotOptions options;
+  options.unit_scale = InertiaToDisplay(1.0, units);
+  options.unit_label = units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+  options.inertia_std_kg_m2 = inertia_std_kg_m2;
+  options.std_label = std_label;
+  TraceFigureData d;
+  if (!MakeTraceFigureData(fit, options, &d, why)) return false;
+  std::vector<PLFLT> tm, ym, yf, tr, yr;
+  const size_t stride = std::max<size_t>(1, d.t_s.size() / 250);
+  for (size_t i = 0; i < d.t_s.size(); i += stride) {
+    tm.push_back(d.t_s[i]);
+    ym.push_back(d.measured_deg_per_s[i]);
+    yf.push_back(d.fitted_deg_per_s[i]);
   }
-  tf = tm;
-  Envelope(fit.t_s, fit.residual_rad_per_s, 150, -kDegPerRad, &tr, &yr);  // measured - fitted
+  Envelope(d.t_s, d.residual_deg_per_s, 150, 1.0, &tr, &yr);
   if (tm.size() < 2) {
     *why = "nothing to plot";
     return false;
@@ -67,22 +76,21 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
   const double t_end = tm.back();
   double y_max = 0.0, r_max = 0.0;
   for (double v : ym) y_max = std::max(y_max, std::abs(v));
+  for (double v : yf) y_max = std::max(y_max, std::abs(v));
   for (double v : yr) r_max = std::max(r_max, std::abs(v));
   const double noise = kDegPerRad * fit.noise_rad_per_s;
   r_max = std::max(r_max, 2.5 * noise) * 1.1;
   y_max = std::max(y_max, 1e-6) * 1.1;
-  char label[256];
-  // Short labels: the SVG embeds an outline of every distinct glyph (the file name is in the
-  // report's caption).
-  (void)title;
+  const double k = options.unit_scale, std_kg_m2 = std::isfinite(inertia_std_kg_m2)
+                                                       ? inertia_std_kg_m2
+                                                       : fit.inertia_std_kg_m2;
   // In the config's units, as every table of the report (I total: rig included).
-  std::snprintf(label, sizeof(label), "I#dtotal#u = %.5f #(2233) %.1e %s (%s)",
-                InertiaToDisplay(fit.params.inertia_kg_m2, units),
-                InertiaToDisplay(fit.inertia_stat_std_kg_m2, units),
-                units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d",
-                ToString(fit.model));
-  const std::string top_title = label;
-  std::snprintf(label, sizeof(label), "residual: rms = %.2f noise", fit.rms_over_noise);
+  const std::string top_title = "I#dtotal#u = " +
+                                ValueWithStd(k * fit.params.inertia_kg_m2, k * std_kg_m2) + " " +
+                                options.unit_label + " (1σ " + std_label + "), " +
+                                (d.from_band ? "lowest-amplitude band" : "whole window");
+  char label[256];
+  std::snprintf(label, sizeof(label), "measured − fit: rms = %.2f × noise", d.rms_over_noise);
   const std::string bottom_title = label;
   FigureOptions figure;
   figure.width_px = width_px;
@@ -97,23 +105,21 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
         plcol0(1);
         plbox("bct", 0, 0, "bcntv", 0, 0);
         pllab("", "deg/s", top_title.c_str());
-        // The fit first (wide, light blue), the measured rate on top of it (thin, dark): where the
-        // two agree the measured line shows inside the fit's band (issue 18).
-        plscol0(9, 150, 185, 235);
-        plcol0(9);
-        plwidth(4.0);
-        plline(static_cast<PLINT>(tf.size()), tf.data(), yf.data());
-        plscol0(15, 0, 0, 0);
-        plcol0(15);
-        plwidth(1.0);
+        // The measured rate first (thin, grey), the fit on top of it (blue): where the two agree
+        // the fit's line stays visible.
+        plcol0(kFigureGrey);
+        plwidth(2.0);
         plline(static_cast<PLINT>(tm.size()), tm.data(), ym.data());
-        plscol0(15, 170, 170, 170);
+        plcol0(kFigureBlue);
+        plwidth(1.2);
+        plline(static_cast<PLINT>(tm.size()), tm.data(), yf.data());
+        plwidth(1.0);
         plvpor(0.1, 0.97, 0.1, 0.32);
         plwind(0, t_end, -r_max, r_max);
         plcol0(1);
         plbox("bcnt", 0, 0, "bcntv", 0, 0);
         pllab("s", "deg/s", bottom_title.c_str());
-        plcol0(15);
+        plcol0(kFigureGrey);
         plline(static_cast<PLINT>(tr.size()), tr.data(), yr.data());
         plscol0(10, 200, 60, 40);
         plcol0(10);

@@ -7,7 +7,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <set>
 #include <sstream>
+#include <vector>
 
 namespace bifilar {
 namespace {
@@ -148,9 +150,248 @@ std::string CompactSvgPaths(const std::string& svg) {
   out.append(svg, at, std::string::npos);
   return out;
 }
+// --- PLplot's own SVG driver ("svg"): text as <text>, shapes as <polyline>, all inside one
+// <g transform="matrix(1 0 0 -1 0 H)">.
+
+// The attributes of one tag (`tag` from '<' to '>'), name -> value.
+std::map<std::string, std::string> Attributes(const std::string& tag) {
+  std::map<std::string, std::string> out;
+  size_t at = tag.find_first_of(" \t\r\n");
+  while (at != std::string::npos && at < tag.size()) {
+    const size_t name_start = tag.find_first_not_of(" \t\r\n", at);
+    if (name_start == std::string::npos) break;
+    const size_t eq = tag.find('=', name_start);
+    if (eq == std::string::npos || tag[eq + 1] != '"') break;
+    const size_t value_end = tag.find('"', eq + 2);
+    if (value_end == std::string::npos) break;
+    out[tag.substr(name_start, eq - name_start)] = tag.substr(eq + 2, value_end - eq - 2);
+    at = value_end + 1;
+  }
+  return out;
+}
+
+// The numbers of a points="x,y x,y ..." list.
+std::vector<double> Numbers(const std::string& text) {
+  std::vector<double> out;
+  const char* c = text.c_str();
+  while (*c != '\0') {
+    char* stop = nullptr;
+    const double v = std::strtod(c, &stop);
+    if (stop == c) {
+      ++c;
+      continue;
+    }
+    out.push_back(v);
+    c = stop;
+  }
+  return out;
+}
+
+// Points (x, y) of the driver's flipped frame as a path "Mx yl dx dy ..." of the page's frame,
+// every point rounded to 0.1 px first; `close` appends "Z".
+std::string PathOfPoints(const std::vector<double>& xy, double height, bool close) {
+  std::string d;
+  long px = 0, py = 0;
+  for (size_t i = 0; i + 1 < xy.size(); i += 2) {
+    const long qx = std::lround(10.0 * xy[i]), qy = std::lround(10.0 * (height - xy[i + 1]));
+    if (i == 0) {
+      d = "M" + ShortNumber(qx / 10.0) + " " + ShortNumber(qy / 10.0) + "l";
+    } else {
+      const std::string dx = ShortNumber((qx - px) / 10.0), dy = ShortNumber((qy - py) / 10.0);
+      if (d.back() != 'l' && dx[0] != '-') d += ' ';
+      d += dx;
+      if (dy[0] != '-') d += ' ';
+      d += dy;
+    }
+    px = qx;
+    py = qy;
+  }
+  if (!d.empty() && d.back() == 'l') d += "0 0";  // one point: a dot (round caps)
+  if (close && !d.empty()) d += "Z";
+  return d;
+}
+
+std::string Number(const std::string& text) { return ShortNumber(std::strtod(text.c_str(), nullptr)); }
+
+// &#xNN; character references as UTF-8 (markup characters stay references), so the text of
+// the figure can be searched.
+std::string DecodeCharacterReferences(const std::string& text) {
+  std::string out;
+  for (size_t i = 0; i < text.size();) {
+    if (text.compare(i, 3, "&#x") == 0) {
+      const size_t end = text.find(';', i);
+      if (end != std::string::npos) {
+        const unsigned long code = std::strtoul(text.substr(i + 3, end - i - 3).c_str(), nullptr, 16);
+        if (code == '<') out += "&lt;";
+        else if (code == '&') out += "&amp;";
+        else if (code == '>') out += "&gt;";
+        else if (code < 0x80) out += static_cast<char>(code);
+        else if (code < 0x800) {
+          out += static_cast<char>(0xC0 | (code >> 6));
+          out += static_cast<char>(0x80 | (code & 0x3F));
+        } else if (code < 0x10000) {
+          out += static_cast<char>(0xE0 | (code >> 12));
+          out += static_cast<char>(0x80 | ((code >> 6) & 0x3F));
+          out += static_cast<char>(0x80 | (code & 0x3F));
+        } else {
+          out += static_cast<char>(0xF0 | (code >> 18));
+          out += static_cast<char>(0x80 | ((code >> 12) & 0x3F));
+          out += static_cast<char>(0x80 | ((code >> 6) & 0x3F));
+          out += static_cast<char>(0x80 | (code & 0x3F));
+        }
+        i = end + 1;
+        continue;
+      }
+    }
+    out += text[i++];
+  }
+  return out;
+}
+
+// The text's content: default font attributes dropped (the <svg> sets the family), numbers
+// shortened, references decoded.
+std::string CompactTextContent(std::string content) {
+  content = ReplaceAll(content, " font-family=\"sans-serif\" font-style=\"normal\" font-weight=\"normal\"", "");
+  return DecodeCharacterReferences(SimplifySvgNumbers(content));
+}
+
+// One <text ...>content</text> of the flipped frame, in the page's frame.
+std::string CompactText(const std::string& tag, const std::string& content, double height) {
+  std::map<std::string, std::string> a = Attributes(tag);
+  const std::vector<double> m = Numbers(a["transform"]);
+  const double x = std::strtod(a["x"].c_str(), nullptr), y = std::strtod(a["y"].c_str(), nullptr);
+  std::string out = "<text";
+  if (m.size() == 6 && std::fabs(m[0] - 1.0) < 1e-9 && std::fabs(m[1]) < 1e-9 &&
+      std::fabs(m[2]) < 1e-9 && std::fabs(m[3] + 1.0) < 1e-9) {
+    out += " x=\"" + ShortNumber(m[4] + x) + "\" y=\"" + ShortNumber(height - m[5] + y) + "\"";
+  } else if (m.size() == 6) {  // rotated: the flip composed with the text's own matrix
+    out += " transform=\"matrix(" + ShortNumber(m[0]) + " " + ShortNumber(-m[1]) + " " +
+           ShortNumber(m[2]) + " " + ShortNumber(-m[3]) + " " + ShortNumber(m[4]) + " " +
+           ShortNumber(height - m[5]) + ")\" x=\"" + ShortNumber(x) + "\" y=\"" + ShortNumber(y) +
+           "\"";
+  }
+  if (!a["font-size"].empty()) out += " font-size=\"" + Number(a["font-size"]) + "\"";
+  if (!a["text-anchor"].empty() && a["text-anchor"] != "start")
+    out += " text-anchor=\"" + a["text-anchor"] + "\"";
+  if (!a["fill"].empty() && a["fill"] != "#000000") out += " fill=\"" + a["fill"] + "\"";
+  if (!a["fill-opacity"].empty() && std::strtod(a["fill-opacity"].c_str(), nullptr) < 1.0)
+    out += " fill-opacity=\"" + ShortNumber(std::strtod(a["fill-opacity"].c_str(), nullptr)) + "\"";
+  return out + " xml:space=\"preserve\">" + CompactTextContent(content) + "</text>";
+}
+
+// The style of a <polyline> as attributes of the <path> it joins; "" for a fill's.
+std::string StrokeStyle(std::map<std::string, std::string>& a) {
+  std::string style = "fill=\"none\" stroke=\"" + a["stroke"] + "\" stroke-width=\"" +
+                      Number(a["stroke-width"].empty() ? "1" : a["stroke-width"]) + "\"";
+  const double opacity = a["stroke-opacity"].empty() ? 1.0 : std::strtod(a["stroke-opacity"].c_str(), nullptr);
+  if (opacity < 1.0) style += " stroke-opacity=\"" + ShortNumber(opacity) + "\"";
+  return style;
+}
+
+std::string FillStyle(std::map<std::string, std::string>& a) {
+  std::string style = "fill=\"" + a["fill"] + "\"";
+  const double opacity = a["fill-opacity"].empty() ? 1.0 : std::strtod(a["fill-opacity"].c_str(), nullptr);
+  if (opacity < 1.0) style += " fill-opacity=\"" + ShortNumber(opacity) + "\"";
+  if (!a["stroke"].empty() && a["stroke"] != "none")  // its outline too (no second fill=)
+    style += " " + StrokeStyle(a).substr(std::string("fill=\"none\" ").size());
+  return style;
+}
+
+// The whole page's clip of the driver's texts clips nothing.
+bool WholePage(const std::vector<double>& xy, double width, double height) {
+  double x_lo = HUGE_VAL, x_hi = -HUGE_VAL, y_lo = HUGE_VAL, y_hi = -HUGE_VAL;
+  for (size_t i = 0; i + 1 < xy.size(); i += 2) {
+    x_lo = std::min(x_lo, xy[i]), x_hi = std::max(x_hi, xy[i]);
+    y_lo = std::min(y_lo, xy[i + 1]), y_hi = std::max(y_hi, xy[i + 1]);
+  }
+  return x_lo <= 0.5 && y_lo <= 0.5 && x_hi >= width - 0.5 && y_hi >= height - 0.5;
+}
+
+// PLplot's svg driver output rewritten: the flip applied, each run of polylines of one style as
+// one <path> (a one-point polyline is a dot: round caps), texts as <text> with plain UTF-8
+// content, clips of the whole page dropped, numbers at 0.1 px.
+std::string CompactPlplotSvg(const std::string& svg) {
+  const size_t svg_at = svg.find("<svg");
+  const size_t svg_end = svg.find('>', svg_at);
+  std::map<std::string, std::string> root = Attributes(svg.substr(svg_at, svg_end - svg_at));
+  const std::vector<double> box = Numbers(root["viewBox"]);
+  if (box.size() != 4) return svg;
+  const double width = box[2], height = box[3];
+  // The page in px, as PLplot was given it (the driver says pt: a third larger on screen).
+  std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" +
+                    ShortNumber(width) + "\" height=\"" + ShortNumber(height) + "\" viewBox=\"" + root["viewBox"] +
+                    "\" font-family=\"sans-serif\" stroke-linecap=\"round\" stroke-linejoin=\"round\">\n";
+  std::string run_style, run_d;
+  auto flush = [&] {
+    if (!run_d.empty()) out += "<path " + run_style + " d=\"" + run_d + "\"/>\n";
+    run_d.clear();
+    run_style.clear();
+  };
+  std::vector<bool> kept_groups;  // per open <g>: written (true) or dropped
+  std::set<std::string> dropped_clips;
+  size_t at = svg_end + 1;
+  while (true) {
+    const size_t start = svg.find('<', at);
+    if (start == std::string::npos) break;
+    const size_t end = svg.find('>', start);
+    if (end == std::string::npos) break;
+    const std::string tag = svg.substr(start, end + 1 - start);
+    at = end + 1;
+    if (tag.rfind("<polyline", 0) == 0) {
+      std::map<std::string, std::string> a = Attributes(tag);
+      const bool fill = !a["fill"].empty() && a["fill"] != "none";
+      const std::string style = fill ? FillStyle(a) : StrokeStyle(a);
+      if (style != run_style) flush();
+      run_style = style;
+      run_d += PathOfPoints(Numbers(a["points"]), height, fill);
+    } else if (tag.rfind("<text", 0) == 0) {
+      flush();
+      const size_t close = svg.find("</text>", at);
+      if (close == std::string::npos) break;
+      out += CompactText(tag, svg.substr(at, close - at), height) + "\n";
+      at = close + 7;
+    } else if (tag.rfind("<rect", 0) == 0) {
+      std::map<std::string, std::string> a = Attributes(tag);
+      out += "<rect width=\"" + a["width"] + "\" height=\"" + a["height"] + "\" fill=\"" + a["fill"] + "\"/>\n";
+    } else if (tag.rfind("<clipPath", 0) == 0) {
+      flush();
+      const std::string id = Attributes(tag)["id"];
+      const size_t poly = svg.find("<polygon", at), close = svg.find("</clipPath>", at);
+      if (poly == std::string::npos || close == std::string::npos) break;
+      const std::vector<double> xy =
+          Numbers(Attributes(svg.substr(poly, svg.find('>', poly) - poly))["points"]);
+      if (WholePage(xy, width, height)) {
+        dropped_clips.insert(id);
+      } else {
+        out += "<clipPath id=\"" + id + "\"><path d=\"" + PathOfPoints(xy, height, true) + "\"/></clipPath>\n";
+      }
+      at = close + 11;
+    } else if (tag.rfind("<g", 0) == 0) {
+      flush();
+      std::map<std::string, std::string> a = Attributes(tag);
+      const std::string clip = a["clip-path"];
+      const std::string id = clip.size() > 6 ? clip.substr(5, clip.size() - 6) : "";
+      const bool keep = !clip.empty() && dropped_clips.count(id) == 0;
+      if (keep) out += "<g clip-path=\"" + clip + "\">\n";
+      kept_groups.push_back(keep);
+    } else if (tag == "</g>") {
+      flush();
+      if (!kept_groups.empty() && kept_groups.back()) out += "</g>\n";
+      if (!kept_groups.empty()) kept_groups.pop_back();
+    }
+    // </svg>, comments: written below / dropped
+  }
+  flush();
+  return out + "</svg>\n";
+}
+
 }  // namespace
 
-std::string CompactSvg(const std::string& svg) { return SimplifySvgNumbers(CompactSvgPaths(svg)); }
+std::string CompactSvg(const std::string& svg) {
+  if (svg.find("<polyline") != std::string::npos || svg.find("dominant-baseline") != std::string::npos)
+    return CompactPlplotSvg(svg);
+  return SimplifySvgNumbers(CompactSvgPaths(svg));
+}
 
 std::string PrefixSvgIds(std::string svg, const std::string& prefix) {
   svg = ReplaceAll(svg, "id=\"", "id=\"" + prefix);

@@ -108,14 +108,12 @@ void TrendCurveAndValueAxis(const AmplitudeSweep& sweep, double inertia_kg_m2,
   p->y_hi += y_pad;
 }
 
-// Text in one size (an SVG embeds every glyph once per size) and short: the report inlines one
-// of these per trace.
+// Text short: the report inlines one of these per trace.
 void SweepTexts(const AmplitudeSweep& sweep, const SweepPlotOptions& options, SweepPage* p) {
   const std::string name = options.title.empty() ? std::string("trace") : options.title;
   const std::string trend_text = "trend z = " + Fmt("%.1f", sweep.trend_z) + ", " +
                                  Fmt("%+.2g", sweep.trend_percent_per_10deg) + " % per 10 deg";
-  // Compact: the page's caption names the trace (a file name is many distinct glyphs) and the
-  // subtitle's facts go in the title.
+  // Compact: the page's caption names the trace and the subtitle's facts go in the title.
   const std::string scatter_text =
       sweep.std_scale > 1.0 ? "bands scatter " + Fmt("%.1f", sweep.std_scale) + "× σ" : "";
   p->title =
@@ -140,8 +138,14 @@ void SweepPageLayout(const SweepPlotOptions& options, SweepPage* p) {
   const double y_abs = std::max(std::fabs(p->y_lo), std::fabs(p->y_hi));
   const int int_digits = std::max(1, static_cast<int>(std::floor(std::log10(std::max(y_abs, 1.0)))) + 1);
   const int label_chars = int_digits + (decimals > 0 ? 1 + decimals : 0) + (p->y_lo < 0.0 ? 1 : 0);
-  p->left = std::min(0.3, (22.0 + 11.0 * label_chars) / std::max(1, options.figure.width_px));
-  p->top = options.compact ? 0.83 : 0.655;
+  // PLplot's characters scale with the page height: font size ~0.04 of it at this kChar, a digit
+  // up to 0.64 of that wide (DejaVu Sans); the tick labels sit ~0.8 font sizes off the axis.
+  // (A fixed 11 px a character clipped ".127" on the 1100 x 700 page of `fit --plot`.)
+  const double font_px = 0.04 * options.figure.height_px;
+  p->left = std::min(0.3, (font_px * (0.64 * label_chars + 1.0)) /
+                              std::max(1, options.figure.width_px));
+  // Not compact: room between the legend's lower row and the axis label above the plot.
+  p->top = options.compact ? 0.83 : 0.63;
   p->px_w = options.figure.width_px * (kRight - p->left);
   p->px_h = options.figure.height_px * (p->top - kBottom);
   p->ring_px = 0.022 * options.figure.width_px;  // radius of the result band's ring

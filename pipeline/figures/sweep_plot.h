@@ -20,7 +20,7 @@ struct SweepPlotOptions {
   std::string unit_label = "kg m#u2#d";  // PLplot text of the display unit
   FigureOptions figure = {800, 500};     // page size (px)
   // true: title and axes only, no subtitle or legend, for a page that explains the figure in its
-  // caption (the report: an SVG embeds the outline of every distinct glyph, so text costs bytes).
+  // caption (the report, which shows one per trace at thumbnail size).
   bool compact = false;
 };
 

@@ -167,20 +167,22 @@ bool WriteTensorFigure(const TensorResult& r, const std::string& path,
   auto draw = [&] {
     plschr(0, 0.85);
     pladv(0);
-    ViewPanel(r, c, options, lim, kViews[0], 0.07, 0.47, 0.54, 0.86);
-    ViewPanel(r, c, options, lim, kViews[1], 0.57, 0.97, 0.54, 0.86);
-    ViewPanel(r, c, options, lim, kViews[2], 0.07, 0.47, 0.09, 0.41);
-    ResidualPanel(r, 0.57, 0.97, 0.11, 0.38);
+    // Rows apart enough for the upper row's x label and the lower row's title (they overlapped,
+    // issue 25).
+    ViewPanel(r, c, options, lim, kViews[0], 0.07, 0.47, 0.57, 0.86);
+    ViewPanel(r, c, options, lim, kViews[1], 0.57, 0.97, 0.57, 0.86);
+    ViewPanel(r, c, options, lim, kViews[2], 0.07, 0.47, 0.09, 0.38);
+    ResidualPanel(r, 0.57, 0.97, 0.11, 0.36);
     plcol0(kFigureBlack);
     plvpor(0.0, 1.0, 0.0, 1.0);
     plwind(0, 1, 0, 1);
     const std::string caption = "ellipsoid of inertia (blue), principal axes 1-3 (red: " +
-                                Fmt("%.4g", r.principal_moments[0].value * scale) + ", " +
-                                Fmt("%.4g", r.principal_moments[1].value * scale) + ", " +
-                                Fmt("%.4g", r.principal_moments[2].value * scale) + " " +
+                                Fmt("%#.4g", r.principal_moments[0].value * scale) + ", " +
+                                Fmt("%#.4g", r.principal_moments[1].value * scale) + ", " +
+                                Fmt("%#.4g", r.principal_moments[2].value * scale) + " " +
                                 options.unit_label + ")";
-    plptex(0.5, 0.98, 1, 0, 0.5, caption.c_str());
-    plptex(0.5, 0.955, 1, 0, 0.5, "o: measured moments whose axes lie near that plane");
+    plptex(0.5, 0.97, 1, 0, 0.5, caption.c_str());  // its superscript inside the page
+    plptex(0.5, 0.943, 1, 0, 0.5, "o: measured moments whose axes lie near that plane");
   };
   return WriteFigure(path, options.figure, draw, why);
 }

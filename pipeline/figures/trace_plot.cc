@@ -15,7 +15,8 @@ namespace {
 
 enum Colour {
   kBlack = kFigureBlack, kBlue = kFigureBlue, kRed = kFigureRed, kGrey = kFigureGrey,
-  kLight = kFigureLight, kBand = kFigureBand
+  kLight = kFigureLight, kBand = kFigureBand,
+  kShade = 8,  // the band's span in the whole-window panel
 };
 
 std::string Fmt(const char* format, double v) {
@@ -24,16 +25,21 @@ std::string Fmt(const char* format, double v) {
   return buf;
 }
 
-// Above this many samples a dot per sample is drawn no more (a 3 M-sample log took 110 s and gave
-// a 750 MB SVG): each series becomes its min/max envelope over `buckets` equal index ranges, as a
-// zigzag line in time order, which at 2 buckets per pixel fills the band the dots would cover.
-constexpr size_t kMaxDotsDrawn = 20000;
+// Above this many samples a dot per sample is drawn no more (more than ~8 per pixel column show
+// nothing more, and a 3 M-sample log took 110 s and gave a 750 MB SVG): each series becomes its
+// min/max envelope over 2 buckets per pixel, as a zigzag line in time order.
+constexpr size_t kMaxDotsDrawn = 8000;
 
 void Envelope(const std::vector<double>& t, const std::vector<double>& v, size_t buckets,
               std::vector<double>* x, std::vector<double>* y) {
   const size_t n = t.size();
   x->clear();
   y->clear();
+  if (n <= 2 * buckets) {
+    *x = t;
+    *y = v;
+    return;
+  }
   for (size_t b = 0; b < buckets; ++b) {
     const size_t lo = b * n / buckets, hi = (b + 1) * n / buckets;
     if (lo >= hi) continue;
@@ -49,185 +55,277 @@ void Envelope(const std::vector<double>& t, const std::vector<double>& v, size_t
   }
 }
 
-// Everything the trace figure draws: the series (time from the start of the window, rates in
-// deg/s), the panels' ranges, the texts, and the envelopes of a dense series.
-struct TracePage {
-  size_t n = 0;
-  std::vector<double> t, meas, fit, res;
-  double t_hi = 0.0, y_abs = 0.0, y_top = 0.0, y_bottom = 0.0, noise_deg = 0.0, r_abs = 0.0;
-  std::string title, subtitle, residual_label;
-  bool dense = false;
-  std::vector<double> env_t, env_meas, fit_t, fit_v, res_t, res_v;
-};
+double Rms(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x * x;
+  return v.empty() ? 0.0 : std::sqrt(s / v.size());
+}
 
-// Time from the start of the window; rates in deg/s (what people read off a gyro); the panels'
-// ranges.
-void TraceSeries(const TraceFitResult& r, TracePage* p) {
-  const size_t n = p->n;
+double AutocorrLag1(const std::vector<double>& v) {
+  if (v.size() < 3) return 0.0;
+  double mean = 0.0;
+  for (double x : v) mean += x;
+  mean /= v.size();
+  double num = 0.0, den = 0.0;
+  for (size_t k = 0; k < v.size(); ++k) {
+    den += (v[k] - mean) * (v[k] - mean);
+    if (k > 0) num += (v[k] - mean) * (v[k - 1] - mean);
+  }
+  return den > 0.0 ? num / den : 0.0;
+}
+
+// The series of the fit that gave I: the band's (t_s[first ...]) or the window's.
+void ResultSeries(const TraceFitResult& r, TraceFigureData* d) {
+  const bool band = !r.band_fitted_rate_rad_per_s.empty() &&
+                    r.band_first_index + r.band_fitted_rate_rad_per_s.size() <= r.t_s.size();
+  d->from_band = band;
+  const size_t first = band ? r.band_first_index : 0;
+  const size_t n = band ? r.band_fitted_rate_rad_per_s.size() : r.t_s.size();
+  d->window_start_s = r.t_s[first];
+  for (size_t k = 0; k < n; ++k) {
+    const size_t i = first + k;
+    const double fitted =
+        band ? r.band_fitted_rate_rad_per_s[k] : r.fitted_rate_rad_per_s[i];
+    d->t_s.push_back(r.t_s[i] - d->window_start_s);
+    d->measured_deg_per_s.push_back(r.measured_rate_rad_per_s[i] * kDegPerRad);
+    d->fitted_deg_per_s.push_back(fitted * kDegPerRad);
+    d->residual_deg_per_s.push_back((r.measured_rate_rad_per_s[i] - fitted) * kDegPerRad);
+  }
+  d->bias_deg_per_s = r.bias_rad_per_s * kDegPerRad;
+  if (band) d->bias_deg_per_s = r.sweep.bands[r.sweep.low_band].bias_rad_per_s * kDegPerRad;
+  d->residual_rms_deg_per_s = Rms(d->residual_deg_per_s);
+  const double noise_deg = r.noise_rad_per_s * kDegPerRad;
+  d->rms_over_noise = noise_deg > 0.0 ? d->residual_rms_deg_per_s / noise_deg : 0.0;
+  d->autocorr_lag1 = AutocorrLag1(d->residual_deg_per_s);
+  if (!band) return;
   const double t0 = r.t_s.front();
-  p->t.resize(n);
-  p->meas.resize(n);
-  p->fit.resize(n);
-  p->res.resize(n);
-  for (size_t k = 0; k < n; ++k) {
-    p->t[k] = r.t_s[k] - t0;
-    p->meas[k] = r.measured_rate_rad_per_s[k] * kDegPerRad;
-    p->fit[k] = r.fitted_rate_rad_per_s[k] * kDegPerRad;
-    p->res[k] = -r.residual_rad_per_s[k] * kDegPerRad;  // measured - fitted
+  for (size_t i = 0; i < r.t_s.size(); ++i) {
+    d->whole_t_s.push_back(r.t_s[i] - t0);
+    d->whole_measured_deg_per_s.push_back(r.measured_rate_rad_per_s[i] * kDegPerRad);
+    d->whole_fitted_deg_per_s.push_back(r.fitted_rate_rad_per_s[i] * kDegPerRad);
   }
-  p->t_hi = p->t.back();
-  double y_abs = 0.0;
-  for (size_t k = 0; k < n; ++k) {
-    y_abs = std::max({y_abs, std::fabs(p->meas[k]), std::fabs(p->fit[k])});
-  }
-  p->y_abs = y_abs;
-  p->y_top = 1.35 * y_abs;  // room for the legend on top
-  p->y_bottom = -1.12 * y_abs;
-  p->noise_deg = r.noise_rad_per_s * kDegPerRad;
-  double r_abs = 0.0;
-  for (double v : p->res) r_abs = std::max(r_abs, std::fabs(v));
-  r_abs = std::max(r_abs, 2.5 * p->noise_deg) * 1.1;
-  if (!(r_abs > 0.0)) r_abs = 1.0;
-  p->r_abs = r_abs;
 }
 
-// Title (file, model, I +- std), subtitle (K_D, C, bias, amplitude) and the residual's label.
-void TraceTexts(const TraceFitResult& r, const TracePlotOptions& options, TracePage* p) {
-  const std::string name = options.title.empty() ? std::string("trace") : options.title;
-  const double k = options.unit_scale;
-  const std::string& unit = options.unit_label;
-  p->title = name + " [" + ToString(r.model) + "]: I = " +
-             Fmt("%.6g", k * r.params.inertia_kg_m2) + " ± " +
-             Fmt("%.2g", k * r.inertia_std_kg_m2) + " " + unit;
-  if (r.status != TraceFitStatus::kOk) p->title += "  (" + std::string(ToString(r.status)) + ")";
-  p->subtitle =
-      "K#dD#u = " + Fmt("%.3g", k * r.params.drag_coeff_kg_m2) + " " + unit + ",  C = " +
-      Fmt("%.3g", k * r.params.viscous_coeff_kg_m2_per_s) + " " + unit + "/s,  bias = " +
-      Fmt("%.3f", r.bias_rad_per_s * kDegPerRad) + " deg/s,  amplitude " +
-      Fmt("%.1f", r.amplitude_start_deg) + " → " + Fmt("%.1f", r.amplitude_end_deg) + " deg";
-  p->residual_label =
-      "residual: rms " + Fmt("%.3f", r.residual_rms_rad_per_s * kDegPerRad) + " deg/s = " +
-      Fmt("%.2f", r.rms_over_noise) + " × noise (" + (r.noise_from_input ? "rest" : "window") +
-      "),  #gr#d1#u = " + Fmt("%.3f", r.residual_autocorr_lag1);
-}
-
-// Dense series: envelopes (above), drawn as lines.
-void DenseEnvelope(int width_px, TracePage* p) {
-  p->dense = p->n > kMaxDotsDrawn;
-  if (!p->dense) return;
-  const size_t buckets = 2 * static_cast<size_t>(std::max(1, width_px));
-  Envelope(p->t, p->meas, buckets, &p->env_t, &p->env_meas);
-  Envelope(p->t, p->fit, buckets, &p->fit_t, &p->fit_v);
-  Envelope(p->t, p->res, buckets, &p->res_t, &p->res_v);
-}
-
-// A dot per sample (x, y), or the envelope (ex, ey) as a line when the series is dense.
-void Dots(const TracePage& p, const std::vector<double>& x, const std::vector<double>& y,
-          const std::vector<double>& ex, const std::vector<double>& ey) {
-  if (p.dense) {
-    plline(static_cast<PLINT>(ex.size()), ex.data(), ey.data());
+// Title (file, I +- std with the std's name), subtitle (which fit), detail (its other
+// parameters, each named), and the panels' labels.
+void Texts(const TraceFitResult& r, const TracePlotOptions& o, TraceFigureData* d) {
+  const std::string name = o.title.empty() ? std::string("trace") : o.title;
+  const double k = o.unit_scale;
+  const std::string& unit = o.unit_label;
+  const double std_kg_m2 = std::isfinite(o.inertia_std_kg_m2) ? o.inertia_std_kg_m2
+                                                              : r.inertia_std_kg_m2;
+  d->title = name + ":  I = " + ValueWithStd(k * r.params.inertia_kg_m2, k * std_kg_m2) + " " +
+             unit + "  (± 1σ " + o.std_label + ")";
+  if (r.status != TraceFitStatus::kOk) d->title += "  (" + std::string(ToString(r.status)) + ")";
+  const std::string model = std::string(ToString(r.model)) + " model";
+  if (d->from_band) {
+    const AmplitudeSweepBand& b = r.sweep.bands[r.sweep.low_band];
+    d->subtitle = "result: fit of the lowest-amplitude band, " + Fmt("%.1f", b.amplitude_start_deg) +
+                  " → " + Fmt("%.1f", b.amplitude_end_deg) + " deg over " +
+                  Fmt("%.1f", b.t1_s - b.t0_s) + " s (I depends on the amplitude)";
   } else {
-    plpoin(static_cast<PLINT>(x.size()), x.data(), y.data(), 1);
+    d->subtitle = "result: fit of the whole window, amplitude " +
+                  Fmt("%.1f", r.amplitude_start_deg) + " → " + Fmt("%.1f", r.amplitude_end_deg) +
+                  " deg";
   }
-}
-
-// Top panel: rates, the titles and the legend.
-void RatePanel(const TracePage& p) {
-  plvpor(0.10, 0.97, 0.45, 0.87);
-  plwind(0.0, p.t_hi, p.y_bottom, p.y_top);
-  plcol0(kLight);
-  plbox("g", 0, 0, "g", 0, 0);
-  plcol0(kBlack);
-  plbox("bcst", 0, 0, "bcnstv", 0, 0);
-  plmtex("l", 4.2, 0.5, 0.5, "swing rate (deg/s)");
-  // Long file names: shrink the title to fit (about 75 characters fit at full size).
-  plschr(0, 1.1 * std::min(1.0, 75.0 / static_cast<double>(p.title.size())));
-  plmtex("t", 2.6, 0.5, 0.5, p.title.c_str());
-  plschr(0, 0.85);
-  plmtex("t", 1.0, 0.5, 0.5, p.subtitle.c_str());
-  plschr(0, 0.95);
-  // The fitted line first, the measured samples on top of it: where they agree the samples
-  // still show (issue 18); the envelope of a dense log is a thin band, so the line under it is
-  // drawn wide enough to show on both sides.
-  plcol0(kBlue);
-  plwidth(p.dense ? 3.0 : 1.2);
-  if (p.dense) {
-    plline(static_cast<PLINT>(p.fit_t.size()), p.fit_t.data(), p.fit_v.data());
-  } else {
-    plline(static_cast<PLINT>(p.n), p.t.data(), p.fit.data());
+  d->detail = model + "; drag K#dD#u = " + Fmt("%.3g", k * r.params.drag_coeff_kg_m2) + " " +
+              unit + ", viscous C = " + Fmt("%.3g", k * r.params.viscous_coeff_kg_m2_per_s) +
+              " " + unit + "/s" + (d->from_band ? " (whole-window fit's)" : "") +
+              "; gyro bias " + Fmt("%.3f", d->bias_deg_per_s) + " deg/s";
+  d->rate_label = std::string(d->from_band ? "band" : "window") +
+                  ": measured samples (grey) and the fit (blue), from t = " +
+                  Fmt("%.2f", d->window_start_s) + " s of the log";
+  d->residual_label =
+      "measured − fit: rms " + Fmt("%.3g", d->residual_rms_deg_per_s) + " deg/s" +
+      (d->rms_over_noise > 0.0
+           ? " = " + Fmt("%.2f", d->rms_over_noise) + " × gyro noise (lines ±1, ±2)"
+           : std::string()) +
+      "; lag-1 autocorrelation " + Fmt("%.2f", d->autocorr_lag1);
+  if (d->from_band) {
+    d->whole_label = "whole window, band shaded; red: whole-window fit, I = " +
+                     Fmt("%.4g", k * r.inertia_window_kg_m2) + " " + unit + " (not the result)";
   }
-  plwidth(1.0);
-  plcol0(kBlack);
-  plssym(0, 0.45);
-  // measured: filled dots that show on the line (Hershey code 17; dense: their envelope)
-  if (p.dense) {
-    Dots(p, p.t, p.meas, p.env_t, p.env_meas);
-  } else {
-    plpoin(static_cast<PLINT>(p.n), p.t.data(), p.meas.data(), 17);
-  }
-  // Legend (top right, inside).
-  const double lx = 0.62 * p.t_hi, ly = 1.22 * p.y_abs, dx = 0.035 * p.t_hi;
-  const double xs[2] = {lx, lx + dx}, ys[2] = {ly, ly};
-  plcol0(kBlue);
-  plline(2, xs, ys);
-  plcol0(kBlack);
-  plptex(lx + 1.3 * dx, ly, 1, 0, 0, "fitted");
-  const double mx = lx + 0.2 * p.t_hi;
-  const double px[3] = {mx + 0.1 * dx, mx + 0.5 * dx, mx + 0.9 * dx}, py[3] = {ly, ly, ly};
-  plcol0(kBlack);
-  plssym(0, 0.45);
-  plpoin(3, px, py, 17);
-  plcol0(kBlack);
-  plptex(mx + 1.3 * dx, ly, 1, 0, 0, "measured");
-}
-
-// Bottom panel: residuals with the noise bands.
-void ResidualPanel(const TracePage& p) {
-  plvpor(0.10, 0.97, 0.10, 0.35);
-  plwind(0.0, p.t_hi, -p.r_abs, p.r_abs);
-  plcol0(kLight);
-  plbox("g", 0, 0, "g", 0, 0);
-  plcol0(kBlack);
-  plbox("bcnst", 0, 0, "bcnstv", 0, 0);
-  plmtex("b", 3.0, 0.5, 0.5, "time from the start of the window (s)");
-  plmtex("l", 4.2, 0.5, 0.5, "meas. - fit (deg/s)");
-  plmtex("t", 1.4, 0.0, 0.0, p.residual_label.c_str());
-  plcol0(kGrey);
-  plssym(0, 0.35);
-  Dots(p, p.t, p.res, p.res_t, p.res_v);
-  if (p.noise_deg > 0.0) {
-    plcol0(kBand);
-    for (double s : {-2.0, -1.0, 1.0, 2.0}) {
-      const double xs[2] = {0.0, p.t_hi}, ys[2] = {s * p.noise_deg, s * p.noise_deg};
-      pllsty(std::fabs(s) > 1.5 ? 2 : 1);
-      plline(2, xs, ys);
-    }
-    pllsty(1);
-  }
-  plcol0(kBlack);
 }
 
 }  // namespace
 
-// TraceSeries -> TraceTexts -> DenseEnvelope, then drawn: RatePanel -> ResidualPanel.
-bool WriteTraceFitFigure(const TraceFitResult& r, const std::string& path,
-                         const TracePlotOptions& options, std::string* why) {
+std::string ValueWithStd(double value, double std_value) {
+  if (!(std::isfinite(value) && std::isfinite(std_value) && std_value > 0.0)) {
+    return Fmt("%.6g", value);
+  }
+  const int std_exp = static_cast<int>(std::floor(std::log10(std_value)));
+  const int value_exp = value != 0.0 ? static_cast<int>(std::floor(std::log10(std::fabs(value))))
+                                     : std_exp;
+  const int shift = value_exp < -3 || value_exp > 4 ? value_exp : 0;
+  const double scale = std::pow(10.0, -shift);
+  const int decimals = std::max(0, 1 - (std_exp - shift));
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "%.*f ± %.*f", decimals, value * scale, decimals,
+                std_value * scale);
+  if (shift == 0) return buf;
+  return "(" + std::string(buf) + ") × 10#u" + std::to_string(shift) + "#d";
+}
+
+bool MakeTraceFigureData(const TraceFitResult& r, const TracePlotOptions& options,
+                         TraceFigureData* d, std::string* why) {
   const size_t n = r.t_s.size();
   if (n < 2 || r.fitted_rate_rad_per_s.size() != n || r.measured_rate_rad_per_s.size() != n ||
       r.residual_rad_per_s.size() != n) {
-    *why = path + ": no fitted series to plot (fit failed or keep_series was off)";
+    *why = "no fitted series to plot (fit failed or keep_series was off)";
     return false;
   }
+  *d = TraceFigureData();
+  ResultSeries(r, d);
+  Texts(r, options, d);
+  return true;
+}
+
+namespace {
+
+// Everything drawn, with the ranges and the envelopes of dense series.
+struct TracePage {
+  TraceFigureData d;
+  double noise_deg = 0.0;
+  double band_t0 = 0.0, band_t1 = 0.0;  // the band in the whole-window panel's time
+  bool dense = false;
+  std::vector<double> env_t, env_meas, env_res_t, env_res, whole_t, whole_meas, whole_fit_t,
+      whole_fit;
+};
+
+double AbsMax(const std::vector<double>& a, const std::vector<double>& b) {
+  double m = 0.0;
+  for (double v : a) m = std::max(m, std::fabs(v));
+  for (double v : b) m = std::max(m, std::fabs(v));
+  return m > 0.0 ? m : 1.0;
+}
+
+// Measured samples: grey dots (an envelope line when dense), under the fit's line.
+void Samples(const TracePage& p, const std::vector<double>& t, const std::vector<double>& v,
+             const std::vector<double>& et, const std::vector<double>& ev, double dot) {
+  plcol0(kGrey);
+  if (p.dense) {
+    plwidth(1.0);
+    plline(static_cast<PLINT>(et.size()), et.data(), ev.data());
+  } else {
+    plwidth(dot);
+    plpoin(static_cast<PLINT>(t.size()), t.data(), v.data(), -1);  // a point: a round dot
+  }
+  plwidth(1.0);
+}
+
+void Axes(const char* x_opt, const char* y_label) {
+  plcol0(kLight);
+  plbox("g", 0, 0, "g", 0, 0);
+  plcol0(kBlack);
+  plbox(x_opt, 0, 0, "bcnstv", 0, 0);
+  plmtex("l", 5.0, 0.5, 0.5, y_label);
+}
+
+// The whole window (band results only): measured envelope, the whole-window fit, the band shaded.
+void WholePanel(const TracePage& p, double y0, double y1) {
+  const TraceFigureData& d = p.d;
+  plvpor(0.10, 0.97, y0, y1);
+  const double y = 1.1 * AbsMax(d.whole_measured_deg_per_s, d.whole_fitted_deg_per_s);
+  plwind(0.0, d.whole_t_s.back(), -y, y);
+  const PLFLT fx[4] = {p.band_t0, p.band_t1, p.band_t1, p.band_t0}, fy[4] = {-y, -y, y, y};
+  plcol0(kShade);
+  plfill(4, fx, fy);
+  Axes("bcnst", "deg/s");
+  plcol0(kGrey);
+  plline(static_cast<PLINT>(p.whole_t.size()), p.whole_t.data(), p.whole_meas.data());
+  plcol0(kRed);
+  plline(static_cast<PLINT>(p.whole_fit_t.size()), p.whole_fit_t.data(), p.whole_fit.data());
+  plcol0(kBlack);
+  plmtex("t", 0.6, 0.0, 0.0, d.whole_label.c_str());
+}
+
+// The result's fit over its samples.
+void RatePanel(const TracePage& p, double y0, double y1) {
+  const TraceFigureData& d = p.d;
+  plvpor(0.10, 0.97, y0, y1);
+  const double y = 1.1 * AbsMax(d.measured_deg_per_s, d.fitted_deg_per_s);
+  plwind(0.0, d.t_s.back(), -y, y);
+  Axes("bcst", "swing rate (deg/s)");
+  Samples(p, d.t_s, d.measured_deg_per_s, p.env_t, p.env_meas, 3.0);
+  plcol0(kBlue);  // the fit on top: the samples show around it, the line stays visible
+  plwidth(1.6);
+  plline(static_cast<PLINT>(d.t_s.size()), d.t_s.data(), d.fitted_deg_per_s.data());
+  plwidth(1.0);
+  plcol0(kBlack);
+  plmtex("t", 0.6, 0.0, 0.0, d.rate_label.c_str());
+}
+
+// That fit's residuals with the noise lines.
+void ResidualPanel(const TracePage& p, double y0, double y1) {
+  const TraceFigureData& d = p.d;
+  plvpor(0.10, 0.97, y0, y1);
+  const double r = std::max(AbsMax(d.residual_deg_per_s, {}), 2.5 * p.noise_deg) * 1.1;
+  plwind(0.0, d.t_s.back(), -r, r);
+  Axes("bcnst", "deg/s");
+  plmtex("b", 2.8, 0.5, 0.5, "time (s)");
+  Samples(p, d.t_s, d.residual_deg_per_s, p.env_res_t, p.env_res, 2.0);
+  if (p.noise_deg > 0.0) {
+    plcol0(kBand);
+    for (double s : {-2.0, -1.0, 1.0, 2.0}) {
+      const PLFLT xs[2] = {0.0, d.t_s.back()}, ys[2] = {s * p.noise_deg, s * p.noise_deg};
+      plwidth(std::fabs(s) > 1.5 ? 1.0 : 1.6);
+      plline(2, xs, ys);
+    }
+    plwidth(1.0);
+  }
+  plcol0(kBlack);
+  plmtex("t", 0.6, 0.0, 0.0, d.residual_label.c_str());
+}
+
+void Titles(const TracePage& p) {
+  plvpor(0.0, 1.0, 0.0, 1.0);
+  plwind(0.0, 1.0, 0.0, 1.0);
+  plcol0(kBlack);
+  // Long file names: shrink the title to fit (about 80 characters fit at full size).
+  plschr(0, 1.05 * std::min(1.0, 80.0 / static_cast<double>(p.d.title.size())));
+  plptex(0.5, 0.955, 1, 0, 0.5, p.d.title.c_str());
+  plschr(0, 0.8);
+  plptex(0.5, 0.918, 1, 0, 0.5, p.d.subtitle.c_str());
+  plptex(0.5, 0.886, 1, 0, 0.5, p.d.detail.c_str());
+}
+
+}  // namespace
+
+// MakeTraceFigureData, the envelopes of dense series, then drawn: titles, the whole window
+// (band results), the result's fit, its residuals.
+bool WriteTraceFitFigure(const TraceFitResult& r, const std::string& path,
+                         const TracePlotOptions& options, std::string* why) {
   TracePage p;
-  p.n = n;
-  TraceSeries(r, &p);
-  TraceTexts(r, options, &p);
-  DenseEnvelope(options.width_px, &p);
+  if (!MakeTraceFigureData(r, options, &p.d, why)) {
+    *why = path + ": " + *why;
+    return false;
+  }
+  const TraceFigureData& d = p.d;
+  p.noise_deg = r.noise_rad_per_s * kDegPerRad;
+  const size_t buckets = 2 * static_cast<size_t>(std::max(1, options.width_px));
+  p.dense = d.t_s.size() > kMaxDotsDrawn;
+  Envelope(d.t_s, d.measured_deg_per_s, buckets, &p.env_t, &p.env_meas);
+  Envelope(d.t_s, d.residual_deg_per_s, buckets, &p.env_res_t, &p.env_res);
+  if (d.from_band) {
+    Envelope(d.whole_t_s, d.whole_measured_deg_per_s, buckets, &p.whole_t, &p.whole_meas);
+    Envelope(d.whole_t_s, d.whole_fitted_deg_per_s, buckets, &p.whole_fit_t, &p.whole_fit);
+    p.band_t0 = d.window_start_s - r.t_s.front();
+    p.band_t1 = p.band_t0 + d.t_s.back();
+  }
   auto draw = [&] {
+    plscol0a(kShade, 120, 160, 220, 0.2);
     pladv(0);
-    plschr(0, 0.95);
-    RatePanel(p);
-    ResidualPanel(p);
+    plschr(0, 0.8);
+    Titles(p);
+    plschr(0, 0.8);
+    if (d.from_band) {
+      WholePanel(p, 0.69, 0.82);
+      RatePanel(p, 0.35, 0.60);
+      ResidualPanel(p, 0.08, 0.26);
+    } else {
+      RatePanel(p, 0.40, 0.82);
+      ResidualPanel(p, 0.08, 0.31);
+    }
   };
   FigureOptions figure;
   figure.width_px = options.width_px;

@@ -448,7 +448,8 @@ void WriteTraceFigures(const CampaignConfig& config, const TraceProcessOptions& 
     bool drawn = false;
     if (options.compact_figure) {
       drawn = WriteReportTraceFigure(fit, name, config.units, figure_path, options.figure_width_px,
-                                     options.figure_height_px, &why);
+                                     options.figure_height_px, &why,
+                                     record->inertia_total_std_total_kg_m2, "total");
     } else {
       TracePlotOptions figure_options;
       figure_options.title = name;
@@ -457,6 +458,8 @@ void WriteTraceFigures(const CampaignConfig& config, const TraceProcessOptions& 
       figure_options.unit_scale = InertiaToDisplay(1.0, config.units);
       figure_options.unit_label =
           config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+      figure_options.inertia_std_kg_m2 = record->inertia_total_std_total_kg_m2;  // as printed
+      figure_options.std_label = "total";
       drawn = WriteTraceFitFigure(fit, figure_path, figure_options, &why);
     }
     NoteFigure(drawn, figure_path, why, record);
