@@ -296,6 +296,67 @@ std::vector<std::string> ExportInertia::Missing() const {
   return m;
 }
 
+namespace {
+
+// A key of the wrong type in results.json is named with the file (the reader names the key).
+template <typename Read>
+auto NamedRead(const std::string& name, const Read& read) {
+  try {
+    return read();
+  } catch (const UserError& e) {
+    throw UserError(name + ": " + e.what());
+  }
+}
+
+// The mass: the option, else results.json's `aircraft` (written from the config), else (files
+// written before that key) the config stored in results.json.
+void ReadExportMass(const ResultsReader& results, const json& j, const std::string& name,
+                    const ExportOptions& options, ExportInertia* in) {
+  const auto named = [&name](const auto& read) { return NamedRead(name, read); };
+  double stored_mass_kg = kNaN, stored_mass_std_kg = kNaN;
+  if (!std::isnan(options.mass_kg)) {
+    in->mass_kg = options.mass_kg;
+    in->mass_source = "--mass-kg";
+  } else if (j.contains("aircraft")) {  // null: the config gave no mass
+    const ResultsReader aircraft = results.Get("aircraft");
+    stored_mass_kg = named([&] { return aircraft.Num("mass_kg"); });
+    stored_mass_std_kg = named([&] { return aircraft.Num("mass_std_kg"); });
+    if (!std::isnan(stored_mass_kg)) {
+      in->mass_kg = stored_mass_kg;
+      in->mass_std_kg = stored_mass_std_kg;
+      in->mass_source = "config aircraft.mass_kg";
+    }
+  } else if (!named([&] { return results.Str("config"); }).empty()) {  // written before `aircraft` existed
+    try {
+      const YAML::Node config = YAML::Load(results.Str("config"));
+      const YAML::Node aircraft = config.IsMap() ? config["aircraft"] : YAML::Node();
+      // A key that is absent gives an invalid node, whose IsScalar() throws: IsDefined first.
+      const auto scalar = [&aircraft](const char* key) {
+        return aircraft[key].IsDefined() && aircraft[key].IsScalar();
+      };
+      // An absent section or key gives an invalid node, which throws on IsMap()/IsScalar():
+      // IsDefined first, so a config without aircraft.mass_std_kg (or without aircraft) is read
+      // without a warning.
+      if (aircraft.IsDefined() && aircraft.IsMap() && scalar("mass_kg")) {
+        in->mass_kg = aircraft["mass_kg"].as<double>();
+        in->mass_source = "config aircraft.mass_kg";
+        if (scalar("mass_std_kg")) in->mass_std_kg = aircraft["mass_std_kg"].as<double>();
+      }
+    } catch (const YAML::Exception& e) {
+      in->warnings.push_back(name + ": the stored config could not be read for the mass (" +
+                            e.what() + ")");
+    }
+    if (!in->mass_source.empty() && !(std::isfinite(in->mass_kg) && in->mass_kg > 0)) {
+      in->mass_problem = "aircraft.mass_kg = " + Num(in->mass_kg) +
+                        " in the config stored in this result is not a positive mass";
+      in->mass_kg = kNaN;
+      in->mass_source.clear();
+    }
+  }
+}
+
+}  // namespace
+
 ExportInertia ReadExportInertia(const std::string& text, const std::string& name,
                                 const ExportOptions& options, KeyLog* keys_read) {
   std::string why;
@@ -308,15 +369,7 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
                     "); export reads the results.json written by `bifilar process`");
   }
   const ResultsReader results(j, keys_read);
-  // A key of the wrong type is named with the file (the reader names the key).
-  const auto named = [&name](const auto& read) {
-    try {
-      return read();
-    } catch (const UserError& e) {
-      throw UserError(name + ": " + e.what());
-    }
-  };
-  if (!j.is_object() || named([&] { return results.Str("program"); }) != "bifilar") {
+  if (!j.is_object() || NamedRead(name, [&] { return results.Str("program"); }) != "bifilar") {
     throw UserError(name +
                     ": not a results.json written by bifilar (no \"program\": "
                     "\"bifilar\"); export reads the results.json of `bifilar process`");
@@ -379,48 +432,7 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
       in.source[k] = "symmetric";
     }
   }
-  // Mass: the option, else results.json's `aircraft` (written from the config), else (files
-  // written before that key) the config stored in results.json.
-  double stored_mass_kg = kNaN, stored_mass_std_kg = kNaN;
-  if (!std::isnan(options.mass_kg)) {
-    in.mass_kg = options.mass_kg;
-    in.mass_source = "--mass-kg";
-  } else if (j.contains("aircraft")) {  // null: the config gave no mass
-    const ResultsReader aircraft = results.Get("aircraft");
-    stored_mass_kg = named([&] { return aircraft.Num("mass_kg"); });
-    stored_mass_std_kg = named([&] { return aircraft.Num("mass_std_kg"); });
-    if (!std::isnan(stored_mass_kg)) {
-      in.mass_kg = stored_mass_kg;
-      in.mass_std_kg = stored_mass_std_kg;
-      in.mass_source = "config aircraft.mass_kg";
-    }
-  } else if (!named([&] { return results.Str("config"); }).empty()) {  // written before `aircraft` existed
-    try {
-      const YAML::Node config = YAML::Load(results.Str("config"));
-      const YAML::Node aircraft = config.IsMap() ? config["aircraft"] : YAML::Node();
-      // A key that is absent gives an invalid node, whose IsScalar() throws: IsDefined first.
-      const auto scalar = [&aircraft](const char* key) {
-        return aircraft[key].IsDefined() && aircraft[key].IsScalar();
-      };
-      // An absent section or key gives an invalid node, which throws on IsMap()/IsScalar():
-      // IsDefined first, so a config without aircraft.mass_std_kg (or without aircraft) is read
-      // without a warning.
-      if (aircraft.IsDefined() && aircraft.IsMap() && scalar("mass_kg")) {
-        in.mass_kg = aircraft["mass_kg"].as<double>();
-        in.mass_source = "config aircraft.mass_kg";
-        if (scalar("mass_std_kg")) in.mass_std_kg = aircraft["mass_std_kg"].as<double>();
-      }
-    } catch (const YAML::Exception& e) {
-      in.warnings.push_back(name + ": the stored config could not be read for the mass (" +
-                            e.what() + ")");
-    }
-    if (!in.mass_source.empty() && !(std::isfinite(in.mass_kg) && in.mass_kg > 0)) {
-      in.mass_problem = "aircraft.mass_kg = " + Num(in.mass_kg) +
-                        " in the config stored in this result is not a positive mass";
-      in.mass_kg = kNaN;
-      in.mass_source.clear();
-    }
-  }
+  ReadExportMass(results, j, name, options, &in);
   in.nonphysical = NonPhysical(in);
   if (!in.nonphysical.empty()) in.warnings.push_back(name + ": " + in.nonphysical);
   return in;
