@@ -11,6 +11,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "base/text_format.h"
 #include "fit/residual_stats.h"
 #include "fit/trace_cost.h"
 #include "fit/trace_fit_steps.h"
@@ -18,12 +19,6 @@
 
 namespace bifilar {
 namespace trace {
-
-std::string Fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), format, v);
-  return buf;
-}
 
 double RmsAboutMean(const std::vector<double>& v) {
   if (v.empty()) return 0.0;
@@ -257,7 +252,6 @@ TraceFitResult Finish(TraceFitResult r, const std::string& label,
 }  // namespace
 }  // namespace trace
 
-using trace::Fmt;
 
 const char* ToString(TraceFitStatus status) {
   switch (status) {

@@ -24,6 +24,7 @@
 // warnings are collected per step and joined in this order.
 #pragma once
 
+#include "base/text_format.h"  // Fmt, a number for a message
 #include "base/units.h"
 #include "fit/trace_fit.h"
 
@@ -42,9 +43,6 @@ namespace trace {
 
 // Scaled parameters, indexed by TraceParamIndex (fit/trace_cost.h).
 using Params = std::array<double, kNumTraceParams>;
-
-// A number for a message, printf-formatted.
-std::string Fmt(const char* format, double v);
 
 // Flags (short machine-readable names) and warnings (one sentence each) raised by a step.
 struct Findings {

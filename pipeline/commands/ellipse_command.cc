@@ -4,18 +4,13 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "base/text_format.h"
 #include "base/user_error.h"
 #include "pipeline/figures/ellipse_plot.h"
 #include "pipeline/records/ellipse_json.h"
 
 namespace bifilar {
 namespace {
-
-std::string Fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
 
 // "value +- std" in display units, or "undefined".
 std::string ValueStd(double v, double s, bool has_std, const char* format) {

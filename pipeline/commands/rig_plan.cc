@@ -9,6 +9,7 @@
 #include <limits>
 #include <random>
 
+#include "base/text_format.h"
 #include "base/user_error.h"
 #include "fit/trace_fit.h"
 #include "fit/trace_synth.h"
@@ -28,12 +29,6 @@ constexpr double kMaxRelaxedSeparationM = 5.0, kMaxRelaxedLengthM = 20.0;  // pl
 constexpr double kMaxSeparationOverLength = 0.9;  // keep the wires from splaying past ~64 deg
 // Machined reference bar: tolerance on length and width, and the weighing (fraction).
 constexpr double kBarToleranceM = 5e-5, kBarWeighingRelStd = 2e-4;
-
-std::string Fmt(const char* format, double v) {
-  char b[96];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
-}
 
 bool Bad(double v) { return !std::isfinite(v); }
 

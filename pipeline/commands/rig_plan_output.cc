@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "base/user_error.h"
+#include "base/text_format.h"
 #include "pipeline/commands/rig_plan.h"
 #include "pipeline/config/config.h"
 #include "pipeline/config/config_template.h"
@@ -14,12 +15,6 @@
 
 namespace bifilar {
 namespace {
-
-std::string Fmt(const char* format, double v) {
-  char b[96];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
-}
 
 std::string Pct(double fraction) { return Fmt("%.3g %%", 100.0 * fraction); }
 

@@ -7,18 +7,13 @@
 #include <string>
 
 #include "base/json_number.h"
+#include "base/text_format.h"
 #include "base/user_error.h"
 
 namespace bifilar {
 namespace {
 
 using nlohmann::json;
-
-std::string Fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
 
 // No "-0.000" in a table.
 double Clean(double v) { return std::fabs(v) < 5e-7 ? 0.0 : v; }

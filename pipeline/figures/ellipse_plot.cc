@@ -7,6 +7,7 @@
 
 #include <plplot.h>
 
+#include "base/text_format.h"
 #include "base/units.h"
 
 namespace bifilar {
@@ -25,12 +26,6 @@ void DrawFittedCurve(const std::vector<double>& x, const std::vector<double>& y)
   plline(static_cast<PLINT>(x.size()), x.data(), y.data());
   pllsty(1);
   plwidth(1.0);
-}
-
-std::string Fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
 }
 
 double Curve(const EllipseResult& r, double pitch_deg) {

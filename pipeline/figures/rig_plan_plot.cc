@@ -7,16 +7,11 @@
 #include <cstdio>
 #include <vector>
 
+#include "base/text_format.h"
 #include "pipeline/figures/figure.h"
 
 namespace bifilar {
 namespace {
-
-std::string Fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
 
 // Row pointers over a column-major copy: z[i][j] at separation i, length j (PLplot's layout).
 struct Grid2 {

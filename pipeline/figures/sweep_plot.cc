@@ -7,6 +7,7 @@
 
 #include <plplot.h>
 
+#include "base/text_format.h"
 #include "base/units.h"
 
 namespace bifilar {
@@ -17,12 +18,6 @@ enum Colour {
   kLight = kFigureLight,
   kBandFill = 8,  // kFigureBand at 25 % opacity: the reported I's +-1 sigma band
 };
-
-std::string Fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
 
 // A red ring of radii (rx, ry) in world units around (mx, my), 2 px wide.
 void DrawRing(double mx, double my, double rx, double ry) {

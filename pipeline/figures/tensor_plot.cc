@@ -7,16 +7,11 @@
 
 #include <plplot.h>
 
+#include "base/text_format.h"
 #include "base/units.h"
 
 namespace bifilar {
 namespace {
-
-std::string Fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
 
 // A body plane seen in a panel: the body axes along the panel's horizontal and vertical
 // directions (unit vectors in body axes) and their labels.

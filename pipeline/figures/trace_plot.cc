@@ -7,6 +7,7 @@
 
 #include <plplot.h>
 
+#include "base/text_format.h"
 #include "base/units.h"
 #include "pipeline/figures/figure.h"
 
@@ -18,12 +19,6 @@ enum Colour {
   kLight = kFigureLight, kBand = kFigureBand,
   kShade = 8,  // the band's span in the whole-window panel
 };
-
-std::string Fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
 
 // Above this many samples a dot per sample is drawn no more (more than ~8 per pixel column show
 // nothing more, and a 3 M-sample log took 110 s and gave a 750 MB SVG): each series becomes its
