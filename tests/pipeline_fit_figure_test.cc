@@ -370,6 +370,15 @@ TEST(FigureExtremes, EllipseFiguresStayOnThePage) {
       SCOPED_TRACE(table + figure);
       ExpectLightSearchableSvg(out + "/" + table + figure, "llipse of inertia");
     }
+    // The polar panels draw tiny and huge radii in units of a power of ten named in the axis
+    // labels, not with PLplot's own "(x10^n)" mark, which covered the title and the unit.
+    const std::string polar = ReadFile(out + "/" + table + "/ellipse_polar.svg");
+    EXPECT_EQ(polar.find("(x10"), std::string::npos) << table;
+    const std::string power = table == "four" ? "3" : "-5";  // slug ft^2 in thousands; 1e-5 kg m^2
+    const size_t ten = polar.find("(10<tspan");
+    ASSERT_NE(ten, std::string::npos) << table;
+    const size_t exponent = polar.find('>', ten + 9) + 1;
+    EXPECT_EQ(polar.compare(exponent, power.size() + 1, power + "<"), 0) << polar.substr(ten, 80);
   }
 }
 

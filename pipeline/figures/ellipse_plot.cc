@@ -209,6 +209,26 @@ static std::string InverseSqrtUnit(const std::string& unit) {
   return "1/#(2267)(" + unit + ")";
 }
 
+namespace {
+
+// The power of ten to draw radii up to `r_max` in: 0 within [0.1, 1000), else its exponent.
+int PowerOfTenFor(double r_max) {
+  if (!(r_max > 0) || !std::isfinite(r_max) || (r_max >= 0.1 && r_max < 1000.0)) return 0;
+  return static_cast<int>(std::floor(std::log10(r_max)));
+}
+
+// "(slug ft^2)" drawn in units of 10^power: "(10^power slug ft^2)".
+std::string ScaledUnit(const std::string& unit, int power) {
+  if (power == 0) return unit;
+  const std::string ten = "10#u" + std::to_string(power) + "#d ";
+  if (unit.size() >= 2 && unit.front() == '(' && unit.back() == ')') {
+    return "(" + ten + unit.substr(1);
+  }
+  return "(" + ten + unit + ")";
+}
+
+}  // namespace
+
 bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
                              const EllipsePlotOptions& options, std::string* why) {
   const double k = options.unit_scale;
@@ -250,6 +270,14 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
       py.push_back(-rr * dy);
       r_max = std::max(r_max, rr);
     }
+    // Radii far from 1 are drawn in units of a power of ten named in the axis labels: PLplot's
+    // own "(x10^n)" mark sits where it covers the title or the unit.
+    const int power = PowerOfTenFor(r_max);
+    const double scale = std::pow(10.0, -power);
+    for (std::vector<double>* v : {&cx, &cy, &px, &py}) {
+      for (double& x : *v) x *= scale;
+    }
+    r_max *= scale;
     // Room between the data and the frame for the axis labels (x_p, x_body were cut or covered).
     const double lim = 1.6 * r_max;
     plcol0(kBlack);
@@ -257,8 +285,9 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
     plwind(-lim, lim, -lim, lim);
     plbox("bcnst", 0, 0, "bcnstv", 0, 0);
     // (slug ft^2)^-1/2 written slug^-1/2 ft^-1: a superscript inside a superscript is garbled.
-    const std::string unit = inverse_sqrt ? InverseSqrtUnit(options.unit_label)
-                                          : "(" + options.unit_label + ")";
+    const std::string unit = ScaledUnit(inverse_sqrt ? InverseSqrtUnit(options.unit_label)
+                                                     : "(" + options.unit_label + ")",
+                                        power);
     pllab(("forward, x#dbody#u  " + unit).c_str(), ("up, -z#dbody#u  " + unit).c_str(),
           inverse_sqrt ? "Ellipse of inertia, radius 1/#(2267)I(#gh)"
                        : "Moments in polar coordinates, radius I(#gh)");
