@@ -196,39 +196,6 @@ bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
 }
 
 
-// "(U)^-1/2" of a display unit "A B#u2#d" (PLplot text) as "A#u-1/2#d B#u-1#d"; other labels as
-// "1/#(2267)(U)".
-static std::string InverseSqrtUnit(const std::string& unit) {
-  const std::string squared = "#u2#d";
-  const size_t space = unit.find(' ');
-  if (space != std::string::npos && unit.size() > squared.size() &&
-      unit.compare(unit.size() - squared.size(), squared.size(), squared) == 0) {
-    return "(" + unit.substr(0, space) + "#u-1/2#d " +
-           unit.substr(space + 1, unit.size() - squared.size() - space - 1) + "#u-1#d)";
-  }
-  return "1/#(2267)(" + unit + ")";
-}
-
-namespace {
-
-// The power of ten to draw radii up to `r_max` in: 0 within [0.1, 1000), else its exponent.
-int PowerOfTenFor(double r_max) {
-  if (!(r_max > 0) || !std::isfinite(r_max) || (r_max >= 0.1 && r_max < 1000.0)) return 0;
-  return static_cast<int>(std::floor(std::log10(r_max)));
-}
-
-// "(slug ft^2)" drawn in units of 10^power: "(10^power slug ft^2)".
-std::string ScaledUnit(const std::string& unit, int power) {
-  if (power == 0) return unit;
-  const std::string ten = "10#u" + std::to_string(power) + "#d ";
-  if (unit.size() >= 2 && unit.front() == '(' && unit.back() == ')') {
-    return "(" + ten + unit.substr(1);
-  }
-  return "(" + ten + unit + ")";
-}
-
-}  // namespace
-
 bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
                              const EllipsePlotOptions& options, std::string* why) {
   const double k = options.unit_scale;

@@ -31,4 +31,15 @@ enum FigureColour {
 bool WriteFigure(const std::string& path, const FigureOptions& options,
                  const std::function<void()>& draw, std::string* why);
 
+// Axis units in PLplot text. "(U)^-1/2" of a display unit "A B#u2#d" as "(A#u-1/2#d B#u-1#d)"
+// (a superscript inside a superscript is garbled); other labels as "1/#(2267)(U)".
+std::string InverseSqrtUnit(const std::string& unit);
+
+// The power of ten to draw values up to `r_max` in: 0 within [0.1, 1000), else its exponent
+// (PLplot's own "(x10^n)" mark sits where it covers titles and units).
+int PowerOfTenFor(double r_max);
+
+// "(slug ft^2)" for values drawn in units of 10^power: "(10^power slug ft^2)".
+std::string ScaledUnit(const std::string& unit, int power);
+
 }  // namespace bifilar

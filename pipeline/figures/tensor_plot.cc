@@ -104,7 +104,7 @@ void ViewPanel(const TensorResult& r, const std::array<double, kTensorComponents
   plvpas(x0, x1, y0, y1, 1.0);
   plwind(-lim, lim, -lim, lim);
   plbox("bcnst", 0, 0, "bcnstv", 0, 0);
-  const std::string unit = "(" + options.unit_label + ")#u-1/2#d";
+  const std::string unit = InverseSqrtUnit(options.unit_label);
   pllab((std::string(view.h_label) + "  " + unit).c_str(),
         (std::string(view.v_label) + "  " + unit).c_str(), view.title);
   plcol0(kFigureGrey);
