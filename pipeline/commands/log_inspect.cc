@@ -10,6 +10,7 @@
 #include "base/bounded_read.h"
 #include "base/gzip.h"
 #include "base/json_number.h"
+#include "base/text_format.h"
 #include "base/units.h"
 #include "base/user_error.h"
 #include "fit/swing_axis.h"
@@ -187,12 +188,6 @@ std::string Abbreviated(const std::string& s, size_t max_bytes = 80) {
   return s.substr(0, cut) + "\u2026 (" + std::to_string(s.size()) + " bytes)";
 }
 
-std::string Format(const char* fmt, double a) {
-  char buffer[128];
-  std::snprintf(buffer, sizeof(buffer), fmt, a);
-  return buffer;
-}
-
 // Delimiter: the one that splits the header into the most cells, consistently with row 2.
 char GuessDelimiter(const std::vector<std::string>& lines) {
   char delim = ',';
@@ -263,7 +258,7 @@ void GuessTimeUnit(const ColumnName& name, const std::vector<double>& tc, Format
     guess->format.time_unit = step < 0.5     ? TimeUnit::kSeconds
                               : step < 500.0 ? TimeUnit::kMilliseconds
                                              : TimeUnit::kMicroseconds;
-    time_why = Format("from its median step, %.4g", step);
+    time_why = Fmt("from its median step, %.4g", step);
   } else {
     time_why = "default, no steps to judge by";
   }
@@ -291,7 +286,7 @@ void GuessGyroUnit(const std::vector<ColumnName>& names, const std::array<int, 3
     gyro_why = "from the column names";
   } else if (std::isfinite(p99)) {
     guess->format.gyro_unit = p99 > kDegPerSGuessAbove ? RateUnit::kDegPerS : RateUnit::kRadPerS;
-    gyro_why = Format("from the readings: 99th percentile of |rate| %.3g", p99) +
+    gyro_why = Fmt("from the readings: 99th percentile of |rate| %.3g", p99) +
                (p99 > kDegPerSGuessAbove ? " is no pendulum in rad/s" : "");
   } else {
     gyro_why = "default";
@@ -316,7 +311,7 @@ void GuessAccelUnit(const std::array<int, 3>& accel,
   guess->guesses.push_back("accelerometer columns " + guess->format.accel_columns[0] + ", " +
                            guess->format.accel_columns[1] + ", " + guess->format.accel_columns[2] +
                            " in " + ToString(guess->format.accel_unit) +
-                           (std::isfinite(norm) ? Format(" (median |f| %.3g)", norm) : ""));
+                           (std::isfinite(norm) ? Fmt(" (median |f| %.3g)", norm) : ""));
 }
 
 }  // namespace
@@ -516,7 +511,7 @@ void RefineGyroUnitGuess(ImuData* data, InspectReport* report) {
     if (g.rfind("gyro columns", 0) == 0) {
       g = "gyro columns " + report->format.gyro_columns[0] + ", " + report->format.gyro_columns[1] +
           ", " + report->format.gyro_columns[2] +
-          Format(" in deg/s (from the readings: 99th percentile of |rate| %.3g over the log is no "
+          Fmt(" in deg/s (from the readings: 99th percentile of |rate| %.3g over the log is no "
                  "pendulum in rad/s)", p99);
     }
   }
@@ -601,7 +596,7 @@ void SwingAndWindow(const ImuData& data, const CampaignConfig* config, InspectRe
     }
     report->amplitude_deg = {hi, lo};
     if (hi < 1.0) {
-      report->warnings.push_back(Format("largest amplitude %.2g deg: a real swing is several deg; "
+      report->warnings.push_back(Fmt("largest amplitude %.2g deg: a real swing is several deg; "
                                         "check the gyro unit (imu.gyro.unit)",
                                         hi));
     }
@@ -731,7 +726,7 @@ std::string InspectReportText(const InspectReport& r) {
       std::snprintf(line, sizeof(line), "    %-32s multi_id %d  %7ld samples", t.topic.c_str(),
                     t.multi_id, t.samples);
       out << line;
-      if (t.rate_hz > 0) out << Format("  %.1f Hz", t.rate_hz);
+      if (t.rate_hz > 0) out << Fmt("  %.1f Hz", t.rate_hz);
       out << "\n";
     }
   }
@@ -740,13 +735,13 @@ std::string InspectReportText(const InspectReport& r) {
     for (const DataflashMessageInfo& m : r.messages) {
       std::snprintf(line, sizeof(line), "    %-6s %8ld", m.name.c_str(), m.count);
       out << line;
-      if (m.rate_hz() > 0) out << Format("  %8.1f Hz", m.rate_hz());
+      if (m.rate_hz() > 0) out << Fmt("  %8.1f Hz", m.rate_hz());
       if (!m.instances.empty()) {
         out << "  instances (" << m.instance_field << "):";
         const double span_s = m.last_time_s - m.first_time_s;
         for (const auto& [instance, count] : m.instances) {
           out << " " << instance << " (" << count;
-          if (span_s > 0 && count > 1) out << Format(", %.1f Hz", (count - 1) / span_s);
+          if (span_s > 0 && count > 1) out << Fmt(", %.1f Hz", (count - 1) / span_s);
           out << ")";
         }
       }
@@ -774,7 +769,7 @@ std::string InspectReportText(const InspectReport& r) {
                   r.swing_axis_in_imu[0], r.swing_axis_in_imu[1], r.swing_axis_in_imu[2],
                   r.swing_axis_source.c_str());
     out << line;
-    if (r.pitch_measured_deg) out << Format(", measured pitch %.2f deg", *r.pitch_measured_deg);
+    if (r.pitch_measured_deg) out << Fmt(", measured pitch %.2f deg", *r.pitch_measured_deg);
     out << "\n";
   }
   if (r.window_status == "ok") {
