@@ -82,6 +82,23 @@ std::string ShortNumber(double value) {
   return text;
 }
 
+
+// Appends point (qx, qy), in tenths of a pixel, to the path `d`: "Mx yl" for the first point,
+// then the relative step from the last (*px, *py), without the blanks a sign makes redundant.
+void AppendPathPoint(long qx, long qy, bool first, long* px, long* py, std::string* d) {
+  if (first) {
+    *d = "M" + ShortNumber(qx / 10.0) + " " + ShortNumber(qy / 10.0) + "l";
+  } else {
+    const std::string dx = ShortNumber((qx - *px) / 10.0), dy = ShortNumber((qy - *py) / 10.0);
+    if (d->back() != 'l' && dx[0] != '-') *d += ' ';
+    *d += dx;
+    if (dy[0] != '-') *d += ' ';
+    *d += dy;
+  }
+  *px = qx;
+  *py = qy;
+}
+
 // A cairo polyline `<path ... d="M x y L x y ..." transform="matrix(1,0,0,-1,0,H)"/>` rewritten
 // with the flip applied and relative line-tos ("M x y l dx dy dx dy ..."), every point rounded
 // to 0.1 px first so the sums do not drift; other paths come back unchanged. About half the
@@ -113,18 +130,7 @@ std::string CompactPolyline(const std::string& tag) {
     double x = NAN, y = NAN;
     if (!(in >> x >> y) || !std::isfinite(x) || !std::isfinite(y)) return tag;
     if (std::isfinite(flip_height)) y = flip_height - y;
-    const long qx = std::lround(10.0 * x), qy = std::lround(10.0 * y);
-    if (first) {
-      d = "M" + ShortNumber(qx / 10.0) + " " + ShortNumber(qy / 10.0) + "l";
-    } else {
-      const std::string dx = ShortNumber((qx - px) / 10.0), dy = ShortNumber((qy - py) / 10.0);
-      if (d.back() != 'l' && dx[0] != '-') d += ' ';
-      d += dx;
-      if (dy[0] != '-') d += ' ';
-      d += dy;
-    }
-    px = qx;
-    py = qy;
+    AppendPathPoint(std::lround(10.0 * x), std::lround(10.0 * y), first, &px, &py, &d);
     first = false;
   }
   if (first) return tag;
@@ -193,18 +199,8 @@ std::string PathOfPoints(const std::vector<double>& xy, double height, bool clos
   std::string d;
   long px = 0, py = 0;
   for (size_t i = 0; i + 1 < xy.size(); i += 2) {
-    const long qx = std::lround(10.0 * xy[i]), qy = std::lround(10.0 * (height - xy[i + 1]));
-    if (i == 0) {
-      d = "M" + ShortNumber(qx / 10.0) + " " + ShortNumber(qy / 10.0) + "l";
-    } else {
-      const std::string dx = ShortNumber((qx - px) / 10.0), dy = ShortNumber((qy - py) / 10.0);
-      if (d.back() != 'l' && dx[0] != '-') d += ' ';
-      d += dx;
-      if (dy[0] != '-') d += ' ';
-      d += dy;
-    }
-    px = qx;
-    py = qy;
+    AppendPathPoint(std::lround(10.0 * xy[i]), std::lround(10.0 * (height - xy[i + 1])), i == 0,
+                    &px, &py, &d);
   }
   if (!d.empty() && d.back() == 'l') d += "0 0";  // one point: a dot (round caps)
   if (close && !d.empty()) d += "Z";
