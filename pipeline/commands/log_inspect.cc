@@ -188,6 +188,13 @@ std::string Abbreviated(const std::string& s, size_t max_bytes = 80) {
   return s.substr(0, cut) + "\u2026 (" + std::to_string(s.size()) + " bytes)";
 }
 
+// Names joined with ", ", at most 400 bytes of them (a header of thousands of columns is cut).
+std::string JoinedNames(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  return Abbreviated(list, 400);
+}
+
 // Delimiter: the one that splits the header into the most cells, consistently with row 2.
 char GuessDelimiter(const std::vector<std::string>& lines) {
   char delim = ',';
@@ -334,12 +341,10 @@ bool ChosenColumnsPresent(const std::vector<std::string>& header, const ColumnCh
   for (const std::string& g : choice.gyro) {
     if (!g.empty()) wanted.push_back(g);
   }
-  std::string list;
-  for (const std::string& h : header) list += (list.empty() ? "" : ", ") + h;
   for (const std::string& w : wanted) {
     if (HeaderIndex(header, w) < 0) {
       *why = "no column '" + w + "' among the " + std::to_string(header.size()) +
-             " column(s) of the first line: " + Abbreviated(list, 400);
+             " column(s) of the first line: " + JoinedNames(header);
       return false;
     }
   }
@@ -350,10 +355,8 @@ bool ChosenColumnsPresent(const std::vector<std::string>& header, const ColumnCh
 
 std::string UnrecognisedColumnsMessage(const std::vector<std::string>& header,
                                        const std::string& what) {
-  std::string list;
-  for (const std::string& h : header) list += (list.empty() ? "" : ", ") + h;
   return "no " + what + " recognised among the " + std::to_string(header.size()) +
-         " column(s) of the first line: " + Abbreviated(list, 400) +
+         " column(s) of the first line: " + JoinedNames(header) +
          ". Name them in the config (imu.time: {column: T, unit: s|ms|us}, imu.gyro: {columns: "
          "[X, Y, Z], unit: rad/s|deg/s}), or let bifilar write that config: bifilar init --log "
          "LOG --time T --gyro X,Y,Z --rig L,D,MASS (units are still guessed from the data)";
@@ -716,9 +719,7 @@ std::string InspectReportText(const InspectReport& r) {
   char line[512];
   out << r.file << ": " << r.kind << (r.compressed ? " (gzip)" : "") << "\n";
   if (!r.columns.empty()) {
-    std::string list;
-    for (const std::string& c : r.columns) list += (list.empty() ? "" : ", ") + c;
-    out << "  columns (" << r.columns.size() << "): " << Abbreviated(list, 400) << "\n";
+    out << "  columns (" << r.columns.size() << "): " << JoinedNames(r.columns) << "\n";
   }
   if (!r.topics.empty()) {
     out << "  topics (" << r.topics.size() << "):\n";
