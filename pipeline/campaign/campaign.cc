@@ -19,6 +19,7 @@
 #include "base/hash.h"
 #include "base/interrupt.h"
 #include "base/parallel_runner.h"
+#include "base/statistics.h"
 #include "base/units.h"
 #include "base/user_error.h"
 #include "base/version.h"
@@ -41,20 +42,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-double Mean(const std::vector<double>& v) {
-  double s = 0.0;
-  for (double x : v) s += x;
-  return v.empty() ? NAN : s / v.size();
-}
-
-double SampleStd(const std::vector<double>& v) {
-  if (v.size() < 2) return NAN;
-  const double m = Mean(v);
-  double s = 0.0;
-  for (double x : v) s += (x - m) * (x - m);
-  return std::sqrt(s / (v.size() - 1));
-}
 
 // ---- Before any work: options, config, the output folder --------------------------------------
 

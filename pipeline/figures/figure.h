@@ -16,13 +16,18 @@ struct FigureOptions {
 // (background white, foreground black).
 enum FigureColour {
   kFigureBlack = 1,
-  kFigureBlue = 2,   // fits, curves
-  kFigureRed = 3,    // principal axes, warnings
-  kFigureGrey = 4,   // measured data
-  kFigureGreen = 5,  // body-axis markers
-  kFigureLight = 6,  // grid lines
-  kFigureBand = 7,   // noise bands
+  kFigureBlue = 2,             // fits, curves
+  kFigureRed = 3,              // principal axes, warnings
+  kFigureGrey = 4,             // measured data
+  kFigureGreen = 5,            // body-axis markers
+  kFigureLight = 6,            // grid lines
+  kFigureBand = 7,             // noise bands
+  kFigureTranslucentBand = 8,  // kFigureBand's colour at an opacity the figure sets (below)
 };
+
+// Sets kFigureTranslucentBand to kFigureBand's colour at `opacity` (0-1): a band behind the
+// data. Call inside `draw`.
+void SetTranslucentBand(double opacity);
 
 // Draws `draw` (PLplot C API calls: plenv, plline, ... between plinit and plend) into `path`.
 // The device follows the extension: ".png" -> pngcairo, ".svg" -> PLplot's svg driver (text
