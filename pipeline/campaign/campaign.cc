@@ -421,7 +421,7 @@ void WarnIfAttitudesDisagree(const CampaignConfig& config, TraceRecord* r) {
       DownInBodyFromAttitude(r->roll_measured_deg.value_or(0.0), *r->pitch_measured_deg);
   double dot = 0.0;
   for (int k = 0; k < 3; ++k) dot += nominal[k] * measured[k];
-  const double angle_deg = std::acos(std::clamp(dot, -1.0, 1.0)) * 180.0 / kPi;
+  const double angle_deg = std::acos(std::clamp(dot, -1.0, 1.0)) * kDegPerRad;
   if (angle_deg <= config.runs.attitude_tolerance_deg) return;
   char buffer[320];
   std::snprintf(buffer, sizeof(buffer),
@@ -622,10 +622,8 @@ void DrawCampaignFigures(const CampaignConfig& config, const EllipseResult& fit,
   }
   const std::string hash = HashToHex(Fnv1a64(key.str()));
   EllipsePlotOptions plot;
-  if (config.units == DisplayUnits::kImperial) {
-    plot.unit_scale = kSlugFt2PerKgM2;
-    plot.unit_label = "slug ft#u2#d";
-  }
+  plot.unit_label = InertiaUnitPlotLabel(config.units);
+  if (config.units == DisplayUnits::kImperial) plot.unit_scale = kSlugFt2PerKgM2;
   const fs::path figures = out->figures();
   std::error_code ec;
   std::string why;

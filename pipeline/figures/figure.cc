@@ -109,6 +109,10 @@ std::string InverseSqrtUnit(const std::string& unit) {
   return "1/#(2267)(" + unit + ")";
 }
 
+const char* InertiaUnitPlotLabel(DisplayUnits units) {
+  return units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+}
+
 void SetTranslucentBand(double opacity) {
   plscol0a(kFigureTranslucentBand, kBandRgb[0], kBandRgb[1], kBandRgb[2], opacity);
 }

@@ -5,6 +5,8 @@
 #include <functional>
 #include <string>
 
+#include "base/units.h"
+
 namespace bifilar {
 
 struct FigureOptions {
@@ -35,6 +37,9 @@ void SetTranslucentBand(double opacity);
 // to a temporary name and renamed. Returns false with *why set on failure.
 bool WriteFigure(const std::string& path, const FigureOptions& options,
                  const std::function<void()>& draw, std::string* why);
+
+// The name of the inertia unit (InertiaUnitName) in PLplot text: "kg m#u2#d" or "slug ft#u2#d".
+const char* InertiaUnitPlotLabel(DisplayUnits units);
 
 // Axis units in PLplot text. "(U)^-1/2" of a display unit "A B#u2#d" as "(A#u-1/2#d B#u-1#d)"
 // (a superscript inside a superscript is garbled); other labels as "1/#(2267)(U)".
