@@ -20,6 +20,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "base/units.h"
 #include "fit/ellipse.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/commands/ellipse_table.h"
@@ -40,7 +41,7 @@ std::string EllipseTable(int rows) {
   text << "pitch_deg,inertia\n";
   text.precision(8);
   for (int i = 0; i < rows; ++i) {
-    const double d = pitch(rng), t = d * M_PI / 180.0;
+    const double d = pitch(rng), t = d * kRadPerDeg;
     text << d << ',' << 2.8 * std::cos(t) * std::cos(t) + 2.3 * std::sin(t) * std::sin(t) +
                             0.02 * std::sin(2 * t) + noise(rng)
          << '\n';
@@ -84,7 +85,7 @@ struct FakeCampaignDir {
       const int pitch = -60 + 30 * (i % 6);
       const std::string name = "p" + std::to_string(pitch) + "/l" + std::to_string(i) + ".csv";
       fs::create_directories(dir + "/logs/p" + std::to_string(pitch));
-      const double t = pitch * M_PI / 180.0;
+      const double t = pitch * kRadPerDeg;
       std::ofstream(dir + "/logs/" + name)
           << "I=" << 3 + std::sin(t) * std::sin(t) + 0.5 + 1e-6 * i << "\n";
       if (windows) yaml << "    " << name << ": [1, 20]\n";

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "base/units.h"
 #include "base/user_error.h"
 #include "fit/glitch.h"
 #include "fit/trace_fit.h"
@@ -221,7 +222,7 @@ std::string CrazyflieFit(double mass_kg) {
 // The synthetic window of tests/pipeline_real_rig_test.cc (CoverageUnderColouredNoise...).
 SyntheticTraceOptions CoverageTrace(double phi, int seed) {
   SyntheticTraceOptions o;
-  o.geometry = {2.0, 1.8, 6.75, 9.80665};
+  o.geometry = {2.0, 1.8, 6.75, kStandardGravityMps2};
   o.params = {4.1, 0.04, 0.01};
   o.amplitude_deg = 10.0 + 0.5 * (seed % 30);
   o.duration_s = 40.0;
@@ -249,11 +250,11 @@ DataSet SyntheticSet(const std::string& name, double phi, int n, double sway_fra
     if (sway_fraction > 0.0) {
       // Sway leaking into the measured rate: a decaying 0.65 Hz oscillation (the swing is at
       // 0.41 Hz) of sway_fraction times the swing's initial rate amplitude.
-      const double omega = 2.0 * M_PI * 0.407;
-      const double amp = sway_fraction * o.amplitude_deg * M_PI / 180.0 * omega;
+      const double omega = 2.0 * kPi * 0.407;
+      const double amp = sway_fraction * o.amplitude_deg * kRadPerDeg * omega;
       for (size_t k = 0; k < in.t_s.size(); ++k) {
         const double t = in.t_s[k] - in.t_s[0];
-        in.rate_rad_per_s[k] += amp * std::exp(-t / 30.0) * std::sin(2.0 * M_PI * 0.65 * t + seed);
+        in.rate_rad_per_s[k] += amp * std::exp(-t / 30.0) * std::sin(2.0 * kPi * 0.65 * t + seed);
       }
     }
     set.traces.push_back(SurveyWindow(in));

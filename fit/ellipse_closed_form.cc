@@ -13,8 +13,6 @@ namespace bifilar {
 namespace ellipse {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 // The variance factor of the covariance mode and the degrees of freedom of its intervals.
 void VarianceFactor(const PreparedData& data, const ClosedFormFit& closed, double* factor,
                     double* dof) {
@@ -42,7 +40,7 @@ void VarianceFactor(const PreparedData& data, const ClosedFormFit& closed, doubl
     }
     default:
       *factor = 1.0;
-      *dof = kInf;
+      *dof = std::numeric_limits<double>::infinity();  // normal intervals
       return;
   }
 }
@@ -53,8 +51,10 @@ double CircleChi2(const Eigen::Vector3d& abc, const Eigen::Matrix3d& cov_abc) {
   const Eigen::Vector2d bc(abc(1), abc(2));
   const Eigen::LDLT<Eigen::Matrix2d> ldlt(cov_bc);
   if (std::hypot(abc(1), abc(2)) == 0.0) return 0.0;
-  return (ldlt.info() == Eigen::Success && cov_bc.determinant() > 0) ? bc.dot(ldlt.solve(bc))
-                                                                     : kInf;
+  if (!(ldlt.info() == Eigen::Success && cov_bc.determinant() > 0)) {
+    return std::numeric_limits<double>::infinity();
+  }
+  return bc.dot(ldlt.solve(bc));
 }
 
 // Standard errors of the six quantities from Ceres' (J^T J)^-1 in (I_zp, I_xp, tau): mapped to

@@ -4,19 +4,11 @@
 #include <cmath>
 #include <cstdio>
 
+#include "base/statistics.h"
 #include "fit/window.h"
 
 namespace bifilar {
 namespace {
-
-double MedianInPlace(std::vector<double>* v) {
-  if (v->empty()) return 0.0;
-  const size_t mid = v->size() / 2;
-  std::nth_element(v->begin(), v->begin() + mid, v->end());
-  double m = (*v)[mid];
-  if (v->size() % 2 == 0) m = 0.5 * (m + *std::max_element(v->begin(), v->begin() + mid));
-  return m;
-}
 
 // The four samples nearest to the span [k, k + m) outside it: two on each side inside the
 // series, else more on the other side; for n >= m + 4. With m = 1, the neighbours of sample k.

@@ -359,7 +359,7 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
   if (solve_budget.Exhausted()) return finish(Stopped(std::move(result), solve_budget));
 
   // 5. The solution: parameters, residual RMS, fitted trajectory and amplitude.
-  const Solution solution = MakeSolution(input, cost, minimum, guess.period_s, noise);
+  const trace::Solution solution = MakeSolution(input, cost, minimum, guess.period_s, noise);
 
   // 6. Statistical uncertainty (HAC), 7. the input uncertainty budget.
   const StatisticalUncertainty stat = EstimateStatisticalStd(cost, minimum);

@@ -7,17 +7,11 @@
 
 #include <Eigen/Dense>
 
+#include "base/statistics.h"
 #include "base/units.h"
 
 namespace bifilar {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
-}
 
 struct Crossing {
   double t_s;
@@ -64,7 +58,7 @@ std::vector<Crossing> WithoutGlitchPairs(const std::vector<double>& t, const std
   if (cross.size() < 4) return cross;
   std::vector<double> spacing(cross.size() - 1);
   for (size_t i = 0; i + 1 < cross.size(); ++i) spacing[i] = cross[i + 1].t_s - cross[i].t_s;
-  const double typical = Median(spacing);
+  const double typical = UpperMedian(spacing, 0.0);
   std::vector<Crossing> out;
   for (size_t i = 0; i < cross.size(); ++i) {
     if (i + 1 < cross.size() && cross[i + 1].t_s - cross[i].t_s < 0.25 * typical) {
@@ -145,7 +139,7 @@ double EstimateSampleNoise(const std::vector<double>& t_s, const std::vector<dou
     const double pred = w0 * x[k - 1] + w2 * x[k + 1];
     e.push_back(std::abs(x[k] - pred) / std::sqrt(1.0 + w0 * w0 + w2 * w2));
   }
-  return 1.4826 * Median(std::move(e));
+  return 1.4826 * UpperMedian(std::move(e), 0.0);
 }
 
 namespace {

@@ -6,19 +6,14 @@
 #include <cstdlib>
 #include <limits>
 
+#include "base/statistics.h"
+#include "base/text_format.h"
 #include "base/units.h"
 
 namespace bifilar {
 namespace {
 
 std::string Prefix(const std::string& name) { return name.empty() ? "" : name + ": "; }
-
-
-std::string Fmt(const char* format, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
-  char buf[256];
-  std::snprintf(buf, sizeof(buf), format, a, b, c, d);
-  return buf;
-}
 
 // A window [first, last] of samples with a gap (a step between two samples) longer than
 // max_gap_periods periods cannot be fitted as one swing: the phase across it is not observed
@@ -43,15 +38,6 @@ bool GapFree(const std::vector<double>& t, size_t first, size_t last, double per
              Fmt(" (%.3f s): the swing cannot be followed across it; give a window on one side "
                  "of it (fit.windows or --window)", period_s);
   return false;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  double m = v[mid];
-  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + mid));
-  return m;
 }
 
 // One half-cycle of x = rate - bias between zero crossings (with hysteresis).

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
 #include "fit/block_mean.h"
 #include "fit/trace_fit.h"
 #include "fit/trace_synth.h"
@@ -69,7 +70,7 @@ TEST(BlockMean, PointNoiseIsMeasuredOnTheRestsBlockMeans) {
     for (int i = 0; i < 1100000; ++i) {
       t.push_back(1e-4 * i);
       e = phi * e + w(rng);
-      rate.push_back(e + (t.back() > 10.0 ? std::sin(2.0 * M_PI * t.back() / 2.5) : 0.0));
+      rate.push_back(e + (t.back() > 10.0 ? std::sin(2.0 * kPi * t.back() / 2.5) : 0.0));
     }
     const size_t first = 100001;
     const FitSeries s = MakeFitSeries(t, rate, first, t.size() - 1, 2.5, kSigma, 10.0, o);

@@ -22,14 +22,14 @@ struct Truth {
 };
 
 double TrueMoment(const Truth& t, double pitch_deg) {
-  const double th = pitch_deg * kPi / 180.0;
+  const double th = pitch_deg * kRadPerDeg;
   return t.iz * std::cos(th) * std::cos(th) + t.ix * std::sin(th) * std::sin(th) +
          t.ixz * std::sin(2 * th);
 }
 
 // tan 2tau = 2 I_xz / (I_z - I_x), tau in (-45, 45] (docs/physics.md section 3).
 double TrueTauDeg(const Truth& t) {
-  double tau = 0.5 * std::atan2(t.ixz, 0.5 * (t.iz - t.ix)) * 180 / kPi;
+  double tau = 0.5 * std::atan2(t.ixz, 0.5 * (t.iz - t.ix)) * kDegPerRad;
   if (tau > 45) tau -= 90;
   if (tau <= -45) tau += 90;
   return tau;
@@ -122,9 +122,9 @@ TEST(EllipseFit, SignConventionsFollowPhysicsMd) {
     const EllipseResult r = MustFit(Simulate(t, PaperAngles(), 1, 0.0, 0.0, &rng), options);
     EXPECT_GT(r.tau_deg.value, -45.0);
     EXPECT_LE(r.tau_deg.value, 45.0);
-    const double tau = r.tau_deg.value * kPi / 180;
+    const double tau = r.tau_deg.value * kRadPerDeg;
     for (double th_deg = -170; th_deg <= 180; th_deg += 7.5) {
-      const double th = th_deg * kPi / 180;
+      const double th = th_deg * kRadPerDeg;
       const double eq7 = r.izp.value * std::pow(std::cos(th - tau), 2) +
                          r.ixp.value * std::pow(std::sin(th - tau), 2);
       EXPECT_NEAR(eq7, TrueMoment(t, th_deg), 1e-12 * t.iz);
@@ -561,7 +561,7 @@ TEST(EllipseFit, PerfectCircleWithStdColumnHasNoTau) {
     const double stdev = k % 2 ? 0.01 : 0.0;
     std::vector<EllipsePoint> points;
     for (int d = -80; d <= 90; d += 10) {
-      const double t = d * kPi / 180;
+      const double t = d * kRadPerDeg;
       points.push_back({double(d), radius * std::cos(t) * std::cos(t) + radius * std::sin(t) * std::sin(t), stdev});
     }
     for (auto mode : {EllipseCovariance::kAuto, EllipseCovariance::kPointResiduals}) {

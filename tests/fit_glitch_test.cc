@@ -2,6 +2,7 @@
 // fit/trace_synth.h (100 Hz with jitter and drops, and ~30 Hz irregular steps of 8-160 ms with
 // AR(1) noise) with glitches inserted at known samples; clean and noise-free series, a quantised
 // axis and a constant one must give none.
+#include "base/units.h"
 #include "fit/glitch.h"
 
 #include <cmath>
@@ -16,7 +17,7 @@ namespace {
 
 TraceFitInput Window(bool irregular, double noise_deg_per_s, double phi, uint64_t seed) {
   SyntheticTraceOptions o;
-  o.geometry = {2.0, 1.8, 6.75, 9.80665};
+  o.geometry = {2.0, 1.8, 6.75, kStandardGravityMps2};
   o.params = {4.1, 0.04, 0.01};
   o.amplitude_deg = 25.0;
   o.duration_s = 40.0;

@@ -14,15 +14,12 @@
 namespace bifilar {
 namespace {
 
-constexpr double kDeg = kPi / 180.0;
-constexpr double kG = 9.80665;
-
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) / kDeg;
+  return std::atan2(a.cross(b).norm(), a.dot(b)) / kRadPerDeg;
 }
 
 Eigen::Vector3d DownInBody(double pitch_deg) {
-  return Eigen::Vector3d(-std::sin(pitch_deg * kDeg), 0.0, std::cos(pitch_deg * kDeg));
+  return Eigen::Vector3d(-std::sin(pitch_deg * kRadPerDeg), 0.0, std::cos(pitch_deg * kRadPerDeg));
 }
 
 TEST(SwingAxis, PitchSignConvention) {
@@ -35,7 +32,7 @@ TEST(SwingAxis, PitchSignConvention) {
   EXPECT_LT(DownInBody(30).x(), 0.0);
   EXPECT_NEAR(PitchFromDownDeg(Eigen::Vector3d(-0.5, 0.0, std::sqrt(0.75))), 30.0, 1e-12);
   // A small roll does not change the pitch (Euler pitch = asin(-n_x)).
-  const double th = 20 * kDeg, ph = 3 * kDeg;
+  const double th = 20 * kRadPerDeg, ph = 3 * kRadPerDeg;
   const Eigen::Vector3d rolled(-std::sin(th), std::sin(ph) * std::cos(th), std::cos(ph) * std::cos(th));
   EXPECT_NEAR(PitchFromDownDeg(rolled), 20.0, 1e-12);
   EXPECT_NEAR(RollFromDownDeg(rolled), 3.0, 1e-12);
@@ -57,7 +54,7 @@ Synthetic MakeSynthetic(double pitch_deg, const Eigen::Matrix3d& imu_to_body, bo
   s.down_in_imu = imu_to_body.transpose() * DownInBody(pitch_deg);
   const Eigen::Vector3d horiz_in_imu = imu_to_body.transpose() * Eigen::Vector3d::UnitY();
   const Eigen::Vector3d bias(0.008, -0.005, 0.006);
-  const double gyro_sigma = 0.25 * kDeg, accel_sigma = 0.02;
+  const double gyro_sigma = 0.25 * kRadPerDeg, accel_sigma = 0.02;
   const double t_release = rest ? 3.0 : 0.0, w = 2 * kPi / 1.8;
   for (int k = 0; k < 4000; ++k) {
     const double t = 0.01 * k;
@@ -70,7 +67,7 @@ Synthetic MakeSynthetic(double pitch_deg, const Eigen::Matrix3d& imu_to_body, bo
     const Eigen::Vector3d noise_a(normal(rng), normal(rng), normal(rng));
     s.data.t_s.push_back(t);
     s.data.gyro_in_imu.push_back(rate * s.down_in_imu + rock * horiz_in_imu + bias + gyro_sigma * noise_g);
-    s.data.accel_in_imu.push_back(-kG * s.down_in_imu + accel_sigma * noise_a);
+    s.data.accel_in_imu.push_back(-kStandardGravityMps2 * s.down_in_imu + accel_sigma * noise_a);
   }
   return s;
 }
@@ -92,7 +89,7 @@ TEST(SwingAxis, RotatedImuAccelerometerAtRest) {
     ASSERT_TRUE(axis.pitch_measured_deg.has_value());
     EXPECT_NEAR(*axis.pitch_measured_deg, pitch, 0.1);
     EXPECT_NEAR(*axis.roll_measured_deg, 0.0, 0.1);
-    EXPECT_NEAR(axis.rest_accel_mps2, kG, 0.01);
+    EXPECT_NEAR(axis.rest_accel_mps2, kStandardGravityMps2, 0.01);
     ASSERT_EQ(axis.rate_rad_per_s.size(), s.data.size());
     EXPECT_NEAR(axis.rate_rad_per_s[100], s.data.gyro_in_imu[100].dot(axis.axis_in_imu), 1e-15);
   }
@@ -156,7 +153,7 @@ TEST(SwingAxis, Rejects) {
   // Accelerometer in g read as m/s^2: |f| = 1, not gravity. An error when the caller needs the
   // accelerometer, naming the unit key.
   ImuData wrong_unit = s.data;
-  for (auto& f : wrong_unit.accel_in_imu) f /= kG;
+  for (auto& f : wrong_unit.accel_in_imu) f /= kStandardGravityMps2;
   SwingAxisOptions required;
   required.accel_required = true;
   EXPECT_FALSE(EstimateSwingAxis(wrong_unit, required, std::nullopt, &axis, &why));
@@ -185,9 +182,11 @@ TEST(SwingAxis, GravityRemovedAccelerometerIsIgnoredWithAWarning) {
     // Residual of a tilt error of tilt_deg about `across x n`: 2 g sin(tilt/2), at 90 - tilt/2
     // deg from n.
     const Eigen::Vector3d n_est =
-        Eigen::AngleAxisd(tilt_deg * kDeg, across.cross(s.down_in_imu).normalized()) * s.down_in_imu;
+        Eigen::AngleAxisd(tilt_deg * kRadPerDeg, across.cross(s.down_in_imu).normalized()) *
+        s.down_in_imu;
     ImuData removed = s.data;
-    for (auto& f : removed.accel_in_imu) f += kG * n_est;  // f + g n_est: gravity removed
+    for (auto& f : removed.accel_in_imu)
+      f += kStandardGravityMps2 * n_est;  // f + g n_est: gravity removed
     SwingAxis axis;
     std::string why;
     ASSERT_TRUE(EstimateSwingAxis(removed, SwingAxisOptions(), std::nullopt, &axis, &why)) << why;
@@ -204,7 +203,8 @@ TEST(SwingAxis, GravityRemovedAccelerometerIsIgnoredWithAWarning) {
   SwingAxisOptions off;
   off.gravity_removed_below_g = 0.0;
   ImuData removed = s.data;
-  for (auto& f : removed.accel_in_imu) f += kG * (s.down_in_imu + 0.2 * s.down_in_imu.unitOrthogonal()).normalized();
+  for (auto& f : removed.accel_in_imu)
+    f += kStandardGravityMps2 * (s.down_in_imu + 0.2 * s.down_in_imu.unitOrthogonal()).normalized();
   SwingAxis axis;
   std::string why;
   ASSERT_TRUE(EstimateSwingAxis(removed, off, std::nullopt, &axis, &why)) << why;
@@ -225,8 +225,8 @@ TEST(SwingAxis, AccelerometerThatDoesNotReadGravityIsIgnored) {
     double scale;
     const char* says;
   } cases[] = {{0.27, "neither gravity"},
-               {1.0 / kG, "set imu.accel.unit: g"},
-               {kG, "set imu.accel.unit: m/s^2"}};
+               {1.0 / kStandardGravityMps2, "set imu.accel.unit: g"},
+               {kStandardGravityMps2, "set imu.accel.unit: m/s^2"}};
   for (const auto& c : cases) {
     ImuData odd = s.data;
     for (auto& f : odd.accel_in_imu) f *= c.scale;
@@ -292,8 +292,8 @@ TEST(SwingAxis, SimulatedLogs) {
     if (!accel_bias) options.sensor.accel_bias_sigma_mps2 = 0.0;
     for (int i = 0; i < 8; ++i) {
       TraceSetup setup = SimulatedRig();
-      setup.pitch_rad = (-75.0 + 21.0 * i) * kDeg;
-      setup.amplitude_rad = (8.0 + 3.0 * i) * kDeg;
+      setup.pitch_rad = (-75.0 + 21.0 * i) * kRadPerDeg;
+      setup.amplitude_rad = (8.0 + 3.0 * i) * kRadPerDeg;
       setup.body_from_imu = MountingFromRollPitchYawDeg(3.0 - i, 2.0 * i - 7.0, 45.0 * i);
       setup.imu_offset_in_body_m = Eigen::Vector3d(0.25, 0.1, -0.05);
       SimulatedTrace trace;
@@ -307,7 +307,7 @@ TEST(SwingAxis, SimulatedLogs) {
       EXPECT_EQ(axis.source, SwingAxisSource::kAccelAtRest);
       EXPECT_LT(AngleDeg(axis.axis_in_imu, trace.truth.swing_axis_in_imu), accel_bias ? 1.2 : 0.1);
       ASSERT_TRUE(axis.pitch_measured_deg.has_value());
-      EXPECT_NEAR(*axis.pitch_measured_deg, setup.pitch_rad / kDeg, accel_bias ? 1.2 : 0.1);
+      EXPECT_NEAR(*axis.pitch_measured_deg, setup.pitch_rad / kRadPerDeg, accel_bias ? 1.2 : 0.1);
       // Gyro only: the principal direction of the same log, within 0.5 deg of the truth.
       ImuData gyro_only = trace.imu;
       gyro_only.accel_in_imu.clear();
@@ -335,8 +335,8 @@ TEST(SwingAxis, NoRestPitchFromTurningPoints) {
   options.sensor.accel_bias_sigma_mps2 = 0.0;
   for (int i = 0; i < 4; ++i) {
     TraceSetup setup = SimulatedRig();
-    setup.pitch_rad = (-40.0 + 25.0 * i) * kDeg;
-    setup.amplitude_rad = 30.0 * kDeg;
+    setup.pitch_rad = (-40.0 + 25.0 * i) * kRadPerDeg;
+    setup.amplitude_rad = 30.0 * kRadPerDeg;
     setup.body_from_imu = MountingFromRollPitchYawDeg(2.0, -4.0, 60.0 * i);
     setup.imu_offset_in_body_m = Eigen::Vector3d(0.35, 0.0, 0.0);
     SimulatedTrace trace;
@@ -352,7 +352,7 @@ TEST(SwingAxis, NoRestPitchFromTurningPoints) {
     const double t0 = trace.truth.t_release_s + 1.0, t1 = trace.truth.t_release_s + 25.0;
     ASSERT_TRUE(EstimateSwingAxis(trace.imu, o, std::make_pair(t0, t1), &axis, &why)) << why;
     ASSERT_TRUE(axis.pitch_measured_deg.has_value());
-    EXPECT_NEAR(*axis.pitch_measured_deg, setup.pitch_rad / kDeg, 0.1);
+    EXPECT_NEAR(*axis.pitch_measured_deg, setup.pitch_rad / kRadPerDeg, 0.1);
     EXPECT_LT(AngleDeg(axis.axis_in_imu, trace.truth.swing_axis_in_imu), 0.1);
     // The plain window average is visibly worse (this is what the turning points fix).
     Eigen::Vector3d f = Eigen::Vector3d::Zero();

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "base/units.h"
 #include "fit/tensor.h"
 #include "fit/tensor_plan.h"
 
@@ -163,7 +164,7 @@ TEST(TensorPlan, RelativeSwingNoiseAndAttitudeErrorMatchAMonteCarlo) {
   // first-order spread (2 tilt |(1 - n n^T) J n| up to ~2e-2), so it moves a std by well under
   // 1 %; the tolerance is the 5-sigma sampling error of 4000 replicates (5.6 %) plus that.
   constexpr double kRelTol = 0.07;
-  const Components mc = MonteCarloStd(plan, 3, 0.5 * 3.14159265358979323846 / 180, 4000, 23);
+  const Components mc = MonteCarloStd(plan, 3, 0.5 * kRadPerDeg, 4000, 23);
   for (int k = 0; k < 6; ++k) {
     SCOPED_TRACE(TensorPlanComponentName(k));
     EXPECT_NEAR(mc[k] / plan.std_kg_m2[k], 1.0, kRelTol);

@@ -97,9 +97,9 @@ TEST(Tensor, EulerAnglesOfARotatedTensor) {
   // Principal moments 0.2, 0.3, 0.45 about axes turned by roll 4, pitch -6, yaw 9 deg.
   const double roll = 4, pitch = -6, yaw = 9;
   const Eigen::Matrix3d rot =
-      (Eigen::AngleAxisd(yaw * kPi / 180, Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(pitch * kPi / 180, Eigen::Vector3d::UnitY()) *
-       Eigen::AngleAxisd(roll * kPi / 180, Eigen::Vector3d::UnitX()))
+      (Eigen::AngleAxisd(yaw * kRadPerDeg, Eigen::Vector3d::UnitZ()) *
+       Eigen::AngleAxisd(pitch * kRadPerDeg, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(roll * kRadPerDeg, Eigen::Vector3d::UnitX()))
           .toRotationMatrix();
   const Eigen::Matrix3d j = rot * Eigen::Vector3d(0.2, 0.3, 0.45).asDiagonal() * rot.transpose();
   const Tensor truth = {j(0, 0), j(1, 1), j(2, 2), -j(0, 1), -j(0, 2), -j(1, 2)};
@@ -285,7 +285,7 @@ TEST(Tensor, AxesInTheXyPlaneLeaveZUnobservable) {
   std::vector<TensorPoint> points;
   for (double yaw : {0.0, 30.0, 60.0, 90.0, 120.0, 150.0}) {
     TensorPoint p;
-    p.direction_in_body = {std::cos(yaw * kPi / 180), std::sin(yaw * kPi / 180), 0.0};
+    p.direction_in_body = {std::cos(yaw * kRadPerDeg), std::sin(yaw * kRadPerDeg), 0.0};
     p.inertia_kg_m2 = TensorMoment(kTruth, p.direction_in_body);
     points.push_back(p);
     points.back().inertia_kg_m2 *= 1.0001;

@@ -17,8 +17,6 @@
 namespace bifilar {
 namespace {
 
-constexpr double kDeg = kPi / 180.0;
-
 struct Synth {
   double rest_s = 3.0;
   double twist_s = 1.0;
@@ -31,8 +29,8 @@ struct Synth {
   bool stop = false;
   double stop_tau_s = 0.1;
   double rest_after_s = 2.0;
-  double noise_rad_per_s = 0.25 * kDeg;
-  double bias_rad_per_s = 0.4 * kDeg;
+  double noise_rad_per_s = 0.25 * kRadPerDeg;
+  double bias_rad_per_s = 0.4 * kRadPerDeg;
   double drop_fraction = 0.01;
   double jitter_s = 0.001;
   double rate_hz = 100.0;
@@ -58,7 +56,7 @@ SynthLog MakeLog(const Synth& s) {
   const double t_free_end = log.t_release_s + s.free_s;
   if (s.stop) log.t_stop_s = t_free_end;
   const double t_end = s.stop ? t_free_end + s.rest_after_s : t_free_end;
-  const double A = s.amplitude_deg * kDeg;
+  const double A = s.amplitude_deg * kRadPerDeg;
   const double w = 2.0 * kPi / s.period_s;
   log.omega = w;
   // Tremor: three sinusoids, 4-9 Hz, RMS angle tremor_deg.
@@ -67,7 +65,7 @@ SynthLog MakeLog(const Synth& s) {
     tf[i] = 4.0 + 5.0 * uniform(rng);
     tp[i] = 2 * kPi * uniform(rng);
   }
-  const double ta = s.tremor_deg * kDeg * std::sqrt(2.0 / 3.0);
+  const double ta = s.tremor_deg * kRadPerDeg * std::sqrt(2.0 / 3.0);
   auto free_rate = [&](double tau) {
     return A * std::exp(-s.decay_per_s * tau) * (-s.decay_per_s * std::cos(w * tau) - w * std::sin(w * tau));
   };
@@ -102,7 +100,7 @@ SynthLog MakeLog(const Synth& s) {
 
 // Rate envelope A w exp(-decay tau) of the synthetic free swing falls to `level` at this time.
 double EnvelopeTime(const Synth& s, const SynthLog& log, double level) {
-  const double peak = s.amplitude_deg * kDeg * log.omega;
+  const double peak = s.amplitude_deg * kRadPerDeg * log.omega;
   return log.t_release_s + std::log(peak / level) / s.decay_per_s;
 }
 
@@ -148,7 +146,8 @@ TEST(Window, LogEndsDuringFreeSwing) {
   EXPECT_NEAR(w.rest_bias_rad_per_s, s.bias_rad_per_s, 5 * s.noise_rad_per_s / std::sqrt(200.0));
   EXPECT_LE(w.rest_end_s, s.rest_s);
   EXPECT_GT(w.rest_end_s, s.rest_s - 1.0);
-  EXPECT_NEAR(w.peak_rate_start_rad_per_s, s.amplitude_deg * kDeg * log.omega, 0.05 * s.amplitude_deg * kDeg * log.omega);
+  EXPECT_NEAR(w.peak_rate_start_rad_per_s, s.amplitude_deg * kRadPerDeg * log.omega,
+              0.05 * s.amplitude_deg * kRadPerDeg * log.omega);
 }
 
 TEST(Window, HandStop) {
@@ -238,7 +237,8 @@ TEST(Window, NoRestSegmentUsesHighFrequencyNoise) {
   EXPECT_NEAR(w.noise_sigma_rad_per_s, s.noise_rad_per_s, 0.1 * s.noise_rad_per_s);
   // Bias from whole periods of the swing: within 1 % of the rate amplitude (the decay over the
   // averaged periods leaves a small mean).
-  EXPECT_NEAR(w.rest_bias_rad_per_s, s.bias_rad_per_s, 0.01 * s.amplitude_deg * kDeg * log.omega);
+  EXPECT_NEAR(w.rest_bias_rad_per_s, s.bias_rad_per_s,
+              0.01 * s.amplitude_deg * kRadPerDeg * log.omega);
   EXPECT_LE(w.t0_s, s.period_s * 1.5);
 }
 
@@ -403,8 +403,8 @@ TEST(Window, SimulatedLogs) {
     setup.params.inertia_kg_m2 = 0.4 + 0.15 * (i % 6);
     setup.params.drag_coeff_kg_m2 = 0.005;
     setup.params.viscous_coeff_kg_m2_per_s = 0.001;
-    setup.pitch_rad = (-60.0 + 10.0 * i) * kDeg;
-    setup.amplitude_rad = (5.0 + 1.6 * i) * kDeg * (i % 2 ? 1 : -1);
+    setup.pitch_rad = (-60.0 + 10.0 * i) * kRadPerDeg;
+    setup.amplitude_rad = (5.0 + 1.6 * i) * kRadPerDeg * (i % 2 ? 1 : -1);
     setup.body_from_imu = MountingFromRollPitchYawDeg(2.0, -3.0, 30.0 * i);
     setup.imu_offset_in_body_m = Eigen::Vector3d(0.2, -0.1, 0.05);
     SimulatedTrace trace;
@@ -434,7 +434,7 @@ TEST(Window, SimulatedLogs) {
       EXPECT_DOUBLE_EQ(w.t1_s, trace.imu.t_s.back());
     }
     // Rest noise: the simulator's per-axis white noise, projected on a unit axis.
-    const double sigma = options.sensor.gyro_noise_sigma_deg_per_s * kDeg;
+    const double sigma = options.sensor.gyro_noise_sigma_deg_per_s * kRadPerDeg;
     ExpectNoiseMatches(w, sigma, truth.t_twist_s - truth.start_time_s, options.sensor.sample_rate_hz);
     EXPECT_NEAR(w.rest_bias_rad_per_s, truth.gyro_bias_rad_per_s.dot(axis.axis_in_imu), 4 * sigma / std::sqrt(150.0));
   }
@@ -495,10 +495,10 @@ TEST(Window, SimulatedCampaign) {
     for (const auto& e : band.extremes) {
       const size_t k = std::min<size_t>(std::lower_bound(ts.begin(), ts.end(), e.t_s) - ts.begin(), ts.size() - 1);
       const size_t nearest = (k > 0 && e.t_s - ts[k - 1] < ts[k] - e.t_s) ? k - 1 : k;
-      const double truth_deg = std::abs(ct.trace.angle_rad[nearest]) / kDeg;
+      const double truth_deg = std::abs(ct.trace.angle_rad[nearest]) / kRadPerDeg;
       EXPECT_NEAR(e.amplitude_deg, truth_deg, 0.02 * truth_deg + 0.1) << "t = " << e.t_s;
     }
-    EXPECT_LE(band.amplitude_start_deg, std::abs(truth.amplitude_rad) / kDeg * 1.01);
+    EXPECT_LE(band.amplitude_start_deg, std::abs(truth.amplitude_rad) / kRadPerDeg * 1.01);
   }
 }
 

@@ -17,7 +17,6 @@
 namespace bifilar {
 namespace {
 
-constexpr double kDeg = kPi / 180.0;
 const PendulumModel kModels[] = {PendulumModel::kFull, PendulumModel::kJardin,
                                  PendulumModel::kLinear};
 const IntegratorMethod kMethods[] = {IntegratorMethod::kRungeKutta, IntegratorMethod::kCvodes};
@@ -171,8 +170,8 @@ TEST(PendulumIntegrator, QuadratureIsConverged) {
   const RigGeometry g = TestGeometry();
   for (PendulumModel model : kModels) {
     for (double deg : {1.0, 20.0, 60.0, 85.0}) {
-      const double t64 = QuadraturePeriod(model, g, 1.5, deg * kDeg, 64);
-      const double t128 = QuadraturePeriod(model, g, 1.5, deg * kDeg, 128);
+      const double t64 = QuadraturePeriod(model, g, 1.5, deg * kRadPerDeg, 64);
+      const double t128 = QuadraturePeriod(model, g, 1.5, deg * kRadPerDeg, 128);
       EXPECT_NEAR(t64 / t128, 1.0, 1e-14) << ToString(model) << " " << deg;
     }
   }
@@ -210,7 +209,7 @@ TEST(PendulumIntegrator, LargeAmplitudePeriodMatchesQuadrature) {
     for (PendulumModel model : kModels) {
       PendulumIntegrator integrator(model, g, WithMethod(method));
       for (double deg : {10.0, 30.0, 60.0}) {
-        const double A = deg * kDeg;
+        const double A = deg * kRadPerDeg;
         const double expected = QuadraturePeriod(model, g, 1.5, A);
         const double measured = IntegratedPeriod(&integrator, Undamped(), A, expected, 10);
         EXPECT_NEAR(measured / expected, 1.0, 1e-7)
@@ -239,8 +238,9 @@ TEST(PendulumIntegrator, EnergyConservedWhenUndamped) {
       SCOPED_TRACE(std::string(ToString(options.method)) + " sens=" + std::to_string(sens));
       Trajectory tr;
       std::string why;
-      ASSERT_TRUE(integrator.Integrate(Undamped(), deg * kDeg, 0.1, t, sens, &tr, &why)) << why;
-      const double e0 = MechanicalEnergy(model, g, Undamped(), deg * kDeg, 0.1);
+      ASSERT_TRUE(integrator.Integrate(Undamped(), deg * kRadPerDeg, 0.1, t, sens, &tr, &why))
+          << why;
+      const double e0 = MechanicalEnergy(model, g, Undamped(), deg * kRadPerDeg, 0.1);
       double worst = 0.0;
       for (size_t k = 0; k < t.size(); ++k) {
         const double e = MechanicalEnergy(model, g, Undamped(), tr.angle_rad[k],
@@ -267,7 +267,7 @@ TEST(PendulumIntegrator, DampedEnergyDecreasesByDampingWork) {
     PendulumIntegrator integrator(model, g, WithMethod(method));
     Trajectory tr;
     std::string why;
-    ASSERT_TRUE(integrator.Integrate(p, 40 * kDeg, 0.0, t, false, &tr, &why)) << why;
+    ASSERT_TRUE(integrator.Integrate(p, 40 * kRadPerDeg, 0.0, t, false, &tr, &why)) << why;
     std::vector<double> e(t.size()), power(t.size());
     for (size_t k = 0; k < t.size(); ++k) {
       const double w = tr.rate_rad_per_s[k];
@@ -305,7 +305,7 @@ TEST(PendulumIntegrator, SensitivitiesMatchCentralDifferences) {
   std::vector<double> t;
   for (int k = 0; k < 3000; ++k) t.push_back(3.2 + 0.02 * k + (k > 0 ? jitter(rng) : 0.0));
   t.insert(t.begin() + 100, t[100]);
-  const double angle0 = 25 * kDeg, rate0 = -0.2;
+  const double angle0 = 25 * kRadPerDeg, rate0 = -0.2;
   IntegratorOptions tight;
   tight.rel_tol = 1e-12;
   tight.abs_tol = 1e-14;
@@ -383,7 +383,7 @@ TEST(PendulumIntegrator, FullVersusJardinInertiaBias) {
   };
   for (const Case& c : {Case{10, 0.0733, 0.08, 0.01}, Case{20, 0.2875, 0.3, 0.05},
                         Case{45, 1.3106, 1.4, 0.1}}) {
-    const double A = c.deg * kDeg;
+    const double A = c.deg * kRadPerDeg;
     const double t0 = SmallAnglePeriod(g, inertia);
     const double t_full = IntegratedPeriod(&full, Undamped(inertia), A, t0, 8);
     const double t_jardin = IntegratedPeriod(&jardin, Undamped(inertia), A, t0, 8);
@@ -428,7 +428,7 @@ TEST(PendulumIntegrator, SmallAngleFormulaOverestimate) {
   };
   for (const Case& c : {Case{10, 0.3818, 0.326, 0.400}, Case{20, 1.5397, 1.317, 1.608},
                         Case{45, 8.1545, 6.989, 8.391}}) {
-    const double A = c.deg * kDeg;
+    const double A = c.deg * kRadPerDeg;
     // Exact simple pendulum: T / T0 = 2 K(k) / pi with k = sin(A/2); K by the AGM.
     double a = 1.0, b = std::cos(A / 2);
     for (int i = 0; i < 30; ++i) {
@@ -469,8 +469,8 @@ TEST(PendulumIntegrator, MethodsAgree) {
     PendulumIntegrator rk(model, g, options);
     options.method = IntegratorMethod::kCvodes;
     PendulumIntegrator cvodes(model, g, options);
-    ASSERT_TRUE(rk.Integrate(p, 50 * kDeg, 0.3, t, true, &a, &why)) << why;
-    ASSERT_TRUE(cvodes.Integrate(p, 50 * kDeg, 0.3, t, true, &b, &why)) << why;
+    ASSERT_TRUE(rk.Integrate(p, 50 * kRadPerDeg, 0.3, t, true, &a, &why)) << why;
+    ASSERT_TRUE(cvodes.Integrate(p, 50 * kRadPerDeg, 0.3, t, true, &b, &why)) << why;
     for (size_t k = 0; k < t.size(); ++k) {
       ASSERT_NEAR(a.rate_rad_per_s[k], b.rate_rad_per_s[k], 1e-9) << ToString(model) << " " << k;
       ASSERT_NEAR(a.angle_rad[k], b.angle_rad[k], 1e-9) << ToString(model) << " " << k;

@@ -16,7 +16,6 @@
 namespace bifilar {
 namespace {
 
-constexpr double kDeg = kPi / 180.0;
 const PendulumModel kModels[] = {PendulumModel::kFull, PendulumModel::kJardin,
                                  PendulumModel::kLinear};
 
@@ -60,7 +59,7 @@ TEST(PendulumModel, RiseMatchesClosedFormAndDerivatives) {
   const RigGeometry g = TestGeometry();
   const double L = g.filar_length_m, D = g.filar_separation_m;
   for (double deg : {-80.0, -45.0, -3.0, 0.0, 1e-3, 7.0, 30.0, 60.0, 89.0}) {
-    const double psi = deg * kDeg;
+    const double psi = deg * kRadPerDeg;
     const double s = std::sqrt(L * L - 0.5 * D * D * (1 - std::cos(psi)));
     // h = L - s: the closed form loses digits to cancellation near 0, hence the absolute 1e-15.
     EXPECT_NEAR(RiseHeight(g, psi), L - s, 1e-15) << deg;
@@ -112,7 +111,7 @@ TEST(PendulumModel, PartialsMatchNumericDifferentiation) {
   for (PendulumModel model : kModels) {
     for (double deg : {-70.0, -20.0, 0.0, 5.0, 45.0}) {
       for (double w : {-2.0, -0.3, 0.0, 0.7, 3.0}) {
-        const double psi = deg * kDeg;
+        const double psi = deg * kRadPerDeg;
         SCOPED_TRACE(std::string(ToString(model)) + " psi_deg=" + std::to_string(deg) +
                      " w=" + std::to_string(w));
         const AccelerationPartials a = AngularAccelerationPartials(model, g, p, psi, w);
@@ -156,7 +155,7 @@ TEST(PendulumModel, EnergyBalanceMatchesDampingPower) {
   for (PendulumModel model : kModels) {
     for (double deg : {-50.0, 0.0, 12.0, 60.0}) {
       for (double w : {-2.5, 0.0, 0.4, 1.9}) {
-        const double psi = deg * kDeg;
+        const double psi = deg * kRadPerDeg;
         const auto e_angle = [&](double x) { return MechanicalEnergy(model, g, p, x, w); };
         const auto e_rate = [&](double x) { return MechanicalEnergy(model, g, p, psi, x); };
         const double dE_dt = Derivative(e_angle, psi, 1e-3) * w +

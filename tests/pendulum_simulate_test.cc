@@ -14,8 +14,6 @@
 namespace bifilar {
 namespace {
 
-constexpr double kDeg = kPi / 180.0;
-
 TraceSetup PrandtlLikeSetup() {
   TraceSetup s;
   s.geometry.filar_length_m = 2.0;
@@ -24,8 +22,8 @@ TraceSetup PrandtlLikeSetup() {
   s.params.inertia_kg_m2 = 4.1;
   s.params.drag_coeff_kg_m2 = 0.04;
   s.params.viscous_coeff_kg_m2_per_s = 0.01;
-  s.pitch_rad = 20 * kDeg;
-  s.amplitude_rad = 25 * kDeg;
+  s.pitch_rad = 20 * kRadPerDeg;
+  s.amplitude_rad = 25 * kRadPerDeg;
   s.imu_offset_in_body_m = Eigen::Vector3d(0.15, 0.10, -0.05);
   return s;
 }
@@ -104,7 +102,7 @@ TEST(Simulate, FreeOscillationIsTheIntegratorOutput) {
 TEST(Simulate, AccelerometerAtRestGivesDownForAPitchedTiltedImu) {
   for (double pitch_deg : {-80.0, 0.0, 35.0, 90.0}) {
     TraceSetup setup = PrandtlLikeSetup();
-    setup.pitch_rad = pitch_deg * kDeg;
+    setup.pitch_rad = pitch_deg * kRadPerDeg;
     setup.body_from_imu = MountingFromRollPitchYawDeg(3, -5, 90);
     SimulatedTrace trace;
     std::string why;
@@ -119,7 +117,7 @@ TEST(Simulate, AccelerometerAtRestGivesDownForAPitchedTiltedImu) {
   }
   // Sanity of the convention: at 90 deg nose-up the swing shows on -x of an aligned IMU.
   TraceSetup up = PrandtlLikeSetup();
-  up.pitch_rad = 90 * kDeg;
+  up.pitch_rad = 90 * kRadPerDeg;
   SimulatedTrace trace;
   std::string why;
   ASSERT_TRUE(SimulateTrace(up, Noiseless(), 3, &trace, &why)) << why;
@@ -177,7 +175,7 @@ TEST(Simulate, SwayCouplingRaisesTheApparentInertiaAsAToTheFourth) {
   // (first-order harmonic balance; tolerance 20 % of delta for the higher orders).
   TraceSetup setup = PrandtlLikeSetup();
   setup.params.drag_coeff_kg_m2 = setup.params.viscous_coeff_kg_m2_per_s = 0;
-  setup.amplitude_rad = 60 * kDeg;
+  setup.amplitude_rad = 60 * kRadPerDeg;
   auto period = [&](double delta) {
     SimulationOptions options = Noiseless();
     options.sway_coupling_at_60deg = delta;
@@ -200,7 +198,7 @@ TEST(Simulate, SwayCouplingRaisesTheApparentInertiaAsAToTheFourth) {
   const double ratio = std::pow(period(delta) / period(0.0), 2);
   EXPECT_NEAR(ratio - 1, delta, 0.2 * delta);
   // A^4 below 60 deg: at 30 deg the excess is delta / 16.
-  setup.amplitude_rad = 30 * kDeg;
+  setup.amplitude_rad = 30 * kRadPerDeg;
   const double ratio30 = std::pow(period(delta) / period(0.0), 2);
   EXPECT_NEAR(ratio30 - 1, delta / 16, 0.2 * delta / 16);
 }
@@ -227,9 +225,9 @@ TEST(Simulate, CampaignTruthAndLayout) {
   EXPECT_EQ(traces[2].relative_path, "pitch_0/trial_1.csv");
   EXPECT_EQ(traces[7].relative_path, "tare/tare_2.csv");
   // Paper Table 2: tau = 0.5 atan2(2 I_xz, I_z - I_x) = 2.0858 deg (the paper prints 2.0875).
-  EXPECT_NEAR(spec.aircraft.PrincipalInclinationRad() / kDeg, 2.0858, 1e-4);
+  EXPECT_NEAR(spec.aircraft.PrincipalInclinationRad() / kRadPerDeg, 2.0858, 1e-4);
   for (const auto& t : traces) {
-    const double theta = t.true_pitch_deg * kDeg;
+    const double theta = t.true_pitch_deg * kRadPerDeg;
     if (t.is_tare) {
       EXPECT_EQ(t.inertia_aircraft_kg_m2, 0.0);
       EXPECT_NEAR(t.setup.geometry.mass_kg, 1.25, 1e-12);
@@ -243,7 +241,7 @@ TEST(Simulate, CampaignTruthAndLayout) {
     }
     EXPECT_NEAR(t.setup.params.inertia_kg_m2, t.inertia_aircraft_kg_m2 + 0.25, 1e-12);
     EXPECT_NEAR(t.setup.pitch_rad, theta, 1e-15);
-    const double amplitude = std::abs(t.setup.amplitude_rad) / kDeg;
+    const double amplitude = std::abs(t.setup.amplitude_rad) / kRadPerDeg;
     EXPECT_GE(amplitude, 5.0);
     EXPECT_LE(amplitude, 30.0);
   }
@@ -335,7 +333,7 @@ TEST(SimulateRealism, Ar1GyroNoiseHasItsPhiAndSigma) {
       EXPECT_NEAR(Lag1Autocorrelation(x), phi, 0.04) << "phi " << phi << " axis " << axis;
       // Marginal std: relative std of the estimate ~ sqrt((1 + phi^2) / (2 n (1 - phi^2))), 2.3 %
       // at phi 0.9; 12 % is > 5 sigma.
-      const double sigma = std::sqrt(sum2 / n) / kDeg;
+      const double sigma = std::sqrt(sum2 / n) / kRadPerDeg;
       EXPECT_NEAR(sigma, 0.5, 0.5 * 0.12) << "phi " << phi << " axis " << axis;
     }
   }
@@ -359,7 +357,7 @@ TEST(SimulateRealism, BiasRandomWalkIncrementsScaleWithSqrtDt) {
     count += 3;
   }
   // ~19 000 normalised increments: relative std of the std estimate 0.5 %; 3 % is 6 sigma.
-  EXPECT_NEAR(std::sqrt(sum2 / count) / kDeg, 0.05, 0.05 * 0.03);
+  EXPECT_NEAR(std::sqrt(sum2 / count) / kRadPerDeg, 0.05, 0.05 * 0.03);
   EXPECT_NEAR((trace.truth.gyro_bias_end_rad_per_s - e.back()).norm(), 0.0, 1e-12);
 }
 
@@ -411,8 +409,8 @@ TEST(SimulateRealism, GravityRemovedAccelerometerMeanIsNearZero) {
   options.sensor.gravity_removal_error_deg = {10, 10};
   ASSERT_TRUE(SimulateTrace(setup, options, 8, &tilted, &why)) << why;
   // A 10 deg attitude error leaves |g (down_est - down)| = 2 g sin(5 deg) = 0.174 g.
-  EXPECT_NEAR(mean_g(tilted), 2 * std::sin(5 * kDeg), 2e-3);
-  EXPECT_NEAR(tilted.truth.gravity_removal_error_rad, 10 * kDeg, 1e-15);
+  EXPECT_NEAR(mean_g(tilted), 2 * std::sin(5 * kRadPerDeg), 2e-3);
+  EXPECT_NEAR(tilted.truth.gravity_removal_error_rad, 10 * kRadPerDeg, 1e-15);
   // The gyro and the timestamps are those of the same log with gravity kept.
   options.sensor.accel_gravity_removed = false;
   ASSERT_TRUE(SimulateTrace(setup, options, 8, &plain, &why)) << why;
@@ -465,7 +463,7 @@ TEST(SimulateRealism, SpikesHaveTheirCountAndSizeAndChangeNothingElse) {
 // Period of an undamped swing at a fixed amplitude, from the downward zero crossings of psi.
 double UndampedPeriod(TraceSetup setup, SimulationOptions options, double amplitude_deg) {
   setup.params.drag_coeff_kg_m2 = setup.params.viscous_coeff_kg_m2_per_s = 0;
-  setup.amplitude_rad = amplitude_deg * kDeg;
+  setup.amplitude_rad = amplitude_deg * kRadPerDeg;
   options.timeline.release_rate_sigma_deg_per_s = 0;
   options.timeline.stop_probability = 0;
   options.sensor.time_jitter_sigma_s = 0;
@@ -493,7 +491,7 @@ TEST(SimulateRealism, SofteningRaisesTheApparentInertiaAsStated) {
   // against 0.02881 at 30 deg (the first-order form I (1 + c_p k A^p) would give 0.0280), 0.01260
   // against 0.01260 at 20 deg; 1 % of the excess leaves room for the neglected harmonics.
   TraceSetup setup;
-  setup.geometry = {0.74, 0.16, 3.34, 9.80665};
+  setup.geometry = {0.74, 0.16, 3.34, kStandardGravityMps2};
   setup.params.inertia_kg_m2 = 0.05;
   SimulationOptions options = Noiseless();
   options.model = PendulumModel::kJardin;
@@ -506,11 +504,11 @@ TEST(SimulateRealism, SofteningRaisesTheApparentInertiaAsStated) {
     soft.softening_at_30deg = 0.028;
     soft.softening_exponent = exponent;
     const double k = SofteningCoefficient(0.028, exponent);
-    EXPECT_NEAR(ApparentInertiaExcess(k, exponent, 30 * kDeg), 0.028, 1e-15);
+    EXPECT_NEAR(ApparentInertiaExcess(k, exponent, 30 * kRadPerDeg), 0.028, 1e-15);
     for (double amplitude_deg : {8.0, 20.0, 30.0}) {
       const double ratio = std::pow(UndampedPeriod(setup, soft, amplitude_deg) /
                                         UndampedPeriod(setup, options, amplitude_deg), 2);
-      const double predicted = ApparentInertiaExcess(k, exponent, amplitude_deg * kDeg);
+      const double predicted = ApparentInertiaExcess(k, exponent, amplitude_deg * kRadPerDeg);
       EXPECT_NEAR(ratio - 1, predicted, 0.01 * predicted)
           << "p " << exponent << " at " << amplitude_deg << " deg";
     }
@@ -589,7 +587,7 @@ TEST(SimulateRealism, BadSettingsNameTheKey) {
     options.softening_at_30deg = 0.5;
     options.softening_exponent = 4;
     TraceSetup setup = PrandtlLikeSetup();
-    setup.amplitude_rad = 45 * kDeg;
+    setup.amplitude_rad = 45 * kRadPerDeg;
     SimulatedTrace trace;
     std::string why;
     EXPECT_FALSE(SimulateTrace(setup, options, 1, &trace, &why));

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "base/units.h"
 #include "base/user_error.h"
 #include "pipeline/campaign/calibration.h"
 #include "pipeline/campaign/campaign.h"
@@ -41,7 +42,7 @@ constexpr double kFitRelStd = 1e-4;                 // each fake fit's std, rela
 const std::vector<double> kPitches = {-60, -30, 0, 30, 60, 90};
 
 double Truth(double pitch_deg) {
-  const double t = pitch_deg * M_PI / 180.0;
+  const double t = pitch_deg * kRadPerDeg;
   return kIz * std::cos(t) * std::cos(t) + kIx * std::sin(t) * std::sin(t) + kIxz * std::sin(2 * t);
 }
 

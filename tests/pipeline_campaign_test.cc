@@ -1,6 +1,7 @@
 // The campaign pipeline with a fake trace fit (the fit reads the total inertia written in the
 // "log"), so discovery, tare, grouping, ellipse, cache and bad-input handling are tested exactly,
 // independently of the trace fit: the truth is known to the last digit.
+#include "base/units.h"
 #include "pipeline/campaign/campaign.h"
 
 #include <atomic>
@@ -30,7 +31,7 @@ constexpr double kTrialOffset = 0.001;
 const std::vector<double> kPitches = {-60, -30, 0, 30, 60, 90};
 
 double Truth(double pitch_deg) {
-  const double t = pitch_deg * M_PI / 180.0;
+  const double t = pitch_deg * kRadPerDeg;
   return kIz * std::cos(t) * std::cos(t) + kIx * std::sin(t) * std::sin(t) +
          kIxz * std::sin(2 * t);
 }

@@ -34,8 +34,6 @@ struct Naming {
   double gyro_per_rad_s;  // the gyro columns' value of 1 rad/s (1 or 180/pi)
 };
 
-const double kDegPerRad = 1.0 / kRadPerDeg;
-
 // At least 15 namings: the ones the issue lists as missed (xGyro/ZGyro, p q r, roll_rate...), the
 // ones guessed before, and time with its unit in the name or in brackets.
 const std::vector<Naming>& Namings() {

@@ -1,5 +1,6 @@
 // Campaign config: every key read, validated, relative paths resolved; typos and missing keys
 // named with file and line.
+#include "base/units.h"
 #include "pipeline/config/config.h"
 
 #include <cstdlib>
@@ -144,7 +145,7 @@ runs: {root: ., pattern: "p{pitch_deg}.csv"}
 TEST(Config, DefaultsAreDocumentedValues) {
   const CampaignConfig c = LoadCampaignConfig(Write(TempDir(), "c.yaml", kMinimal));
   EXPECT_EQ(c.units, DisplayUnits::kSi);
-  EXPECT_DOUBLE_EQ(c.gravity_mps2, 9.80665);
+  EXPECT_DOUBLE_EQ(c.gravity_mps2, kStandardGravityMps2);
   EXPECT_EQ(c.rig_inertia.kind, RigInertiaSpec::Kind::kValue);
   EXPECT_DOUBLE_EQ(c.rig_inertia.inertia_kg_m2, 0.1);
   EXPECT_EQ(c.fit.model, PendulumModel::kFull);

@@ -72,7 +72,7 @@ std::string PaperTable(bool with_std, double noise_slug) {
   s << "# PRANDTL-D, slug ft^2\n" << (with_std ? "pitch_deg, inertia, std\n" : "pitch_deg,inertia\n");
   s.precision(10);
   for (int d = -80; d <= 90; d += 10) {
-    const double t = d * kPi / 180;
+    const double t = d * kRadPerDeg;
     for (int k = 0; k < 3; ++k) {
       const double i = 2.8477 * std::cos(t) * std::cos(t) + 2.3596 * std::sin(t) * std::sin(t) +
                        0.0178 * std::sin(2 * t) + noise_slug * normal(rng);

@@ -303,7 +303,8 @@ TEST(FigureExtremes, WindowFitFiguresAtTheExtremes) {
   for (double inertia : {1.6e-5, 1.1616, 4500.0}) {
     for (double rate_hz : {20.0, 100.0}) {
       SyntheticTraceOptions o;
-      o.geometry = {2.0, 0.88, 6.0 * inertia / 1.1616, 9.80665};  // same period for every I
+      o.geometry = {2.0, 0.88, 6.0 * inertia / 1.1616,
+                    kStandardGravityMps2};  // same period for every I
       o.params = {inertia, 0.004 * inertia, 0.002 * inertia};
       o.amplitude_deg = 10.0;
       o.duration_s = 150.0;
@@ -346,13 +347,13 @@ TEST(FigureExtremes, EllipseFiguresStayOnThePage) {
   TempDir dir("bifilar_ellipse_extremes");
   std::string many = "pitch_deg,inertia,std\n", four = "pitch_deg,inertia,std\n";
   for (int i = 0; i < 200; ++i) {
-    const double theta = -85.0 + 170.0 * i / 199.0, t = (theta - 2.0) * kPi / 180.0;
+    const double theta = -85.0 + 170.0 * i / 199.0, t = (theta - 2.0) * kRadPerDeg;
     many += std::to_string(theta) + "," +
             std::to_string(1.6e-5 * std::cos(t) * std::cos(t) + 2.4e-5 * std::sin(t) * std::sin(t)) +
             ",3e-8\n";
   }
   for (int theta : {-60, -20, 20, 60}) {
-    const double t = (theta - 5.0) * kPi / 180.0;
+    const double t = (theta - 5.0) * kRadPerDeg;
     four += std::to_string(theta) + "," +
             std::to_string(4500.0 * std::cos(t) * std::cos(t) + 6100.0 * std::sin(t) * std::sin(t)) +
             ",5\n";

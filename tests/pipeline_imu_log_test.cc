@@ -66,7 +66,7 @@ TEST(ImuLog, ConvertsUnits) {
   EXPECT_DOUBLE_EQ(d.t_s[1], 0.020);
   EXPECT_DOUBLE_EQ(d.gyro_in_imu[0].x(), kPi);
   EXPECT_DOUBLE_EQ(d.gyro_in_imu[0].z(), -kPi / 2);
-  EXPECT_DOUBLE_EQ(d.accel_in_imu[0].z(), -9.80665);
+  EXPECT_DOUBLE_EQ(d.accel_in_imu[0].z(), -kStandardGravityMps2);
   f.time_unit = TimeUnit::kMicroseconds;
   const ImuData u = ReadImuLogFromString(kHeader + "1700000000000000,0,0,0,0,0,1\n1700000000010000,0,0,0,0,0,1\n",
                                          "us.csv", f);

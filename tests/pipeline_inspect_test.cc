@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
 #include "pendulum/model.h"
 #include "pendulum/simulate.h"
 #include "pipeline/commands/log_inspect.h"
@@ -33,7 +34,7 @@ TraceSetup SmallSwing() {
   setup.params.inertia_kg_m2 = 4.0;
   setup.params.drag_coeff_kg_m2 = 0.0;
   setup.params.viscous_coeff_kg_m2_per_s = 0.002;
-  setup.amplitude_rad = 5.0 * M_PI / 180.0;
+  setup.amplitude_rad = 5.0 * kRadPerDeg;
   return setup;
 }
 
@@ -71,7 +72,7 @@ TEST(GuessCsvFormat, UnitsFromTheDataAlone) {
   format.gyro_unit = RateUnit::kDegPerS;
   format.accel_columns = {"", "", ""};
   TraceSetup setup = SmallSwing();
-  setup.amplitude_rad = 30.0 * M_PI / 180.0;  // peak rate ~0.84 rad/s = 48 deg/s
+  setup.amplitude_rad = 30.0 * kRadPerDeg;  // peak rate ~0.84 rad/s = 48 deg/s
   TempDir dir;
   WriteImuLog(dir.path + "/deg.csv", Simulate(setup), format);
   // The first rows are the rest before the twist: the whole series decides the gyro unit.

@@ -1,6 +1,7 @@
 // The output folder (pipeline/store/output_set.h): the user's files are never removed, one run at a
 // time, a mixed set is detected. A fake trace fit (the "log" holds its total inertia) keeps the
 // runs instant.
+#include "base/units.h"
 #include "pipeline/store/output_set.h"
 
 #include <fcntl.h>
@@ -64,7 +65,7 @@ struct Campaign {
   }
 
   void SetLog(int pitch, int trial, double offset) {
-    const double t = pitch * M_PI / 180.0;
+    const double t = pitch * kRadPerDeg;
     std::ostringstream text;
     text.precision(17);
     text << "I=" << 3 * std::cos(t) * std::cos(t) + 2 * std::sin(t) * std::sin(t) +

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
 #include "fit/trace_fit.h"
 #include "fit/trace_synth.h"
 #include "pipeline/config/config.h"
@@ -98,7 +99,7 @@ TEST(RealRig, CoverageUnderColouredNoiseAndIrregularSampling) {
     double max_z = 0.0;
     for (int seed = 1; seed <= 40; ++seed) {
       SyntheticTraceOptions o;
-      o.geometry = {2.0, 1.8, 6.75, 9.80665};
+      o.geometry = {2.0, 1.8, 6.75, kStandardGravityMps2};
       o.params = {4.1, 0.04, 0.01};
       o.amplitude_deg = 10.0 + 0.5 * (seed % 30);
       o.duration_s = 40.0;

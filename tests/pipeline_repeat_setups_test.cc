@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "base/units.h"
 #include "base/user_error.h"
 #include "pipeline/commands/fit_command.h"
 #include "pipeline/trace/repeats.h"
@@ -73,7 +74,7 @@ TraceRecord Swing(const std::string& file, double inertia, double std, double a,
     b.amplitude_mean_deg = band;
     r.sweep.bands.push_back(b);
   }
-  const double t = tilt_deg * 3.14159265358979 / 180.0;
+  const double t = tilt_deg * kRadPerDeg;
   r.swing_axis_in_imu = {std::cos(t), std::sin(t), 0.0};
   return r;
 }

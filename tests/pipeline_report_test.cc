@@ -1,6 +1,7 @@
 // report.html: self-contained (figures embedded), every section present, rebuilt from
 // results.json alone, and loading in headless Chromium without console errors where Chromium is
 // installed (/usr/bin/chromium; the test is skipped otherwise).
+#include "base/units.h"
 #include "pipeline/report/report.h"
 
 #include <cstdio>
@@ -65,7 +66,7 @@ std::string MakeCampaign() {
   const std::string dir = mkdtemp(tmpl);
   for (double p : {-45.0, 0.0, 45.0, 90.0}) {
     for (int k = 1; k <= 2; ++k) {
-      const double t = p * M_PI / 180.0;
+      const double t = p * kRadPerDeg;
       const double inertia = 3.0 * std::cos(t) * std::cos(t) + 2.0 * std::sin(t) * std::sin(t) +
                              0.05 * std::sin(2 * t) + 0.5 + (k == 1 ? 1e-3 : -1e-3);
       std::ostringstream name;

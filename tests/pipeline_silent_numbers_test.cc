@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/units.h"
 #include "base/user_error.h"
 #include "fit/ellipse.h"
 #include "pipeline/campaign/campaign.h"
@@ -195,7 +196,7 @@ TEST(SilentNumbers, NonPhysicalEllipseIsAWarningAndExitOne) {
   TempDir dir;
   std::string text = "pitch_deg,inertia\n";
   for (int p = -80; p <= 90; p += 10) {
-    const double t = p * M_PI / 180.0;
+    const double t = p * kRadPerDeg;
     char row[64];
     std::snprintf(row, sizeof(row), "%d,%.6f\n", p,
                   p == 30 ? 1000.0 : 3.0 * std::cos(t) * std::cos(t) + 2.0 * std::sin(t) * std::sin(t));
@@ -237,7 +238,7 @@ TEST(SilentNumbers, TinyStdIsNamedAndMergedAnglesAreSaid) {
   // them (Table 1's "raw data sigma" then holds the curve's change, not noise).
   std::vector<EllipsePoint> points;
   for (double p : {0.0, 0.25, 30.0, 30.25, 60.0, 90.0, -30.0}) {
-    const double t = p * M_PI / 180.0;
+    const double t = p * kRadPerDeg;
     points.push_back({p, 3.0 * std::cos(t) * std::cos(t) + 2.0 * std::sin(t) * std::sin(t), 0.0});
   }
   EllipseOptions options;

@@ -26,7 +26,6 @@ namespace bifilar {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDeg = kPi / 180.0;
 
 std::string ReadText(const fs::path& path) {
   std::ifstream file(path, std::ios::binary);
@@ -122,8 +121,8 @@ TEST(SimulateWriter, UnitsAndRoundTrip) {
   data.t_s = {0.0, 0.0101, 0.0199};
   data.gyro_in_imu = {Eigen::Vector3d(0.1, -0.2, 0.3), Eigen::Vector3d(0, 0, 1),
                       Eigen::Vector3d(1e-4, 2, -3)};
-  data.accel_in_imu = {Eigen::Vector3d(0, 0, -9.80665), Eigen::Vector3d(1, 2, 3),
-                       Eigen::Vector3d(-1, 0.5, 9.80665)};
+  data.accel_in_imu = {Eigen::Vector3d(0, 0, -kStandardGravityMps2), Eigen::Vector3d(1, 2, 3),
+                       Eigen::Vector3d(-1, 0.5, kStandardGravityMps2)};
   ImuFormat format;
   format.time_unit = TimeUnit::kMilliseconds;
   format.gyro_unit = RateUnit::kDegPerS;
@@ -144,8 +143,10 @@ TEST(SimulateWriter, UnitsAndRoundTrip) {
     // 9 significant digits: relative round-trip error below 1e-8.
     EXPECT_NEAR(v[0] * 1e-3, data.t_s[k], 1e-12);
     for (int i = 0; i < 3; ++i) {
-      EXPECT_NEAR(v[1 + i] * kDeg, data.gyro_in_imu[k][i], 1e-8 * std::abs(data.gyro_in_imu[k][i]) + 1e-15);
-      EXPECT_NEAR(v[4 + i] * 9.80665, data.accel_in_imu[k][i], 1e-8 * std::abs(data.accel_in_imu[k][i]) + 1e-15);
+      EXPECT_NEAR(v[1 + i] * kRadPerDeg, data.gyro_in_imu[k][i],
+                  1e-8 * std::abs(data.gyro_in_imu[k][i]) + 1e-15);
+      EXPECT_NEAR(v[4 + i] * kStandardGravityMps2, data.accel_in_imu[k][i],
+                  1e-8 * std::abs(data.accel_in_imu[k][i]) + 1e-15);
     }
   }
   // No accelerometer: only four columns.
@@ -187,10 +188,10 @@ TEST(SimulateCampaign, SameSeedSameBytesAndTruthConsistent) {
   const auto& ac = truth["aircraft"];
   const double ix = ac["ix_kg_m2"], iz = ac["iz_kg_m2"], ixz = ac["ixz_kg_m2"];
   EXPECT_NEAR(ix, 2.3596 * 1.35581795, 1e-12);
-  EXPECT_NEAR(ac["tau_deg"].get<double>(), 0.5 * std::atan2(2 * ixz, iz - ix) / kDeg, 1e-12);
+  EXPECT_NEAR(ac["tau_deg"].get<double>(), 0.5 * std::atan2(2 * ixz, iz - ix) / kRadPerDeg, 1e-12);
   ASSERT_EQ(truth["traces"].size(), 5u);
   for (const auto& t : truth["traces"]) {
-    const double theta = t["true_pitch_deg"].get<double>() * kDeg;
+    const double theta = t["true_pitch_deg"].get<double>() * kRadPerDeg;
     const double rig = t["inertia_rig_kg_m2"];
     EXPECT_NEAR(rig, 0.25, 1e-15);
     if (t["kind"] == "tare") {
@@ -633,7 +634,7 @@ TEST(SimulatePresets, NonidealRigRecordsItsSoftening) {
       ++rows;
     }
     // |mean| = 2 sin(error/2) g, plus the lever-arm and bias terms (< 0.02 g).
-    EXPECT_NEAR(mean.norm() / rows, 2 * std::sin(error / 2 * kDeg), 0.02) << file;
+    EXPECT_NEAR(mean.norm() / rows, 2 * std::sin(error / 2 * kRadPerDeg), 0.02) << file;
   }
   fs::remove_all(a);
   fs::remove_all(b);

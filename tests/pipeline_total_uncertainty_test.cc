@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "base/units.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/campaign/campaign_summary.h"
 #include "pipeline/records/total_uncertainty.h"
@@ -192,7 +193,7 @@ TEST(TotalUncertainty, CampaignTable2AndFilesCarryTheTotal) {
   const double kRig = 0.5;
   for (double pitch : {-60.0, -30.0, 0.0, 30.0, 60.0, 90.0}) {
     for (int k = 1; k <= 2; ++k) {
-      const double th = pitch * M_PI / 180.0;
+      const double th = pitch * kRadPerDeg;
       const double i = 2.0 * std::pow(std::cos(th), 2) + 1.5 * std::pow(std::sin(th), 2) +
                        0.05 * std::sin(2 * th) + kRig + (k == 1 ? 1e-3 : -1e-3);
       std::ostringstream name;

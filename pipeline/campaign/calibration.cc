@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "base/statistics.h"
+#include "base/text_format.h"
 #include "base/user_error.h"
 #include "pipeline/campaign/rig_inertia.h"
 #include "pipeline/campaign/run_discovery.h"
@@ -11,21 +13,6 @@
 
 namespace bifilar {
 namespace {
-
-std::string Format(const char* format, double a, double b = 0.0, double c = 0.0) {
-  char buffer[640];
-  std::snprintf(buffer, sizeof(buffer), format, a, b, c);
-  return buffer;
-}
-
-double SampleStd(const std::vector<double>& v) {
-  if (v.size() < 2) return NAN;
-  double mean = 0.0;
-  for (double x : v) mean += x / v.size();
-  double s = 0.0;
-  for (double x : v) s += (x - mean) * (x - mean);
-  return std::sqrt(s / (v.size() - 1));
-}
 
 // The message of a record that is not ok, with its file named once.
 std::string Described(const TraceRecord& r) {
@@ -66,12 +53,13 @@ std::string FarFromOneWarning(const CampaignConfig& config, const RigCalibration
       "and its std does not cover such an error",
       c.factor, 100.0 * (c.factor - 1.0), 100.0 * allowed, u.filar_length_std_m,
       u.filar_separation_std_m,
-      u.gravity_std_mps2 > 0 ? (", g +- " + Format("%.3g", u.gravity_std_mps2) + " m/s^2").c_str()
+      u.gravity_std_mps2 > 0 ? (", g +- " + Fmt("%.3g", u.gravity_std_mps2) + " m/s^2").c_str()
                              : "",
       100.0 * c.factor_rel_std, 100.0 * kCalibrationFactorWarnFraction, c.effective_separation_m,
       c.nominal_separation_m, 100.0 * (std::sqrt(c.factor) - 1.0), c.filar_length_m / c.factor,
       c.filar_length_m, c.reference_inertia_kg_m2, c.reference_mass_kg, c.rig_inertia_kg_m2,
-      c.rig_inertia_source == "tare" ? "the tare logs" : ("rig.inertia " + c.rig_inertia_source).c_str());
+      c.rig_inertia_source == "tare" ? "the tare logs"
+                                     : ("rig.inertia " + c.rig_inertia_source).c_str());
   return buffer;
 }
 
@@ -102,7 +90,7 @@ void GivenRigInertia(const CampaignConfig& config, double* rig_given, double* ri
   if (!RigInertiaAt(config, NAN, NAN, config.calibration.rig_pitch_deg, rig_given, rig_given_std,
                     &why)) {
     throw UserError("rig.calibration: rig inertia at rig_pitch_deg " +
-                    Format("%g", config.calibration.rig_pitch_deg) + " deg: " + why);
+                    Fmt("%g", config.calibration.rig_pitch_deg) + " deg: " + why);
   }
 }
 
@@ -155,10 +143,10 @@ double FactorFromRound(const RigCalibrationSpec& spec, bool from_tare, double ri
   const double measured_reference = out.swings_total_kg_m2 - out.rig_inertia_kg_m2;
   if (!(measured_reference > 0.0)) {
     throw UserError(
-        Format("rig.calibration: the reference swings (I = %.6g kg m^2) are not "
-               "above the rig alone (%.6g kg m^2): check rig.calibration.logs, "
-               "reference_mass_kg and rig.inertia",
-               out.swings_total_kg_m2, out.rig_inertia_kg_m2));
+        Fmt("rig.calibration: the reference swings (I = %.6g kg m^2) are not "
+            "above the rig alone (%.6g kg m^2): check rig.calibration.logs, "
+            "reference_mass_kg and rig.inertia",
+            out.swings_total_kg_m2, out.rig_inertia_kg_m2));
   }
   // Tare: I_rig scales with k too, so target/fitted = I_ref / (I_swings - I_tare); given rig:
   // (I_rig + I_ref) / I_swings.
@@ -167,11 +155,11 @@ double FactorFromRound(const RigCalibrationSpec& spec, bool from_tare, double ri
   const double next = k * *ratio;
   if (!(next >= kMinCalibrationFactor && next <= kMaxCalibrationFactor)) {
     throw UserError(
-        Format("rig.calibration: the reference swings give an effective D^2/L %.4g times the "
-               "configured one (allowed %g to %g): not a tape-measure error. Check "
-               "reference_inertia_kg_m2 (about the swing axis, kg m^2), reference_mass_kg (kg), "
-               "rig.inertia and rig.mass_kg",
-               next, kMinCalibrationFactor, kMaxCalibrationFactor));
+        Fmt("rig.calibration: the reference swings give an effective D^2/L %.4g times the "
+            "configured one (allowed %g to %g): not a tape-measure error. Check "
+            "reference_inertia_kg_m2 (about the swing axis, kg m^2), reference_mass_kg (kg), "
+            "rig.inertia and rig.mass_kg",
+            next, kMinCalibrationFactor, kMaxCalibrationFactor));
   }
   return next;
 }
@@ -211,10 +199,10 @@ void CalibrationUncertainty(const CampaignConfig& config, bool from_tare, double
         "-5 times, so that their scatter is measured and enters the calibration's std");
   }
   if (out->factor_rel_std > 0.01) {
-    out->warnings.push_back(Format(
-        "rig.calibration: the calibration's std is %.2g %%: a heavier reference (inertia well "
-        "above the rig's), more swings or a better known reference inertia shrink it",
-        100.0 * out->factor_rel_std));
+    out->warnings.push_back(
+        Fmt("rig.calibration: the calibration's std is %.2g %%: a heavier reference (inertia well "
+            "above the rig's), more swings or a better known reference inertia shrink it",
+            100.0 * out->factor_rel_std));
   }
   const std::string far = FarFromOneWarning(config, *out);
   if (!far.empty()) out->warnings.push_back(far);
@@ -262,7 +250,7 @@ RigCalibrationResult CalibrateRig(const CampaignConfig& config, const Calibratio
   if (!converged) {
     throw UserError("rig.calibration: the effective geometry did not converge in " +
                     std::to_string(kCalibrationMaxIterations) + " rounds (last factor " +
-                    Format("%.8g", k) + ")");
+                    Fmt("%.8g", k) + ")");
   }
   CalibrationUncertainty(config, from_tare, rig_given, rig_given_std, k, &out);
   if (records_out) *records_out = std::move(records);

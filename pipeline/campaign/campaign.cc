@@ -19,6 +19,7 @@
 #include "base/hash.h"
 #include "base/interrupt.h"
 #include "base/parallel_runner.h"
+#include "base/statistics.h"
 #include "base/units.h"
 #include "base/user_error.h"
 #include "base/version.h"
@@ -41,20 +42,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-double Mean(const std::vector<double>& v) {
-  double s = 0.0;
-  for (double x : v) s += x;
-  return v.empty() ? NAN : s / v.size();
-}
-
-double SampleStd(const std::vector<double>& v) {
-  if (v.size() < 2) return NAN;
-  const double m = Mean(v);
-  double s = 0.0;
-  for (double x : v) s += (x - m) * (x - m);
-  return std::sqrt(s / (v.size() - 1));
-}
 
 // ---- Before any work: options, config, the output folder --------------------------------------
 
@@ -434,7 +421,7 @@ void WarnIfAttitudesDisagree(const CampaignConfig& config, TraceRecord* r) {
       DownInBodyFromAttitude(r->roll_measured_deg.value_or(0.0), *r->pitch_measured_deg);
   double dot = 0.0;
   for (int k = 0; k < 3; ++k) dot += nominal[k] * measured[k];
-  const double angle_deg = std::acos(std::clamp(dot, -1.0, 1.0)) * 180.0 / kPi;
+  const double angle_deg = std::acos(std::clamp(dot, -1.0, 1.0)) * kDegPerRad;
   if (angle_deg <= config.runs.attitude_tolerance_deg) return;
   char buffer[320];
   std::snprintf(buffer, sizeof(buffer),
@@ -635,10 +622,8 @@ void DrawCampaignFigures(const CampaignConfig& config, const EllipseResult& fit,
   }
   const std::string hash = HashToHex(Fnv1a64(key.str()));
   EllipsePlotOptions plot;
-  if (config.units == DisplayUnits::kImperial) {
-    plot.unit_scale = kSlugFt2PerKgM2;
-    plot.unit_label = "slug ft#u2#d";
-  }
+  plot.unit_label = InertiaUnitPlotLabel(config.units);
+  if (config.units == DisplayUnits::kImperial) plot.unit_scale = kSlugFt2PerKgM2;
   const fs::path figures = out->figures();
   std::error_code ec;
   std::string why;

@@ -51,10 +51,8 @@ void DrawTensorFigure(const CampaignConfig& config, const TensorResult& fit,
   const std::string name = "tensor_" + HashToHex(Fnv1a64(key.str())) + ".png";
   record_figure(name);
   TensorPlotOptions plot;
-  if (config.units == DisplayUnits::kImperial) {
-    plot.unit_scale = kSlugFt2PerKgM2;
-    plot.unit_label = "slug ft#u2#d";
-  }
+  plot.unit_label = InertiaUnitPlotLabel(config.units);
+  if (config.units == DisplayUnits::kImperial) plot.unit_scale = kSlugFt2PerKgM2;
   const fs::path path = fs::path(figures_dir) / name;
   std::error_code ec;
   std::string why;

@@ -105,8 +105,8 @@ void RegisterInitCommand(CLI::App& app, int* exit_code) {
                   "them (their unit is still guessed from the readings)");
   char gravity_help[160];
   std::snprintf(gravity_help, sizeof(gravity_help),
-                "local gravity (m/s^2) in [%g, %g], the range a config accepts; default 9.80665",
-                kMinEarthGravityMps2, kMaxEarthGravityMps2);
+                "local gravity (m/s^2) in [%g, %g], the range a config accepts; default %g",
+                kMinEarthGravityMps2, kMaxEarthGravityMps2, kStandardGravityMps2);
   sub->add_option("--gravity", args->gravity_mps2, gravity_help)->check(FiniteNumber());
   sub->add_flag("--force", args->force, "overwrite PATH if it exists");
   sub->callback([args, gyro, exit_code] {

@@ -4,6 +4,8 @@
 #include <iostream>
 
 #include "base/atomic_file.h"
+#include "base/text_format.h"
+#include "base/units.h"
 #include "pipeline/cli/cli_commands.h"
 #include "pipeline/commands/rig_plan.h"
 
@@ -50,7 +52,8 @@ std::shared_ptr<RigPlanCli> AddRigPlanOptions(CLI::App* plan) {
                         "with --rig: 1-sigma of D, m (0.001)"));
   only(plan->add_option("--mass-std", o.mass_std_kg,
                         "with --rig: 1-sigma of the suspended mass, kg (0.1 % of it)"));
-  only(plan->add_option("--gravity", o.gravity_mps2, "with --rig: local g, m/s^2 (9.80665)"));
+  only(plan->add_option("--gravity", o.gravity_mps2,
+                        Fmt("with --rig: local g, m/s^2 (%g)", kStandardGravityMps2)));
   only(plan->add_option("--gravity-std", o.gravity_std_mps2, "with --rig: 1-sigma of g (0)"));
   only(plan->add_option("--imu-rate", o.imu_rate_hz, "with --rig: IMU sample rate, Hz (100)"));
   only(plan->add_option("--gyro-noise", o.gyro_noise_deg_per_s,

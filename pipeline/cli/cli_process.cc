@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "base/interrupt.h"
+#include "pendulum/integrator.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/campaign/campaign_summary.h"
 #include "pipeline/cli/cli_commands.h"
@@ -69,7 +70,8 @@ void RegisterProcessCommands(CLI::App& app, int* exit_code) {
       ->check(CLI::Range(0, kMaxJobs));
   process->add_flag("--force", args->force, "ignore the cache and refit every log");
   process->add_option("--integrator", args->integrator,
-                      "ODE solver of the fits: rk853 or cvodes; overrides fit.integrator")
+                      "ODE solver of the fits: " + IntegratorMethodAllowedValues() +
+                          "; overrides fit.integrator")
       ->check(CLI::IsMember(IntegratorMethodNames()));
   process->add_option("--runs-root", args->runs_root,
                       "folder of the aircraft logs, instead of the config's runs.root");

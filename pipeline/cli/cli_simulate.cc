@@ -9,6 +9,8 @@
 #include <limits>
 #include <optional>
 
+#include "base/text_format.h"
+#include "base/units.h"
 #include "pipeline/cli/cli_commands.h"
 #include "pipeline/commands/simulate_spec.h"
 
@@ -52,7 +54,8 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
   raw->o_mass = sub->add_option("--mass-kg", raw->mass, "--trace: whole suspended mass m (kg)");
   raw->o_length = sub->add_option("-L,--filar-length-m", raw->length, "filar (wire) length L (m), > D");
   raw->o_separation = sub->add_option("-D,--filar-separation-m", raw->separation, "filar separation D (m), > 0");
-  raw->o_gravity = sub->add_option("--gravity-mps2", raw->gravity, "local gravity (m/s^2), default 9.80665");
+  raw->o_gravity = sub->add_option("--gravity-mps2", raw->gravity,
+                                   Fmt("local gravity (m/s^2), default %g", kStandardGravityMps2));
   raw->o_amplitude = sub->add_option("--amplitude-deg", raw->amplitude, "--trace: psi at release (deg), default 20");
   raw->o_pitch = sub->add_option("--pitch-deg", raw->pitch, "--trace: true pitch of the body (deg), default 0");
   raw->o_duration = sub->add_option("--duration-s", raw->duration, "free-oscillation duration (s)");

@@ -150,7 +150,7 @@ std::vector<std::string> WriteEllipsePlots(const EllipseResult& result, DisplayU
   if (ec) throw UserError(dir + ": cannot create the plot directory: " + ec.message());
   EllipsePlotOptions plot;
   plot.unit_scale = 1.0 / InertiaToSi(units);
-  plot.unit_label = units == DisplayUnits::kSi ? "kg m#u2#d" : "slug ft#u2#d";
+  plot.unit_label = InertiaUnitPlotLabel(units);
   std::vector<std::string> written;
   for (const char* ext : {".png", ".svg"}) {
     const std::string moments = (std::filesystem::path(dir) / "ellipse_moments").string() + ext;

@@ -10,6 +10,7 @@
 #include "base/bounded_read.h"
 #include "base/gzip.h"
 #include "base/json_number.h"
+#include "base/statistics.h"
 #include "base/text_format.h"
 #include "base/units.h"
 #include "base/user_error.h"
@@ -35,7 +36,8 @@ std::string Lower(std::string s) {
   return s;
 }
 
-std::string Trim(const std::string& s) {
+// `s` without surrounding white space, then without one pair of surrounding quotes ("" or '').
+std::string TrimAndUnquote(const std::string& s) {
   size_t b = 0, e = s.size();
   while (b < e && std::isspace(static_cast<unsigned char>(s[b]))) ++b;
   while (e > b && std::isspace(static_cast<unsigned char>(s[e - 1]))) --e;
@@ -57,13 +59,13 @@ std::vector<std::string> SplitLine(const std::string& line, char delim) {
   std::string cell;
   for (char c : line) {
     if (c == delim) {
-      out.push_back(Trim(cell));
+      out.push_back(TrimAndUnquote(cell));
       cell.clear();
     } else if (c != '\r') {
       cell += c;
     }
   }
-  out.push_back(Trim(cell));
+  out.push_back(TrimAndUnquote(cell));
   return out;
 }
 
@@ -75,7 +77,7 @@ bool IsNumber(const std::string& cell, double* value) {
 }
 
 bool IsCommentLine(const std::string& line) {
-  const std::string t = Trim(line);
+  const std::string t = TrimAndUnquote(line);
   return t.rfind("#", 0) == 0 || t.rfind("%", 0) == 0 || t.rfind("//", 0) == 0;
 }
 
@@ -89,7 +91,8 @@ std::vector<std::string> HeadLines(const std::string& text, size_t max_lines) {
     if (end == std::string::npos) end = text.size();
     std::string line = text.substr(start, end - start);
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (!(lines.empty() && (Trim(line).empty() || IsCommentLine(line)))) lines.push_back(line);
+    if (!(lines.empty() && (TrimAndUnquote(line).empty() || IsCommentLine(line))))
+      lines.push_back(line);
     start = end + 1;
   }
   return lines;
@@ -123,7 +126,7 @@ ColumnName Normalise(const std::string& name) {
     if (depth > 0 && !std::isdigit(static_cast<unsigned char>(c))) continue;
     if (std::isalnum(static_cast<unsigned char>(c))) out.bare += c;
   }
-  out.bracket = Trim(inside);
+  out.bracket = TrimAndUnquote(inside);
   const std::string all = lower;
   if (all.find("deg") != std::string::npos || all.find("dps") != std::string::npos) {
     out.unit_hint = "deg/s";
@@ -171,12 +174,6 @@ std::array<int, 3> FindTriplet(const std::vector<ColumnName>& names,
     if (found(idx)) return idx;
   }
   return {-1, -1, -1};
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 // At most `max_bytes` of `s` (cut at a UTF-8 character boundary) and "…" when cut: a file's own
@@ -246,7 +243,7 @@ void GuessTimeUnit(const ColumnName& name, const std::vector<double>& tc, Format
   for (size_t i = 1; i < tc.size(); ++i) {
     if (tc[i] > tc[i - 1]) steps.push_back(tc[i] - tc[i - 1]);
   }
-  const double step = Median(steps);
+  const double step = UpperMedian(steps, NAN);
   std::string time_why;
   const std::string& unit = name.bracket;
   if (unit == "s" || unit == "sec" || unit == "ms" || unit == "us" || unit == "\u00b5s") {
@@ -312,7 +309,7 @@ void GuessAccelUnit(const std::array<int, 3>& accel,
   for (size_t i = 0; i < n; ++i) {
     norms.push_back(std::hypot(columns[accel[0]][i], columns[accel[1]][i], columns[accel[2]][i]));
   }
-  const double norm = Median(norms);
+  const double norm = UpperMedian(norms, NAN);
   guess->format.accel_unit =
       std::isfinite(norm) && norm < 3.0 ? AccelUnit::kStandardGravity : AccelUnit::kMetresPerS2;
   guess->guesses.push_back("accelerometer columns " + guess->format.accel_columns[0] + ", " +
@@ -328,7 +325,7 @@ namespace {
 // The index of the header cell named `name` (case and surrounding blanks aside), or -1.
 int HeaderIndex(const std::vector<std::string>& header, const std::string& name) {
   for (size_t i = 0; i < header.size(); ++i) {
-    if (Lower(Trim(header[i])) == Lower(Trim(name))) return static_cast<int>(i);
+    if (Lower(TrimAndUnquote(header[i])) == Lower(TrimAndUnquote(name))) return static_cast<int>(i);
   }
   return -1;
 }
@@ -396,10 +393,10 @@ FormatGuess GuessCsvFormat(const std::string& text, const ColumnChoice& choice) 
     return guess;
   }
   guess.found = true;
-  guess.format.time_column = Trim(header[time]);
-  for (int a = 0; a < 3; ++a) guess.format.gyro_columns[a] = Trim(header[gyro[a]]);
+  guess.format.time_column = TrimAndUnquote(header[time]);
+  for (int a = 0; a < 3; ++a) guess.format.gyro_columns[a] = TrimAndUnquote(header[gyro[a]]);
   if (accel[0] >= 0) {
-    for (int a = 0; a < 3; ++a) guess.format.accel_columns[a] = Trim(header[accel[a]]);
+    for (int a = 0; a < 3; ++a) guess.format.accel_columns[a] = TrimAndUnquote(header[accel[a]]);
   } else {
     guess.format.accel_columns = {"", "", ""};
   }
@@ -429,7 +426,7 @@ std::string ClassifyText(const std::string& text) {
   }
   if (odd * 20 > n) return "binary";
   for (const std::string& line : HeadLines(text, 40)) {
-    const std::string t = Trim(line);
+    const std::string t = TrimAndUnquote(line);
     for (const char* key : {"rig:", "imu:", "runs:", "aircraft:", "fit:", "filar_length_m"}) {
       if (t.rfind(key, 0) == 0) return "config";
     }
@@ -528,7 +525,7 @@ void SeriesStatistics(const ImuData& data, InspectReport* report) {
   report->rate_mean_hz = (data.size() - 1) / report->duration_s;
   std::vector<double> steps(data.size() - 1);
   for (size_t i = 1; i < data.size(); ++i) steps[i - 1] = data.t_s[i] - data.t_s[i - 1];
-  report->step_median_s = Median(steps);
+  report->step_median_s = UpperMedian(steps, NAN);
   double sum = 0, sum2 = 0, longest = 0;
   int kept = 0;
   for (double s : steps) {

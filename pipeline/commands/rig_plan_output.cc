@@ -11,6 +11,7 @@
 #include "pipeline/commands/rig_plan.h"
 #include "pipeline/config/config.h"
 #include "pipeline/config/config_template.h"
+#include "pipeline/figures/figure.h"
 #include "pipeline/figures/rig_plan_plot.h"
 
 namespace bifilar {
@@ -279,7 +280,8 @@ bool WriteRigPlanPlot(const RigPlan& p, const std::string& path, std::string* wh
   f.chosen_length_m = p.recommended.length_m;
   f.chosen_total_percent = 100.0 * p.recommended.terms.Total();
   f.title = "bifilar plan --rig: " + Fmt("%.4g", p.options.mass_kg) + " kg, I " +
-            Fmt("%.3g", p.options.inertia_kg_m2) + " kg m#u2#d, target " +
+            Fmt("%.3g", p.options.inertia_kg_m2) + " " +
+            InertiaUnitPlotLabel(DisplayUnits::kSi) + ", target " +
             Fmt("%g", p.options.target_percent) + " %";
   return WriteRigPlanFigure(f, path, why);
 }

@@ -15,6 +15,7 @@
 #include "base/units.h"
 #include "base/user_error.h"
 #include "base/version.h"
+#include "pendulum/model.h"
 #include "pipeline/config/yaml_reader.h"
 #include "pipeline/logs/simulated_log.h"
 #include "pipeline/logs/dataflash.h"
@@ -837,7 +838,8 @@ SimulateCommandResult RunSimulate(const SimulateCommandOptions& a) {
                                           : ReadSimulateSpec(a.spec_file);
   if (a.spec_file.empty()) spec.file.clear();
   if (!a.model.empty() && !ParsePendulumModel(a.model, &spec.options.model)) {
-    throw UserError(n.model + ": unknown model '" + a.model + "'; allowed full, jardin, linear");
+    throw UserError(n.model + ": unknown model '" + a.model + "'; allowed " +
+                    PendulumModelAllowedValues());
   }
   if (a.sample_rate) SetSampleRateFromFlag(&spec, *a.sample_rate, n.sample_rate);
   if (!a.trace_csv.empty()) {

@@ -13,14 +13,9 @@
 namespace bifilar {
 namespace {
 
-enum Colour {
-  kBlack = kFigureBlack, kBlue = kFigureBlue, kRed = kFigureRed, kGrey = kFigureGrey,
-  kGreen = kFigureGreen, kLight = kFigureLight
-};
-
 // The fitted curve: blue, thick, dashed.
 void DrawFittedCurve(const std::vector<double>& x, const std::vector<double>& y) {
-  plcol0(kBlue);
+  plcol0(kFigureBlue);
   plwidth(2.0);
   pllsty(2);
   plline(static_cast<PLINT>(x.size()), x.data(), y.data());
@@ -103,7 +98,7 @@ void DrawPrincipalLines(const EllipseResult& r, const MomentPage& p) {
       principal.push_back({t, std::fabs(t - r.tau_deg.value) < 1 ? "z#dp#u" : "x#dp#u"});
     }
   }
-  plcol0(kRed);
+  plcol0(kFigureRed);
   pllsty(3);
   plwidth(1.5);
   for (const auto& [t, label] : principal) {
@@ -119,12 +114,12 @@ void DrawPrincipalLines(const EllipseResult& r, const MomentPage& p) {
 
 // Error bars and trials, then the body-axis moments: I_z at 0 deg, I_x at +-90 deg.
 void DrawTrials(const EllipseResult& r, const MomentPage& p) {
-  plcol0(kGrey);
+  plcol0(kFigureGrey);
   if (!p.ex.empty()) plerry(static_cast<PLINT>(p.ex.size()), p.ex.data(), p.elo.data(), p.ehi.data());
-  plcol0(kBlack);
+  plcol0(kFigureBlack);
   plssym(0, 0.9);
   plpoin(static_cast<PLINT>(p.px.size()), p.px.data(), p.py.data(), 4);  // open circles
-  plcol0(kGreen);
+  plcol0(kFigureGreen);
   plssym(0, 1.6);
   std::vector<double> bx, by;
   for (double t : {-90.0, 0.0, 90.0}) {
@@ -149,20 +144,20 @@ void DrawMomentLegend(const EllipseResult& r, const MomentPage& p) {
   const char* texts[4] = {"trials", r.weighted ? "± 1 std (given)" : "angle mean ± 1 std",
                           curve_text.c_str(), body_text.c_str()};
   PLINT opts[4] = {PL_LEGEND_SYMBOL, PL_LEGEND_LINE, PL_LEGEND_LINE, PL_LEGEND_SYMBOL};
-  PLINT text_colors[4] = {kBlack, kBlack, kBlack, kBlack};
-  PLINT line_colors[4] = {kBlack, kGrey, kBlue, kGreen};
+  PLINT text_colors[4] = {kFigureBlack, kFigureBlack, kFigureBlack, kFigureBlack};
+  PLINT line_colors[4] = {kFigureBlack, kFigureGrey, kFigureBlue, kFigureGreen};
   PLINT line_styles[4] = {1, 1, 2, 1};
   PLFLT line_widths[4] = {1, 1, 2, 1};
-  PLINT symbol_colors[4] = {kBlack, kBlack, kBlack, kGreen};
+  PLINT symbol_colors[4] = {kFigureBlack, kFigureBlack, kFigureBlack, kFigureGreen};
   PLFLT symbol_scales[4] = {1.2, 1, 1, 1.6};
   PLINT symbol_numbers[4] = {1, 1, 1, 1};
   const char* symbols[4] = {"○", "", "", "×"};
   PLFLT lw, lh;
   pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-           (p.legend_below ? PL_POSITION_BOTTOM : PL_POSITION_TOP) | PL_POSITION_INSIDE, 0.0,
-           0.02, 0.06, 0, kBlack, 1, 4, 1, 4, opts, 0.8, 0.8, 2.0, 0.0, text_colors, texts,
-           nullptr, nullptr, nullptr, nullptr, line_colors, line_styles, line_widths,
-           symbol_colors, symbol_scales, symbol_numbers, symbols);
+           (p.legend_below ? PL_POSITION_BOTTOM : PL_POSITION_TOP) | PL_POSITION_INSIDE, 0.0, 0.02,
+           0.06, 0, kFigureBlack, 1, 4, 1, 4, opts, 0.8, 0.8, 2.0, 0.0, text_colors, texts, nullptr,
+           nullptr, nullptr, nullptr, line_colors, line_styles, line_widths, symbol_colors,
+           symbol_scales, symbol_numbers, symbols);
 }
 
 }  // namespace
@@ -177,13 +172,13 @@ bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
   MomentAxes(r, &p);
   auto draw = [&] {
     plschr(0, 1.1);
-    plcol0(kBlack);
+    plcol0(kFigureBlack);
     pladv(0);
     plvsta();
     plwind(p.x_lo, p.x_hi, p.y_lo, p.y_hi);
-    plcol0(kLight);
+    plcol0(kFigureLight);
     plbox("g", 30, 0, "g", 0, 0);
-    plcol0(kBlack);
+    plcol0(kFigureBlack);
     plbox("bcnst", 30, 3, "bcnstv", 0, 0);
     pllab("pitch #gh (deg, nose up)", ("moment of inertia (" + options.unit_label + ")").c_str(),
           "Moments against pitch and the fitted ellipse of inertia");
@@ -247,7 +242,7 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
     r_max *= scale;
     // Room between the data and the frame for the axis labels (x_p, x_body were cut or covered).
     const double lim = 1.6 * r_max;
-    plcol0(kBlack);
+    plcol0(kFigureBlack);
     plvpas(vx0, vx1, 0.2, 0.86, 1.0);
     plwind(-lim, lim, -lim, lim);
     plbox("bcnst", 0, 0, "bcnstv", 0, 0);
@@ -259,17 +254,17 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
           inverse_sqrt ? "Ellipse of inertia, radius 1/#(2267)I(#gh)"
                        : "Moments in polar coordinates, radius I(#gh)");
     // Body axes.
-    plcol0(kGrey);
+    plcol0(kFigureGrey);
     pllsty(1);
     const double hx[2] = {-lim, lim}, hy[2] = {0, 0};
     plline(2, hx, hy);
     plline(2, hy, hx);
-    plcol0(kBlack);
+    plcol0(kFigureBlack);
     plptex(0.98 * lim, 0.05 * lim, 1, 0, 1, "x#dbody#u");
     plptex(0.04 * lim, -0.9 * lim, 1, 0, 0, "z#dbody#u");
     // Principal axes: principal z at pitch tau, principal x perpendicular.
     if (r.tau_defined) {
-      plcol0(kRed);
+      plcol0(kFigureRed);
       pllsty(3);
       plwidth(1.5);
       double zx, zy;
@@ -286,7 +281,7 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
     }
     // Curve and data.
     DrawFittedCurve(cx, cy);
-    plcol0(kBlack);
+    plcol0(kFigureBlack);
     plssym(0, 0.8);
     plpoin(static_cast<PLINT>(px.size()), px.data(), py.data(), 4);
     plssym(0, 1.0);
@@ -299,7 +294,7 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
     // edge, issue 25).
     panel(false, 0.1, 0.44);
     panel(true, 0.6, 0.91);
-    plcol0(kBlack);
+    plcol0(kFigureBlack);
     plvpor(0.0, 1.0, 0.0, 1.0);
     plwind(0, 1, 0, 1);
     const std::string caption =

@@ -14,7 +14,7 @@ namespace bifilar {
 
 struct EllipsePlotOptions {
   double unit_scale = 1.0;             // display value = kg m^2 value * unit_scale; > 0
-  std::string unit_label = "kg m#u2#d";  // PLplot text of the display unit
+  std::string unit_label = InertiaUnitPlotLabel(DisplayUnits::kSi);  // PLplot text
   FigureOptions figure;                // page size (px)
 };
 

@@ -15,6 +15,9 @@
 namespace bifilar {
 namespace {
 
+// kFigureBand's red, green and blue (kFigureTranslucentBand's too).
+constexpr PLINT kBandRgb[3] = {120, 160, 220};
+
 std::mutex& PlplotMutex() {
   static std::mutex mutex;
   return mutex;
@@ -76,7 +79,7 @@ bool WriteFigure(const std::string& path, const FigureOptions& options,
     plscol0(kFigureGrey, 135, 135, 135);
     plscol0(kFigureGreen, 20, 140, 60);
     plscol0(kFigureLight, 220, 220, 220);
-    plscol0(kFigureBand, 120, 160, 220);
+    plscol0(kFigureBand, kBandRgb[0], kBandRgb[1], kBandRgb[2]);
     draw();
     plend1();
   }
@@ -104,6 +107,14 @@ std::string InverseSqrtUnit(const std::string& unit) {
            unit.substr(space + 1, unit.size() - squared.size() - space - 1) + "#u-1#d)";
   }
   return "1/#(2267)(" + unit + ")";
+}
+
+const char* InertiaUnitPlotLabel(DisplayUnits units) {
+  return units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+}
+
+void SetTranslucentBand(double opacity) {
+  plscol0a(kFigureTranslucentBand, kBandRgb[0], kBandRgb[1], kBandRgb[2], opacity);
 }
 
 // The power of ten to draw radii up to `r_max` in: 0 within [0.1, 1000), else its exponent.

@@ -5,6 +5,8 @@
 #include <functional>
 #include <string>
 
+#include "base/units.h"
+
 namespace bifilar {
 
 struct FigureOptions {
@@ -16,13 +18,18 @@ struct FigureOptions {
 // (background white, foreground black).
 enum FigureColour {
   kFigureBlack = 1,
-  kFigureBlue = 2,   // fits, curves
-  kFigureRed = 3,    // principal axes, warnings
-  kFigureGrey = 4,   // measured data
-  kFigureGreen = 5,  // body-axis markers
-  kFigureLight = 6,  // grid lines
-  kFigureBand = 7,   // noise bands
+  kFigureBlue = 2,             // fits, curves
+  kFigureRed = 3,              // principal axes, warnings
+  kFigureGrey = 4,             // measured data
+  kFigureGreen = 5,            // body-axis markers
+  kFigureLight = 6,            // grid lines
+  kFigureBand = 7,             // noise bands
+  kFigureTranslucentBand = 8,  // kFigureBand's colour at an opacity the figure sets (below)
 };
+
+// Sets kFigureTranslucentBand to kFigureBand's colour at `opacity` (0-1): a band behind the
+// data. Call inside `draw`.
+void SetTranslucentBand(double opacity);
 
 // Draws `draw` (PLplot C API calls: plenv, plline, ... between plinit and plend) into `path`.
 // The device follows the extension: ".png" -> pngcairo, ".svg" -> PLplot's svg driver (text
@@ -30,6 +37,9 @@ enum FigureColour {
 // to a temporary name and renamed. Returns false with *why set on failure.
 bool WriteFigure(const std::string& path, const FigureOptions& options,
                  const std::function<void()>& draw, std::string* why);
+
+// The name of the inertia unit (InertiaUnitName) in PLplot text: "kg m#u2#d" or "slug ft#u2#d".
+const char* InertiaUnitPlotLabel(DisplayUnits units);
 
 // Axis units in PLplot text. "(U)^-1/2" of a display unit "A B#u2#d" as "(A#u-1/2#d B#u-1#d)"
 // (a superscript inside a superscript is garbled); other labels as "1/#(2267)(U)".

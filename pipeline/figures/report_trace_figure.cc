@@ -56,7 +56,7 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
   // residual's min/max envelope over 150 buckets.
   TracePlotOptions options;
   options.unit_scale = InertiaToDisplay(1.0, units);
-  options.unit_label = units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+  options.unit_label = InertiaUnitPlotLabel(units);
   options.inertia_std_kg_m2 = inertia_std_kg_m2;
   options.std_label = std_label;
   TraceFigureData d;

@@ -13,12 +13,6 @@
 namespace bifilar {
 namespace {
 
-enum Colour {
-  kBlack = kFigureBlack, kBlue = kFigureBlue, kRed = kFigureRed, kGrey = kFigureGrey,
-  kLight = kFigureLight,
-  kBandFill = 8,  // kFigureBand at 25 % opacity: the reported I's +-1 sigma band
-};
-
 // A red ring of radii (rx, ry) in world units around (mx, my), 2 px wide.
 void DrawRing(double mx, double my, double rx, double ry) {
   PLFLT cx[41], cy[41];
@@ -26,7 +20,7 @@ void DrawRing(double mx, double my, double rx, double ry) {
     cx[j] = mx + rx * std::cos(2.0 * kPi * j / 40.0);
     cy[j] = my + ry * std::sin(2.0 * kPi * j / 40.0);
   }
-  plcol0(kRed);
+  plcol0(kFigureRed);
   plwidth(2.0);
   plline(41, cx, cy);
   plwidth(1.0);
@@ -151,10 +145,10 @@ void DrawReportedBand(const SweepPage& p) {
   const PLFLT fx[4] = {p.x_lo, p.x_hi, p.x_hi, p.x_lo};
   const double lo = p.y_ref - p.y_ref_std, hi = p.y_ref + p.y_ref_std;
   const PLFLT fy[4] = {lo, lo, hi, hi};
-  plcol0(kBandFill);
+  plcol0(kFigureTranslucentBand);
   plfill(4, fx, fy);
   const PLFLT lx[2] = {p.x_lo, p.x_hi}, ly[2] = {p.y_ref, p.y_ref};
-  plcol0(kBlue);
+  plcol0(kFigureBlue);
   plwidth(2.0);
   plline(2, lx, ly);
 }
@@ -163,15 +157,15 @@ void DrawReportedBand(const SweepPage& p) {
 // was taken from ringed.
 void DrawBands(const AmplitudeSweep& sweep, const SweepPage& p) {
   if (p.trend) {  // solid: PLplot draws a dashed line as one SVG path per dash
-    plcol0(kRed);
+    plcol0(kFigureRed);
     plwidth(2.0);
     plline(static_cast<PLINT>(p.tx.size()), p.tx.data(), p.ty.data());
   }
   plwidth(1.5);
   const PLINT n = static_cast<PLINT>(p.ax.size());
-  plcol0(kGrey);
+  plcol0(kFigureGrey);
   plerrx(n, p.a_lo.data(), p.a_hi.data(), p.ai.data());
-  plcol0(kBlack);
+  plcol0(kFigureBlack);
   plerry(n, p.ax.data(), p.i_lo.data(), p.i_hi.data());
   plstring(n, p.ax.data(), p.ai.data(), "●");
   if (p.marked) {  // the band the result was taken from: a red ring around its point
@@ -185,7 +179,7 @@ void DrawBands(const AmplitudeSweep& sweep, const SweepPage& p) {
 
 // Axes: I on the left, its deviation from the result in % on the right.
 void DrawAxes(const SweepPage& p) {
-  plcol0(kBlack);
+  plcol0(kFigureBlack);
   plbox("bnt", 0, 0, "bntv", 0, 0);  // no minor ticks: the grid is the reference
   plmtex("b", 2.9, 0.5, 0.5, "amplitude (deg)");
   plwind(p.x_lo, p.x_hi, 100.0 * (p.y_lo / p.y_ref - 1.0), 100.0 * (p.y_hi / p.y_ref - 1.0));
@@ -196,7 +190,7 @@ void DrawAxes(const SweepPage& p) {
 void DrawTitles(const SweepPage& p) {
   plvpor(0.0, 1.0, 0.0, 1.0);
   plwind(0.0, 1.0, 0.0, 1.0);
-  plcol0(kBlack);
+  plcol0(kFigureBlack);
   plptex(0.02, p.top + 0.035, 1, 0, 0.0, p.y_label.c_str());
   plptex(0.98, p.top + 0.035, 1, 0, 1.0, "I / result - 1 (%)");
   // A long file name shrinks the title (about 62 characters fit at full size).
@@ -219,26 +213,26 @@ void DrawSubtitleAndLegend(const AmplitudeSweep& sweep, const SweepPlotOptions& 
     plwidth(1.0);
   };
   auto text = [&](double x, double y, const char* t) {
-    plcol0(kBlack);
+    plcol0(kFigureBlack);
     plptex(x + w + 0.015, y - 0.015, 1, 0, 0, t);
   };
   {  // a band: its amplitude range (grey) and its point
-    sample_line(col[0], row[0], kGrey, 1.5);
+    sample_line(col[0], row[0], kFigureGrey, 1.5);
     const PLFLT mx = col[0] + 0.5 * w, my = row[0];
-    plcol0(kBlack);
+    plcol0(kFigureBlack);
     plstring(1, &mx, &my, "●");
     text(col[0], row[0], "band: I ± 1σ, amplitude range");
   }
   {  // the result and its band
     const PLFLT fx[4] = {col[0], col[0] + w, col[0] + w, col[0]};
     const PLFLT fy[4] = {row[1] - 0.02, row[1] - 0.02, row[1] + 0.02, row[1] + 0.02};
-    plcol0(kBandFill);
+    plcol0(kFigureTranslucentBand);
     plfill(4, fx, fy);
-    sample_line(col[0], row[1], kBlue, 2.0);
+    sample_line(col[0], row[1], kFigureBlue, 2.0);
     text(col[0], row[1], p.reported_text.c_str());
   }
   if (p.trend) {
-    sample_line(col[1], row[0], kRed, 2.0);
+    sample_line(col[1], row[0], kFigureRed, 2.0);
     const std::string legend = "trend I#d0#u (1 + c A" +
                                (sweep.trend_exponent == 1.0
                                     ? std::string()
@@ -288,13 +282,13 @@ bool WriteAmplitudeSweepFigure(const AmplitudeSweep& sweep, double inertia_kg_m2
   SweepTexts(sweep, options, &p);
   SweepPageLayout(options, &p);
   auto draw = [&] {
-    plscol0a(kBandFill, 120, 160, 220, 0.25);
+    SetTranslucentBand(0.25);
     pladv(0);
     plschr(0, kChar);
     plvpor(p.left, kRight, kBottom, p.top);
     plwind(p.x_lo, p.x_hi, p.y_lo, p.y_hi);
     plsyax(7, 0);  // up to 7 digits before PLplot switches to its own "x10^n"
-    plcol0(kLight);
+    plcol0(kFigureLight);
     plbox("g", 0, 0, "g", 0, 0);
     DrawReportedBand(p);
     DrawBands(sweep, p);

@@ -74,7 +74,7 @@ void DrawPrincipalAxes(const TensorResult& r, double scale, double lim, const Vi
 // Measured moments whose axes lie near this plane, at both ends of the axis.
 void DrawMeasuredMoments(const TensorResult& r, const TensorPlotOptions& options,
                          const View& view) {
-  const double sin_near = std::sin(options.near_plane_deg * kPi / 180.0);
+  const double sin_near = std::sin(options.near_plane_deg * kRadPerDeg);
   const double normal[3] = {view.h[1] * view.v[2] - view.h[2] * view.v[1],
                             view.h[2] * view.v[0] - view.h[0] * view.v[2],
                             view.h[0] * view.v[1] - view.h[1] * view.v[0]};

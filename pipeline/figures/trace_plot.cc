@@ -14,12 +14,6 @@
 namespace bifilar {
 namespace {
 
-enum Colour {
-  kBlack = kFigureBlack, kBlue = kFigureBlue, kRed = kFigureRed, kGrey = kFigureGrey,
-  kLight = kFigureLight, kBand = kFigureBand,
-  kShade = 8,  // the band's span in the whole-window panel
-};
-
 // Above this many samples a dot per sample is drawn no more (more than ~8 per pixel column show
 // nothing more, and a 3 M-sample log took 110 s and gave a 750 MB SVG): each series becomes its
 // min/max envelope over 2 buckets per pixel, as a zigzag line in time order.
@@ -197,7 +191,7 @@ double AbsMax(const std::vector<double>& a, const std::vector<double>& b) {
 // Measured samples: grey dots (an envelope line when dense), under the fit's line.
 void Samples(const TracePage& p, const std::vector<double>& t, const std::vector<double>& v,
              const std::vector<double>& et, const std::vector<double>& ev, double dot) {
-  plcol0(kGrey);
+  plcol0(kFigureGrey);
   if (p.dense) {
     plwidth(1.0);
     plline(static_cast<PLINT>(et.size()), et.data(), ev.data());
@@ -209,9 +203,9 @@ void Samples(const TracePage& p, const std::vector<double>& t, const std::vector
 }
 
 void Axes(const char* x_opt, const char* y_label) {
-  plcol0(kLight);
+  plcol0(kFigureLight);
   plbox("g", 0, 0, "g", 0, 0);
-  plcol0(kBlack);
+  plcol0(kFigureBlack);
   plbox(x_opt, 0, 0, "bcnstv", 0, 0);
   plmtex("l", 5.0, 0.5, 0.5, y_label);
 }
@@ -223,14 +217,14 @@ void WholePanel(const TracePage& p, double y0, double y1) {
   const double y = 1.1 * AbsMax(d.whole_measured_deg_per_s, d.whole_fitted_deg_per_s);
   plwind(0.0, d.whole_t_s.back(), -y, y);
   const PLFLT fx[4] = {p.band_t0, p.band_t1, p.band_t1, p.band_t0}, fy[4] = {-y, -y, y, y};
-  plcol0(kShade);
+  plcol0(kFigureTranslucentBand);
   plfill(4, fx, fy);
   Axes("bcnst", "deg/s");
-  plcol0(kGrey);
+  plcol0(kFigureGrey);
   plline(static_cast<PLINT>(p.whole_t.size()), p.whole_t.data(), p.whole_meas.data());
-  plcol0(kRed);
+  plcol0(kFigureRed);
   plline(static_cast<PLINT>(p.whole_fit_t.size()), p.whole_fit_t.data(), p.whole_fit.data());
-  plcol0(kBlack);
+  plcol0(kFigureBlack);
   plmtex("t", 0.6, 0.0, 0.0, d.whole_label.c_str());
 }
 
@@ -242,11 +236,11 @@ void RatePanel(const TracePage& p, double y0, double y1) {
   plwind(0.0, d.t_s.back(), -y, y);
   Axes("bcst", "swing rate (deg/s)");
   Samples(p, d.t_s, d.measured_deg_per_s, p.env_t, p.env_meas, 3.0);
-  plcol0(kBlue);  // the fit on top: the samples show around it, the line stays visible
+  plcol0(kFigureBlue);  // the fit on top: the samples show around it, the line stays visible
   plwidth(1.6);
   plline(static_cast<PLINT>(d.t_s.size()), d.t_s.data(), d.fitted_deg_per_s.data());
   plwidth(1.0);
-  plcol0(kBlack);
+  plcol0(kFigureBlack);
   plmtex("t", 0.6, 0.0, 0.0, d.rate_label.c_str());
 }
 
@@ -260,7 +254,7 @@ void ResidualPanel(const TracePage& p, double y0, double y1) {
   plmtex("b", 2.8, 0.5, 0.5, "time (s)");
   Samples(p, d.t_s, d.residual_deg_per_s, p.env_res_t, p.env_res, 2.0);
   if (p.noise_deg > 0.0) {
-    plcol0(kBand);
+    plcol0(kFigureBand);
     for (double s : {-2.0, -1.0, 1.0, 2.0}) {
       const PLFLT xs[2] = {0.0, d.t_s.back()}, ys[2] = {s * p.noise_deg, s * p.noise_deg};
       plwidth(std::fabs(s) > 1.5 ? 1.0 : 1.6);
@@ -268,14 +262,14 @@ void ResidualPanel(const TracePage& p, double y0, double y1) {
     }
     plwidth(1.0);
   }
-  plcol0(kBlack);
+  plcol0(kFigureBlack);
   plmtex("t", 0.6, 0.0, 0.0, d.residual_label.c_str());
 }
 
 void Titles(const TracePage& p) {
   plvpor(0.0, 1.0, 0.0, 1.0);
   plwind(0.0, 1.0, 0.0, 1.0);
-  plcol0(kBlack);
+  plcol0(kFigureBlack);
   // Long file names: shrink the title to fit (about 80 characters fit at full size).
   plschr(0, 1.05 * std::min(1.0, 80.0 / static_cast<double>(p.d.title.size())));
   plptex(0.5, 0.955, 1, 0, 0.5, p.d.title.c_str());
@@ -308,7 +302,7 @@ bool WriteTraceFitFigure(const TraceFitResult& r, const std::string& path,
     p.band_t1 = p.band_t0 + d.t_s.back();
   }
   auto draw = [&] {
-    plscol0a(kShade, 120, 160, 220, 0.2);
+    SetTranslucentBand(0.2);
     pladv(0);
     plschr(0, 0.8);
     Titles(p);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fit/trace_fit.h"
+#include "pipeline/figures/figure.h"
 
 namespace bifilar {
 
@@ -21,7 +22,7 @@ struct TracePlotOptions {
   // Inertias (I, K_D, C) in the title are multiplied by unit_scale and labelled unit_label
   // (PLplot text): the config's display units (slug ft^2 under units: imperial).
   double unit_scale = 1.0;
-  std::string unit_label = "kg m#u2#d";
+  std::string unit_label = InertiaUnitPlotLabel(DisplayUnits::kSi);
   // The 1-sigma std of I shown in the title (kg m^2) and its name ("total", "stat"); NaN: the
   // fit's own inertia_std_kg_m2, named "total".
   double inertia_std_kg_m2 = NAN;

@@ -7,6 +7,7 @@
 #include <set>
 #include <utility>
 
+#include "base/text_format.h"
 #include "base/units.h"
 #include "base/user_error.h"
 #include "pipeline/logs/imu_log_finish.h"
@@ -98,14 +99,8 @@ std::string DecodeString(const unsigned char* p, size_t width) {
   return std::string(reinterpret_cast<const char*>(p), n);
 }
 
-std::string Printable(std::string_view s, size_t max_len = 64) {
-  std::string out;
-  for (char c : s.substr(0, max_len)) {
-    out += (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) ? '?' : c;
-  }
-  if (s.size() > max_len) out += "...";
-  return out;
-}
+// Bytes of a name or format echoed in a message (PrintableAscii).
+constexpr size_t kDataflashTextEcho = 64;
 
 std::vector<std::string> SplitLabels(const std::string& labels) {
   std::vector<std::string> out;
@@ -122,14 +117,15 @@ std::vector<std::string> SplitLabels(const std::string& labels) {
 }
 
 // Fills offsets/decodable/problem of a format from its characters, labels and length.
-void Layout(DataflashFormat* f) {
+void LayOutFields(DataflashFormat* f) {
   f->offsets.clear();
   int at = 0;
   for (char c : f->format) {
     const int size = DataflashFieldSize(c);
     if (size == 0) {
-      f->problem = std::string("unknown format character '") + Printable(std::string(1, c)) +
-                   "' in '" + Printable(f->format) + "'";
+      f->problem = std::string("unknown format character '") +
+                   PrintableAscii(std::string(1, c), kDataflashTextEcho) + "' in '" +
+                   PrintableAscii(f->format, kDataflashTextEcho) + "'";
       f->decodable = false;
       return;
     }
@@ -138,15 +134,15 @@ void Layout(DataflashFormat* f) {
   }
   if (f->labels.size() != f->format.size()) {
     f->problem = std::to_string(f->labels.size()) + " labels for the " +
-                 std::to_string(f->format.size()) + " fields of format '" + Printable(f->format) +
-                 "'";
+                 std::to_string(f->format.size()) + " fields of format '" +
+                 PrintableAscii(f->format, kDataflashTextEcho) + "'";
     f->decodable = false;
     return;
   }
   if (static_cast<int>(kHeader) + at > f->length) {
     f->problem = "its length " + std::to_string(f->length) + " is too short for its format '" +
-                 Printable(f->format) + "', which needs 3 + " + std::to_string(at) + " = " +
-                 std::to_string(3 + at) + " bytes";
+                 PrintableAscii(f->format, kDataflashTextEcho) + "', which needs 3 + " +
+                 std::to_string(at) + " = " + std::to_string(3 + at) + " bytes";
     f->decodable = false;
     return;
   }
@@ -172,9 +168,9 @@ int LabelIndex(const DataflashFormat& f, const std::string& label) {
   return -1;
 }
 
-class Parser {
+class DataflashParser {
  public:
-  Parser(std::string_view bytes, const std::string& name, const DataflashRequest& request)
+  DataflashParser(std::string_view bytes, const std::string& name, const DataflashRequest& request)
       : data_(reinterpret_cast<const unsigned char*>(bytes.data())),
         size_(bytes.size()),
         name_(name),
@@ -185,7 +181,7 @@ class Parser {
     fmt.name = "FMT";
     fmt.format = "BBnNZ";
     fmt.labels = {"Type", "Length", "Name", "Format", "Columns"};
-    Layout(&fmt);
+    LayOutFields(&fmt);
     out_.formats[fmt.type] = fmt;
     out_.unit_labels = BuiltinUnits();
     out_.multiplier_values = BuiltinMultipliers();
@@ -229,7 +225,7 @@ class Parser {
   int request_instance_index_ = -1;
 };
 
-size_t Parser::WholeMessageAt(size_t pos, bool in_sync) {
+size_t DataflashParser::WholeMessageAt(size_t pos, bool in_sync) {
   const auto it = out_.formats.find(data_[pos + 2]);
   if (it == out_.formats.end()) return 0;
   const size_t length = static_cast<size_t>(it->second.length);
@@ -249,7 +245,7 @@ size_t Parser::WholeMessageAt(size_t pos, bool in_sync) {
   return 0;
 }
 
-DataflashContents Parser::Run() {
+DataflashContents DataflashParser::Run() {
   size_t pos = 0, skip_start = 0;
   bool skipping = false;
   while (pos < size_) {
@@ -298,16 +294,16 @@ DataflashContents Parser::Run() {
   return std::move(out_);
 }
 
-void Parser::NoteSkipped(size_t start, size_t end, bool at_end) {
+void DataflashParser::NoteSkipped(size_t start, size_t end, bool at_end) {
   out_.skipped_bytes += end - start;
   if (at_end && end - start >= kHeader && data_[start] == kDataflashHead1 &&
       data_[start + 1] == kDataflashHead2) {
     const auto it = out_.formats.find(data_[start + 2]);
     if (it != out_.formats.end() && static_cast<size_t>(it->second.length) > end - start) {
       tail_bytes_ = end - start;
-      tail_ = "the log ends inside a " + Printable(it->second.name) + " message at byte " +
-              std::to_string(start) + " (" + std::to_string(end - start) + " of its " +
-              std::to_string(it->second.length) +
+      tail_ = "the log ends inside a " + PrintableAscii(it->second.name, kDataflashTextEcho) +
+              " message at byte " + std::to_string(start) + " (" + std::to_string(end - start) +
+              " of its " + std::to_string(it->second.length) +
               " bytes): the logger stopped mid-write; read "
               "to the last whole message";
       return;
@@ -319,7 +315,7 @@ void Parser::NoteSkipped(size_t start, size_t end, bool at_end) {
   }
 }
 
-void Parser::OnMessage(size_t pos, const DataflashFormat& f) {
+void DataflashParser::OnMessage(size_t pos, const DataflashFormat& f) {
   ++out_.messages_read;
   const unsigned char* body = data_ + pos + kHeader;
   if (f.type == kDataflashFmtType) {
@@ -338,7 +334,7 @@ void Parser::OnMessage(size_t pos, const DataflashFormat& f) {
   if (!request_.message.empty() && f.name == request_.message) Decode(pos, f, body);
 }
 
-void Parser::OnFmt(size_t pos, const unsigned char* body) {
+void DataflashParser::OnFmt(size_t pos, const unsigned char* body) {
   DataflashFormat f;
   f.type = body[0];
   f.length = body[1];
@@ -356,12 +352,12 @@ void Parser::OnFmt(size_t pos, const unsigned char* body) {
   }
   if (f.length < static_cast<int>(kHeader)) {
     out_.warnings.push_back("the FMT at byte " + std::to_string(pos) + " gives message '" +
-                            Printable(f.name) + "' (type " + std::to_string(f.type) +
-                            ") a length of " + std::to_string(f.length) +
+                            PrintableAscii(f.name, kDataflashTextEcho) + "' (type " +
+                            std::to_string(f.type) + ") a length of " + std::to_string(f.length) +
                             " bytes, less than its 3-byte header; ignored");
     return;
   }
-  Layout(&f);
+  LayOutFields(&f);
   const auto old = out_.formats.find(f.type);
   if (old != out_.formats.end() && old->second.name == f.name && old->second.format == f.format &&
       old->second.labels == f.labels && old->second.length == f.length) {
@@ -371,7 +367,7 @@ void Parser::OnFmt(size_t pos, const unsigned char* body) {
   slot_by_type_[f.type] = -1;  // its name may have changed
 }
 
-void Parser::OnFmtu(const DataflashFormat& f, const unsigned char* body) {
+void DataflashParser::OnFmtu(const DataflashFormat& f, const unsigned char* body) {
   const int type_at = LabelIndex(f, "FmtType"), units_at = LabelIndex(f, "UnitIds"),
             mults_at = LabelIndex(f, "MultIds");
   if (type_at < 0 || units_at < 0 || mults_at < 0 || f.format[type_at] != 'B' ||
@@ -384,7 +380,7 @@ void Parser::OnFmtu(const DataflashFormat& f, const unsigned char* body) {
   it->second.multipliers = DecodeString(body + f.offsets[mults_at], 16);
 }
 
-void Parser::OnUnitOrMult(const DataflashFormat& f, const unsigned char* body) {
+void DataflashParser::OnUnitOrMult(const DataflashFormat& f, const unsigned char* body) {
   const int id_at = LabelIndex(f, "Id");
   if (id_at < 0 || f.format[id_at] != 'b') return;
   const char id = static_cast<char>(body[f.offsets[id_at]]);
@@ -402,7 +398,7 @@ void Parser::OnUnitOrMult(const DataflashFormat& f, const unsigned char* body) {
   }
 }
 
-void Parser::OnMsg(const DataflashFormat& f, const unsigned char* body) {
+void DataflashParser::OnMsg(const DataflashFormat& f, const unsigned char* body) {
   const int text_at = LabelIndex(f, "Message");
   if (text_at < 0 || f.format[text_at] != 'Z' || simulated_noted_) return;
   const std::string text = DecodeString(body + f.offsets[text_at], 64);
@@ -412,7 +408,7 @@ void Parser::OnMsg(const DataflashFormat& f, const unsigned char* body) {
 }
 
 // The count, time span and instances of a message name.
-void Parser::Count(const DataflashFormat& f, const unsigned char* body) {
+void DataflashParser::Count(const DataflashFormat& f, const unsigned char* body) {
   int& slot = slot_by_type_[f.type];
   if (slot < 0) {
     auto [it, added] = message_index_.emplace(f.name, out_.messages.size());
@@ -438,7 +434,7 @@ void Parser::Count(const DataflashFormat& f, const unsigned char* body) {
   }
 }
 
-void Parser::Decode(size_t pos, const DataflashFormat& f, const unsigned char* body) {
+void DataflashParser::Decode(size_t pos, const DataflashFormat& f, const unsigned char* body) {
   if (request_format_at_ != f.byte_offset) {
     request_format_at_ = f.byte_offset;
     request_index_.clear();
@@ -449,7 +445,8 @@ void Parser::Decode(size_t pos, const DataflashFormat& f, const unsigned char* b
       const int i = LabelIndex(f, label);
       if (i < 0 || IsStringChar(f.format[i]) || f.format[i] == 'a') {
         std::string list;
-        for (const std::string& l : f.labels) list += (list.empty() ? "" : ", ") + Printable(l);
+        for (const std::string& l : f.labels)
+          list += (list.empty() ? "" : ", ") + PrintableAscii(l, kDataflashTextEcho);
         Fail("message " + f.name + " (FMT at byte " + std::to_string(f.byte_offset) +
              ") has no numeric field '" + label + "'; its fields are: " + list);
       }
@@ -528,7 +525,8 @@ std::string ListMessages(const DataflashContents& log) {
       list += ", ... (" + std::to_string(log.messages.size()) + " in all)";
       break;
     }
-    list += (list.empty() ? "" : ", ") + Printable(m.name) + " (" + std::to_string(m.count) + ")";
+    list += (list.empty() ? "" : ", ") + PrintableAscii(m.name, kDataflashTextEcho) + " (" +
+            std::to_string(m.count) + ")";
   }
   return list.empty() ? "none" : list;
 }
@@ -736,7 +734,7 @@ DataflashContents ParseDataflash(std::string_view bytes, const std::string& name
   if (bytes.empty()) {
     throw UserError(name + ": the file is empty (expected an ArduPilot DataFlash log)");
   }
-  return Parser(bytes, name, request).Run();
+  return DataflashParser(bytes, name, request).Run();
 }
 
 ImuData ReadDataflashImu(std::string_view bytes, const std::string& name,

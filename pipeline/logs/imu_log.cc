@@ -1,21 +1,21 @@
 #include "pipeline/logs/imu_log.h"
 
+#include <fast_float/fast_float.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
-#include <limits>
 #include <cstdio>
 #include <cstring>
-#include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <string_view>
 #include <system_error>
 #include <vector>
 
-#include <fast_float/fast_float.h>
-
 #include "base/gzip.h"
+#include "base/text_format.h"
 #include "base/user_error.h"
 #include "pipeline/logs/dataflash.h"
 #include "pipeline/logs/imu_log_finish.h"
@@ -24,8 +24,6 @@
 
 namespace bifilar {
 namespace {
-
-constexpr int kTime = 0;  // slot of the time column in the needed-column table; gyro 1-3, accel 4-6
 
 std::string_view Trim(std::string_view s) {
   size_t b = 0, e = s.size();
@@ -124,12 +122,6 @@ int CountNonBlankLinesLeft(LineReader* reader) {
   std::string_view line;
   while (reader->Next(&line)) count += IsBlank(line) ? 0 : 1;
   return count;
-}
-
-std::string FormatNumber(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
 }
 
 [[noreturn]] void Fail(const std::string& message) { throw UserError(message); }
@@ -352,7 +344,7 @@ std::string ReadRowCells(const std::vector<std::string_view>& fields, std::strin
                             std::to_string(c.column[k] + 1) + ": column '" + c.names[k] +
                             "' holds '" + Printable(Trim(cell)) +
                             "'; NaN and infinite values are not allowed";
-    } else if (k != kTime && !non_finite) {
+    } else if (k != kImuRowTime && !non_finite) {
       // A reading no sensor gives (imu_log.h): an error like NaN, if the row is data.
       const bool gyro = k <= 3;
       const double bound = gyro ? kMaxGyroRateRadPerS : kMaxAccelMps2;
@@ -360,8 +352,8 @@ std::string ReadRowCells(const std::vector<std::string_view>& fields, std::strin
         non_finite = true;
         *non_finite_message = name + ":" + std::to_string(line_number) + ":" +
                               std::to_string(c.column[k] + 1) + ": column '" + c.names[k] +
-                              "' holds '" + Printable(Trim(cell)) + "' = " +
-                              FormatNumber(row[k] * c.scale[k]) +
+                              "' holds '" + Printable(Trim(cell)) +
+                              "' = " + Fmt("%g", row[k] * c.scale[k]) +
                               (gyro ? " rad/s, beyond any gyro (|rate| <= 1e4 rad/s)"
                                     : " m/s^2, beyond any accelerometer (|f| <= 1e5 m/s^2)") +
                               ": a corrupt value, or the wrong unit or column";
@@ -423,9 +415,9 @@ CsvRows ParseRows(LineReader* reader, size_t text_size, const CsvColumns& c,
     }
     // A numeric row after a break: does it continue the time series?
     const bool after_break = r.bad_rows > 0 || first_blank_line > 0;
-    const bool continues = r.row_line.empty() ||
-                           row[kTime] * c.scale[kTime] >
-                               r.values[(r.row_line.size() - 1) * needed + kTime];
+    const bool continues =
+        r.row_line.empty() || row[kImuRowTime] * c.scale[kImuRowTime] >
+                                  r.values[(r.row_line.size() - 1) * needed + kImuRowTime];
     if (after_break && !continues) {
       r.end_line = r.bad_rows > 0 && (first_blank_line == 0 || r.first_bad_line < first_blank_line)
                        ? r.first_bad_line

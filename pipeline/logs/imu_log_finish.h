@@ -10,6 +10,10 @@
 
 namespace bifilar {
 
+// The slot of the time in a row of samples (the CSV reader's needed columns, FinishImuLog's
+// `values`): time 0, gyro x y z 1-3, accel x y z 4-6.
+constexpr int kImuRowTime = 0;
+
 // `values` holds the samples row-major, `needed` per row (4: t, gyro x y z; 7: + accel x y z),
 // in SI; `row_line[r]` is where row r is in the file (a CSV line; the ULog reader passes the
 // sample number and reworded the warnings); `scale[0]` is the SI factor of the file's time unit.

@@ -8,6 +8,7 @@
 #include <set>
 #include <utility>
 
+#include "base/text_format.h"
 #include "base/user_error.h"
 #include "pipeline/logs/imu_log_finish.h"
 #include "pipeline/logs/simulated_log.h"
@@ -119,14 +120,8 @@ double Decode(const unsigned char* p, Kind kind) {
   return 0.0;
 }
 
-std::string Printable(std::string_view s, size_t max_len = 60) {
-  std::string out;
-  for (char c : s.substr(0, max_len)) {
-    out += (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) ? '?' : c;
-  }
-  if (s.size() > max_len) out += "...";
-  return out;
-}
+// Bytes of a name or format echoed in a message (PrintableAscii).
+constexpr size_t kUlogTextEcho = 60;
 
 std::string Join(const std::vector<std::string>& items, size_t max_items = 200) {
   std::string out;
@@ -135,9 +130,9 @@ std::string Join(const std::vector<std::string>& items, size_t max_items = 200) 
   return out.empty() ? "none" : out;
 }
 
-class Parser {
+class UlogParser {
  public:
-  Parser(std::string_view bytes, const std::string& name, const UlogRequest& request)
+  UlogParser(std::string_view bytes, const std::string& name, const UlogRequest& request)
       : data_(reinterpret_cast<const unsigned char*>(bytes.data())),
         size_(bytes.size()),
         name_(name),
@@ -221,7 +216,7 @@ class Parser {
   std::vector<Kind> timestamp_kind_;
 };
 
-void Parser::ReadHeader() {
+void UlogParser::ReadHeader() {
   if (size_ < kHeaderSize) {
     Fail(size_, "the file is " + std::to_string(size_) +
                     " bytes long, shorter than a ULog header (16 bytes)");
@@ -237,7 +232,7 @@ void Parser::ReadHeader() {
   }
 }
 
-UlogContents Parser::Run() {
+UlogContents UlogParser::Run() {
   subscription_index_.assign(65536, -1);
   if (request_.topic_timestamps) {
     timestamp_at_.assign(65536, -1);
@@ -264,7 +259,7 @@ UlogContents Parser::Run() {
   return std::move(out_);
 }
 
-void Parser::ReadSection(uint64_t pos, uint64_t end, bool last) {
+void UlogParser::ReadSection(uint64_t pos, uint64_t end, bool last) {
   while (pos < end) {
     if (end - pos < kMessageHeader || pos + kMessageHeader +
                                               LoadUnsigned<uint16_t>(data_ + pos) > end) {
@@ -285,7 +280,7 @@ void Parser::ReadSection(uint64_t pos, uint64_t end, bool last) {
   }
 }
 
-void Parser::OnMessage(uint64_t offset, char type, const unsigned char* body, uint32_t size) {
+void UlogParser::OnMessage(uint64_t offset, char type, const unsigned char* body, uint32_t size) {
   switch (type) {
     case 'D': OnData(offset, body, size); return;
     case 'F': OnFormat(offset, body, size); return;
@@ -329,7 +324,7 @@ void Parser::OnMessage(uint64_t offset, char type, const unsigned char* body, ui
 
 // An info message "char[N] bifilar_simulated" (the key length was checked): a log written by
 // `bifilar simulate` says so once in the warnings (pipeline/logs/simulated_log.h).
-void Parser::NoteSimulatedInfo(const unsigned char* body, uint32_t size) {
+void UlogParser::NoteSimulatedInfo(const unsigned char* body, uint32_t size) {
   const std::string_view key(reinterpret_cast<const char*>(body) + 1, body[0]);
   const std::string suffix = std::string("] ") + kSimulatedUlogInfoKey;
   if (key.substr(0, 5) != "char[" || key.size() < suffix.size() ||
@@ -341,7 +336,7 @@ void Parser::NoteSimulatedInfo(const unsigned char* body, uint32_t size) {
       reinterpret_cast<const char*>(body) + 1 + body[0], size - 1 - body[0])));
 }
 
-void Parser::OnFlagBits(uint64_t offset, const unsigned char* body, uint32_t size) {
+void UlogParser::OnFlagBits(uint64_t offset, const unsigned char* body, uint32_t size) {
   if (size < kFlagBitsSize) {
     Fail(offset, "flag-bits message too short (" + std::to_string(size) + " bytes, expected 40)");
   }
@@ -366,11 +361,12 @@ void Parser::OnFlagBits(uint64_t offset, const unsigned char* body, uint32_t siz
   }
 }
 
-void Parser::OnFormat(uint64_t offset, const unsigned char* body, uint32_t size) {
+void UlogParser::OnFormat(uint64_t offset, const unsigned char* body, uint32_t size) {
   const std::string_view text(reinterpret_cast<const char*>(body), size);
   const size_t colon = text.find(':');
   if (colon == std::string_view::npos || colon == 0) {
-    Fail(offset, "format definition without 'name:' ('" + Printable(text) + "')");
+    Fail(offset,
+         "format definition without 'name:' ('" + PrintableAscii(text, kUlogTextEcho) + "')");
   }
   const std::string type_name(text.substr(0, colon));
   RawFormat format;
@@ -384,8 +380,8 @@ void Parser::OnFormat(uint64_t offset, const unsigned char* body, uint32_t size)
     if (field.empty()) continue;
     const size_t space = field.rfind(' ');
     if (space == std::string_view::npos || space == 0 || space + 1 == field.size()) {
-      Fail(offset, "format '" + Printable(type_name) + "': field '" + Printable(field) +
-                       "' is not 'type name'");
+      Fail(offset, "format '" + PrintableAscii(type_name, kUlogTextEcho) + "': field '" +
+                       PrintableAscii(field, kUlogTextEcho) + "' is not 'type name'");
     }
     RawField f;
     std::string_view type = field.substr(0, space);
@@ -397,8 +393,8 @@ void Parser::OnFormat(uint64_t offset, const unsigned char* body, uint32_t size)
       size_t i = 0;
       for (; i < len.size() && len[i] >= '0' && len[i] <= '9' && n <= 65535; ++i) n = n * 10 + (len[i] - '0');
       if (i == 0 || i + 1 != len.size() || len[i] != ']' || n == 0 || n > 65535) {
-        Fail(offset, "format '" + Printable(type_name) + "': bad array size in '" +
-                         Printable(field) + "'");
+        Fail(offset, "format '" + PrintableAscii(type_name, kUlogTextEcho) +
+                         "': bad array size in '" + PrintableAscii(field, kUlogTextEcho) + "'");
       }
       f.array_len = static_cast<uint32_t>(n);
       f.is_array = true;
@@ -407,7 +403,8 @@ void Parser::OnFormat(uint64_t offset, const unsigned char* body, uint32_t size)
     f.type = std::string(type);
     format.fields.push_back(std::move(f));
   }
-  if (format.fields.empty()) Fail(offset, "format '" + Printable(type_name) + "' has no fields");
+  if (format.fields.empty())
+    Fail(offset, "format '" + PrintableAscii(type_name, kUlogTextEcho) + "' has no fields");
   // A new type changes no measured one (a type used before its definition was not measured);
   // a redefinition may.
   if (formats_.count(type_name) != 0) {
@@ -420,21 +417,24 @@ void Parser::OnFormat(uint64_t offset, const unsigned char* body, uint32_t size)
 
 bool IsPadding(const RawField& f) { return f.name.rfind("_padding", 0) == 0; }
 
-Parser::TypeInfo Parser::Measure(const std::string& type, uint64_t offset) {
+UlogParser::TypeInfo UlogParser::Measure(const std::string& type, uint64_t offset) {
   if (const Scalar* s = FindScalar(type)) return {static_cast<uint32_t>(s->size), 1, 0};
   if (const auto it = measured_.find(type); it != measured_.end()) return it->second;
   const auto it = formats_.find(type);
-  if (it == formats_.end()) Fail(offset, "type '" + Printable(type) + "' is used but never defined");
+  if (it == formats_.end())
+    Fail(offset, "type '" + PrintableAscii(type, kUlogTextEcho) + "' is used but never defined");
   const uint64_t at = it->second.byte_offset;
   if (std::find(resolving_.begin(), resolving_.end(), type) != resolving_.end()) {
     std::string chain;
-    for (const std::string& t : resolving_) chain += Printable(t, 40) + " -> ";
-    Fail(at, "format '" + Printable(type) + "' contains itself (circular definition: " + chain +
-                 Printable(type, 40) + ")");
+    for (const std::string& t : resolving_) chain += PrintableAscii(t, 40) + " -> ";
+    Fail(at, "format '" + PrintableAscii(type, kUlogTextEcho) +
+                 "' contains itself (circular definition: " + chain + PrintableAscii(type, 40) +
+                 ")");
   }
   if (static_cast<int>(resolving_.size()) >= kMaxNestingDepth) {
-    Fail(at, "format '" + Printable(resolving_.front()) + "' nests types more than " +
-                 std::to_string(kMaxNestingDepth) + " levels deep (at '" + Printable(type) +
+    Fail(at, "format '" + PrintableAscii(resolving_.front(), kUlogTextEcho) +
+                 "' nests types more than " + std::to_string(kMaxNestingDepth) +
+                 " levels deep (at '" + PrintableAscii(type, kUlogTextEcho) +
                  "'); this reader accepts at most " + std::to_string(kMaxNestingDepth));
   }
   resolving_.push_back(type);
@@ -445,8 +445,9 @@ Parser::TypeInfo Parser::Measure(const std::string& type, uint64_t offset) {
     const TypeInfo element = Measure(f.type, at);
     size += static_cast<uint64_t>(element.size) * f.array_len;
     if (size > kMaxTypeSize) {
-      Fail(at, "format '" + Printable(type) + "' is more than " + std::to_string(kMaxTypeSize) +
-                   " bytes (at field '" + Printable(f.name) +
+      Fail(at, "format '" + PrintableAscii(type, kUlogTextEcho) + "' is more than " +
+                   std::to_string(kMaxTypeSize) + " bytes (at field '" +
+                   PrintableAscii(f.name, kUlogTextEcho) +
                    "'), more than a ULog data message can hold");
     }
     if (IsPadding(f)) continue;
@@ -456,10 +457,10 @@ Parser::TypeInfo Parser::Measure(const std::string& type, uint64_t offset) {
     info.fields += static_cast<uint64_t>(f.array_len) * element.fields;
     info.name_bytes += static_cast<uint64_t>(f.array_len) * (element.fields * own + element.name_bytes);
     if (info.name_bytes > kMaxFlatNameBytes) {
-      Fail(at, "format '" + Printable(type) + "' flattens to " + std::to_string(info.fields) +
-                   " or more fields whose names take more than " +
+      Fail(at, "format '" + PrintableAscii(type, kUlogTextEcho) + "' flattens to " +
+                   std::to_string(info.fields) + " or more fields whose names take more than " +
                    std::to_string(kMaxFlatNameBytes >> 20) + " MiB (at field '" +
-                   Printable(f.name) + "'): no real log has such a topic");
+                   PrintableAscii(f.name, kUlogTextEcho) + "'): no real log has such a topic");
     }
   }
   resolving_.pop_back();
@@ -470,8 +471,8 @@ Parser::TypeInfo Parser::Measure(const std::string& type, uint64_t offset) {
 
 // Every field of a measured type visits at least one byte of it, so this is bounded by the
 // type's size (<= 65535) plus its fields; the names by kMaxFlatNameBytes.
-void Parser::Flatten(const std::string& type, const std::string& prefix, uint32_t base,
-                     Layout* layout) {
+void UlogParser::Flatten(const std::string& type, const std::string& prefix, uint32_t base,
+                         Layout* layout) {
   const RawFormat& format = formats_.at(type);
   uint32_t at = base;
   for (const RawField& f : format.fields) {
@@ -491,10 +492,11 @@ void Parser::Flatten(const std::string& type, const std::string& prefix, uint32_
   }
 }
 
-Layout Parser::Resolve(const std::string& topic, uint64_t offset) {
+Layout UlogParser::Resolve(const std::string& topic, uint64_t offset) {
   if (const auto it = layouts_.find(topic); it != layouts_.end()) return it->second;
   if (formats_.find(topic) == formats_.end()) {
-    Fail(offset, "topic '" + Printable(topic) + "' is subscribed but has no format definition");
+    Fail(offset, "topic '" + PrintableAscii(topic, kUlogTextEcho) +
+                     "' is subscribed but has no format definition");
   }
   Layout layout;
   const TypeInfo info = Measure(topic, offset);  // bounds the allocations below
@@ -507,7 +509,8 @@ Layout Parser::Resolve(const std::string& topic, uint64_t offset) {
   return layout;
 }
 
-bool Parser::FindTimestamp(const std::string& topic, uint64_t offset, uint32_t* at, Kind* kind) {
+bool UlogParser::FindTimestamp(const std::string& topic, uint64_t offset, uint32_t* at,
+                               Kind* kind) {
   if (const auto it = timestamps_.find(topic); it != timestamps_.end()) {
     *at = static_cast<uint32_t>(std::max(0, it->second.first));
     *kind = it->second.second;
@@ -539,7 +542,7 @@ bool Parser::FindTimestamp(const std::string& topic, uint64_t offset, uint32_t* 
 }
 
 // What is lost when the last section ends inside a message at `pos`.
-std::string Parser::DroppedTail(uint64_t pos) const {
+std::string UlogParser::DroppedTail(uint64_t pos) const {
   const uint64_t rest = size_ - pos;
   std::string what = "the log ends inside a message at byte " + std::to_string(pos) + " of " +
                      std::to_string(size_);
@@ -558,13 +561,13 @@ std::string Parser::DroppedTail(uint64_t pos) const {
     const long lost = std::lround(static_cast<double>(rest) / bytes_per_sample);
     if (lost > 0) {
       what += "; at the rate of the data before it, that is about " + std::to_string(lost) +
-              " sample(s) of topic '" + Printable(request_.topic) + "'";
+              " sample(s) of topic '" + PrintableAscii(request_.topic, kUlogTextEcho) + "'";
     }
   }
   return what;
 }
 
-void Parser::OnSubscription(uint64_t offset, const unsigned char* body, uint32_t size) {
+void UlogParser::OnSubscription(uint64_t offset, const unsigned char* body, uint32_t size) {
   if (size < 4) Fail(offset, "subscription message too short (" + std::to_string(size) + " bytes)");
   UlogSubscription s;
   s.multi_id = body[0];
@@ -608,7 +611,7 @@ void Parser::OnSubscription(uint64_t offset, const unsigned char* body, uint32_t
   out_.subscriptions.push_back(std::move(s));
 }
 
-void Parser::OnData(uint64_t offset, const unsigned char* body, uint32_t size) {
+void UlogParser::OnData(uint64_t offset, const unsigned char* body, uint32_t size) {
   if (size < 2) Fail(offset, "data message too short (" + std::to_string(size) + " bytes)");
   const uint16_t msg_id = LoadUnsigned<uint16_t>(body);
   const uint8_t role = msg_role_[msg_id];
@@ -709,7 +712,7 @@ bool UlogTopicDefaults(const std::string& topic, UlogSelection* selection) {
 }
 
 UlogContents ParseUlog(std::string_view bytes, const std::string& name, const UlogRequest& request) {
-  return Parser(bytes, name, request).Run();
+  return UlogParser(bytes, name, request).Run();
 }
 
 ImuData ReadUlogImu(std::string_view bytes, const std::string& name, const ImuFormat& format,

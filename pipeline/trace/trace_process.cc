@@ -456,8 +456,7 @@ void WriteTraceFigures(const CampaignConfig& config, const TraceProcessOptions& 
       figure_options.width_px = options.figure_width_px;
       figure_options.height_px = options.figure_height_px;
       figure_options.unit_scale = InertiaToDisplay(1.0, config.units);
-      figure_options.unit_label =
-          config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+      figure_options.unit_label = InertiaUnitPlotLabel(config.units);
       figure_options.inertia_std_kg_m2 = record->inertia_total_std_total_kg_m2;  // as printed
       figure_options.std_label = "total";
       drawn = WriteTraceFitFigure(fit, figure_path, figure_options, &why);
@@ -468,7 +467,7 @@ void WriteTraceFigures(const CampaignConfig& config, const TraceProcessOptions& 
   SweepPlotOptions sweep_options;
   sweep_options.title = name;
   sweep_options.unit_scale = InertiaToDisplay(1.0, config.units);
-  sweep_options.unit_label = config.units == DisplayUnits::kImperial ? "slug ft#u2#d" : "kg m#u2#d";
+  sweep_options.unit_label = InertiaUnitPlotLabel(config.units);
   sweep_options.figure.width_px = options.figure_width_px;
   sweep_options.figure.height_px = options.figure_height_px;
   sweep_options.compact = options.compact_figure;  // the report explains it in the caption

@@ -34,6 +34,7 @@
 #include "fit/tensor.h"
 #include "fit/trace_fit.h"
 #include "fit/window.h"
+#include "pendulum/model.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/commands/log_inspect.h"
 #include "pipeline/commands/simulate_spec.h"
@@ -82,7 +83,8 @@ CampaignConfig FitTraceConfig(const FitTraceArgs& a) {
   if (a.g) config.gravity_mps2 = *a.g;
   if (a.model && !ParsePendulumModel(*a.model, &config.fit.model)) {
     throw std::invalid_argument("fit_trace: model '" + *a.model +
-                                "': expected full, jardin or linear");
+                                "': expected " +
+                                PendulumModelAllowedValues());
   }
   if (a.max_amplitude_deg) config.fit.max_amplitude_deg = *a.max_amplitude_deg;
   if (a.min_amplitude_deg) config.fit.min_amplitude_deg = *a.min_amplitude_deg;
