@@ -260,19 +260,19 @@ TEST(ReportKinds, EveryKeyTheReportReadsIsWritten) {
     EXPECT_TRUE(exported.count("tensor.Ixx_kg_m2") == 1) << "export read no tensor";
     read.insert(exported.begin(), exported.end());
   }
-  // Written only with a rig calibration (pipeline/records/results_json.cc CalibrationToJson):
-  // the campaigns above have none, so the report reads none of them. A trace's
+  // A trace's
   // uncertainty.repeat_scatter_kg_m2 and amplitude_correction are written only by `fit
   // --repeats`: the trace reader looks for them in every record, and
   // tests/pipeline_trace_record_json_test.cc checks them against the writer.
   const KeyLog only_elsewhere = {"traces[].uncertainty.repeat_scatter_kg_m2",
                                  "traces[].amplitude_correction"};
   for (const std::string& key : read) {
-    EXPECT_TRUE(written.count(key) == 1 || key.rfind("calibration.", 0) == 0 ||
-                only_elsewhere.count(key) == 1)
-        << key << " is never written";
+    EXPECT_TRUE(written.count(key) == 1 || only_elsewhere.count(key) == 1) << key << " is never written";
   }
-  // The traces are read whole by TraceRecordFromJson (the cache's reader too).
+  // The traces, the summary and the calibration (none here: null) are read whole by their typed
+  // readers (pipeline/records/results_json.h; TraceRecordFromJson is the cache's reader too).
+  EXPECT_EQ(read.count("summary.n_reused"), 1u);
+  EXPECT_EQ(read.count("calibration"), 1u);
   EXPECT_EQ(read.count("traces[].period_s"), 1u);
   EXPECT_EQ(read.count("traces[].amplitude_sweep.low_band"), 1u);
   EXPECT_GT(read.size(), 80u);

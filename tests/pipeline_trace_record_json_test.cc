@@ -4,7 +4,8 @@
 // error; tare and calibration; with and without a sweep; warnings; NaN); the keys it reads are
 // the keys the writer writes, less the ones it composes from the fields (DerivedTraceKeys), so a
 // read of a key the writer never writes fails here; a record that lacks a key or holds one of
-// another type is refused naming the key. On real output: the committed sample's results.json.
+// another type is refused naming the key. On real output: the committed sample's results.json. The
+// same for the calibration and summary sections.
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -375,6 +376,90 @@ TEST(TraceRecordJson, AMissingOrMistypedKeyIsRefusedNamingIt) {
               TraceRecordFromJson(TraceRecordToJson(FullRecord(), false), true);
             }),
             "'role' is missing");
+}
+
+// The calibration and summary sections have one typed reader each too (the report's): every
+// field written comes back bit for bit, and the keys read are the keys written.
+TEST(ResultsSectionsJson, CalibrationAndSummaryReadBackEveryFieldAndOnlyWrittenKeys) {
+  RigCalibrationResult c;
+  c.applied = true;
+  c.factor = 1.0 + kThird * 0.09;
+  c.factor_std = 4.1e-4;
+  c.factor_rel_std = 4.0e-4;
+  c.rel_std_reference = 3.0e-4;
+  c.rel_std_swings = 2.0e-4;
+  c.rel_std_rig = kTiny;
+  c.filar_length_m = 1.5;
+  c.nominal_separation_m = 0.5;
+  c.effective_separation_m = 0.5 * std::sqrt(c.factor);
+  c.nominal_d2_over_l_m = 0.25 / 1.5;
+  c.effective_d2_over_l_m = c.nominal_d2_over_l_m * c.factor;
+  c.reference_inertia_kg_m2 = 0.2;
+  c.reference_inertia_std_kg_m2 = 1e-4;
+  c.reference_mass_kg = 2.0;
+  c.n_swings = 3;
+  c.swings_total_kg_m2 = 0.2312;
+  c.swings_total_std_kg_m2 = 2.2e-5;
+  c.swings_scatter_kg_m2 = NAN;  // one swing: written null
+  c.rig_inertia_source = "tare";
+  c.rig_inertia_kg_m2 = 0.0312;
+  c.rig_inertia_std_kg_m2 = 1.1e-5;
+  c.iterations = 2;
+  c.logs = {"calibration/plate_1.csv", "calibration/plate_2.csv", "calibration/plate_3.csv"};
+  c.warnings = {"rig.calibration: the factor k = 1.03 moves D^2/L by +3.0 %"};
+  const json written = CalibrationToJson(c);
+  KeyLog read;
+  const RigCalibrationResult b = CalibrationFromJson(json::parse(written.dump()), &read);
+  EXPECT_EQ(read, KeyPaths(written));
+  EXPECT_EQ(CalibrationToJson(b).dump(), written.dump());
+  EXPECT_EQ(b.applied, c.applied);
+  for (const auto& [x, y] : std::vector<std::pair<double, double>>{
+           {b.factor, c.factor}, {b.factor_std, c.factor_std}, {b.factor_rel_std, c.factor_rel_std},
+           {b.rel_std_reference, c.rel_std_reference}, {b.rel_std_swings, c.rel_std_swings},
+           {b.rel_std_rig, c.rel_std_rig}, {b.filar_length_m, c.filar_length_m},
+           {b.nominal_separation_m, c.nominal_separation_m},
+           {b.effective_separation_m, c.effective_separation_m},
+           {b.nominal_d2_over_l_m, c.nominal_d2_over_l_m},
+           {b.effective_d2_over_l_m, c.effective_d2_over_l_m},
+           {b.reference_inertia_kg_m2, c.reference_inertia_kg_m2},
+           {b.reference_inertia_std_kg_m2, c.reference_inertia_std_kg_m2},
+           {b.reference_mass_kg, c.reference_mass_kg}, {b.swings_total_kg_m2, c.swings_total_kg_m2},
+           {b.swings_total_std_kg_m2, c.swings_total_std_kg_m2},
+           {b.swings_scatter_kg_m2, c.swings_scatter_kg_m2},
+           {b.rig_inertia_kg_m2, c.rig_inertia_kg_m2},
+           {b.rig_inertia_std_kg_m2, c.rig_inertia_std_kg_m2}}) {
+    EXPECT_TRUE(SameBits(x, y)) << x << " against " << y;
+  }
+  EXPECT_EQ(b.n_swings, c.n_swings);
+  EXPECT_EQ(b.rig_inertia_source, c.rig_inertia_source);
+  EXPECT_EQ(b.iterations, c.iterations);
+  EXPECT_EQ(b.logs, c.logs);
+  EXPECT_EQ(b.warnings, c.warnings);
+  json without = written;
+  without["swings"].erase("n");
+  EXPECT_EQ(test_support::ErrorOf([&] { CalibrationFromJson(without); }), "'swings.n' is missing");
+
+  CampaignSummary s;
+  s.n_traces = 57;
+  s.n_ok = 55;
+  s.n_rejected = 1;
+  s.n_error = 1;
+  s.n_fitted = 40;
+  s.n_reused = 17;
+  s.wall_s = 2.32 + kTiny;
+  s.ellipse_fitted = true;
+  s.ellipse_message = "";
+  s.tensor_fitted = false;
+  s.tensor_message = "a pitch-only campaign";
+  s.exit_code = 1;
+  const json summary = CampaignSummaryToJson(s);
+  KeyLog summary_read;
+  const CampaignSummary t = CampaignSummaryFromJson(json::parse(summary.dump()), &summary_read);
+  EXPECT_EQ(summary_read, KeyPaths(summary));
+  EXPECT_EQ(CampaignSummaryToJson(t).dump(), summary.dump());
+  EXPECT_TRUE(SameBits(t.wall_s, s.wall_s));
+  EXPECT_EQ(t.n_reused, 17);
+  EXPECT_EQ(t.tensor_message, s.tensor_message);
 }
 
 // A copy of a written record without the keys composed from its fields (DerivedTraceKeys).

@@ -529,6 +529,86 @@ json CalibrationToJson(const RigCalibrationResult& c) {
           {"warnings", c.warnings}};
 }
 
+RigCalibrationResult CalibrationFromJson(const json& j, KeyLog* keys_read) {
+  if (!j.is_object()) throw UserError(std::string("a calibration is an object, not ") + j.type_name());
+  const RecordNode c(j, "", keys_read);
+  RigCalibrationResult r;
+  r.applied = c.Bool("applied");
+  r.factor = c.Num("factor");
+  r.factor_std = c.Num("factor_std");
+  r.factor_rel_std = c.Num("factor_relative_std");
+  const RecordNode parts = c.Object("relative_std_parts");
+  r.rel_std_reference = parts.Num("reference_inertia");
+  r.rel_std_swings = parts.Num("reference_swings");
+  r.rel_std_rig = parts.Num("rig_inertia");
+  const RecordNode nominal = c.Object("nominal"), effective = c.Object("effective");
+  r.filar_length_m = nominal.Num("filar_length_m");
+  r.nominal_separation_m = nominal.Num("filar_separation_m");
+  r.nominal_d2_over_l_m = nominal.Num("d2_over_l_m");
+  // L is kept: the effective geometry's L is the configured one.
+  const double effective_length_m = effective.Num("filar_length_m");
+  if (!(effective_length_m == r.filar_length_m ||
+        (std::isnan(effective_length_m) && std::isnan(r.filar_length_m)))) {
+    throw UserError("'effective.filar_length_m' is not 'nominal.filar_length_m' (the calibration "
+                    "keeps L)");
+  }
+  r.effective_separation_m = effective.Num("filar_separation_m");
+  r.effective_d2_over_l_m = effective.Num("d2_over_l_m");
+  const RecordNode reference = c.Object("reference");
+  r.reference_inertia_kg_m2 = reference.Num("inertia_kg_m2");
+  r.reference_inertia_std_kg_m2 = reference.Num("inertia_std_kg_m2");
+  r.reference_mass_kg = reference.Num("mass_kg");
+  const RecordNode swings = c.Object("swings");
+  r.n_swings = swings.Int("n");
+  r.logs = swings.Strs("logs");
+  r.swings_total_kg_m2 = swings.Num("total_mean_kg_m2");
+  r.swings_total_std_kg_m2 = swings.Num("total_standard_error_kg_m2");
+  r.swings_scatter_kg_m2 = swings.Num("scatter_kg_m2");
+  const RecordNode rig = c.Object("rig_inertia");
+  r.rig_inertia_source = rig.Str("source");
+  r.rig_inertia_kg_m2 = rig.Num("inertia_kg_m2");
+  r.rig_inertia_std_kg_m2 = rig.Num("inertia_std_kg_m2");
+  r.iterations = c.Int("iterations");
+  r.warnings = c.Strs("warnings");
+  return r;
+}
+
+json CampaignSummaryToJson(const CampaignSummary& s) {
+  json summary;
+  summary["n_traces"] = s.n_traces;
+  summary["n_ok"] = s.n_ok;
+  summary["n_rejected"] = s.n_rejected;
+  summary["n_error"] = s.n_error;
+  summary["n_fitted"] = s.n_fitted;
+  summary["n_reused"] = s.n_reused;
+  summary["wall_s"] = s.wall_s;
+  summary["ellipse_fitted"] = s.ellipse_fitted;
+  summary["ellipse_message"] = s.ellipse_message;
+  summary["tensor_fitted"] = s.tensor_fitted;
+  summary["tensor_message"] = s.tensor_message;
+  summary["exit_code"] = s.exit_code;
+  return summary;
+}
+
+CampaignSummary CampaignSummaryFromJson(const json& j, KeyLog* keys_read) {
+  if (!j.is_object()) throw UserError(std::string("a summary is an object, not ") + j.type_name());
+  const RecordNode node(j, "", keys_read);
+  CampaignSummary s;
+  s.n_traces = node.Int("n_traces");
+  s.n_ok = node.Int("n_ok");
+  s.n_rejected = node.Int("n_rejected");
+  s.n_error = node.Int("n_error");
+  s.n_fitted = node.Int("n_fitted");
+  s.n_reused = node.Int("n_reused");
+  s.wall_s = node.Num("wall_s");
+  s.ellipse_fitted = node.Bool("ellipse_fitted");
+  s.ellipse_message = node.Str("ellipse_message");
+  s.tensor_fitted = node.Bool("tensor_fitted");
+  s.tensor_message = node.Str("tensor_message");
+  s.exit_code = node.Int("exit_code");
+  return s;
+}
+
 json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   json j;
   j["program"] = "bifilar";
@@ -560,21 +640,7 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
                   {"range_factor", glitch.range_factor},
                   {"excursion_fraction", glitch.excursion_fraction},
                   {"max_fraction", glitch.max_fraction}}}};
-  json summary;
-  const CampaignSummary& s = result.summary;
-  summary["n_traces"] = s.n_traces;
-  summary["n_ok"] = s.n_ok;
-  summary["n_rejected"] = s.n_rejected;
-  summary["n_error"] = s.n_error;
-  summary["n_fitted"] = s.n_fitted;
-  summary["n_reused"] = s.n_reused;
-  summary["wall_s"] = s.wall_s;
-  summary["ellipse_fitted"] = s.ellipse_fitted;
-  summary["ellipse_message"] = s.ellipse_message;
-  summary["tensor_fitted"] = s.tensor_fitted;
-  summary["tensor_message"] = s.tensor_message;
-  summary["exit_code"] = s.exit_code;
-  j["summary"] = summary;
+  j["summary"] = CampaignSummaryToJson(result.summary);
   json rig;
   rig["filar_length_m"] = config.filar_length_m;
   rig["filar_separation_m"] = config.filar_separation_m;

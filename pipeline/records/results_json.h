@@ -39,6 +39,16 @@ const KeyLog& DerivedTraceKeys();
 // effective against nominal geometry, the factor with its std and the std's three parts.
 nlohmann::json CalibrationToJson(const RigCalibrationResult& calibration);
 
+// The inverse of CalibrationToJson, as TraceRecordFromJson reads a record: every key required,
+// a missing or mistyped one a UserError naming it; `keys_read` receives the key paths read. Not
+// written, so not read: cache_keys.
+RigCalibrationResult CalibrationFromJson(const nlohmann::json& json, KeyLog* keys_read = nullptr);
+
+// The `summary` section of results.json (every field but n_cache_refused) and its inverse, read
+// as CalibrationFromJson reads.
+nlohmann::json CampaignSummaryToJson(const CampaignSummary& summary);
+CampaignSummary CampaignSummaryFromJson(const nlohmann::json& json, KeyLog* keys_read = nullptr);
+
 // The whole results.json document.
 nlohmann::json ResultsToJson(const CampaignConfig& config, const CampaignResult& result);
 

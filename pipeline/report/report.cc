@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -220,35 +221,49 @@ const char* kScrollClose = "</div>\n";
 // (the paper's ellipse), a full tensor, a partial one, or three separate axes (moments only).
 enum class CampaignKind { kPlanar, kFullTensor, kPartialTensor, kSeparateAxes };
 
-// results.json's traces, each read by the one reader of a trace record (TraceRecordFromJson,
-// pipeline/records/results_json.h, as the cache reads its entries); the keys it reads go to `log`
-// as "traces[].KEY". A trace the reader refuses (a key missing or of another type: a file of
-// another version, or edited) throws UserError naming the trace, the key and the version that
-// wrote the file; RunReport adds the file and what to do.
-std::vector<TraceRecord> ReadTraces(const json& results, KeyLog* log) {
-  const R reader(results, log);
+// A section of results.json read by its one typed reader (pipeline/records/results_json.h, the
+// one the cache uses for a trace record): a key missing or of another type (a file of another
+// version, or edited) throws UserError naming the section, the key and the version that wrote
+// the file; RunReport adds the file and what to do. The keys read go to `log` under `path`.
+template <typename Read>
+auto ReadSection(const R& results, const std::string& what, const std::string& path, KeyLog* log,
+                 const Read& read) {
+  KeyLog keys;
+  try {
+    auto value = read(&keys);
+    if (log != nullptr) {
+      for (const std::string& key : keys) log->insert(path + "." + key);
+    }
+    return value;
+  } catch (const UserError& e) {
+    const std::string version = results.Str("version");
+    throw UserError(what + ": " + e.what() + "; the file was written by bifilar " +
+                    (version.empty() ? std::string("of an unknown version") : version) +
+                    ", this is bifilar " + ProgramVersion());
+  }
+}
+
+// results.json's traces, each read by TraceRecordFromJson as the cache reads its entries.
+std::vector<TraceRecord> ReadTraces(const R& results, KeyLog* log) {
   std::vector<TraceRecord> out;
-  const std::vector<R> items = reader.Items("traces");
+  const std::vector<R> items = results.Items("traces");
   for (size_t i = 0; i < items.size(); ++i) {
     const json& element = items[i].node();
-    KeyLog keys;
-    try {
-      out.push_back(TraceRecordFromJson(element, true, &keys));
-    } catch (const UserError& e) {
-      const auto file = element.is_object() ? element.find("file") : element.end();
-      const std::string name =
-          file != element.end() && file->is_string() ? " (" + file->get<std::string>() + ")" : "";
-      const std::string version = reader.Str("version");
-      throw UserError("traces[" + std::to_string(i) + "]" + name + ": " + e.what() +
-                      "; the file was written by bifilar " +
-                      (version.empty() ? std::string("of an unknown version") : version) +
-                      ", this is bifilar " + ProgramVersion());
-    }
-    if (log != nullptr) {
-      for (const std::string& key : keys) log->insert("traces[]." + key);
-    }
+    const auto file = element.is_object() ? element.find("file") : element.end();
+    const std::string name =
+        file != element.end() && file->is_string() ? " (" + file->get<std::string>() + ")" : "";
+    out.push_back(ReadSection(results, "traces[" + std::to_string(i) + "]" + name, "traces[]", log,
+                              [&](KeyLog* keys) { return TraceRecordFromJson(element, true, keys); }));
   }
   return out;
+}
+
+// The calibration section (null without rig.calibration).
+std::optional<RigCalibrationResult> ReadCalibration(const R& results, KeyLog* log) {
+  const R section = results.Get("calibration");
+  if (!section.IsObject()) return std::nullopt;
+  return ReadSection(results, "calibration", "calibration", log,
+                     [&](KeyLog* keys) { return CalibrationFromJson(section.node(), keys); });
 }
 
 // One trace in the order of the tables: by roll, pitch (numerically), then file.
@@ -261,7 +276,7 @@ struct TraceRow {
 // the number of figures embedded so far (the inline SVGs' id prefixes).
 struct ReportPage {
   ReportPage(const json& results_in, const std::string& out_dir_in, KeyLog* log)
-      : results(results_in, log), out_dir(out_dir_in) {
+      : results(results_in, log), log_(log), out_dir(out_dir_in) {
     if (results.Str("units") == "imperial") {
       u.imperial = true;
       u.scale = kSlugFt2PerKgM2;
@@ -273,7 +288,7 @@ struct ReportPage {
     kind = mode == "full_3d"   ? CampaignKind::kFullTensor
            : mode == "partial" ? (products ? CampaignKind::kPartialTensor : CampaignKind::kSeparateAxes)
                                : CampaignKind::kPlanar;
-    for (TraceRecord& t : ReadTraces(results_in, log)) {
+    for (TraceRecord& t : ReadTraces(results, log_)) {
       TraceRow row{std::move(t)};
       const double roll = row.t.roll_used_deg;
       row.roll = std::isfinite(roll) ? roll : 0.0;
@@ -292,9 +307,13 @@ struct ReportPage {
   }
   bool Planar() const { return kind == CampaignKind::kPlanar; }
   R results;
+  KeyLog* log_;  // every key read (ReportKeysRead), or null
   const std::string& out_dir;
   Units u;
-  const R summary = results.Get("summary");
+  const CampaignSummary summary = ReadSection(
+      results, "summary", "summary", log_,
+      [this](KeyLog* keys) { return CampaignSummaryFromJson(results.Get("summary").node(), keys); });
+  const std::optional<RigCalibrationResult> calibration = ReadCalibration(results, log_);
   const R ellipse = results.Get("ellipse");
   const R tensor = results.Get("tensor");
   const R figures = results.Get("figures");
@@ -326,7 +345,7 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
   };
   if (p.Planar()) {
     if (!p.ellipse.IsObject()) {
-      h << "<p class=\"bad\">" << Escape(p.summary.Str("ellipse_message")) << "</p>\n";
+      h << "<p class=\"bad\">" << Escape(p.summary.ellipse_message) << "</p>\n";
       return;
     }
     const R total = p.results.Get("total_uncertainty");
@@ -340,7 +359,7 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
     return;
   }
   if (!p.tensor.IsObject()) {
-    h << "<p class=\"bad\">" << Escape(p.summary.Str("tensor_message")) << "</p>\n";
+    h << "<p class=\"bad\">" << Escape(p.summary.tensor_message) << "</p>\n";
     return;
   }
   for (const char* name : {"Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"}) {
@@ -353,7 +372,7 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
 
 // Title, version, config, the campaign kind and the trace counts, then the main result.
 void WriteHeader(const ReportPage& p, std::ostream& h) {
-  const R& summary = p.summary;
+  const CampaignSummary& summary = p.summary;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
     << "<title>bifilar report</title><style>" << kStyle << "</style></head><body>\n";
   h << "<h1>Mass properties from bifilar pendulum swings</h1>\n";
@@ -367,9 +386,9 @@ void WriteHeader(const ReportPage& p, std::ostream& h) {
       << Escape(settings.Str("integrator")) << "</code>";
     if (!settings.Get("glitch").Bool("enabled", true)) h << ", glitch removal off";
   }
-  h << ". Traces: " << summary.Int("n_traces") << " (<span class=\"ok\">" << summary.Int("n_ok")
-    << " ok</span>, " << summary.Int("n_rejected") << " rejected, " << summary.Int("n_error")
-    << " error); fits reused from cache: " << summary.Int("n_reused") << ".</p>\n";
+  h << ". Traces: " << summary.n_traces << " (<span class=\"ok\">" << summary.n_ok
+    << " ok</span>, " << summary.n_rejected << " rejected, " << summary.n_error
+    << " error); fits reused from cache: " << summary.n_reused << ".</p>\n";
   // Simulated logs say so in their warnings (pipeline/logs/simulated_log.h): the page says it first.
   int simulated = 0;
   std::string mark;  // the first log's own words, once for the page
@@ -440,7 +459,7 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
   const R& ellipse = p.ellipse;
   h << "<h2>Table 2: inertia properties</h2>\n";
   if (!ellipse.IsObject()) {
-    h << "<p class=\"bad\">" << Escape(p.summary.Str("ellipse_message")) << "</p>\n";
+    h << "<p class=\"bad\">" << Escape(p.summary.ellipse_message) << "</p>\n";
     return;
   }
   // The total column (results.json total_uncertainty, pipeline/records/total_uncertainty.h): the
@@ -468,7 +487,7 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
     h << "<td class=\"l\">" << (row.angle ? "deg" : u.name) << "</td></tr>\n";
   }
   h << "</table>" << kScrollClose;
-  const bool calibrated = p.results.Get("calibration").IsObject();
+  const bool calibrated = p.calibration.has_value();
   const double common = total.Num("common_mode_relative_std");
   const bool assumed = total.Bool("configured_inputs_assumed");
   h << "<p><b>std (stat)</b>: the scatter between trials and angles, the fits' own errors and the "
@@ -491,28 +510,27 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
 
 // rig.calibration: effective against configured geometry, the factor with its std and parts.
 void WriteCalibration(const ReportPage& p, std::ostream& h) {
-  const R c = p.results.Get("calibration");
-  if (!c.IsObject()) return;
-  const R parts = c.Get("relative_std_parts"), swings = c.Get("swings"), reference = c.Get("reference");
+  if (!p.calibration) return;
+  const RigCalibrationResult& c = *p.calibration;
   h << "<h2>Rig calibration (reference object)</h2>\n<table><tr><th class=\"l\">geometry</th>"
        "<th>L (m)</th><th>D (m)</th><th>D<sup>2</sup>/L (m)</th></tr>\n";
-  for (const char* label : {"nominal", "effective"}) {
-    const R g = c.Get(label);
-    h << "<tr><td class=\"l\">" << (std::string(label) == "nominal" ? "configured" : label)
-      << "</td><td>" << Fmt(g.Num("filar_length_m"), "%.4f") << "</td><td>"
-      << Fmt(g.Num("filar_separation_m"), "%.5f") << "</td><td>" << Fmt(g.Num("d2_over_l_m"), "%.6f")
+  const auto row = [&](const char* label, double separation_m, double d2_over_l_m) {
+    h << "<tr><td class=\"l\">" << label << "</td><td>" << Fmt(c.filar_length_m, "%.4f")
+      << "</td><td>" << Fmt(separation_m, "%.5f") << "</td><td>" << Fmt(d2_over_l_m, "%.6f")
       << "</td></tr>\n";
-  }
-  h << "</table>\n<p>Factor k = " << Fmt(c.Num("factor"), "%.5f") << " &plusmn; "
-    << Fmt(c.Num("factor_std"), "%.5f") << " (&plusmn;" << Fmt(100.0 * c.Num("factor_relative_std"), "%.3f")
-    << " %, common to every moment: reference inertia " << Fmt(100.0 * parts.Num("reference_inertia"), "%.3f")
-    << " %, reference swings " << Fmt(100.0 * parts.Num("reference_swings"), "%.3f") << " %, rig inertia "
-    << Fmt(100.0 * parts.Num("rig_inertia"), "%.3f") << " %), from " << swings.Int("n")
-    << " swing(s) of a reference of " << p.u.Inertia(reference.Num("inertia_kg_m2"), "%.5g") << " "
-    << p.u.name << " and " << Fmt(reference.Num("mass_kg"), "%.4g")
+  };
+  row("configured", c.nominal_separation_m, c.nominal_d2_over_l_m);
+  row("effective", c.effective_separation_m, c.effective_d2_over_l_m);
+  h << "</table>\n<p>Factor k = " << Fmt(c.factor, "%.5f") << " &plusmn; "
+    << Fmt(c.factor_std, "%.5f") << " (&plusmn;" << Fmt(100.0 * c.factor_rel_std, "%.3f")
+    << " %, common to every moment: reference inertia " << Fmt(100.0 * c.rel_std_reference, "%.3f")
+    << " %, reference swings " << Fmt(100.0 * c.rel_std_swings, "%.3f") << " %, rig inertia "
+    << Fmt(100.0 * c.rel_std_rig, "%.3f") << " %), from " << c.n_swings
+    << " swing(s) of a reference of " << p.u.Inertia(c.reference_inertia_kg_m2, "%.5g") << " "
+    << p.u.name << " and " << Fmt(c.reference_mass_kg, "%.4g")
     << " kg. Every trace, tare logs included, was fitted with the effective geometry; the "
        "tape-measure uncertainties of L and D and that of g do not apply.</p>\n";
-  WriteNotes(c.Strs("warnings"), p.u, h);
+  WriteNotes(c.warnings, p.u, h);
 }
 
 // Table 1 (data quality) and the rig line. The regression RMSE is the ellipse's (planar) or the
@@ -636,7 +654,7 @@ void WriteTensorSection(ReportPage& p, std::ostream& h) {
   const R& tensor = p.tensor;
   h << "<h2>Inertia tensor</h2>\n";
   if (!tensor.IsObject()) {
-    h << "<p class=\"bad\">" << Escape(p.summary.Str("tensor_message")) << "</p>\n";
+    h << "<p class=\"bad\">" << Escape(p.summary.tensor_message) << "</p>\n";
     return;
   }
   h << "<p>" << tensor.Int("n_points") << " moments about " << tensor.Int("n_orientations")
