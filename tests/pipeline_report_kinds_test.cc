@@ -2,16 +2,16 @@
 // pitch) and three separate axes, each from a fast fake fit with known moments. Each page shows
 // only the sections its campaign has; the page's details (issue 25 item 4); and every
 // results.json key the report reads is one that ResultsToJson writes (issue 24 item 5).
+#include <gtest/gtest.h>
+
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include "fit/tensor.h"
 #include "pipeline/campaign/campaign.h"
@@ -138,9 +138,10 @@ void ExpectCommonDetails(const Page& p) {
   EXPECT_NE(Find(page, "Table 1: data quality"), std::string::npos);
   // The warning: the console's line (LineOfWarning: its one sentence is cut to leave room for
   // the clause that says what to do), the full text on click.
-  EXPECT_NE(Find(page, "<details><summary>I depends on the amplitude beyond its statistical error "
-                       "(trend 0.3 % per 10 deg); I is taken ... &rarr; <b>lower the release "
-                       "amplitude or set fit.max_amplitude_deg</b></summary><p>I depends"),
+  EXPECT_NE(Find(page,
+                 "<details><summary>I depends on the amplitude beyond its statistical error "
+                 "(trend 0.3 % per 10 deg); I is taken ... &rarr; <b>lower the release "
+                 "amplitude or set fit.max_amplitude_deg</b></summary><p>I depends"),
             std::string::npos);
   EXPECT_EQ(LineOfWarning(kWarning).Text(),
             "I depends on the amplitude beyond its statistical error (trend 0.3 % per 10 deg); I "
@@ -234,13 +235,15 @@ TEST(ReportKinds, ATraceOfAnotherVersionIsOneClearError) {
   mistyped["traces"][0]["window_s"] = "6.8 to 46.6";
   mistyped["traces"][0]["uncertainty"]["hac_bandwidth"] = 2.5;
   WriteFile(path, mistyped.dump(1));
-  EXPECT_NE(test_support::ErrorOf([&] { RunReport(p.out); })
-                .find("traces[0] (log_0.csv): 'window_s' is not a pair of numbers (string)"),
+  EXPECT_NE(test_support::ErrorOf([&] {
+              RunReport(p.out);
+            }).find("traces[0] (log_0.csv): 'window_s' is not a pair of numbers (string)"),
             std::string::npos);
   mistyped["traces"][0]["window_s"] = nullptr;
   WriteFile(path, mistyped.dump(1));
-  EXPECT_NE(test_support::ErrorOf([&] { RunReport(p.out); })
-                .find("'uncertainty.hac_bandwidth' is not a whole number (number)"),
+  EXPECT_NE(test_support::ErrorOf([&] {
+              RunReport(p.out);
+            }).find("'uncertainty.hac_bandwidth' is not a whole number (number)"),
             std::string::npos);
 }
 
@@ -267,7 +270,8 @@ TEST(ReportKinds, EveryKeyTheReportReadsIsWritten) {
   const KeyLog only_elsewhere = {"traces[].uncertainty.repeat_scatter_kg_m2",
                                  "traces[].amplitude_correction"};
   for (const std::string& key : read) {
-    EXPECT_TRUE(written.count(key) == 1 || only_elsewhere.count(key) == 1) << key << " is never written";
+    EXPECT_TRUE(written.count(key) == 1 || only_elsewhere.count(key) == 1)
+        << key << " is never written";
   }
   // The traces, the summary and the calibration (none here: null) are read whole by their typed
   // readers (pipeline/records/results_json.h; TraceRecordFromJson is the cache's reader too).

@@ -3,11 +3,11 @@
 // (pipeline/records/trace_record.h): the warning's first sentence and, when that does not hold
 // the clause saying what to do, the clause after it. Checked on the real warnings the sample
 // campaign's fits raise, through the binary, and on warning texts the fit has written.
+#include <gtest/gtest.h>
+
 #include <map>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "pipeline/records/trace_record.h"
 #include "test_support.h"
@@ -50,7 +50,8 @@ std::map<std::string, std::vector<std::string>> ReportLines(const std::string& h
        row = html.find("<tr class=\"warned\">", row + 1)) {
     const size_t file_at = html.find("<td class=\"l\">", row) + 14;
     const std::string file = html.substr(file_at, html.find("</td>", file_at) - file_at);
-    const size_t cell = html.find("<td class=\"l w\">", row), cell_end = html.find("</td></tr>", cell);
+    const size_t cell = html.find("<td class=\"l w\">", row),
+                 cell_end = html.find("</td></tr>", cell);
     for (size_t at = cell; at < cell_end;) {
       const size_t details = html.find("<details><summary>", at), paragraph = html.find("<p>", at);
       if (details < cell_end && details <= paragraph) {
@@ -92,7 +93,8 @@ std::map<std::string, std::vector<std::string>> ConsoleLines(const std::string& 
 TEST(ReportWarnings, TheSampleShowsTheSameLineOnTheConsoleAndInTheReport) {
   TempDir dir("bifilar_report_warnings");
   const std::string config = std::string(BIFILAR_SOURCE_DIR) + "/configs/prandtl_d.yaml";
-  const test_support::CliRun run = Bifilar(dir, "process " + config + " --out " + dir.path + "/out");
+  const test_support::CliRun run =
+      Bifilar(dir, "process " + config + " --out " + dir.path + "/out");
   ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
   const auto console = ConsoleLines(run.out);
   const auto report = ReportLines(ReadFile(dir.path + "/out/report.html"));
@@ -138,8 +140,9 @@ TEST(ReportWarnings, TheLineHoldsWhatToDo) {
             "between 24.5 and ... -> Swing at smaller amplitude, or set fit.max_amplitude_deg");
   EXPECT_LE(line.Text().size(), 160u);
   // A short warning with nothing more to it: the whole text, not folded.
-  const std::string footer = "the time series ends at line 243 (a blank line, then a "
-                             "non-numeric row); 3 row(s) after it (a footer?) are ignored";
+  const std::string footer =
+      "the time series ends at line 243 (a blank line, then a "
+      "non-numeric row); 3 row(s) after it (a footer?) are ignored";
   EXPECT_EQ(LineOfWarning(footer).Text(), footer);
   EXPECT_FALSE(LineOfWarning(footer).folded);
   EXPECT_EQ(WarningAction("not observable from these swing axes: Ixy; swing about axes that mix "

@@ -6,15 +6,15 @@
 // read of a key the writer never writes fails here; a record that lacks a key or holds one of
 // another type is refused naming the key. On real output: the committed sample's results.json. The
 // same for the calibration and summary sections.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include "base/user_error.h"
 #include "pipeline/records/results_json.h"
@@ -90,13 +90,17 @@ TraceRecord FullRecord() {
   r.model = "full";
   r.iterations = 17;
   r.fit_seconds = 0.041;
-  r.budget = {{"filar_length", 1.2e-4}, {"filar_separation", 2.6e-2}, {"mass", 3.3e-3},
-              {"gravity", 4.0e-5}, {"gyro_scale", kTiny}};
+  r.budget = {{"filar_length", 1.2e-4},
+              {"filar_separation", 2.6e-2},
+              {"mass", 3.3e-3},
+              {"gravity", 4.0e-5},
+              {"gyro_scale", kTiny}};
   r.budget_total_std_kg_m2 = 2.7e-2;
   r.flags = {"amplitude_trend", kAssumedInputsFlag};
-  r.warnings = {"I changes with amplitude (+0.127 % per 10 deg, z = 4.1): the rig departs from "
-                "the model; swing lower, or set fit.max_amplitude_deg (--max-amplitude). Detail.",
-                "second warning"};
+  r.warnings = {
+      "I changes with amplitude (+0.127 % per 10 deg, z = 4.1): the rig departs from "
+      "the model; swing lower, or set fit.max_amplitude_deg (--max-amplitude). Detail.",
+      "second warning"};
   r.figure = "e66b1c80ca5f617c.svg";
   r.figures = {"/out/figures/e66b1c80ca5f617c.svg", "/out/figures/e66b1c80ca5f617c_sweep.svg"};
   r.sweep_figure = "e66b1c80ca5f617c_sweep.svg";
@@ -322,7 +326,8 @@ TEST(TraceRecordJson, TheReaderReadsExactlyTheKeysTheWriterWrites) {
       TraceRecordFromJson(j, campaign_fields, &read);
     }
     // Reading a key the writer never writes (a misspelt key, one of an older version).
-    for (const std::string& key : read) EXPECT_EQ(written.count(key), 1u) << key << " is never written";
+    for (const std::string& key : read)
+      EXPECT_EQ(written.count(key), 1u) << key << " is never written";
     // A key written and neither read nor composed from the fields (a field the reader forgot).
     for (const std::string& key : written) {
       EXPECT_TRUE(read.count(key) == 1 || DerivedTraceKeys().count(key) == 1)
@@ -364,17 +369,17 @@ TEST(TraceRecordJson, AMissingOrMistypedKeyIsRefusedNamingIt) {
             "'amplitude_sweep.bands[].window_s' is not a pair of numbers (array)");
   mistyped = full;
   mistyped["amplitude_sweep"]["low_band"] = 7;
-  EXPECT_NE(test_support::ErrorOf([&] { TraceRecordFromJson(mistyped, true); })
-                .find("'amplitude_sweep.low_band' = 7 is not a band's index"),
+  EXPECT_NE(test_support::ErrorOf([&] {
+              TraceRecordFromJson(mistyped, true);
+            }).find("'amplitude_sweep.low_band' = 7 is not a band's index"),
             std::string::npos);
   mistyped = full;
   mistyped["status"] = "fine";
   EXPECT_EQ(test_support::ErrorOf([&] { TraceRecordFromJson(mistyped, true); }),
             "'status' is not ok, rejected or error");
   // The fit's form has no campaign fields: read as the campaign's, its first is missing.
-  EXPECT_EQ(test_support::ErrorOf([&] {
-              TraceRecordFromJson(TraceRecordToJson(FullRecord(), false), true);
-            }),
+  EXPECT_EQ(test_support::ErrorOf(
+                [&] { TraceRecordFromJson(TraceRecordToJson(FullRecord(), false), true); }),
             "'role' is missing");
 }
 
@@ -414,16 +419,21 @@ TEST(ResultsSectionsJson, CalibrationAndSummaryReadBackEveryFieldAndOnlyWrittenK
   EXPECT_EQ(CalibrationToJson(b).dump(), written.dump());
   EXPECT_EQ(b.applied, c.applied);
   for (const auto& [x, y] : std::vector<std::pair<double, double>>{
-           {b.factor, c.factor}, {b.factor_std, c.factor_std}, {b.factor_rel_std, c.factor_rel_std},
-           {b.rel_std_reference, c.rel_std_reference}, {b.rel_std_swings, c.rel_std_swings},
-           {b.rel_std_rig, c.rel_std_rig}, {b.filar_length_m, c.filar_length_m},
+           {b.factor, c.factor},
+           {b.factor_std, c.factor_std},
+           {b.factor_rel_std, c.factor_rel_std},
+           {b.rel_std_reference, c.rel_std_reference},
+           {b.rel_std_swings, c.rel_std_swings},
+           {b.rel_std_rig, c.rel_std_rig},
+           {b.filar_length_m, c.filar_length_m},
            {b.nominal_separation_m, c.nominal_separation_m},
            {b.effective_separation_m, c.effective_separation_m},
            {b.nominal_d2_over_l_m, c.nominal_d2_over_l_m},
            {b.effective_d2_over_l_m, c.effective_d2_over_l_m},
            {b.reference_inertia_kg_m2, c.reference_inertia_kg_m2},
            {b.reference_inertia_std_kg_m2, c.reference_inertia_std_kg_m2},
-           {b.reference_mass_kg, c.reference_mass_kg}, {b.swings_total_kg_m2, c.swings_total_kg_m2},
+           {b.reference_mass_kg, c.reference_mass_kg},
+           {b.swings_total_kg_m2, c.swings_total_kg_m2},
            {b.swings_total_std_kg_m2, c.swings_total_std_kg_m2},
            {b.swings_scatter_kg_m2, c.swings_scatter_kg_m2},
            {b.rig_inertia_kg_m2, c.rig_inertia_kg_m2},
@@ -485,7 +495,8 @@ TEST(TraceRecordJson, CommittedSampleTracesReadAndWriteBackUnchanged) {
     const json back = TraceRecordToJson(r, true);
     EXPECT_EQ(WithoutDerivedKeys(back).dump(), WithoutDerivedKeys(trace).dump()) << r.file;
     for (const char* key : {"stat_kg_m2", "common_mode_kg_m2", "total_kg_m2", "total_percent"}) {
-      const double a = back["uncertainty"][key].get<double>(), b = trace["uncertainty"][key].get<double>();
+      const double a = back["uncertainty"][key].get<double>(),
+                   b = trace["uncertainty"][key].get<double>();
       EXPECT_NEAR(a, b, 1e-15 * std::abs(b)) << r.file << " uncertainty." << key;
     }
   }

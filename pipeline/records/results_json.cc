@@ -81,7 +81,8 @@ class RecordNode {
     out.fill(NAN);
     const json& v = At(key);
     if (v.is_null()) return out;
-    if (!v.is_array() || v.size() != N) Mistyped(key, N == 2 ? "a pair of numbers" : "3 numbers", v);
+    if (!v.is_array() || v.size() != N)
+      Mistyped(key, N == 2 ? "a pair of numbers" : "3 numbers", v);
     for (size_t k = 0; k < N; ++k) {
       if (!v[k].is_number() && !v[k].is_null()) Mistyped(key, "a list of numbers", v);
       if (v[k].is_number()) out[k] = v[k].get<double>();
@@ -110,7 +111,9 @@ class RecordNode {
   }
 
  private:
-  std::string Where(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  std::string Where(const std::string& key) const {
+    return path_.empty() ? key : path_ + "." + key;
+  }
   const json& At(const char* key) const {
     Log(key);
     const auto it = node_.find(key);
@@ -183,7 +186,8 @@ AmplitudeSweep SweepFromJson(const RecordNode& j) {
   s.low_band = j.Int("low_band");
   if (s.low_band < -1 || s.low_band >= static_cast<int>(s.bands.size())) {
     throw UserError("'amplitude_sweep.low_band' = " + std::to_string(s.low_band) +
-                    " is not a band's index (-1 to " + std::to_string(static_cast<int>(s.bands.size()) - 1) + ")");
+                    " is not a band's index (-1 to " +
+                    std::to_string(static_cast<int>(s.bands.size()) - 1) + ")");
   }
   if (!s.evaluated) return s;  // the trend keys are written only for an evaluated sweep
   s.trend_exponent = j.Num("trend_exponent");
@@ -205,7 +209,8 @@ void BudgetFromJson(const RecordNode& budget, TraceRecord* r) {
   const std::string suffix = "_kg_m2";
   for (const auto& [key, value] : budget.node().items()) {
     budget.Log(key);
-    if (key.size() <= suffix.size() || key.compare(key.size() - suffix.size(), suffix.size(), suffix) != 0 ||
+    if (key.size() <= suffix.size() ||
+        key.compare(key.size() - suffix.size(), suffix.size(), suffix) != 0 ||
         !(value.is_number() || value.is_null())) {
       throw UserError("'budget." + key + "' is not a term NAME_kg_m2 with a number");
     }
@@ -488,15 +493,19 @@ TraceRecord TraceRecordFromJson(const json& j, bool campaign_fields, KeyLog* key
 }
 
 const KeyLog& DerivedTraceKeys() {
-  static const KeyLog kKeys = {
-      "uncertainty.terms",          "uncertainty.terms[].name",
-      "uncertainty.terms[].std_kg_m2", "uncertainty.terms[].kind",
-      "uncertainty.terms[].assumed", "uncertainty.stat_kg_m2",
-      "uncertainty.common_mode_kg_m2", "uncertainty.total_kg_m2",
-      "uncertainty.total_percent",  "uncertainty.assumed_inputs",
-      "uncertainty.assumed_inputs.filar_length_std_m",
-      "uncertainty.assumed_inputs.filar_separation_std_m",
-      "amplitude_correction.to_amplitude_deg"};
+  static const KeyLog kKeys = {"uncertainty.terms",
+                               "uncertainty.terms[].name",
+                               "uncertainty.terms[].std_kg_m2",
+                               "uncertainty.terms[].kind",
+                               "uncertainty.terms[].assumed",
+                               "uncertainty.stat_kg_m2",
+                               "uncertainty.common_mode_kg_m2",
+                               "uncertainty.total_kg_m2",
+                               "uncertainty.total_percent",
+                               "uncertainty.assumed_inputs",
+                               "uncertainty.assumed_inputs.filar_length_std_m",
+                               "uncertainty.assumed_inputs.filar_separation_std_m",
+                               "amplitude_correction.to_amplitude_deg"};
   return kKeys;
 }
 
@@ -530,7 +539,8 @@ json CalibrationToJson(const RigCalibrationResult& c) {
 }
 
 RigCalibrationResult CalibrationFromJson(const json& j, KeyLog* keys_read) {
-  if (!j.is_object()) throw UserError(std::string("a calibration is an object, not ") + j.type_name());
+  if (!j.is_object())
+    throw UserError(std::string("a calibration is an object, not ") + j.type_name());
   const RecordNode c(j, "", keys_read);
   RigCalibrationResult r;
   r.applied = c.Bool("applied");
@@ -549,8 +559,9 @@ RigCalibrationResult CalibrationFromJson(const json& j, KeyLog* keys_read) {
   const double effective_length_m = effective.Num("filar_length_m");
   if (!(effective_length_m == r.filar_length_m ||
         (std::isnan(effective_length_m) && std::isnan(r.filar_length_m)))) {
-    throw UserError("'effective.filar_length_m' is not 'nominal.filar_length_m' (the calibration "
-                    "keeps L)");
+    throw UserError(
+        "'effective.filar_length_m' is not 'nominal.filar_length_m' (the calibration "
+        "keeps L)");
   }
   r.effective_separation_m = effective.Num("filar_separation_m");
   r.effective_d2_over_l_m = effective.Num("d2_over_l_m");

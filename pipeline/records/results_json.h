@@ -3,9 +3,8 @@
 // (kg m^2, s, rad/s, deg for angles); numbers that do not apply are null (JSON) or empty (CSV).
 #pragma once
 
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "pipeline/config/config.h"
 #include "pipeline/records/campaign_result.h"

@@ -61,10 +61,10 @@ std::vector<std::string> Clauses(const std::string& text) {
 }  // namespace
 
 std::string WarningAction(const std::string& warning) {
-  static const char* const kVerbs[] = {"raise", "lower", "set", "swing", "check", "give", "rerun",
-                                       "use", "add", "remove", "release", "hang", "fix", "measure",
-                                       "increase", "decrease", "shorten", "lengthen", "reprocess",
-                                       "replace", "move", "weigh", "repeat"};
+  static const char* const kVerbs[] = {
+      "raise",   "lower",    "set",       "swing",   "check", "give",    "rerun",    "use",
+      "add",     "remove",   "release",   "hang",    "fix",   "measure", "increase", "decrease",
+      "shorten", "lengthen", "reprocess", "replace", "move",  "weigh",   "repeat"};
   std::string action;
   for (const std::string& clause : Clauses(warning)) {
     std::string word = clause.substr(0, clause.find(' '));
@@ -76,7 +76,9 @@ std::string WarningAction(const std::string& warning) {
   return action;
 }
 
-std::string WarningLine::Text() const { return action.empty() ? summary : summary + " -> " + action; }
+std::string WarningLine::Text() const {
+  return action.empty() ? summary : summary + " -> " + action;
+}
 
 WarningLine LineOfWarning(const std::string& warning, size_t max_chars) {
   WarningLine line;

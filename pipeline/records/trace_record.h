@@ -143,9 +143,9 @@ std::string WarningAction(const std::string& warning);
 // summary does not hold the clause that says what to do (a first sentence cut short), that
 // clause after it; the summary is then cut shorter so that the line stays near max_chars.
 struct WarningLine {
-  std::string summary;  // WarningSummary of the warning
-  std::string action;   // WarningAction, "" when the summary holds it or there is none
-  bool folded = false;  // the line leaves out part of the warning (the rest is on click)
+  std::string summary;       // WarningSummary of the warning
+  std::string action;        // WarningAction, "" when the summary holds it or there is none
+  bool folded = false;       // the line leaves out part of the warning (the rest is on click)
   std::string Text() const;  // "summary -> action" (the console's form)
 };
 WarningLine LineOfWarning(const std::string& warning, size_t max_chars = 160);

@@ -15,8 +15,8 @@
 #include "base/hash.h"
 #include "base/json_error.h"
 #include "base/units.h"
-#include "base/version.h"
 #include "base/user_error.h"
+#include "base/version.h"
 #include "pipeline/figures/svg_compact.h"
 #include "pipeline/logs/simulated_log.h"
 #include "pipeline/records/results_json.h"
@@ -252,8 +252,9 @@ std::vector<TraceRecord> ReadTraces(const R& results, KeyLog* log) {
     const auto file = element.is_object() ? element.find("file") : element.end();
     const std::string name =
         file != element.end() && file->is_string() ? " (" + file->get<std::string>() + ")" : "";
-    out.push_back(ReadSection(results, "traces[" + std::to_string(i) + "]" + name, "traces[]", log,
-                              [&](KeyLog* keys) { return TraceRecordFromJson(element, true, keys); }));
+    out.push_back(
+        ReadSection(results, "traces[" + std::to_string(i) + "]" + name, "traces[]", log,
+                    [&](KeyLog* keys) { return TraceRecordFromJson(element, true, keys); }));
   }
   return out;
 }
@@ -310,9 +311,10 @@ struct ReportPage {
   KeyLog* log_;  // every key read (ReportKeysRead), or null
   const std::string& out_dir;
   Units u;
-  const CampaignSummary summary = ReadSection(
-      results, "summary", "summary", log_,
-      [this](KeyLog* keys) { return CampaignSummaryFromJson(results.Get("summary").node(), keys); });
+  const CampaignSummary summary =
+      ReadSection(results, "summary", "summary", log_, [this](KeyLog* keys) {
+        return CampaignSummaryFromJson(results.Get("summary").node(), keys);
+      });
   const std::optional<RigCalibrationResult> calibration = ReadCalibration(results, log_);
   const R ellipse = results.Get("ellipse");
   const R tensor = results.Get("tensor");
@@ -386,8 +388,8 @@ void WriteHeader(const ReportPage& p, std::ostream& h) {
       << Escape(settings.Str("integrator")) << "</code>";
     if (!settings.Get("glitch").Bool("enabled", true)) h << ", glitch removal off";
   }
-  h << ". Traces: " << summary.n_traces << " (<span class=\"ok\">" << summary.n_ok
-    << " ok</span>, " << summary.n_rejected << " rejected, " << summary.n_error
+  h << ". Traces: " << summary.n_traces << " (<span class=\"ok\">" << summary.n_ok << " ok</span>, "
+    << summary.n_rejected << " rejected, " << summary.n_error
     << " error); fits reused from cache: " << summary.n_reused << ".</p>\n";
   // Simulated logs say so in their warnings (pipeline/logs/simulated_log.h): the page says it first.
   int simulated = 0;
@@ -753,7 +755,8 @@ void WriteWarnings(const ReportPage& p, std::ostream& h) {
     const std::vector<std::string> warnings = TraceWarnings(row.t);
     if (warnings.empty()) continue;
     ++warned;
-    rows << "<tr class=\"warned\"><td class=\"l\">" << Escape(row.t.file) << "</td><td class=\"l w\">";
+    rows << "<tr class=\"warned\"><td class=\"l\">" << Escape(row.t.file)
+         << "</td><td class=\"l w\">";
     for (const std::string& w : warnings) rows << WarningItem(p.u, w);
     rows << "</td></tr>\n";
   }
@@ -797,8 +800,10 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
     const std::array<double, 2>& w = t.window_s;
     const std::array<double, 2>& a = t.amplitude_deg;
     // A pair is written only when both ends are finite (null otherwise).
-    if (std::isfinite(w[0]) && std::isfinite(w[1])) window = Fmt(w[0], "%.2f") + "&ndash;" + Fmt(w[1], "%.2f");
-    if (std::isfinite(a[0]) && std::isfinite(a[1])) amplitude = Fmt(a[0], "%.1f") + "&rarr;" + Fmt(a[1], "%.1f");
+    if (std::isfinite(w[0]) && std::isfinite(w[1]))
+      window = Fmt(w[0], "%.2f") + "&ndash;" + Fmt(w[1], "%.2f");
+    if (std::isfinite(a[0]) && std::isfinite(a[1]))
+      amplitude = Fmt(a[0], "%.1f") + "&rarr;" + Fmt(a[1], "%.1f");
     const double total_std = t.inertia_total_std_kg_m2, std = t.inertia_std_kg_m2;
     const std::string row_class = DisplayStatus(t) == "ok (warned)" ? "warned"
                                   : status == "ok"                 ? ""
@@ -808,12 +813,10 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
       << StatusCell(u, t) << "</td><td>" << Fmt(row.roll, "%.2f") << "</td><td>"
       << Fmt(row.pitch, "%.2f") << "</td><td>" << u.Value(t.inertia_total_kg_m2, total_std)
       << "</td><td>" << u.Std(total_std) << "</td><td>" << u.Std(t.inertia_total_std_total_kg_m2)
-      << "</td><td>" << Fmt(t.period_s, "%.4f") << "</td><td>"
-      << u.Value(t.inertia_kg_m2, std) << "</td><td>" << u.Std(std) << "</td><td>"
-      << u.Std(t.inertia_std_total_kg_m2) << "</td><td>" << window << "</td><td>"
-      << amplitude << "</td><td>"
-      << Fmt(t.residual_rms_rad_per_s / t.noise_rms_rad_per_s, "%.2f")
-      << "</td></tr>\n";
+      << "</td><td>" << Fmt(t.period_s, "%.4f") << "</td><td>" << u.Value(t.inertia_kg_m2, std)
+      << "</td><td>" << u.Std(std) << "</td><td>" << u.Std(t.inertia_std_total_kg_m2) << "</td><td>"
+      << window << "</td><td>" << amplitude << "</td><td>"
+      << Fmt(t.residual_rms_rad_per_s / t.noise_rms_rad_per_s, "%.2f") << "</td></tr>\n";
   }
   h << "</table>" << kScrollClose;
 }
@@ -830,12 +833,13 @@ std::string TraceCaptionFacts(const ReportPage& p, const TraceRecord& t) {
   }
   const double period = t.period_s;
   if (std::isfinite(period)) {
-    out += " &middot; T = " + Fmt(period, "%.4f") + " s, small-angle I = " +
-           p.u.Inertia(t.small_angle_inertia_total_kg_m2, "%.5f") + " " + p.u.name;
+    out += " &middot; T = " + Fmt(period, "%.4f") +
+           " s, small-angle I = " + p.u.Inertia(t.small_angle_inertia_total_kg_m2, "%.5f") + " " +
+           p.u.name;
   }
   for (const std::string& w : TraceWarnings(t)) {
-    out += "<br><span class=\"warn\">warning: " + WarningLineHtml(LineOfWarning(InDisplayUnits(p.u, w))) +
-           "</span>";
+    out += "<br><span class=\"warn\">warning: " +
+           WarningLineHtml(LineOfWarning(InDisplayUnits(p.u, w))) + "</span>";
   }
   return out;
 }
@@ -848,8 +852,8 @@ void WriteTraceFigures(ReportPage& p, std::ostream& h) {
     if (fig.empty()) continue;
     figures << "<figure>"
             << Figure(p.out_dir, fig, "fit of " + row.t.file, "trace", &p.figures_drawn)
-            << "<figcaption>" << Escape(row.t.file) << " &middot; "
-            << Escape(DisplayStatus(row.t)) << TraceCaptionFacts(p, row.t) << "</figcaption></figure>\n"
+            << "<figcaption>" << Escape(row.t.file) << " &middot; " << Escape(DisplayStatus(row.t))
+            << TraceCaptionFacts(p, row.t) << "</figcaption></figure>\n"
             << SweepFigure(row.t, p.out_dir, &p.figures_drawn);
   }
   if (figures.tellp() == 0) return;  // no figures drawn (process --no-figures): no section
