@@ -305,17 +305,18 @@ struct ReportPage {
     });
     // A campaign whose tensor fit failed is still not planar when its logs roll.
     if (kind == CampaignKind::kPlanar && rolls) kind = CampaignKind::kPartialTensor;
+    summary = ReadSection(results, "summary", "summary", log_, [this](KeyLog* keys) {
+      return CampaignSummaryFromJson(results.Get("summary").node(), keys);
+    });
+    calibration = ReadCalibration(results, log_);
   }
   bool Planar() const { return kind == CampaignKind::kPlanar; }
   R results;
   KeyLog* log_;  // every key read (ReportKeysRead), or null
   const std::string& out_dir;
   Units u;
-  const CampaignSummary summary =
-      ReadSection(results, "summary", "summary", log_, [this](KeyLog* keys) {
-        return CampaignSummaryFromJson(results.Get("summary").node(), keys);
-      });
-  const std::optional<RigCalibrationResult> calibration = ReadCalibration(results, log_);
+  CampaignSummary summary;  // read after the traces (a broken trace is named first)
+  std::optional<RigCalibrationResult> calibration;
   const R ellipse = results.Get("ellipse");
   const R tensor = results.Get("tensor");
   const R figures = results.Get("figures");
