@@ -336,6 +336,10 @@ TEST(TraceRecordJson, TheReaderReadsExactlyTheKeysTheWriterWrites) {
     // The list of composed keys names keys the writer writes.
     for (const std::string& key : DerivedTraceKeys()) EXPECT_EQ(written.count(key), 1u) << key;
     EXPECT_EQ(read.count("role"), campaign_fields ? 1u : 0u);
+    // The two keys pipeline/store/output_set.cc reads by hand from results.json's traces (the
+    // files a folder's manifest adopts and the mixed-set check): written.
+    EXPECT_EQ(written.count("cache_key"), campaign_fields ? 1u : 0u);
+    EXPECT_EQ(written.count("figure"), 1u);
   }
 }
 
