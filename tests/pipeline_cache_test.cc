@@ -1,13 +1,17 @@
 // Cache: the FNV-1a hash against published test vectors, which config values enter a trace's
-// key (and which do not), and entries surviving a store/load round trip.
+// key (and which do not), entries surviving a store/load round trip, and entries refused.
 #include "pipeline/store/cache.h"
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "base/version.h"
 
 namespace bifilar {
 namespace {
@@ -164,6 +168,56 @@ TEST(Cache, EntryProvesItsKeyAndIntegrity) {
   EXPECT_NE(refused(negative), "");
   // A record without the envelope (an older entry, or hand-made).
   EXPECT_NE(refused(R"({"status": "ok", "inertia_total_kg_m2": 4.1})").find("format 2"),
+            std::string::npos);
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+}
+
+// An entry is read by the one reader of a trace record (TraceRecordFromJson): an entry that lacks
+// a key the writer writes (an older format), or holds a number beyond a double, is refused naming
+// the key even with its checksum fixed up, and refitted.
+TEST(Cache, AnEntryLackingAKeyIsRefusedNamingIt) {
+  char tmpl[] = "/tmp/bifilar_cache_test_XXXXXX";
+  const std::string dir = mkdtemp(tmpl);
+  const TraceCache cache(dir + "/cache");
+  TraceRecord r;
+  r.file = "pitch_0/trial_1.csv";
+  r.status = TraceStatus::kOk;
+  r.inertia_total_kg_m2 = 4.1;
+  r.inertia_total_std_kg_m2 = 2e-5;
+  r.period_s = 2.49;
+  r.model = "full";
+  const std::string key = "00000000000000k1", hash = "00000000000000aa";
+  cache.Store(key, hash, r);
+  const nlohmann::json good = nlohmann::json::parse(ReadText(cache.EntryPath(key)));
+  // The entry as TraceCache::Store writes it, with its checksum made to match `record`.
+  const auto write = [&](nlohmann::json record, const std::string& text_of_inertia = "") {
+    nlohmann::json entry = good;
+    entry["record"] = record;
+    entry["checksum"] = HashToHex(Fnv1a64(key + ";" + hash + ";" + ProgramVersion() + ";" +
+                                          record.dump(-1, ' ', false)));
+    std::string text = entry.dump(1);
+    if (!text_of_inertia.empty()) {
+      const std::string written = "\"inertia_total_kg_m2\": null";
+      text.replace(text.find(written), written.size(),
+                   "\"inertia_total_kg_m2\": " + text_of_inertia);
+    }
+    std::ofstream(cache.EntryPath(key)) << text;
+    TraceRecord loaded;
+    std::string problem;
+    return cache.Load(key, hash, &loaded, &problem) ? std::string("loaded") : problem;
+  };
+  nlohmann::json record = good["record"];
+  EXPECT_EQ(write(record), "loaded");  // the checksum made here is the cache's
+  record.erase("period_s");
+  EXPECT_NE(write(record).find("cache entry refused ('period_s' is missing)"), std::string::npos);
+  record = good["record"];
+  record["uncertainty"].erase("hac_bandwidth");
+  EXPECT_NE(write(record).find("('uncertainty.hac_bandwidth' is missing)"), std::string::npos);
+  // 1e999 reads as infinity; the checksum is of the record as parsed (infinity dumps as null).
+  record = good["record"];
+  record["inertia_total_kg_m2"] = std::numeric_limits<double>::infinity();
+  EXPECT_NE(write(record, "1e999").find("inertia_total_kg_m2 is not a finite number"),
             std::string::npos);
   std::error_code ec;
   std::filesystem::remove_all(dir, ec);

@@ -59,7 +59,7 @@ TEST(Console, FitPrintsOneShortResultLineThenOneLinePerWarning) {
     std::vector<std::string> expected;
     for (const auto& w : record["warnings"]) {
       if (!IsAssumedInputsWarning(w.get<std::string>()))
-        expected.push_back("    warning: " + WarningSummary(w.get<std::string>()));
+        expected.push_back("    warning: " + LineOfWarning(w.get<std::string>()).Text());
     }
     EXPECT_GE(expected.size(), 2u) << "the simulated log has a footer and a glitch";
     std::vector<std::string> shown;

@@ -85,7 +85,7 @@ TEST(PeriodRecord, SmallAngleInertiaFromTheMeasuredPeriod) {
   EXPECT_DOUBLE_EQ(j.at("frequency_hz").get<double>(), small.frequency_hz);
   EXPECT_DOUBLE_EQ(j.at("small_angle_inertia_total_kg_m2").get<double>(),
                    small.small_angle_inertia_total_kg_m2);
-  const TraceRecord back = TraceRecordFromJson(j);
+  const TraceRecord back = TraceRecordFromJson(j, false);
   EXPECT_DOUBLE_EQ(back.period_s, small.period_s);
   EXPECT_DOUBLE_EQ(back.small_angle_inertia_total_kg_m2, small.small_angle_inertia_total_kg_m2);
 

@@ -2,20 +2,21 @@
 // pitch) and three separate axes, each from a fast fake fit with known moments. Each page shows
 // only the sections its campaign has; the page's details (issue 25 item 4); and every
 // results.json key the report reads is one that ResultsToJson writes (issue 24 item 5).
+#include <gtest/gtest.h>
+
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
 #include "fit/tensor.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/records/results_reader.h"
+#include "pipeline/records/trace_record.h"
 #include "pipeline/report/export.h"
 #include "pipeline/report/report.h"
 #include "test_support.h"
@@ -135,11 +136,16 @@ void ExpectCommonDetails(const Page& p) {
   EXPECT_LT(Find(page, "<p class=\"result\">Result: "), Find(page, "<h2>"));
   // Table 1 before Table 2 (the paper's order) where both are shown.
   EXPECT_NE(Find(page, "Table 1: data quality"), std::string::npos);
-  // The warning: one line with its action, the full text on click.
-  EXPECT_NE(Find(page, "<details><summary>I depends on the amplitude beyond its statistical error "
-                       "(trend 0.3 % per 10 deg) &rarr; <b>lower the release amplitude or set "
-                       "fit.max_amplitude_deg</b></summary><p>I depends"),
+  // The warning: the console's line (LineOfWarning: its one sentence is cut to leave room for
+  // the clause that says what to do), the full text on click.
+  EXPECT_NE(Find(page,
+                 "<details><summary>I depends on the amplitude beyond its statistical error "
+                 "(trend 0.3 % per 10 deg); I is taken ... &rarr; <b>lower the release "
+                 "amplitude or set fit.max_amplitude_deg</b></summary><p>I depends"),
             std::string::npos);
+  EXPECT_EQ(LineOfWarning(kWarning).Text(),
+            "I depends on the amplitude beyond its statistical error (trend 0.3 % per 10 deg); I "
+            "is taken ... -> lower the release amplitude or set fit.max_amplitude_deg");
 }
 
 // The traces table's pitch cells in page order.
@@ -206,6 +212,41 @@ TEST(ReportKinds, ThreeSeparateAxesShowTheirMomentsAndNothingEmpty) {
   EXPECT_NE(Find(p.html, "the logs behind the scatter"), std::string::npos);
 }
 
+// A results.json whose trace lacks a key (written by another version) or holds one of another
+// type: `bifilar report` stops with one error naming the file, the trace, the key, the version
+// that wrote it and what to do, and leaves the page as it was.
+TEST(ReportKinds, ATraceOfAnotherVersionIsOneClearError) {
+  TempDir dir("bifilar_report_kinds");
+  const Page p = RunFake(dir, kPlanar);
+  const std::string path = p.out + "/results.json";
+  nlohmann::json old = p.results;
+  old["version"] = "0.2.0";
+  old["traces"][2].erase("period_s");
+  WriteFile(path, old.dump(1));
+  const std::string error = test_support::ErrorOf([&] { RunReport(p.out); });
+  for (const std::string& part :
+       {path + ": not a results file bifilar can read", std::string("traces[2] (log_2.csv)"),
+        std::string("'period_s' is missing"), std::string("written by bifilar 0.2.0"),
+        std::string("rerun `bifilar process` to rewrite it")}) {
+    EXPECT_NE(error.find(part), std::string::npos) << part << " not in: " << error;
+  }
+  EXPECT_EQ(ReadFile(p.out + "/report.html"), p.html);  // not rewritten
+  nlohmann::json mistyped = p.results;
+  mistyped["traces"][0]["window_s"] = "6.8 to 46.6";
+  mistyped["traces"][0]["uncertainty"]["hac_bandwidth"] = 2.5;
+  WriteFile(path, mistyped.dump(1));
+  EXPECT_NE(test_support::ErrorOf([&] {
+              RunReport(p.out);
+            }).find("traces[0] (log_0.csv): 'window_s' is not a pair of numbers (string)"),
+            std::string::npos);
+  mistyped["traces"][0]["window_s"] = nullptr;
+  WriteFile(path, mistyped.dump(1));
+  EXPECT_NE(test_support::ErrorOf([&] {
+              RunReport(p.out);
+            }).find("'uncertainty.hac_bandwidth' is not a whole number (number)"),
+            std::string::npos);
+}
+
 TEST(ReportKinds, EveryKeyTheReportReadsIsWritten) {
   KeyLog written, read;
   for (const auto* attitudes : {&kPlanar, &kTensor, &kThreeAxes}) {
@@ -222,11 +263,22 @@ TEST(ReportKinds, EveryKeyTheReportReadsIsWritten) {
     EXPECT_TRUE(exported.count("tensor.Ixx_kg_m2") == 1) << "export read no tensor";
     read.insert(exported.begin(), exported.end());
   }
-  // Written only with a rig calibration (pipeline/records/results_json.cc CalibrationToJson):
-  // the campaigns above have none, so the report reads none of them.
+  // A trace's
+  // uncertainty.repeat_scatter_kg_m2 and amplitude_correction are written only by `fit
+  // --repeats`: the trace reader looks for them in every record, and
+  // tests/pipeline_trace_record_json_test.cc checks them against the writer.
+  const KeyLog only_elsewhere = {"traces[].uncertainty.repeat_scatter_kg_m2",
+                                 "traces[].amplitude_correction"};
   for (const std::string& key : read) {
-    EXPECT_TRUE(written.count(key) == 1 || key.rfind("calibration.", 0) == 0) << key << " is never written";
+    EXPECT_TRUE(written.count(key) == 1 || only_elsewhere.count(key) == 1)
+        << key << " is never written";
   }
+  // The traces, the summary and the calibration (none here: null) are read whole by their typed
+  // readers (pipeline/records/results_json.h; TraceRecordFromJson is the cache's reader too).
+  EXPECT_EQ(read.count("summary.n_reused"), 1u);
+  EXPECT_EQ(read.count("calibration"), 1u);
+  EXPECT_EQ(read.count("traces[].period_s"), 1u);
+  EXPECT_EQ(read.count("traces[].amplitude_sweep.low_band"), 1u);
   EXPECT_GT(read.size(), 80u);
 }
 

@@ -28,7 +28,7 @@ namespace {
 // Console output of one record (issue 25 item 5): one result line of at most ~160 characters,
 // indented detail lines (the fit's settings and solver, the period and the hand calculation,
 // I(A)), then one line per warning, the most important first (the record's order), each shown by
-// its one-line summary (WarningSummary); *folded is set when a summary shortens a warning.
+// its one line (LineOfWarning); *folded is set when a line shortens a warning.
 
 // "FILE: ok  I = ... kg m^2  amplitude A0 -> A1 deg  rms/noise R": status, the result, and how
 // well the model follows the data. No fit (an error, or rejected before fitting): status only.
@@ -131,9 +131,9 @@ std::string WarningLines(const TraceRecord& r, DisplayUnits units, bool* folded)
   for (const std::string& w : r.warnings) {
     if (IsAssumedInputsWarning(w)) continue;
     const std::string shown = SiTextInDisplayUnits(w, units);
-    const std::string summary = WarningSummary(shown);
-    if (summary.size() < shown.size()) *folded = true;
-    lines += "\n    warning: " + summary;
+    const WarningLine line = LineOfWarning(shown);  // the report's line too
+    if (line.folded) *folded = true;
+    lines += "\n    warning: " + line.Text();
   }
   // --plot: which files are this log's figures (a name may carry a hash: FigureStems).
   if (!r.figures.empty()) {

@@ -18,7 +18,8 @@ namespace bifilar {
 namespace {
 
 // The traces' warnings after the summary (issue 25 item 5), in the traces' order: each trace that
-// raised one, then one line per warning by its summary (WarningSummary), the most important first.
+// raised one, then one line per warning (LineOfWarning, the report's line too), the most
+// important first.
 // The assumed +-1 mm on L and D is said once in the summary. At most kShownTraces traces; the rest
 // and the full texts are named where to find them.
 void PrintTraceWarnings(const CampaignResult& campaign, DisplayUnits units, std::ostream& out) {
@@ -29,7 +30,7 @@ void PrintTraceWarnings(const CampaignResult& campaign, DisplayUnits units, std:
     std::string lines;
     for (const std::string& w : r.warnings) {
       if (!IsAssumedInputsWarning(w))
-        lines += "    warning: " + WarningSummary(SiTextInDisplayUnits(w, units)) + "\n";
+        lines += "    warning: " + LineOfWarning(SiTextInDisplayUnits(w, units)).Text() + "\n";
     }
     if (lines.empty()) continue;
     if (++warned > kShownTraces) continue;

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -24,42 +25,108 @@ json Pair(const std::array<double, 2>& v) {
   return json::array({v[0], v[1]});
 }
 
-double GetNumber(const json& j, const char* key) {
-  auto it = j.find(key);
-  if (it == j.end() || it->is_null()) return NAN;
-  if (!it->is_number()) throw UserError(std::string("trace record: '") + key + "' is not a number");
-  return it->get<double>();
-}
+// One object of a trace record being read (TraceRecordFromJson): a key is required unless read
+// through Has(); each key read is logged with its path; a value of another type throws UserError
+// naming the path. null reads as NaN (numbers) or none (optional numbers), as JsonNumber writes
+// a NaN.
+class RecordNode {
+ public:
+  RecordNode(const json& node, std::string path, KeyLog* log)
+      : node_(node), path_(std::move(path)), log_(log) {}
 
-std::array<double, 2> GetPair(const json& j, const char* key) {
-  auto it = j.find(key);
-  if (it == j.end() || it->is_null()) return {NAN, NAN};
-  if (!it->is_array() || it->size() != 2) {
-    throw UserError(std::string("trace record: '") + key + "' is not a pair");
+  // Logs `key`; true when it is present (a key the writer writes only sometimes).
+  bool Has(const char* key) const {
+    Log(key);
+    return node_.contains(key);
   }
-  return {(*it)[0].is_number() ? (*it)[0].get<double>() : NAN,
-          (*it)[1].is_number() ? (*it)[1].get<double>() : NAN};
-}
-
-std::string GetString(const json& j, const char* key) {
-  auto it = j.find(key);
-  if (it == j.end() || it->is_null()) return "";
-  if (!it->is_string()) throw UserError(std::string("trace record: '") + key + "' is not text");
-  return it->get<std::string>();
-}
-
-std::vector<std::string> GetStrings(const json& j, const char* key) {
-  std::vector<std::string> out;
-  auto it = j.find(key);
-  if (it == j.end() || it->is_null()) return out;
-  if (!it->is_array()) throw UserError(std::string("trace record: '") + key + "' is not a list");
-  for (const auto& v : *it) {
-    if (!v.is_string()) throw UserError(std::string("trace record: '") + key + "' holds non-text");
-    out.push_back(v.get<std::string>());
+  double Num(const char* key) const {
+    const json& v = At(key);
+    if (v.is_null()) return NAN;
+    if (!v.is_number()) Mistyped(key, "a number", v);
+    return v.get<double>();
   }
-  return out;
-}
+  std::optional<double> OptionalNum(const char* key) const {
+    const double v = Num(key);
+    return std::isnan(v) ? std::nullopt : std::optional<double>(v);
+  }
+  int Int(const char* key) const {
+    const json& v = At(key);
+    if (!v.is_number_integer()) Mistyped(key, "a whole number", v);
+    return v.get<int>();
+  }
+  bool Bool(const char* key) const {
+    const json& v = At(key);
+    if (!v.is_boolean()) Mistyped(key, "true or false", v);
+    return v.get<bool>();
+  }
+  std::string Str(const char* key) const {
+    const json& v = At(key);
+    if (!v.is_string()) Mistyped(key, "text", v);
+    return v.get<std::string>();
+  }
+  std::vector<std::string> Strs(const char* key) const {
+    const json& v = At(key);
+    if (!v.is_array()) Mistyped(key, "a list of texts", v);
+    std::vector<std::string> out;
+    for (const json& e : v) {
+      if (!e.is_string()) Mistyped(key, "a list of texts", v);
+      out.push_back(e.get<std::string>());
+    }
+    return out;
+  }
+  // N numbers (null elements NaN), or null (all NaN) as the writer's Pair and swing axis write.
+  template <size_t N>
+  std::array<double, N> Numbers(const char* key) const {
+    std::array<double, N> out;
+    out.fill(NAN);
+    const json& v = At(key);
+    if (v.is_null()) return out;
+    if (!v.is_array() || v.size() != N)
+      Mistyped(key, N == 2 ? "a pair of numbers" : "3 numbers", v);
+    for (size_t k = 0; k < N; ++k) {
+      if (!v[k].is_number() && !v[k].is_null()) Mistyped(key, "a list of numbers", v);
+      if (v[k].is_number()) out[k] = v[k].get<double>();
+    }
+    return out;
+  }
+  RecordNode Object(const char* key) const {
+    const json& v = At(key);
+    if (!v.is_object()) Mistyped(key, "an object", v);
+    return RecordNode(v, Where(key), log_);
+  }
+  std::vector<RecordNode> Objects(const char* key) const {
+    const json& v = At(key);
+    if (!v.is_array()) Mistyped(key, "a list", v);
+    std::vector<RecordNode> out;
+    for (const json& e : v) {
+      if (!e.is_object()) Mistyped(key, "a list of objects", v);
+      out.emplace_back(e, Where(key) + "[]", log_);
+    }
+    return out;
+  }
+  // Every key of this object with its value (the budget, whose keys are the terms' names).
+  const json& node() const { return node_; }
+  void Log(const std::string& key) const {
+    if (log_ != nullptr) log_->insert(Where(key));
+  }
 
+ private:
+  std::string Where(const std::string& key) const {
+    return path_.empty() ? key : path_ + "." + key;
+  }
+  const json& At(const char* key) const {
+    Log(key);
+    const auto it = node_.find(key);
+    if (it == node_.end()) throw UserError("'" + Where(key) + "' is missing");
+    return *it;
+  }
+  [[noreturn]] void Mistyped(const char* key, const char* expected, const json& v) const {
+    throw UserError("'" + Where(key) + "' is not " + expected + " (" + v.type_name() + ")");
+  }
+  const json& node_;
+  std::string path_;
+  KeyLog* log_;
+};
 json SweepToJson(const AmplitudeSweep& s) {
   json bands = json::array();
   for (const AmplitudeSweepBand& b : s.bands) {
@@ -90,57 +157,151 @@ json SweepToJson(const AmplitudeSweep& s) {
   return j;
 }
 
-double NumberOr0(const json& j, const char* key) {
-  const double v = GetNumber(j, key);
-  return std::isfinite(v) ? v : 0.0;
+AmplitudeSweepBand SweepBandFromJson(const RecordNode& b) {
+  AmplitudeSweepBand band;
+  const std::array<double, 2> w = b.Numbers<2>("window_s");
+  const std::array<double, 2> a = b.Numbers<2>("amplitude_deg");
+  band.t0_s = w[0];
+  band.t1_s = w[1];
+  band.num_samples = b.Int("samples");
+  band.cycles = b.Num("cycles");
+  band.amplitude_start_deg = a[0];
+  band.amplitude_end_deg = a[1];
+  band.amplitude_mean_deg = b.Num("amplitude_mean_deg");
+  band.ok = b.Bool("ok");
+  // A failed band's I is written null: it keeps the struct's 0.
+  const double inertia = b.Num("inertia_kg_m2"), inertia_std = b.Num("inertia_std_kg_m2");
+  if (band.ok) {
+    band.inertia_kg_m2 = inertia;
+    band.inertia_std_kg_m2 = inertia_std;
+  }
+  return band;
 }
 
-AmplitudeSweep SweepFromJson(const json& j) {
+AmplitudeSweep SweepFromJson(const RecordNode& j) {
   AmplitudeSweep s;
-  s.evaluated = j.value("evaluated", false);
-  s.note = GetString(j, "note");
-  if (auto it = j.find("bands"); it != j.end() && it->is_array()) {
-    for (const json& b : *it) {
-      if (!b.is_object()) throw UserError("trace record: a sweep band is not an object");
-      AmplitudeSweepBand band;
-      const std::array<double, 2> w = GetPair(b, "window_s");
-      const std::array<double, 2> a = GetPair(b, "amplitude_deg");
-      band.t0_s = w[0];
-      band.t1_s = w[1];
-      band.num_samples = b.value("samples", 0);
-      band.cycles = NumberOr0(b, "cycles");
-      band.amplitude_start_deg = a[0];
-      band.amplitude_end_deg = a[1];
-      band.amplitude_mean_deg = NumberOr0(b, "amplitude_mean_deg");
-      band.inertia_kg_m2 = NumberOr0(b, "inertia_kg_m2");
-      band.inertia_std_kg_m2 = NumberOr0(b, "inertia_std_kg_m2");
-      band.ok = b.value("ok", false);
-      s.bands.push_back(band);
-    }
+  s.evaluated = j.Bool("evaluated");
+  s.note = j.Str("note");
+  for (const RecordNode& b : j.Objects("bands")) s.bands.push_back(SweepBandFromJson(b));
+  s.low_band = j.Int("low_band");
+  if (s.low_band < -1 || s.low_band >= static_cast<int>(s.bands.size())) {
+    throw UserError("'amplitude_sweep.low_band' = " + std::to_string(s.low_band) +
+                    " is not a band's index (-1 to " +
+                    std::to_string(static_cast<int>(s.bands.size()) - 1) + ")");
   }
-  if (auto it = j.find("low_band"); it != j.end() && it->is_number_integer() && *it >= 0 &&
-                                      *it < static_cast<int>(s.bands.size())) {
-    s.low_band = it->get<int>();
-  }
-  if (s.evaluated) {
-    // Records of earlier versions carry the A^2 line only (trend_coeff_per_deg2).
-    const bool power = j.contains("trend_exponent");
-    s.trend_exponent = power ? NumberOr0(j, "trend_exponent") : 2.0;
-    s.trend_coeff = NumberOr0(j, power ? "trend_coeff_per_deg_p" : "trend_coeff_per_deg2");
-    s.trend_coeff_std =
-        NumberOr0(j, power ? "trend_coeff_std_per_deg_p" : "trend_coeff_std_per_deg2");
-    s.trend_z = NumberOr0(j, "trend_z");
-    s.trend_chi2 = NumberOr0(j, "trend_chi2");
-    s.trend_dof = static_cast<int>(NumberOr0(j, "trend_dof"));
-    s.trend_scale = j.contains("trend_scale") ? NumberOr0(j, "trend_scale") : 1.0;
-    s.std_scale = j.contains("std_scale") ? NumberOr0(j, "std_scale") : 1.0;
-    s.trend_percent_per_10deg = NumberOr0(j, "trend_percent_per_10deg");
-    s.inertia_zero_amplitude_kg_m2 = NumberOr0(j, "inertia_zero_amplitude_kg_m2");
-    s.trend_detected = j.value("trend_detected", false);
-  }
+  if (!s.evaluated) return s;  // the trend keys are written only for an evaluated sweep
+  s.trend_exponent = j.Num("trend_exponent");
+  s.trend_coeff = j.Num("trend_coeff_per_deg_p");
+  s.trend_coeff_std = j.Num("trend_coeff_std_per_deg_p");
+  s.trend_z = j.Num("trend_z");
+  s.trend_chi2 = j.Num("trend_chi2");
+  s.trend_dof = j.Int("trend_dof");
+  s.trend_scale = j.Num("trend_scale");
+  s.std_scale = j.Num("std_scale");
+  s.trend_percent_per_10deg = j.Num("trend_percent_per_10deg");
+  s.inertia_zero_amplitude_kg_m2 = j.Num("inertia_zero_amplitude_kg_m2");
+  s.trend_detected = j.Bool("trend_detected");
   return s;
 }
 
+// The budget object: "<term>_kg_m2" per term and "total_kg_m2" (TraceRecordToJson).
+void BudgetFromJson(const RecordNode& budget, TraceRecord* r) {
+  const std::string suffix = "_kg_m2";
+  for (const auto& [key, value] : budget.node().items()) {
+    budget.Log(key);
+    if (key.size() <= suffix.size() ||
+        key.compare(key.size() - suffix.size(), suffix.size(), suffix) != 0 ||
+        !(value.is_number() || value.is_null())) {
+      throw UserError("'budget." + key + "' is not a term NAME_kg_m2 with a number");
+    }
+    const std::string name = key.substr(0, key.size() - suffix.size());
+    const double v = value.is_number() ? value.get<double>() : NAN;
+    if (name == "total") {
+      r->budget_total_std_kg_m2 = v;
+    } else {
+      r->budget.push_back({name, v});
+    }
+  }
+  if (!budget.node().contains("total_kg_m2")) throw UserError("'budget.total_kg_m2' is missing");
+}
+
+// The "uncertainty" object's fields of the record (the rest is composed from them).
+void UncertaintyFromJson(const RecordNode& u, TraceRecord* r) {
+  r->inertia_stat_std_kg_m2 = u.Num("statistical_kg_m2");
+  r->inertia_iid_std_kg_m2 = u.Num("iid_kg_m2");
+  r->hac_bandwidth = u.Int("hac_bandwidth");
+  r->model_inadequacy_std_kg_m2 = u.Num("model_inadequacy_kg_m2");
+  if (u.Has("repeat_scatter_kg_m2")) r->repeat_scatter_std_kg_m2 = u.Num("repeat_scatter_kg_m2");
+  r->budget_assumed = u.Bool("configured_inputs_assumed");
+  r->calibrated = u.Bool("calibrated");
+  r->calibration_relative_std = u.Num("calibration_relative_std");
+}
+
+// The fields of `bifilar process` (TraceRecordToJson with campaign_fields).
+void CampaignFieldsFromJson(const RecordNode& j, TraceRecord* r) {
+  if (!ParseTraceRole(j.Str("role"), &r->role)) {
+    throw UserError("'role' is not " + TraceRoleAllowedValues());
+  }
+  r->content_hash = j.Str("content_hash");
+  r->cache_key = j.Str("cache_key");
+  r->from_cache = j.Bool("from_cache");
+  r->pitch_nominal_deg = j.OptionalNum("pitch_nominal_deg");
+  r->pitch_used_deg = j.Num("pitch_used_deg");
+  r->roll_nominal_deg = j.OptionalNum("roll_nominal_deg");
+  r->roll_used_deg = j.Num("roll_used_deg");
+  r->rig_inertia_kg_m2 = j.Num("rig_inertia_kg_m2");
+  r->inertia_kg_m2 = j.Num("inertia_kg_m2");
+  r->inertia_std_kg_m2 = j.Num("inertia_std_kg_m2");
+  r->inertia_std_total_kg_m2 = j.Num("inertia_std_total_kg_m2");
+  r->aircraft_scale_std_kg_m2 = j.Num("aircraft_scale_std_kg_m2");
+}
+
+// The fit's numbers and its diagnostics (the keys of TraceRecordToJson in its order).
+void FitFieldsFromJson(const RecordNode& j, TraceRecord* r) {
+  r->message = j.Str("message");
+  r->inertia_total_kg_m2 = j.Num("inertia_total_kg_m2");
+  r->inertia_total_std_kg_m2 = j.Num("inertia_total_std_kg_m2");
+  r->drag_coeff_kg_m2 = j.Num("drag_coeff_kg_m2");
+  r->viscous_coeff_kg_m2_per_s = j.Num("viscous_coeff_kg_m2_per_s");
+  r->window_s = j.Numbers<2>("window_s");
+  r->amplitude_deg = j.Numbers<2>("amplitude_deg");
+  r->amplitude_band_deg = j.Numbers<2>("amplitude_band_deg");
+  r->period_s = j.Num("period_s");
+  r->frequency_hz = j.Num("frequency_hz");
+  r->small_angle_inertia_total_kg_m2 = j.Num("small_angle_inertia_total_kg_m2");
+  r->bias_rad_per_s = j.Num("bias_rad_per_s");
+  r->residual_rms_rad_per_s = j.Num("residual_rms_rad_per_s");
+  r->noise_rms_rad_per_s = j.Num("noise_rms_rad_per_s");
+  r->pitch_measured_deg = j.OptionalNum("pitch_measured_deg");
+  r->roll_measured_deg = j.OptionalNum("roll_measured_deg");
+  r->model = j.Str("model");
+  r->iterations = j.Int("iterations");
+  r->fit_seconds = j.Num("fit_seconds");
+  BudgetFromJson(j.Object("budget"), r);
+  r->flags = j.Strs("flags");
+  r->warnings = j.Strs("warnings");
+  r->figure = j.Str("figure");
+  r->figures = j.Strs("figures");
+  r->sweep_figure = j.Str("sweep_figure");
+  r->swing_axis_in_imu = j.Numbers<3>("swing_axis_in_imu");
+  r->secondary_motion_ratio = j.Num("secondary_motion_ratio");
+  r->rms_over_noise = j.Num("rms_over_noise");
+  const RecordNode autocorrelation = j.Object("residual_autocorrelation");
+  r->residual_autocorr_lag1 = autocorrelation.Num("lag1");
+  r->residual_ar1_phi = autocorrelation.Num("ar1_phi");
+  r->prewhitened_autocorr_max = autocorrelation.Num("prewhitened_max");
+  r->inertia_window_kg_m2 = j.Num("inertia_window_kg_m2");
+  r->inertia_source = j.Str("inertia_source");
+  UncertaintyFromJson(j.Object("uncertainty"), r);
+  if (j.Has("amplitude_correction")) {
+    const RecordNode c = j.Object("amplitude_correction");
+    r->amplitude_correction_kg_m2 = c.Num("correction_kg_m2");
+    r->amplitude_correction_std_kg_m2 = c.Num("std_kg_m2");
+    r->amplitude_correction_from_deg = c.Num("from_amplitude_deg");
+  }
+  r->inertia_total_std_total_kg_m2 = j.Num("inertia_total_std_total_kg_m2");
+  r->sweep = SweepFromJson(j.Object("amplitude_sweep"));
+}
 // CSV cell: numbers with full precision, NaN empty; text quoted when needed.
 std::string Cell(double value) {
   if (!std::isfinite(value)) return "";
@@ -316,103 +477,36 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
   return j;
 }
 
-TraceRecord TraceRecordFromJson(const json& j) {
-  if (!j.is_object()) throw UserError("trace record: not a JSON object");
+TraceRecord TraceRecordFromJson(const json& j, bool campaign_fields, KeyLog* keys_read) {
+  if (!j.is_object()) {
+    throw UserError(std::string("a trace record is an object, not ") + j.type_name());
+  }
+  const RecordNode node(j, "", keys_read);
   TraceRecord r;
-  r.file = GetString(j, "file");
-  if (!ParseTraceStatus(GetString(j, "status"), &r.status)) {
-    throw UserError("trace record: bad 'status' (allowed " + TraceStatusAllowedValues() + ")");
+  r.file = node.Str("file");
+  if (!ParseTraceStatus(node.Str("status"), &r.status)) {
+    throw UserError("'status' is not " + TraceStatusAllowedValues());
   }
-  r.message = GetString(j, "message");
-  r.inertia_total_kg_m2 = GetNumber(j, "inertia_total_kg_m2");
-  r.inertia_total_std_kg_m2 = GetNumber(j, "inertia_total_std_kg_m2");
-  r.drag_coeff_kg_m2 = GetNumber(j, "drag_coeff_kg_m2");
-  r.viscous_coeff_kg_m2_per_s = GetNumber(j, "viscous_coeff_kg_m2_per_s");
-  r.window_s = GetPair(j, "window_s");
-  r.amplitude_deg = GetPair(j, "amplitude_deg");
-  r.amplitude_band_deg = GetPair(j, "amplitude_band_deg");
-  r.bias_rad_per_s = GetNumber(j, "bias_rad_per_s");
-  r.residual_rms_rad_per_s = GetNumber(j, "residual_rms_rad_per_s");
-  r.noise_rms_rad_per_s = GetNumber(j, "noise_rms_rad_per_s");
-  const double pitch = GetNumber(j, "pitch_measured_deg");
-  if (std::isfinite(pitch)) r.pitch_measured_deg = pitch;
-  const double roll = GetNumber(j, "roll_measured_deg");
-  if (std::isfinite(roll)) r.roll_measured_deg = roll;
-  r.model = GetString(j, "model");
-  r.iterations = j.value("iterations", 0);
-  r.fit_seconds = GetNumber(j, "fit_seconds");
-  if (auto it = j.find("budget"); it != j.end() && it->is_object()) {
-    for (auto& [key, value] : it->items()) {
-      const std::string suffix = "_kg_m2";
-      std::string name = key.size() > suffix.size() ? key.substr(0, key.size() - suffix.size()) : key;
-      const double v = value.is_number() ? value.get<double>() : NAN;
-      if (name == "total") {
-        r.budget_total_std_kg_m2 = v;
-      } else {
-        r.budget.push_back({name, v});
-      }
-    }
-  }
-  if (auto it = j.find("flags"); it != j.end() && it->is_array()) {
-    for (const auto& flag : *it) r.flags.push_back(flag.get<std::string>());
-  }
-  r.figure = GetString(j, "figure");
-  r.warnings = GetStrings(j, "warnings");
-  r.figures = GetStrings(j, "figures");
-  r.sweep_figure = GetString(j, "sweep_figure");
-  if (auto it = j.find("swing_axis_in_imu"); it != j.end() && it->is_array() && it->size() == 3) {
-    for (int k = 0; k < 3; ++k)
-      r.swing_axis_in_imu[k] = (*it)[k].is_number() ? (*it)[k].get<double>() : NAN;
-  }
-  r.secondary_motion_ratio = GetNumber(j, "secondary_motion_ratio");
-  r.rms_over_noise = GetNumber(j, "rms_over_noise");
-  if (auto it = j.find("residual_autocorrelation"); it != j.end() && it->is_object()) {
-    r.residual_autocorr_lag1 = GetNumber(*it, "lag1");
-    r.residual_ar1_phi = GetNumber(*it, "ar1_phi");
-    r.prewhitened_autocorr_max = GetNumber(*it, "prewhitened_max");
-  }
-  r.inertia_window_kg_m2 = GetNumber(j, "inertia_window_kg_m2");
-  r.period_s = GetNumber(j, "period_s");
-  r.frequency_hz = GetNumber(j, "frequency_hz");
-  r.small_angle_inertia_total_kg_m2 = GetNumber(j, "small_angle_inertia_total_kg_m2");
-  r.inertia_source = GetString(j, "inertia_source");
-  if (auto it = j.find("uncertainty"); it != j.end() && it->is_object()) {
-    r.inertia_stat_std_kg_m2 = GetNumber(*it, "statistical_kg_m2");
-    r.inertia_iid_std_kg_m2 = GetNumber(*it, "iid_kg_m2");
-    r.hac_bandwidth = it->value("hac_bandwidth", 0);
-    r.model_inadequacy_std_kg_m2 = GetNumber(*it, "model_inadequacy_kg_m2");
-    if (it->contains("repeat_scatter_kg_m2"))
-      r.repeat_scatter_std_kg_m2 = GetNumber(*it, "repeat_scatter_kg_m2");
-    r.budget_assumed = it->value("configured_inputs_assumed", false);
-    r.calibrated = it->value("calibrated", false);
-    r.calibration_relative_std = NumberOr0(*it, "calibration_relative_std");
-  }
-  if (auto it = j.find("amplitude_correction"); it != j.end() && it->is_object()) {
-    r.amplitude_correction_kg_m2 = GetNumber(*it, "correction_kg_m2");
-    r.amplitude_correction_std_kg_m2 = GetNumber(*it, "std_kg_m2");
-    r.amplitude_correction_from_deg = GetNumber(*it, "from_amplitude_deg");
-  }
-  if (auto it = j.find("amplitude_sweep"); it != j.end() && it->is_object()) r.sweep = SweepFromJson(*it);
-  if (j.contains("role") && !ParseTraceRole(GetString(j, "role"), &r.role)) {
-    throw UserError("trace record: bad 'role' (allowed " + TraceRoleAllowedValues() + ")");
-  }
-  r.content_hash = GetString(j, "content_hash");
-  r.cache_key = GetString(j, "cache_key");
-  r.from_cache = j.value("from_cache", false);
-  const double nominal = GetNumber(j, "pitch_nominal_deg");
-  if (std::isfinite(nominal)) r.pitch_nominal_deg = nominal;
-  r.pitch_used_deg = GetNumber(j, "pitch_used_deg");
-  const double roll_nominal = GetNumber(j, "roll_nominal_deg");
-  if (std::isfinite(roll_nominal)) r.roll_nominal_deg = roll_nominal;
-  r.roll_used_deg = GetNumber(j, "roll_used_deg");
-  r.rig_inertia_kg_m2 = GetNumber(j, "rig_inertia_kg_m2");
-  r.inertia_kg_m2 = GetNumber(j, "inertia_kg_m2");
-  r.inertia_std_kg_m2 = GetNumber(j, "inertia_std_kg_m2");
-  r.inertia_std_total_kg_m2 = GetNumber(j, "inertia_std_total_kg_m2");
-  r.aircraft_scale_std_kg_m2 = GetNumber(j, "aircraft_scale_std_kg_m2");
-  // composed from the fields just read (pipeline/records/total_uncertainty.h)
-  UpdateTotalUncertainty(&r);
+  FitFieldsFromJson(node, &r);
+  if (campaign_fields) CampaignFieldsFromJson(node, &r);
   return r;
+}
+
+const KeyLog& DerivedTraceKeys() {
+  static const KeyLog kKeys = {"uncertainty.terms",
+                               "uncertainty.terms[].name",
+                               "uncertainty.terms[].std_kg_m2",
+                               "uncertainty.terms[].kind",
+                               "uncertainty.terms[].assumed",
+                               "uncertainty.stat_kg_m2",
+                               "uncertainty.common_mode_kg_m2",
+                               "uncertainty.total_kg_m2",
+                               "uncertainty.total_percent",
+                               "uncertainty.assumed_inputs",
+                               "uncertainty.assumed_inputs.filar_length_std_m",
+                               "uncertainty.assumed_inputs.filar_separation_std_m",
+                               "amplitude_correction.to_amplitude_deg"};
+  return kKeys;
 }
 
 json CalibrationToJson(const RigCalibrationResult& c) {
@@ -442,6 +536,88 @@ json CalibrationToJson(const RigCalibrationResult& c) {
                            {"inertia_std_kg_m2", JsonNumber(c.rig_inertia_std_kg_m2)}}},
           {"iterations", c.iterations},
           {"warnings", c.warnings}};
+}
+
+RigCalibrationResult CalibrationFromJson(const json& j, KeyLog* keys_read) {
+  if (!j.is_object())
+    throw UserError(std::string("a calibration is an object, not ") + j.type_name());
+  const RecordNode c(j, "", keys_read);
+  RigCalibrationResult r;
+  r.applied = c.Bool("applied");
+  r.factor = c.Num("factor");
+  r.factor_std = c.Num("factor_std");
+  r.factor_rel_std = c.Num("factor_relative_std");
+  const RecordNode parts = c.Object("relative_std_parts");
+  r.rel_std_reference = parts.Num("reference_inertia");
+  r.rel_std_swings = parts.Num("reference_swings");
+  r.rel_std_rig = parts.Num("rig_inertia");
+  const RecordNode nominal = c.Object("nominal"), effective = c.Object("effective");
+  r.filar_length_m = nominal.Num("filar_length_m");
+  r.nominal_separation_m = nominal.Num("filar_separation_m");
+  r.nominal_d2_over_l_m = nominal.Num("d2_over_l_m");
+  // L is kept: the effective geometry's L is the configured one.
+  const double effective_length_m = effective.Num("filar_length_m");
+  if (!(effective_length_m == r.filar_length_m ||
+        (std::isnan(effective_length_m) && std::isnan(r.filar_length_m)))) {
+    throw UserError(
+        "'effective.filar_length_m' is not 'nominal.filar_length_m' (the calibration "
+        "keeps L)");
+  }
+  r.effective_separation_m = effective.Num("filar_separation_m");
+  r.effective_d2_over_l_m = effective.Num("d2_over_l_m");
+  const RecordNode reference = c.Object("reference");
+  r.reference_inertia_kg_m2 = reference.Num("inertia_kg_m2");
+  r.reference_inertia_std_kg_m2 = reference.Num("inertia_std_kg_m2");
+  r.reference_mass_kg = reference.Num("mass_kg");
+  const RecordNode swings = c.Object("swings");
+  r.n_swings = swings.Int("n");
+  r.logs = swings.Strs("logs");
+  r.swings_total_kg_m2 = swings.Num("total_mean_kg_m2");
+  r.swings_total_std_kg_m2 = swings.Num("total_standard_error_kg_m2");
+  r.swings_scatter_kg_m2 = swings.Num("scatter_kg_m2");
+  const RecordNode rig = c.Object("rig_inertia");
+  r.rig_inertia_source = rig.Str("source");
+  r.rig_inertia_kg_m2 = rig.Num("inertia_kg_m2");
+  r.rig_inertia_std_kg_m2 = rig.Num("inertia_std_kg_m2");
+  r.iterations = c.Int("iterations");
+  r.warnings = c.Strs("warnings");
+  return r;
+}
+
+json CampaignSummaryToJson(const CampaignSummary& s) {
+  json summary;
+  summary["n_traces"] = s.n_traces;
+  summary["n_ok"] = s.n_ok;
+  summary["n_rejected"] = s.n_rejected;
+  summary["n_error"] = s.n_error;
+  summary["n_fitted"] = s.n_fitted;
+  summary["n_reused"] = s.n_reused;
+  summary["wall_s"] = s.wall_s;
+  summary["ellipse_fitted"] = s.ellipse_fitted;
+  summary["ellipse_message"] = s.ellipse_message;
+  summary["tensor_fitted"] = s.tensor_fitted;
+  summary["tensor_message"] = s.tensor_message;
+  summary["exit_code"] = s.exit_code;
+  return summary;
+}
+
+CampaignSummary CampaignSummaryFromJson(const json& j, KeyLog* keys_read) {
+  if (!j.is_object()) throw UserError(std::string("a summary is an object, not ") + j.type_name());
+  const RecordNode node(j, "", keys_read);
+  CampaignSummary s;
+  s.n_traces = node.Int("n_traces");
+  s.n_ok = node.Int("n_ok");
+  s.n_rejected = node.Int("n_rejected");
+  s.n_error = node.Int("n_error");
+  s.n_fitted = node.Int("n_fitted");
+  s.n_reused = node.Int("n_reused");
+  s.wall_s = node.Num("wall_s");
+  s.ellipse_fitted = node.Bool("ellipse_fitted");
+  s.ellipse_message = node.Str("ellipse_message");
+  s.tensor_fitted = node.Bool("tensor_fitted");
+  s.tensor_message = node.Str("tensor_message");
+  s.exit_code = node.Int("exit_code");
+  return s;
 }
 
 json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
@@ -475,21 +651,7 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
                   {"range_factor", glitch.range_factor},
                   {"excursion_fraction", glitch.excursion_fraction},
                   {"max_fraction", glitch.max_fraction}}}};
-  json summary;
-  const CampaignSummary& s = result.summary;
-  summary["n_traces"] = s.n_traces;
-  summary["n_ok"] = s.n_ok;
-  summary["n_rejected"] = s.n_rejected;
-  summary["n_error"] = s.n_error;
-  summary["n_fitted"] = s.n_fitted;
-  summary["n_reused"] = s.n_reused;
-  summary["wall_s"] = s.wall_s;
-  summary["ellipse_fitted"] = s.ellipse_fitted;
-  summary["ellipse_message"] = s.ellipse_message;
-  summary["tensor_fitted"] = s.tensor_fitted;
-  summary["tensor_message"] = s.tensor_message;
-  summary["exit_code"] = s.exit_code;
-  j["summary"] = summary;
+  j["summary"] = CampaignSummaryToJson(result.summary);
   json rig;
   rig["filar_length_m"] = config.filar_length_m;
   rig["filar_separation_m"] = config.filar_separation_m;

@@ -3,12 +3,12 @@
 // (kg m^2, s, rad/s, deg for angles); numbers that do not apply are null (JSON) or empty (CSV).
 #pragma once
 
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "pipeline/config/config.h"
 #include "pipeline/records/campaign_result.h"
+#include "pipeline/records/results_reader.h"
 #include "pipeline/records/trace_record.h"
 
 namespace bifilar {
@@ -16,12 +16,37 @@ namespace bifilar {
 // The per-trace record (issue 3 item 9 fields first, then the campaign's). With
 // `campaign_fields` false only the fit fields (what `bifilar fit --json` and the cache store).
 nlohmann::json TraceRecordToJson(const TraceRecord& record, bool campaign_fields = true);
-// Inverse of TraceRecordToJson; throws UserError when a required field is missing or mistyped.
-TraceRecord TraceRecordFromJson(const nlohmann::json& json);
+// The one reader of a trace record (the cache's entries, results.json's traces[] for the report):
+// the inverse of TraceRecordToJson with the same `campaign_fields`. Every key the writer always
+// writes is required; the ones it writes only sometimes (uncertainty.repeat_scatter_kg_m2,
+// amplitude_correction, the sweep's trend_* when evaluated, the campaign fields) are read when
+// the writer would have written them. Throws UserError naming the key ("'period_s' is missing",
+// "'window_s' is not a pair of numbers (string)"); the caller adds the file and what to do. The
+// keys written but derived from the fields, not read back, are DerivedTraceKeys(). `keys_read`,
+// when given, receives every key path read ("uncertainty.statistical_kg_m2",
+// "amplitude_sweep.bands[].window_s"): tests/pipeline_trace_record_json_test.cc checks that they
+// are the keys the writer writes.
+TraceRecord TraceRecordFromJson(const nlohmann::json& json, bool campaign_fields,
+                                KeyLog* keys_read = nullptr);
+
+// Keys TraceRecordToJson writes for other readers (people, scripts) that TraceRecordFromJson
+// does not read: composed from the record's fields (pipeline/records/total_uncertainty.h) or
+// constant.
+const KeyLog& DerivedTraceKeys();
 
 // The `calibration` section of results.json and of `bifilar fit --json` (rig.calibration):
 // effective against nominal geometry, the factor with its std and the std's three parts.
 nlohmann::json CalibrationToJson(const RigCalibrationResult& calibration);
+
+// The inverse of CalibrationToJson, as TraceRecordFromJson reads a record: every key required,
+// a missing or mistyped one a UserError naming it; `keys_read` receives the key paths read. Not
+// written, so not read: cache_keys.
+RigCalibrationResult CalibrationFromJson(const nlohmann::json& json, KeyLog* keys_read = nullptr);
+
+// The `summary` section of results.json (every field but n_cache_refused) and its inverse, read
+// as CalibrationFromJson reads.
+nlohmann::json CampaignSummaryToJson(const CampaignSummary& summary);
+CampaignSummary CampaignSummaryFromJson(const nlohmann::json& json, KeyLog* keys_read = nullptr);
 
 // The whole results.json document.
 nlohmann::json ResultsToJson(const CampaignConfig& config, const CampaignResult& result);

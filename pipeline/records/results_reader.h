@@ -40,6 +40,8 @@ class ResultsReader {
   // An array of arrays of numbers (rows of NaN for non-arrays).
   std::vector<std::vector<double>> Rows(const char* key) const;
   const std::string& path() const { return path_; }
+  // The node itself, for the typed reader of a section (TraceRecordFromJson for traces[]).
+  const nlohmann::json& node() const { return *node_; }
 
  private:
   const nlohmann::json* At(const char* key) const;

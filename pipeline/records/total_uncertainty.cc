@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 namespace bifilar {
 namespace {
@@ -17,14 +18,20 @@ bool ReplacedByCalibration(const std::string& budget_name) {
 }
 
 // The configured-inputs term of I_total (kg m^2): the budget in quadrature, without the lines a
-// calibration replaces and without the calibration's own line (its term is separate).
+// calibration replaces and without the calibration's own line (its term is separate). Summed in
+// the order of the terms' names, the order results.json and the cache hold them in (a JSON
+// object): a record read back composes the same bits as the one written.
 double ConfiguredInputsStd(const TraceRecord& r) {
   if (r.budget.empty()) return OrZero(r.budget_total_std_kg_m2);
+  std::vector<const BudgetTerm*> terms;
+  for (const BudgetTerm& term : r.budget) terms.push_back(&term);
+  std::stable_sort(terms.begin(), terms.end(),
+                   [](const BudgetTerm* a, const BudgetTerm* b) { return a->name < b->name; });
   double sum_sq = 0.0;
-  for (const BudgetTerm& term : r.budget) {
-    if (r.calibrated && ReplacedByCalibration(term.name)) continue;
-    if (term.name == kTermCalibration) continue;  // the calibration term of its own (below)
-    sum_sq += OrZero(term.std_kg_m2) * OrZero(term.std_kg_m2);
+  for (const BudgetTerm* term : terms) {
+    if (r.calibrated && ReplacedByCalibration(term->name)) continue;
+    if (term->name == kTermCalibration) continue;  // the calibration term of its own (below)
+    sum_sq += OrZero(term->std_kg_m2) * OrZero(term->std_kg_m2);
   }
   return std::sqrt(sum_sq);
 }

@@ -1,5 +1,6 @@
 #include "pipeline/records/trace_record.h"
 
+#include <algorithm>
 #include <cctype>
 #include <vector>
 
@@ -40,6 +41,60 @@ std::string WarningSummary(const std::string& warning, size_t max_chars) {
   size_t cut = summary.rfind(' ', max_chars - 4);
   if (cut == std::string::npos || cut < max_chars / 2) cut = max_chars - 4;
   return summary.substr(0, cut) + " ...";
+}
+
+namespace {
+
+// A warning's clauses, split at ". " and "; ".
+std::vector<std::string> Clauses(const std::string& text) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = std::min(text.find(". ", start), text.find("; ", start));
+    if (end == std::string::npos) end = text.size();
+    out.push_back(text.substr(start, end - start));
+    start = end + 2;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string WarningAction(const std::string& warning) {
+  static const char* const kVerbs[] = {
+      "raise",   "lower",    "set",       "swing",   "check", "give",    "rerun",    "use",
+      "add",     "remove",   "release",   "hang",    "fix",   "measure", "increase", "decrease",
+      "shorten", "lengthen", "reprocess", "replace", "move",  "weigh",   "repeat"};
+  std::string action;
+  for (const std::string& clause : Clauses(warning)) {
+    std::string word = clause.substr(0, clause.find(' '));
+    std::transform(word.begin(), word.end(), word.begin(), ::tolower);
+    for (const char* verb : kVerbs) {
+      if (word == verb) action = clause;
+    }
+  }
+  return action;
+}
+
+std::string WarningLine::Text() const {
+  return action.empty() ? summary : summary + " -> " + action;
+}
+
+WarningLine LineOfWarning(const std::string& warning, size_t max_chars) {
+  WarningLine line;
+  line.summary = WarningSummary(warning, max_chars);
+  const std::string action = WarningAction(warning);
+  if (!action.empty() && line.summary.find(action) == std::string::npos) {
+    // Room for " -> action", the summary keeping at least its first 60 characters.
+    constexpr size_t kSeparator = 4, kShortest = 60;
+    const size_t room = max_chars > action.size() + kSeparator + kShortest
+                            ? max_chars - action.size() - kSeparator
+                            : kShortest;
+    line.summary = WarningSummary(warning, room);
+    line.action = action;
+  }
+  line.folded = line.summary.size() < warning.size();
+  return line;
 }
 
 const char* ToString(TraceStatus status) {

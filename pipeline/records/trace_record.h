@@ -131,9 +131,24 @@ struct TraceRecord {
 // A warning's one-line summary. Warnings (TraceRecord::warnings, TraceFitResult::warnings) state
 // the finding and what to do in their first sentence and give the detail after it: the summary
 // is that first sentence (up to ". " or "? " before a capital letter), cut at a word to at most
-// max_chars with " ..." when longer. The console and the report show it; the full text is in
-// results.json, `bifilar fit --json` and the report's expanded warning.
+// max_chars with " ..." when longer. The console and the report show it through LineOfWarning;
+// the full text is in results.json, `bifilar fit --json` and the report's expanded warning.
 std::string WarningSummary(const std::string& warning, size_t max_chars = 160);
+
+// The clause of a warning that says what to do: the last clause (the text split at ". " and
+// "; ") whose first word is a verb of action ("raise ...", "swing ...", "set ..."); "" when none.
+std::string WarningAction(const std::string& warning);
+
+// A warning on one line, as the console and the report both show it: its summary and, when the
+// summary does not hold the clause that says what to do (a first sentence cut short), that
+// clause after it; the summary is then cut shorter so that the line stays near max_chars.
+struct WarningLine {
+  std::string summary;       // WarningSummary of the warning
+  std::string action;        // WarningAction, "" when the summary holds it or there is none
+  bool folded = false;       // the line leaves out part of the warning (the rest is on click)
+  std::string Text() const;  // "summary -> action" (the console's form)
+};
+WarningLine LineOfWarning(const std::string& warning, size_t max_chars = 160);
 
 // The geometry (L, D, suspended mass, g) a trace of `role` is fitted with.
 RigGeometry GeometryForRole(const CampaignConfig& config, TraceRole role);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -15,8 +16,10 @@
 #include "base/json_error.h"
 #include "base/units.h"
 #include "base/user_error.h"
+#include "base/version.h"
 #include "pipeline/figures/svg_compact.h"
 #include "pipeline/logs/simulated_log.h"
+#include "pipeline/records/results_json.h"
 #include "pipeline/records/results_reader.h"
 #include "pipeline/records/tensor_json.h"
 #include "pipeline/records/total_uncertainty.h"
@@ -70,60 +73,18 @@ std::string Fixed(double value, int decimals) {
 
 // Trace `t`'s warnings as the report lists them: not the assumed +-1 mm on L and D (Table 2
 // states it once) nor the simulated-log mark (the page says it once, at the top).
-std::vector<std::string> TraceWarnings(const R& t) {
+std::vector<std::string> TraceWarnings(const TraceRecord& t) {
   std::vector<std::string> out;
-  for (const std::string& w : t.Strs("warnings")) {
+  for (const std::string& w : t.warnings) {
     if (!IsAssumedInputsWarning(w) && !IsSimulatedLogWarning(w)) out.push_back(w);
   }
   return out;
 }
 
 // The status a reader sees: "ok (warned)" for an ok trace with warnings, else the record's.
-std::string DisplayStatus(const R& t) {
-  const std::string status = t.Str("status");
+std::string DisplayStatus(const TraceRecord& t) {
+  const std::string status = ToString(t.status);
   return status == "ok" && !TraceWarnings(t).empty() ? "ok (warned)" : status;
-}
-
-// A warning's clauses, split at ". " and "; ".
-std::vector<std::string> Clauses(const std::string& text) {
-  std::vector<std::string> out;
-  size_t start = 0;
-  while (start < text.size()) {
-    size_t end = std::min(text.find(". ", start), text.find("; ", start));
-    if (end == std::string::npos) end = text.size();
-    out.push_back(text.substr(start, end - start));
-    start = end + 2;
-  }
-  return out;
-}
-
-// A warning's one line: its first clause (shortened at " (" or ": " when over 100 characters),
-// at most 160 characters. The one place to swap for a structured warning's own summary.
-std::string WarningSummary(const std::string& text) {
-  const std::vector<std::string> clauses = Clauses(text);
-  std::string line = clauses.empty() ? text : clauses.front();
-  constexpr size_t kLong = 100, kMax = 160;
-  if (line.size() > kLong) line = line.substr(0, std::min(line.find(" ("), line.find(": ")));
-  if (line.size() > kMax) line = line.substr(0, kMax - 3) + "...";
-  return line;
-}
-
-// The clause of a warning that says what to do (it starts with a verb: "raise ...", "swing
-// ...", "set ..."), "" when it has none.
-std::string WarningAction(const std::string& text) {
-  static const char* const kVerbs[] = {"raise", "lower", "set", "swing", "check", "give", "rerun",
-                                       "use", "add", "remove", "release", "hang", "fix", "measure",
-                                       "increase", "decrease", "shorten", "lengthen", "reprocess",
-                                       "replace", "move", "weigh", "repeat"};
-  std::string action;
-  for (const std::string& clause : Clauses(text)) {
-    std::string word = clause.substr(0, clause.find(' '));
-    std::transform(word.begin(), word.end(), word.begin(), ::tolower);
-    for (const char* verb : kVerbs) {
-      if (word == verb) action = clause;
-    }
-  }
-  return action;
 }
 
 struct Units {
@@ -208,18 +169,19 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
 
 // The amplitude-sweep figure beside trace `t`'s fit figure (I against amplitude,
 // pipeline/figures/sweep_plot.h), or a note saying why there is none.
-std::string SweepFigure(const R& t, const std::string& out_dir, int* counter) {
-  const std::string name = t.Str("sweep_figure"), file = Escape(t.Str("file"));
-  const R sweep = t.Get("amplitude_sweep");
+std::string SweepFigure(const TraceRecord& t, const std::string& out_dir, int* counter) {
+  const std::string& name = t.sweep_figure;
+  const std::string file = Escape(t.file);
+  const AmplitudeSweep& sweep = t.sweep;
   if (name.empty()) {
-    const std::string note = sweep.Str("note");
+    const std::string& note = sweep.note;
     return "<figure><p class=\"note\">" + file + ": no amplitude sweep" +
            (note.empty() ? std::string() : " (" + Escape(note) + ")") + ".</p></figure>\n";
   }
   // The compact figure has no legend: the caption is its legend.
-  const bool trend = sweep.Bool("trend_detected");
-  const double exponent = sweep.Num("trend_exponent");
-  const std::string alt = "I against amplitude, " + t.Str("file");
+  const bool trend = sweep.trend_detected;
+  const double exponent = sweep.trend_exponent;
+  const std::string alt = "I against amplitude, " + t.file;
   return "<figure>" + Figure(out_dir, name, alt, "sweep", counter) + "<figcaption>" + file +
          " &middot; I against amplitude, flat for the ideal model: each band &plusmn; 1&sigma; "
          "over its amplitude range; blue, the result &plusmn; 1&sigma;" +
@@ -259,9 +221,55 @@ const char* kScrollClose = "</div>\n";
 // (the paper's ellipse), a full tensor, a partial one, or three separate axes (moments only).
 enum class CampaignKind { kPlanar, kFullTensor, kPartialTensor, kSeparateAxes };
 
+// A section of results.json read by its one typed reader (pipeline/records/results_json.h, the
+// one the cache uses for a trace record): a key missing or of another type (a file of another
+// version, or edited) throws UserError naming the section, the key and the version that wrote
+// the file; RunReport adds the file and what to do. The keys read go to `log` under `path`.
+template <typename Read>
+auto ReadSection(const R& results, const std::string& what, const std::string& path, KeyLog* log,
+                 const Read& read) {
+  KeyLog keys;
+  try {
+    auto value = read(&keys);
+    if (log != nullptr) {
+      for (const std::string& key : keys) log->insert(path + "." + key);
+    }
+    return value;
+  } catch (const UserError& e) {
+    const std::string version = results.Str("version");
+    throw UserError(what + ": " + e.what() + "; the file was written by bifilar " +
+                    (version.empty() ? std::string("of an unknown version") : version) +
+                    ", this is bifilar " + ProgramVersion());
+  }
+}
+
+// results.json's traces, each read by TraceRecordFromJson as the cache reads its entries.
+std::vector<TraceRecord> ReadTraces(const R& results, KeyLog* log) {
+  std::vector<TraceRecord> out;
+  const std::vector<R> items = results.Items("traces");
+  for (size_t i = 0; i < items.size(); ++i) {
+    const json& element = items[i].node();
+    const auto file = element.is_object() ? element.find("file") : element.end();
+    const std::string name =
+        file != element.end() && file->is_string() ? " (" + file->get<std::string>() + ")" : "";
+    out.push_back(
+        ReadSection(results, "traces[" + std::to_string(i) + "]" + name, "traces[]", log,
+                    [&](KeyLog* keys) { return TraceRecordFromJson(element, true, keys); }));
+  }
+  return out;
+}
+
+// The calibration section (null without rig.calibration).
+std::optional<RigCalibrationResult> ReadCalibration(const R& results, KeyLog* log) {
+  const R section = results.Get("calibration");
+  if (!section.IsObject()) return std::nullopt;
+  return ReadSection(results, "calibration", "calibration", log,
+                     [&](KeyLog* keys) { return CalibrationFromJson(section.node(), keys); });
+}
+
 // One trace in the order of the tables: by roll, pitch (numerically), then file.
 struct TraceRow {
-  R t;
+  TraceRecord t;
   double roll = 0.0, pitch = NAN;
 };
 
@@ -269,7 +277,7 @@ struct TraceRow {
 // the number of figures embedded so far (the inline SVGs' id prefixes).
 struct ReportPage {
   ReportPage(const json& results_in, const std::string& out_dir_in, KeyLog* log)
-      : results(results_in, log), out_dir(out_dir_in) {
+      : results(results_in, log), log_(log), out_dir(out_dir_in) {
     if (results.Str("units") == "imperial") {
       u.imperial = true;
       u.scale = kSlugFt2PerKgM2;
@@ -281,11 +289,11 @@ struct ReportPage {
     kind = mode == "full_3d"   ? CampaignKind::kFullTensor
            : mode == "partial" ? (products ? CampaignKind::kPartialTensor : CampaignKind::kSeparateAxes)
                                : CampaignKind::kPlanar;
-    for (const R& t : results.Items("traces")) {
-      TraceRow row{t};
-      const double roll = t.Num("roll_used_deg");
+    for (TraceRecord& t : ReadTraces(results, log_)) {
+      TraceRow row{std::move(t)};
+      const double roll = row.t.roll_used_deg;
       row.roll = std::isfinite(roll) ? roll : 0.0;
-      row.pitch = t.Num("pitch_used_deg");
+      row.pitch = row.t.pitch_used_deg;
       if (row.roll != 0.0) rolls = true;
       traces.push_back(row);
     }
@@ -293,16 +301,22 @@ struct ReportPage {
       const double pa = std::isfinite(a.pitch) ? a.pitch : 1e9, pb = std::isfinite(b.pitch) ? b.pitch : 1e9;
       if (a.roll != b.roll) return a.roll < b.roll;
       if (pa != pb) return pa < pb;
-      return a.t.Str("file") < b.t.Str("file");
+      return a.t.file < b.t.file;
     });
     // A campaign whose tensor fit failed is still not planar when its logs roll.
     if (kind == CampaignKind::kPlanar && rolls) kind = CampaignKind::kPartialTensor;
+    summary = ReadSection(results, "summary", "summary", log_, [this](KeyLog* keys) {
+      return CampaignSummaryFromJson(results.Get("summary").node(), keys);
+    });
+    calibration = ReadCalibration(results, log_);
   }
   bool Planar() const { return kind == CampaignKind::kPlanar; }
   R results;
+  KeyLog* log_;  // every key read (ReportKeysRead), or null
   const std::string& out_dir;
   Units u;
-  const R summary = results.Get("summary");
+  CampaignSummary summary;  // read after the traces (a broken trace is named first)
+  std::optional<RigCalibrationResult> calibration;
   const R ellipse = results.Get("ellipse");
   const R tensor = results.Get("tensor");
   const R figures = results.Get("figures");
@@ -334,7 +348,7 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
   };
   if (p.Planar()) {
     if (!p.ellipse.IsObject()) {
-      h << "<p class=\"bad\">" << Escape(p.summary.Str("ellipse_message")) << "</p>\n";
+      h << "<p class=\"bad\">" << Escape(p.summary.ellipse_message) << "</p>\n";
       return;
     }
     const R total = p.results.Get("total_uncertainty");
@@ -348,7 +362,7 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
     return;
   }
   if (!p.tensor.IsObject()) {
-    h << "<p class=\"bad\">" << Escape(p.summary.Str("tensor_message")) << "</p>\n";
+    h << "<p class=\"bad\">" << Escape(p.summary.tensor_message) << "</p>\n";
     return;
   }
   for (const char* name : {"Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"}) {
@@ -361,7 +375,7 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
 
 // Title, version, config, the campaign kind and the trace counts, then the main result.
 void WriteHeader(const ReportPage& p, std::ostream& h) {
-  const R& summary = p.summary;
+  const CampaignSummary& summary = p.summary;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
     << "<title>bifilar report</title><style>" << kStyle << "</style></head><body>\n";
   h << "<h1>Mass properties from bifilar pendulum swings</h1>\n";
@@ -375,15 +389,15 @@ void WriteHeader(const ReportPage& p, std::ostream& h) {
       << Escape(settings.Str("integrator")) << "</code>";
     if (!settings.Get("glitch").Bool("enabled", true)) h << ", glitch removal off";
   }
-  h << ". Traces: " << summary.Int("n_traces") << " (<span class=\"ok\">" << summary.Int("n_ok")
-    << " ok</span>, " << summary.Int("n_rejected") << " rejected, " << summary.Int("n_error")
-    << " error); fits reused from cache: " << summary.Int("n_reused") << ".</p>\n";
+  h << ". Traces: " << summary.n_traces << " (<span class=\"ok\">" << summary.n_ok << " ok</span>, "
+    << summary.n_rejected << " rejected, " << summary.n_error
+    << " error); fits reused from cache: " << summary.n_reused << ".</p>\n";
   // Simulated logs say so in their warnings (pipeline/logs/simulated_log.h): the page says it first.
   int simulated = 0;
   std::string mark;  // the first log's own words, once for the page
   for (const TraceRow& row : p.traces) {
     bool marked = false;
-    for (const std::string& w : row.t.Strs("warnings")) {
+    for (const std::string& w : row.t.warnings) {
       if (!IsSimulatedLogWarning(w)) continue;
       marked = true;
       if (mark.empty()) mark = w;
@@ -398,15 +412,19 @@ void WriteHeader(const ReportPage& p, std::ostream& h) {
   WriteHeadline(p, h);
 }
 
-// One warning as a line with the action, the full text on click.
+// A warning's line (LineOfWarning, pipeline/records/trace_record.h: the console's line) as page
+// content: the clause that says what to do, when the summary does not hold it, in bold after it.
+std::string WarningLineHtml(const WarningLine& line) {
+  return Escape(line.summary) +
+         (line.action.empty() ? std::string() : " &rarr; <b>" + Escape(line.action) + "</b>");
+}
+
+// One warning as its line, the full text on click.
 std::string WarningItem(const Units& u, const std::string& warning) {
   const std::string text = InDisplayUnits(u, warning);
-  const std::string line = WarningSummary(text), action = WarningAction(text);
-  std::string summary = Escape(line);
-  if (!action.empty() && line.find(action) == std::string::npos) {
-    summary += " &rarr; <b>" + Escape(action) + "</b>";
-  }
-  if (line.size() == text.size()) return "<p>" + summary + "</p>";  // nothing more to expand
+  const WarningLine line = LineOfWarning(text);
+  const std::string summary = WarningLineHtml(line);
+  if (!line.folded) return "<p>" + summary + "</p>";  // nothing more to expand
   return "<details><summary>" + summary + "</summary><p>" + Escape(text) + "</p></details>";
 }
 
@@ -444,7 +462,7 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
   const R& ellipse = p.ellipse;
   h << "<h2>Table 2: inertia properties</h2>\n";
   if (!ellipse.IsObject()) {
-    h << "<p class=\"bad\">" << Escape(p.summary.Str("ellipse_message")) << "</p>\n";
+    h << "<p class=\"bad\">" << Escape(p.summary.ellipse_message) << "</p>\n";
     return;
   }
   // The total column (results.json total_uncertainty, pipeline/records/total_uncertainty.h): the
@@ -472,7 +490,7 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
     h << "<td class=\"l\">" << (row.angle ? "deg" : u.name) << "</td></tr>\n";
   }
   h << "</table>" << kScrollClose;
-  const bool calibrated = p.results.Get("calibration").IsObject();
+  const bool calibrated = p.calibration.has_value();
   const double common = total.Num("common_mode_relative_std");
   const bool assumed = total.Bool("configured_inputs_assumed");
   h << "<p><b>std (stat)</b>: the scatter between trials and angles, the fits' own errors and the "
@@ -495,28 +513,27 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
 
 // rig.calibration: effective against configured geometry, the factor with its std and parts.
 void WriteCalibration(const ReportPage& p, std::ostream& h) {
-  const R c = p.results.Get("calibration");
-  if (!c.IsObject()) return;
-  const R parts = c.Get("relative_std_parts"), swings = c.Get("swings"), reference = c.Get("reference");
+  if (!p.calibration) return;
+  const RigCalibrationResult& c = *p.calibration;
   h << "<h2>Rig calibration (reference object)</h2>\n<table><tr><th class=\"l\">geometry</th>"
        "<th>L (m)</th><th>D (m)</th><th>D<sup>2</sup>/L (m)</th></tr>\n";
-  for (const char* label : {"nominal", "effective"}) {
-    const R g = c.Get(label);
-    h << "<tr><td class=\"l\">" << (std::string(label) == "nominal" ? "configured" : label)
-      << "</td><td>" << Fmt(g.Num("filar_length_m"), "%.4f") << "</td><td>"
-      << Fmt(g.Num("filar_separation_m"), "%.5f") << "</td><td>" << Fmt(g.Num("d2_over_l_m"), "%.6f")
+  const auto row = [&](const char* label, double separation_m, double d2_over_l_m) {
+    h << "<tr><td class=\"l\">" << label << "</td><td>" << Fmt(c.filar_length_m, "%.4f")
+      << "</td><td>" << Fmt(separation_m, "%.5f") << "</td><td>" << Fmt(d2_over_l_m, "%.6f")
       << "</td></tr>\n";
-  }
-  h << "</table>\n<p>Factor k = " << Fmt(c.Num("factor"), "%.5f") << " &plusmn; "
-    << Fmt(c.Num("factor_std"), "%.5f") << " (&plusmn;" << Fmt(100.0 * c.Num("factor_relative_std"), "%.3f")
-    << " %, common to every moment: reference inertia " << Fmt(100.0 * parts.Num("reference_inertia"), "%.3f")
-    << " %, reference swings " << Fmt(100.0 * parts.Num("reference_swings"), "%.3f") << " %, rig inertia "
-    << Fmt(100.0 * parts.Num("rig_inertia"), "%.3f") << " %), from " << swings.Int("n")
-    << " swing(s) of a reference of " << p.u.Inertia(reference.Num("inertia_kg_m2"), "%.5g") << " "
-    << p.u.name << " and " << Fmt(reference.Num("mass_kg"), "%.4g")
+  };
+  row("configured", c.nominal_separation_m, c.nominal_d2_over_l_m);
+  row("effective", c.effective_separation_m, c.effective_d2_over_l_m);
+  h << "</table>\n<p>Factor k = " << Fmt(c.factor, "%.5f") << " &plusmn; "
+    << Fmt(c.factor_std, "%.5f") << " (&plusmn;" << Fmt(100.0 * c.factor_rel_std, "%.3f")
+    << " %, common to every moment: reference inertia " << Fmt(100.0 * c.rel_std_reference, "%.3f")
+    << " %, reference swings " << Fmt(100.0 * c.rel_std_swings, "%.3f") << " %, rig inertia "
+    << Fmt(100.0 * c.rel_std_rig, "%.3f") << " %), from " << c.n_swings
+    << " swing(s) of a reference of " << p.u.Inertia(c.reference_inertia_kg_m2, "%.5g") << " "
+    << p.u.name << " and " << Fmt(c.reference_mass_kg, "%.4g")
     << " kg. Every trace, tare logs included, was fitted with the effective geometry; the "
        "tape-measure uncertainties of L and D and that of g do not apply.</p>\n";
-  WriteNotes(c.Strs("warnings"), p.u, h);
+  WriteNotes(c.warnings, p.u, h);
 }
 
 // Table 1 (data quality) and the rig line. The regression RMSE is the ellipse's (planar) or the
@@ -640,7 +657,7 @@ void WriteTensorSection(ReportPage& p, std::ostream& h) {
   const R& tensor = p.tensor;
   h << "<h2>Inertia tensor</h2>\n";
   if (!tensor.IsObject()) {
-    h << "<p class=\"bad\">" << Escape(p.summary.Str("tensor_message")) << "</p>\n";
+    h << "<p class=\"bad\">" << Escape(p.summary.tensor_message) << "</p>\n";
     return;
   }
   h << "<p>" << tensor.Int("n_points") << " moments about " << tensor.Int("n_orientations")
@@ -717,12 +734,12 @@ void WriteRejectedTraces(const ReportPage& p, std::ostream& h) {
   int bad = 0;
   std::ostringstream rows;
   for (const TraceRow& row : p.traces) {
-    const std::string status = row.t.Str("status");
-    if (status == "ok") continue;
+    const std::string status = ToString(row.t.status);
+    if (row.t.ok()) continue;
     ++bad;
-    rows << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(row.t.Str("file"))
+    rows << "<tr class=\"" << Escape(status) << "\"><td class=\"l\">" << Escape(row.t.file)
          << "</td><td class=\"l\">" << Escape(status) << "</td><td class=\"l w\">"
-         << Escape(InDisplayUnits(p.u, row.t.Str("message"))) << "</td></tr>\n";
+         << Escape(InDisplayUnits(p.u, row.t.message)) << "</td></tr>\n";
   }
   if (bad == 0) return;  // nothing to show: the header's counts say every trace was fitted
   h << "<h2>Rejected and failed traces</h2>\n" << kScrollOpen
@@ -735,11 +752,12 @@ void WriteWarnings(const ReportPage& p, std::ostream& h) {
   std::ostringstream rows;
   int warned = 0;
   for (const TraceRow& row : p.traces) {
-    if (row.t.Str("status") != "ok") continue;  // rejected and failed: the section above
+    if (!row.t.ok()) continue;  // rejected and failed: the section above
     const std::vector<std::string> warnings = TraceWarnings(row.t);
     if (warnings.empty()) continue;
     ++warned;
-    rows << "<tr class=\"warned\"><td class=\"l\">" << Escape(row.t.Str("file")) << "</td><td class=\"l w\">";
+    rows << "<tr class=\"warned\"><td class=\"l\">" << Escape(row.t.file)
+         << "</td><td class=\"l w\">";
     for (const std::string& w : warnings) rows << WarningItem(p.u, w);
     rows << "</td></tr>\n";
   }
@@ -757,12 +775,12 @@ void WriteWarnings(const ReportPage& p, std::ostream& h) {
 
 // The traces table's status cell: "ok (warned)" links to the Warnings section and carries the
 // warnings' first lines as its tooltip.
-std::string StatusCell(const Units& u, const R& t) {
+std::string StatusCell(const Units& u, const TraceRecord& t) {
   const std::string shown = DisplayStatus(t);
   if (shown != "ok (warned)") return Escape(shown);
   std::string tip;
   for (const std::string& w : TraceWarnings(t)) {
-    tip += (tip.empty() ? "" : "\n") + WarningSummary(InDisplayUnits(u, w));
+    tip += (tip.empty() ? "" : "\n") + LineOfWarning(InDisplayUnits(u, w)).Text();
   }
   return "<a href=\"#warnings\" title=\"" + Escape(tip) + "\">" + Escape(shown) + "</a>";
 }
@@ -777,48 +795,52 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
     << ")</th><th>std (stat)</th><th>std (total)</th><th>period (s)</th><th>I aircraft</th><th>std (stat)</th>"
        "<th>std (total)</th><th>window (s)</th><th>amplitude (deg)</th><th>rms/noise</th></tr>\n";
   for (const TraceRow& row : p.traces) {
-    const R& t = row.t;
-    const std::string status = t.Str("status");
+    const TraceRecord& t = row.t;
+    const std::string status = ToString(t.status);
     std::string window = "&ndash;", amplitude = "&ndash;";
-    const std::vector<double> w = t.Nums("window_s"), a = t.Nums("amplitude_deg");
-    if (w.size() == 2) window = Fmt(w[0], "%.2f") + "&ndash;" + Fmt(w[1], "%.2f");
-    if (a.size() == 2) amplitude = Fmt(a[0], "%.1f") + "&rarr;" + Fmt(a[1], "%.1f");
-    const double total_std = t.Num("inertia_total_std_kg_m2"), std = t.Num("inertia_std_kg_m2");
+    const std::array<double, 2>& w = t.window_s;
+    const std::array<double, 2>& a = t.amplitude_deg;
+    // A pair is written only when both ends are finite (null otherwise).
+    if (std::isfinite(w[0]) && std::isfinite(w[1]))
+      window = Fmt(w[0], "%.2f") + "&ndash;" + Fmt(w[1], "%.2f");
+    if (std::isfinite(a[0]) && std::isfinite(a[1]))
+      amplitude = Fmt(a[0], "%.1f") + "&rarr;" + Fmt(a[1], "%.1f");
+    const double total_std = t.inertia_total_std_kg_m2, std = t.inertia_std_kg_m2;
     const std::string row_class = DisplayStatus(t) == "ok (warned)" ? "warned"
                                   : status == "ok"                 ? ""
                                                                    : status;
-    h << "<tr class=\"" << Escape(row_class) << "\"><td class=\"l\">" << Escape(t.Str("file"))
-      << "</td><td class=\"l\">" << Escape(t.Str("role")) << "</td><td class=\"l\">"
+    h << "<tr class=\"" << Escape(row_class) << "\"><td class=\"l\">" << Escape(t.file)
+      << "</td><td class=\"l\">" << Escape(ToString(t.role)) << "</td><td class=\"l\">"
       << StatusCell(u, t) << "</td><td>" << Fmt(row.roll, "%.2f") << "</td><td>"
-      << Fmt(row.pitch, "%.2f") << "</td><td>" << u.Value(t.Num("inertia_total_kg_m2"), total_std)
-      << "</td><td>" << u.Std(total_std) << "</td><td>" << u.Std(t.Num("inertia_total_std_total_kg_m2"))
-      << "</td><td>" << Fmt(t.Num("period_s"), "%.4f") << "</td><td>"
-      << u.Value(t.Num("inertia_kg_m2"), std) << "</td><td>" << u.Std(std) << "</td><td>"
-      << u.Std(t.Num("inertia_std_total_kg_m2")) << "</td><td>" << window << "</td><td>"
-      << amplitude << "</td><td>"
-      << Fmt(t.Num("residual_rms_rad_per_s") / t.Num("noise_rms_rad_per_s"), "%.2f")
-      << "</td></tr>\n";
+      << Fmt(row.pitch, "%.2f") << "</td><td>" << u.Value(t.inertia_total_kg_m2, total_std)
+      << "</td><td>" << u.Std(total_std) << "</td><td>" << u.Std(t.inertia_total_std_total_kg_m2)
+      << "</td><td>" << Fmt(t.period_s, "%.4f") << "</td><td>" << u.Value(t.inertia_kg_m2, std)
+      << "</td><td>" << u.Std(std) << "</td><td>" << u.Std(t.inertia_std_total_kg_m2) << "</td><td>"
+      << window << "</td><td>" << amplitude << "</td><td>"
+      << Fmt(t.residual_rms_rad_per_s / t.noise_rms_rad_per_s, "%.2f") << "</td></tr>\n";
   }
   h << "</table>" << kScrollClose;
 }
 
 // A trace figure's caption after the status: the record's I with its stds, labelled (the number
 // the tables give), period and small-angle I, and each warning's line.
-std::string TraceCaptionFacts(const ReportPage& p, const R& t) {
+std::string TraceCaptionFacts(const ReportPage& p, const TraceRecord& t) {
   std::string out;
-  const double value = t.Num("inertia_total_kg_m2"), stat = t.Num("inertia_total_std_kg_m2");
-  const double total = t.Num("inertia_total_std_total_kg_m2");
+  const double value = t.inertia_total_kg_m2, stat = t.inertia_total_std_kg_m2;
+  const double total = t.inertia_total_std_total_kg_m2;
   if (std::isfinite(value)) {
     out += "<br>I<sub>total</sub> = " + p.u.Value(value, stat) + " &plusmn; " + p.u.Std(stat) +
            " (stat) &plusmn; " + p.u.Std(total) + " (total) " + p.u.name;
   }
-  const double period = t.Num("period_s");
+  const double period = t.period_s;
   if (std::isfinite(period)) {
-    out += " &middot; T = " + Fmt(period, "%.4f") + " s, small-angle I = " +
-           p.u.Inertia(t.Num("small_angle_inertia_total_kg_m2"), "%.5f") + " " + p.u.name;
+    out += " &middot; T = " + Fmt(period, "%.4f") +
+           " s, small-angle I = " + p.u.Inertia(t.small_angle_inertia_total_kg_m2, "%.5f") + " " +
+           p.u.name;
   }
   for (const std::string& w : TraceWarnings(t)) {
-    out += "<br><span class=\"warn\">warning: " + Escape(WarningSummary(InDisplayUnits(p.u, w))) + "</span>";
+    out += "<br><span class=\"warn\">warning: " +
+           WarningLineHtml(LineOfWarning(InDisplayUnits(p.u, w))) + "</span>";
   }
   return out;
 }
@@ -827,12 +849,12 @@ std::string TraceCaptionFacts(const ReportPage& p, const R& t) {
 void WriteTraceFigures(ReportPage& p, std::ostream& h) {
   std::ostringstream figures;
   for (const TraceRow& row : p.traces) {
-    const std::string fig = row.t.Str("figure");
+    const std::string& fig = row.t.figure;
     if (fig.empty()) continue;
     figures << "<figure>"
-            << Figure(p.out_dir, fig, "fit of " + row.t.Str("file"), "trace", &p.figures_drawn)
-            << "<figcaption>" << Escape(row.t.Str("file")) << " &middot; "
-            << Escape(DisplayStatus(row.t)) << TraceCaptionFacts(p, row.t) << "</figcaption></figure>\n"
+            << Figure(p.out_dir, fig, "fit of " + row.t.file, "trace", &p.figures_drawn)
+            << "<figcaption>" << Escape(row.t.file) << " &middot; " << Escape(DisplayStatus(row.t))
+            << TraceCaptionFacts(p, row.t) << "</figcaption></figure>\n"
             << SweepFigure(row.t, p.out_dir, &p.figures_drawn);
   }
   if (figures.tellp() == 0) return;  // no figures drawn (process --no-figures): no section

@@ -121,11 +121,6 @@ std::string EntryChecksum(const std::string& key, const std::string& content_has
   return HashToHex(Fnv1a64(key + ";" + content_hash + ";" + version + ";" + text));
 }
 
-bool FiniteOrNull(const nlohmann::json& j, const char* field) {
-  return !j.contains(field) || j[field].is_null() ||
-         (j[field].is_number() && std::isfinite(j[field].get<double>()));
-}
-
 }  // namespace
 
 bool TraceCache::Load(const std::string& key, const std::string& content_hash,
@@ -164,16 +159,19 @@ bool TraceCache::Load(const std::string& key, const std::string& content_hash,
   if (text("checksum") != EntryChecksum(key, content_hash, ProgramVersion(), fields)) {
     return refuse("checksum mismatch: the entry was changed after it was written");
   }
+  // The one reader of a record (pipeline/records/results_json.h): an entry missing a key the
+  // writer writes (one of an older format, such as before records carried the period) is
+  // refitted, not shown with a blank.
   try {
-    *record = TraceRecordFromJson(fields);
+    *record = TraceRecordFromJson(fields, false);  // the fit fields, as Store writes them
   } catch (const std::exception& e) {
     return refuse(DescribeJsonError(e));
   }
-  // Entries written before records carried the measured period are refitted, not shown with a
-  // blank period.
-  if (!fields.contains("period_s")) return refuse("written before records carried the period");
-  for (const char* field : {"inertia_total_kg_m2", "inertia_total_std_kg_m2"}) {
-    if (!FiniteOrNull(fields, field)) return refuse(std::string(field) + " is not a finite number");
+  // null reads as NaN (no fit); a number beyond a double (1e999) reads as infinity: refused.
+  for (const auto& [field, value] :
+       {std::make_pair("inertia_total_kg_m2", record->inertia_total_kg_m2),
+        std::make_pair("inertia_total_std_kg_m2", record->inertia_total_std_kg_m2)}) {
+    if (std::isinf(value)) return refuse(std::string(field) + " is not a finite number");
   }
   if (record->ok() && !(record->inertia_total_kg_m2 > 0.0 &&
                         std::isfinite(record->inertia_total_kg_m2) &&
