@@ -167,7 +167,8 @@ bool TraceCache::Load(const std::string& key, const std::string& content_hash,
   } catch (const std::exception& e) {
     return refuse(DescribeJsonError(e));
   }
-  // null reads as NaN (no fit); a number beyond a double (1e999) reads as infinity: refused.
+  // null reads as NaN (no fit); an infinity cannot come from the parser (it refuses 1e999 as a
+  // number overflow), but a record is never taken with one.
   for (const auto& [field, value] :
        {std::make_pair("inertia_total_kg_m2", record->inertia_total_kg_m2),
         std::make_pair("inertia_total_std_kg_m2", record->inertia_total_std_kg_m2)}) {
