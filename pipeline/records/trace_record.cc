@@ -11,20 +11,11 @@ namespace bifilar {
 namespace {
 
 // The one table of each enumeration (Ceres types.h style): results.json, the cache, reports.
-struct TraceStatusRow {
-  TraceStatus status;
-  const char* name;
-};
-constexpr TraceStatusRow kTraceStatusTable[] = {
+constexpr EnumName<TraceStatus> kTraceStatusNames[] = {
     {TraceStatus::kOk, "ok"}, {TraceStatus::kRejected, "rejected"}, {TraceStatus::kError, "error"}};
-
-struct TraceRoleRow {
-  TraceRole role;
-  const char* name;
-};
-constexpr TraceRoleRow kTraceRoleTable[] = {{TraceRole::kAircraft, "aircraft"},
-                                            {TraceRole::kTare, "tare"},
-                                            {TraceRole::kCalibration, "calibration"}};
+constexpr EnumName<TraceRole> kTraceRoleNames[] = {{TraceRole::kAircraft, "aircraft"},
+                                                   {TraceRole::kTare, "tare"},
+                                                   {TraceRole::kCalibration, "calibration"}};
 
 }  // namespace
 
@@ -97,51 +88,17 @@ WarningLine LineOfWarning(const std::string& warning, size_t max_chars) {
   return line;
 }
 
-const char* ToString(TraceStatus status) {
-  for (const TraceStatusRow& row : kTraceStatusTable) {
-    if (row.status == status) return row.name;
-  }
-  return "error";
-}
-
+const char* ToString(TraceStatus status) { return EnumToString(kTraceStatusNames, status, "error"); }
 bool ParseTraceStatus(const std::string& name, TraceStatus* status) {
-  for (const TraceStatusRow& row : kTraceStatusTable) {
-    if (name == row.name) {
-      *status = row.status;
-      return true;
-    }
-  }
-  return false;
+  return ParseEnum(kTraceStatusNames, name, status);
 }
+std::string TraceStatusAllowedValues() { return EnumAllowedValues(kTraceStatusNames); }
 
-std::string TraceStatusAllowedValues() {
-  std::vector<std::string> names;
-  for (const TraceStatusRow& row : kTraceStatusTable) names.push_back(row.name);
-  return JoinAllowedValues(names);
-}
-
-const char* ToString(TraceRole role) {
-  for (const TraceRoleRow& row : kTraceRoleTable) {
-    if (row.role == role) return row.name;
-  }
-  return "aircraft";
-}
-
+const char* ToString(TraceRole role) { return EnumToString(kTraceRoleNames, role, "aircraft"); }
 bool ParseTraceRole(const std::string& name, TraceRole* role) {
-  for (const TraceRoleRow& row : kTraceRoleTable) {
-    if (name == row.name) {
-      *role = row.role;
-      return true;
-    }
-  }
-  return false;
+  return ParseEnum(kTraceRoleNames, name, role);
 }
-
-std::string TraceRoleAllowedValues() {
-  std::vector<std::string> names;
-  for (const TraceRoleRow& row : kTraceRoleTable) names.push_back(row.name);
-  return JoinAllowedValues(names);
-}
+std::string TraceRoleAllowedValues() { return EnumAllowedValues(kTraceRoleNames); }
 
 RigGeometry GeometryForRole(const CampaignConfig& config, TraceRole role) {
   switch (role) {
