@@ -32,6 +32,11 @@ bool FailWith(const CheckFailure& failure, std::string* why, const std::string& 
   return false;
 }
 
+bool SetWhy(std::string* why, const std::string& message) {
+  if (why != nullptr) *why = message;
+  return false;
+}
+
 bool CheckFail(const std::string& field, double value, const std::string& allowed,
                CheckFailure* failure) {
   if (failure != nullptr) *failure = CheckFailure{field, value, allowed, "", false};

@@ -38,6 +38,10 @@ std::string CheckMessage(const std::string& name, double value, const std::strin
 // *why = `context` + failure.Message() (context e.g. "window: "; why may be null); returns false.
 bool FailWith(const CheckFailure& failure, std::string* why, const std::string& context = "");
 
+// *why = message (why may be null); returns false. For failures that are not a bound (an
+// integration that diverged), so that a file needs no `Fail` helper of its own.
+bool SetWhy(std::string* why, const std::string& message);
+
 // A failure with any bound text ("a rotation matrix"): fills *failure, returns false.
 bool CheckFail(const std::string& field, double value, const std::string& allowed,
                CheckFailure* failure);
