@@ -634,6 +634,7 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
   for (const auto& c : a.cycles) max_peak = std::max(max_peak, c.peak);
   const double half = HalfPeriod(a.cycles, std::max(floor, 0.1 * max_peak), o);
   if (half <= 0.0) {
+    w.no_oscillation_found = true;
     w.message = Prefix(name) + Fmt("no oscillation found (no swing with a period in [%g, %g] s "
                                    "above the noise floor of %.3g rad/s)",
                                    o.min_period_s, o.max_period_s, floor);
@@ -646,6 +647,7 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
   const std::vector<Run> runs = FreeRuns(cycles, rules);
   const Run* best = LongestRun(runs, cycles);
   if (!best) {
+    w.no_oscillation_found = true;
     w.message = Prefix(name) + "no oscillation found (no sequence of half-cycles that decays like a "
                                "free swing)";
     return w;
@@ -714,6 +716,7 @@ FreeOscillationWindow ApplyWindowOverride(const std::vector<double>& t,
   const double half = HalfPeriod(inside, o.noise_floor_sigmas * sigma_eff, o);
   if (half <= 0.0) {
     w.status = WindowStatus::kRejected;
+    w.no_oscillation_found = true;
     w.message = Prefix(name) + Fmt("no oscillation found inside the window [%g, %g] s", w.t0_s, w.t1_s);
     return w;
   }
