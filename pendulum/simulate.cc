@@ -899,8 +899,8 @@ bool CampaignSpec::Check(std::string* why) const {
   // The true geometry (0: the configured one) keeps the wires taut.
   if (!CheckFiniteGe("true_filar_length_m", true_filar_length_m, 0.0, &f) ||
       !CheckFiniteGe("true_filar_separation_m", true_filar_separation_m, 0.0, &f) ||
-      !CheckGt("true filar length (m)", TrueLengthM(), "the true filar separation (m)",
-               TrueSeparationM(), &f)) {
+      !CheckGt("true_filar_length_m (0: filar_length_m)", TrueLengthM(),
+               "true_filar_separation_m (0: filar_separation_m)", TrueSeparationM(), &f)) {
     return FailWith(f, why);
   }
   if (calibration_logs > 0) {

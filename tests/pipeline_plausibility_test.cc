@@ -72,7 +72,8 @@ TEST(PlausibleConfig, LengthsAndMassInMillimetresAndGramsNameKeyLineAndUnit) {
   EXPECT_TRUE(Contains(why, "if this is in mm, write 0.03")) << why;
   // The separation in cm is within D's range but not below L: named, with the cm reading.
   why = FitConfigError(dir, Rig("0.594", "3", "0.0343"));
-  EXPECT_TRUE(Contains(why, "'rig.filar_separation_m': filar_separation_m (D) = 3 m is not below")) << why;
+  EXPECT_TRUE(Contains(why, "'rig.filar_separation_m': filar_separation_m (D) = 3; must be < "
+                           "filar_length_m (L) = 0.594")) << why;
   EXPECT_TRUE(Contains(why, "if this is in cm, write 0.03")) << why;
   // The fixed-wing's length in cm.
   why = FitConfigError(dir, Rig("74", "0.16", "3.34"));

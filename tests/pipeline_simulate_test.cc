@@ -84,7 +84,7 @@ TEST(SimulateSpec, BadInputNamesTheKeyAndLine) {
       {base + "sensor: {sample_rat_hz: 100}\n", "spec.yaml:2:10: unknown key 'sensor.sample_rat_hz'"},
       {base + "bogus: 1\n", "unknown key 'bogus'"},
       {"geometry: {filar_length_m: 1.5, filar_separation_m: 1.8}\n",
-       "'geometry.filar_separation_m': filar_separation_m (D) = 1.8 m is not below filar_length_m (L) = 1.5 m"},
+       "'geometry.filar_separation_m': filar_separation_m (D) = 1.8; must be < filar_length_m (L) = 1.5"},
       {"geometry: {filar_length_m: -1, filar_separation_m: 1.8}\n",
        "spec.yaml:1:28: 'geometry.filar_length_m' = -1 is out of range; allowed (0, 1000]"},
       {base + "sensor: {sample_rate_hz: 0}\n", "'sensor.sample_rate_hz' = 0 is out of range"},
