@@ -307,6 +307,33 @@ TEST(Config, DuplicateKeysDocumentsAndTablePitchesNameBothLines) {
   ExpectError(buffer, {":8:", "pitch 0.0 deg twice", ":7:"});
 }
 
+// The log reader's options as a config sets them: each bad value names the key, its value and the
+// bound (the one format of base/option_check.h), and ImuLogOptions::Check does the same for
+// options built in code.
+TEST(ConfigCheck, LogOptionsNameKeyValueAndBound) {
+  const std::string yaml = kMinimal;
+  ExpectError(yaml + "limits: {max_log_mb: 0.5}\n",
+              {"limits.max_log_mb = 0.5; must be in [1, 1000000] (MB)", ":8:"});
+  ExpectError(yaml + "limits: {max_decompressed_log_mb: 2e6}\n",
+              {"limits.max_decompressed_log_mb = 2000000; must be in [1, 1000000] (MB)"});
+  ExpectError(yaml + "imu: {dataflash: {instance: 300}}\n",
+              {"imu.dataflash.instance = 300; must be in [0, 255]"});
+  ImuLogOptions options;
+  std::string why;
+  EXPECT_TRUE(options.Check(&why)) << why;
+  options.max_dropped_fraction = 2;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "max_dropped_fraction = 2; must be in [0, 1]");
+  options = ImuLogOptions();
+  options.min_rows = 0;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "min_rows = 0; must be >= 1");
+  options = ImuLogOptions();
+  options.dataflash_instance = 256;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "dataflash_instance = 256; must be in [0, 255] (or -1: the lowest in the log)");
+}
+
 // Every bound lives in the options struct's Check (a config built in code is checked for the
 // quality, sweep and glitch ranges too), reported as field, value and bound; the config layer
 // maps the field to its YAML key and line.

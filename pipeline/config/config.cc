@@ -220,9 +220,10 @@ void ReadImu(YamlMap imu, ImuConfig* out) {
     const YAML::Node node = dataflash.Optional("instance");
     out->dataflash_instance = dataflash.OptionalInt("instance", -1);
     if (dataflash.Has("instance") && (out->dataflash_instance < 0 || out->dataflash_instance > 255)) {
-      throw UserError(dataflash.Where(node) + ": 'imu.dataflash.instance' must be in [0, 255] (the "
-                      "IMU instance of an ArduPilot log; leave it out for the lowest), not " +
-                      std::to_string(out->dataflash_instance));
+      throw UserError(dataflash.Where(node) + ": " +
+                      CheckMessage("imu.dataflash.instance", out->dataflash_instance,
+                                   "in [0, 255] (the IMU instance of an ArduPilot log; leave it "
+                                   "out for the lowest)"));
     }
     dataflash.Finish();
   }
@@ -940,8 +941,9 @@ InputLimits ReadLimits(YamlMap limits) {
     if (!node.IsDefined()) continue;
     const double mb = limits.AsDouble(node, key);
     if (!(mb >= 1 && mb <= kMaxLimitMb)) {
-      throw UserError(limits.Where(node) + ": '" + limits.KeyPath(key) + "' must be in [1, " +
-                      std::to_string(static_cast<long long>(kMaxLimitMb)) + "] (MB)");
+      throw UserError(limits.Where(node) + ": " +
+                      CheckMessage(limits.KeyPath(key), mb,
+                                   "in " + IntervalText(1, kMaxLimitMb, Ends::kClosed) + " (MB)"));
     }
     *value = mb;
   }
