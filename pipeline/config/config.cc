@@ -358,22 +358,23 @@ RigGeometry CampaignConfig::CalibrationGeometry() const {
 }
 
 bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why) {
-  char buffer[320];
+  CheckFailure f;
   if (off_earth) {
-    if (gravity_mps2 > 0.0 && gravity_mps2 <= kMaxOffEarthGravityMps2) return true;
-    std::snprintf(buffer, sizeof(buffer),
-                  "'gravity_mps2' must be in (0, %g] m/s^2 (gravity_off_earth: true), got %g",
-                  kMaxOffEarthGravityMps2, gravity_mps2);
-  } else {
-    if (gravity_mps2 >= kMinEarthGravityMps2 && gravity_mps2 <= kMaxEarthGravityMps2) return true;
-    std::snprintf(buffer, sizeof(buffer),
-                  "'gravity_mps2' = %g m/s^2 is not a gravity found on Earth ([%g, %g] m/s^2, "
-                  "from the equator's mountains to the poles); check for a typo (9.80665 is "
-                  "standard gravity), or set 'gravity_off_earth: true' for a rig elsewhere",
-                  gravity_mps2, kMinEarthGravityMps2, kMaxEarthGravityMps2);
+    if (CheckIn("gravity_mps2", gravity_mps2, 0, kMaxOffEarthGravityMps2, Ends::kOpenClosed,
+                &f)) {
+      return true;
+    }
+    f.allowed += " (gravity_off_earth: true)";
+    return FailWith(f, why);
   }
-  *why = buffer;
-  return false;
+  if (CheckIn("gravity_mps2", gravity_mps2, kMinEarthGravityMps2, kMaxEarthGravityMps2,
+              Ends::kClosed, &f)) {
+    return true;
+  }
+  f.allowed += ", a gravity found on Earth (from the equator's mountains to the poles); check "
+               "for a typo (9.80665 is standard gravity), or set 'gravity_off_earth: true' for a "
+               "rig elsewhere";
+  return FailWith(f, why);
 }
 
 bool CampaignConfig::Check(std::string* why) const {
