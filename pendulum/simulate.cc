@@ -890,6 +890,11 @@ bool RigTruth::Check(std::string* why) const {
 bool CampaignSpec::Check(std::string* why) const {
   if (!aircraft.Check(why) || !rig.Check(why)) return false;
   CheckFailure f;
+  const auto fail = [&](const std::string& field, double value, const std::string& allowed) {
+    CheckFail(field, value, allowed, &f);
+    return FailWith(f, why);
+  };
+  const std::string kTablePitch = "a pitch of rig.inertia_by_pitch_kg_m2";
   if (!CheckIn("filar_length_m (L)", filar_length_m, 0.0, 1000.0, Ends::kOpenClosed, &f) ||
       !CheckIn("filar_separation_m (D)", filar_separation_m, 0.0, 1000.0, Ends::kOpenClosed, &f) ||
       !CheckIn("gravity_mps2", gravity_mps2, 0.0, 100.0, Ends::kOpenClosed, &f)) {
@@ -915,15 +920,18 @@ bool CampaignSpec::Check(std::string* why) const {
     }
     double unused;
     if (!rig.InertiaAtPitch(tare_pitch_deg, &unused)) {
-      return SetWhy(why, "rig.inertia_by_pitch_kg_m2 has no entry for the tare pitch " +
-                           Fmt("%g", tare_pitch_deg) + " deg (the reference swings' rig pitch)");
+      return fail("tare_pitch_deg", tare_pitch_deg, kTablePitch + " (the reference swings')");
     }
   }
   if (!attitudes_deg.empty()) {
-    if (!pitch_deg.empty()) return SetWhy(why, "give either pitch_deg or attitudes_deg, not both");
+    if (!pitch_deg.empty()) {
+      return fail("pitch_deg (count)", static_cast<double>(pitch_deg.size()),
+                  "0 with attitudes_deg (give either, not both)");
+    }
     if (!aircraft.HasTensor()) {
-      return SetWhy(why, "attitudes_deg (a campaign that rolls) needs the whole tensor: aircraft "
-                       "iy_kg_m2 (and ixy_kg_m2, iyz_kg_m2 when not 0)");
+      return fail("aircraft iy_kg_m2", aircraft.iy_kg_m2,
+                  "given with attitudes_deg: a campaign that rolls needs the whole tensor (and "
+                  "ixy_kg_m2, iyz_kg_m2 when not 0)");
     }
     for (size_t i = 0; i < attitudes_deg.size(); ++i) {
       const std::array<double, 2>& a = attitudes_deg[i];
@@ -933,13 +941,14 @@ bool CampaignSpec::Check(std::string* why) const {
       }
       for (size_t j = 0; j < i; ++j) {
         if (AttitudeFolder(attitudes_deg[j]) == AttitudeFolder(a)) {
-          return SetWhy(why, "attitudes_deg: roll " + Fmt("%g", a[0]) + ", pitch " + Fmt("%g", a[1]) +
-                               " appears twice");
+          CheckFailText("attitudes_deg", "roll " + Fmt("%g", a[0]) + ", pitch " + Fmt("%g", a[1]),
+                        "distinct attitudes (it appears twice)", &f);
+          return FailWith(f, why);
         }
       }
       double unused;
       if (!rig.InertiaAtPitch(a[1], &unused)) {
-        return SetWhy(why, "rig.inertia_by_pitch_kg_m2 has no entry for pitch " + Fmt("%g", a[1]) + " deg");
+        return fail("attitudes_deg pitch", a[1], kTablePitch);
       }
     }
     if (!CheckIn("roll_error_sigma_deg", roll_error_sigma_deg, 0.0, 10.0, Ends::kClosed, &f)) {
@@ -947,23 +956,23 @@ bool CampaignSpec::Check(std::string* why) const {
     }
   }
   if (pitch_deg.empty() && attitudes_deg.empty() && tare_logs == 0) {
-    return SetWhy(why, "pitch_deg: no pitch angles and no tare logs");
+    return fail("pitch_deg (count)", 0, "> 0 (or attitudes_deg, or tare_logs > 0)");
   }
   for (size_t i = 0; i < pitch_deg.size(); ++i) {
     if (!CheckIn("pitch_deg", pitch_deg[i], -90.0, 90.0, Ends::kClosed, &f)) return FailWith(f, why);
     for (size_t j = 0; j < i; ++j) {
       if (FormatPitchDeg(pitch_deg[j]) == FormatPitchDeg(pitch_deg[i])) {
-        return SetWhy(why, "pitch_deg: " + Fmt("%g", pitch_deg[i]) + " appears twice");
+        return fail("pitch_deg", pitch_deg[i], "distinct (it appears twice)");
       }
     }
     double unused;
     if (!rig.InertiaAtPitch(pitch_deg[i], &unused)) {
-      return SetWhy(why, "rig.inertia_by_pitch_kg_m2 has no entry for pitch " + Fmt("%g", pitch_deg[i]) + " deg");
+      return fail("pitch_deg", pitch_deg[i], kTablePitch);
     }
   }
   double unused;
   if (tare_logs > 0 && !rig.InertiaAtPitch(tare_pitch_deg, &unused)) {
-    return SetWhy(why, "rig.inertia_by_pitch_kg_m2 has no entry for the tare pitch " + Fmt("%g", tare_pitch_deg) + " deg");
+    return fail("tare_pitch_deg", tare_pitch_deg, kTablePitch);
   }
   return (CheckIn("trials_per_pitch", trials_per_pitch, 1.0, 1000.0, Ends::kClosed, &f) &&
          CheckIn("tare_logs", tare_logs, 0.0, 1000.0, Ends::kClosed, &f) &&

@@ -226,7 +226,7 @@ TEST(SimulateCampaign, ErrorWritesNothing) {
     RunSimulateCampaign(ParseSimulateSpec(yaml, "table.yaml"), dir.string());
     FAIL() << "expected an error";
   } catch (const UserError& e) {
-    EXPECT_NE(std::string(e.what()).find("no entry for pitch 60"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("pitch_deg = 60; must be a pitch of rig.inertia_by_pitch_kg_m2"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(dir));
 }
