@@ -36,6 +36,9 @@ class Rng {
   std::mt19937_64 engine_;
 };
 
+// An angle (rad) in degrees as a message shows it: 12 digits, so that 120 deg given reads 120.
+double ShownDeg(double rad) { return std::stod(Fmt("%.12g", rad / kRadPerDeg)); }
+
 // A UniformRange [min, max] of `field`: both ends finite, min <= max, min above `lower`.
 bool CheckUniformRange(const UniformRange& r, const std::string& field, double lower,
                        bool lower_open, CheckFailure* f) {
@@ -256,12 +259,12 @@ bool TraceSetup::Check(std::string* why) const {
       (body_from_imu.transpose() * body_from_imu - Eigen::Matrix3d::Identity()).norm();
   const bool ok =
       ((std::isfinite(pitch_rad) && std::abs(pitch_rad) <= kPi / 2 + 1e-9) ||
-       CheckFail("pitch_deg", pitch_rad * kDegPerRad, "in [-90, 90]", &f)) &&
+       CheckFail("pitch_deg", ShownDeg(pitch_rad), "in [-90, 90]", &f)) &&
       ((std::isfinite(roll_rad) && std::abs(roll_rad) <= kPi + 1e-9) ||
-       CheckFail("roll_deg", roll_rad * kDegPerRad, "in [-180, 180]", &f)) &&
+       CheckFail("roll_deg", ShownDeg(roll_rad), "in [-180, 180]", &f)) &&
       ((std::isfinite(amplitude_rad) && amplitude_rad != 0.0 &&
         std::abs(amplitude_rad) < 89 * kRadPerDeg) ||
-       CheckFail("amplitude_deg", amplitude_rad * kDegPerRad, "0 < |amplitude_deg| < 89", &f)) &&
+       CheckFail("amplitude_deg", ShownDeg(amplitude_rad), "0 < |amplitude_deg| < 89", &f)) &&
       // A rotation matrix: orthonormal (to 1e-6), determinant +1.
       CheckLe("|body_from_imu^T body_from_imu - I|", orthogonality, 1e-6, &f) &&
       CheckGt("det(body_from_imu)", body_from_imu.determinant(), 0, &f) &&
