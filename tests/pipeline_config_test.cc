@@ -196,7 +196,7 @@ TEST(Config, MissingSectionsAndBadValues) {
   ExpectError(yaml + "fit: {quality: {max_rms_over_noise: 0.5}}\n", {"fit.quality"});
   ExpectError(yaml + "ellipse: {covariance: magic}\n", {"ellipse.covariance"});
   yaml.replace(yaml.find("mass_kg: 2.0"), 12, "mass_kg: -2.0");
-  ExpectError(yaml, {"'rig.mass_kg' must be > 0", ":4:"});
+  ExpectError(yaml, {"rig.mass_kg = -2; must be > 0", ":4:"});
   ExpectError("rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1,\n"
               "      inertia: {inertia_kg_m2: 0.1, table: {0: 0.1}}}\n"
               "aircraft: {mass_kg: 1}\nruns: {root: ., pattern: '*.csv'}\n",

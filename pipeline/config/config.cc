@@ -42,7 +42,7 @@ std::string ReadText(const std::string& path) { return ReadRegularFileOrThrow(pa
 double Positive(YamlMap& map, const std::string& key) {
   YAML::Node node = map.Required(key);
   const double value = map.AsDouble(node, key);
-  if (!(value > 0.0)) throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be > 0");
+  if (!(value > 0.0)) throw UserError(map.Where(node) + ": " + CheckMessage(map.KeyPath(key), value, "> 0"));
   return value;
 }
 
@@ -50,7 +50,7 @@ double NonNegative(YamlMap& map, const std::string& key, double fallback) {
   YAML::Node node = map.Optional(key);
   if (!map.Given(node, key, "a number >= 0")) return fallback;
   const double value = map.AsDouble(node, key);
-  if (value < 0.0) throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be >= 0");
+  if (value < 0.0) throw UserError(map.Where(node) + ": " + CheckMessage(map.KeyPath(key), value, ">= 0"));
   return value;
 }
 
@@ -92,7 +92,8 @@ void ReadLogContainer(YamlMap& imu, ImuFormat* format) {
   const YAML::Node multi = ulog.Optional("multi_id");
   sel.multi_id = ulog.OptionalInt("multi_id", 0);
   if (sel.multi_id < 0 || sel.multi_id > 255) {
-    throw UserError(ulog.Where(multi) + ": 'imu.ulog.multi_id' must be in [0, 255]");
+    throw UserError(ulog.Where(multi) + ": " +
+                    CheckMessage("imu.ulog.multi_id", sel.multi_id, "in [0, 255]"));
   }
   sel.time_field = ulog.OptionalString("time_field", sel.time_field);
   if (ulog.Has("gyro_fields")) {
@@ -257,14 +258,19 @@ void ReadRigCalibration(YamlMap cal, const std::string& folder, RigCalibrationSp
   const YAML::Node std_node = cal.Required("reference_inertia_std_kg_m2");
   out->reference_inertia_std_kg_m2 = NonNegative(cal, "reference_inertia_std_kg_m2", 0.0);
   if (!(out->reference_inertia_std_kg_m2 < out->reference_inertia_kg_m2)) {
-    throw UserError(cal.Where(std_node) + ": '" + cal.KeyPath("reference_inertia_std_kg_m2") +
-                    "' must be below reference_inertia_kg_m2 (the quantity it qualifies)");
+    throw UserError(cal.Where(std_node) + ": " +
+                    CheckMessage(cal.KeyPath("reference_inertia_std_kg_m2"),
+                                 out->reference_inertia_std_kg_m2,
+                                 "< reference_inertia_kg_m2 = " +
+                                     FormatCheckValue(out->reference_inertia_kg_m2) +
+                                     " (the quantity it qualifies)"));
   }
   out->reference_mass_kg = Positive(cal, "reference_mass_kg");
   out->rig_pitch_deg = cal.OptionalDouble("rig_pitch_deg", 0.0);
   if (!(std::abs(out->rig_pitch_deg) <= 180.0)) {
-    throw UserError(cal.Where(cal.Optional("rig_pitch_deg")) + ": '" +
-                    cal.KeyPath("rig_pitch_deg") + "' must be in [-180, 180] deg");
+    throw UserError(cal.Where(cal.Optional("rig_pitch_deg")) + ": " +
+                    CheckMessage(cal.KeyPath("rig_pitch_deg"), out->rig_pitch_deg,
+                                 "in [-180, 180]"));
   }
   cal.Finish();
 }
@@ -281,7 +287,8 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
     YAML::Node value = inertia.Required("inertia_kg_m2");  // blank or ~: an error, never 0
     out->inertia_kg_m2 = inertia.AsDouble(value, "inertia_kg_m2");
     if (out->inertia_kg_m2 < 0.0) {
-      throw UserError(inertia.Where(value) + ": 'rig.inertia.inertia_kg_m2' must be >= 0");
+      throw UserError(inertia.Where(value) + ": " +
+                      CheckMessage("rig.inertia.inertia_kg_m2", out->inertia_kg_m2, ">= 0"));
     }
   } else if (inertia.Has("table")) {
     out->kind = RigInertiaSpec::Kind::kTable;
@@ -294,7 +301,11 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
     for (const auto& item : table) {
       const double pitch = inertia.AsDouble(item.first, "table");
       const double value = inertia.AsDouble(item.second, "table");
-      if (value < 0.0) throw UserError(inertia.Where(item.second) + ": rig inertia must be >= 0");
+      if (value < 0.0) {
+        throw UserError(inertia.Where(item.second) + ": " +
+                        CheckMessage("rig.inertia.table (pitch " + FormatCheckValue(pitch) + " deg)",
+                                     value, ">= 0"));
+      }
       auto [it, inserted] = first_key.emplace(pitch, item.first);
       if (!inserted) {
         throw UserError(inertia.Where(item.first) + ": 'rig.inertia.table' gives pitch " +
@@ -384,10 +395,9 @@ bool CampaignConfig::Check(std::string* why) const {
     const RigCalibrationSpec& c = calibration;
     const bool ok =
         (!c.log_patterns.empty() ||
-         CheckFail("rig.calibration.logs", 0, "a list of at least one file", &f)) &&
-        CheckFiniteGt("rig.calibration.reference_inertia_kg_m2", c.reference_inertia_kg_m2, 0,
-                      &f) &&
-        CheckFiniteGt("rig.calibration.reference_mass_kg", c.reference_mass_kg, 0, &f) &&
+         CheckFail("rig.calibration.logs (files)", 0, "a list of at least one file", &f)) &&
+        CheckGt("rig.calibration.reference_inertia_kg_m2", c.reference_inertia_kg_m2, 0, &f) &&
+        CheckGt("rig.calibration.reference_mass_kg", c.reference_mass_kg, 0, &f) &&
         CheckGe("rig.calibration.reference_inertia_std_kg_m2", c.reference_inertia_std_kg_m2, 0,
                 &f) &&
         CheckLt("rig.calibration.reference_inertia_std_kg_m2", c.reference_inertia_std_kg_m2,
@@ -804,8 +814,9 @@ void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& o
   if (tolerance.IsDefined() && !tolerance.IsNull()) {
     r.attitude_tolerance_deg = runs.AsDouble(tolerance, "attitude_tolerance_deg");
     if (!(r.attitude_tolerance_deg > 0.0 && r.attitude_tolerance_deg <= 180.0)) {
-      throw UserError(runs.Where(tolerance) +
-                      ": 'runs.attitude_tolerance_deg' must be in (0, 180] deg");
+      throw UserError(runs.Where(tolerance) + ": " +
+                      CheckMessage("runs.attitude_tolerance_deg", r.attitude_tolerance_deg,
+                                   "in (0, 180]"));
     }
   }
   if (r.pitch_source == PitchSource::kMeasured && !config->imu.format.has_accel()) {
