@@ -51,7 +51,9 @@ bool CheckFailText(const std::string& field, const std::string& value, const std
 
 namespace {
 
-std::string OpBoundText(const char* op, double bound) { return std::string(op) + FormatCheckValue(bound); }
+std::string OpBoundText(const char* op, double bound) {
+  return std::string(op) + FormatCheckValue(bound);
+}
 
 std::string OpFieldText(const char* op, const std::string& bound_field, double bound) {
   return op + bound_field + " = " + FormatCheckValue(bound);

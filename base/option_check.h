@@ -23,7 +23,7 @@ struct CheckFailure {
   std::string allowed;  // the bound, e.g. "in [1, 1000]", "> min_period_s = 2"
   // When the value is not a number (a name, a path, a choice): shown quoted instead of `value`.
   std::string value_text = std::string();
-  bool text = false;    // value_text is the value
+  bool text = false;  // value_text is the value
 
   // "<field> = <value>; must be <allowed>".
   std::string Message() const;

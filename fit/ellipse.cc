@@ -309,11 +309,12 @@ std::string EllipseCovarianceAllowedValues() {
 bool EllipseOptions::Check(std::string* why) const {
   CheckFailure f;
   const bool ok =
-      (bootstrap_replicates == 0 || (bootstrap_replicates >= kMinBootstrapReplicates &&
-                                     bootstrap_replicates <= kMaxBootstrapReplicates) ||
+      (bootstrap_replicates == 0 ||
+       (bootstrap_replicates >= kMinBootstrapReplicates &&
+        bootstrap_replicates <= kMaxBootstrapReplicates) ||
        CheckFail("bootstrap_replicates", bootstrap_replicates,
-                 "0 (off) or in " + IntervalText(kMinBootstrapReplicates,
-                                                 kMaxBootstrapReplicates, Ends::kClosed),
+                 "0 (off) or in " +
+                     IntervalText(kMinBootstrapReplicates, kMaxBootstrapReplicates, Ends::kClosed),
                  &f)) &&
       CheckIn("confidence", confidence, 0, 1, Ends::kOpen, &f) &&
       CheckIn("angle_group_tol_deg", angle_group_tol_deg, 0, 45, Ends::kClosedOpen, &f) &&

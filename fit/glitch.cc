@@ -34,11 +34,11 @@ void Neighbours(size_t k, size_t m, size_t n, size_t idx[4]) {
 
 bool GlitchOptions::Check(std::string* why) const {
   CheckFailure f;
-  const bool ok = CheckFiniteGe("threshold_sigmas (0 disables the search)", threshold_sigmas, 0,
-                                &f) &&
-                  CheckFiniteGe("range_factor", range_factor, 0, &f) &&
-                  CheckFiniteGe("excursion_fraction", excursion_fraction, 0, &f) &&
-                  CheckIn("max_fraction", max_fraction, 0, 1, Ends::kOpenClosed, &f);
+  const bool ok =
+      CheckFiniteGe("threshold_sigmas (0 disables the search)", threshold_sigmas, 0, &f) &&
+      CheckFiniteGe("range_factor", range_factor, 0, &f) &&
+      CheckFiniteGe("excursion_fraction", excursion_fraction, 0, &f) &&
+      CheckIn("max_fraction", max_fraction, 0, 1, Ends::kOpenClosed, &f);
   return ok || FailWith(f, why, "glitch: ");
 }
 

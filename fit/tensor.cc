@@ -133,7 +133,8 @@ bool PrepareTensorData(const std::vector<TensorPoint>& points, const TensorOptio
       return false;
     }
     if (p.std_kg_m2 < 0.0 || std::isinf(p.std_kg_m2) || (p.std_kg_m2 > 0 && p.std_kg_m2 < 1e-100)) {
-      *why = where + "std must be >= 0 and finite (0 or NaN = unknown), got " + Fmt("%g", p.std_kg_m2);
+      *why =
+          where + "std must be >= 0 and finite (0 or NaN = unknown), got " + Fmt("%g", p.std_kg_m2);
       return false;
     }
     if (p.std_kg_m2 > 0.0) ++n_std;
@@ -566,7 +567,8 @@ void CompareWithClosedForm(const Solution& closed, const Solution& solved, Tenso
   }
   if (r.closed_form_max_relative_difference > 1e-6) {
     r.warnings.push_back("Ceres and the closed form disagree by " +
-                         Fmt("%g", r.closed_form_max_relative_difference) + " of the largest moment");
+                         Fmt("%g", r.closed_form_max_relative_difference) +
+                         " of the largest moment");
   }
 }
 
@@ -636,7 +638,8 @@ void FillPrincipal(const Solution& solved, const Covariance& cov,
   r.warnings.insert(r.warnings.end(), p.warnings.begin(), p.warnings.end());
   if (r.condition_number > 100) {
     r.warnings.push_back("the swing axes are nearly degenerate (design condition number " +
-                         Fmt("%g", r.condition_number) + "): some components are poorly determined");
+                         Fmt("%g", r.condition_number) +
+                         "): some components are poorly determined");
   }
 }
 

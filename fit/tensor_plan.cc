@@ -230,9 +230,11 @@ bool ScaledVariances(const TensorPlanOptions& options, const std::vector<Stds>& 
   *scale_out = scale;
   // Below 1e-300 kg m^2 the stds themselves (about the per-swing std) would be subnormal or 0.
   if (!(scale >= 1e-300) || !std::isfinite(scale)) {
-    *error = "the per-swing std (absolute " + Fmt("%g", options.sigma_kg_m2) + " kg m^2, relative " +
-             Fmt("%g", options.sigma_relative) + ") gives no std of a moment in [1e-300, 1e100] "
-             "kg m^2 (largest " + Fmt("%g", scale) + "): too small to compute with";
+    *error = "the per-swing std (absolute " + Fmt("%g", options.sigma_kg_m2) +
+             " kg m^2, relative " + Fmt("%g", options.sigma_relative) +
+             ") gives no std of a moment in [1e-300, 1e100] "
+             "kg m^2 (largest " +
+             Fmt("%g", scale) + "): too small to compute with";
     return false;
   }
   for (size_t i = 0; i < cand->size(); ++i) {

@@ -397,20 +397,20 @@ const char* ToString(WindowEnd end) {
 
 bool WindowOptions::Check(std::string* why) const {
   CheckFailure f;
-  const bool ok =
-      CheckGt("min_period_s", min_period_s, 0, &f) &&
-      CheckGt("max_period_s", max_period_s, "min_period_s", min_period_s, &f) &&
-      CheckGt("rest_block_s", rest_block_s, 0, &f) && CheckGt("min_rest_s", min_rest_s, 0, &f) &&
-      CheckGt("hysteresis_sigmas", hysteresis_sigmas, 0, &f) &&
-      CheckIn("half_period_tolerance", half_period_tolerance, 0, 1, Ends::kOpen, &f) &&
-      CheckGe("growth_tolerance", growth_tolerance, 0, &f) &&
-      CheckIn("stop_drop_factor", stop_drop_factor, 0, 1, Ends::kOpen, &f) &&
-      CheckGt("noise_floor_sigmas", noise_floor_sigmas, 0, &f) &&
-      CheckGe("start_delay_periods", start_delay_periods, 0, &f) &&
-      CheckGe("end_margin_periods", end_margin_periods, 0, &f) &&
-      CheckGt("min_periods", min_periods, 0, &f) &&
-      CheckIn("blip_fraction", blip_fraction, 0, 0.5, Ends::kClosedOpen, &f) &&
-      CheckGt("max_gap_periods", max_gap_periods, 0, &f);
+  const bool ok = CheckGt("min_period_s", min_period_s, 0, &f) &&
+                  CheckGt("max_period_s", max_period_s, "min_period_s", min_period_s, &f) &&
+                  CheckGt("rest_block_s", rest_block_s, 0, &f) &&
+                  CheckGt("min_rest_s", min_rest_s, 0, &f) &&
+                  CheckGt("hysteresis_sigmas", hysteresis_sigmas, 0, &f) &&
+                  CheckIn("half_period_tolerance", half_period_tolerance, 0, 1, Ends::kOpen, &f) &&
+                  CheckGe("growth_tolerance", growth_tolerance, 0, &f) &&
+                  CheckIn("stop_drop_factor", stop_drop_factor, 0, 1, Ends::kOpen, &f) &&
+                  CheckGt("noise_floor_sigmas", noise_floor_sigmas, 0, &f) &&
+                  CheckGe("start_delay_periods", start_delay_periods, 0, &f) &&
+                  CheckGe("end_margin_periods", end_margin_periods, 0, &f) &&
+                  CheckGt("min_periods", min_periods, 0, &f) &&
+                  CheckIn("blip_fraction", blip_fraction, 0, 0.5, Ends::kClosedOpen, &f) &&
+                  CheckGt("max_gap_periods", max_gap_periods, 0, &f);
   return ok || FailWith(f, why, "window: ");
 }
 
@@ -824,10 +824,10 @@ std::vector<AngleExtreme> AngleExtremes(const std::vector<double>& t, const std:
 
 bool AmplitudeBandOptions::Check(std::string* why) const {
   CheckFailure f;
-  const bool ok = CheckGe("min_amplitude_deg", min_amplitude_deg, 0, &f) &&
-                  CheckGt("max_amplitude_deg", max_amplitude_deg, "min_amplitude_deg",
-                          min_amplitude_deg, &f) &&
-                  CheckGt("min_periods", min_periods, 0, &f);
+  const bool ok =
+      CheckGe("min_amplitude_deg", min_amplitude_deg, 0, &f) &&
+      CheckGt("max_amplitude_deg", max_amplitude_deg, "min_amplitude_deg", min_amplitude_deg, &f) &&
+      CheckGt("min_periods", min_periods, 0, &f);
   return ok || FailWith(f, why, "amplitude band: ");
 }
 

@@ -102,10 +102,10 @@ bool CheckSeparationBelowLength(double filar_length_m, double filar_separation_m
                                 std::string* why) {
   if (filar_separation_m < filar_length_m) return true;
   CheckFailure f;
-  CheckFail("filar_separation_m (D)", filar_separation_m,
-            "< filar_length_m (L) = " + FormatCheckValue(filar_length_m) +
-                " (the wires would go slack)",
-            &f);
+  CheckFail(
+      "filar_separation_m (D)", filar_separation_m,
+      "< filar_length_m (L) = " + FormatCheckValue(filar_length_m) + " (the wires would go slack)",
+      &f);
   return FailWith(f, why);
 }
 

@@ -106,7 +106,8 @@ bool IntegrateRk4(const TruthDynamics& dyn, double angle0, double rate0,
       v += h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
     }
     now = t[k];
-    if (!std::isfinite(x) || !std::isfinite(v)) return SetWhy(why, "truth integration (RK4) diverged");
+    if (!std::isfinite(x) || !std::isfinite(v))
+      return SetWhy(why, "truth integration (RK4) diverged");
     (*angle)[k] = x;
     (*rate)[k] = v;
   }
@@ -203,8 +204,8 @@ bool SensorOptions::Check(std::string* why) const {
       CheckIn("sensor.drop_fraction", drop_fraction, 0.0, 0.5, Ends::kClosed, &f) &&
       CheckIn("sensor.drop_burst_probability", drop_burst_probability, 0.0, 1.0, Ends::kClosed,
               &f) &&
-      CheckIn("sensor.drop_burst_max_samples", drop_burst_max_samples, 2.0, 100000.0,
-              Ends::kClosed, &f) &&
+      CheckIn("sensor.drop_burst_max_samples", drop_burst_max_samples, 2.0, 100000.0, Ends::kClosed,
+              &f) &&
       CheckUniformRange(start_time_s, "sensor.start_time_s", -1e9, false, &f) &&
       CheckIn("sensor.start_time_s.max", start_time_s.max, -1e9, 1e9, Ends::kClosed, &f) &&
       CheckIn("sensor.gyro_noise_sigma_deg_per_s", gyro_noise_sigma_deg_per_s, 0.0, 100.0,
@@ -243,8 +244,7 @@ bool TraceSetup::Check(std::string* why) const {
   CheckFailure f;
   const bool in_range =
       CheckIn("filar_length_m (L)", g.filar_length_m, 0.0, 1000.0, Ends::kOpenClosed, &f) &&
-      CheckIn("filar_separation_m (D)", g.filar_separation_m, 0.0, 1000.0, Ends::kOpenClosed,
-              &f) &&
+      CheckIn("filar_separation_m (D)", g.filar_separation_m, 0.0, 1000.0, Ends::kOpenClosed, &f) &&
       CheckIn("mass_kg (whole suspended mass)", g.mass_kg, 0.0, 1e6, Ends::kOpenClosed, &f) &&
       CheckIn("gravity_mps2", g.gravity_mps2, 0.0, 100.0, Ends::kOpenClosed, &f) &&
       CheckIn("inertia_kg_m2 (whole suspended inertia)", params.inertia_kg_m2, 0.0, 1e9,
@@ -362,11 +362,11 @@ bool MakeTimeline(const RandomInputs& in, const SimulationOptions& options, Time
                    : std::floor((tm.t_end - in.start_time) * so.sample_rate_hz) + 1.0;
   if (tm.samples_real > 5e7) {
     return SetWhy(why, "log too long: up to " + Fmt("%g", tm.samples_real) + " samples (" +
-                         Fmt("%g", tm.t_end - in.start_time) + " s at " +
-                         (tm.lognormal ? "steps down to " + Fmt("%g", so.step_range_s.min) + " s"
-                                       : Fmt("%g", so.sample_rate_hz) + " Hz") +
-                         "); the limit is 5e7: shorten timeline.free_s or lower "
-                         "sensor.sample_rate_hz");
+                           Fmt("%g", tm.t_end - in.start_time) + " s at " +
+                           (tm.lognormal ? "steps down to " + Fmt("%g", so.step_range_s.min) + " s"
+                                         : Fmt("%g", so.sample_rate_hz) + " Hz") +
+                           "); the limit is 5e7: shorten timeline.free_s or lower "
+                           "sensor.sample_rate_hz");
   }
   return true;
 }
@@ -491,11 +491,12 @@ bool AddTruthDiscrepancies(const TraceSetup& setup, const SimulationOptions& opt
     const double amplitude = setup.amplitude_rad;
     const double weakening = dyn.soft_k * std::pow(std::abs(amplitude), dyn.soft_p);
     if (weakening > 0.5) {
-      return SetWhy(why, "swing.softening_percent_at_30deg = " + Fmt("%g", 100 * options.softening_at_30deg) +
-                           " with swing.softening_exponent = " + Fmt("%g", dyn.soft_p) + " removes " +
-                           Fmt("%g", 100 * weakening) + " % of the restoring torque at the amplitude " +
-                           Fmt("%g", std::abs(amplitude) / kRadPerDeg) +
-                           " deg (at most 50 % allowed); lower the softening or the amplitude");
+      return SetWhy(
+          why, "swing.softening_percent_at_30deg = " + Fmt("%g", 100 * options.softening_at_30deg) +
+                   " with swing.softening_exponent = " + Fmt("%g", dyn.soft_p) + " removes " +
+                   Fmt("%g", 100 * weakening) + " % of the restoring torque at the amplitude " +
+                   Fmt("%g", std::abs(amplitude) / kRadPerDeg) +
+                   " deg (at most 50 % allowed); lower the softening or the amplitude");
     }
   }
   return true;
@@ -690,8 +691,8 @@ bool AddSpikes(const SensorOptions& so, uint64_t seed, const SwingFrame& f,
   const size_t n = times.size();
   if (static_cast<size_t>(so.spike_count) * 2 > n) {
     return SetWhy(why, "sensor.spike_count = " + std::to_string(so.spike_count) +
-                         " is more than half the log's " + std::to_string(n) +
-                         " samples; lower it");
+                           " is more than half the log's " + std::to_string(n) +
+                           " samples; lower it");
   }
   TraceTruth& truth = out->truth;
   Rng spike_rng(DeriveSeed(seed, "spikes"));
@@ -836,8 +837,10 @@ bool AircraftTruth::Check(std::string* why) const {
     // inequality of the principal moments (else no rigid body has the tensor).
     if (!CheckGt("aircraft smallest principal moment (products of inertia too large)", m(0), 0,
                  &f) ||
-        !CheckLe("aircraft largest principal moment", m(2), "the sum of the other two (triangle "
-                 "inequality)", m(0) + m(1), &f)) {
+        !CheckLe("aircraft largest principal moment", m(2),
+                 "the sum of the other two (triangle "
+                 "inequality)",
+                 m(0) + m(1), &f)) {
       return FailWith(f, why);
     }
   } else if (ixy_kg_m2 != 0.0 || iyz_kg_m2 != 0.0) {
@@ -879,10 +882,12 @@ bool RigTruth::Check(std::string* why) const {
     return FailWith(f, why);
   }
   if (inertia_by_pitch_kg_m2.empty()) {
-    if (!CheckIn("rig.inertia_kg_m2", inertia_kg_m2, 0.0, 1e9, Ends::kOpenClosed, &f)) return FailWith(f, why);
+    if (!CheckIn("rig.inertia_kg_m2", inertia_kg_m2, 0.0, 1e9, Ends::kOpenClosed, &f))
+      return FailWith(f, why);
   } else {
     for (const auto& entry : inertia_by_pitch_kg_m2) {
-      if (!CheckIn("rig.inertia_by_pitch_kg_m2 at " + Fmt("%g", entry.first) + " deg", entry.second, 0.0, 1e9, Ends::kOpenClosed, &f)) {
+      if (!CheckIn("rig.inertia_by_pitch_kg_m2 at " + Fmt("%g", entry.first) + " deg", entry.second,
+                   0.0, 1e9, Ends::kOpenClosed, &f)) {
         return FailWith(f, why);
       }
     }
@@ -912,13 +917,17 @@ bool CampaignSpec::Check(std::string* why) const {
     return FailWith(f, why);
   }
   if (calibration_logs > 0) {
-    if (!CheckIn("calibration.reference_inertia_kg_m2", reference_inertia_kg_m2, 0.0, 1e9, Ends::kOpenClosed, &f) ||
-        !CheckIn("calibration.reference_mass_kg", reference_mass_kg, 0.0, 1e6, Ends::kOpenClosed, &f)) {
+    if (!CheckIn("calibration.reference_inertia_kg_m2", reference_inertia_kg_m2, 0.0, 1e9,
+                 Ends::kOpenClosed, &f) ||
+        !CheckIn("calibration.reference_mass_kg", reference_mass_kg, 0.0, 1e6, Ends::kOpenClosed,
+                 &f)) {
       return FailWith(f, why);
     }
     if (calibration_amplitude_deg.max > 0.0 &&
-        (!CheckUniformRange(calibration_amplitude_deg, "calibration.amplitude_deg", 0.0, true, &f) ||
-         !CheckIn("calibration.amplitude_deg.max", calibration_amplitude_deg.max, 0.0, 75.0, Ends::kOpenClosed, &f))) {
+        (!CheckUniformRange(calibration_amplitude_deg, "calibration.amplitude_deg", 0.0, true,
+                            &f) ||
+         !CheckIn("calibration.amplitude_deg.max", calibration_amplitude_deg.max, 0.0, 75.0,
+                  Ends::kOpenClosed, &f))) {
       return FailWith(f, why);
     }
     double unused;
@@ -962,7 +971,8 @@ bool CampaignSpec::Check(std::string* why) const {
     return fail("pitch_deg (count)", 0, "> 0 (or attitudes_deg, or tare_logs > 0)");
   }
   for (size_t i = 0; i < pitch_deg.size(); ++i) {
-    if (!CheckIn("pitch_deg", pitch_deg[i], -90.0, 90.0, Ends::kClosed, &f)) return FailWith(f, why);
+    if (!CheckIn("pitch_deg", pitch_deg[i], -90.0, 90.0, Ends::kClosed, &f))
+      return FailWith(f, why);
     for (size_t j = 0; j < i; ++j) {
       if (FormatPitchDeg(pitch_deg[j]) == FormatPitchDeg(pitch_deg[i])) {
         return fail("pitch_deg", pitch_deg[i], "distinct (it appears twice)");
@@ -978,15 +988,16 @@ bool CampaignSpec::Check(std::string* why) const {
     return fail("tare_pitch_deg", tare_pitch_deg, kTablePitch);
   }
   return (CheckIn("trials_per_pitch", trials_per_pitch, 1.0, 1000.0, Ends::kClosed, &f) &&
-         CheckIn("tare_logs", tare_logs, 0.0, 1000.0, Ends::kClosed, &f) &&
-         CheckIn("calibration.logs", calibration_logs, 0.0, 1000.0, Ends::kClosed, &f) &&
-         CheckIn("tare_pitch_deg", tare_pitch_deg, -90.0, 90.0, Ends::kClosed, &f) &&
-         CheckIn("pitch_error_sigma_deg", pitch_error_sigma_deg, 0.0, 10.0, Ends::kClosed, &f) &&
-         CheckUniformRange(amplitude_deg, "amplitude_deg", 0.0, true, &f) &&
-         CheckIn("amplitude_deg.max", amplitude_deg.max, 0.0, 85.0, Ends::kOpenClosed, &f) &&
-         CheckUniformRange(drag_coeff_kg_m2, "drag_coeff_kg_m2", 0.0, false, &f) &&
-         CheckUniformRange(viscous_coeff_kg_m2_per_s, "viscous_coeff_kg_m2_per_s", 0.0, false, &f) &&
-         CheckIn("rig.tare_damping_scale", tare_damping_scale, 0.0, 1.0, Ends::kClosed, &f)) ||
+          CheckIn("tare_logs", tare_logs, 0.0, 1000.0, Ends::kClosed, &f) &&
+          CheckIn("calibration.logs", calibration_logs, 0.0, 1000.0, Ends::kClosed, &f) &&
+          CheckIn("tare_pitch_deg", tare_pitch_deg, -90.0, 90.0, Ends::kClosed, &f) &&
+          CheckIn("pitch_error_sigma_deg", pitch_error_sigma_deg, 0.0, 10.0, Ends::kClosed, &f) &&
+          CheckUniformRange(amplitude_deg, "amplitude_deg", 0.0, true, &f) &&
+          CheckIn("amplitude_deg.max", amplitude_deg.max, 0.0, 85.0, Ends::kOpenClosed, &f) &&
+          CheckUniformRange(drag_coeff_kg_m2, "drag_coeff_kg_m2", 0.0, false, &f) &&
+          CheckUniformRange(viscous_coeff_kg_m2_per_s, "viscous_coeff_kg_m2_per_s", 0.0, false,
+                            &f) &&
+          CheckIn("rig.tare_damping_scale", tare_damping_scale, 0.0, 1.0, Ends::kClosed, &f)) ||
          FailWith(f, why);
 }
 

@@ -1,7 +1,6 @@
 #include "pipeline/commands/simulate_spec.h"
 
 #include <Eigen/Eigenvalues>
-
 #include <cmath>
 #include <limits>
 #include <cstdio>
@@ -57,8 +56,9 @@ double ReadValue(YamlMap& map, const std::string& key, double fallback, double l
   const double value = map.AsDouble(node, key);
   const bool ok = (lower_open ? value > lower : value >= lower) && value <= upper;
   if (!ok) {
-    throw UserError(map.Where(node) + ": " +
-                    CheckMessage(map.KeyPath(key), value, "in " + RangeText(lower, lower_open, upper)));
+    throw UserError(
+        map.Where(node) + ": " +
+        CheckMessage(map.KeyPath(key), value, "in " + RangeText(lower, lower_open, upper)));
   }
   return value;
 }
@@ -90,9 +90,9 @@ UniformRange ReadRange(YamlMap& map, const std::string& key, UniformRange fallba
   }
   const bool ok = (lower_open ? r.min > lower : r.min >= lower) && r.max <= upper && r.min <= r.max;
   if (!ok) {
-    throw UserError(map.Where(node) + ": " + map.KeyPath(key) + " = [" +
-                    FormatCheckValue(r.min) + ", " + FormatCheckValue(r.max) +
-                    "]; must be min <= max, both in " + RangeText(lower, lower_open, upper));
+    throw UserError(map.Where(node) + ": " + map.KeyPath(key) + " = [" + FormatCheckValue(r.min) +
+                    ", " + FormatCheckValue(r.max) + "]; must be min <= max, both in " +
+                    RangeText(lower, lower_open, upper));
   }
   return r;
 }

@@ -42,7 +42,9 @@ std::string ReadText(const std::string& path) { return ReadRegularFileOrThrow(pa
 double Positive(YamlMap& map, const std::string& key) {
   YAML::Node node = map.Required(key);
   const double value = map.AsDouble(node, key);
-  if (!(value > 0.0)) throw UserError(map.Where(node) + ": " + CheckMessage(map.KeyPath(key), value, "> 0"));
+  if (!(value > 0.0)) {
+    throw UserError(map.Where(node) + ": " + CheckMessage(map.KeyPath(key), value, "> 0"));
+  }
   return value;
 }
 
@@ -50,7 +52,9 @@ double NonNegative(YamlMap& map, const std::string& key, double fallback) {
   YAML::Node node = map.Optional(key);
   if (!map.Given(node, key, "a number >= 0")) return fallback;
   const double value = map.AsDouble(node, key);
-  if (value < 0.0) throw UserError(map.Where(node) + ": " + CheckMessage(map.KeyPath(key), value, ">= 0"));
+  if (value < 0.0) {
+    throw UserError(map.Where(node) + ": " + CheckMessage(map.KeyPath(key), value, ">= 0"));
+  }
   return value;
 }
 
@@ -258,19 +262,19 @@ void ReadRigCalibration(YamlMap cal, const std::string& folder, RigCalibrationSp
   const YAML::Node std_node = cal.Required("reference_inertia_std_kg_m2");
   out->reference_inertia_std_kg_m2 = NonNegative(cal, "reference_inertia_std_kg_m2", 0.0);
   if (!(out->reference_inertia_std_kg_m2 < out->reference_inertia_kg_m2)) {
-    throw UserError(cal.Where(std_node) + ": " +
-                    CheckMessage(cal.KeyPath("reference_inertia_std_kg_m2"),
-                                 out->reference_inertia_std_kg_m2,
-                                 "< reference_inertia_kg_m2 = " +
-                                     FormatCheckValue(out->reference_inertia_kg_m2) +
-                                     " (the quantity it qualifies)"));
+    throw UserError(
+        cal.Where(std_node) + ": " +
+        CheckMessage(
+            cal.KeyPath("reference_inertia_std_kg_m2"), out->reference_inertia_std_kg_m2,
+            "< reference_inertia_kg_m2 = " + FormatCheckValue(out->reference_inertia_kg_m2) +
+                " (the quantity it qualifies)"));
   }
   out->reference_mass_kg = Positive(cal, "reference_mass_kg");
   out->rig_pitch_deg = cal.OptionalDouble("rig_pitch_deg", 0.0);
   if (!(std::abs(out->rig_pitch_deg) <= 180.0)) {
-    throw UserError(cal.Where(cal.Optional("rig_pitch_deg")) + ": " +
-                    CheckMessage(cal.KeyPath("rig_pitch_deg"), out->rig_pitch_deg,
-                                 "in [-180, 180]"));
+    throw UserError(
+        cal.Where(cal.Optional("rig_pitch_deg")) + ": " +
+        CheckMessage(cal.KeyPath("rig_pitch_deg"), out->rig_pitch_deg, "in [-180, 180]"));
   }
   cal.Finish();
 }
@@ -302,9 +306,10 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
       const double pitch = inertia.AsDouble(item.first, "table");
       const double value = inertia.AsDouble(item.second, "table");
       if (value < 0.0) {
-        throw UserError(inertia.Where(item.second) + ": " +
-                        CheckMessage("rig.inertia.table (pitch " + FormatCheckValue(pitch) + " deg)",
-                                     value, ">= 0"));
+        throw UserError(
+            inertia.Where(item.second) + ": " +
+            CheckMessage("rig.inertia.table (pitch " + FormatCheckValue(pitch) + " deg)", value,
+                         ">= 0"));
       }
       auto [it, inserted] = first_key.emplace(pitch, item.first);
       if (!inserted) {
@@ -371,8 +376,7 @@ RigGeometry CampaignConfig::CalibrationGeometry() const {
 bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why) {
   CheckFailure f;
   if (off_earth) {
-    if (CheckIn("gravity_mps2", gravity_mps2, 0, kMaxOffEarthGravityMps2, Ends::kOpenClosed,
-                &f)) {
+    if (CheckIn("gravity_mps2", gravity_mps2, 0, kMaxOffEarthGravityMps2, Ends::kOpenClosed, &f)) {
       return true;
     }
     f.allowed += " (gravity_off_earth: true)";
@@ -382,9 +386,10 @@ bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why) {
               Ends::kClosed, &f)) {
     return true;
   }
-  f.allowed += ", a gravity found on Earth (from the equator's mountains to the poles); check "
-               "for a typo (9.80665 is standard gravity), or set 'gravity_off_earth: true' for a "
-               "rig elsewhere";
+  f.allowed +=
+      ", a gravity found on Earth (from the equator's mountains to the poles); check "
+      "for a typo (9.80665 is standard gravity), or set 'gravity_off_earth: true' for a "
+      "rig elsewhere";
   return FailWith(f, why);
 }
 
@@ -441,8 +446,9 @@ bool CampaignConfig::Check(std::string* why) const {
   for (const auto& s : stds) {
     // "below 0.5 (the quantity it qualifies)": the bound is the quantity's value.
     if (!CheckGe(s.key, s.std, 0, &f) ||
-        !(s.std < s.of || CheckFail(s.key, s.std, "< " + FormatCheckValue(s.of) +
-                                                      " (the quantity it qualifies)", &f))) {
+        !(s.std < s.of ||
+          CheckFail(s.key, s.std, "< " + FormatCheckValue(s.of) + " (the quantity it qualifies)",
+                    &f))) {
       return FailWith(f, why);
     }
   }
@@ -561,8 +567,8 @@ YAML::Node FailureNode(YamlMap& map, const FieldKey& key) {
 }
 
 bool CheckGlitch(const GlitchConfig& g, CheckFailure* f) {
-  return CheckIn("glitch.threshold_sigmas", g.threshold_sigmas, kMinGlitchSigmas,
-                 kMaxGlitchSigmas, Ends::kClosed, f) &&
+  return CheckIn("glitch.threshold_sigmas", g.threshold_sigmas, kMinGlitchSigmas, kMaxGlitchSigmas,
+                 Ends::kClosed, f) &&
          CheckIn("glitch.range_factor", g.range_factor, kMinGlitchRange, kMaxGlitchRange,
                  Ends::kClosed, f) &&
          CheckIn("glitch.excursion_fraction", g.excursion_fraction, 0, kMaxGlitchExcursion,
@@ -585,8 +591,7 @@ bool CheckQuality(const QualityThresholds& q, CheckFailure* f) {
 }
 
 bool CheckSweep(const SweepConfig& sw, CheckFailure* f) {
-  return CheckIn("sweep.min_cycles_per_band", sw.min_cycles_per_band, 1, 1000, Ends::kClosed,
-                 f) &&
+  return CheckIn("sweep.min_cycles_per_band", sw.min_cycles_per_band, 1, 1000, Ends::kClosed, f) &&
          CheckIn("sweep.max_bands", sw.max_bands, 2, 20, Ends::kClosed, f) &&
          CheckIn("sweep.trend_z", sw.trend_z, 0, 1000, Ends::kOpen, f);
 }
@@ -599,9 +604,9 @@ bool FitConfig::Check(CheckFailure* failure) const {
                                     kMaxMaxAmplitudeDeg, Ends::kClosed, failure)) {
     return false;
   }
-  if (min_amplitude_deg && !(CheckGe("min_amplitude_deg", *min_amplitude_deg, 0, failure) &&
-                             CheckLt("min_amplitude_deg", *min_amplitude_deg, "max_amplitude_deg",
-                                     max_deg, failure))) {
+  if (min_amplitude_deg &&
+      !(CheckGe("min_amplitude_deg", *min_amplitude_deg, 0, failure) &&
+        CheckLt("min_amplitude_deg", *min_amplitude_deg, "max_amplitude_deg", max_deg, failure))) {
     return false;
   }
   return CheckQuality(quality, failure) && CheckSweep(sweep, failure) &&
@@ -814,9 +819,9 @@ void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& o
   if (tolerance.IsDefined() && !tolerance.IsNull()) {
     r.attitude_tolerance_deg = runs.AsDouble(tolerance, "attitude_tolerance_deg");
     if (!(r.attitude_tolerance_deg > 0.0 && r.attitude_tolerance_deg <= 180.0)) {
-      throw UserError(runs.Where(tolerance) + ": " +
-                      CheckMessage("runs.attitude_tolerance_deg", r.attitude_tolerance_deg,
-                                   "in (0, 180]"));
+      throw UserError(
+          runs.Where(tolerance) + ": " +
+          CheckMessage("runs.attitude_tolerance_deg", r.attitude_tolerance_deg, "in (0, 180]"));
     }
   }
   if (r.pitch_source == PitchSource::kMeasured && !config->imu.format.has_accel()) {

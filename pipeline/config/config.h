@@ -195,7 +195,7 @@ struct EllipseConfig {
   int min_angles = 3;             // distinct pitch angles needed to fit the ellipse; [3, 1000]
 
   bool Check(CheckFailure* failure) const;  // the ranges above: the first field outside them
-  bool Check(std::string* why) const;  // *why = "ellipse.<key> = <value>; must be .."
+  bool Check(std::string* why) const;       // *why = "ellipse.<key> = <value>; must be .."
 };
 
 // `limits`: size caps of the logs (MB = 1e6 bytes), README "Input size limits". The other

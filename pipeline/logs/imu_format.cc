@@ -64,12 +64,13 @@ bool ImuFormat::Check(std::string* why) const {
   };
   static const char* const kAxes[3] = {"[0]", "[1]", "[2]"};
   bool ok = add(time_column, "time_column");
-  for (int k = 0; ok && k < 3; ++k) ok = add(gyro_columns[k], std::string("gyro_columns") + kAxes[k]);
+  for (int k = 0; ok && k < 3; ++k)
+    ok = add(gyro_columns[k], std::string("gyro_columns") + kAxes[k]);
   const int accel_named =
       !accel_columns[0].empty() + !accel_columns[1].empty() + !accel_columns[2].empty();
-  ok = ok && (accel_named == 0 || accel_named == 3 ||
-              CheckFail("accel_columns (names given)", accel_named, "0 or 3 (all three or none)",
-                        &f));
+  ok = ok &&
+       (accel_named == 0 || accel_named == 3 ||
+        CheckFail("accel_columns (names given)", accel_named, "0 or 3 (all three or none)", &f));
   for (int k = 0; ok && accel_named == 3 && k < 3; ++k) {
     ok = add(accel_columns[k], std::string("accel_columns") + kAxes[k]);
   }

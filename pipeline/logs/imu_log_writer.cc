@@ -23,10 +23,9 @@ void AppendNumber(double value, int digits, std::string* out) {
 
 bool ImuLogWriteOptions::Check(std::string* why) const {
   CheckFailure f;
-  const bool ok =
-      CheckIn("significant_digits", significant_digits, 6, 17, Ends::kClosed, &f) &&
-      (line_end == "\n" || line_end == "\r\n" ||
-       CheckFailText("line_end", line_end, "\"\\n\" or \"\\r\\n\"", &f));
+  const bool ok = CheckIn("significant_digits", significant_digits, 6, 17, Ends::kClosed, &f) &&
+                  (line_end == "\n" || line_end == "\r\n" ||
+                   CheckFailText("line_end", line_end, "\"\\n\" or \"\\r\\n\"", &f));
   return ok || FailWith(f, why);
 }
 

@@ -265,7 +265,8 @@ bool ParseExportFrame(const std::string& name, ExportFrame* frame) {
 bool ExportOptions::Check(std::string* why) const {
   CheckFailure f;
   bool ok =
-      (!results_path.empty() || CheckFailText("results_path", results_path, "a results.json", &f)) &&
+      (!results_path.empty() ||
+       CheckFailText("results_path", results_path, "a results.json", &f)) &&
       (!frame_given || format == ExportFormat::kUrdf || format == ExportFormat::kSdf ||
        CheckFailText("--frame (with --format)", ExportFormatName(format),
                      "urdf or sdf (--frame applies to urdf and sdf only; the others have a fixed "
