@@ -1,5 +1,7 @@
 #include "base/units.h"
 
+#include "base/enum_names.h"
+
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -9,9 +11,9 @@
 namespace bifilar {
 namespace {
 
-// The one table of display units: name (config `units`, --units), inertia unit, factor to SI.
+// The one table of display units: name (config `units`, --units), inertia unit.
 struct DisplayUnitsRow {
-  DisplayUnits units;
+  DisplayUnits value;
   const char* name;
   const char* inertia_unit;
 };
@@ -22,7 +24,7 @@ constexpr DisplayUnitsRow kDisplayUnitsTable[] = {
 
 const DisplayUnitsRow& RowOf(DisplayUnits units) {
   for (const DisplayUnitsRow& row : kDisplayUnitsTable) {
-    if (row.units == units) return row;
+    if (row.value == units) return row;
   }
   return kDisplayUnitsTable[0];
 }
@@ -32,24 +34,10 @@ const DisplayUnitsRow& RowOf(DisplayUnits units) {
 const char* ToString(DisplayUnits units) { return RowOf(units).name; }
 
 bool ParseDisplayUnits(const std::string& name, DisplayUnits* units) {
-  for (const DisplayUnitsRow& row : kDisplayUnitsTable) {
-    if (name == row.name) {
-      *units = row.units;
-      return true;
-    }
-  }
-  return false;
+  return ParseEnum(kDisplayUnitsTable, name, units);
 }
 
-std::string DisplayUnitsAllowedValues() {
-  std::string text;
-  const size_t n = sizeof(kDisplayUnitsTable) / sizeof(kDisplayUnitsTable[0]);
-  for (size_t i = 0; i < n; ++i) {
-    text += i == 0 ? "" : (i + 1 == n ? " or " : ", ");
-    text += kDisplayUnitsTable[i].name;
-  }
-  return text;
-}
+std::string DisplayUnitsAllowedValues() { return EnumAllowedValues(kDisplayUnitsTable); }
 
 double InertiaToDisplay(double inertia_kg_m2, DisplayUnits units) {
   return units == DisplayUnits::kSi ? inertia_kg_m2 : inertia_kg_m2 * kSlugFt2PerKgM2;

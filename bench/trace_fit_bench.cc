@@ -21,17 +21,7 @@ namespace bifilar {
 namespace {
 
 TraceFitInput Window(double amplitude_deg) {
-  SyntheticTraceOptions o;
-  o.geometry.filar_length_m = 2.0;
-  o.geometry.filar_separation_m = 0.88;
-  o.geometry.mass_kg = 6.0;
-  o.params.inertia_kg_m2 = 1.1616;
-  o.params.drag_coeff_kg_m2 = 0.004;
-  o.params.viscous_coeff_kg_m2_per_s = 0.002;
-  o.amplitude_deg = amplitude_deg;
-  o.duration_s = 60.0;
-  o.sample_rate_hz = 100.0;
-  o.seed = 9;
+  SyntheticTraceOptions o = ExampleRigTraceOptions(amplitude_deg, 9);
   TraceFitInput in;
   if (!MakeSyntheticTrace(o, &in)) std::abort();
   return in;

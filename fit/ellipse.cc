@@ -275,36 +275,22 @@ bool PrepareData(const std::vector<EllipsePoint>& points, const EllipseOptions& 
 // The rest of this file is the public face and the procedure: its steps by their names.
 using namespace ellipse;
 
-// Every mode, in the order of the names table below (config, --covariance, JSON).
-constexpr EllipseCovariance kEllipseCovariances[] = {
-    EllipseCovariance::kAuto, EllipseCovariance::kPointResiduals, EllipseCovariance::kAngleMeans,
-    EllipseCovariance::kAbsolute};
+// The one table of covariance modes (config `ellipse.covariance`, --covariance, JSON).
+constexpr EnumName<EllipseCovariance> kEllipseCovarianceNames[] = {
+    {EllipseCovariance::kAuto, "auto"},
+    {EllipseCovariance::kPointResiduals, "points"},
+    {EllipseCovariance::kAngleMeans, "angle_means"},
+    {EllipseCovariance::kAbsolute, "absolute"}};
 
 const char* EllipseCovarianceName(EllipseCovariance mode) {
-  switch (mode) {
-    case EllipseCovariance::kAuto: return "auto";
-    case EllipseCovariance::kPointResiduals: return "points";
-    case EllipseCovariance::kAngleMeans: return "angle_means";
-    case EllipseCovariance::kAbsolute: return "absolute";
-  }
-  return "?";
+  return EnumToString(kEllipseCovarianceNames, mode, "?");
 }
 
 bool ParseEllipseCovariance(const std::string& name, EllipseCovariance* mode) {
-  for (EllipseCovariance m : kEllipseCovariances) {
-    if (name == EllipseCovarianceName(m)) {
-      *mode = m;
-      return true;
-    }
-  }
-  return false;
+  return ParseEnum(kEllipseCovarianceNames, name, mode);
 }
 
-std::string EllipseCovarianceAllowedValues() {
-  std::vector<std::string> names;
-  for (EllipseCovariance m : kEllipseCovariances) names.push_back(EllipseCovarianceName(m));
-  return JoinAllowedValues(names);
-}
+std::string EllipseCovarianceAllowedValues() { return EnumAllowedValues(kEllipseCovarianceNames); }
 
 bool EllipseOptions::Check(std::string* why) const {
   CheckFailure f;

@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "base/enum_names.h"
 #include "base/option_check.h"
 #include "base/units.h"
 
@@ -92,16 +93,17 @@ Eigen::Vector3d BodySignedAxis(Eigen::Vector3d axis, const Eigen::Matrix3d& imu_
 
 }  // namespace
 
-const char* ToString(SwingAxisMode mode) { return mode == SwingAxisMode::kAuto ? "auto" : "fixed"; }
+constexpr EnumName<SwingAxisMode> kSwingAxisModeNames[] = {{SwingAxisMode::kAuto, "auto"},
+                                                           {SwingAxisMode::kFixed, "fixed"}};
+constexpr EnumName<SwingAxisSource> kSwingAxisSourceNames[] = {
+    {SwingAxisSource::kAccelAtRest, "accel_rest"},
+    {SwingAxisSource::kAccelOverWindow, "accel_window"},
+    {SwingAxisSource::kGyroPrincipal, "gyro_principal"},
+    {SwingAxisSource::kFixed, "fixed"}};
 
+const char* ToString(SwingAxisMode mode) { return EnumToString(kSwingAxisModeNames, mode, "?"); }
 const char* ToString(SwingAxisSource source) {
-  switch (source) {
-    case SwingAxisSource::kAccelAtRest: return "accel_rest";
-    case SwingAxisSource::kAccelOverWindow: return "accel_window";
-    case SwingAxisSource::kGyroPrincipal: return "gyro_principal";
-    case SwingAxisSource::kFixed: return "fixed";
-  }
-  return "?";
+  return EnumToString(kSwingAxisSourceNames, source, "?");
 }
 
 bool SwingAxisOptions::Check(std::string* why) const {

@@ -8,6 +8,19 @@
 
 namespace bifilar {
 
+SyntheticTraceOptions ExampleRigTraceOptions(double amplitude_deg, uint64_t seed) {
+  SyntheticTraceOptions o;
+  o.geometry.filar_length_m = 2.0;
+  o.geometry.filar_separation_m = 0.88;
+  o.geometry.mass_kg = 6.0;
+  o.params.inertia_kg_m2 = 1.1616;
+  o.params.drag_coeff_kg_m2 = 0.004;
+  o.params.viscous_coeff_kg_m2_per_s = 0.002;
+  o.amplitude_deg = amplitude_deg;
+  o.seed = seed;
+  return o;
+}
+
 bool MakeSyntheticTrace(const SyntheticTraceOptions& o, TraceFitInput* input) {
   std::mt19937_64 rng(o.seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);

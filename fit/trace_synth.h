@@ -31,6 +31,11 @@ struct SyntheticTraceOptions {
   uint64_t seed = 1;
 };
 
+// The example rig of docs/physics.md §2 (L 2.0 m, D 0.88 m, m 6 kg; I 1.1616 kg m^2, where
+// m (D/2)^2 / I = 1 and the full model's kinetic term matters; K_D 0.004 kg m^2, C 0.002 kg m^2/s;
+// period ~2.8 s) released at `amplitude_deg`: the tests' and benchmarks' common truth.
+SyntheticTraceOptions ExampleRigTraceOptions(double amplitude_deg, uint64_t seed);
+
 // The window (t_s, rate_rad_per_s, geometry, noise_rad_per_s = the true sigma). The truth is
 // integrated with CVODE at rel_tol 1e-12. Returns false if the integration fails.
 bool MakeSyntheticTrace(const SyntheticTraceOptions& options, TraceFitInput* input);

@@ -79,44 +79,25 @@ struct AugmentedRhs {
 namespace {
 
 // The one table of integrators (Ceres types.h style): config `integrator`, --integrator, JSON.
-struct IntegratorMethodRow {
-  IntegratorMethod method;
-  const char* name;
-};
-constexpr IntegratorMethodRow kIntegratorMethodTable[] = {
+constexpr EnumName<IntegratorMethod> kIntegratorMethodNames[] = {
     {IntegratorMethod::kRungeKutta, "rk853"},
     {IntegratorMethod::kCvodes, "cvodes"},
 };
 
 }  // namespace
 
-const char* ToString(IntegratorMethod method) {
-  for (const IntegratorMethodRow& row : kIntegratorMethodTable) {
-    if (row.method == method) return row.name;
-  }
-  return "unknown";
-}
+const char* ToString(IntegratorMethod method) { return EnumToString(kIntegratorMethodNames, method); }
 
 bool ParseIntegratorMethod(const std::string& name, IntegratorMethod* method) {
-  for (const IntegratorMethodRow& row : kIntegratorMethodTable) {
-    if (name == row.name) {
-      *method = row.method;
-      return true;
-    }
-  }
-  return false;
+  return ParseEnum(kIntegratorMethodNames, name, method);
 }
 
 const std::vector<std::string>& IntegratorMethodNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> out;
-    for (const IntegratorMethodRow& row : kIntegratorMethodTable) out.push_back(row.name);
-    return out;
-  }();
+  static const std::vector<std::string> names = EnumNames(kIntegratorMethodNames);
   return names;
 }
 
-std::string IntegratorMethodAllowedValues() { return JoinAllowedValues(IntegratorMethodNames()); }
+std::string IntegratorMethodAllowedValues() { return EnumAllowedValues(kIntegratorMethodNames); }
 
 bool IntegratorOptions::Check(std::string* why) const {
   CheckFailure f;

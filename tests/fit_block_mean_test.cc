@@ -87,14 +87,7 @@ TEST(BlockMean, PointNoiseIsMeasuredOnTheRestsBlockMeans) {
 // A 2 kHz window (40 k samples, period ~2.8 s): the fit on block means of 5 samples (max_points
 // 5000 here, so the test stays fast) against the fit on every sample and the truth.
 TEST(BlockMean, FitOnBlockMeansMatchesTheFitOnEverySample) {
-  SyntheticTraceOptions truth;
-  truth.geometry.filar_length_m = 2.0;
-  truth.geometry.filar_separation_m = 0.88;
-  truth.geometry.mass_kg = 6.0;
-  truth.params.inertia_kg_m2 = 1.1616;
-  truth.params.drag_coeff_kg_m2 = 0.004;
-  truth.params.viscous_coeff_kg_m2_per_s = 0.002;
-  truth.amplitude_deg = 25.0;
+  SyntheticTraceOptions truth = ExampleRigTraceOptions(25.0, 1);
   truth.duration_s = 20.0;
   truth.sample_rate_hz = 2000.0;
   truth.noise_deg_per_s = 0.5;

@@ -18,18 +18,7 @@ namespace bifilar {
 namespace {
 
 // The docs/physics.md §2 example rig (period ~2.8 s), as in fit_trace_fit_test.cc.
-SyntheticTraceOptions Truth(double amplitude_deg) {
-  SyntheticTraceOptions o;
-  o.geometry.filar_length_m = 2.0;
-  o.geometry.filar_separation_m = 0.88;
-  o.geometry.mass_kg = 6.0;
-  o.params.inertia_kg_m2 = 1.1616;
-  o.params.drag_coeff_kg_m2 = 0.004;
-  o.params.viscous_coeff_kg_m2_per_s = 0.002;
-  o.amplitude_deg = amplitude_deg;
-  o.seed = 7;
-  return o;
-}
+SyntheticTraceOptions Truth(double amplitude_deg) { return ExampleRigTraceOptions(amplitude_deg, 7); }
 
 bool HasFlag(const TraceFitResult& r, const std::string& flag) {
   return std::find(r.flags.begin(), r.flags.end(), flag) != r.flags.end();

@@ -21,25 +21,10 @@
 namespace bifilar {
 namespace {
 
-// The docs/physics.md §2 example rig: D/L = 0.44 and m (D/2)^2 / I = 1 at I = 1.1616 kg m^2, where
-// the full model's kinetic term matters (period ~2.8 s).
-RigGeometry TestRig() {
-  RigGeometry g;
-  g.filar_length_m = 2.0;
-  g.filar_separation_m = 0.88;
-  g.mass_kg = 6.0;
-  return g;
-}
-
+// The docs/physics.md §2 example rig (fit/trace_synth.h): D/L = 0.44 and m (D/2)^2 / I = 1 at
+// I = 1.1616 kg m^2, where the full model's kinetic term matters (period ~2.8 s).
 SyntheticTraceOptions Truth(double amplitude_deg, uint64_t seed) {
-  SyntheticTraceOptions o;
-  o.geometry = TestRig();
-  o.params.inertia_kg_m2 = 1.1616;
-  o.params.drag_coeff_kg_m2 = 0.004;
-  o.params.viscous_coeff_kg_m2_per_s = 0.002;
-  o.amplitude_deg = amplitude_deg;
-  o.seed = seed;
-  return o;
+  return ExampleRigTraceOptions(amplitude_deg, seed);
 }
 
 TraceFitInput Make(const SyntheticTraceOptions& o) {

@@ -32,17 +32,9 @@ struct JacobianCase {
 };
 
 JacobianCase MakeSetup(PendulumModel model, double amplitude_deg, IntegratorMethod method) {
-  SyntheticTraceOptions o;
+  SyntheticTraceOptions o = ExampleRigTraceOptions(amplitude_deg, 3);
   o.model = model;
-  o.geometry.filar_length_m = 2.0;
-  o.geometry.filar_separation_m = 0.88;
-  o.geometry.mass_kg = 6.0;
-  o.params.inertia_kg_m2 = 1.1616;
-  o.params.drag_coeff_kg_m2 = 0.004;
-  o.params.viscous_coeff_kg_m2_per_s = 0.002;
-  o.amplitude_deg = amplitude_deg;
   o.duration_s = 20.0;  // 7 periods: long enough for sensitivities to grow, quick to run
-  o.seed = 3;
   JacobianCase s;
   EXPECT_TRUE(MakeSyntheticTrace(o, &s.input));
   s.integrator.rel_tol = 1e-12;

@@ -90,7 +90,7 @@ TEST(SimulateSpec, BadInputNamesTheKeyAndLine) {
       {base + "sensor: {sample_rate_hz: 0}\n", "sensor.sample_rate_hz = 0; must be in (0, 100000]"},
       {base + "timeline: {free_s: 0}\n", "timeline.free_s = [0, 0]; must be min <= max, both in (0, 86400]"},
       {base + "timeline: {free_s: [50, 40]}\n", "timeline.free_s = [50, 40]; must be min <= max, both in (0, 86400]"},
-      {base + "format: {time_unit: min}\n", "unknown unit 'min' for 'format.time_unit'; allowed s, ms, us"},
+      {base + "format: {time_unit: min}\n", "unknown unit 'min' for 'format.time_unit'; allowed s, ms or us"},
       {base + "format: {gyro_unit: rpm}\n", "unknown unit 'rpm' for 'format.gyro_unit'"},
       {base + "format: {accel_unit: ft/s^2}\n", "unknown unit 'ft/s^2' for 'format.accel_unit'"},
       {base + "model: exact\n", "unknown model 'exact'"},

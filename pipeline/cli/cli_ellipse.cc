@@ -98,7 +98,7 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
       opts->fit.seed = ParseSeed(*seed, "--seed", std::numeric_limits<uint64_t>::max());
     }
     if (!ParseEllipseCovariance(*covariance, &opts->fit.covariance)) {
-      throw UserError("--covariance must be auto, points, angle_means or absolute, got '" +
+      throw UserError("--covariance must be " + EllipseCovarianceAllowedValues() + ", got '" +
                       *covariance + "'");
     }
     const EllipseCommandResult result = RunEllipse(*opts);

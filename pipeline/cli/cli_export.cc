@@ -22,7 +22,7 @@ void RegisterExportCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("results", opts->results_path,
                   "results.json written by `bifilar process` (or its output folder)")
       ->required();
-  cmd->add_option("--format", *format, "urdf, sdf, jsbsim or csv")->required();
+  cmd->add_option("--format", *format, ExportFormatAllowedValues())->required();
   cmd->add_option("--out", opts->out_path, "write this file (default: print to stdout)");
   auto* frame_option = cmd->add_option(
       "--frame", *frame,
@@ -42,10 +42,12 @@ void RegisterExportCommand(CLI::App& app, int* exit_code) {
                 "its x-z plane)");
   cmd->callback([opts, format, frame, frame_option, sets, exit_code] {
     if (!ParseExportFormat(*format, &opts->format)) {
-      throw UserError("export: --format must be urdf, sdf, jsbsim or csv, got '" + *format + "'");
+      throw UserError("export: --format must be " + ExportFormatAllowedValues() + ", got '" +
+                      *format + "'");
     }
     if (!ParseExportFrame(*frame, &opts->frame)) {
-      throw UserError("export: --frame must be flu or frd, got '" + *frame + "'");
+      throw UserError("export: --frame must be " + ExportFrameAllowedValues() + ", got '" +
+                      *frame + "'");
     }
     opts->frame_given = frame_option->count() > 0;
     for (const std::string& s : *sets) {

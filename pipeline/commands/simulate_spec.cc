@@ -122,7 +122,7 @@ std::array<std::string, 3> ReadColumns(YamlMap& map, const std::string& key,
 }
 
 template <typename Unit, typename Parse>
-Unit ReadUnit(YamlMap& map, const std::string& key, Unit fallback, Parse parse, const char* allowed) {
+Unit ReadUnit(YamlMap& map, const std::string& key, Unit fallback, Parse parse, const std::string& allowed) {
   const YAML::Node node = map.Optional(key);
   if (!node.IsDefined() || node.IsNull()) return fallback;
   const std::string name = map.AsString(node, key);
@@ -139,15 +139,15 @@ void ReadFormat(YamlMap map, SimulateSpec* spec) {
   f.time_column = map.OptionalString("time_column", f.time_column);
   f.time_unit = ReadUnit(map, "time_unit", f.time_unit,
                          [](const std::string& n, TimeUnit* u) { return ParseTimeUnit(n, u); },
-                         "s, ms, us");
+                         TimeUnitAllowedValues());
   f.gyro_columns = ReadColumns(map, "gyro_columns", f.gyro_columns);
   f.gyro_unit = ReadUnit(map, "gyro_unit", f.gyro_unit,
                          [](const std::string& n, RateUnit* u) { return ParseRateUnit(n, u); },
-                         "rad/s, deg/s");
+                         RateUnitAllowedValues());
   f.accel_columns = ReadColumns(map, "accel_columns", f.accel_columns);
   f.accel_unit = ReadUnit(map, "accel_unit", f.accel_unit,
                           [](const std::string& n, AccelUnit* u) { return ParseAccelUnit(n, u); },
-                          "m/s^2, g");
+                          AccelUnitAllowedValues());
   const YAML::Node delim = map.Optional("delimiter");
   if (delim.IsDefined() && !delim.IsNull()) {
     const std::string d = map.AsString(delim, "delimiter");

@@ -1,5 +1,6 @@
 #include "pipeline/config/config.h"
 
+#include "base/enum_names.h"
 #include "base/units.h"
 #include "fit/ellipse.h"
 
@@ -81,12 +82,9 @@ Eigen::Vector3d ThreeVector(const YamlMap& map, const YAML::Node& node, const st
 // fields (pipeline/logs/ulog.h).
 void ReadLogContainer(YamlMap& imu, ImuFormat* format) {
   const std::string container = imu.OptionalString("format", "auto");
-  if (container == "auto") format->container = LogContainer::kAuto;
-  else if (container == "csv") format->container = LogContainer::kCsv;
-  else if (container == "ulog") format->container = LogContainer::kUlog;
-  else {
-    throw UserError(imu.Where(imu.Optional("format")) + ": 'imu.format' must be auto, csv or ulog, not '" +
-                    container + "'");
+  if (!ParseLogContainer(container, &format->container)) {
+    throw UserError(imu.Where(imu.Optional("format")) + ": 'imu.format' must be " +
+                    LogContainerAllowedValues() + ", not '" + container + "'");
   }
   YamlMap ulog = Sub(imu, "ulog");
   UlogSelection& sel = format->ulog;
@@ -132,7 +130,7 @@ void ReadImuColumns(YamlMap& imu, ImuConfig* out) {
     const std::string unit = time.OptionalString("unit", ToString(format.time_unit));
     if (!ParseTimeUnit(unit, &format.time_unit)) {
       throw UserError(time.Where(time.Optional("unit")) + ": '" + time.KeyPath("unit") +
-                      "' must be s, ms or us, not '" + unit + "'");
+                      "' must be " + TimeUnitAllowedValues() + ", not '" + unit + "'");
     }
     time.Finish();
   }
@@ -143,7 +141,7 @@ void ReadImuColumns(YamlMap& imu, ImuConfig* out) {
     const std::string unit = gyro.OptionalString("unit", ToString(format.gyro_unit));
     if (!ParseRateUnit(unit, &format.gyro_unit)) {
       throw UserError(gyro.Where(gyro.Optional("unit")) + ": '" + gyro.KeyPath("unit") +
-                      "' must be rad/s or deg/s, not '" + unit + "'");
+                      "' must be " + RateUnitAllowedValues() + ", not '" + unit + "'");
     }
     gyro.Finish();
   }
@@ -155,7 +153,7 @@ void ReadImuColumns(YamlMap& imu, ImuConfig* out) {
     const std::string unit = accel.OptionalString("unit", ToString(format.accel_unit));
     if (!ParseAccelUnit(unit, &format.accel_unit)) {
       throw UserError(accel.Where(accel.Optional("unit")) + ": '" + accel.KeyPath("unit") +
-                      "' must be m/s^2 or g, not '" + unit + "'");
+                      "' must be " + AccelUnitAllowedValues() + ", not '" + unit + "'");
     }
     accel.Finish();
   }
@@ -330,9 +328,14 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
 
 }  // namespace
 
-const char* ToString(PitchSource source) {
-  return source == PitchSource::kNominal ? "nominal" : "measured";
+constexpr EnumName<PitchSource> kPitchSourceNames[] = {{PitchSource::kNominal, "nominal"},
+                                                       {PitchSource::kMeasured, "measured"}};
+
+const char* ToString(PitchSource source) { return EnumToString(kPitchSourceNames, source, "?"); }
+bool ParsePitchSource(const std::string& name, PitchSource* source) {
+  return ParseEnum(kPitchSourceNames, name, source);
 }
+std::string PitchSourceAllowedValues() { return EnumAllowedValues(kPitchSourceNames); }
 
 std::string ResolvePath(const std::string& folder, const std::string& path) {
   fs::path p(path);
@@ -807,13 +810,9 @@ void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& o
     r.table = ResolvePath(config->folder, runs.RequiredString("table"));
   }
   const std::string source = runs.OptionalString("pitch_source", "nominal");
-  if (source == "nominal") {
-    r.pitch_source = PitchSource::kNominal;
-  } else if (source == "measured") {
-    r.pitch_source = PitchSource::kMeasured;
-  } else {
-    throw UserError(runs.Where(runs.Optional("pitch_source")) +
-                    ": 'runs.pitch_source' must be nominal or measured, not '" + source + "'");
+  if (!ParsePitchSource(source, &r.pitch_source)) {
+    throw UserError(runs.Where(runs.Optional("pitch_source")) + ": 'runs.pitch_source' must be " +
+                    PitchSourceAllowedValues() + ", not '" + source + "'");
   }
   const YAML::Node tolerance = runs.Optional("attitude_tolerance_deg");
   if (tolerance.IsDefined() && !tolerance.IsNull()) {

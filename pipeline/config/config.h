@@ -279,6 +279,8 @@ CampaignConfig LoadCampaignConfigText(const std::string& text, const std::string
                                       const ConfigLoadOptions& options = ConfigLoadOptions());
 
 const char* ToString(PitchSource source);
+bool ParsePitchSource(const std::string& name, PitchSource* source);  // false: no such name
+std::string PitchSourceAllowedValues();  // "nominal or measured"
 
 // `path` resolved against `folder` unless absolute; lexically normalised.
 std::string ResolvePath(const std::string& folder, const std::string& path);

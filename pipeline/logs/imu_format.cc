@@ -2,44 +2,41 @@
 
 #include <set>
 
+#include "base/enum_names.h"
 #include "base/option_check.h"
 #include "base/units.h"
 
 namespace bifilar {
 
-bool ParseTimeUnit(const std::string& name, TimeUnit* unit) {
-  if (name == "s") *unit = TimeUnit::kSeconds;
-  else if (name == "ms") *unit = TimeUnit::kMilliseconds;
-  else if (name == "us") *unit = TimeUnit::kMicroseconds;
-  else return false;
-  return true;
+namespace {
+
+constexpr EnumName<TimeUnit> kTimeUnitNames[] = {
+    {TimeUnit::kSeconds, "s"}, {TimeUnit::kMilliseconds, "ms"}, {TimeUnit::kMicroseconds, "us"}};
+constexpr EnumName<RateUnit> kRateUnitNames[] = {{RateUnit::kRadPerS, "rad/s"},
+                                                 {RateUnit::kDegPerS, "deg/s"}};
+constexpr EnumName<AccelUnit> kAccelUnitNames[] = {{AccelUnit::kMetresPerS2, "m/s^2"},
+                                                   {AccelUnit::kStandardGravity, "g"}};
+constexpr EnumName<LogContainer> kLogContainerNames[] = {
+    {LogContainer::kAuto, "auto"}, {LogContainer::kCsv, "csv"}, {LogContainer::kUlog, "ulog"}};
+
+}  // namespace
+
+bool ParseTimeUnit(const std::string& name, TimeUnit* unit) { return ParseEnum(kTimeUnitNames, name, unit); }
+bool ParseRateUnit(const std::string& name, RateUnit* unit) { return ParseEnum(kRateUnitNames, name, unit); }
+bool ParseAccelUnit(const std::string& name, AccelUnit* unit) { return ParseEnum(kAccelUnitNames, name, unit); }
+bool ParseLogContainer(const std::string& name, LogContainer* container) {
+  return ParseEnum(kLogContainerNames, name, container);
 }
 
-bool ParseRateUnit(const std::string& name, RateUnit* unit) {
-  if (name == "rad/s") *unit = RateUnit::kRadPerS;
-  else if (name == "deg/s") *unit = RateUnit::kDegPerS;
-  else return false;
-  return true;
-}
+const char* ToString(TimeUnit unit) { return EnumToString(kTimeUnitNames, unit, "?"); }
+const char* ToString(RateUnit unit) { return EnumToString(kRateUnitNames, unit, "?"); }
+const char* ToString(AccelUnit unit) { return EnumToString(kAccelUnitNames, unit, "?"); }
+const char* ToString(LogContainer container) { return EnumToString(kLogContainerNames, container, "?"); }
 
-bool ParseAccelUnit(const std::string& name, AccelUnit* unit) {
-  if (name == "m/s^2") *unit = AccelUnit::kMetresPerS2;
-  else if (name == "g") *unit = AccelUnit::kStandardGravity;
-  else return false;
-  return true;
-}
-
-const char* ToString(TimeUnit unit) {
-  switch (unit) {
-    case TimeUnit::kSeconds: return "s";
-    case TimeUnit::kMilliseconds: return "ms";
-    case TimeUnit::kMicroseconds: return "us";
-  }
-  return "?";
-}
-
-const char* ToString(RateUnit unit) { return unit == RateUnit::kRadPerS ? "rad/s" : "deg/s"; }
-const char* ToString(AccelUnit unit) { return unit == AccelUnit::kMetresPerS2 ? "m/s^2" : "g"; }
+std::string TimeUnitAllowedValues() { return EnumAllowedValues(kTimeUnitNames); }
+std::string RateUnitAllowedValues() { return EnumAllowedValues(kRateUnitNames); }
+std::string AccelUnitAllowedValues() { return EnumAllowedValues(kAccelUnitNames); }
+std::string LogContainerAllowedValues() { return EnumAllowedValues(kLogContainerNames); }
 
 double ToSi(TimeUnit unit) {
   switch (unit) {

@@ -12,13 +12,17 @@ enum class TimeUnit { kSeconds, kMilliseconds, kMicroseconds };  // "s", "ms", "
 enum class RateUnit { kRadPerS, kDegPerS };                      // "rad/s", "deg/s"
 enum class AccelUnit { kMetresPerS2, kStandardGravity };          // "m/s^2", "g"
 
-// Parse the unit names above; false for anything else.
+// Parse the unit names above; false for anything else. One name table per enum
+// (base/enum_names.h) gives these, ToString and the "allowed values" text of messages.
 bool ParseTimeUnit(const std::string& name, TimeUnit* unit);
 bool ParseRateUnit(const std::string& name, RateUnit* unit);
 bool ParseAccelUnit(const std::string& name, AccelUnit* unit);
 const char* ToString(TimeUnit unit);
 const char* ToString(RateUnit unit);
 const char* ToString(AccelUnit unit);
+std::string TimeUnitAllowedValues();   // "s, ms or us"
+std::string RateUnitAllowedValues();   // "rad/s or deg/s"
+std::string AccelUnitAllowedValues();  // "m/s^2 or g"
 
 // Multiply a file value by this to get SI (s, rad/s, m/s^2).
 double ToSi(TimeUnit unit);
@@ -41,6 +45,9 @@ struct UlogSelection {
 
 // How a log file is read: by its content (ULog magic bytes, else CSV), or forced.
 enum class LogContainer { kAuto, kCsv, kUlog };  // "auto", "csv", "ulog"
+bool ParseLogContainer(const std::string& name, LogContainer* container);
+const char* ToString(LogContainer container);
+std::string LogContainerAllowedValues();  // "auto, csv or ulog"
 
 struct ImuFormat {
   std::string time_column = "t";                              // header name of the time column

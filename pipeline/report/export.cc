@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "base/enum_names.h"
 #include "base/atomic_file.h"
 #include "base/bounded_read.h"
 #include "base/json_error.h"
@@ -222,45 +223,29 @@ const char* ExportComponentName(int component) {
   return component >= 0 && component < 6 ? kNames[component] : "?";
 }
 
-bool ParseExportFormat(const std::string& name, ExportFormat* format) {
-  if (name == "urdf") {
-    *format = ExportFormat::kUrdf;
-  } else if (name == "sdf") {
-    *format = ExportFormat::kSdf;
-  } else if (name == "jsbsim") {
-    *format = ExportFormat::kJsbsim;
-  } else if (name == "csv") {
-    *format = ExportFormat::kCsv;
-  } else {
-    return false;
-  }
-  return true;
-}
+namespace {
 
-const char* ExportFormatName(ExportFormat format) {
-  switch (format) {
-    case ExportFormat::kUrdf:
-      return "urdf";
-    case ExportFormat::kSdf:
-      return "sdf";
-    case ExportFormat::kJsbsim:
-      return "jsbsim";
-    case ExportFormat::kCsv:
-      return "csv";
-  }
-  return "?";
+constexpr EnumName<ExportFormat> kExportFormatNames[] = {{ExportFormat::kUrdf, "urdf"},
+                                                         {ExportFormat::kSdf, "sdf"},
+                                                         {ExportFormat::kJsbsim, "jsbsim"},
+                                                         {ExportFormat::kCsv, "csv"}};
+constexpr EnumName<ExportFrame> kExportFrameNames[] = {{ExportFrame::kFlu, "flu"},
+                                                       {ExportFrame::kFrd, "frd"}};
+
+}  // namespace
+
+bool ParseExportFormat(const std::string& name, ExportFormat* format) {
+  return ParseEnum(kExportFormatNames, name, format);
 }
+const char* ExportFormatName(ExportFormat format) {
+  return EnumToString(kExportFormatNames, format, "?");
+}
+std::string ExportFormatAllowedValues() { return EnumAllowedValues(kExportFormatNames); }
 
 bool ParseExportFrame(const std::string& name, ExportFrame* frame) {
-  if (name == "flu") {
-    *frame = ExportFrame::kFlu;
-  } else if (name == "frd") {
-    *frame = ExportFrame::kFrd;
-  } else {
-    return false;
-  }
-  return true;
+  return ParseEnum(kExportFrameNames, name, frame);
 }
+std::string ExportFrameAllowedValues() { return EnumAllowedValues(kExportFrameNames); }
 
 bool ExportOptions::Check(std::string* why) const {
   CheckFailure f;

@@ -41,12 +41,14 @@
 namespace bifilar {
 
 enum class ExportFormat { kUrdf, kSdf, kJsbsim, kCsv };
-bool ParseExportFormat(const std::string& name, ExportFormat* format);  // urdf|sdf|jsbsim|csv
+bool ParseExportFormat(const std::string& name, ExportFormat* format);  // false: no such name
 const char* ExportFormatName(ExportFormat format);
+std::string ExportFormatAllowedValues();  // "urdf, sdf, jsbsim or csv"
 
 // The frame of a URDF/SDF <inertial>: FLU (REP 103, the default) or the body FRD as measured.
 enum class ExportFrame { kFlu, kFrd };
-bool ParseExportFrame(const std::string& name, ExportFrame* frame);  // flu|frd
+bool ParseExportFrame(const std::string& name, ExportFrame* frame);  // false: no such name
+std::string ExportFrameAllowedValues();  // "flu or frd"
 
 struct ExportOptions {
   std::string results_path;  // results.json written by `bifilar process`

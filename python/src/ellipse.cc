@@ -104,7 +104,7 @@ py::object FitEllipseCore(const Array& pitch_array, const Array& inertia_array,
   options.confidence = confidence;
   if (!ParseEllipseCovariance(covariance, &options.covariance)) {
     throw std::invalid_argument("fit_ellipse: covariance '" + covariance +
-                                "': expected auto, points, angle_means or absolute");
+                                "': expected " + EllipseCovarianceAllowedValues());
   }
   EllipseResult result;
   std::string why;

@@ -115,7 +115,7 @@ py::object FitTensorCore(const Array& direction_array, const Array& inertia_arra
   options.attitude_scatter = attitude_scatter;
   if (!ParseEllipseCovariance(covariance, &options.covariance)) {
     throw std::invalid_argument("fit_tensor: covariance '" + covariance +
-                                "': expected auto, points, angle_means or absolute");
+                                "': expected " + EllipseCovarianceAllowedValues());
   }
   std::string why;
   if (!options.Check(&why)) throw UserError("tensor options: " + why);
