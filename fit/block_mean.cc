@@ -3,18 +3,15 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/option_check.h"
+
 namespace bifilar {
 
 bool BlockMeanOptions::Check(std::string* why) const {
-  if (max_points < 1000) {
-    *why = "max_points must be >= 1000";
-    return false;
-  }
-  if (!(min_blocks_per_period >= 100.0) || !std::isfinite(min_blocks_per_period)) {
-    *why = "min_blocks_per_period must be >= 100";
-    return false;
-  }
-  return true;
+  CheckFailure f;
+  return (CheckGe("max_points", max_points, 1000, &f) &&
+          CheckFiniteGe("min_blocks_per_period", min_blocks_per_period, 100, &f)) ||
+         FailWith(f, why);
 }
 
 double BlockMeanSpan(size_t n, double duration_s, double period_s,

@@ -5,6 +5,7 @@
 #include "fit/ellipse.h"
 
 #include "base/enum_names.h"
+#include "base/option_check.h"
 #include "fit/ellipse_steps.h"
 #include "fit/solver_logging.h"
 
@@ -292,40 +293,22 @@ bool ParseEllipseCovariance(const std::string& name, EllipseCovariance* mode) {
 std::string EllipseCovarianceAllowedValues() { return EnumAllowedValues(kEllipseCovarianceNames); }
 
 bool EllipseOptions::Check(std::string* why) const {
-  if (bootstrap_replicates < 0 ||
-      (bootstrap_replicates > 0 && bootstrap_replicates < kMinBootstrapReplicates) ||
-      bootstrap_replicates > kMaxBootstrapReplicates) {
-    *why = "bootstrap replicates must be 0 (off) or in [" +
-           std::to_string(kMinBootstrapReplicates) + ", " +
-           std::to_string(kMaxBootstrapReplicates) + "], got " +
-           std::to_string(bootstrap_replicates);
-    return false;
-  }
-  if (!(confidence > 0.0 && confidence < 1.0)) {
-    *why = "confidence must be in (0, 1), got " + Num(confidence);
-    return false;
-  }
-  if (!(angle_group_tol_deg >= 0.0 && angle_group_tol_deg < 45.0)) {
-    *why = "angle_group_tol_deg must be in [0, 45), got " + Num(angle_group_tol_deg);
-    return false;
-  }
-  if (!(outlier_threshold > 0.0)) {
-    *why = "outlier_threshold must be > 0, got " + Num(outlier_threshold);
-    return false;
-  }
-  if (!(tau_test_alpha > 0.0 && tau_test_alpha < 1.0)) {
-    *why = "tau_test_alpha must be in (0, 1), got " + Num(tau_test_alpha);
-    return false;
-  }
-  if (!(common_offset_std_kg_m2 >= 0.0 && std::isfinite(common_offset_std_kg_m2))) {
-    *why = "common_offset_std_kg_m2 must be finite and >= 0, got " + Num(common_offset_std_kg_m2);
-    return false;
-  }
-  if (!(naca_exclusion_deg >= 0.0 && naca_exclusion_deg < 45.0)) {
-    *why = "naca_exclusion_deg must be in [0, 45), got " + Num(naca_exclusion_deg);
-    return false;
-  }
-  return true;
+  CheckFailure f;
+  const bool ok =
+      (bootstrap_replicates == 0 ||
+       (bootstrap_replicates >= kMinBootstrapReplicates &&
+        bootstrap_replicates <= kMaxBootstrapReplicates) ||
+       CheckFail("bootstrap_replicates", bootstrap_replicates,
+                 "0 (off) or in " +
+                     IntervalText(kMinBootstrapReplicates, kMaxBootstrapReplicates, Ends::kClosed),
+                 &f)) &&
+      CheckIn("confidence", confidence, 0, 1, Ends::kOpen, &f) &&
+      CheckIn("angle_group_tol_deg", angle_group_tol_deg, 0, 45, Ends::kClosedOpen, &f) &&
+      CheckGt("outlier_threshold", outlier_threshold, 0, &f) &&
+      CheckIn("tau_test_alpha", tau_test_alpha, 0, 1, Ends::kOpen, &f) &&
+      CheckFiniteGe("common_offset_std_kg_m2", common_offset_std_kg_m2, 0, &f) &&
+      CheckIn("naca_exclusion_deg", naca_exclusion_deg, 0, 45, Ends::kClosedOpen, &f);
+  return ok || FailWith(f, why);
 }
 
 EllipseParameters EllipseFromCoefficients(double a, double b, double c) {

@@ -9,6 +9,8 @@
 #include <limits>
 #include <vector>
 
+#include "base/option_check.h"
+
 namespace bifilar {
 namespace ellipse {
 namespace {
@@ -162,37 +164,27 @@ CovarianceEstimate EstimateCovariance(const PreparedData& data, const ClosedForm
 using namespace ellipse;
 
 bool EllipsePlanOptions::Check(std::string* why) const {
-  if (trials_per_angle < 1) {
-    *why = "trials per angle must be >= 1, got " + std::to_string(trials_per_angle);
-    return false;
-  }
   // 1e100 kg m^2 bounds every moment and std, as the fits' inputs; any sigma down to 1e-300
   // works (the plan is computed for sigma 1 and scaled, as the stds are linear in it).
   constexpr double kMax = 1e100;
-  if (!(sigma_kg_m2 >= 1e-300) || !(sigma_kg_m2 <= kMax)) {
-    *why = "sigma must be in [1e-300, 1e100] kg m^2, got " + Num(sigma_kg_m2);
-    return false;
+  CheckFailure f;
+  bool ok = CheckGe("trials_per_angle", trials_per_angle, 1, &f) &&
+            CheckIn("sigma_kg_m2", sigma_kg_m2, 1e-300, kMax, Ends::kClosed, &f) &&
+            CheckIn("ix_kg_m2", ix_kg_m2, 0, kMax, Ends::kOpenClosed, &f) &&
+            CheckIn("iz_kg_m2", iz_kg_m2, 0, kMax, Ends::kOpenClosed, &f) &&
+            CheckIn("ixz_kg_m2", ixz_kg_m2, -kMax, kMax, Ends::kClosed, &f);
+  for (size_t i = 0; ok && i < pitch_deg.size(); ++i) {
+    ok = CheckIn("pitch_deg", pitch_deg[i], -180, 180, Ends::kClosed, &f);
   }
-  if (!(ix_kg_m2 > 0.0) || !(iz_kg_m2 > 0.0) || !(ix_kg_m2 <= kMax) || !(iz_kg_m2 <= kMax) ||
-      !(std::fabs(ixz_kg_m2) <= kMax)) {
-    *why = "I_x and I_z guesses must be in (0, 1e100] kg m^2 and |I_xz| <= 1e100, got " +
-           Num(ix_kg_m2) + ", " + Num(iz_kg_m2) + ", " + Num(ixz_kg_m2);
-    return false;
-  }
-  for (double a : pitch_deg) {
-    if (!std::isfinite(a) || a < -180.0 || a > 180.0) {
-      *why = "pitch angles must be in [-180, 180], got " + Num(a);
-      return false;
-    }
-  }
+  if (!ok) return FailWith(f, why);
   std::vector<double> axis;
   for (double a : pitch_deg) axis.push_back(AxisAngleDeg(a));
   std::sort(axis.begin(), axis.end());
   axis.erase(std::unique(axis.begin(), axis.end()), axis.end());
-  if (axis.size() < 3) {
-    *why = "need >= 3 distinct pitch angles (mod 180 deg), got " + std::to_string(axis.size());
-    return false;
+  if (!CheckGe("distinct pitch angles (mod 180 deg)", static_cast<double>(axis.size()), 3, &f)) {
+    return FailWith(f, why);
   }
+
   return true;
 }
 

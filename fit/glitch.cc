@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "base/option_check.h"
 #include "base/statistics.h"
 #include "fit/window.h"
 
@@ -24,20 +25,13 @@ void Neighbours(size_t k, size_t m, size_t n, size_t idx[4]) {
 }  // namespace
 
 bool GlitchOptions::Check(std::string* why) const {
-  if (!(threshold_sigmas >= 0.0) || !std::isfinite(threshold_sigmas)) {
-    *why = "glitch: threshold_sigmas must be >= 0 (0 disables the search)";
-    return false;
-  }
-  if (!(range_factor >= 0.0) || !(excursion_fraction >= 0.0) || !std::isfinite(range_factor) ||
-      !std::isfinite(excursion_fraction)) {
-    *why = "glitch: range_factor and excursion_fraction must be finite and >= 0";
-    return false;
-  }
-  if (!(max_fraction > 0.0 && max_fraction <= 1.0)) {
-    *why = "glitch: max_fraction must be in (0, 1]";
-    return false;
-  }
-  return true;
+  CheckFailure f;
+  const bool ok =
+      CheckFiniteGe("threshold_sigmas (0 disables the search)", threshold_sigmas, 0, &f) &&
+      CheckFiniteGe("range_factor", range_factor, 0, &f) &&
+      CheckFiniteGe("excursion_fraction", excursion_fraction, 0, &f) &&
+      CheckIn("max_fraction", max_fraction, 0, 1, Ends::kOpenClosed, &f);
+  return ok || FailWith(f, why, "glitch: ");
 }
 
 std::vector<size_t> FindGlitches(const std::vector<double>& t, const std::vector<double>& x,

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "base/enum_names.h"
+#include "base/option_check.h"
 #include "base/units.h"
 
 namespace bifilar {
@@ -106,33 +107,28 @@ const char* ToString(SwingAxisSource source) {
 }
 
 bool SwingAxisOptions::Check(std::string* why) const {
-  if (mode == SwingAxisMode::kFixed && !(fixed_axis_in_imu.allFinite() && fixed_axis_in_imu.norm() > 1e-9)) {
-    *why = "swing axis: the fixed axis must be a finite non-zero vector";
-    return false;
-  }
-  if (!imu_to_body.allFinite() ||
-      (imu_to_body.transpose() * imu_to_body - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
-      imu_to_body.determinant() < 0.0) {
-    *why = "swing axis: imu_to_body must be a rotation matrix (orthonormal, determinant +1)";
-    return false;
-  }
-  if (!(rest_rate_threshold_rad_per_s > 0.0) || !(rest_half_width_s > 0.0)) {
-    *why = "swing axis: rest_rate_threshold_rad_per_s and rest_half_width_s must be > 0";
-    return false;
-  }
-  if (min_rest_samples < 1) {
-    *why = "swing axis: min_rest_samples must be >= 1";
-    return false;
-  }
-  if (!(gravity_removed_below_g >= 0.0 && gravity_removed_below_g < 1.0 - gravity_tolerance)) {
-    *why = "swing axis: gravity_removed_below_g must be in [0, 1 - gravity_tolerance)";
-    return false;
-  }
-  if (!(gravity_tolerance > 0.0 && gravity_tolerance < 1.0)) {
-    *why = "swing axis: gravity_tolerance must be in (0, 1)";
-    return false;
-  }
-  return true;
+  CheckFailure f;
+  const double axis_norm = fixed_axis_in_imu.norm();
+  // A rotation matrix: orthonormal to 1e-6, determinant not negative.
+  const double orthogonality =
+      imu_to_body.allFinite()
+          ? (imu_to_body.transpose() * imu_to_body - Eigen::Matrix3d::Identity())
+                .cwiseAbs()
+                .maxCoeff()
+          : NAN;
+  const bool ok =
+      (mode != SwingAxisMode::kFixed || (fixed_axis_in_imu.allFinite() && axis_norm > 1e-9) ||
+       CheckFail("|fixed_axis_in_imu|", axis_norm, "finite and > 1e-09", &f)) &&
+      CheckLe("max |imu_to_body^T imu_to_body - I|", orthogonality, 1e-6, &f) &&
+      CheckGe("det(imu_to_body)", imu_to_body.determinant(), 0, &f) &&
+      CheckGt("rest_rate_threshold_rad_per_s", rest_rate_threshold_rad_per_s, 0, &f) &&
+      CheckGt("rest_half_width_s", rest_half_width_s, 0, &f) &&
+      CheckGe("min_rest_samples", min_rest_samples, 1, &f) &&
+      CheckGe("gravity_removed_below_g", gravity_removed_below_g, 0, &f) &&
+      CheckLt("gravity_removed_below_g", gravity_removed_below_g, "1 - gravity_tolerance",
+              1.0 - gravity_tolerance, &f) &&
+      CheckIn("gravity_tolerance", gravity_tolerance, 0, 1, Ends::kOpen, &f);
+  return ok || FailWith(f, why, "swing axis: ");
 }
 
 double PitchFromDownDeg(const Eigen::Vector3d& down_in_body) {

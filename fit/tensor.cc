@@ -4,6 +4,8 @@
 // tensor_steps.h lists the steps. Conventions: fit/tensor.h, docs/physics.md §3.5.
 #include "fit/tensor.h"
 
+#include "base/option_check.h"
+#include "base/text_format.h"
 #include "base/units.h"
 #include "fit/ellipse_steps.h"
 #include "fit/solver_logging.h"
@@ -19,13 +21,6 @@ namespace bifilar {
 namespace tensor {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
-}
 
 Eigen::Vector3d ToVector(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
@@ -121,8 +116,8 @@ bool PrepareTensorData(const std::vector<TensorPoint>& points, const TensorOptio
       }
       if (zero_allowed && largest == 0) return true;
       *why = where + "the " + what + " must be a finite, non-zero vector" +
-             (zero_allowed ? " (or all zero: the swing axis)" : "") + ", got (" + Num(v(0)) +
-             ", " + Num(v(1)) + ", " + Num(v(2)) + ")";
+             (zero_allowed ? " (or all zero: the swing axis)" : "") + ", got (" + Fmt("%g", v(0)) +
+             ", " + Fmt("%g", v(1)) + ", " + Fmt("%g", v(2)) + ")";
       return false;
     };
     Eigen::Vector3d nominal_unit = Eigen::Vector3d::Zero();
@@ -134,11 +129,12 @@ bool PrepareTensorData(const std::vector<TensorPoint>& points, const TensorOptio
     if (!std::isfinite(p.inertia_kg_m2) || !(p.inertia_kg_m2 > 0.0) || p.inertia_kg_m2 > 1e100 ||
         p.inertia_kg_m2 < 1e-100) {
       *why = where + "inertia must be finite and in [1e-100, 1e100] kg m^2, got " +
-             Num(p.inertia_kg_m2);
+             Fmt("%g", p.inertia_kg_m2);
       return false;
     }
     if (p.std_kg_m2 < 0.0 || std::isinf(p.std_kg_m2) || (p.std_kg_m2 > 0 && p.std_kg_m2 < 1e-100)) {
-      *why = where + "std must be >= 0 and finite (0 or NaN = unknown), got " + Num(p.std_kg_m2);
+      *why =
+          where + "std must be >= 0 and finite (0 or NaN = unknown), got " + Fmt("%g", p.std_kg_m2);
       return false;
     }
     if (p.std_kg_m2 > 0.0) ++n_std;
@@ -167,7 +163,7 @@ bool PrepareTensorData(const std::vector<TensorPoint>& points, const TensorOptio
   d.sqrt_w = d.w.cwiseSqrt();
   // Orientation groups: the given ids when every point has one, else nominal axes within the
   // tolerance of a group's first axis (sign-free: n and -n are one axis).
-  const double cos_tol = std::cos(options.group_tol_deg * kPi / 180.0);
+  const double cos_tol = std::cos(options.group_tol_deg * kRadPerDeg);
   std::vector<int> ids;
   for (int i = 0; i < d.n; ++i) {
     int g = -1;
@@ -337,7 +333,7 @@ const char* TensorComponentName(int component) {
 }
 
 std::array<double, 3> DownInBodyFromAttitude(double roll_deg, double pitch_deg) {
-  const double t = pitch_deg * kPi / 180.0, f = roll_deg * kPi / 180.0;
+  const double t = pitch_deg * kRadPerDeg, f = roll_deg * kRadPerDeg;
   return {-std::sin(t), std::sin(f) * std::cos(t), std::cos(f) * std::cos(t)};
 }
 
@@ -358,15 +354,10 @@ bool TensorOptions::Check(std::string* why) const {
   e.outlier_threshold = outlier_threshold;
   e.common_offset_std_kg_m2 = common_offset_std_kg_m2;
   if (!e.Check(why)) return false;
-  if (!(group_tol_deg >= 0.0 && group_tol_deg < 45.0)) {
-    *why = "group_tol_deg must be in [0, 45), got " + Num(group_tol_deg);
-    return false;
-  }
-  if (!(rank_tolerance > 0.0 && rank_tolerance < 1.0)) {
-    *why = "rank_tolerance must be in (0, 1), got " + Num(rank_tolerance);
-    return false;
-  }
-  return true;
+  CheckFailure f;
+  return (CheckIn("group_tol_deg", group_tol_deg, 0, 45, Ends::kClosedOpen, &f) &&
+          CheckIn("rank_tolerance", rank_tolerance, 0, 1, Ends::kOpen, &f)) ||
+         FailWith(f, why);
 }
 
 bool TensorResult::IsUsable() const {
@@ -576,7 +567,8 @@ void CompareWithClosedForm(const Solution& closed, const Solution& solved, Tenso
   }
   if (r.closed_form_max_relative_difference > 1e-6) {
     r.warnings.push_back("Ceres and the closed form disagree by " +
-                         Num(r.closed_form_max_relative_difference) + " of the largest moment");
+                         Fmt("%g", r.closed_form_max_relative_difference) +
+                         " of the largest moment");
   }
 }
 
@@ -646,7 +638,8 @@ void FillPrincipal(const Solution& solved, const Covariance& cov,
   r.warnings.insert(r.warnings.end(), p.warnings.begin(), p.warnings.end());
   if (r.condition_number > 100) {
     r.warnings.push_back("the swing axes are nearly degenerate (design condition number " +
-                         Num(r.condition_number) + "): some components are poorly determined");
+                         Fmt("%g", r.condition_number) +
+                         "): some components are poorly determined");
   }
 }
 
@@ -677,7 +670,7 @@ bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& opti
   Covariance cov;
   if (!EstimateTensorCovariance(data, design, solved, options, &cov, why)) return false;
   FillFitSummary(data, design, solved, cov, &r);
-  r.attitude_scatter_deg = attitude_scatter_rad * 180.0 / kPi;
+  r.attitude_scatter_deg = attitude_scatter_rad * kDegPerRad;
   r.relative_scatter = relative_scatter;
   CompareWithClosedForm(closed, solved, &r);
   const TensorIntervalSet intervals =

@@ -1,6 +1,8 @@
 // D-optimal choice of attitudes for a tensor campaign (fit/tensor_plan.h).
 #include "fit/tensor_plan.h"
 
+#include "base/option_check.h"
+#include "base/text_format.h"
 #include "base/units.h"
 #include "fit/tensor.h"
 
@@ -28,12 +30,6 @@ struct Candidate {
   double swing_var = 0.0;       // per-swing variance (absolute and relative parts)
   double tilt_var = 0.0;        // variance of the moment from the attitude error
 };
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
 
 // lo, lo + step, ... and hi itself; {lo} when the range has no width.
 std::vector<double> GridValues(double lo, double hi, double step) {
@@ -118,58 +114,49 @@ Row TensorDesignRow(const std::array<double, 3>& axis) {
 }
 
 bool TensorPlanOptions::Check(std::string* why) const {
-  const auto fail = [why](const std::string& m) {
-    if (why != nullptr) *why = m;
-    return false;
-  };
-  const auto finite = [](double v) { return std::isfinite(v); };
-  if (!finite(roll_min_deg) || !finite(roll_max_deg) || roll_min_deg < -180 || roll_max_deg > 180 ||
-      roll_min_deg > roll_max_deg) {
-    return fail("the roll range must lie in [-180, 180] deg with min <= max");
-  }
-  if (!finite(pitch_min_deg) || !finite(pitch_max_deg) || pitch_min_deg < -90 ||
-      pitch_max_deg > 90 || pitch_min_deg > pitch_max_deg) {
-    return fail("the pitch range must lie in [-90, 90] deg with min <= max");
-  }
-  if (!(grid_step_deg >= 0.5 && grid_step_deg <= 90)) {
-    return fail("the grid step must lie in [0.5, 90] deg");
-  }
-  if (n_orientations < 1 || n_orientations > 100) {
-    return fail("the number of orientations must lie in [1, 100]");
-  }
-  if (trials_per_orientation < 1 || trials_per_orientation > 1000000) {
-    return fail("the trials per orientation must lie in [1, 1000000]");
-  }
+  CheckFailure f;
   // 1e100 kg m^2 bounds every moment and std, as the tensor fit's inputs: their squares (the
   // covariance) stay finite. Small stds need no bound: the plan works in units of the largest.
-  if (!finite(sigma_kg_m2) || sigma_kg_m2 < 0 || sigma_kg_m2 > kMaxMomentKgM2 ||
-      !finite(sigma_relative) || sigma_relative < 0 || sigma_relative >= 1) {
-    return fail("the per-swing std must be in [0, 1e100] kg m^2 (absolute, got " +
-                Num(sigma_kg_m2) + ") and in [0, 1) (relative, got " + Num(sigma_relative) + ")");
+  constexpr double kMax = kMaxMomentKgM2;
+  bool ok =
+      CheckIn("roll_min_deg", roll_min_deg, -180, 180, Ends::kClosed, &f) &&
+      CheckIn("roll_max_deg", roll_max_deg, -180, 180, Ends::kClosed, &f) &&
+      CheckLe("roll_min_deg", roll_min_deg, "roll_max_deg", roll_max_deg, &f) &&
+      CheckIn("pitch_min_deg", pitch_min_deg, -90, 90, Ends::kClosed, &f) &&
+      CheckIn("pitch_max_deg", pitch_max_deg, -90, 90, Ends::kClosed, &f) &&
+      CheckLe("pitch_min_deg", pitch_min_deg, "pitch_max_deg", pitch_max_deg, &f) &&
+      CheckIn("grid_step_deg", grid_step_deg, 0.5, 90, Ends::kClosed, &f) &&
+      CheckIn("n_orientations", n_orientations, 1, 100, Ends::kClosed, &f) &&
+      CheckIn("trials_per_orientation", trials_per_orientation, 1, 1000000, Ends::kClosed, &f) &&
+      CheckIn("sigma_kg_m2", sigma_kg_m2, 0, kMax, Ends::kClosed, &f) &&
+      CheckIn("sigma_relative", sigma_relative, 0, 1, Ends::kClosedOpen, &f) &&
+      (sigma_kg_m2 != 0 || sigma_relative != 0 ||
+       CheckFail("sigma_kg_m2", sigma_kg_m2,
+                 "> 0 when sigma_relative = 0 (a per-swing std, absolute or relative)", &f)) &&
+      CheckIn("attitude_std_deg", attitude_std_deg, 0, 10, Ends::kClosed, &f) &&
+      ((sigma_relative == 0 && attitude_std_deg == 0) || guess_given ||
+       CheckFailText("guess_kg_m2", "not given",
+                     "given (at least Ixx, Iyy, Izz) with a relative swing std or an attitude "
+                     "error",
+                     &f));
+  static const char* const kGuessNames[kTensorPlanComponents] = {
+      "guess_kg_m2 Ixx", "guess_kg_m2 Iyy", "guess_kg_m2 Izz",
+      "guess_kg_m2 Ixy", "guess_kg_m2 Ixz", "guess_kg_m2 Iyz"};
+  for (int k = 0; ok && k < kTensorPlanComponents; ++k) {
+    ok = CheckIn(kGuessNames[k], guess_kg_m2[k], -kMax, kMax, Ends::kClosed, &f);
   }
-  if (sigma_kg_m2 == 0 && sigma_relative == 0) {
-    return fail("give a per-swing std (absolute or relative), > 0");
+  ok = ok &&
+       (target_std_kg_m2 == 0 ||
+        CheckIn("target_std_kg_m2 (0: none)", target_std_kg_m2, 0, kMax, Ends::kOpenClosed, &f)) &&
+       CheckIn("rank_tolerance", rank_tolerance, 0, 1, Ends::kOpen, &f);
+  if (ok && guess_given) {
+    // The guessed tensor is positive definite.
+    const Eigen::Vector3d eig =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(TensorMatrix(guess_kg_m2)).eigenvalues();
+    ok = eig[0] > 0 || CheckFail("smallest principal moment of guess_kg_m2", eig[0],
+                                 "> 0 (check the products' signs and sizes)", &f);
   }
-  if (!finite(attitude_std_deg) || attitude_std_deg < 0 || attitude_std_deg > 10) {
-    return fail("the attitude std must lie in [0, 10] deg");
-  }
-  if ((sigma_relative > 0 || attitude_std_deg > 0) && !guess_given) {
-    return fail(
-        "a relative swing std or an attitude error needs a guess of the tensor (at least "
-        "Ixx, Iyy, Izz)");
-  }
-  for (double g : guess_kg_m2) {
-    if (!finite(g) || std::fabs(g) > kMaxMomentKgM2) {
-      return fail("the guessed tensor has a value that is not a finite number within +-1e100 "
-                  "kg m^2 (got " + Num(g) + ")");
-    }
-  }
-  if (!finite(target_std_kg_m2) || target_std_kg_m2 < 0 || target_std_kg_m2 > kMaxMomentKgM2) {
-    return fail("the target std must be in (0, 1e100] kg m^2 (or 0 for none), got " +
-                Num(target_std_kg_m2));
-  }
-  if (!(rank_tolerance > 0 && rank_tolerance < 1)) return fail("rank_tolerance must be in (0, 1)");
-  return true;
+  return ok || FailWith(f, why);
 }
 
 namespace {
@@ -186,19 +173,6 @@ struct Subspace {
   Eigen::MatrixXd reduced;  // candidates' rows in row-space coordinates (n_cand x rank)
   int rank = 0;
 };
-
-// A guessed tensor must be positive definite.
-bool CheckGuess(const TensorPlanOptions& options, const Eigen::Matrix3d& j_guess,
-                std::string* error) {
-  if (!options.guess_given) return true;
-  const Eigen::Vector3d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(j_guess).eigenvalues();
-  if (!(eig[0] > 0)) {
-    *error = "the guessed tensor is not positive definite (smallest principal moment " +
-             Num(eig[0]) + " kg m^2): check the products' signs and sizes";
-    return false;
-  }
-  return true;
-}
 
 // 1. Candidates: the grid, one per distinct axis, the easiest attitude (smallest |roll| +
 // |pitch|) kept for each, with their stds.
@@ -256,9 +230,11 @@ bool ScaledVariances(const TensorPlanOptions& options, const std::vector<Stds>& 
   *scale_out = scale;
   // Below 1e-300 kg m^2 the stds themselves (about the per-swing std) would be subnormal or 0.
   if (!(scale >= 1e-300) || !std::isfinite(scale)) {
-    *error = "the per-swing std (absolute " + Num(options.sigma_kg_m2) + " kg m^2, relative " +
-             Num(options.sigma_relative) + ") gives no std of a moment in [1e-300, 1e100] "
-             "kg m^2 (largest " + Num(scale) + "): too small to compute with";
+    *error = "the per-swing std (absolute " + Fmt("%g", options.sigma_kg_m2) +
+             " kg m^2, relative " + Fmt("%g", options.sigma_relative) +
+             ") gives no std of a moment in [1e-300, 1e100] "
+             "kg m^2 (largest " +
+             Fmt("%g", scale) + "): too small to compute with";
     return false;
   }
   for (size_t i = 0; i < cand->size(); ++i) {
@@ -270,8 +246,8 @@ bool ScaledVariances(const TensorPlanOptions& options, const std::vector<Stds>& 
     // number, so every weight is finite. Only a relative std at an axis whose moment is 139
     // decades below the largest std, and no attitude error there, fails this.
     if (!(c.swing_var / 1e12 + c.tilt_var >= 1e-290)) {
-      *error = "the per-swing std at roll " + Num(c.roll_deg) + " deg, pitch " +
-               Num(c.pitch_deg) + " deg is below 1e-139 of the largest (" + Num(scale) +
+      *error = "the per-swing std at roll " + Fmt("%g", c.roll_deg) + " deg, pitch " +
+               Fmt("%g", c.pitch_deg) + " deg is below 1e-139 of the largest (" + Fmt("%g", scale) +
                " kg m^2): give an absolute --sigma too, or check the guessed tensor";
       return false;
     }
@@ -312,9 +288,9 @@ bool ObservableSubspace(const std::vector<Candidate>& cand, const TensorPlanOpti
     std::string names;
     for (const std::string& u : plan->unobservable) names += (names.empty() ? "" : ", ") + u;
     plan->warnings.push_back(
-        "the reachable attitudes (roll " + Num(options.roll_min_deg) + ".." +
-        Num(options.roll_max_deg) + " deg, pitch " + Num(options.pitch_min_deg) + ".." +
-        Num(options.pitch_max_deg) + " deg) cannot observe " + names +
+        "the reachable attitudes (roll " + Fmt("%g", options.roll_min_deg) + ".." +
+        Fmt("%g", options.roll_max_deg) + " deg, pitch " + Fmt("%g", options.pitch_min_deg) + ".." +
+        Fmt("%g", options.pitch_max_deg) + " deg) cannot observe " + names +
         ": no reachable swing axis separates them from the rest; widen the roll or pitch range "
         "(a rig that holds roll at 0 keeps every axis in the body x-z plane: Iyy, Ixy, Iyz)");
   }
@@ -425,7 +401,7 @@ bool ChooseDOptimal(const std::vector<Candidate>& cand, const Subspace& space, d
     const int c = BestAddition(info, reduced, w_all, in_design, rank, &d);
     if (c < 0) {  // every weight is finite and positive (above), so a candidate always adds
       *error = "internal: no orientation adds information to the plan (variance function " +
-               Num(d) + "); please report this with the command line";
+               Fmt("%g", d) + "); please report this with the command line";
       return false;
     }
     chosen->push_back(c);
@@ -520,7 +496,7 @@ bool CheckPredictedStds(const TensorPlan& plan, std::string* error) {
   for (int k = 0; k < kTensorPlanComponents; ++k) {
     if (plan.observable[k] && !(std::isfinite(plan.std_kg_m2[k]) && plan.std_kg_m2[k] > 0)) {
       *error = std::string("internal: the predicted std of ") + TensorPlanComponentName(k) +
-               " is " + Num(plan.std_kg_m2[k]) + "; please report this with the command line";
+               " is " + Fmt("%g", plan.std_kg_m2[k]) + "; please report this with the command line";
       return false;
     }
   }
@@ -558,7 +534,6 @@ bool PlanTensor(const TensorPlanOptions& options, TensorPlan* plan, std::string*
     return false;
   };
   const Eigen::Matrix3d j_guess = TensorMatrix(options.guess_kg_m2);
-  if (!CheckGuess(options, j_guess, &error)) return fail();
   std::vector<Stds> stds;
   std::vector<Candidate> cand = CandidateAttitudes(options, j_guess, &stds);
   double scale = 0.0;

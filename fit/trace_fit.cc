@@ -11,6 +11,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "base/option_check.h"
 #include "base/text_format.h"
 #include "fit/residual_stats.h"
 #include "fit/trace_cost.h"
@@ -266,40 +267,35 @@ const char* ToString(TraceFitStatus status) {
 }
 
 bool TraceFitOptions::Check(std::string* why) const {
-  auto fail = [why](const std::string& m) {
-    if (why != nullptr) *why = m;
-    return false;
-  };
   std::string integ_why;
-  if (!integrator.Check(&integ_why)) return fail("integrator: " + integ_why);
-  if (max_iterations <= 0) return fail("max_iterations must be > 0");
-  if (max_total_iterations < 1) return fail("max_total_iterations must be >= 1");
-  if (!(max_fit_cpu_seconds > 0.0) || !std::isfinite(max_fit_cpu_seconds))
-    return fail("max_fit_cpu_seconds must be finite and > 0");
-  if (!(max_rms_over_noise > 1.0)) return fail("max_rms_over_noise must be > 1");
-  if (!(max_residual_autocorr > 0.0 && max_residual_autocorr < 1.0))
-    return fail("max_residual_autocorr must be in (0, 1)");
-  if (whiteness_lags < 1) return fail("whiteness_lags must be >= 1");
-  if (!(max_secondary_motion_ratio >= 0.0)) return fail("max_secondary_motion_ratio must be >= 0");
-  if (!(min_amplitude_deg >= 0.0)) return fail("min_amplitude_deg must be >= 0");
-  if (!(max_amplitude_deg > min_amplitude_deg && max_amplitude_deg <= 90.0))
-    return fail("max_amplitude_deg must be in (min_amplitude_deg, 90]");
-  if (!(min_periods >= 2.0)) return fail("min_periods must be >= 2");
-  if (!(refine_rms_over_noise > 1.0)) return fail("refine_rms_over_noise must be > 1");
-  if (!(reject_secondary_motion_ratio >= max_secondary_motion_ratio))
-    return fail("reject_secondary_motion_ratio must be >= max_secondary_motion_ratio");
-  if (!(reject_residual_fraction > 0.0 && reject_residual_fraction <= 1.0))
-    return fail("reject_residual_fraction must be in (0, 1]");
-  if (!(sweep_min_cycles_per_band >= 1.0 && sweep_min_cycles_per_band <= 1000.0))
-    return fail("sweep_min_cycles_per_band must be in [1, 1000]");
-  if (sweep_max_bands < 2 || sweep_max_bands > 20) return fail("sweep_max_bands must be in [2, 20]");
-  if (!(sweep_trend_z > 0.0 && sweep_trend_z < 1e3)) return fail("sweep_trend_z must be in (0, 1000)");
-  for (double std_input : {filar_length_std_m, filar_separation_std_m, mass_std_kg,
-                           gravity_std_mps2, gyro_scale_std}) {
-    if (!(std_input >= 0.0) || !std::isfinite(std_input))
-      return fail("budget uncertainties (geometry, gyro scale) must be finite and >= 0");
-  }
-  return true;
+  if (!integrator.Check(&integ_why)) return SetWhy(why, "integrator: " + integ_why);
+  CheckFailure f;
+  const bool ok =
+      CheckGt("max_iterations", max_iterations, 0, &f) &&
+      CheckGe("max_total_iterations", max_total_iterations, 1, &f) &&
+      CheckFiniteGt("max_fit_cpu_seconds", max_fit_cpu_seconds, 0, &f) &&
+      CheckGt("max_rms_over_noise", max_rms_over_noise, 1, &f) &&
+      CheckIn("max_residual_autocorr", max_residual_autocorr, 0, 1, Ends::kOpen, &f) &&
+      CheckGe("whiteness_lags", whiteness_lags, 1, &f) &&
+      CheckGe("max_secondary_motion_ratio", max_secondary_motion_ratio, 0, &f) &&
+      CheckGe("min_amplitude_deg", min_amplitude_deg, 0, &f) &&
+      CheckGt("max_amplitude_deg", max_amplitude_deg, "min_amplitude_deg", min_amplitude_deg, &f) &&
+      CheckLe("max_amplitude_deg", max_amplitude_deg, 90, &f) &&
+      CheckGe("min_periods", min_periods, 2, &f) &&
+      CheckGt("refine_rms_over_noise", refine_rms_over_noise, 1, &f) &&
+      CheckGe("reject_secondary_motion_ratio", reject_secondary_motion_ratio,
+              "max_secondary_motion_ratio", max_secondary_motion_ratio, &f) &&
+      CheckIn("reject_residual_fraction", reject_residual_fraction, 0, 1, Ends::kOpenClosed, &f) &&
+      CheckIn("sweep_min_cycles_per_band", sweep_min_cycles_per_band, 1, 1000, Ends::kClosed, &f) &&
+      CheckIn("sweep_max_bands", sweep_max_bands, 2, 20, Ends::kClosed, &f) &&
+      CheckIn("sweep_trend_z", sweep_trend_z, 0, 1e3, Ends::kOpen, &f) &&
+      // The budget's uncertainties (geometry, gyro scale).
+      CheckFiniteGe("filar_length_std_m", filar_length_std_m, 0, &f) &&
+      CheckFiniteGe("filar_separation_std_m", filar_separation_std_m, 0, &f) &&
+      CheckFiniteGe("mass_std_kg", mass_std_kg, 0, &f) &&
+      CheckFiniteGe("gravity_std_mps2", gravity_std_mps2, 0, &f) &&
+      CheckFiniteGe("gyro_scale_std", gyro_scale_std, 0, &f);
+  return ok || FailWith(f, why);
 }
 
 std::string TraceFitResult::BriefReport() const {

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <limits>
 
+#include "base/option_check.h"
 #include "base/statistics.h"
 #include "base/text_format.h"
 #include "base/units.h"
@@ -381,19 +382,22 @@ const char* ToString(WindowEnd end) {
 }
 
 bool WindowOptions::Check(std::string* why) const {
-  auto fail = [&](const char* m) { *why = std::string("window: ") + m; return false; };
-  if (!(min_period_s > 0.0 && max_period_s > min_period_s)) return fail("need 0 < min_period_s < max_period_s");
-  if (!(rest_block_s > 0.0 && min_rest_s > 0.0)) return fail("rest_block_s and min_rest_s must be > 0");
-  if (!(hysteresis_sigmas > 0.0)) return fail("hysteresis_sigmas must be > 0");
-  if (!(half_period_tolerance > 0.0 && half_period_tolerance < 1.0)) return fail("half_period_tolerance must be in (0, 1)");
-  if (!(growth_tolerance >= 0.0)) return fail("growth_tolerance must be >= 0");
-  if (!(stop_drop_factor > 0.0 && stop_drop_factor < 1.0)) return fail("stop_drop_factor must be in (0, 1)");
-  if (!(noise_floor_sigmas > 0.0)) return fail("noise_floor_sigmas must be > 0");
-  if (!(start_delay_periods >= 0.0 && end_margin_periods >= 0.0)) return fail("start_delay_periods and end_margin_periods must be >= 0");
-  if (!(min_periods > 0.0)) return fail("min_periods must be > 0");
-  if (!(blip_fraction >= 0.0 && blip_fraction < 0.5)) return fail("blip_fraction must be in [0, 0.5)");
-  if (!(max_gap_periods > 0.0)) return fail("max_gap_periods must be > 0");
-  return true;
+  CheckFailure f;
+  const bool ok = CheckGt("min_period_s", min_period_s, 0, &f) &&
+                  CheckGt("max_period_s", max_period_s, "min_period_s", min_period_s, &f) &&
+                  CheckGt("rest_block_s", rest_block_s, 0, &f) &&
+                  CheckGt("min_rest_s", min_rest_s, 0, &f) &&
+                  CheckGt("hysteresis_sigmas", hysteresis_sigmas, 0, &f) &&
+                  CheckIn("half_period_tolerance", half_period_tolerance, 0, 1, Ends::kOpen, &f) &&
+                  CheckGe("growth_tolerance", growth_tolerance, 0, &f) &&
+                  CheckIn("stop_drop_factor", stop_drop_factor, 0, 1, Ends::kOpen, &f) &&
+                  CheckGt("noise_floor_sigmas", noise_floor_sigmas, 0, &f) &&
+                  CheckGe("start_delay_periods", start_delay_periods, 0, &f) &&
+                  CheckGe("end_margin_periods", end_margin_periods, 0, &f) &&
+                  CheckGt("min_periods", min_periods, 0, &f) &&
+                  CheckIn("blip_fraction", blip_fraction, 0, 0.5, Ends::kClosedOpen, &f) &&
+                  CheckGt("max_gap_periods", max_gap_periods, 0, &f);
+  return ok || FailWith(f, why, "window: ");
 }
 
 std::string FreeOscillationWindow::BriefReport() const {
@@ -616,6 +620,7 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
   for (const auto& c : a.cycles) max_peak = std::max(max_peak, c.peak);
   const double half = HalfPeriod(a.cycles, std::max(floor, 0.1 * max_peak), o);
   if (half <= 0.0) {
+    w.no_oscillation_found = true;
     w.message = Prefix(name) + Fmt("no oscillation found (no swing with a period in [%g, %g] s "
                                    "above the noise floor of %.3g rad/s)",
                                    o.min_period_s, o.max_period_s, floor);
@@ -628,6 +633,7 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
   const std::vector<Run> runs = FreeRuns(cycles, rules);
   const Run* best = LongestRun(runs, cycles);
   if (!best) {
+    w.no_oscillation_found = true;
     w.message = Prefix(name) + "no oscillation found (no sequence of half-cycles that decays like a "
                                "free swing)";
     return w;
@@ -696,6 +702,7 @@ FreeOscillationWindow ApplyWindowOverride(const std::vector<double>& t,
   const double half = HalfPeriod(inside, o.noise_floor_sigmas * sigma_eff, o);
   if (half <= 0.0) {
     w.status = WindowStatus::kRejected;
+    w.no_oscillation_found = true;
     w.message = Prefix(name) + Fmt("no oscillation found inside the window [%g, %g] s", w.t0_s, w.t1_s);
     return w;
   }
@@ -802,15 +809,12 @@ std::vector<AngleExtreme> AngleExtremes(const std::vector<double>& t, const std:
 }
 
 bool AmplitudeBandOptions::Check(std::string* why) const {
-  if (!(min_amplitude_deg >= 0.0 && max_amplitude_deg > min_amplitude_deg)) {
-    *why = "amplitude band: need 0 <= min_amplitude_deg < max_amplitude_deg";
-    return false;
-  }
-  if (!(min_periods > 0.0)) {
-    *why = "amplitude band: min_periods must be > 0";
-    return false;
-  }
-  return true;
+  CheckFailure f;
+  const bool ok =
+      CheckGe("min_amplitude_deg", min_amplitude_deg, 0, &f) &&
+      CheckGt("max_amplitude_deg", max_amplitude_deg, "min_amplitude_deg", min_amplitude_deg, &f) &&
+      CheckGt("min_periods", min_periods, 0, &f);
+  return ok || FailWith(f, why, "amplitude band: ");
 }
 
 AmplitudeBand TrimToAmplitudeBand(const std::vector<double>& t, const std::vector<double>& r,

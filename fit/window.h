@@ -75,6 +75,9 @@ const char* ToString(WindowEnd end);        // "log_end", "noise_floor", "stoppe
 struct FreeOscillationWindow {
   WindowStatus status = WindowStatus::kRejected;
   std::string message;  // why rejected / error, naming the log; empty when ok
+  // Rejected because no oscillation was found at all (the message says "no oscillation found"):
+  // callers act on this (pipeline/trace/trace_process.cc's time-unit hint), never on the text.
+  bool no_oscillation_found = false;
   double t0_s = 0.0, t1_s = 0.0;        // the window (s, the log's own time)
   size_t first_index = 0, last_index = 0;  // samples with t0 <= t <= t1 (inclusive)
   WindowEnd end_reason = WindowEnd::kLogEnd;

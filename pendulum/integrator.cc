@@ -30,6 +30,7 @@
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include "base/enum_names.h"
+#include "base/option_check.h"
 #include "pendulum/dop853.h"
 
 namespace bifilar {
@@ -99,25 +100,13 @@ const std::vector<std::string>& IntegratorMethodNames() {
 std::string IntegratorMethodAllowedValues() { return EnumAllowedValues(kIntegratorMethodNames); }
 
 bool IntegratorOptions::Check(std::string* why) const {
-  if (!std::isfinite(rel_tol) || !(rel_tol > 0.0) || !(rel_tol <= 1e-2)) {
-    std::ostringstream os;
-    os << "rel_tol must be in (0, 1e-2], got " << rel_tol;
-    return Fail(why, os.str());
-  }
-  if (!std::isfinite(abs_tol) || !(abs_tol > 0.0)) {
-    std::ostringstream os;
-    os << "abs_tol must be finite and > 0, got " << abs_tol;
-    return Fail(why, os.str());
-  }
-  if (max_steps <= 0) {
-    std::ostringstream os;
-    os << "max_steps must be > 0, got " << max_steps;
-    return Fail(why, os.str());
-  }
-  if (method != IntegratorMethod::kRungeKutta && method != IntegratorMethod::kCvodes) {
-    return Fail(why, "method must be kRungeKutta or kCvodes");
-  }
-  return true;
+  CheckFailure f;
+  const bool ok =
+      CheckIn("rel_tol", rel_tol, 0, 1e-2, Ends::kOpenClosed, &f) &&
+      CheckFiniteGt("abs_tol", abs_tol, 0, &f) && CheckGt("max_steps", max_steps, 0, &f) &&
+      ((method == IntegratorMethod::kRungeKutta || method == IntegratorMethod::kCvodes) ||
+       CheckFail("method", static_cast<double>(method), "kRungeKutta or kCvodes", &f));
+  return ok || FailWith(f, why);
 }
 
 // One CVODE instance on the 2-component state (Sens = false) or the 12-component augmented

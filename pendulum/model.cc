@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "base/enum_names.h"
+#include "base/option_check.h"
 #include "base/units.h"
 
 namespace bifilar {
@@ -50,18 +51,6 @@ Rise ComputeRise(const RigGeometry& g, double psi, bool want_d3) {
 // Linear (small-angle) stiffness per unit mass g D^2 / (4 L) (m^2/s^2 per rad).
 double LinearStiffnessPerMass(const RigGeometry& g) {
   return g.gravity_mps2 * g.filar_separation_m * g.filar_separation_m / (4.0 * g.filar_length_m);
-}
-
-bool Fail(std::string* why, const std::string& message) {
-  if (why != nullptr) *why = message;
-  return false;
-}
-
-std::string Num(double v) {
-  std::ostringstream os;
-  os.precision(12);
-  os << v;
-  return os.str();
 }
 
 }  // namespace
@@ -111,43 +100,33 @@ std::string PendulumModelAllowedValues() { return JoinAllowedValues(PendulumMode
 
 bool CheckSeparationBelowLength(double filar_length_m, double filar_separation_m,
                                 std::string* why) {
-  if (filar_length_m > filar_separation_m) return true;
-  return Fail(why, "filar_separation_m (D) = " + Num(filar_separation_m) +
-                       " m is not below filar_length_m (L) = " + Num(filar_length_m) +
-                       " m (the wires would go slack); allowed D < L");
+  if (filar_separation_m < filar_length_m) return true;
+  CheckFailure f;
+  CheckFail(
+      "filar_separation_m (D)", filar_separation_m,
+      "< filar_length_m (L) = " + FormatCheckValue(filar_length_m) + " (the wires would go slack)",
+      &f);
+  return FailWith(f, why);
 }
 
 bool RigGeometry::Check(std::string* why) const {
-  if (!std::isfinite(filar_length_m) || !(filar_length_m > 0.0)) {
-    return Fail(why, "filar_length_m (L) must be finite and > 0 m, got " + Num(filar_length_m));
-  }
-  if (!std::isfinite(filar_separation_m) || !(filar_separation_m > 0.0)) {
-    return Fail(why, "filar_separation_m (D) must be finite and > 0 m, got " +
-                         Num(filar_separation_m));
+  CheckFailure f;
+  if (!CheckFiniteGt("filar_length_m (L)", filar_length_m, 0, &f) ||
+      !CheckFiniteGt("filar_separation_m (D)", filar_separation_m, 0, &f)) {
+    return FailWith(f, why);
   }
   if (!CheckSeparationBelowLength(filar_length_m, filar_separation_m, why)) return false;
-  if (!std::isfinite(mass_kg) || !(mass_kg > 0.0)) {
-    return Fail(why, "mass_kg (m) must be finite and > 0 kg, got " + Num(mass_kg));
-  }
-  if (!std::isfinite(gravity_mps2) || !(gravity_mps2 > 0.0)) {
-    return Fail(why, "gravity_mps2 (g) must be finite and > 0 m/s^2, got " + Num(gravity_mps2));
-  }
-  return true;
+  return (CheckFiniteGt("mass_kg (m)", mass_kg, 0, &f) &&
+          CheckFiniteGt("gravity_mps2 (g)", gravity_mps2, 0, &f)) ||
+         FailWith(f, why);
 }
 
 bool PendulumParams::Check(std::string* why) const {
-  if (!std::isfinite(inertia_kg_m2) || !(inertia_kg_m2 > 0.0)) {
-    return Fail(why, "inertia_kg_m2 (I) must be finite and > 0 kg m^2, got " + Num(inertia_kg_m2));
-  }
-  if (!std::isfinite(drag_coeff_kg_m2) || !(drag_coeff_kg_m2 >= 0.0)) {
-    return Fail(why, "drag_coeff_kg_m2 (K_D) must be finite and >= 0 kg m^2, got " +
-                         Num(drag_coeff_kg_m2));
-  }
-  if (!std::isfinite(viscous_coeff_kg_m2_per_s) || !(viscous_coeff_kg_m2_per_s >= 0.0)) {
-    return Fail(why, "viscous_coeff_kg_m2_per_s (C) must be finite and >= 0 kg m^2/s, got " +
-                         Num(viscous_coeff_kg_m2_per_s));
-  }
-  return true;
+  CheckFailure f;
+  return (CheckFiniteGt("inertia_kg_m2 (I)", inertia_kg_m2, 0, &f) &&
+          CheckFiniteGe("drag_coeff_kg_m2 (K_D)", drag_coeff_kg_m2, 0, &f) &&
+          CheckFiniteGe("viscous_coeff_kg_m2_per_s (C)", viscous_coeff_kg_m2_per_s, 0, &f)) ||
+         FailWith(f, why);
 }
 
 double RiseHeight(const RigGeometry& geometry, double angle_rad) {

@@ -11,6 +11,8 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "base/option_check.h"
+#include "base/text_format.h"
 #include "base/units.h"
 
 namespace bifilar {
@@ -34,38 +36,16 @@ class Rng {
   std::mt19937_64 engine_;
 };
 
-std::string Num(double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%g", value);
-  return buffer;
-}
+// An angle (rad) in degrees as a message shows it: 12 digits, so that 120 deg given reads 120.
+double ShownDeg(double rad) { return std::stod(Fmt("%.12g", rad / kRadPerDeg)); }
 
-bool Fail(std::string* why, const std::string& message) {
-  if (why) *why = message;
-  return false;
-}
-
-bool CheckRange(const UniformRange& r, const char* name, double lower, bool lower_open,
-                std::string* why) {
-  if (!std::isfinite(r.min) || !std::isfinite(r.max)) return Fail(why, std::string(name) + " must be finite");
-  if (r.min > r.max) {
-    return Fail(why, std::string(name) + ": min " + Num(r.min) + " is larger than max " + Num(r.max));
-  }
-  if (lower_open ? !(r.min > lower) : !(r.min >= lower)) {
-    return Fail(why, std::string(name) + " must be " + (lower_open ? "> " : ">= ") + Num(lower) +
-                         " (got " + Num(r.min) + ")");
-  }
-  return true;
-}
-
-bool CheckValue(double value, const char* name, double lower, bool lower_open, double upper,
-                std::string* why) {
-  const bool ok = std::isfinite(value) && (lower_open ? value > lower : value >= lower) &&
-                  value <= upper;
-  if (ok) return true;
-  std::string range = std::string(lower_open ? "(" : "[") + Num(lower) + ", " +
-                      (std::isinf(upper) ? std::string("inf)") : Num(upper) + "]");
-  return Fail(why, std::string(name) + " = " + Num(value) + " is out of range; allowed " + range);
+// A UniformRange [min, max] of `field`: both ends finite, min <= max, min above `lower`.
+bool CheckUniformRange(const UniformRange& r, const std::string& field, double lower,
+                       bool lower_open, CheckFailure* f) {
+  const std::string min = field + ".min", max = field + ".max";
+  return CheckFinite(min, r.min, f) && CheckFinite(max, r.max, f) &&
+         CheckLe(min, r.min, max, r.max, f) &&
+         (lower_open ? CheckGt(min, r.min, lower, f) : CheckGe(min, r.min, lower, f));
 }
 
 // Quintic smoothstep q(s), s in [0,1]: q(0)=0, q(1)=1, zero slope and curvature at both ends.
@@ -126,7 +106,8 @@ bool IntegrateRk4(const TruthDynamics& dyn, double angle0, double rate0,
       v += h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
     }
     now = t[k];
-    if (!std::isfinite(x) || !std::isfinite(v)) return Fail(why, "truth integration (RK4) diverged");
+    if (!std::isfinite(x) || !std::isfinite(v))
+      return SetWhy(why, "truth integration (RK4) diverged");
     (*angle)[k] = x;
     (*rate)[k] = v;
   }
@@ -179,120 +160,116 @@ TimelineOptions FixedTimeline(double rest_s, double twist_s, double hold_s, doub
 }
 
 bool TimelineOptions::Check(std::string* why) const {
-  return CheckRange(rest_before_s, "timeline.rest_before_s", 0.0, false, why) &&
-         CheckRange(twist_s, "timeline.twist_s", 0.0, true, why) &&
-         CheckRange(hold_s, "timeline.hold_s", 0.0, false, why) &&
-         CheckValue(tremor_deg, "timeline.tremor_deg", 0.0, false, 5.0, why) &&
-         CheckRange(tremor_hz, "timeline.tremor_hz", 0.0, true, why) &&
-         CheckValue(release_rate_sigma_deg_per_s, "timeline.release_rate_sigma_deg_per_s", 0.0,
-                    false, 90.0, why) &&
-         CheckRange(free_s, "timeline.free_s", 0.0, true, why) &&
-         CheckValue(free_s.max, "timeline.free_s (max)", 0.0, true, 86400.0, why) &&
-         CheckValue(stop_probability, "timeline.stop_probability", 0.0, false, 1.0, why) &&
-         CheckValue(stop_time_constant_s, "timeline.stop_time_constant_s", 0.0, true, 10.0, why) &&
-         CheckRange(rest_after_s, "timeline.rest_after_s", 0.0, false, why);
+  CheckFailure f;
+  const bool ok =
+      CheckUniformRange(rest_before_s, "timeline.rest_before_s", 0.0, false, &f) &&
+      CheckUniformRange(twist_s, "timeline.twist_s", 0.0, true, &f) &&
+      CheckUniformRange(hold_s, "timeline.hold_s", 0.0, false, &f) &&
+      CheckIn("timeline.tremor_deg", tremor_deg, 0.0, 5.0, Ends::kClosed, &f) &&
+      CheckUniformRange(tremor_hz, "timeline.tremor_hz", 0.0, true, &f) &&
+      CheckIn("timeline.release_rate_sigma_deg_per_s", release_rate_sigma_deg_per_s, 0.0, 90.0,
+              Ends::kClosed, &f) &&
+      CheckUniformRange(free_s, "timeline.free_s", 0.0, true, &f) &&
+      CheckIn("timeline.free_s.max", free_s.max, 0.0, 86400.0, Ends::kOpenClosed, &f) &&
+      CheckIn("timeline.stop_probability", stop_probability, 0.0, 1.0, Ends::kClosed, &f) &&
+      CheckIn("timeline.stop_time_constant_s", stop_time_constant_s, 0.0, 10.0, Ends::kOpenClosed,
+              &f) &&
+      CheckUniformRange(rest_after_s, "timeline.rest_after_s", 0.0, false, &f);
+  return ok || FailWith(f, why);
 }
 
 bool SensorOptions::Check(std::string* why) const {
-  if (!CheckValue(sample_rate_hz, "sensor.sample_rate_hz", 0.0, true, 100000.0, why)) return false;
-  if (!(time_jitter_sigma_s <= 1.0 / sample_rate_hz) && std::isfinite(time_jitter_sigma_s)) {
-    return Fail(why, "sensor.time_jitter_sigma_s = " + Num(time_jitter_sigma_s) +
-                         " s is more than one sample period (1/sensor.sample_rate_hz = " +
-                         Num(1.0 / sample_rate_hz) + " s at " + Num(sample_rate_hz) +
-                         " Hz); lower sensor.time_jitter_sigma_s or the sample rate");
-  }
-  if (!CheckValue(time_jitter_sigma_s, "sensor.time_jitter_sigma_s", 0.0, false,
-                  1.0 / sample_rate_hz, why))
-    return false;
-  if (!CheckValue(step_log_sigma, "sensor.step_log_sigma", 0.0, false, 3.0, why) ||
-      !CheckRange(step_range_s, "sensor.step_range_s", 0.0, true, why) ||
-      !CheckValue(step_range_s.max, "sensor.step_range_s (max)", 0.0, true, 3600.0, why) ||
-      !CheckValue(gyro_noise_ar1_phi, "sensor.gyro_noise_ar1_phi", 0.0, false, 0.99, why) ||
-      !CheckValue(gyro_bias_walk_deg_per_s_per_sqrt_s, "sensor.gyro_bias_walk_deg_per_s_per_sqrt_s",
-                  0.0, false, 10.0, why) ||
-      !CheckValue(spike_count, "sensor.spike_count", 0.0, false, 1000.0, why) ||
-      !CheckValue(spike_rate_rad_per_s, "sensor.spike_rate_rad_per_s", 0.0, true, 1e4, why) ||
-      !CheckRange(gravity_removal_error_deg, "sensor.gravity_removal_error_deg", 0.0, false, why) ||
-      !CheckValue(gravity_removal_error_deg.max, "sensor.gravity_removal_error_deg (max)", 0.0,
-                  false, 30.0, why)) {
-    return false;
-  }
-  if (rocking_frequency_hz > sample_rate_hz / 4.0 && std::isfinite(rocking_frequency_hz)) {
-    return Fail(why, "sensor.rocking_frequency_hz = " + Num(rocking_frequency_hz) +
-                         " Hz is above a quarter of sensor.sample_rate_hz (" +
-                         Num(sample_rate_hz) + " Hz); lower it or raise the sample rate");
-  }
-  return CheckValue(drop_fraction, "sensor.drop_fraction", 0.0, false, 0.5, why) &&
-         CheckValue(drop_burst_probability, "sensor.drop_burst_probability", 0.0, false, 1.0,
-                    why) &&
-         CheckValue(drop_burst_max_samples, "sensor.drop_burst_max_samples", 2.0, false, 100000.0,
-                    why) &&
-         CheckRange(start_time_s, "sensor.start_time_s", -1e9, false, why) &&
-         CheckValue(start_time_s.max, "sensor.start_time_s (max)", -1e9, false, 1e9, why) &&
-         CheckValue(gyro_noise_sigma_deg_per_s, "sensor.gyro_noise_sigma_deg_per_s", 0.0, false,
-                    100.0, why) &&
-         CheckValue(gyro_bias_sigma_deg_per_s, "sensor.gyro_bias_sigma_deg_per_s", 0.0, false,
-                    100.0, why) &&
-         CheckValue(gyro_scale_error_sigma, "sensor.gyro_scale_error_sigma", 0.0, false, 0.2,
-                    why) &&
-         CheckValue(accel_noise_sigma_mps2, "sensor.accel_noise_sigma_mps2", 0.0, false, 10.0,
-                    why) &&
-         CheckValue(accel_bias_sigma_mps2, "sensor.accel_bias_sigma_mps2", 0.0, false, 10.0,
-                    why) &&
-         CheckValue(rocking_max_deg, "sensor.rocking_max_deg", 0.0, false, 10.0, why) &&
-         CheckValue(rocking_frequency_hz, "sensor.rocking_frequency_hz", 0.0, false,
-                    sample_rate_hz / 4.0, why) &&
-         CheckValue(rocking_decay_s, "sensor.rocking_decay_s", 0.0, true, 1e6, why);
+  CheckFailure f;
+  const bool ok =
+      CheckIn("sensor.sample_rate_hz", sample_rate_hz, 0.0, 100000.0, Ends::kOpenClosed, &f) &&
+      // At most one sample period: jitter beyond it would reorder the samples.
+      CheckFiniteGe("sensor.time_jitter_sigma_s", time_jitter_sigma_s, 0.0, &f) &&
+      CheckLe("sensor.time_jitter_sigma_s", time_jitter_sigma_s,
+              "one sample period 1 / sensor.sample_rate_hz", 1.0 / sample_rate_hz, &f) &&
+      CheckIn("sensor.step_log_sigma", step_log_sigma, 0.0, 3.0, Ends::kClosed, &f) &&
+      CheckUniformRange(step_range_s, "sensor.step_range_s", 0.0, true, &f) &&
+      CheckIn("sensor.step_range_s.max", step_range_s.max, 0.0, 3600.0, Ends::kOpenClosed, &f) &&
+      CheckIn("sensor.gyro_noise_ar1_phi", gyro_noise_ar1_phi, 0.0, 0.99, Ends::kClosed, &f) &&
+      CheckIn("sensor.gyro_bias_walk_deg_per_s_per_sqrt_s", gyro_bias_walk_deg_per_s_per_sqrt_s,
+              0.0, 10.0, Ends::kClosed, &f) &&
+      CheckIn("sensor.spike_count", spike_count, 0.0, 1000.0, Ends::kClosed, &f) &&
+      CheckIn("sensor.spike_rate_rad_per_s", spike_rate_rad_per_s, 0.0, 1e4, Ends::kOpenClosed,
+              &f) &&
+      CheckUniformRange(gravity_removal_error_deg, "sensor.gravity_removal_error_deg", 0.0, false,
+                        &f) &&
+      CheckIn("sensor.gravity_removal_error_deg.max", gravity_removal_error_deg.max, 0.0, 30.0,
+              Ends::kClosed, &f) &&
+      CheckLe("sensor.rocking_frequency_hz", rocking_frequency_hz, "sensor.sample_rate_hz / 4",
+              sample_rate_hz / 4.0, &f) &&
+      CheckIn("sensor.drop_fraction", drop_fraction, 0.0, 0.5, Ends::kClosed, &f) &&
+      CheckIn("sensor.drop_burst_probability", drop_burst_probability, 0.0, 1.0, Ends::kClosed,
+              &f) &&
+      CheckIn("sensor.drop_burst_max_samples", drop_burst_max_samples, 2.0, 100000.0, Ends::kClosed,
+              &f) &&
+      CheckUniformRange(start_time_s, "sensor.start_time_s", -1e9, false, &f) &&
+      CheckIn("sensor.start_time_s.max", start_time_s.max, -1e9, 1e9, Ends::kClosed, &f) &&
+      CheckIn("sensor.gyro_noise_sigma_deg_per_s", gyro_noise_sigma_deg_per_s, 0.0, 100.0,
+              Ends::kClosed, &f) &&
+      CheckIn("sensor.gyro_bias_sigma_deg_per_s", gyro_bias_sigma_deg_per_s, 0.0, 100.0,
+              Ends::kClosed, &f) &&
+      CheckIn("sensor.gyro_scale_error_sigma", gyro_scale_error_sigma, 0.0, 0.2, Ends::kClosed,
+              &f) &&
+      CheckIn("sensor.accel_noise_sigma_mps2", accel_noise_sigma_mps2, 0.0, 10.0, Ends::kClosed,
+              &f) &&
+      CheckIn("sensor.accel_bias_sigma_mps2", accel_bias_sigma_mps2, 0.0, 10.0, Ends::kClosed,
+              &f) &&
+      CheckIn("sensor.rocking_max_deg", rocking_max_deg, 0.0, 10.0, Ends::kClosed, &f) &&
+      CheckFiniteGe("sensor.rocking_frequency_hz", rocking_frequency_hz, 0.0, &f) &&
+      CheckIn("sensor.rocking_decay_s", rocking_decay_s, 0.0, 1e6, Ends::kOpenClosed, &f);
+  return ok || FailWith(f, why);
 }
 
 bool SimulationOptions::Check(std::string* why) const {
   std::string integrator_why;
-  if (!integrator.Check(&integrator_why)) return Fail(why, "integrator: " + integrator_why);
-  return timeline.Check(why) && sensor.Check(why) &&
-         CheckValue(negative_amplitude_probability, "negative_amplitude_probability", 0.0, false,
-                    1.0, why) &&
-         CheckValue(sway_coupling_at_60deg, "sway_coupling_at_60deg", 0.0, false, 0.5, why) &&
-         CheckValue(softening_at_30deg, "swing.softening_percent_at_30deg (fraction)", 0.0, false,
-                    0.5, why) &&
-         CheckValue(softening_exponent, "swing.softening_exponent", 1.0, false, 4.0, why);
+  if (!integrator.Check(&integrator_why)) return SetWhy(why, "integrator: " + integrator_why);
+  if (!timeline.Check(why) || !sensor.Check(why)) return false;
+  CheckFailure f;
+  const bool ok =
+      CheckIn("negative_amplitude_probability", negative_amplitude_probability, 0.0, 1.0,
+              Ends::kClosed, &f) &&
+      CheckIn("sway_coupling_at_60deg", sway_coupling_at_60deg, 0.0, 0.5, Ends::kClosed, &f) &&
+      CheckIn("swing.softening_percent_at_30deg (fraction)", softening_at_30deg, 0.0, 0.5,
+              Ends::kClosed, &f) &&
+      CheckIn("swing.softening_exponent", softening_exponent, 1.0, 4.0, Ends::kClosed, &f);
+  return ok || FailWith(f, why);
 }
 
 bool TraceSetup::Check(std::string* why) const {
   const RigGeometry& g = geometry;
-  if (!CheckValue(g.filar_length_m, "filar_length_m (L)", 0.0, true, 1000.0, why) ||
-      !CheckValue(g.filar_separation_m, "filar_separation_m (D)", 0.0, true, 1000.0, why) ||
-      !CheckValue(g.mass_kg, "mass_kg (whole suspended mass)", 0.0, true, 1e6, why) ||
-      !CheckValue(g.gravity_mps2, "gravity_mps2", 0.0, true, 100.0, why) ||
-      !CheckValue(params.inertia_kg_m2, "inertia_kg_m2 (whole suspended inertia)", 0.0, true,
-                  1e9, why) ||
-      !CheckValue(params.drag_coeff_kg_m2, "drag_coeff_kg_m2 (K_D)", 0.0, false, 1e9, why) ||
-      !CheckValue(params.viscous_coeff_kg_m2_per_s, "viscous_coeff_kg_m2_per_s (C)", 0.0, false,
-                  1e9, why)) {
-    return false;
-  }
+  CheckFailure f;
+  const bool in_range =
+      CheckIn("filar_length_m (L)", g.filar_length_m, 0.0, 1000.0, Ends::kOpenClosed, &f) &&
+      CheckIn("filar_separation_m (D)", g.filar_separation_m, 0.0, 1000.0, Ends::kOpenClosed, &f) &&
+      CheckIn("mass_kg (whole suspended mass)", g.mass_kg, 0.0, 1e6, Ends::kOpenClosed, &f) &&
+      CheckIn("gravity_mps2", g.gravity_mps2, 0.0, 100.0, Ends::kOpenClosed, &f) &&
+      CheckIn("inertia_kg_m2 (whole suspended inertia)", params.inertia_kg_m2, 0.0, 1e9,
+              Ends::kOpenClosed, &f) &&
+      CheckIn("drag_coeff_kg_m2 (K_D)", params.drag_coeff_kg_m2, 0.0, 1e9, Ends::kClosed, &f) &&
+      CheckIn("viscous_coeff_kg_m2_per_s (C)", params.viscous_coeff_kg_m2_per_s, 0.0, 1e9,
+              Ends::kClosed, &f);
+  if (!in_range) return FailWith(f, why);
   if (!CheckSeparationBelowLength(g.filar_length_m, g.filar_separation_m, why)) return false;
-  if (!std::isfinite(pitch_rad) || std::abs(pitch_rad) > kPi / 2 + 1e-9) {
-    return Fail(why, "pitch = " + Num(pitch_rad / kRadPerDeg) +
-                         " deg is out of range; allowed [-90, 90]");
-  }
-  if (!std::isfinite(roll_rad) || std::abs(roll_rad) > kPi + 1e-9) {
-    return Fail(why, "roll = " + Num(roll_rad / kRadPerDeg) +
-                         " deg is out of range; allowed [-180, 180]");
-  }
-  if (!std::isfinite(amplitude_rad) || amplitude_rad == 0.0 ||
-      std::abs(amplitude_rad) >= 89 * kRadPerDeg) {
-    return Fail(why, "amplitude = " + Num(amplitude_rad / kRadPerDeg) +
-                         " deg is out of range; allowed 0 < |amplitude| < 89 deg");
-  }
-  if (!body_from_imu.allFinite() ||
-      (body_from_imu.transpose() * body_from_imu - Eigen::Matrix3d::Identity()).norm() > 1e-6 ||
-      body_from_imu.determinant() < 0) {
-    return Fail(why, "IMU mounting (body_from_imu) must be a rotation matrix");
-  }
-  if (!imu_offset_in_body_m.allFinite() || imu_offset_in_body_m.norm() > 100.0) {
-    return Fail(why, "IMU offset must be finite and within 100 m of the CG");
-  }
-  return true;
+  // The angles are shown in degrees; the bounds hold to 1e-9 rad.
+  const double orthogonality =
+      (body_from_imu.transpose() * body_from_imu - Eigen::Matrix3d::Identity()).norm();
+  const bool ok =
+      ((std::isfinite(pitch_rad) && std::abs(pitch_rad) <= kPi / 2 + 1e-9) ||
+       CheckFail("pitch_deg", ShownDeg(pitch_rad), "in [-90, 90]", &f)) &&
+      ((std::isfinite(roll_rad) && std::abs(roll_rad) <= kPi + 1e-9) ||
+       CheckFail("roll_deg", ShownDeg(roll_rad), "in [-180, 180]", &f)) &&
+      ((std::isfinite(amplitude_rad) && amplitude_rad != 0.0 &&
+        std::abs(amplitude_rad) < 89 * kRadPerDeg) ||
+       CheckFail("amplitude_deg", ShownDeg(amplitude_rad), "0 < |amplitude_deg| < 89", &f)) &&
+      // A rotation matrix: orthonormal (to 1e-6), determinant +1.
+      CheckLe("|body_from_imu^T body_from_imu - I|", orthogonality, 1e-6, &f) &&
+      CheckGt("det(body_from_imu)", body_from_imu.determinant(), 0, &f) &&
+      CheckLe("|imu_offset_in_body_m|", imu_offset_in_body_m.norm(), 100.0, &f);
+  return ok || FailWith(f, why);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -384,12 +361,12 @@ bool MakeTimeline(const RandomInputs& in, const SimulationOptions& options, Time
       tm.lognormal ? std::floor((tm.t_end - in.start_time) / so.step_range_s.min) + 1.0
                    : std::floor((tm.t_end - in.start_time) * so.sample_rate_hz) + 1.0;
   if (tm.samples_real > 5e7) {
-    return Fail(why, "log too long: up to " + Num(tm.samples_real) + " samples (" +
-                         Num(tm.t_end - in.start_time) + " s at " +
-                         (tm.lognormal ? "steps down to " + Num(so.step_range_s.min) + " s"
-                                       : Num(so.sample_rate_hz) + " Hz") +
-                         "); the limit is 5e7: shorten timeline.free_s or lower "
-                         "sensor.sample_rate_hz");
+    return SetWhy(why, "log too long: up to " + Fmt("%g", tm.samples_real) + " samples (" +
+                           Fmt("%g", tm.t_end - in.start_time) + " s at " +
+                           (tm.lognormal ? "steps down to " + Fmt("%g", so.step_range_s.min) + " s"
+                                         : Fmt("%g", so.sample_rate_hz) + " Hz") +
+                           "); the limit is 5e7: shorten timeline.free_s or lower "
+                           "sensor.sample_rate_hz");
   }
   return true;
 }
@@ -442,7 +419,7 @@ bool SampleTimes(const SensorOptions& so, double start_time, const Timeline& tm,
     times.push_back(tm.lognormal ? irregular[k] : start_time + k * dt + jitter);
   }
   samples->dropped = dropped;
-  if (times.size() < 2) return Fail(why, "the log would have fewer than 2 samples");
+  if (times.size() < 2) return SetWhy(why, "the log would have fewer than 2 samples");
   return true;
 }
 
@@ -493,7 +470,7 @@ bool HandBeforeRelease(const TraceSetup& setup, const RandomInputs& in, const Ti
     }
   }
   if (samples->free_index.size() < 2) {
-    return Fail(why, "the free oscillation has fewer than 2 samples");
+    return SetWhy(why, "the free oscillation has fewer than 2 samples");
   }
   samples->free_times.push_back(tm.t_stop);  // the state at the stop starts the hand's deceleration
   return true;
@@ -514,11 +491,12 @@ bool AddTruthDiscrepancies(const TraceSetup& setup, const SimulationOptions& opt
     const double amplitude = setup.amplitude_rad;
     const double weakening = dyn.soft_k * std::pow(std::abs(amplitude), dyn.soft_p);
     if (weakening > 0.5) {
-      return Fail(why, "swing.softening_percent_at_30deg = " + Num(100 * options.softening_at_30deg) +
-                           " with swing.softening_exponent = " + Num(dyn.soft_p) + " removes " +
-                           Num(100 * weakening) + " % of the restoring torque at the amplitude " +
-                           Num(std::abs(amplitude) / kRadPerDeg) +
-                           " deg (at most 50 % allowed); lower the softening or the amplitude");
+      return SetWhy(
+          why, "swing.softening_percent_at_30deg = " + Fmt("%g", 100 * options.softening_at_30deg) +
+                   " with swing.softening_exponent = " + Fmt("%g", dyn.soft_p) + " removes " +
+                   Fmt("%g", 100 * weakening) + " % of the restoring torque at the amplitude " +
+                   Fmt("%g", std::abs(amplitude) / kRadPerDeg) +
+                   " deg (at most 50 % allowed); lower the softening or the amplitude");
     }
   }
   return true;
@@ -537,7 +515,7 @@ bool IntegrateFreeSwing(const TraceSetup& setup, const SimulationOptions& option
     std::string integrator_why;
     if (!integrator.Integrate(setup.params, amplitude, release_rate, free_times, false, &trajectory,
                               &integrator_why)) {
-      return Fail(why, "integration of the free oscillation failed: " + integrator_why);
+      return SetWhy(why, "integration of the free oscillation failed: " + integrator_why);
     }
     *free_angle = trajectory.angle_rad;
     *free_rate = trajectory.rate_rad_per_s;
@@ -545,7 +523,7 @@ bool IntegrateFreeSwing(const TraceSetup& setup, const SimulationOptions& option
     return false;
   }
   if (free_angle->size() != free_times.size() || free_rate->size() != free_times.size()) {
-    return Fail(why, "integrator returned the wrong number of samples");
+    return SetWhy(why, "integrator returned the wrong number of samples");
   }
   return true;
 }
@@ -712,9 +690,9 @@ bool AddSpikes(const SensorOptions& so, uint64_t seed, const SwingFrame& f,
   const std::vector<size_t>& free_index = samples.free_index;
   const size_t n = times.size();
   if (static_cast<size_t>(so.spike_count) * 2 > n) {
-    return Fail(why, "sensor.spike_count = " + std::to_string(so.spike_count) +
-                         " is more than half the log's " + std::to_string(n) +
-                         " samples; lower it");
+    return SetWhy(why, "sensor.spike_count = " + std::to_string(so.spike_count) +
+                           " is more than half the log's " + std::to_string(n) +
+                           " samples; lower it");
   }
   TraceTruth& truth = out->truth;
   Rng spike_rng(DeriveSeed(seed, "spikes"));
@@ -746,7 +724,7 @@ bool CheckFinite(const SensorOptions& so, const SimulatedTrace& out, std::string
   for (size_t k = 0; k < times.size(); ++k) {
     if (!out.imu.gyro_in_imu[k].allFinite() ||
         (so.accelerometer && !out.imu.accel_in_imu[k].allFinite()) || !std::isfinite(times[k])) {
-      return Fail(why, "simulation produced a non-finite value (check the parameters)");
+      return SetWhy(why, "simulation produced a non-finite value (check the parameters)");
     }
   }
   return true;
@@ -841,37 +819,44 @@ double AircraftTruth::PrincipalInclinationRad() const {
 }
 
 bool AircraftTruth::Check(std::string* why) const {
-  if (!CheckValue(mass_kg, "aircraft.mass_kg", 0.0, true, 1e6, why) ||
-      !CheckValue(ix_kg_m2, "aircraft I_x", 0.0, true, 1e9, why) ||
-      !CheckValue(iz_kg_m2, "aircraft I_z", 0.0, true, 1e9, why) ||
-      !CheckValue(ixz_kg_m2, "aircraft I_xz", -1e9, false, 1e9, why)) {
-    return false;
+  CheckFailure f;
+  if (!CheckIn("aircraft.mass_kg", mass_kg, 0.0, 1e6, Ends::kOpenClosed, &f) ||
+      !CheckIn("aircraft I_x", ix_kg_m2, 0.0, 1e9, Ends::kOpenClosed, &f) ||
+      !CheckIn("aircraft I_z", iz_kg_m2, 0.0, 1e9, Ends::kOpenClosed, &f) ||
+      !CheckIn("aircraft I_xz", ixz_kg_m2, -1e9, 1e9, Ends::kClosed, &f)) {
+    return FailWith(f, why);
   }
   if (HasTensor()) {
-    if (!CheckValue(iy_kg_m2, "aircraft I_y", 0.0, true, 1e9, why) ||
-        !CheckValue(ixy_kg_m2, "aircraft I_xy", -1e9, false, 1e9, why) ||
-        !CheckValue(iyz_kg_m2, "aircraft I_yz", -1e9, false, 1e9, why)) {
-      return false;
+    if (!CheckIn("aircraft I_y", iy_kg_m2, 0.0, 1e9, Ends::kOpenClosed, &f) ||
+        !CheckIn("aircraft I_xy", ixy_kg_m2, -1e9, 1e9, Ends::kClosed, &f) ||
+        !CheckIn("aircraft I_yz", iyz_kg_m2, -1e9, 1e9, Ends::kClosed, &f)) {
+      return FailWith(f, why);
     }
     const Eigen::Vector3d m = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Tensor()).eigenvalues();
-    if (!(m(0) > 0)) {
-      return Fail(why, "aircraft products of inertia are too large: the tensor is not positive "
-                       "definite (smallest principal moment " + Num(m(0)) + " kg m^2)");
-    }
-    if (!(m(2) <= m(0) + m(1))) {
-      return Fail(why, "aircraft tensor breaks the triangle inequality of principal moments (" +
-                           Num(m(2)) + " > " + Num(m(0)) + " + " + Num(m(1)) +
-                           "): no rigid body has it");
+    // Positive definite (else the products of inertia are too large), and the triangle
+    // inequality of the principal moments (else no rigid body has the tensor).
+    if (!CheckGt("aircraft smallest principal moment (products of inertia too large)", m(0), 0,
+                 &f) ||
+        !CheckLe("aircraft largest principal moment", m(2),
+                 "the sum of the other two (triangle "
+                 "inequality)",
+                 m(0) + m(1), &f)) {
+      return FailWith(f, why);
     }
   } else if (ixy_kg_m2 != 0.0 || iyz_kg_m2 != 0.0) {
-    return Fail(why, "aircraft I_xy or I_yz given without I_y (iy_kg_m2)");
+    const bool xy = ixy_kg_m2 != 0.0;
+    CheckFail(xy ? "aircraft I_xy" : "aircraft I_yz", xy ? ixy_kg_m2 : iyz_kg_m2,
+              "0 without I_y (iy_kg_m2)", &f);
+    return FailWith(f, why);
   }
   // Smallest value of I(theta) = A - sqrt(B^2 + C^2) must be positive.
   const double a = 0.5 * (ix_kg_m2 + iz_kg_m2), b = 0.5 * (iz_kg_m2 - ix_kg_m2);
   if (a - std::hypot(b, ixz_kg_m2) <= 0) {
-    return Fail(why, "aircraft I_xz = " + Num(ixz_kg_m2) +
-                         " is too large: the inertia about some axis would be <= 0; allowed "
-                         "|I_xz| < sqrt(I_x I_z)");
+    CheckFail("aircraft I_xz", ixz_kg_m2,
+              "|I_xz| < sqrt(I_x I_z) = " + FormatCheckValue(std::sqrt(ix_kg_m2 * iz_kg_m2)) +
+                  " (else the inertia about some axis would be <= 0)",
+              &f);
+    return FailWith(f, why);
   }
   return true;
 }
@@ -891,17 +876,19 @@ bool RigTruth::InertiaAtPitch(double nominal_pitch_deg, double* inertia) const {
 }
 
 bool RigTruth::Check(std::string* why) const {
-  if (!CheckValue(mass_kg, "rig.mass_kg", 0.0, true, 1e6, why) ||
-      !CheckValue(imu_mass_kg, "rig.imu_mass_kg", 0.0, false, 1e3, why)) {
-    return false;
+  CheckFailure f;
+  if (!CheckIn("rig.mass_kg", mass_kg, 0.0, 1e6, Ends::kOpenClosed, &f) ||
+      !CheckIn("rig.imu_mass_kg", imu_mass_kg, 0.0, 1e3, Ends::kClosed, &f)) {
+    return FailWith(f, why);
   }
   if (inertia_by_pitch_kg_m2.empty()) {
-    if (!CheckValue(inertia_kg_m2, "rig.inertia_kg_m2", 0.0, true, 1e9, why)) return false;
+    if (!CheckIn("rig.inertia_kg_m2", inertia_kg_m2, 0.0, 1e9, Ends::kOpenClosed, &f))
+      return FailWith(f, why);
   } else {
     for (const auto& entry : inertia_by_pitch_kg_m2) {
-      if (!CheckValue(entry.second, ("rig.inertia_by_pitch_kg_m2 at " + Num(entry.first) + " deg").c_str(),
-                      0.0, true, 1e9, why)) {
-        return false;
+      if (!CheckIn("rig.inertia_by_pitch_kg_m2 at " + Fmt("%g", entry.first) + " deg", entry.second,
+                   0.0, 1e9, Ends::kOpenClosed, &f)) {
+        return FailWith(f, why);
       }
     }
   }
@@ -910,93 +897,108 @@ bool RigTruth::Check(std::string* why) const {
 
 bool CampaignSpec::Check(std::string* why) const {
   if (!aircraft.Check(why) || !rig.Check(why)) return false;
-  if (!CheckValue(filar_length_m, "filar_length_m (L)", 0.0, true, 1000.0, why) ||
-      !CheckValue(filar_separation_m, "filar_separation_m (D)", 0.0, true, 1000.0, why) ||
-      !CheckValue(gravity_mps2, "gravity_mps2", 0.0, true, 100.0, why)) {
-    return false;
+  CheckFailure f;
+  const auto fail = [&](const std::string& field, double value, const std::string& allowed) {
+    CheckFail(field, value, allowed, &f);
+    return FailWith(f, why);
+  };
+  const std::string kTablePitch = "a pitch of rig.inertia_by_pitch_kg_m2";
+  if (!CheckIn("filar_length_m (L)", filar_length_m, 0.0, 1000.0, Ends::kOpenClosed, &f) ||
+      !CheckIn("filar_separation_m (D)", filar_separation_m, 0.0, 1000.0, Ends::kOpenClosed, &f) ||
+      !CheckIn("gravity_mps2", gravity_mps2, 0.0, 100.0, Ends::kOpenClosed, &f)) {
+    return FailWith(f, why);
   }
   if (!CheckSeparationBelowLength(filar_length_m, filar_separation_m, why)) return false;
-  if (!(TrueLengthM() > TrueSeparationM()) || !(true_filar_length_m >= 0.0) ||
-      !(true_filar_separation_m >= 0.0) || !std::isfinite(true_filar_length_m) ||
-      !std::isfinite(true_filar_separation_m)) {
-    return Fail(why, "true_filar_length_m = " + Num(TrueLengthM()) +
-                         " must be greater than true_filar_separation_m = " +
-                         Num(TrueSeparationM()) + " > 0 (the wires would go slack)");
+  // The true geometry (0: the configured one) keeps the wires taut.
+  if (!CheckFiniteGe("true_filar_length_m", true_filar_length_m, 0.0, &f) ||
+      !CheckFiniteGe("true_filar_separation_m", true_filar_separation_m, 0.0, &f) ||
+      !CheckGt("true_filar_length_m (0: filar_length_m)", TrueLengthM(),
+               "true_filar_separation_m (0: filar_separation_m)", TrueSeparationM(), &f)) {
+    return FailWith(f, why);
   }
   if (calibration_logs > 0) {
-    if (!CheckValue(reference_inertia_kg_m2, "calibration.reference_inertia_kg_m2", 0.0, true,
-                    1e9, why) ||
-        !CheckValue(reference_mass_kg, "calibration.reference_mass_kg", 0.0, true, 1e6, why)) {
-      return false;
+    if (!CheckIn("calibration.reference_inertia_kg_m2", reference_inertia_kg_m2, 0.0, 1e9,
+                 Ends::kOpenClosed, &f) ||
+        !CheckIn("calibration.reference_mass_kg", reference_mass_kg, 0.0, 1e6, Ends::kOpenClosed,
+                 &f)) {
+      return FailWith(f, why);
     }
     if (calibration_amplitude_deg.max > 0.0 &&
-        (!CheckRange(calibration_amplitude_deg, "calibration.amplitude_deg", 0.0, true, why) ||
-         !CheckValue(calibration_amplitude_deg.max, "calibration.amplitude_deg (max)", 0.0, true,
-                     75.0, why))) {
-      return false;
+        (!CheckUniformRange(calibration_amplitude_deg, "calibration.amplitude_deg", 0.0, true,
+                            &f) ||
+         !CheckIn("calibration.amplitude_deg.max", calibration_amplitude_deg.max, 0.0, 75.0,
+                  Ends::kOpenClosed, &f))) {
+      return FailWith(f, why);
     }
     double unused;
     if (!rig.InertiaAtPitch(tare_pitch_deg, &unused)) {
-      return Fail(why, "rig.inertia_by_pitch_kg_m2 has no entry for the tare pitch " +
-                           Num(tare_pitch_deg) + " deg (the reference swings' rig pitch)");
+      return fail("tare_pitch_deg", tare_pitch_deg, kTablePitch + " (the reference swings')");
     }
   }
   if (!attitudes_deg.empty()) {
-    if (!pitch_deg.empty()) return Fail(why, "give either pitch_deg or attitudes_deg, not both");
+    if (!pitch_deg.empty()) {
+      return fail("pitch_deg (count)", static_cast<double>(pitch_deg.size()),
+                  "0 with attitudes_deg (give either, not both)");
+    }
     if (!aircraft.HasTensor()) {
-      return Fail(why, "attitudes_deg (a campaign that rolls) needs the whole tensor: aircraft "
-                       "iy_kg_m2 (and ixy_kg_m2, iyz_kg_m2 when not 0)");
+      return fail("aircraft iy_kg_m2", aircraft.iy_kg_m2,
+                  "given with attitudes_deg: a campaign that rolls needs the whole tensor (and "
+                  "ixy_kg_m2, iyz_kg_m2 when not 0)");
     }
     for (size_t i = 0; i < attitudes_deg.size(); ++i) {
       const std::array<double, 2>& a = attitudes_deg[i];
-      if (!CheckValue(a[0], "attitudes_deg roll", -180.0, false, 180.0, why) ||
-          !CheckValue(a[1], "attitudes_deg pitch", -90.0, false, 90.0, why)) {
-        return false;
+      if (!CheckIn("attitudes_deg roll", a[0], -180.0, 180.0, Ends::kClosed, &f) ||
+          !CheckIn("attitudes_deg pitch", a[1], -90.0, 90.0, Ends::kClosed, &f)) {
+        return FailWith(f, why);
       }
       for (size_t j = 0; j < i; ++j) {
         if (AttitudeFolder(attitudes_deg[j]) == AttitudeFolder(a)) {
-          return Fail(why, "attitudes_deg: roll " + Num(a[0]) + ", pitch " + Num(a[1]) +
-                               " appears twice");
+          CheckFailText("attitudes_deg", "roll " + Fmt("%g", a[0]) + ", pitch " + Fmt("%g", a[1]),
+                        "distinct attitudes (it appears twice)", &f);
+          return FailWith(f, why);
         }
       }
       double unused;
       if (!rig.InertiaAtPitch(a[1], &unused)) {
-        return Fail(why, "rig.inertia_by_pitch_kg_m2 has no entry for pitch " + Num(a[1]) + " deg");
+        return fail("attitudes_deg pitch", a[1], kTablePitch);
       }
     }
-    if (!CheckValue(roll_error_sigma_deg, "roll_error_sigma_deg", 0.0, false, 10.0, why)) {
-      return false;
+    if (!CheckIn("roll_error_sigma_deg", roll_error_sigma_deg, 0.0, 10.0, Ends::kClosed, &f)) {
+      return FailWith(f, why);
     }
   }
   if (pitch_deg.empty() && attitudes_deg.empty() && tare_logs == 0) {
-    return Fail(why, "pitch_deg: no pitch angles and no tare logs");
+    return fail("pitch_deg (count)", 0, "> 0 (or attitudes_deg, or tare_logs > 0)");
   }
   for (size_t i = 0; i < pitch_deg.size(); ++i) {
-    if (!CheckValue(pitch_deg[i], "pitch_deg", -90.0, false, 90.0, why)) return false;
+    if (!CheckIn("pitch_deg", pitch_deg[i], -90.0, 90.0, Ends::kClosed, &f))
+      return FailWith(f, why);
     for (size_t j = 0; j < i; ++j) {
       if (FormatPitchDeg(pitch_deg[j]) == FormatPitchDeg(pitch_deg[i])) {
-        return Fail(why, "pitch_deg: " + Num(pitch_deg[i]) + " appears twice");
+        return fail("pitch_deg", pitch_deg[i], "distinct (it appears twice)");
       }
     }
     double unused;
     if (!rig.InertiaAtPitch(pitch_deg[i], &unused)) {
-      return Fail(why, "rig.inertia_by_pitch_kg_m2 has no entry for pitch " + Num(pitch_deg[i]) + " deg");
+      return fail("pitch_deg", pitch_deg[i], kTablePitch);
     }
   }
   double unused;
   if (tare_logs > 0 && !rig.InertiaAtPitch(tare_pitch_deg, &unused)) {
-    return Fail(why, "rig.inertia_by_pitch_kg_m2 has no entry for the tare pitch " + Num(tare_pitch_deg) + " deg");
+    return fail("tare_pitch_deg", tare_pitch_deg, kTablePitch);
   }
-  return CheckValue(trials_per_pitch, "trials_per_pitch", 1.0, false, 1000.0, why) &&
-         CheckValue(tare_logs, "tare_logs", 0.0, false, 1000.0, why) &&
-         CheckValue(calibration_logs, "calibration.logs", 0.0, false, 1000.0, why) &&
-         CheckValue(tare_pitch_deg, "tare_pitch_deg", -90.0, false, 90.0, why) &&
-         CheckValue(pitch_error_sigma_deg, "pitch_error_sigma_deg", 0.0, false, 10.0, why) &&
-         CheckRange(amplitude_deg, "amplitude_deg", 0.0, true, why) &&
-         CheckValue(amplitude_deg.max, "amplitude_deg (max)", 0.0, true, 85.0, why) &&
-         CheckRange(drag_coeff_kg_m2, "drag_coeff_kg_m2", 0.0, false, why) &&
-         CheckRange(viscous_coeff_kg_m2_per_s, "viscous_coeff_kg_m2_per_s", 0.0, false, why) &&
-         CheckValue(tare_damping_scale, "rig.tare_damping_scale", 0.0, false, 1.0, why);
+  return (CheckIn("trials_per_pitch", trials_per_pitch, 1.0, 1000.0, Ends::kClosed, &f) &&
+          CheckIn("tare_logs", tare_logs, 0.0, 1000.0, Ends::kClosed, &f) &&
+          CheckIn("calibration.logs", calibration_logs, 0.0, 1000.0, Ends::kClosed, &f) &&
+          CheckIn("tare_pitch_deg", tare_pitch_deg, -90.0, 90.0, Ends::kClosed, &f) &&
+          CheckIn("pitch_error_sigma_deg", pitch_error_sigma_deg, 0.0, 10.0, Ends::kClosed, &f) &&
+          CheckUniformRange(amplitude_deg, "amplitude_deg", 0.0, true, &f) &&
+          CheckIn("amplitude_deg.max", amplitude_deg.max, 0.0, 85.0, Ends::kOpenClosed, &f) &&
+          CheckUniformRange(drag_coeff_kg_m2, "drag_coeff_kg_m2", 0.0, false, &f) &&
+          CheckUniformRange(viscous_coeff_kg_m2_per_s, "viscous_coeff_kg_m2_per_s", 0.0, false,
+                            &f) &&
+          CheckIn("rig.tare_damping_scale", tare_damping_scale, 0.0, 1.0, Ends::kClosed, &f)) ||
+         FailWith(f, why);
 }
 
 std::string AttitudeFolder(const std::array<double, 2>& roll_pitch_deg) {
@@ -1093,7 +1095,7 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
     s.imu_offset_in_body_m = spec.rig.imu_offset_in_body_m;
     std::string trace_why;
     if (!SimulateTrace(s, options, DeriveSeed(seed, path), &ct.trace, &trace_why)) {
-      return Fail(why, path + ": " + trace_why);
+      return SetWhy(why, path + ": " + trace_why);
     }
     out->push_back(std::move(ct));
     return true;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "base/option_check.h"
 #include "base/units.h"
 #include "fit/tensor.h"
 #include "fit/tensor_plan.h"
@@ -272,19 +273,24 @@ TEST(TensorPlan, BadOptionsSayWhatIsWrong) {
   TensorPlanOptions o = FullRig();
   o.roll_max_deg = 200;
   EXPECT_FALSE(PlanTensor(o, &plan, &why));
-  EXPECT_NE(why.find("roll range"), std::string::npos) << why;
+  EXPECT_EQ(why, "roll_max_deg = 200; must be in [-180, 180]");
   o = FullRig();
   o.sigma_kg_m2 = 0;
   EXPECT_FALSE(PlanTensor(o, &plan, &why));
-  EXPECT_NE(why.find("per-swing std"), std::string::npos) << why;
+  EXPECT_EQ(why, "sigma_kg_m2 = 0; must be > 0 when sigma_relative = 0 (a per-swing std, "
+                 "absolute or relative)");
   o = FullRig();
   o.sigma_relative = 0.01;
   EXPECT_FALSE(PlanTensor(o, &plan, &why));
-  EXPECT_NE(why.find("guess"), std::string::npos) << why;
+  EXPECT_EQ(why, "guess_kg_m2 = \"not given\"; must be given (at least Ixx, Iyy, Izz) with a "
+                 "relative swing std or an attitude error");
   o.guess_given = true;
   o.guess_kg_m2 = {1, 1, 1, 2, 0, 0};  // |Ixy| > the moments: not positive definite
   EXPECT_FALSE(PlanTensor(o, &plan, &why));
-  EXPECT_NE(why.find("not positive definite"), std::string::npos) << why;
+  // The eigenvalue -1 to rounding: the field, the value, the bound.
+  EXPECT_EQ(why.rfind("smallest principal moment of guess_kg_m2 = -0.99999", 0), 0u) << why;
+  EXPECT_NE(why.find("; must be > 0 (check the products' signs and sizes)"), std::string::npos)
+      << why;
   o = FullRig();
   o.n_orientations = 4;  // fewer than the 6 components the rig can observe
   EXPECT_FALSE(PlanTensor(o, &plan, &why));
@@ -369,13 +375,13 @@ TEST(TensorPlan, TinyAndHugeSigmasGiveTheSameDesignScaled) {
     o.sigma_kg_m2 = sigma;
     TensorPlan plan;
     EXPECT_FALSE(PlanTensor(o, &plan, &why));
-    EXPECT_NE(why.find("per-swing std must be in [0, 1e100] kg m^2"), std::string::npos) << why;
+    EXPECT_EQ(why, "sigma_kg_m2 = " + FormatCheckValue(sigma) + "; must be in [0, 1e+100]");
   }
   TensorPlanOptions huge_guess = rel;
   huge_guess.guess_kg_m2 = {1e300, 1e300, 1e300, 0, 0, 0};
   TensorPlan plan;
   EXPECT_FALSE(PlanTensor(huge_guess, &plan, &why));
-  EXPECT_NE(why.find("guessed tensor"), std::string::npos) << why;
+  EXPECT_EQ(why, "guess_kg_m2 Ixx = 1e+300; must be in [-1e+100, 1e+100]");
 }
 
 }  // namespace

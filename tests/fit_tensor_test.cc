@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include "base/option_check.h"
 #include "base/units.h"
 #include "fit/ellipse.h"
 
@@ -484,6 +485,35 @@ TEST(Tensor, HugeAndTinyDirectionsAreTheirDirectionsAndNonFiniteOnesAreErrors) {
   points[4].nominal_in_body = {INFINITY, 0, 0};
   EXPECT_FALSE(FitTensor(points, options, &a, &why));
   EXPECT_NE(why.find("point 5: the nominal swing axis"), std::string::npos) << why;
+}
+
+// Every bound of TensorOptions (its own and the ellipse fit's it shares) names the field, the
+// value and the bound.
+TEST(TensorOptions, CheckNamesFieldValueAndBound) {
+  std::string why;
+  EXPECT_TRUE(TensorOptions().Check(&why)) << why;
+  TensorOptions o;
+  o.group_tol_deg = 45;
+  EXPECT_FALSE(o.Check(&why));
+  EXPECT_EQ(why, "group_tol_deg = 45; must be in [0, 45)");
+  o = TensorOptions();
+  o.rank_tolerance = 0;
+  EXPECT_FALSE(o.Check(&why));
+  EXPECT_EQ(why, "rank_tolerance = 0; must be in (0, 1)");
+  o = TensorOptions();
+  o.confidence = NAN;
+  EXPECT_FALSE(o.Check(&why));
+  EXPECT_EQ(why, "confidence = nan; must be in (0, 1)");
+  o = TensorOptions();
+  o.bootstrap_replicates = 50;
+  EXPECT_FALSE(o.Check(&why));
+  EXPECT_EQ(why, "bootstrap_replicates = 50; must be 0 (off) or in [" +
+                     std::to_string(kMinBootstrapReplicates) + ", " +
+                     std::to_string(kMaxBootstrapReplicates) + "]");
+  o = TensorOptions();
+  o.common_offset_std_kg_m2 = INFINITY;
+  EXPECT_FALSE(o.Check(&why));
+  EXPECT_EQ(why, "common_offset_std_kg_m2 = inf; must be finite and >= 0");
 }
 
 }  // namespace

@@ -124,11 +124,20 @@ TEST(TraceFitBounds, OptionsCheckNamesTheBounds) {
   std::string why;
   options.max_total_iterations = 0;
   EXPECT_FALSE(options.Check(&why));
-  EXPECT_EQ(why, "max_total_iterations must be >= 1");
+  EXPECT_EQ(why, "max_total_iterations = 0; must be >= 1");
   options = TraceFitOptions();
   options.max_fit_cpu_seconds = NAN;
   EXPECT_FALSE(options.Check(&why));
-  EXPECT_EQ(why, "max_fit_cpu_seconds must be finite and > 0");
+  EXPECT_EQ(why, "max_fit_cpu_seconds = nan; must be finite and > 0");
+  options = TraceFitOptions();
+  options.min_amplitude_deg = 20;
+  options.max_amplitude_deg = 10;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "max_amplitude_deg = 10; must be > min_amplitude_deg = 20");
+  options = TraceFitOptions();
+  options.mass_std_kg = -0.5;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "mass_std_kg = -0.5; must be finite and >= 0");
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/option_check.h"
 #include "base/units.h"
 #include "fit/swing_axis.h"
 #include "pendulum/simulate.h"
@@ -140,6 +141,7 @@ TEST(Window, LogEndsDuringFreeSwing) {
   const SynthLog log = MakeLog(s);
   const auto w = FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions(), "a.csv");
   ExpectWindowMatches(w, log, s);
+  EXPECT_FALSE(w.no_oscillation_found);
   ASSERT_TRUE(w.noise_from_rest);
   EXPECT_NEAR(w.noise_sigma_rad_per_s, s.noise_rad_per_s, 0.1 * s.noise_rad_per_s);
   // Bias: mean of >= 200 rest samples, 5 standard errors.
@@ -252,6 +254,7 @@ TEST(Window, RejectsConstantData) {
   EXPECT_EQ(w.status, WindowStatus::kRejected);
   EXPECT_NE(w.message.find("flat.csv"), std::string::npos);
   EXPECT_NE(w.message.find("constant"), std::string::npos);
+  EXPECT_FALSE(w.no_oscillation_found);  // rejected for another reason
 }
 
 TEST(Window, RejectsNoOscillation) {
@@ -263,6 +266,7 @@ TEST(Window, RejectsNoOscillation) {
   EXPECT_EQ(w.status, WindowStatus::kRejected);
   EXPECT_NE(w.message.find("no oscillation"), std::string::npos) << w.message;
   EXPECT_NE(w.message.find("noise.csv"), std::string::npos);
+  EXPECT_TRUE(w.no_oscillation_found);  // what callers test, not the text
 }
 
 TEST(Window, RejectsShorterThanTwoPeriods) {
@@ -287,6 +291,36 @@ TEST(Window, RejectsBadSeries) {
   bad.min_period_s = -1;
   std::string why;
   EXPECT_FALSE(bad.Check(&why));
+  EXPECT_EQ(why, "window: min_period_s = -1; must be > 0");
+}
+
+// Every bound of WindowOptions names the field, the value and the bound; a cross-field bound
+// names both fields and both values.
+TEST(Window, OptionsCheckNamesFieldValueAndBound) {
+  std::string why;
+  EXPECT_TRUE(WindowOptions().Check(&why)) << why;
+  WindowOptions o;
+  o.max_period_s = o.min_period_s;
+  EXPECT_FALSE(o.Check(&why));
+  EXPECT_EQ(why, "window: max_period_s = " + FormatCheckValue(o.min_period_s) +
+                     "; must be > min_period_s = " + FormatCheckValue(o.min_period_s));
+  o = WindowOptions();
+  o.blip_fraction = 0.5;
+  EXPECT_FALSE(o.Check(&why));
+  EXPECT_EQ(why, "window: blip_fraction = 0.5; must be in [0, 0.5)");
+  o = WindowOptions();
+  o.hysteresis_sigmas = NAN;
+  EXPECT_FALSE(o.Check(&why));
+  EXPECT_EQ(why, "window: hysteresis_sigmas = nan; must be > 0");
+  o = WindowOptions();
+  o.end_margin_periods = -0.25;
+  EXPECT_FALSE(o.Check(&why));
+  EXPECT_EQ(why, "window: end_margin_periods = -0.25; must be >= 0");
+  AmplitudeBandOptions band;
+  band.min_amplitude_deg = 30;
+  band.max_amplitude_deg = 20;
+  EXPECT_FALSE(band.Check(&why));
+  EXPECT_EQ(why, "amplitude band: max_amplitude_deg = 20; must be > min_amplitude_deg = 30");
 }
 
 TEST(Window, Override) {

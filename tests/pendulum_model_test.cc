@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/option_check.h"
 #include "base/units.h"
 #include "pendulum/integrator.h"
 
@@ -214,27 +215,27 @@ TEST(PendulumModel, RigGeometryCheck) {
   for (double bad : {0.0, -1.0, nan, inf}) {
     RigGeometry g = TestGeometry();
     g.filar_length_m = bad;
-    ExpectRigError(g, "filar_length_m (L) must be finite and > 0");
+    ExpectRigError(g, "filar_length_m (L) = " + FormatCheckValue(bad) + "; must be finite and > 0");
     g = TestGeometry();
     g.filar_separation_m = bad;
-    ExpectRigError(g, "filar_separation_m (D) must be finite and > 0");
+    ExpectRigError(g, "filar_separation_m (D) = " + FormatCheckValue(bad) + "; must be finite and > 0");
     g = TestGeometry();
     g.mass_kg = bad;
-    ExpectRigError(g, "mass_kg (m) must be finite and > 0");
+    ExpectRigError(g, "mass_kg (m) = " + FormatCheckValue(bad) + "; must be finite and > 0");
     g = TestGeometry();
     g.gravity_mps2 = bad;
-    ExpectRigError(g, "gravity_mps2 (g) must be finite and > 0");
+    ExpectRigError(g, "gravity_mps2 (g) = " + FormatCheckValue(bad) + "; must be finite and > 0");
   }
   // Slack wires: L <= D.
   for (double length : {0.8, 0.5}) {
     RigGeometry g = TestGeometry();
     g.filar_length_m = length;
-    ExpectRigError(g, "filar_separation_m (D) = 0.8 m is not below filar_length_m (L)");
+    ExpectRigError(g, "filar_separation_m (D) = 0.8; must be < filar_length_m (L) = " + FormatCheckValue(length));
   }
   RigGeometry g = TestGeometry();
   g.filar_length_m = 0.5;
   ASSERT_FALSE(g.Check(&why));
-  EXPECT_NE(why.find("filar_separation_m (D) = 0.8 m is not below filar_length_m (L) = 0.5 m"), std::string::npos) << why;
+  EXPECT_NE(why.find("filar_separation_m (D) = 0.8; must be < filar_length_m (L) = 0.5 (the wires would go slack)"), std::string::npos) << why;
 }
 
 TEST(PendulumModel, PendulumParamsCheck) {
@@ -248,18 +249,18 @@ TEST(PendulumModel, PendulumParamsCheck) {
     PendulumParams p = TestParams();
     p.inertia_kg_m2 = bad;
     EXPECT_FALSE(p.Check(&why));
-    EXPECT_NE(why.find("inertia_kg_m2 (I) must be finite and > 0"), std::string::npos) << why;
+    EXPECT_NE(why.find("inertia_kg_m2 (I) = " + FormatCheckValue(bad) + "; must be finite and > 0"), std::string::npos) << why;
   }
   for (double bad : {-1e-9, nan, std::numeric_limits<double>::infinity()}) {
     PendulumParams p = TestParams();
     p.drag_coeff_kg_m2 = bad;
     EXPECT_FALSE(p.Check(&why));
-    EXPECT_NE(why.find("drag_coeff_kg_m2 (K_D) must be finite and >= 0"), std::string::npos)
+    EXPECT_NE(why.find("drag_coeff_kg_m2 (K_D) = " + FormatCheckValue(bad) + "; must be finite and >= 0"), std::string::npos)
         << why;
     p = TestParams();
     p.viscous_coeff_kg_m2_per_s = bad;
     EXPECT_FALSE(p.Check(&why));
-    EXPECT_NE(why.find("viscous_coeff_kg_m2_per_s (C) must be finite and >= 0"),
+    EXPECT_NE(why.find("viscous_coeff_kg_m2_per_s (C) = " + FormatCheckValue(bad) + "; must be finite and >= 0"),
               std::string::npos)
         << why;
   }
@@ -292,8 +293,8 @@ TEST(EnumTables, SeparationBelowLengthIsOneCheck) {
   std::string why;
   EXPECT_TRUE(CheckSeparationBelowLength(2.0, 1.0, &why));
   EXPECT_FALSE(CheckSeparationBelowLength(1.0, 1.0, &why));
-  EXPECT_EQ(why, "filar_separation_m (D) = 1 m is not below filar_length_m (L) = 1 m (the wires "
-                 "would go slack); allowed D < L");
+  EXPECT_EQ(why, "filar_separation_m (D) = 1; must be < filar_length_m (L) = 1 (the wires would "
+                 "go slack)");
   EXPECT_FALSE(CheckSeparationBelowLength(NAN, 1.0, nullptr));
 }
 

@@ -261,19 +261,24 @@ TEST(Simulate, BadInputNamesTheParameter) {
     std::function<void(TraceSetup*, SimulationOptions*)> edit;
   };
   const std::vector<Case> cases = {
-      {"filar_length_m", [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_length_m = -1; }},
-      {"filar_separation_m (D) = 1.8 m is not below filar_length_m (L) = 1.5 m",
+      {"filar_length_m (L) = -1; must be in (0, 1000]", [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_length_m = -1; }},
+      {"filar_separation_m (D) = 1.8; must be < filar_length_m (L) = 1.5 (the wires would go slack)",
        [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_length_m = 1.5; }},
-      {"filar_separation_m", [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_separation_m = 0; }},
-      {"mass_kg", [](TraceSetup* s, SimulationOptions*) { s->geometry.mass_kg = 0; }},
-      {"inertia_kg_m2", [](TraceSetup* s, SimulationOptions*) { s->params.inertia_kg_m2 = -2; }},
-      {"inertia_kg_m2", [](TraceSetup* s, SimulationOptions*) { s->params.inertia_kg_m2 = NAN; }},
-      {"amplitude", [](TraceSetup* s, SimulationOptions*) { s->amplitude_rad = 0; }},
-      {"sensor.sample_rate_hz", [](TraceSetup*, SimulationOptions* o) { o->sensor.sample_rate_hz = 0; }},
-      {"timeline.free_s", [](TraceSetup*, SimulationOptions* o) { o->timeline.free_s = {0, 0}; }},
-      {"timeline.free_s", [](TraceSetup*, SimulationOptions* o) { o->timeline.free_s = {-5, 10}; }},
-      {"sensor.drop_fraction", [](TraceSetup*, SimulationOptions* o) { o->sensor.drop_fraction = 0.9; }},
-      {"timeline.stop_probability", [](TraceSetup*, SimulationOptions* o) { o->timeline.stop_probability = 2; }},
+      {"filar_separation_m (D) = 0; must be in (0, 1000]", [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_separation_m = 0; }},
+      {"mass_kg (whole suspended mass) = 0; must be in (0, 1000000]", [](TraceSetup* s, SimulationOptions*) { s->geometry.mass_kg = 0; }},
+      {"inertia_kg_m2 (whole suspended inertia) = -2; must be in (0, 1000000000]", [](TraceSetup* s, SimulationOptions*) { s->params.inertia_kg_m2 = -2; }},
+      {"inertia_kg_m2 (whole suspended inertia) = nan; must be in (0, 1000000000]", [](TraceSetup* s, SimulationOptions*) { s->params.inertia_kg_m2 = NAN; }},
+      {"amplitude_deg = 0; must be 0 < |amplitude_deg| < 89", [](TraceSetup* s, SimulationOptions*) { s->amplitude_rad = 0; }},
+      {"pitch_deg = 100; must be in [-90, 90]", [](TraceSetup* s, SimulationOptions*) { s->pitch_rad = 100 * kRadPerDeg; }},
+      {"|imu_offset_in_body_m| = 200; must be <= 100", [](TraceSetup* s, SimulationOptions*) { s->imu_offset_in_body_m = {200, 0, 0}; }},
+      {"det(body_from_imu) = -1; must be > 0", [](TraceSetup* s, SimulationOptions*) { s->body_from_imu = -Eigen::Matrix3d::Identity(); }},
+      {"sensor.sample_rate_hz = 0; must be in (0, 100000]", [](TraceSetup*, SimulationOptions* o) { o->sensor.sample_rate_hz = 0; }},
+      {"timeline.free_s.min = 0; must be > 0", [](TraceSetup*, SimulationOptions* o) { o->timeline.free_s = {0, 0}; }},
+      {"timeline.free_s.min = -5; must be > 0", [](TraceSetup*, SimulationOptions* o) { o->timeline.free_s = {-5, 10}; }},
+      {"timeline.free_s.min = 20; must be <= timeline.free_s.max = 10", [](TraceSetup*, SimulationOptions* o) { o->timeline.free_s = {20, 10}; }},
+      {"integrator: rel_tol = 0.1; must be in (0, 0.01]", [](TraceSetup*, SimulationOptions* o) { o->integrator.rel_tol = 0.1; }},
+      {"sensor.drop_fraction = 0.9; must be in [0, 0.5]", [](TraceSetup*, SimulationOptions* o) { o->sensor.drop_fraction = 0.9; }},
+      {"timeline.stop_probability = 2; must be in [0, 1]", [](TraceSetup*, SimulationOptions* o) { o->timeline.stop_probability = 2; }},
   };
   for (const Case& c : cases) {
     TraceSetup setup = PrandtlLikeSetup();
@@ -559,18 +564,18 @@ TEST(SimulateRealism, BadSettingsNameTheKey) {
     std::function<void(SimulationOptions*)> edit;
   };
   const std::vector<Case> cases = {
-      {"sensor.gyro_noise_ar1_phi", [](SimulationOptions* o) { o->sensor.gyro_noise_ar1_phi = 1.0; }},
+      {"sensor.gyro_noise_ar1_phi = 1; must be in [0, 0.99]", [](SimulationOptions* o) { o->sensor.gyro_noise_ar1_phi = 1.0; }},
       {"sensor.gyro_bias_walk_deg_per_s_per_sqrt_s",
        [](SimulationOptions* o) { o->sensor.gyro_bias_walk_deg_per_s_per_sqrt_s = -1; }},
       {"sensor.spike_count", [](SimulationOptions* o) { o->sensor.spike_count = -1; }},
-      {"sensor.spike_rate_rad_per_s", [](SimulationOptions* o) { o->sensor.spike_rate_rad_per_s = 0; }},
+      {"sensor.spike_rate_rad_per_s = 0; must be in (0, 10000]", [](SimulationOptions* o) { o->sensor.spike_rate_rad_per_s = 0; }},
       {"sensor.step_range_s", [](SimulationOptions* o) { o->sensor.step_range_s = {0, 0.1}; }},
-      {"sensor.step_log_sigma", [](SimulationOptions* o) { o->sensor.step_log_sigma = NAN; }},
+      {"sensor.step_log_sigma = nan; must be in [0, 3]", [](SimulationOptions* o) { o->sensor.step_log_sigma = NAN; }},
       {"sensor.gravity_removal_error_deg",
        [](SimulationOptions* o) { o->sensor.gravity_removal_error_deg = {0, 45}; }},
       {"swing.softening_percent_at_30deg", [](SimulationOptions* o) { o->softening_at_30deg = 0.9; }},
-      {"swing.softening_exponent", [](SimulationOptions* o) { o->softening_exponent = 0.5; }},
-      {"more than one sample period", [](SimulationOptions* o) { o->sensor.sample_rate_hz = 2000; }},
+      {"swing.softening_exponent = 0.5; must be in [1, 4]", [](SimulationOptions* o) { o->softening_exponent = 0.5; }},
+      {"sensor.time_jitter_sigma_s = 0.001; must be <= one sample period 1 / sensor.sample_rate_hz = 5e-04", [](SimulationOptions* o) { o->sensor.sample_rate_hz = 2000; }},
   };
   for (const Case& c : cases) {
     SimulationOptions options;

@@ -179,12 +179,21 @@ TEST(Config, LimitsAreReadCheckedAndReachTheLogReader) {
       test_support::LoadFitConfig(WriteFile(dir.path + "/d.yaml", kFitConfig));
   EXPECT_EQ(defaults.limits.LogOptions().max_file_bytes, 1'000'000'000u);
   EXPECT_EQ(defaults.limits.LogOptions().max_decompressed_bytes, 1'000'000'000u);
-  for (const char* bad : {"limits: {max_log_mb: 0.5}\n", "limits: {max_decompressed_log_mb: nan}\n",
-                          "limits: {max_log_mb: 2e6}\n", "limits: {max_log_mb: }\n"}) {
-    const std::string p = WriteFile(dir.path + "/bad.yaml", std::string(kFitConfig) + bad);
+  const struct {
+    const char* bad;
+    const char* expect;  // the key, its value and the bound; or the key when it is no number
+  } cases[] = {
+      {"limits: {max_log_mb: 0.5}\n", "limits.max_log_mb = 0.5; must be in [1, 1000000] (MB)"},
+      {"limits: {max_decompressed_log_mb: nan}\n",
+       "'limits.max_decompressed_log_mb' must be a finite number"},  // refused as it is read
+      {"limits: {max_log_mb: 2e6}\n", "limits.max_log_mb = 2000000; must be in [1, 1000000] (MB)"},
+      {"limits: {max_log_mb: }\n", "'limits.max_log_mb'"},
+  };
+  for (const auto& c : cases) {
+    const std::string p = WriteFile(dir.path + "/bad.yaml", std::string(kFitConfig) + c.bad);
     const std::string error = ErrorOf([&] { test_support::LoadFitConfig(p); });
     EXPECT_TRUE(Contains(error, p + ":6:")) << error;
-    EXPECT_TRUE(Contains(error, "'limits.max_")) << error;
+    EXPECT_TRUE(Contains(error, c.expect)) << error << " lacks " << c.expect;
   }
   const std::string typo =
       WriteFile(dir.path + "/typo.yaml", std::string(kFitConfig) + "limits: {max_log_gb: 5}\n");

@@ -262,12 +262,12 @@ TEST(Calibration, BadSectionsNameTheKey) {
   } cases[] = {
       {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 1.2, reference_mass_kg: 0" +
            tail,
-       "'rig.calibration.reference_mass_kg' must be > 0"},
+       "rig.calibration.reference_mass_kg = 0; must be > 0"},
       {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: -1.2, reference_mass_kg: 4" +
            tail,
-       "'rig.calibration.reference_inertia_kg_m2' must be > 0"},
+       "rig.calibration.reference_inertia_kg_m2 = -1.2; must be > 0"},
       {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 0, reference_mass_kg: 4" + tail,
-       "'rig.calibration.reference_inertia_kg_m2' must be > 0"},
+       "rig.calibration.reference_inertia_kg_m2 = 0; must be > 0"},
       {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 1.2}\n",
        "rig.calibration.reference_inertia_std_kg_m2"},
       {"  calibration: {logs: [], reference_inertia_kg_m2: 1.2, reference_mass_kg: 4" + tail,
@@ -281,7 +281,8 @@ TEST(Calibration, BadSectionsNameTheKey) {
        "rig.calibration.logs: folder"},
       {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 1.2, reference_mass_kg: 4, "
        "reference_inertia_std_kg_m2: 1.5}\n",
-       "'rig.calibration.reference_inertia_std_kg_m2' must be below"},
+       "rig.calibration.reference_inertia_std_kg_m2 = 1.5; must be < reference_inertia_kg_m2 = 1.2 "
+       "(the quantity it qualifies)"},
       {"  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: 1.2, reference_mas_kg: 4" +
            tail,
        "missing required key 'rig.calibration.reference_mass_kg'"},  // a typo

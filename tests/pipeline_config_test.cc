@@ -197,7 +197,7 @@ TEST(Config, MissingSectionsAndBadValues) {
   ExpectError(yaml + "fit: {quality: {max_rms_over_noise: 0.5}}\n", {"fit.quality"});
   ExpectError(yaml + "ellipse: {covariance: magic}\n", {"ellipse.covariance"});
   yaml.replace(yaml.find("mass_kg: 2.0"), 12, "mass_kg: -2.0");
-  ExpectError(yaml, {"'rig.mass_kg' must be > 0", ":4:"});
+  ExpectError(yaml, {"rig.mass_kg = -2; must be > 0", ":4:"});
   ExpectError("rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1,\n"
               "      inertia: {inertia_kg_m2: 0.1, table: {0: 0.1}}}\n"
               "aircraft: {mass_kg: 1}\nruns: {root: ., pattern: '*.csv'}\n",
@@ -253,19 +253,19 @@ namespace {
 TEST(Config, CountsAndRangesAreBoundedAtLoad) {
   const std::string yaml = kMinimal;
   ExpectError(yaml + "ellipse:\n  bootstrap: 2147483647\n",
-              {"'ellipse.bootstrap' must be 0 (off) or in [100, 100000]", ":9:"});
-  ExpectError(yaml + "ellipse: {bootstrap: 50}\n", {"ellipse.bootstrap", "got 50"});
-  ExpectError(yaml + "ellipse: {min_angles: 100000}\n", {"ellipse.min_angles", "[3, 1000]"});
-  ExpectError(yaml + "fit: {max_amplitude_deg: 0}\n", {"'fit.max_amplitude_deg' must be in [1, 90]"});
-  ExpectError(yaml + "fit: {max_amplitude_deg: 179.9}\n", {"fit.max_amplitude_deg"});
+              {"ellipse.bootstrap = 2147483647; must be 0 (off) or in [100, 100000]", ":9:"});
+  ExpectError(yaml + "ellipse: {bootstrap: 50}\n", {"ellipse.bootstrap = 50; must be 0 (off) or in [100, 100000]"});
+  ExpectError(yaml + "ellipse: {min_angles: 100000}\n", {"ellipse.min_angles = 100000; must be in [3, 1000]"});
+  ExpectError(yaml + "fit: {max_amplitude_deg: 0}\n", {"fit.max_amplitude_deg = 0; must be in [1, 90]"});
+  ExpectError(yaml + "fit: {max_amplitude_deg: 179.9}\n", {"fit.max_amplitude_deg = 179.9; must be in [1, 90]"});
   ExpectError(yaml + "fit: {max_amplitude_deg: 20, min_amplitude_deg: 25}\n",
-              {"fit.min_amplitude_deg"});
-  ExpectError(yaml + "fit: {quality: {whiteness_lags: 100000000}}\n", {"'fit.quality.whiteness_lags' must be in [1, 1000], got 100000000"});
+              {"fit.min_amplitude_deg = 25; must be < max_amplitude_deg = 20"});
+  ExpectError(yaml + "fit: {quality: {whiteness_lags: 100000000}}\n", {"fit.quality.whiteness_lags = 100000000; must be in [1, 1000]"});
   // Nested keys: the line of the key itself, found through the field -> key table.
   ExpectError(yaml + "fit:\n  amplitude_sweep:\n    max_bands: 50\n",
-              {"'fit.amplitude_sweep.max_bands' must be in [2, 20], got 50", ":10:"});
+              {"fit.amplitude_sweep.max_bands = 50; must be in [2, 20]", ":10:"});
   ExpectError(yaml + "fit:\n  quality:\n    reject_residual_fraction: 0\n",
-              {"'fit.quality.reject_residual_fraction' must be in (0, 1], got 0", ":10:"});
+              {"fit.quality.reject_residual_fraction = 0; must be in (0, 1]", ":10:"});
   ExpectError(yaml + "ellipse: {covariance: magic}\n",
               {"'ellipse.covariance' must be auto, points, angle_means or absolute, not 'magic'"});
   // Check() holds the same ranges for a config built in code.
@@ -276,7 +276,7 @@ TEST(Config, CountsAndRangesAreBoundedAtLoad) {
   config.ellipse.bootstrap = 0;
   config.fit.max_amplitude_deg = 0.0;
   EXPECT_FALSE(config.fit.Check(&why));
-  EXPECT_NE(why.find("max_amplitude_deg"), std::string::npos);
+  EXPECT_EQ(why, "fit.max_amplitude_deg = 0; must be in [1, 90]");
 }
 
 }  // namespace
@@ -308,6 +308,33 @@ TEST(Config, DuplicateKeysDocumentsAndTablePitchesNameBothLines) {
   ExpectError(buffer, {":8:", "pitch 0.0 deg twice", ":7:"});
 }
 
+// The log reader's options as a config sets them: each bad value names the key, its value and the
+// bound (the one format of base/option_check.h), and ImuLogOptions::Check does the same for
+// options built in code.
+TEST(ConfigCheck, LogOptionsNameKeyValueAndBound) {
+  const std::string yaml = kMinimal;
+  ExpectError(yaml + "limits: {max_log_mb: 0.5}\n",
+              {"limits.max_log_mb = 0.5; must be in [1, 1000000] (MB)", ":8:"});
+  ExpectError(yaml + "limits: {max_decompressed_log_mb: 2e6}\n",
+              {"limits.max_decompressed_log_mb = 2000000; must be in [1, 1000000] (MB)"});
+  ExpectError(yaml + "imu: {dataflash: {instance: 300}}\n",
+              {"imu.dataflash.instance = 300; must be in [0, 255]"});
+  ImuLogOptions options;
+  std::string why;
+  EXPECT_TRUE(options.Check(&why)) << why;
+  options.max_dropped_fraction = 2;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "max_dropped_fraction = 2; must be in [0, 1]");
+  options = ImuLogOptions();
+  options.min_rows = 0;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "min_rows = 0; must be >= 1");
+  options = ImuLogOptions();
+  options.dataflash_instance = 256;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "dataflash_instance = 256; must be in [0, 255] (or -1: the lowest in the log)");
+}
+
 // Every bound lives in the options struct's Check (a config built in code is checked for the
 // quality, sweep and glitch ranges too), reported as field, value and bound; the config layer
 // maps the field to its YAML key and line.
@@ -322,7 +349,7 @@ TEST(ConfigCheck, FailureNamesFieldValueAndBound) {
   EXPECT_EQ(failure.allowed, "in [2, 20]");
   std::string why;
   ASSERT_FALSE(fit.Check(&why));
-  EXPECT_EQ(why, "'fit.amplitude_sweep.max_bands' must be in [2, 20], got 50");
+  EXPECT_EQ(why, "fit.amplitude_sweep.max_bands = 50; must be in [2, 20]");
   fit = FitConfig();
   fit.quality.reject_residual_fraction = 1.5;
   ASSERT_FALSE(fit.Check(&failure));
@@ -332,7 +359,7 @@ TEST(ConfigCheck, FailureNamesFieldValueAndBound) {
   ASSERT_FALSE(ellipse.Check(&failure));
   EXPECT_EQ(failure.field, "confidence");
   ASSERT_FALSE(ellipse.Check(&why));
-  EXPECT_EQ(why, "'ellipse.confidence' must be in (0, 1), got 1");
+  EXPECT_EQ(why, "ellipse.confidence = 1; must be in (0, 1)");
 }
 
 }  // namespace

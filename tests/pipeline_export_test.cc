@@ -385,7 +385,7 @@ TEST(ExportCli, WritesEachFormatAndRefusesBadInputNamingTheFile) {
       {"export " + results + " --format stl", "--format must be urdf, sdf, jsbsim or csv"},
       {"export " + results + " --format jsbsim --frame flu", "--frame applies to urdf and sdf"},
       {"export " + results + " --format urdf --set Ixx=1", "--set Ixx: " + results + " measured"},
-      {"export " + results + " --format urdf --set Ixq=1", "--set Ixq: unknown component"},
+      {"export " + results + " --format urdf --set Ixq=1", "--set = \"Ixq\"; must be Ixx, Iyy, Izz, Ixy, Ixz or Iyz (unknown component)"},
       {"export " + results + " --format urdf --set Iyy", "expected NAME=VALUE"},
       {"export " + no_mass + " --format urdf", no_mass + ": URDF needs the mass"},
   };

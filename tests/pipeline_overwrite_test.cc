@@ -298,9 +298,9 @@ TEST(Overwrite, InitWritesOnlyConfigsFitAccepts) {
   const struct {
     std::string args, says;
   } refused[] = {
-      {"--rig 594,30,34.3", "'rig.filar_length_m': 594 m is longer than any lab rig's"},
-      {"--rig 0.594,0.030,0.0343 --gravity 9.7", "init: --gravity: 'gravity_mps2' = 9.7"},
-      {"--rig 0.594,0.030,0.0343 --gravity 9.9", "init: --gravity: 'gravity_mps2' = 9.9"},
+      {"--rig 594,30,34.3", "rig.filar_length_m = 594; must be in [0.05, 20] (m), a lab rig's range"},
+      {"--rig 0.594,0.030,0.0343 --gravity 9.7", "init: --gravity: gravity_mps2 = 9.7; must be in [9.76, 9.84]"},
+      {"--rig 0.594,0.030,0.0343 --gravity 9.9", "init: --gravity: gravity_mps2 = 9.9; must be in [9.76, 9.84]"},
       {"--rig 0.594,0.030,0.0343 --gravity nan", "--gravity: 'nan' is not a finite number"},
   };
   for (const auto& c : refused) {

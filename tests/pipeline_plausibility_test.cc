@@ -64,31 +64,33 @@ TEST(PlausibleConfig, LengthsAndMassInMillimetresAndGramsNameKeyLineAndUnit) {
   // The case: the quadrotor rig written in mm and g.
   std::string why = FitConfigError(dir, Rig("594", "30", "34.3"));
   EXPECT_TRUE(Contains(why, "fit.yaml:1:")) << why;  // the line of the key
-  EXPECT_TRUE(Contains(why, "'rig.filar_length_m': 594 m")) << why;
+  EXPECT_TRUE(Contains(why, "rig.filar_length_m = 594; must be in [0.05, 20] (m), a lab rig's range")) << why;
   EXPECT_TRUE(Contains(why, "if this is in mm, write 0.594")) << why;
   // The separation alone in mm.
   why = FitConfigError(dir, Rig("0.594", "30", "0.0343"));
-  EXPECT_TRUE(Contains(why, "'rig.filar_separation_m': 30 m")) << why;
+  EXPECT_TRUE(Contains(why, "rig.filar_separation_m = 30; must be in [0.005, 5] (m)")) << why;
   EXPECT_TRUE(Contains(why, "if this is in mm, write 0.03")) << why;
   // The separation in cm is within D's range but not below L: named, with the cm reading.
   why = FitConfigError(dir, Rig("0.594", "3", "0.0343"));
-  EXPECT_TRUE(Contains(why, "'rig.filar_separation_m': filar_separation_m (D) = 3 m is not below")) << why;
+  EXPECT_TRUE(Contains(why, "'rig.filar_separation_m': filar_separation_m (D) = 3; must be < "
+                           "filar_length_m (L) = 0.594")) << why;
   EXPECT_TRUE(Contains(why, "if this is in cm, write 0.03")) << why;
   // The fixed-wing's length in cm.
   why = FitConfigError(dir, Rig("74", "0.16", "3.34"));
-  EXPECT_TRUE(Contains(why, "'rig.filar_length_m': 74 m")) << why;
+  EXPECT_TRUE(Contains(why, "rig.filar_length_m = 74; must be in [0.05, 20] (m)")) << why;
   EXPECT_TRUE(Contains(why, "if in cm, 0.74")) << why;
   // Masses in g: the rig's, and the aircraft's of a campaign.
   why = FitConfigError(dir, Rig("0.74", "0.16", "3340"));
-  EXPECT_TRUE(Contains(why, "'rig.mass_kg': 3340 kg")) << why;
+  EXPECT_TRUE(Contains(why, "rig.mass_kg = 3340; must be in [0, 1000] (kg)")) << why;
   EXPECT_TRUE(Contains(why, "if this is in g, write 3.34")) << why;
   why = FitConfigError(dir, Rig("2", "1.8", "1.25") + "aircraft: {mass_kg: 5500}\n");
-  EXPECT_TRUE(Contains(why, "'aircraft.mass_kg': 5500 kg")) << why;
+  EXPECT_TRUE(Contains(why, "aircraft.mass_kg = 5500; must be in [0, 1000] (kg)")) << why;
   EXPECT_TRUE(Contains(why, "if this is in g, write 5.5")) << why;
   // Too short for any rig, with no unit that fixes it: the range and "SI" are named.
   why = FitConfigError(dir, Rig("0.01", "0.006", "0.0343"));
   EXPECT_TRUE(
-      Contains(why, "'rig.filar_length_m': 0.01 m is shorter than any lab rig's (0.05 to 20 m)"))
+      Contains(why, "rig.filar_length_m = 0.01; must be in [0.05, 20] (m), a lab rig's range; "
+                    "values are SI (m)"))
       << why;
 }
 
@@ -100,10 +102,10 @@ TEST(PlausibleConfig, RigInertiaInKgCm2IsAnError) {
       "rig:\n  filar_length_m: 2.0\n  filar_separation_m: 1.8\n  mass_kg: 1.25\n";
   std::string why = FitConfigError(dir, rig + "  inertia: {inertia_kg_m2: 2500}\n" + rest);
   EXPECT_TRUE(Contains(why, "fit.yaml:5:")) << why;
-  EXPECT_TRUE(Contains(why, "'rig.inertia.inertia_kg_m2': 2500 kg m^2")) << why;
+  EXPECT_TRUE(Contains(why, "rig.inertia.inertia_kg_m2 = 2500; must be <= 101.2 (kg m^2)")) << why;
   EXPECT_TRUE(Contains(why, "if this is in kg cm^2, write 0.25")) << why;
   why = FitConfigError(dir, rig + "  inertia:\n    table: {0: 0.25, 90: 2600}\n" + rest);
-  EXPECT_TRUE(Contains(why, "'rig.inertia.table (pitch 90 deg)': 2600 kg m^2")) << why;
+  EXPECT_TRUE(Contains(why, "rig.inertia.table (pitch 90 deg) = 2600; must be <= 101.2 (kg m^2)")) << why;
   EXPECT_EQ(FitConfigError(dir, rig + "  inertia: {inertia_kg_m2: 0.25}\n" + rest), "");
   // The quadrotor preset's thread "rig" (0.1 g, 1e-10 kg m^2) is fine.
   EXPECT_EQ(FitConfigError(dir, Rig("0.594", "0.030", "0.0001") + "aircraft: {mass_kg: 0.0342}\n"),
@@ -130,7 +132,7 @@ TEST(PlausibleConfig, RealRigsPass) {
   EXPECT_TRUE(config.Check(&why)) << why;
   config.aircraft_mass_kg = 3240;
   EXPECT_FALSE(config.Check(&why));
-  EXPECT_TRUE(Contains(why, "'aircraft.mass_kg': 3240 kg")) << why;
+  EXPECT_TRUE(Contains(why, "aircraft.mass_kg = 3240; must be in [0, 1000] (kg)")) << why;
   EXPECT_TRUE(Contains(why, "if this is in g, write 3.24")) << why;
 }
 

@@ -113,11 +113,11 @@ TEST(SilentNumbers, BlankOrNullNumberIsAnErrorNamingTheKey) {
 TEST(SilentNumbers, GravityIsBoundedToEarthUnlessOverridden) {
   TempDir dir;
   const std::string why = LoadError(dir, Config("    inertia_kg_m2: 0.5\n", "gravity_mps2: 98.0665\n"));
-  EXPECT_TRUE(Contains(why, "'gravity_mps2' = 98.0665 m/s^2 is not a gravity found on Earth")) << why;
+  EXPECT_TRUE(Contains(why, "gravity_mps2 = 98.0665; must be in [9.76, 9.84], a gravity found on Earth")) << why;
   EXPECT_TRUE(Contains(why, "[9.76, 9.84]")) << why;
   EXPECT_TRUE(Contains(why, "gravity_off_earth: true")) << why;
   EXPECT_TRUE(Contains(LoadError(dir, Config("    inertia_kg_m2: 0.5\n", "gravity_mps2: 9.7\n")),
-                       "not a gravity found on Earth"));
+                       "gravity_mps2 = 9.7; must be in [9.76, 9.84], a gravity found on Earth"));
   // Earth's extremes pass; Mars with the override passes; 0 and 1000 never.
   for (const char* ok : {"gravity_mps2: 9.7639\n", "gravity_mps2: 9.8337\n",
                          "gravity_mps2: 3.71\ngravity_off_earth: true\n"}) {
@@ -128,7 +128,7 @@ TEST(SilentNumbers, GravityIsBoundedToEarthUnlessOverridden) {
   for (const char* bad : {"gravity_mps2: 0\ngravity_off_earth: true\n",
                           "gravity_mps2: 1000\ngravity_off_earth: true\n"}) {
     EXPECT_TRUE(Contains(LoadError(dir, Config("    inertia_kg_m2: 0.5\n", bad)),
-                         "must be in (0, 100] m/s^2"))
+                         "must be in (0, 100] (gravity_off_earth: true)"))
         << bad;
   }
 }

@@ -194,7 +194,7 @@ TEST(TensorCampaign, ConfigKeysAreChecked) {
   };
   const std::string rig = "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1}\n";
   EXPECT_NE(error_of(rig + "runs: {root: logs, pattern: \"*.csv\", attitude_tolerance_deg: 0}\n")
-                .find("'runs.attitude_tolerance_deg' must be in (0, 180]"),
+                .find("runs.attitude_tolerance_deg = 0; must be in (0, 180]"),
             std::string::npos);
   // aircraft without rig.inertia (or the other way round) still names the missing key.
   EXPECT_NE(error_of(rig + "aircraft: {mass_kg: 3}\nruns: {root: logs, pattern: \"*.csv\"}\n")

@@ -454,7 +454,7 @@ TEST(UlogConfig, KeysAndTopicDefaults) {
   EXPECT_TRUE(c.imu.format.ulog.accel_fields[0].empty());
   EXPECT_TRUE(Contains(ErrorOf([&] { load("  format: px4\n"); }), "'imu.format' must be auto, csv or ulog"));
   EXPECT_TRUE(Contains(ErrorOf([&] { load("  ulog: {topic: my_imu}\n"); }), "'imu.ulog.gyro_fields' is needed"));
-  EXPECT_TRUE(Contains(ErrorOf([&] { load("  ulog: {multi_id: 300}\n"); }), "'imu.ulog.multi_id' must be in [0, 255]"));
+  EXPECT_TRUE(Contains(ErrorOf([&] { load("  ulog: {multi_id: 300}\n"); }), "imu.ulog.multi_id = 300; must be in [0, 255]"));
   EXPECT_TRUE(Contains(ErrorOf([&] { load("  ulog: {topik: x}\n"); }), "unknown key 'imu.ulog.topik'"));
   std::error_code ec;
   fs::remove_all(dir, ec);

@@ -18,6 +18,7 @@
 #include "base/bounded_read.h"
 #include "base/hash.h"
 #include "base/interrupt.h"
+#include "base/option_check.h"
 #include "base/parallel_runner.h"
 #include "base/statistics.h"
 #include "base/units.h"
@@ -752,16 +753,11 @@ void WriteCampaignOutputs(const CampaignConfig& config, const CampaignOptions& o
 }  // namespace
 
 bool CampaignOptions::Check(std::string* why) const {
-  if (out_dir.empty()) {
-    *why = "output folder not set";
-    return false;
-  }
-  if (jobs < 0 || jobs > kMaxJobs) {
-    *why = "--jobs must be in [0, " + std::to_string(kMaxJobs) + "] (0 = all cores), got " +
-           std::to_string(jobs);
-    return false;
-  }
-  return true;
+  CheckFailure f;
+  const bool ok =
+      (!out_dir.empty() || CheckFailText("out_dir", out_dir, "set (the output folder)", &f)) &&
+      CheckIn("--jobs (0 = all cores)", jobs, 0, kMaxJobs, Ends::kClosed, &f);
+  return ok || FailWith(f, why);
 }
 
 // discover -> calibrate (rig.calibration) -> fit traces -> tare -> group -> ellipse -> write.

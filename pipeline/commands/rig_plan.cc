@@ -9,6 +9,7 @@
 #include <limits>
 #include <random>
 
+#include "base/option_check.h"
 #include "base/text_format.h"
 #include "base/user_error.h"
 #include "fit/trace_fit.h"
@@ -30,8 +31,6 @@ constexpr double kMaxSeparationOverLength = 0.9;  // keep the wires from splayin
 // Machined reference bar: tolerance on length and width, and the weighing (fraction).
 constexpr double kBarToleranceM = 5e-5, kBarWeighingRelStd = 2e-4;
 
-bool Bad(double v) { return !std::isfinite(v); }
-
 double SuspendedMass(const RigPlanOptions& o) { return o.mass_kg + o.cradle_mass_kg; }
 
 }  // namespace
@@ -49,15 +48,16 @@ double RigPlanTerms::Total() const {
 double RigPlanTerms::SingleSwing() const { return std::hypot(Common(), statistical); }
 
 bool RigPlanOptions::Check(std::string* why) const {
-  if (std::isnan(inertia_kg_m2) == std::isnan(radius_of_gyration_m)) {
-    *why = "plan --rig: give --inertia or --radius-of-gyration (exactly one)";
-    return false;
+  const std::string context = "plan --rig: ";
+  CheckFailure f;
+  const int given = !std::isnan(inertia_kg_m2) + !std::isnan(radius_of_gyration_m);
+  if (given != 1) {
+    CheckFail("--inertia and --radius-of-gyration (given)", given, "exactly one", &f);
+    return FailWith(f, why, context);
   }
   if (!std::isnan(radius_of_gyration_m)) {
-    if (!(radius_of_gyration_m > 0.0 && radius_of_gyration_m < 100.0)) {
-      *why = "plan --rig: --radius-of-gyration must be in (0, 100) m, got " +
-             Fmt("%g", radius_of_gyration_m);
-      return false;
+    if (!CheckIn("--radius-of-gyration", radius_of_gyration_m, 0, 100, Ends::kOpen, &f)) {
+      return FailWith(f, why, context);
     }
     RigPlanOptions with_inertia = *this;
     with_inertia.inertia_kg_m2 =
@@ -65,65 +65,43 @@ bool RigPlanOptions::Check(std::string* why) const {
     with_inertia.radius_of_gyration_m = NAN;
     return with_inertia.Check(why);
   }
-  struct Bound {
-    const char* flag;
-    double value;
-    bool ok;
-    const char* allowed;
-  };
-  const Bound bounds[] = {
-      {"--mass", mass_kg, mass_kg > 0.0, "> 0 kg"},
-      {"--cradle-mass", cradle_mass_kg, cradle_mass_kg >= 0.0, ">= 0 kg"},
-      {"--inertia", inertia_kg_m2, inertia_kg_m2 > 0.0, "> 0 kg m^2"},
-      {"--inertia-max", inertia_max_kg_m2,
-       std::isnan(inertia_max_kg_m2) || inertia_max_kg_m2 >= inertia_kg_m2, ">= --inertia"},
-      {"--max-length", max_length_m, max_length_m > 0.0 && max_length_m <= kMaxRelaxedLengthM,
-       "in (0, 20] m"},
-      {"--max-separation", max_separation_m, max_separation_m > 0.0, "> 0 m"},
-      {"--max-separation", max_separation_m, max_separation_m < max_length_m,
-       "below --max-length (D >= L: the wires would go slack)"},
-      {"--min-length", min_length_m, min_length_m > 0.0 && min_length_m <= max_length_m,
-       "in (0, --max-length]"},
-      {"--min-separation", min_separation_m,
-       min_separation_m > 0.0 && min_separation_m <= max_separation_m, "in (0, --max-separation]"},
-      {"--min-period", min_period_s, min_period_s > 0.0, "> 0 s"},
-      {"--max-period", max_period_s, max_period_s > 0.0, "> 0 s"},
-      {"--length-std", length_std_m, length_std_m >= 0.0 && length_std_m < max_length_m,
-       ">= 0 and below --max-length"},
-      {"--separation-std", separation_std_m,
-       separation_std_m >= 0.0 && separation_std_m < max_separation_m,
-       ">= 0 and below --max-separation"},
-      {"--mass-std", mass_std_kg,
-       std::isnan(mass_std_kg) || (mass_std_kg >= 0.0 && mass_std_kg < mass_kg + cradle_mass_kg),
-       ">= 0 and below the suspended mass"},
-      {"--gravity", gravity_mps2, gravity_mps2 > 0.0 && gravity_mps2 <= 100.0, "in (0, 100] m/s^2"},
-      {"--gravity-std", gravity_std_mps2,
-       gravity_std_mps2 >= 0.0 && gravity_std_mps2 < gravity_mps2, ">= 0 and below --gravity"},
-      {"--imu-rate", imu_rate_hz, imu_rate_hz >= 5.0 && imu_rate_hz <= 10000.0, "in [5, 10000] Hz"},
-      {"--gyro-noise", gyro_noise_deg_per_s, gyro_noise_deg_per_s > 0.0, "> 0 deg/s"},
-      {"--repeat-scatter", repeat_scatter_percent, repeat_scatter_percent >= 0.0, ">= 0 %"},
-      {"--rig-departure", rig_departure_percent,
-       rig_departure_percent >= 0.0 && rig_departure_percent <= 50.0, "in [0, 50] %"},
-      {"--target-percent", target_percent, target_percent > 0.0 && target_percent < 100.0,
-       "in (0, 100) %"},
-  };
-  for (const Bound& b : bounds) {
-    // NaN fails every comparison; an optional NaN (not given) passes its own test above.
-    if (!b.ok || (Bad(b.value) && !std::isnan(b.value))) {
-      *why = std::string("plan --rig: ") + b.flag + " must be " + b.allowed + ", got " +
-             Fmt("%g", b.value);
-      return false;
-    }
-  }
-  if (!(decay_periods > 1.0)) {
-    *why = "plan --rig: the decay (periods) must be > 1, got " + Fmt("%g", decay_periods);
-    return false;
-  }
-  if (monte_carlo_swings < 0 || monte_carlo_swings > 100000) {
-    *why = "plan --rig: --monte-carlo must be in [0, 100000]";
-    return false;
-  }
-  return true;
+  // NaN fails every bound; an optional NaN (not given) skips its own.
+  const bool ok =
+      CheckFiniteGt("--mass", mass_kg, 0, &f) &&
+      CheckFiniteGe("--cradle-mass", cradle_mass_kg, 0, &f) &&
+      CheckFiniteGt("--inertia", inertia_kg_m2, 0, &f) &&
+      (std::isnan(inertia_max_kg_m2) ||
+       (CheckFinite("--inertia-max", inertia_max_kg_m2, &f) &&
+        CheckGe("--inertia-max", inertia_max_kg_m2, "--inertia", inertia_kg_m2, &f))) &&
+      CheckIn("--max-length", max_length_m, 0, kMaxRelaxedLengthM, Ends::kOpenClosed, &f) &&
+      CheckFiniteGt("--max-separation", max_separation_m, 0, &f) &&
+      // D >= L: the wires would go slack.
+      CheckLt("--max-separation", max_separation_m, "--max-length", max_length_m, &f) &&
+      CheckFiniteGt("--min-length", min_length_m, 0, &f) &&
+      CheckLe("--min-length", min_length_m, "--max-length", max_length_m, &f) &&
+      CheckFiniteGt("--min-separation", min_separation_m, 0, &f) &&
+      CheckLe("--min-separation", min_separation_m, "--max-separation", max_separation_m, &f) &&
+      CheckFiniteGt("--min-period", min_period_s, 0, &f) &&
+      CheckFiniteGt("--max-period", max_period_s, 0, &f) &&
+      CheckFiniteGe("--length-std", length_std_m, 0, &f) &&
+      CheckLt("--length-std", length_std_m, "--max-length", max_length_m, &f) &&
+      CheckFiniteGe("--separation-std", separation_std_m, 0, &f) &&
+      CheckLt("--separation-std", separation_std_m, "--max-separation", max_separation_m, &f) &&
+      (std::isnan(mass_std_kg) ||
+       (CheckFiniteGe("--mass-std", mass_std_kg, 0, &f) &&
+        CheckLt("--mass-std", mass_std_kg, "the suspended mass --mass + --cradle-mass",
+                mass_kg + cradle_mass_kg, &f))) &&
+      CheckIn("--gravity", gravity_mps2, 0, 100, Ends::kOpenClosed, &f) &&
+      CheckFiniteGe("--gravity-std", gravity_std_mps2, 0, &f) &&
+      CheckLt("--gravity-std", gravity_std_mps2, "--gravity", gravity_mps2, &f) &&
+      CheckIn("--imu-rate", imu_rate_hz, 5, 10000, Ends::kClosed, &f) &&
+      CheckFiniteGt("--gyro-noise", gyro_noise_deg_per_s, 0, &f) &&
+      CheckFiniteGe("--repeat-scatter", repeat_scatter_percent, 0, &f) &&
+      CheckIn("--rig-departure", rig_departure_percent, 0, 50, Ends::kClosed, &f) &&
+      CheckIn("--target-percent", target_percent, 0, 100, Ends::kOpen, &f) &&
+      CheckGt("decay_periods", decay_periods, 1, &f) &&
+      CheckIn("--monte-carlo", monte_carlo_swings, 0, 100000, Ends::kClosed, &f);
+  return ok || FailWith(f, why, context);
 }
 
 namespace {

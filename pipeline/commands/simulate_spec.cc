@@ -1,7 +1,6 @@
 #include "pipeline/commands/simulate_spec.h"
 
 #include <Eigen/Eigenvalues>
-
 #include <cmath>
 #include <limits>
 #include <cstdio>
@@ -12,6 +11,7 @@
 
 #include "base/atomic_file.h"
 #include "base/gzip.h"
+#include "base/option_check.h"
 #include "base/units.h"
 #include "base/user_error.h"
 #include "base/version.h"
@@ -40,7 +40,16 @@ std::string Num(double value) {
   return buffer;
 }
 
-// Reads a number that must lie in a range; the message names the key, line and range.
+// The interval (lower, upper] or [lower, upper]; open at an infinite upper end.
+std::string RangeText(double lower, bool lower_open, double upper) {
+  const bool upper_open = std::isinf(upper);
+  return IntervalText(lower, upper,
+                      lower_open ? (upper_open ? Ends::kOpen : Ends::kOpenClosed)
+                                 : (upper_open ? Ends::kClosedOpen : Ends::kClosed));
+}
+
+// Reads a number that must lie in a range; the message names the key, line, value and range
+// (base/option_check.h's format).
 double ReadValue(YamlMap& map, const std::string& key, double fallback, double lower,
                  bool lower_open, double upper) {
   const YAML::Node node = map.Optional(key);
@@ -48,9 +57,9 @@ double ReadValue(YamlMap& map, const std::string& key, double fallback, double l
   const double value = map.AsDouble(node, key);
   const bool ok = (lower_open ? value > lower : value >= lower) && value <= upper;
   if (!ok) {
-    throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' = " + Num(value) +
-                    " is out of range; allowed " + (lower_open ? "(" : "[") + Num(lower) + ", " +
-                    (std::isinf(upper) ? std::string("inf)") : Num(upper) + "]"));
+    throw UserError(
+        map.Where(node) + ": " +
+        CheckMessage(map.KeyPath(key), value, "in " + RangeText(lower, lower_open, upper)));
   }
   return value;
 }
@@ -82,10 +91,9 @@ UniformRange ReadRange(YamlMap& map, const std::string& key, UniformRange fallba
   }
   const bool ok = (lower_open ? r.min > lower : r.min >= lower) && r.max <= upper && r.min <= r.max;
   if (!ok) {
-    throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' = [" + Num(r.min) + ", " +
-                    Num(r.max) + "] is out of range; allowed min <= max within " +
-                    (lower_open ? "(" : "[") + Num(lower) + ", " +
-                    (std::isinf(upper) ? std::string("inf)") : Num(upper) + "]"));
+    throw UserError(map.Where(node) + ": " + map.KeyPath(key) + " = [" + FormatCheckValue(r.min) +
+                    ", " + FormatCheckValue(r.max) + "]; must be min <= max, both in " +
+                    RangeText(lower, lower_open, upper));
   }
   return r;
 }
@@ -401,9 +409,10 @@ void ReadRigInertia(YamlMap& rig, CampaignSpec* c) {
       const double pitch = rig.AsDouble(item.first, "inertia_by_pitch_kg_m2 (pitch)");
       const double inertia = rig.AsDouble(item.second, "inertia_by_pitch_kg_m2");
       if (!(inertia > 0)) {
-        throw UserError(rig.Where(item.second) + ": '" + rig.KeyPath("inertia_by_pitch_kg_m2") +
-                        "' at " + Num(pitch) + " deg = " + Num(inertia) +
-                        " is out of range; allowed (0, inf)");
+        throw UserError(rig.Where(item.second) + ": " +
+                        CheckMessage(rig.KeyPath("inertia_by_pitch_kg_m2") + " at " +
+                                         FormatCheckValue(pitch) + " deg",
+                                     inertia, "> 0"));
       }
       c->rig.inertia_by_pitch_kg_m2.emplace_back(pitch, inertia);
     }
@@ -822,7 +831,7 @@ SimulateCommandResult RunSimulate(const SimulateCommandOptions& a) {
   const SimulateOverrides& o = a.o;
   const SimulateSettingNames& n = a.names;
   auto positive = [](const std::optional<double>& v, const std::string& name) {
-    if (v && !(*v > 0)) throw UserError(name + " = " + Num(*v) + " is out of range; allowed > 0");
+    if (v && !(*v > 0)) throw UserError(CheckMessage(name, *v, "> 0"));
   };
   positive(o.duration_s, n.duration);
   positive(a.sample_rate, n.sample_rate);
@@ -876,7 +885,7 @@ SimulateCommandResult RunSimulate(const SimulateCommandOptions& a) {
 
 void SetSampleRateFromFlag(SimulateSpec* spec, double rate_hz, const std::string& flag) {
   if (!(rate_hz > 0 && rate_hz <= 100000)) {
-    throw UserError(flag + " = " + Num(rate_hz) + " is out of range; allowed (0, 100000]");
+    throw UserError(CheckMessage(flag, rate_hz, "in (0, 100000]"));
   }
   SensorOptions& s = spec->options.sensor;
   const std::string from = spec->file.empty() ? std::string("the spec") : spec->file;

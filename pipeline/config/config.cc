@@ -43,7 +43,9 @@ std::string ReadText(const std::string& path) { return ReadRegularFileOrThrow(pa
 double Positive(YamlMap& map, const std::string& key) {
   YAML::Node node = map.Required(key);
   const double value = map.AsDouble(node, key);
-  if (!(value > 0.0)) throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be > 0");
+  if (!(value > 0.0)) {
+    throw UserError(map.Where(node) + ": " + CheckMessage(map.KeyPath(key), value, "> 0"));
+  }
   return value;
 }
 
@@ -51,7 +53,9 @@ double NonNegative(YamlMap& map, const std::string& key, double fallback) {
   YAML::Node node = map.Optional(key);
   if (!map.Given(node, key, "a number >= 0")) return fallback;
   const double value = map.AsDouble(node, key);
-  if (value < 0.0) throw UserError(map.Where(node) + ": '" + map.KeyPath(key) + "' must be >= 0");
+  if (value < 0.0) {
+    throw UserError(map.Where(node) + ": " + CheckMessage(map.KeyPath(key), value, ">= 0"));
+  }
   return value;
 }
 
@@ -90,7 +94,8 @@ void ReadLogContainer(YamlMap& imu, ImuFormat* format) {
   const YAML::Node multi = ulog.Optional("multi_id");
   sel.multi_id = ulog.OptionalInt("multi_id", 0);
   if (sel.multi_id < 0 || sel.multi_id > 255) {
-    throw UserError(ulog.Where(multi) + ": 'imu.ulog.multi_id' must be in [0, 255]");
+    throw UserError(ulog.Where(multi) + ": " +
+                    CheckMessage("imu.ulog.multi_id", sel.multi_id, "in [0, 255]"));
   }
   sel.time_field = ulog.OptionalString("time_field", sel.time_field);
   if (ulog.Has("gyro_fields")) {
@@ -218,9 +223,10 @@ void ReadImu(YamlMap imu, ImuConfig* out) {
     const YAML::Node node = dataflash.Optional("instance");
     out->dataflash_instance = dataflash.OptionalInt("instance", -1);
     if (dataflash.Has("instance") && (out->dataflash_instance < 0 || out->dataflash_instance > 255)) {
-      throw UserError(dataflash.Where(node) + ": 'imu.dataflash.instance' must be in [0, 255] (the "
-                      "IMU instance of an ArduPilot log; leave it out for the lowest), not " +
-                      std::to_string(out->dataflash_instance));
+      throw UserError(dataflash.Where(node) + ": " +
+                      CheckMessage("imu.dataflash.instance", out->dataflash_instance,
+                                   "in [0, 255] (the IMU instance of an ArduPilot log; leave it "
+                                   "out for the lowest)"));
     }
     dataflash.Finish();
   }
@@ -254,14 +260,19 @@ void ReadRigCalibration(YamlMap cal, const std::string& folder, RigCalibrationSp
   const YAML::Node std_node = cal.Required("reference_inertia_std_kg_m2");
   out->reference_inertia_std_kg_m2 = NonNegative(cal, "reference_inertia_std_kg_m2", 0.0);
   if (!(out->reference_inertia_std_kg_m2 < out->reference_inertia_kg_m2)) {
-    throw UserError(cal.Where(std_node) + ": '" + cal.KeyPath("reference_inertia_std_kg_m2") +
-                    "' must be below reference_inertia_kg_m2 (the quantity it qualifies)");
+    throw UserError(
+        cal.Where(std_node) + ": " +
+        CheckMessage(
+            cal.KeyPath("reference_inertia_std_kg_m2"), out->reference_inertia_std_kg_m2,
+            "< reference_inertia_kg_m2 = " + FormatCheckValue(out->reference_inertia_kg_m2) +
+                " (the quantity it qualifies)"));
   }
   out->reference_mass_kg = Positive(cal, "reference_mass_kg");
   out->rig_pitch_deg = cal.OptionalDouble("rig_pitch_deg", 0.0);
   if (!(std::abs(out->rig_pitch_deg) <= 180.0)) {
-    throw UserError(cal.Where(cal.Optional("rig_pitch_deg")) + ": '" +
-                    cal.KeyPath("rig_pitch_deg") + "' must be in [-180, 180] deg");
+    throw UserError(
+        cal.Where(cal.Optional("rig_pitch_deg")) + ": " +
+        CheckMessage(cal.KeyPath("rig_pitch_deg"), out->rig_pitch_deg, "in [-180, 180]"));
   }
   cal.Finish();
 }
@@ -278,7 +289,8 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
     YAML::Node value = inertia.Required("inertia_kg_m2");  // blank or ~: an error, never 0
     out->inertia_kg_m2 = inertia.AsDouble(value, "inertia_kg_m2");
     if (out->inertia_kg_m2 < 0.0) {
-      throw UserError(inertia.Where(value) + ": 'rig.inertia.inertia_kg_m2' must be >= 0");
+      throw UserError(inertia.Where(value) + ": " +
+                      CheckMessage("rig.inertia.inertia_kg_m2", out->inertia_kg_m2, ">= 0"));
     }
   } else if (inertia.Has("table")) {
     out->kind = RigInertiaSpec::Kind::kTable;
@@ -291,7 +303,12 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
     for (const auto& item : table) {
       const double pitch = inertia.AsDouble(item.first, "table");
       const double value = inertia.AsDouble(item.second, "table");
-      if (value < 0.0) throw UserError(inertia.Where(item.second) + ": rig inertia must be >= 0");
+      if (value < 0.0) {
+        throw UserError(
+            inertia.Where(item.second) + ": " +
+            CheckMessage("rig.inertia.table (pitch " + FormatCheckValue(pitch) + " deg)", value,
+                         ">= 0"));
+      }
       auto [it, inserted] = first_key.emplace(pitch, item.first);
       if (!inserted) {
         throw UserError(inertia.Where(item.first) + ": 'rig.inertia.table' gives pitch " +
@@ -360,46 +377,45 @@ RigGeometry CampaignConfig::CalibrationGeometry() const {
 }
 
 bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why) {
-  char buffer[320];
+  CheckFailure f;
   if (off_earth) {
-    if (gravity_mps2 > 0.0 && gravity_mps2 <= kMaxOffEarthGravityMps2) return true;
-    std::snprintf(buffer, sizeof(buffer),
-                  "'gravity_mps2' must be in (0, %g] m/s^2 (gravity_off_earth: true), got %g",
-                  kMaxOffEarthGravityMps2, gravity_mps2);
-  } else {
-    if (gravity_mps2 >= kMinEarthGravityMps2 && gravity_mps2 <= kMaxEarthGravityMps2) return true;
-    std::snprintf(buffer, sizeof(buffer),
-                  "'gravity_mps2' = %g m/s^2 is not a gravity found on Earth ([%g, %g] m/s^2, "
-                  "from the equator's mountains to the poles); check for a typo (9.80665 is "
-                  "standard gravity), or set 'gravity_off_earth: true' for a rig elsewhere",
-                  gravity_mps2, kMinEarthGravityMps2, kMaxEarthGravityMps2);
+    if (CheckIn("gravity_mps2", gravity_mps2, 0, kMaxOffEarthGravityMps2, Ends::kOpenClosed, &f)) {
+      return true;
+    }
+    f.allowed += " (gravity_off_earth: true)";
+    return FailWith(f, why);
   }
-  *why = buffer;
-  return false;
+  if (CheckIn("gravity_mps2", gravity_mps2, kMinEarthGravityMps2, kMaxEarthGravityMps2,
+              Ends::kClosed, &f)) {
+    return true;
+  }
+  f.allowed +=
+      ", a gravity found on Earth (from the equator's mountains to the poles); check "
+      "for a typo (9.80665 is standard gravity), or set 'gravity_off_earth: true' for a "
+      "rig elsewhere";
+  return FailWith(f, why);
 }
 
 bool CampaignConfig::Check(std::string* why) const {
   std::string reason;
+  CheckFailure f;
   if (calibration.enabled) {
     const RigCalibrationSpec& c = calibration;
-    const char* bad = c.log_patterns.empty()               ? "'rig.calibration.logs' lists no file"
-                      : !(c.reference_inertia_kg_m2 > 0.0) ? "'rig.calibration.reference_inertia_kg_m2' must be > 0"
-                      : !(c.reference_mass_kg > 0.0)       ? "'rig.calibration.reference_mass_kg' must be > 0"
-                      : !(c.reference_inertia_std_kg_m2 >= 0.0 &&
-                          c.reference_inertia_std_kg_m2 < c.reference_inertia_kg_m2)
-                          ? "'rig.calibration.reference_inertia_std_kg_m2' must be >= 0 and below "
-                            "reference_inertia_kg_m2"
-                          : nullptr;
-    if (bad) {
-      *why = bad;
-      return false;
-    }
+    const bool ok =
+        (!c.log_patterns.empty() ||
+         CheckFail("rig.calibration.logs (files)", 0, "a list of at least one file", &f)) &&
+        CheckGt("rig.calibration.reference_inertia_kg_m2", c.reference_inertia_kg_m2, 0, &f) &&
+        CheckGt("rig.calibration.reference_mass_kg", c.reference_mass_kg, 0, &f) &&
+        CheckGe("rig.calibration.reference_inertia_std_kg_m2", c.reference_inertia_std_kg_m2, 0,
+                &f) &&
+        CheckLt("rig.calibration.reference_inertia_std_kg_m2", c.reference_inertia_std_kg_m2,
+                "rig.calibration.reference_inertia_kg_m2", c.reference_inertia_kg_m2, &f);
+    if (!ok) return FailWith(f, why);
   }
-  if (!(geometry_calibration.factor > 0.0 && std::isfinite(geometry_calibration.factor) &&
-        geometry_calibration.factor_rel_std >= 0.0 &&
-        std::isfinite(geometry_calibration.factor_rel_std))) {
-    *why = "rig.calibration: the calibration factor is not a finite number > 0";
-    return false;
+  if (!CheckFiniteGt("rig.calibration factor", geometry_calibration.factor, 0, &f) ||
+      !CheckFiniteGe("rig.calibration factor_rel_std", geometry_calibration.factor_rel_std, 0,
+                     &f)) {
+    return FailWith(f, why);
   }
   if (!CheckGravity(gravity_mps2, gravity_off_earth, why)) return false;
   if (!AircraftGeometry().Check(&reason)) {
@@ -431,12 +447,12 @@ bool CampaignConfig::Check(std::string* why) const {
       {"rig.inertia.inertia_std_kg_m2", rig_inertia.inertia_std_kg_m2, kMaxRigInertiaStdKgM2},
   };
   for (const auto& s : stds) {
-    if (!(s.std >= 0.0 && s.std < s.of)) {
-      char buffer[240];
-      std::snprintf(buffer, sizeof(buffer), "'%s' must be >= 0 and below %g (the quantity it "
-                    "qualifies), got %g", s.key, s.of, s.std);
-      *why = buffer;
-      return false;
+    // "below 0.5 (the quantity it qualifies)": the bound is the quantity's value.
+    if (!CheckGe(s.key, s.std, 0, &f) ||
+        !(s.std < s.of ||
+          CheckFail(s.key, s.std, "< " + FormatCheckValue(s.of) + " (the quantity it qualifies)",
+                    &f))) {
+      return FailWith(f, why);
     }
   }
   return fit.Check(why) && ellipse.Check(why);
@@ -493,27 +509,6 @@ bool GlitchConfig::IsDefault() const {
 
 namespace {
 
-// A number as users write it: integers exactly, others with %g.
-std::string BoundNum(double value) {
-  char buffer[64];
-  if (std::isfinite(value) && value == std::floor(value) && std::fabs(value) < 1e15) {
-    std::snprintf(buffer, sizeof(buffer), "%.0f", value);
-  } else {
-    std::snprintf(buffer, sizeof(buffer), "%g", value);
-  }
-  return buffer;
-}
-
-// "[lo, hi]", "(lo, hi]", ...
-std::string Interval(char open, double lo, double hi, char close) {
-  return std::string(1, open) + BoundNum(lo) + ", " + BoundNum(hi) + std::string(1, close);
-}
-
-bool Fail(CheckFailure* failure, const char* field, double value, const std::string& allowed) {
-  if (failure != nullptr) *failure = CheckFailure{field, value, allowed};
-  return false;
-}
-
 // The one map from an options field to its YAML key: `section` below the struct's own section
 // (empty: directly in it), then `key`. Every field a Check can name has a row.
 struct FieldKey {
@@ -559,8 +554,9 @@ std::string YamlKeyPath(const std::string& root, const FieldKey& key) {
   return root + "." + (key.section[0] != '\0' ? std::string(key.section) + "." : "") + key.key;
 }
 
+// The failure in the one format (base/option_check.h), naming the YAML key instead of the field.
 std::string FailureMessage(const std::string& root, const FieldKey& key, const CheckFailure& f) {
-  return "'" + YamlKeyPath(root, key) + "' must be " + f.allowed + ", got " + BoundNum(f.value);
+  return CheckMessage(YamlKeyPath(root, key), f.value, f.allowed);
 }
 
 // The node to name in an error: the key's value, else its section, else the struct's section.
@@ -573,83 +569,48 @@ YAML::Node FailureNode(YamlMap& map, const FieldKey& key) {
   return section;
 }
 
-bool CheckGlitch(const GlitchConfig& g, CheckFailure* failure) {
-  if (!(g.threshold_sigmas >= kMinGlitchSigmas && g.threshold_sigmas <= kMaxGlitchSigmas)) {
-    return Fail(failure, "glitch.threshold_sigmas", g.threshold_sigmas,
-                "in " + Interval('[', kMinGlitchSigmas, kMaxGlitchSigmas, ']'));
-  }
-  if (!(g.range_factor >= kMinGlitchRange && g.range_factor <= kMaxGlitchRange)) {
-    return Fail(failure, "glitch.range_factor", g.range_factor,
-                "in " + Interval('[', kMinGlitchRange, kMaxGlitchRange, ']'));
-  }
-  if (!(g.excursion_fraction >= 0.0 && g.excursion_fraction <= kMaxGlitchExcursion)) {
-    return Fail(failure, "glitch.excursion_fraction", g.excursion_fraction,
-                "in " + Interval('[', 0, kMaxGlitchExcursion, ']'));
-  }
-  if (!(g.max_fraction > 0.0 && g.max_fraction <= kMaxGlitchFraction)) {
-    return Fail(failure, "glitch.max_fraction", g.max_fraction,
-                "in " + Interval('(', 0, kMaxGlitchFraction, ']'));
-  }
-  return true;
+bool CheckGlitch(const GlitchConfig& g, CheckFailure* f) {
+  return CheckIn("glitch.threshold_sigmas", g.threshold_sigmas, kMinGlitchSigmas, kMaxGlitchSigmas,
+                 Ends::kClosed, f) &&
+         CheckIn("glitch.range_factor", g.range_factor, kMinGlitchRange, kMaxGlitchRange,
+                 Ends::kClosed, f) &&
+         CheckIn("glitch.excursion_fraction", g.excursion_fraction, 0, kMaxGlitchExcursion,
+                 Ends::kClosed, f) &&
+         CheckIn("glitch.max_fraction", g.max_fraction, 0, kMaxGlitchFraction, Ends::kOpenClosed,
+                 f);
 }
 
-bool CheckQuality(const QualityThresholds& q, CheckFailure* failure) {
-  if (!(q.max_rms_over_noise > 1.0) || !std::isfinite(q.max_rms_over_noise)) {
-    return Fail(failure, "quality.max_rms_over_noise", q.max_rms_over_noise, "finite and > 1");
-  }
-  if (!(q.max_residual_autocorr > 0.0 && q.max_residual_autocorr < 1.0)) {
-    return Fail(failure, "quality.max_residual_autocorr", q.max_residual_autocorr,
-                "in (0, 1)");
-  }
-  if (q.whiteness_lags < 1 || q.whiteness_lags > kMaxWhitenessLags) {
-    return Fail(failure, "quality.whiteness_lags", q.whiteness_lags,
-                "in " + Interval('[', 1, kMaxWhitenessLags, ']'));
-  }
-  if (!(q.max_secondary_motion_ratio >= 0.0) || !std::isfinite(q.max_secondary_motion_ratio)) {
-    return Fail(failure, "quality.max_secondary_motion_ratio", q.max_secondary_motion_ratio,
-                "finite and >= 0");
-  }
-  if (!(q.reject_secondary_motion_ratio >= q.max_secondary_motion_ratio)) {
-    return Fail(failure, "quality.reject_secondary_motion_ratio",
-                q.reject_secondary_motion_ratio,
-                ">= max_secondary_motion_ratio = " + BoundNum(q.max_secondary_motion_ratio));
-  }
-  if (!(q.reject_residual_fraction > 0.0 && q.reject_residual_fraction <= 1.0)) {
-    return Fail(failure, "quality.reject_residual_fraction", q.reject_residual_fraction,
-                "in (0, 1]");
-  }
-  if (!(q.min_periods >= 2.0 && q.min_periods <= kMaxMinPeriods)) {
-    return Fail(failure, "quality.min_periods", q.min_periods,
-                "in " + Interval('[', 2, kMaxMinPeriods, ']'));
-  }
-  return true;
+bool CheckQuality(const QualityThresholds& q, CheckFailure* f) {
+  return CheckFiniteGt("quality.max_rms_over_noise", q.max_rms_over_noise, 1, f) &&
+         CheckIn("quality.max_residual_autocorr", q.max_residual_autocorr, 0, 1, Ends::kOpen, f) &&
+         CheckIn("quality.whiteness_lags", q.whiteness_lags, 1, kMaxWhitenessLags, Ends::kClosed,
+                 f) &&
+         CheckFiniteGe("quality.max_secondary_motion_ratio", q.max_secondary_motion_ratio, 0, f) &&
+         CheckGe("quality.reject_secondary_motion_ratio", q.reject_secondary_motion_ratio,
+                 "max_secondary_motion_ratio", q.max_secondary_motion_ratio, f) &&
+         CheckIn("quality.reject_residual_fraction", q.reject_residual_fraction, 0, 1,
+                 Ends::kOpenClosed, f) &&
+         CheckIn("quality.min_periods", q.min_periods, 2, kMaxMinPeriods, Ends::kClosed, f);
 }
 
-bool CheckSweep(const SweepConfig& sw, CheckFailure* failure) {
-  if (!(sw.min_cycles_per_band >= 1.0 && sw.min_cycles_per_band <= 1000.0)) {
-    return Fail(failure, "sweep.min_cycles_per_band", sw.min_cycles_per_band, "in [1, 1000]");
-  }
-  if (sw.max_bands < 2 || sw.max_bands > 20) {
-    return Fail(failure, "sweep.max_bands", sw.max_bands, "in [2, 20]");
-  }
-  if (!(sw.trend_z > 0.0 && sw.trend_z < 1000.0)) {
-    return Fail(failure, "sweep.trend_z", sw.trend_z, "in (0, 1000)");
-  }
-  return true;
+bool CheckSweep(const SweepConfig& sw, CheckFailure* f) {
+  return CheckIn("sweep.min_cycles_per_band", sw.min_cycles_per_band, 1, 1000, Ends::kClosed, f) &&
+         CheckIn("sweep.max_bands", sw.max_bands, 2, 20, Ends::kClosed, f) &&
+         CheckIn("sweep.trend_z", sw.trend_z, 0, 1000, Ends::kOpen, f);
 }
 
 }  // namespace
 
 bool FitConfig::Check(CheckFailure* failure) const {
   const double max_deg = max_amplitude_deg.value_or(kMaxMaxAmplitudeDeg);
-  if (max_amplitude_deg && !(*max_amplitude_deg >= kMinMaxAmplitudeDeg &&
-                             *max_amplitude_deg <= kMaxMaxAmplitudeDeg)) {
-    return Fail(failure, "max_amplitude_deg", *max_amplitude_deg,
-                "in " + Interval('[', kMinMaxAmplitudeDeg, kMaxMaxAmplitudeDeg, ']') + " deg");
+  if (max_amplitude_deg && !CheckIn("max_amplitude_deg", *max_amplitude_deg, kMinMaxAmplitudeDeg,
+                                    kMaxMaxAmplitudeDeg, Ends::kClosed, failure)) {
+    return false;
   }
-  if (min_amplitude_deg && !(*min_amplitude_deg >= 0.0 && *min_amplitude_deg < max_deg)) {
-    return Fail(failure, "min_amplitude_deg", *min_amplitude_deg,
-                "in [0, max_amplitude_deg = " + BoundNum(max_deg) + ") deg");
+  if (min_amplitude_deg &&
+      !(CheckGe("min_amplitude_deg", *min_amplitude_deg, 0, failure) &&
+        CheckLt("min_amplitude_deg", *min_amplitude_deg, "max_amplitude_deg", max_deg, failure))) {
+    return false;
   }
   return CheckQuality(quality, failure) && CheckSweep(sweep, failure) &&
          CheckGlitch(glitch, failure);
@@ -665,17 +626,13 @@ bool FitConfig::Check(std::string* why) const {
 bool EllipseConfig::Check(CheckFailure* failure) const {
   if (bootstrap != 0 &&
       !(bootstrap >= kMinBootstrapReplicates && bootstrap <= kMaxBootstrapReplicates)) {
-    return Fail(failure, "bootstrap", bootstrap,
-                "0 (off) or in " +
-                    Interval('[', kMinBootstrapReplicates, kMaxBootstrapReplicates, ']'));
+    return CheckFail("bootstrap", bootstrap,
+                     "0 (off) or in " + IntervalText(kMinBootstrapReplicates,
+                                                     kMaxBootstrapReplicates, Ends::kClosed),
+                     failure);
   }
-  if (!(confidence > 0.0 && confidence < 1.0)) {
-    return Fail(failure, "confidence", confidence, "in (0, 1)");
-  }
-  if (min_angles < 3 || min_angles > kMaxMinAngles) {
-    return Fail(failure, "min_angles", min_angles, "in " + Interval('[', 3, kMaxMinAngles, ']'));
-  }
-  return true;
+  return CheckIn("confidence", confidence, 0, 1, Ends::kOpen, failure) &&
+         CheckIn("min_angles", min_angles, 3, kMaxMinAngles, Ends::kClosed, failure);
 }
 
 bool EllipseConfig::Check(std::string* why) const {
@@ -861,8 +818,9 @@ void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& o
   if (tolerance.IsDefined() && !tolerance.IsNull()) {
     r.attitude_tolerance_deg = runs.AsDouble(tolerance, "attitude_tolerance_deg");
     if (!(r.attitude_tolerance_deg > 0.0 && r.attitude_tolerance_deg <= 180.0)) {
-      throw UserError(runs.Where(tolerance) +
-                      ": 'runs.attitude_tolerance_deg' must be in (0, 180] deg");
+      throw UserError(
+          runs.Where(tolerance) + ": " +
+          CheckMessage("runs.attitude_tolerance_deg", r.attitude_tolerance_deg, "in (0, 180]"));
     }
   }
   if (r.pitch_source == PitchSource::kMeasured && !config->imu.format.has_accel()) {
@@ -999,8 +957,9 @@ InputLimits ReadLimits(YamlMap limits) {
     if (!node.IsDefined()) continue;
     const double mb = limits.AsDouble(node, key);
     if (!(mb >= 1 && mb <= kMaxLimitMb)) {
-      throw UserError(limits.Where(node) + ": '" + limits.KeyPath(key) + "' must be in [1, " +
-                      std::to_string(static_cast<long long>(kMaxLimitMb)) + "] (MB)");
+      throw UserError(limits.Where(node) + ": " +
+                      CheckMessage(limits.KeyPath(key), mb,
+                                   "in " + IntervalText(1, kMaxLimitMb, Ends::kClosed) + " (MB)"));
     }
     *value = mb;
   }

@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include "base/option_check.h"
 #include "base/units.h"
 #include "fit/ellipse.h"
 #include "fit/glitch.h"
@@ -150,15 +151,6 @@ constexpr double kMinGlitchRange = 1, kMaxGlitchRange = 100;     // fit.glitch.r
 constexpr double kMaxGlitchExcursion = 10;                       // fit.glitch.excursion_fraction
 constexpr double kMaxGlitchFraction = 0.1;                       // fit.glitch.max_fraction
 
-// A value outside its bound (Ceres OPTION_GE, COLMAP CHECK_OPTION_*): the options field, its
-// value and what is allowed. The config layer maps `field` to its YAML key with a table
-// (config.cc), never by reading text.
-struct CheckFailure {
-  std::string field;    // the options struct's field, e.g. "quality.whiteness_lags"
-  double value = 0.0;   // its value
-  std::string allowed;  // the bound, e.g. "in [1, 1000]", "0 (off) or in [100, 100000]"
-};
-
 struct FitConfig {
   PendulumModel model = PendulumModel::kFull;  // `fit.model`: full | jardin | linear
   // `fit.integrator`: rk853 (default) | cvodes; the fit's ODE solver (pendulum/integrator.h).
@@ -175,7 +167,7 @@ struct FitConfig {
   // Every bound of the fields above (amplitude band, quality, sweep, glitch): the first field
   // outside its bound in *failure.
   bool Check(CheckFailure* failure) const;
-  // The same; *why = "'fit.<YAML key>' must be <allowed>, got <value>".
+  // The same; *why = "fit.<YAML key> = <value>; must be <allowed>" (base/option_check.h).
   bool Check(std::string* why) const;
 };
 
@@ -203,7 +195,7 @@ struct EllipseConfig {
   int min_angles = 3;             // distinct pitch angles needed to fit the ellipse; [3, 1000]
 
   bool Check(CheckFailure* failure) const;  // the ranges above: the first field outside them
-  bool Check(std::string* why) const;  // the same; *why = "'ellipse.<key>' must be .., got .."
+  bool Check(std::string* why) const;       // *why = "ellipse.<key> = <value>; must be .."
 };
 
 // `limits`: size caps of the logs (MB = 1e6 bytes), README "Input size limits". The other

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "base/option_check.h"
 #include "base/units.h"
 #include "pendulum/model.h"
 
@@ -53,10 +54,10 @@ std::string ImplausibleValue(const std::string& key, const char* quantity, doubl
   if (value >= min && value <= max) return "";
   const bool length = std::string(quantity) == "length";
   const char* unit = length ? "m" : "kg";
-  std::string text =
-      "'" + key + "': " + Num(value) + " " + unit + " is " +
-      (value > max ? (length ? "longer" : "heavier") : (length ? "shorter" : "lighter")) +
-      " than any lab rig's (" + Num(min) + " to " + Num(max) + " " + unit + ")";
+  // "rig.filar_length_m = 594; must be in [0.05, 20] (m), a lab rig's range: if this is in mm, ..."
+  const std::string text = CheckMessage(
+      key, value,
+      "in " + IntervalText(min, max, Ends::kClosed) + " (" + unit + "), a lab rig's range");
   const auto fits = [&](double si) { return si >= min && si <= max; };
   const std::string hint =
       length ? Suggestion(kLengthUnits, value, fits) : Suggestion(kMassUnits, value, fits);
@@ -76,10 +77,15 @@ std::string ImplausibleRigInertia(const std::string& key, double inertia_kg_m2, 
     return r >= half / kGyrationFactor && r <= kGyrationFactor * half;
   };
   const std::string hint = Suggestion(kInertiaUnits, inertia_kg_m2, fits);
-  return "'" + key + "': " + Num(inertia_kg_m2) + " kg m^2 gives the rig (rig.mass_kg " +
-         Num(rig_mass_kg) + " kg) a radius of gyration sqrt(I/m) of " + Num(radius_m) +
-         " m, more than " + Num(kMaxRigGyrationOverSeparation) +
-         " times the wire separation D = " + Num(filar_separation_m) + " m: no lab rig" +
+  // The bound: the inertia at which sqrt(I/m) reaches its largest plausible value.
+  const double max_inertia_kg_m2 = rig_mass_kg * max_radius_m * max_radius_m;
+  return CheckMessage(key, inertia_kg_m2,
+                      "<= " + Num(max_inertia_kg_m2) +
+                          " (kg m^2), where the rig's radius of "
+                          "gyration sqrt(I / rig.mass_kg) (rig.mass_kg " +
+                          Num(rig_mass_kg) + " kg) is " + Num(kMaxRigGyrationOverSeparation) +
+                          " times the wire separation D = " + Num(filar_separation_m) +
+                          " m; this I gives " + Num(radius_m) + " m: no lab rig") +
          (hint.empty() ? "; values are SI (kg m^2)" : hint);
 }
 

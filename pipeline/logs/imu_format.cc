@@ -3,6 +3,7 @@
 #include <set>
 
 #include "base/enum_names.h"
+#include "base/option_check.h"
 #include "base/units.h"
 
 namespace bifilar {
@@ -50,31 +51,30 @@ double ToSi(RateUnit unit) { return unit == RateUnit::kRadPerS ? 1.0 : kRadPerDe
 double ToSi(AccelUnit unit) { return unit == AccelUnit::kMetresPerS2 ? 1.0 : kStandardGravityMps2; }
 
 bool ImuFormat::Check(std::string* why) const {
+  CheckFailure f;
   std::set<std::string> names;
-  auto add = [&](const std::string& name, const char* what) {
-    if (name.empty()) {
-      *why = std::string(what) + " column name is empty";
-      return false;
-    }
-    if (!names.insert(name).second) {
-      *why = "column '" + name + "' is used twice";
-      return false;
-    }
-    return true;
+  // A column name: not empty, and not the name of another column.
+  auto add = [&](const std::string& name, const std::string& field) {
+    if (name.empty()) return CheckFailText(field, name, "a column name", &f);
+    return names.insert(name).second ||
+           CheckFailText(field, name, "a column not used by another field", &f);
   };
-  if (!add(time_column, "time")) return false;
-  for (const auto& c : gyro_columns) if (!add(c, "gyro")) return false;
-  const int accel_named = !accel_columns[0].empty() + !accel_columns[1].empty() + !accel_columns[2].empty();
-  if (accel_named != 0 && accel_named != 3) {
-    *why = "accelerometer columns: give all three or none";
-    return false;
+  static const char* const kAxes[3] = {"[0]", "[1]", "[2]"};
+  bool ok = add(time_column, "time_column");
+  for (int k = 0; ok && k < 3; ++k)
+    ok = add(gyro_columns[k], std::string("gyro_columns") + kAxes[k]);
+  const int accel_named =
+      !accel_columns[0].empty() + !accel_columns[1].empty() + !accel_columns[2].empty();
+  ok = ok &&
+       (accel_named == 0 || accel_named == 3 ||
+        CheckFail("accel_columns (names given)", accel_named, "0 or 3 (all three or none)", &f));
+  for (int k = 0; ok && accel_named == 3 && k < 3; ++k) {
+    ok = add(accel_columns[k], std::string("accel_columns") + kAxes[k]);
   }
-  if (accel_named == 3) for (const auto& c : accel_columns) if (!add(c, "accelerometer")) return false;
-  if (delimiter == '\n' || delimiter == '"' || delimiter == '.' || delimiter == '-') {
-    *why = "delimiter must be a separator such as ',' ';' or tab";
-    return false;
-  }
-  return true;
+  ok = ok && ((delimiter != '\n' && delimiter != '"' && delimiter != '.' && delimiter != '-') ||
+              CheckFailText("delimiter", std::string(1, delimiter),
+                            "a separator such as ',' ';' or tab", &f));
+  return ok || FailWith(f, why);
 }
 
 }  // namespace bifilar

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "base/atomic_file.h"
+#include "base/option_check.h"
 #include "base/gzip.h"
 #include "base/user_error.h"
 
@@ -21,16 +22,11 @@ void AppendNumber(double value, int digits, std::string* out) {
 }  // namespace
 
 bool ImuLogWriteOptions::Check(std::string* why) const {
-  if (significant_digits < 6 || significant_digits > 17) {
-    *why = "significant_digits = " + std::to_string(significant_digits) +
-           " is out of range; allowed [6, 17]";
-    return false;
-  }
-  if (line_end != "\n" && line_end != "\r\n") {
-    *why = "line_end must be \"\\n\" or \"\\r\\n\"";
-    return false;
-  }
-  return true;
+  CheckFailure f;
+  const bool ok = CheckIn("significant_digits", significant_digits, 6, 17, Ends::kClosed, &f) &&
+                  (line_end == "\n" || line_end == "\r\n" ||
+                   CheckFailText("line_end", line_end, "\"\\n\" or \"\\r\\n\"", &f));
+  return ok || FailWith(f, why);
 }
 
 std::string FormatImuLog(const ImuData& data, const ImuFormat& format,

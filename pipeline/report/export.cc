@@ -14,6 +14,7 @@
 #include "base/atomic_file.h"
 #include "base/bounded_read.h"
 #include "base/json_error.h"
+#include "base/option_check.h"
 #include "base/user_error.h"
 #include "pipeline/records/results_reader.h"
 #include "pipeline/store/output_set.h"
@@ -247,30 +248,29 @@ bool ParseExportFrame(const std::string& name, ExportFrame* frame) {
 std::string ExportFrameAllowedValues() { return EnumAllowedValues(kExportFrameNames); }
 
 bool ExportOptions::Check(std::string* why) const {
-  const auto fail = [why](const std::string& m) {
-    if (why != nullptr) *why = m;
-    return false;
-  };
-  if (results_path.empty()) return fail("no results.json given");
-  if (frame_given && format != ExportFormat::kUrdf && format != ExportFormat::kSdf) {
-    return fail(std::string("--frame applies to urdf and sdf only (") + ExportFormatName(format) +
-                " has a fixed frame)");
-  }
-  if (!std::isnan(mass_kg) && !(std::isfinite(mass_kg) && mass_kg > 0)) {
-    return fail("--mass-kg must be a positive number");
-  }
-  for (const auto& [name, value] : set_kg_m2) {
+  CheckFailure f;
+  bool ok =
+      (!results_path.empty() ||
+       CheckFailText("results_path", results_path, "a results.json", &f)) &&
+      (!frame_given || format == ExportFormat::kUrdf || format == ExportFormat::kSdf ||
+       CheckFailText("--frame (with --format)", ExportFormatName(format),
+                     "urdf or sdf (--frame applies to urdf and sdf only; the others have a fixed "
+                     "frame)",
+                     &f)) &&
+      (std::isnan(mass_kg) || CheckFiniteGt("--mass-kg", mass_kg, 0, &f));
+  for (auto it = set_kg_m2.begin(); ok && it != set_kg_m2.end(); ++it) {
+    const std::string& name = it->first;
     int k = 0;
     while (k < 6 && name != ExportComponentName(k)) ++k;
     if (k == 6) {
-      return fail("--set " + name + ": unknown component (Ixx, Iyy, Izz, Ixy, Ixz or Iyz)");
-    }
-    if (!std::isfinite(value) || (k < 3 && !(value > 0))) {
-      return fail("--set " + name + ": the value must be a finite number" +
-                  (k < 3 ? ", > 0 for a moment" : ""));
+      ok = CheckFailText("--set", name, "Ixx, Iyy, Izz, Ixy, Ixz or Iyz (unknown component)", &f);
+    } else {
+      // A moment (Ixx, Iyy, Izz) is > 0; a product any finite number.
+      ok = k < 3 ? CheckFiniteGt("--set " + name, it->second, 0, &f)
+                 : CheckFinite("--set " + name, it->second, &f);
     }
   }
-  return true;
+  return ok || FailWith(f, why);
 }
 
 std::vector<std::string> ExportInertia::Missing() const {

@@ -210,7 +210,7 @@ bool FindWindowAndPitch(const CampaignConfig& config, const std::string& path, c
     // Time in s declared ms (or the reverse) puts every period 1000 times outside the range.
     const std::string hint =
         !override_s && config.imu.format.container != LogContainer::kUlog &&
-                window->message.find("no oscillation found") != std::string::npos
+                window->no_oscillation_found
             ? TimeUnitHint(data.t_s, axis->rate_rad_per_s, window_options,
                            config.imu.format.time_unit)
             : "";

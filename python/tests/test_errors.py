@@ -115,7 +115,7 @@ def test_ellipse_input_errors():
 
 
 def test_simulate_errors():
-    with pytest.raises(ValueError, match="inertia_kg_m2 = -1 is out of range"):
+    with pytest.raises(ValueError, match="inertia_kg_m2 = -1; must be > 0"):
         bifilar.simulate(inertia_kg_m2=-1, mass_kg=6, length_m=2, separation_m=0.9)
     with pytest.raises(ValueError, match="give inertia_kg_m2"):
         bifilar.simulate(mass_kg=6, length_m=2, separation_m=0.9)
