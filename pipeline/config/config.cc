@@ -1,7 +1,5 @@
 #include "pipeline/config/config.h"
 
-#include "base/enum_names.h"
-#include "base/units.h"
 #include "fit/ellipse.h"
 
 #include <cassert>
@@ -19,6 +17,9 @@
 #include <Eigen/Geometry>
 
 #include "base/bounded_read.h"
+#include "base/enum_names.h"
+#include "base/text_format.h"
+#include "base/units.h"
 #include "base/user_error.h"
 #include "pipeline/config/plausibility.h"
 #include "pipeline/config/yaml_reader.h"
@@ -389,10 +390,9 @@ bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why) {
               Ends::kClosed, &f)) {
     return true;
   }
-  f.allowed +=
-      ", a gravity found on Earth (from the equator's mountains to the poles); check "
-      "for a typo (9.80665 is standard gravity), or set 'gravity_off_earth: true' for a "
-      "rig elsewhere";
+  f.allowed += ", a gravity found on Earth (from the equator's mountains to the poles); check "
+               "for a typo (" + Fmt("%g", kStandardGravityMps2) + " is standard gravity), or set "
+               "'gravity_off_earth: true' for a rig elsewhere";
   return FailWith(f, why);
 }
 
