@@ -58,11 +58,7 @@ double LinearStiffnessPerMass(const RigGeometry& g) {
 namespace {
 
 // The one table of pendulum models (Ceres types.h style): config `model`, --model, JSON.
-struct PendulumModelRow {
-  PendulumModel model;
-  const char* name;
-};
-constexpr PendulumModelRow kPendulumModelTable[] = {
+constexpr EnumName<PendulumModel> kPendulumModelNames[] = {
     {PendulumModel::kFull, "full"},
     {PendulumModel::kJardin, "jardin"},
     {PendulumModel::kLinear, "linear"},
@@ -70,33 +66,18 @@ constexpr PendulumModelRow kPendulumModelTable[] = {
 
 }  // namespace
 
-const char* ToString(PendulumModel model) {
-  for (const PendulumModelRow& row : kPendulumModelTable) {
-    if (row.model == model) return row.name;
-  }
-  return "unknown";
-}
+const char* ToString(PendulumModel model) { return EnumToString(kPendulumModelNames, model); }
 
 bool ParsePendulumModel(const std::string& name, PendulumModel* model) {
-  for (const PendulumModelRow& row : kPendulumModelTable) {
-    if (name == row.name) {
-      *model = row.model;
-      return true;
-    }
-  }
-  return false;
+  return ParseEnum(kPendulumModelNames, name, model);
 }
 
 const std::vector<std::string>& PendulumModelNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> out;
-    for (const PendulumModelRow& row : kPendulumModelTable) out.push_back(row.name);
-    return out;
-  }();
+  static const std::vector<std::string> names = EnumNames(kPendulumModelNames);
   return names;
 }
 
-std::string PendulumModelAllowedValues() { return JoinAllowedValues(PendulumModelNames()); }
+std::string PendulumModelAllowedValues() { return EnumAllowedValues(kPendulumModelNames); }
 
 bool CheckSeparationBelowLength(double filar_length_m, double filar_separation_m,
                                 std::string* why) {

@@ -11,6 +11,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "base/enum_names.h"
 #include "base/option_check.h"
 #include "base/text_format.h"
 #include "base/units.h"
@@ -117,20 +118,14 @@ bool IntegrateRk4(const TruthDynamics& dyn, double angle0, double rate0,
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
-const char* ToString(SampleSteps steps) {
-  return steps == SampleSteps::kLogNormal ? "lognormal" : "regular";
-}
+constexpr EnumName<SampleSteps> kSampleStepsNames[] = {{SampleSteps::kRegular, "regular"},
+                                                       {SampleSteps::kLogNormal, "lognormal"}};
 
+const char* ToString(SampleSteps steps) { return EnumToString(kSampleStepsNames, steps, "regular"); }
 bool ParseSampleSteps(const std::string& name, SampleSteps* steps) {
-  if (name == "regular") {
-    *steps = SampleSteps::kRegular;
-  } else if (name == "lognormal") {
-    *steps = SampleSteps::kLogNormal;
-  } else {
-    return false;
-  }
-  return true;
+  return ParseEnum(kSampleStepsNames, name, steps);
 }
+std::string SampleStepsAllowedValues() { return EnumAllowedValues(kSampleStepsNames); }
 
 double SofteningHarmonicConstant(double exponent) {
   // <|cos|^(p+2)> / <cos^2> over a cycle: first harmonic of |psi|^p psi for psi = A cos.

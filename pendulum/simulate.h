@@ -77,6 +77,7 @@ enum class SampleSteps { kRegular, kLogNormal };
 // "regular", "lognormal".
 const char* ToString(SampleSteps steps);
 bool ParseSampleSteps(const std::string& name, SampleSteps* steps);
+std::string SampleStepsAllowedValues();  // "regular or lognormal"
 
 struct SensorOptions {
   double sample_rate_hz = 100.0;             // nominal sample rate (Hz); > 0

@@ -12,6 +12,7 @@
 #include "fit/ellipse.h"
 #include "pendulum/integrator.h"
 #include "pendulum/model.h"
+#include "pendulum/simulate.h"
 #include "pipeline/config/config.h"
 #include "pipeline/logs/imu_format.h"
 #include "pipeline/records/trace_record.h"
@@ -99,6 +100,9 @@ TEST(EnumNames, EveryTableReadsBackAndListsWhatItParses) {
   ExpectOneTable<TraceStatus>({TraceStatus::kOk, TraceStatus::kRejected, TraceStatus::kError},
                               [](TraceStatus v) { return ToString(v); }, ParseTraceStatus,
                               TraceStatusAllowedValues());
+  ExpectOneTable<SampleSteps>({SampleSteps::kRegular, SampleSteps::kLogNormal},
+                              [](SampleSteps v) { return ToString(v); }, ParseSampleSteps,
+                              SampleStepsAllowedValues());
   ExpectOneTable<TraceRole>({TraceRole::kAircraft, TraceRole::kTare, TraceRole::kCalibration},
                             [](TraceRole v) { return ToString(v); }, ParseTraceRole,
                             TraceRoleAllowedValues());

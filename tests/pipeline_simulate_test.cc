@@ -325,7 +325,7 @@ TEST(SimulateSpec, RealismKeysParseAndBadValuesNameTheKey) {
 
   const std::vector<std::pair<std::string, std::string>> bad = {
       {"sensor: {gyro_noise_ar1_phi: 1.0}\n", "spec.yaml:2:30: sensor.gyro_noise_ar1_phi = 1; must be in [0, 0.99]"},
-      {"sensor: {sample_steps: poisson}\n", "unknown value 'poisson' for 'sensor.sample_steps'; allowed regular, lognormal"},
+      {"sensor: {sample_steps: poisson}\n", "unknown value 'poisson' for 'sensor.sample_steps'; allowed regular or lognormal"},
       {"sensor: {step_range_s: [0.2, 0.1]}\n", "sensor.step_range_s = [0.2, 0.1]; must be min <= max, both in (0, 3600]"},
       {"sensor: {spike_count: 2.5}\n", "'sensor.spike_count' must be a whole number"},
       {"sensor: {spike_count: 5000}\n", "sensor.spike_count = 5000; must be in [0, 1000]"},

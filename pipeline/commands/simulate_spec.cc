@@ -195,7 +195,7 @@ void ReadSensor(YamlMap map, SensorOptions* s, bool* time_jitter_given) {
       const std::string name = map.AsString(steps, "sample_steps");
       if (!ParseSampleSteps(name, &s->sample_steps)) {
         throw UserError(map.Where(steps) + ": unknown value '" + name + "' for '" +
-                        map.KeyPath("sample_steps") + "'; allowed regular, lognormal");
+                        map.KeyPath("sample_steps") + "'; allowed " + SampleStepsAllowedValues());
       }
     }
   }
