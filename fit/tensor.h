@@ -26,13 +26,12 @@
 #include <vector>
 
 #include "fit/ellipse.h"  // EllipseCovariance, EllipseSolverSummary
+#include "fit/tensor_components.h"
 
 namespace bifilar {
 
-// The six components in the order used everywhere (results.json keys "Ixx_kg_m2", ...).
-constexpr int kTensorComponents = 6;
-enum TensorComponent { kIxx = 0, kIyy, kIzz, kIxy, kIxz, kIyz };
-const char* TensorComponentName(int component);  // "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"
+// The six components: kTensorComponents, kIxx ... kIyz, TensorComponentName
+// (fit/tensor_components.h).
 
 // The swing axis (down vertical) in body axes of an aircraft hung at roll phi and pitch theta
 // (deg): (-sin theta, sin phi cos theta, cos phi cos theta).

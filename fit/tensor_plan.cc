@@ -18,7 +18,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kMaxMomentKgM2 = 1e100;  // bound of any moment or std (kg m^2)
 
-using Row = std::array<double, kTensorPlanComponents>;
+using Row = std::array<double, kTensorComponents>;
 
 // One reachable attitude: its axis, its design row and its weight.
 struct Candidate {
@@ -72,7 +72,7 @@ Eigen::VectorXd Weights(const std::vector<Candidate>& c, const std::vector<int>&
 // weights w, on the observable subspace spanned by the columns of basis.
 Eigen::MatrixXd Covariance6(const Eigen::MatrixXd& reduced_rows, const std::vector<int>& chosen,
                             const Eigen::VectorXd& w, const Eigen::MatrixXd& basis,
-                            const std::array<bool, kTensorPlanComponents>& observable,
+                            const std::array<bool, kTensorComponents>& observable,
                             double* log_det) {
   const int r = static_cast<int>(basis.cols());
   Eigen::MatrixXd info = Eigen::MatrixXd::Zero(r, r);
@@ -88,7 +88,7 @@ Eigen::MatrixXd Covariance6(const Eigen::MatrixXd& reduced_rows, const std::vect
   const Eigen::MatrixXd inv = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() *
                               eig.eigenvectors().transpose();
   Eigen::MatrixXd cov = basis * inv * basis.transpose();
-  for (int k = 0; k < kTensorPlanComponents; ++k) {
+  for (int k = 0; k < kTensorComponents; ++k) {
     if (observable[k]) continue;
     cov.row(k).setConstant(kNaN);
     cov.col(k).setConstant(kNaN);
@@ -97,12 +97,6 @@ Eigen::MatrixXd Covariance6(const Eigen::MatrixXd& reduced_rows, const std::vect
 }
 
 }  // namespace
-
-const char* TensorPlanComponentName(int component) {
-  static const char* const kNames[kTensorPlanComponents] = {"Ixx", "Iyy", "Izz",
-                                                            "Ixy", "Ixz", "Iyz"};
-  return component >= 0 && component < kTensorPlanComponents ? kNames[component] : "?";
-}
 
 Row TensorDesignRow(const std::array<double, 3>& axis) {
   // Scaled by the largest component first: no square of a huge or tiny component overflows.
@@ -139,10 +133,10 @@ bool TensorPlanOptions::Check(std::string* why) const {
                      "given (at least Ixx, Iyy, Izz) with a relative swing std or an attitude "
                      "error",
                      &f));
-  static const char* const kGuessNames[kTensorPlanComponents] = {
+  static const char* const kGuessNames[kTensorComponents] = {
       "guess_kg_m2 Ixx", "guess_kg_m2 Iyy", "guess_kg_m2 Izz",
       "guess_kg_m2 Ixy", "guess_kg_m2 Ixz", "guess_kg_m2 Iyz"};
-  for (int k = 0; ok && k < kTensorPlanComponents; ++k) {
+  for (int k = 0; ok && k < kTensorComponents; ++k) {
     ok = CheckIn(kGuessNames[k], guess_kg_m2[k], -kMax, kMax, Ends::kClosed, &f);
   }
   ok = ok &&
@@ -260,9 +254,9 @@ bool ObservableSubspace(const std::vector<Candidate>& cand, const TensorPlanOpti
                         TensorPlan* plan, Subspace* space, std::string* error) {
   const int n_cand = static_cast<int>(cand.size());
   Eigen::MatrixXd& a = space->a;
-  a.resize(n_cand, kTensorPlanComponents);
+  a.resize(n_cand, kTensorComponents);
   for (int i = 0; i < n_cand; ++i) {
-    for (int k = 0; k < kTensorPlanComponents; ++k) a(i, k) = cand[i].row[k];
+    for (int k = 0; k < kTensorComponents; ++k) a(i, k) = cand[i].row[k];
   }
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeThinV);
   const Eigen::VectorXd sv = svd.singularValues();
@@ -272,14 +266,14 @@ bool ObservableSubspace(const std::vector<Candidate>& cand, const TensorPlanOpti
   space->rank = rank;
   space->basis = svd.matrixV().leftCols(rank);  // 6 x r
   int n_observable = 0;
-  for (int k = 0; k < kTensorPlanComponents; ++k) {
+  for (int k = 0; k < kTensorComponents; ++k) {
     // e_k lies in the row space when its projection keeps its length.
     const double in_space = space->basis.row(k).squaredNorm();
     plan->observable[k] = 1.0 - in_space < 1e-12;
     if (plan->observable[k]) {
       ++n_observable;
     } else {
-      plan->unobservable.push_back(TensorPlanComponentName(k));
+      plan->unobservable.push_back(TensorComponentName(k));
     }
   }
   plan->n_combinations = rank - n_observable;
@@ -427,7 +421,7 @@ bool DesignCovariance(const std::vector<Candidate>& cand, const std::vector<int>
                       TensorPlan* plan, std::string* error) {
   const int n = static_cast<int>(chosen.size());
   const int rank = space.rank;
-  Eigen::MatrixXd chosen_rows(n, kTensorPlanComponents);
+  Eigen::MatrixXd chosen_rows(n, kTensorComponents);
   for (int i = 0; i < n; ++i) chosen_rows.row(i) = space.a.row(chosen[i]);
   const Eigen::VectorXd chosen_sv = Eigen::JacobiSVD<Eigen::MatrixXd>(chosen_rows).singularValues();
   if (!(chosen_sv[rank - 1] > options.rank_tolerance * chosen_sv[0])) {
@@ -441,13 +435,13 @@ bool DesignCovariance(const std::vector<Candidate>& cand, const std::vector<int>
                                           &plan->log_det_information);
   // Back from units of scale^2: the information matrix is 1/scale^2 of the one computed.
   plan->log_det_information -= 2.0 * rank * std::log(scale);
-  for (int k = 0; k < kTensorPlanComponents; ++k) {
+  for (int k = 0; k < kTensorComponents; ++k) {
     plan->std_kg_m2[k] = plan->observable[k] ? scale * std::sqrt(cov(k, k)) : kNaN;
-    for (int l = 0; l < kTensorPlanComponents; ++l) {
+    for (int l = 0; l < kTensorComponents; ++l) {
       plan->covariance[k][l] = cov(k, l) * scale * scale;
     }
   }
-  for (int k = 0; k < kTensorPlanComponents; ++k) {
+  for (int k = 0; k < kTensorComponents; ++k) {
     // The floor: the attitude error alone, as the trials grow without bound (1e12 stands for
     // infinity; an axis along a principal axis of the guess does not feel a tilt at first order
     // and keeps a finite weight there).
@@ -466,7 +460,7 @@ void TrialsNeeded(const std::vector<Candidate>& cand, const std::vector<int>& ch
     return StdAt(cand, chosen, space, *plan, scale, t, k);
   };
   plan->trials_needed_all = 1;
-  for (int k = 0; k < kTensorPlanComponents; ++k) {
+  for (int k = 0; k < kTensorComponents; ++k) {
     if (!plan->observable[k]) continue;
     constexpr int kMaxTrials = 1000000;
     int needed = -1;
@@ -493,9 +487,9 @@ void TrialsNeeded(const std::vector<Candidate>& cand, const std::vector<int>& ch
 
 // Every observable component has a finite, positive predicted std.
 bool CheckPredictedStds(const TensorPlan& plan, std::string* error) {
-  for (int k = 0; k < kTensorPlanComponents; ++k) {
+  for (int k = 0; k < kTensorComponents; ++k) {
     if (plan.observable[k] && !(std::isfinite(plan.std_kg_m2[k]) && plan.std_kg_m2[k] > 0)) {
-      *error = std::string("internal: the predicted std of ") + TensorPlanComponentName(k) +
+      *error = std::string("internal: the predicted std of ") + TensorComponentName(k) +
                " is " + Fmt("%g", plan.std_kg_m2[k]) + "; please report this with the command line";
       return false;
     }

@@ -28,15 +28,13 @@
 #include <string>
 #include <vector>
 
-namespace bifilar {
+#include "fit/tensor_components.h"
 
-// The six components in the tensor fit's order: Ixx, Iyy, Izz, Ixy, Ixz, Iyz.
-constexpr int kTensorPlanComponents = 6;
-const char* TensorPlanComponentName(int component);  // "Ixx", ..., "Iyz"
+namespace bifilar {
 
 // The row of the design matrix for the axis n (normalised first):
 // (nx^2, ny^2, nz^2, -2 nx ny, -2 nx nz, -2 ny nz), so I(n) = row . components.
-std::array<double, kTensorPlanComponents> TensorDesignRow(const std::array<double, 3>& n);
+std::array<double, kTensorComponents> TensorDesignRow(const std::array<double, 3>& n);
 
 struct TensorPlanOptions {
   // The rig's reachable attitudes (deg): roll in [-180, 180], pitch in [-90, 90], min <= max.
@@ -66,7 +64,7 @@ struct TensorPlanOptions {
   // Each within +-1e100. Needed (and positive definite) when sigma_relative > 0 or
   // attitude_std_deg > 0;
   // otherwise unused, and `guess_given` may be false.
-  std::array<double, kTensorPlanComponents> guess_kg_m2 = {0, 0, 0, 0, 0, 0};
+  std::array<double, kTensorComponents> guess_kg_m2 = {0, 0, 0, 0, 0, 0};
   bool guess_given = false;
   // Target standard error of every observable component (kg m^2), in (0, 1e100], or 0 for none.
   // Default 0.
@@ -93,23 +91,23 @@ struct TensorPlan {
   int n_candidates = 0;                             // distinct reachable axes on the grid
   int n_points = 0;                                 // orientations x trials
   int rank = 0;  // of the reachable axes' design (6: every component observable)
-  std::array<bool, kTensorPlanComponents> observable = {};
+  std::array<bool, kTensorComponents> observable = {};
   std::vector<std::string> unobservable;  // component names, in order
   // Number of determined directions that are combinations of unobservable components (rank
   // minus the observable components), e.g. 1 for a rig that holds pitch at 0 and 90 only.
   int n_combinations = 0;
   // Expected standard errors (kg m^2) and covariance (kg^2 m^4) of the components; entries of
   // unobservable components are NaN (never printed as numbers).
-  std::array<double, kTensorPlanComponents> std_kg_m2 = {};
-  std::array<std::array<double, kTensorPlanComponents>, kTensorPlanComponents> covariance = {};
+  std::array<double, kTensorComponents> std_kg_m2 = {};
+  std::array<std::array<double, kTensorComponents>, kTensorComponents> covariance = {};
   // The part of each std that more trials cannot shrink (attitude error only; 0 without it).
-  std::array<double, kTensorPlanComponents> floor_std_kg_m2 = {};
+  std::array<double, kTensorComponents> floor_std_kg_m2 = {};
   double log_det_information = 0.0;  // of the chosen design, on the observable subspace
   double condition_number = 0.0;     // of the chosen unit-axis design rows (non-zero values)
   int exchange_sweeps = 0;           // Fedorov sweeps until no swap improved
   // With a target: trials per orientation needed for each component (0 when unobservable), and
   // for all of them; -1 when more trials cannot reach it (the attitude error's floor is above it).
-  std::array<int, kTensorPlanComponents> trials_needed = {};
+  std::array<int, kTensorComponents> trials_needed = {};
   int trials_needed_all = 0;
   std::vector<std::string> warnings;
 };

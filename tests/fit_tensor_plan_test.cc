@@ -18,7 +18,7 @@
 namespace bifilar {
 namespace {
 
-using Components = std::array<double, kTensorPlanComponents>;
+using Components = std::array<double, kTensorComponents>;
 
 // A tensor with products of 2-4 % of the moments (the hidden campaign kind), kg m^2.
 const Components kTruth = {2.0, 3.0, 4.5, 0.08, 0.12, -0.06};
@@ -44,11 +44,11 @@ Eigen::Vector3d Axis(const TensorPlanOrientation& o) {
 Components MonteCarloStd(const TensorPlan& plan, int trials, double tilt_std_rad, int replicates,
                          std::uint64_t seed) {
   const int n = static_cast<int>(plan.orientations.size());
-  Eigen::MatrixXd a(n, kTensorPlanComponents);
+  Eigen::MatrixXd a(n, kTensorComponents);
   Eigen::VectorXd w(n);
   for (int i = 0; i < n; ++i) {
     const auto row = TensorDesignRow(plan.orientations[i].axis_in_body);
-    for (int k = 0; k < kTensorPlanComponents; ++k) a(i, k) = row[k];
+    for (int k = 0; k < kTensorComponents; ++k) a(i, k) = row[k];
     w[i] = 1.0 / std::pow(plan.orientations[i].mean_std_kg_m2, 2);
   }
   // theta = (A^T W A)^-1 A^T W y: one estimator matrix for every replicate.
@@ -142,7 +142,7 @@ TEST(TensorPlan, FullRigGivesAFullRankDesignWhoseStdsMatchAMonteCarlo) {
   constexpr double kRelTol = 0.06;  // 5 sigma of that sampling error
   const Components mc = MonteCarloStd(plan, 2, 0.0, 4000, 17);
   for (int k = 0; k < 6; ++k) {
-    SCOPED_TRACE(TensorPlanComponentName(k));
+    SCOPED_TRACE(TensorComponentName(k));
     EXPECT_GT(plan.std_kg_m2[k], 0);
     EXPECT_NEAR(mc[k] / plan.std_kg_m2[k], 1.0, kRelTol);
   }
@@ -167,7 +167,7 @@ TEST(TensorPlan, RelativeSwingNoiseAndAttitudeErrorMatchAMonteCarlo) {
   constexpr double kRelTol = 0.07;
   const Components mc = MonteCarloStd(plan, 3, 0.5 * kRadPerDeg, 4000, 23);
   for (int k = 0; k < 6; ++k) {
-    SCOPED_TRACE(TensorPlanComponentName(k));
+    SCOPED_TRACE(TensorComponentName(k));
     EXPECT_NEAR(mc[k] / plan.std_kg_m2[k], 1.0, kRelTol);
     // The attitude error is a floor that more trials cannot lower.
     EXPECT_GT(plan.floor_std_kg_m2[k], 0);

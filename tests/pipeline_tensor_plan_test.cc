@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "fit/tensor.h"
 #include "fit/tensor_plan.h"
 #include "test_support.h"
 
@@ -44,8 +45,8 @@ TEST(TensorPlanCli, JsonMatchesTheLibraryAndUnitsConvert) {
     EXPECT_EQ(j["orientations"][i]["roll_deg"].get<double>(), plan.orientations[i].roll_deg);
     EXPECT_EQ(j["orientations"][i]["pitch_deg"].get<double>(), plan.orientations[i].pitch_deg);
   }
-  for (int k = 0; k < kTensorPlanComponents; ++k) {
-    const json& c = j["components"][TensorPlanComponentName(k)];
+  for (int k = 0; k < kTensorComponents; ++k) {
+    const json& c = j["components"][TensorComponentName(k)];
     EXPECT_EQ(c["std_kg_m2"].get<double>(), plan.std_kg_m2[k]);
     EXPECT_EQ(c["trials_needed"].get<int>(), plan.trials_needed[k]);
   }
@@ -117,8 +118,8 @@ TEST(TensorPlanCli, TinySigmasPlanAndHugeOnesAreRefused) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const json j = json::parse(r.out);
     ASSERT_EQ(j["orientations"].size(), 12u);
-    for (int k = 0; k < kTensorPlanComponents; ++k) {
-      const json& std_json = j["components"][TensorPlanComponentName(k)]["std_kg_m2"];
+    for (int k = 0; k < kTensorComponents; ++k) {
+      const json& std_json = j["components"][TensorComponentName(k)]["std_kg_m2"];
       ASSERT_TRUE(std_json.is_number()) << std_json;
       EXPECT_GT(std_json.get<double>(), 0.0);
     }

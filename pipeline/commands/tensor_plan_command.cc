@@ -9,6 +9,7 @@
 #include "base/json_number.h"
 #include "base/text_format.h"
 #include "base/user_error.h"
+#include "fit/tensor.h"
 
 namespace bifilar {
 namespace {
@@ -19,7 +20,7 @@ using nlohmann::json;
 double Clean(double v) { return std::fabs(v) < 5e-7 ? 0.0 : v; }
 
 // The largest principal moment of the guessed tensor (kg m^2).
-double LargestPrincipal(const std::array<double, kTensorPlanComponents>& c) {
+double LargestPrincipal(const std::array<double, kTensorComponents>& c) {
   Eigen::Matrix3d j;
   j << c[0], -c[3], -c[4], -c[3], c[1], -c[5], -c[4], -c[5], c[2];
   return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(j).eigenvalues()[2];
@@ -40,8 +41,8 @@ json TensorPlanToJson(const TensorPlan& p, const TensorPlanOptions& o) {
   j["attitude_std_deg"] = o.attitude_std_deg;
   if (o.guess_given) {
     json g;
-    for (int k = 0; k < kTensorPlanComponents; ++k) {
-      g[std::string(TensorPlanComponentName(k)) + "_kg_m2"] = o.guess_kg_m2[k];
+    for (int k = 0; k < kTensorComponents; ++k) {
+      g[std::string(TensorComponentName(k)) + "_kg_m2"] = o.guess_kg_m2[k];
     }
     j["guess"] = g;
   } else {
@@ -65,9 +66,9 @@ json TensorPlanToJson(const TensorPlan& p, const TensorPlanOptions& o) {
   }
   j["orientations"] = orientations;
   json components;
-  for (int k = 0; k < kTensorPlanComponents; ++k) {
+  for (int k = 0; k < kTensorComponents; ++k) {
     const bool obs = p.observable[k];
-    components[TensorPlanComponentName(k)] = {
+    components[TensorComponentName(k)] = {
         {"observable", obs},
         {"std_kg_m2", obs ? JsonNumber(p.std_kg_m2[k]) : json(nullptr)},
         {"floor_std_kg_m2", obs ? JsonNumber(p.floor_std_kg_m2[k]) : json(nullptr)},
@@ -94,7 +95,7 @@ TensorPlanCommandResult RunTensorPlan(const TensorPlanCommandOptions& options) {
   TensorPlanOptions o = options.plan;
   o.sigma_kg_m2 = options.sigma * to_si;
   o.guess_given = options.guess_given;
-  for (int k = 0; k < kTensorPlanComponents; ++k) o.guess_kg_m2[k] = options.guess[k] * to_si;
+  for (int k = 0; k < kTensorComponents; ++k) o.guess_kg_m2[k] = options.guess[k] * to_si;
   if (options.target > 0 && options.target_relative > 0) {
     throw UserError("plan --tensor: give --target or --target-rel, not both");
   }
@@ -151,8 +152,8 @@ void PrintTensorPlan(const TensorPlanCommandResult& result, DisplayUnits units, 
   out << "\n";
   if (o.guess_given) {
     out << "Assumed tensor (" << u << "): ";
-    for (int c = 0; c < kTensorPlanComponents; ++c) {
-      out << (c ? ", " : "") << TensorPlanComponentName(c) << " "
+    for (int c = 0; c < kTensorComponents; ++c) {
+      out << (c ? ", " : "") << TensorComponentName(c) << " "
           << Fmt("%.5g", o.guess_kg_m2[c] * k);
     }
     out << "\n";
@@ -175,8 +176,8 @@ void PrintTensorPlan(const TensorPlanCommandResult& result, DisplayUnits units, 
                        Fmt("%.4g ", o.target_std_kg_m2 * k) + u
                  : std::string())
       << ":\n";
-  for (int c = 0; c < kTensorPlanComponents; ++c) {
-    out << "  " << TensorPlanComponentName(c) << "  ";
+  for (int c = 0; c < kTensorComponents; ++c) {
+    out << "  " << TensorComponentName(c) << "  ";
     if (!plan.observable[c]) {
       out << "not observable from the reachable attitudes\n";
       continue;

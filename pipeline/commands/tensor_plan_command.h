@@ -19,7 +19,7 @@ struct TensorPlanCommandOptions {
   // RunTensorPlan from the values below, which are in `units`.
   TensorPlanOptions plan;
   double sigma = 0.0;  // per-swing std, absolute, in `units` (>= 0)
-  std::array<double, kTensorPlanComponents> guess = {0, 0, 0, 0, 0, 0};  // in `units`
+  std::array<double, kTensorComponents> guess = {0, 0, 0, 0, 0, 0};  // in `units`
   bool guess_given = false;  // Ixx, Iyy, Izz given (products default 0)
   double target = 0.0;       // target std of each component, in `units`; 0 = none
   // Target as a fraction of the largest guessed principal moment (needs the guess); 0 = none.

@@ -10,12 +10,13 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "base/enum_names.h"
 #include "base/atomic_file.h"
 #include "base/bounded_read.h"
+#include "base/enum_names.h"
 #include "base/json_error.h"
 #include "base/option_check.h"
 #include "base/user_error.h"
+#include "fit/tensor.h"
 #include "pipeline/records/results_reader.h"
 #include "pipeline/store/output_set.h"
 
@@ -24,7 +25,6 @@ namespace {
 
 using nlohmann::json;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-enum { kIxx = 0, kIyy, kIzz, kIxy, kIxz, kIyz };
 
 // Numbers in the files: 10 significant digits (a bifilar std is >= 1e-5 of the moment), the C
 // locale's '.', no "-0".
@@ -102,7 +102,7 @@ std::string XmlHeader(const ExportInertia& in, const std::string& frame_text,
   s += "     Inertia about the CG in body axes (x forward, y right, z down; products positive, "
        "I_xy = integral x y dm), kg m^2, value +- std:\n";
   for (int k = 0; k < 6; ++k) {
-    s += "       " + std::string(ExportComponentName(k)) + " ";
+    s += "       " + std::string(TensorComponentName(k)) + " ";
     if (in.source[k] == "measured") {
       s += Num(in.value_kg_m2[k]) + " +- " +
            (std::isfinite(in.std_kg_m2[k]) ? Num(in.std_kg_m2[k]) : std::string("unknown")) + "\n";
@@ -126,7 +126,7 @@ std::string NonPhysical(const ExportInertia& in) {
   for (int k = 0; k < 6; ++k) {
     if (in.source[k] == "missing") continue;
     const std::string what = std::string(k < 3 ? "the moment " : "the product ") +
-                             ExportComponentName(k) + " = " + Num(v[k]) + " kg m^2";
+                             TensorComponentName(k) + " = " + Num(v[k]) + " kg m^2";
     if (!std::isfinite(v[k])) return what + " is not finite";
     if (std::abs(v[k]) > kMaxExportInertiaKgM2) {
       return what + " is beyond any aircraft (|I| <= " + Num(kMaxExportInertiaKgM2) +
@@ -159,11 +159,11 @@ std::string NonPhysical(const ExportInertia& in) {
       continue;
     }
     if (!(v[pr[0]] * v[pr[1]] > v[pr[2]] * v[pr[2]])) {
-      return std::string("the product ") + ExportComponentName(pr[2]) + " = " + Num(v[pr[2]]) +
-             " kg m^2 is too large for the moments " + ExportComponentName(pr[0]) + " = " +
-             Num(v[pr[0]]) + " and " + ExportComponentName(pr[1]) + " = " + Num(v[pr[1]]) +
-             " (" + ExportComponentName(pr[2]) + "^2 >= " + ExportComponentName(pr[0]) + " " +
-             ExportComponentName(pr[1]) + "): the tensor is not positive definite";
+      return std::string("the product ") + TensorComponentName(pr[2]) + " = " + Num(v[pr[2]]) +
+             " kg m^2 is too large for the moments " + TensorComponentName(pr[0]) + " = " +
+             Num(v[pr[0]]) + " and " + TensorComponentName(pr[1]) + " = " + Num(v[pr[1]]) +
+             " (" + TensorComponentName(pr[2]) + "^2 >= " + TensorComponentName(pr[0]) + " " +
+             TensorComponentName(pr[1]) + "): the tensor is not positive definite";
     }
   }
   return "";
@@ -218,11 +218,6 @@ void RefuseCampaignFile(const std::string& out_path, const std::string& results_
 
 }  // namespace
 
-const char* ExportComponentName(int component) {
-  static const char* const kNames[6] = {"Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"};
-  return component >= 0 && component < 6 ? kNames[component] : "?";
-}
-
 namespace {
 
 constexpr EnumName<ExportFormat> kExportFormatNames[] = {{ExportFormat::kUrdf, "urdf"},
@@ -261,7 +256,7 @@ bool ExportOptions::Check(std::string* why) const {
   for (auto it = set_kg_m2.begin(); ok && it != set_kg_m2.end(); ++it) {
     const std::string& name = it->first;
     int k = 0;
-    while (k < 6 && name != ExportComponentName(k)) ++k;
+    while (k < 6 && name != TensorComponentName(k)) ++k;
     if (k == 6) {
       ok = CheckFailText("--set", name, "Ixx, Iyy, Izz, Ixy, Ixz or Iyz (unknown component)", &f);
     } else {
@@ -276,7 +271,7 @@ bool ExportOptions::Check(std::string* why) const {
 std::vector<std::string> ExportInertia::Missing() const {
   std::vector<std::string> m;
   for (int k = 0; k < 6; ++k) {
-    if (source[k] == "missing") m.push_back(ExportComponentName(k));
+    if (source[k] == "missing") m.push_back(TensorComponentName(k));
   }
   return m;
 }
@@ -370,7 +365,7 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
   const ResultsReader tensor = results.Get("tensor");
   if (tensor.IsObject()) {
     for (int k = 0; k < 6; ++k) {
-      const std::string key = std::string(ExportComponentName(k)) + "_kg_m2";
+      const std::string key = std::string(TensorComponentName(k)) + "_kg_m2";
       in.value_kg_m2[k] = tensor.NumOrNull(key.c_str(), name);
       if (std::isnan(in.value_kg_m2[k])) continue;
       in.std_kg_m2[k] = tensor.NumOrNull((key + "_std").c_str(), name);
@@ -400,7 +395,7 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
   // Fill what the result does not hold.
   for (const auto& [component, value] : options.set_kg_m2) {
     int k = 0;
-    while (ExportComponentName(k) != component) ++k;
+    while (TensorComponentName(k) != component) ++k;
     if (in.source[k] == "measured") {
       throw UserError("export: --set " + component + ": " + name + " measured " + component + " (" +
                       Num(in.value_kg_m2[k]) +
@@ -504,7 +499,7 @@ std::string FormatInertiaCsv(const ExportInertia& in) {
                     CsvNum(in.mass_kg) + "," + CsvNum(in.mass_std_kg) + "," +
                     CsvField(in.mass_source.empty() ? "missing" : in.mass_source);
   for (int k = 0; k < 6; ++k) {
-    const std::string n = ExportComponentName(k);
+    const std::string n = TensorComponentName(k);
     header += "," + n + "_kg_m2," + n + "_std_kg_m2," + n + "_source";
     row += "," + CsvNum(in.value_kg_m2[k]) + "," + CsvNum(in.std_kg_m2[k]) + "," + in.source[k];
   }

@@ -102,8 +102,6 @@ struct ExportInertia {
   std::vector<std::string> Missing() const;  // names of the missing components
 };
 
-const char* ExportComponentName(int component);  // "Ixx", ..., "Iyz"
-
 // Reads the inertia from results.json text (`name` prefixes every message) and fills missing
 // components from the options. Throws UserError naming the file on: text that is not JSON, a
 // document bifilar did not write, no `tensor` or `ellipse` section with a number, a --set of a

@@ -17,6 +17,7 @@
 #include "base/units.h"
 #include "base/user_error.h"
 #include "base/version.h"
+#include "fit/tensor_components.h"
 #include "pipeline/figures/svg_compact.h"
 #include "pipeline/logs/simulated_log.h"
 #include "pipeline/records/results_json.h"
@@ -365,7 +366,8 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
     h << "<p class=\"bad\">" << Escape(p.summary.tensor_message) << "</p>\n";
     return;
   }
-  for (const char* name : {"Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"}) {
+  for (int k = 0; k < kTensorComponents; ++k) {
+    const char* name = TensorComponentName(k);
     add(std::string("I<sub>") + (name + 1) + "</sub>", GetEstimate(p.tensor, std::string(name) + "_kg_m2"),
         NAN);
   }
@@ -669,7 +671,8 @@ void WriteTensorSection(ReportPage& p, std::ostream& h) {
        "(docs/physics.md &sect;3.5). Values are given to the digits their std supports.</p>\n";
   h << kScrollOpen << "<table><tr><th class=\"l\">component</th><th>value</th><th>std (stat)</th>"
        "<th>interval (stat)</th><th class=\"l\">unit</th></tr>\n";
-  for (const char* name : {"Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"}) {
+  for (int k = 0; k < kTensorComponents; ++k) {
+    const char* name = TensorComponentName(k);
     const Estimate e = GetEstimate(tensor, std::string(name) + "_kg_m2");
     h << "<tr><td class=\"l\">I<sub>" << (name + 1) << "</sub></td>";
     if (!e.defined) {
