@@ -11,6 +11,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "base/enum_names.h"
 #include "base/option_check.h"
 #include "base/text_format.h"
 #include "fit/residual_stats.h"
@@ -253,17 +254,12 @@ TraceFitResult Finish(TraceFitResult r, const std::string& label,
 }  // namespace
 }  // namespace trace
 
+constexpr EnumName<TraceFitStatus> kTraceFitStatusNames[] = {{TraceFitStatus::kOk, "ok"},
+                                                             {TraceFitStatus::kRejected, "rejected"},
+                                                             {TraceFitStatus::kError, "error"}};
 
 const char* ToString(TraceFitStatus status) {
-  switch (status) {
-    case TraceFitStatus::kOk:
-      return "ok";
-    case TraceFitStatus::kRejected:
-      return "rejected";
-    case TraceFitStatus::kError:
-      return "error";
-  }
-  return "error";
+  return EnumToString(kTraceFitStatusNames, status, "error");
 }
 
 bool TraceFitOptions::Check(std::string* why) const {

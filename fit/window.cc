@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <limits>
 
+#include "base/enum_names.h"
 #include "base/option_check.h"
 #include "base/statistics.h"
 #include "base/text_format.h"
@@ -362,24 +363,16 @@ void FillPeaks(const Analysis& a, FreeOscillationWindow* w) {
 
 }  // namespace
 
-const char* ToString(WindowStatus status) {
-  switch (status) {
-    case WindowStatus::kOk: return "ok";
-    case WindowStatus::kRejected: return "rejected";
-    case WindowStatus::kError: return "error";
-  }
-  return "?";
-}
+constexpr EnumName<WindowStatus> kWindowStatusNames[] = {{WindowStatus::kOk, "ok"},
+                                                         {WindowStatus::kRejected, "rejected"},
+                                                         {WindowStatus::kError, "error"}};
+constexpr EnumName<WindowEnd> kWindowEndNames[] = {{WindowEnd::kLogEnd, "log_end"},
+                                                   {WindowEnd::kNoiseFloor, "noise_floor"},
+                                                   {WindowEnd::kStopped, "stopped"},
+                                                   {WindowEnd::kOverride, "override"}};
 
-const char* ToString(WindowEnd end) {
-  switch (end) {
-    case WindowEnd::kLogEnd: return "log_end";
-    case WindowEnd::kNoiseFloor: return "noise_floor";
-    case WindowEnd::kStopped: return "stopped";
-    case WindowEnd::kOverride: return "override";
-  }
-  return "?";
-}
+const char* ToString(WindowStatus status) { return EnumToString(kWindowStatusNames, status, "?"); }
+const char* ToString(WindowEnd end) { return EnumToString(kWindowEndNames, end, "?"); }
 
 bool WindowOptions::Check(std::string* why) const {
   CheckFailure f;
