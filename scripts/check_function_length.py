@@ -13,6 +13,8 @@ each with a `# reason`; an entry that is no longer needed is reported too, so th
 """
 import os, re, sys
 
+from cxx_text import blank_cxx
+
 LIMIT = 120
 ROOTS = ["base", "pendulum", "fit", "pipeline"]
 EXCLUDED = {"pendulum/dop853.h"}
@@ -27,45 +29,7 @@ CTOR_INIT = re.compile(r"([A-Za-z_~][\w:~]*)\s*\([^;{}]*\)\s*(?:noexcept\s*)?:[^
 
 def strip_code(text):
     """Comments, string and char literals blanked (newlines kept): braces in them do not count."""
-    out, i, n = [], 0, len(text)
-    while i < n:
-        c = text[i]
-        if text.startswith("//", i):
-            j = text.find("\n", i)
-            j = n if j < 0 else j
-            out.append(" " * (j - i)); i = j
-        elif text.startswith("/*", i):
-            j = text.find("*/", i + 2)
-            j = n if j < 0 else j + 2
-            out.append(re.sub(r"[^\n]", " ", text[i:j])); i = j
-        elif text.startswith('R"', i) and (i == 0 or not (text[i - 1].isalnum()
-                                                          or text[i - 1] == "_")):
-            k = text.find("(", i)
-            delim = ")" + text[i + 2:k] + '"'
-            j = text.find(delim, k)
-            j = n if j < 0 else j + len(delim)
-            out.append(re.sub(r"[^\n]", " ", text[i:j])); i = j
-        elif c in "\"'":
-            if c == "'" and i > 0 and text[i - 1].isalnum() and text[i + 1:i + 2].isalnum():
-                out.append(c); i += 1; continue  # digit separator 1'000
-            j = i + 1
-            while j < n and text[j] != c and text[j] != "\n":
-                j += 2 if text[j] == "\\" else 1
-            j = min(j + 1, n)
-            out.append(c + " " * (j - i - 2) + c if j - i >= 2 else text[i:j]); i = j
-        elif c == "#" and (i == 0 or text[i - 1] == "\n"):
-            j = i
-            while True:  # preprocessor line, with continuations
-                j = text.find("\n", j)
-                if j < 0:
-                    j = n; break
-                if text[j - 1] != "\\":
-                    break
-                j += 1
-            out.append(re.sub(r"[^\n]", " ", text[i:j])); i = j
-        else:
-            out.append(c); i += 1
-    return "".join(out)
+    return blank_cxx(text)
 
 
 def functions(text):

@@ -16,6 +16,8 @@ stay for now, one a line; an entry that matches nothing is reported too, so the 
 """
 import os, re, sys
 
+from cxx_text import blank_cxx
+
 ROOTS = ["base", "pendulum", "fit", "pipeline", os.path.join("python", "src"), "tests", "bench"]
 EXEMPT = {"base/units.h", "tests/base_units_test.cc"}
 ALLOW_FILE = "scripts/unit_facts_allow.txt"
@@ -37,28 +39,7 @@ SPELLINGS = [
 
 def without_comments(text):
     """// and /* */ comments blanked (newlines kept); string and char literals kept as they are."""
-    out, i, n = [], 0, len(text)
-    while i < n:
-        c = text[i]
-        if text.startswith("//", i):
-            j = text.find("\n", i)
-            j = n if j < 0 else j
-            out.append(" " * (j - i)); i = j
-        elif text.startswith("/*", i):
-            j = text.find("*/", i + 2)
-            j = n if j < 0 else j + 2
-            out.append(re.sub(r"[^\n]", " ", text[i:j])); i = j
-        elif c in "\"'":
-            if c == "'" and i > 0 and text[i - 1].isalnum() and text[i + 1:i + 2].isalnum():
-                out.append(c); i += 1; continue  # digit separator 1'000
-            j = i + 1
-            while j < n and text[j] != c and text[j] != "\n":
-                j += 2 if text[j] == "\\" else 1
-            j = min(j + 1, n)
-            out.append(text[i:j]); i = j
-        else:
-            out.append(c); i += 1
-    return "".join(out)
+    return blank_cxx(text, literals=False, preprocessor=False)
 
 
 def source_files(src):
