@@ -198,10 +198,14 @@ void AddFitOptions(CLI::App* sub, FitCli* args) {
       ->required();
   sub->add_option("logs", o.logs, "IMU logs: CSV (optionally .gz) or PX4 ULog (.ulg)")->required();
   sub->add_flag("--json", args->json, "print a JSON array of trace records instead of lines");
-  sub->add_option("--model", o.model, "full (default), jardin or linear")
+  sub->add_option("--model", o.model,
+                  "pendulum model: " + PendulumModelAllowedValues() + "; overrides fit.model " +
+                      "(default " + ToString(FitConfig().model) + ")")
       ->check(CLI::IsMember(PendulumModelNames()));
   sub->add_option("--integrator", o.integrator,
-                  "ODE solver of the fit: rk853 (default) or cvodes; overrides fit.integrator")
+                  "ODE solver of the fit: " + IntegratorMethodAllowedValues() +
+                      "; overrides fit.integrator (default " + ToString(FitConfig().integrator) +
+                      ")")
       ->check(CLI::IsMember(IntegratorMethodNames()));
   sub->add_option("--window", o.window, "fit only T0:T1 (s, the log's own time)");
   sub->add_option("--max-amplitude", o.max_amplitude_deg, "upper end of the amplitude band (deg)")

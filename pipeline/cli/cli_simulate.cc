@@ -65,7 +65,9 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
                               raw->o_sample_rate}) {
     option->check(FiniteNumber());
   }
-  sub->add_option("--model", args->model, "truth model: full (default), jardin, linear");
+  sub->add_option("--model", args->model,
+                  "truth model: " + PendulumModelAllowedValues() + " (default " +
+                      ToString(SimulationOptions().model) + ")");
   sub->add_flag("--no-accel", args->o.no_accel, "write no accelerometer columns");
   sub->add_flag("--force", args->force,
                 "overwrite files that exist (--trace, --truth, or the logs and truth.json of "
