@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """One name per unit fact (issue 24): fails (exit 1) listing every second spelling of pi, of a
-degree/radian factor or of standard gravity g0 outside base/units.h. Run by CTest as
+degree/radian factor, of standard gravity g0 or of the slug ft^2 factor outside base/units.h. Run by CTest as
 layout/unit_facts:
   python3 scripts/check_unit_facts.py SOURCE_DIR
   python3 scripts/check_unit_facts.py --self-test   # CTest layout/unit_facts_self_test
@@ -9,7 +9,8 @@ sub-folders), comments left out (code and string literals are read: a help text 
 "9.80665" by hand is a second spelling; one formatted from kStandardGravityMps2 is not).
 Flagged: `kPi =` and the other constants of units.h defined again, M_PI, 3.14159..., pi over 180
 (`kPi / 180`, `x * kPi / 180.0`), 180 over pi (`180.0 / kPi`, `x * 180 / kPi`), 57.29... and
-0.01745..., and 9.80665. Use kPi, kRadPerDeg, kDegPerRad and kStandardGravityMps2.
+0.01745..., 9.80665, and 1.3558.../0.73756... (slug ft^2). Use kPi, kRadPerDeg, kDegPerRad,
+kStandardGravityMps2, kKgM2PerSlugFt2 and kSlugFt2PerKgM2.
 Not scanned: base/units.h (the definitions) and tests/base_units_test.cc (which pins each constant
 to its literal value). scripts/unit_facts_allow.txt lists `path:spelling  # reason` pairs that may
 stay for now, one a line; an entry that matches nothing is reported too, so the list only shrinks.
@@ -34,6 +35,8 @@ SPELLINGS = [
     (r"\b57\.29", "degrees per radian", "kDegPerRad"),
     (r"\b0\.01745", "radians per degree", "kRadPerDeg"),
     (r"\b9\.80665", "standard gravity g0", "kStandardGravityMps2"),
+    (r"\b1\.3558\d*", "kg m^2 per slug ft^2", "kKgM2PerSlugFt2"),
+    (r"\b0\.73756\d*", "slug ft^2 per kg m^2", "kSlugFt2PerKgM2"),
 ]
 
 
@@ -121,6 +124,8 @@ PLANTED = [
     'app.add_option("--gravity", g, "local g, m/s^2 (9.80665)");',
     "constexpr double kRadPerDeg = 0.017453292519943295;",
     "constexpr double kStandardGravityMps2 = 9.81;",
+    "const double imperial = si / 1.35581795;",
+    "const double imperial = si * 0.737562;",
 ]
 CLEAN = [
     "const double t = pitch * kRadPerDeg;",
@@ -133,6 +138,7 @@ CLEAN = [
     "if (kPi == other) return;",
     "plwind(-180.0, 180.0, 0.0, 1.0);",
     "const double x = y / 1800.0 * kPi;",
+    "const double imperial = si * kSlugFt2PerKgM2;  // 1 slug ft^2 = 1.35581795 kg m^2",
 ]
 
 

@@ -16,7 +16,7 @@
 namespace bifilar {
 namespace {
 
-constexpr double kSlugFt2 = 1.35581795;  // kg m^2 per slug ft^2
+constexpr double kSlugFt2 = kKgM2PerSlugFt2;  // kg m^2 per slug ft^2
 
 struct Truth {
   double ix, iz, ixz;  // kg m^2

@@ -205,7 +205,7 @@ TEST(Simulate, SwayCouplingRaisesTheApparentInertiaAsAToTheFourth) {
 
 TEST(Simulate, CampaignTruthAndLayout) {
   CampaignSpec spec;
-  constexpr double kSlug = 1.35581795;
+  constexpr double kSlug = kKgM2PerSlugFt2;
   spec.aircraft = {5.5, 2.3596 * kSlug, 2.8477 * kSlug, 0.0178 * kSlug};
   spec.rig.mass_kg = 1.2;
   spec.rig.imu_mass_kg = 0.05;

@@ -104,9 +104,9 @@ TEST_F(EllipseCli, JsonHasTheIssueKeysInSi) {
   EXPECT_EQ(j["n_points"], 54);
   EXPECT_EQ(j["n_angles"], 18);
   // Exact data in slug ft^2, converted to SI (1 slug ft^2 = 1.35581795 kg m^2).
-  EXPECT_NEAR(j["Ix_kg_m2"].get<double>(), 2.3596 * 1.35581795, 1e-9);
-  EXPECT_NEAR(j["Iz_kg_m2"].get<double>(), 2.8477 * 1.35581795, 1e-9);
-  EXPECT_NEAR(j["Ixz_kg_m2"].get<double>(), 0.0178 * 1.35581795, 1e-9);
+  EXPECT_NEAR(j["Ix_kg_m2"].get<double>(), 2.3596 * kKgM2PerSlugFt2, 1e-9);
+  EXPECT_NEAR(j["Iz_kg_m2"].get<double>(), 2.8477 * kKgM2PerSlugFt2, 1e-9);
+  EXPECT_NEAR(j["Ixz_kg_m2"].get<double>(), 0.0178 * kKgM2PerSlugFt2, 1e-9);
   EXPECT_NEAR(j["tau_deg"].get<double>(), 2.0856, 1e-3);
   EXPECT_TRUE(j["fits"]["nelder_mead"]["converged"].get<bool>());
   EXPECT_NEAR(j["fits"]["ceres"]["parameters"]["Ixz_kg_m2"].get<double>(),
@@ -203,7 +203,7 @@ TEST_F(EllipseCli, PlanPredictsStandardErrors) {
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["n_points"], 54);
   // sigma^2 (X^T X)^-1 for 18 equally spaced angles x 3: var C = sigma^2 / (54 / 2).
-  EXPECT_NEAR(j["Ixz_kg_m2_std"].get<double>(), 0.005 * 1.35581795 / std::sqrt(27.0), 1e-9);
+  EXPECT_NEAR(j["Ixz_kg_m2_std"].get<double>(), 0.005 * kKgM2PerSlugFt2 / std::sqrt(27.0), 1e-9);
   EXPECT_TRUE(j["tau_deg_std"].is_number());
   const CliRun human = Bifilar("plan --angles 0,30,60,90 --sigma 0.01 --ix 2 --iz 3 --ixz 0.1");
   ASSERT_EQ(human.exit_code, 0) << human.err;

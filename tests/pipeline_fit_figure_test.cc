@@ -261,7 +261,7 @@ TEST(FigureExtremes, SweepTickLabelsAndTextStayOnThePage) {
   TempDir dir("bifilar_sweep_extremes");
   int k = 0;
   for (double inertia : {1.6e-5, 0.127, 0.12703, 0.25, 2.9, 4500.0}) {
-    for (double unit_scale : {1.0, 1.0 / 1.35581795}) {
+    for (double unit_scale : {1.0, 1.0 / kKgM2PerSlugFt2}) {
       for (int bands : {3, 20}) {
         for (int page : {0, 1, 2}) {  // 800 x 500 (default), 640 x 400 compact, 1100 x 700
           const bool compact = page == 1;
@@ -321,7 +321,7 @@ TEST(FigureExtremes, WindowFitFiguresAtTheExtremes) {
       EXPECT_FALSE(d.from_band);
       EXPECT_EQ(d.t_s.size(), fit.t_s.size());
       EXPECT_TRUE(d.whole_t_s.empty());
-      for (double unit_scale : {1.0, 1.0 / 1.35581795}) {
+      for (double unit_scale : {1.0, 1.0 / kKgM2PerSlugFt2}) {
         TracePlotOptions options;
         options.title = "pitch_-10/trial_1.csv";
         options.unit_scale = unit_scale;

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "base/units.h"
 #include "pendulum/model.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/records/results_json.h"
@@ -124,7 +125,7 @@ TEST(PeriodRecord, FitConsoleLineInTheConfigUnits) {
   EXPECT_NE(text.find(expected), std::string::npos) << text;
   // units: imperial: every inertia of the line in slug ft^2 (1 slug ft^2 = 1.35581795 kg m^2).
   std::snprintf(expected, sizeof(expected), "= %.5g slug ft^2",
-                r.small_angle_inertia_total_kg_m2 / 1.35581795);
+                r.small_angle_inertia_total_kg_m2 / kKgM2PerSlugFt2);
   EXPECT_NE(text.find(expected), std::string::npos) << text;
   EXPECT_EQ(text.find("kg m^2"), std::string::npos) << text;
 }

@@ -67,8 +67,8 @@ TEST(SimulateSpec, SampleConfigParses) {
   ASSERT_TRUE(spec.has_campaign);
   EXPECT_EQ(spec.campaign.pitch_deg.size(), 18u);
   EXPECT_EQ(spec.campaign.trials_per_pitch, 3);
-  EXPECT_NEAR(spec.campaign.aircraft.ix_kg_m2, 2.3596 * 1.35581795, 1e-12);
-  EXPECT_NEAR(spec.campaign.aircraft.ixz_kg_m2, 0.0178 * 1.35581795, 1e-12);
+  EXPECT_NEAR(spec.campaign.aircraft.ix_kg_m2, 2.3596 * kKgM2PerSlugFt2, 1e-12);
+  EXPECT_NEAR(spec.campaign.aircraft.ixz_kg_m2, 0.0178 * kKgM2PerSlugFt2, 1e-12);
   EXPECT_EQ(spec.options.model, PendulumModel::kFull);
   std::string why;
   EXPECT_TRUE(spec.campaign.Check(&why)) << why;
@@ -187,7 +187,7 @@ TEST(SimulateCampaign, SameSeedSameBytesAndTruthConsistent) {
   const nlohmann::json truth = nlohmann::json::parse(ReadText(a / "truth.json"));
   const auto& ac = truth["aircraft"];
   const double ix = ac["ix_kg_m2"], iz = ac["iz_kg_m2"], ixz = ac["ixz_kg_m2"];
-  EXPECT_NEAR(ix, 2.3596 * 1.35581795, 1e-12);
+  EXPECT_NEAR(ix, 2.3596 * kKgM2PerSlugFt2, 1e-12);
   EXPECT_NEAR(ac["tau_deg"].get<double>(), 0.5 * std::atan2(2 * ixz, iz - ix) / kRadPerDeg, 1e-12);
   ASSERT_EQ(truth["traces"].size(), 5u);
   for (const auto& t : truth["traces"]) {

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "base/units.h"
 #include "fit/tensor.h"
 #include "fit/tensor_plan.h"
 #include "test_support.h"
@@ -54,12 +55,12 @@ TEST(TensorPlanCli, JsonMatchesTheLibraryAndUnitsConvert) {
 
   // The same plan in slug ft^2: the printed stds are the SI ones divided by 1.35581795.
   char sigma[64];
-  std::snprintf(sigma, sizeof sigma, "%.17g", 0.005 / 1.35581795);
+  std::snprintf(sigma, sizeof sigma, "%.17g", 0.005 / kKgM2PerSlugFt2);
   const CliRun imperial = Bifilar(dir, "plan --tensor --roll=-45:45 --trials 2 --sigma " +
                                            std::string(sigma) + " --units imperial");
   ASSERT_EQ(imperial.exit_code, 0) << imperial.err;
   char izz[64];
-  std::snprintf(izz, sizeof izz, "Izz  %-11.4g", plan.std_kg_m2[2] / 1.35581795);
+  std::snprintf(izz, sizeof izz, "Izz  %-11.4g", plan.std_kg_m2[2] / kKgM2PerSlugFt2);
   EXPECT_NE(imperial.out.find(izz), std::string::npos) << izz << "\n" << imperial.out;
   EXPECT_NE(imperial.out.find("slug ft^2"), std::string::npos);
 }
