@@ -109,6 +109,11 @@ Row TensorDesignRow(const std::array<double, 3>& axis) {
 
 bool TensorPlanOptions::Check(std::string* why) const {
   CheckFailure f;
+  return Check(&f) || FailWith(f, why);
+}
+
+bool TensorPlanOptions::Check(CheckFailure* failure) const {
+  CheckFailure& f = *failure;
   // 1e100 kg m^2 bounds every moment and std, as the tensor fit's inputs: their squares (the
   // covariance) stay finite. Small stds need no bound: the plan works in units of the largest.
   constexpr double kMax = kMaxMomentKgM2;
@@ -147,10 +152,12 @@ bool TensorPlanOptions::Check(std::string* why) const {
     // The guessed tensor is positive definite.
     const Eigen::Vector3d eig =
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(TensorMatrix(guess_kg_m2)).eigenvalues();
-    ok = eig[0] > 0 || CheckFail("smallest principal moment of guess_kg_m2", eig[0],
+    // Shown to 6 digits: a derived value, its last digits are rounding.
+    ok = eig[0] > 0 || CheckFail("smallest principal moment of guess_kg_m2",
+                                 std::stod(Fmt("%.6g", eig[0])),
                                  "> 0 (check the products' signs and sizes)", &f);
   }
-  return ok || FailWith(f, why);
+  return ok;
 }
 
 namespace {

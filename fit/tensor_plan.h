@@ -32,6 +32,8 @@
 
 namespace bifilar {
 
+struct CheckFailure;  // base/option_check.h
+
 // The row of the design matrix for the axis n (normalised first):
 // (nx^2, ny^2, nz^2, -2 nx ny, -2 nx nz, -2 ny nz), so I(n) = row . components.
 std::array<double, kTensorComponents> TensorDesignRow(const std::array<double, 3>& n);
@@ -74,6 +76,9 @@ struct TensorPlanOptions {
   double rank_tolerance = 1e-6;
 
   bool Check(std::string* why) const;
+  // The same, the first failing bound as field, value and bound (base/option_check.h), so that
+  // `plan --tensor` names the flag of the field.
+  bool Check(CheckFailure* failure) const;
 };
 
 struct TensorPlanOrientation {

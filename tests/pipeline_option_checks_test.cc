@@ -78,9 +78,13 @@ TEST(OptionChecks, PlanRigNamesFieldValueAndBound) {
 TEST(OptionChecks, PlanTensorNamesFieldValueAndBound) {
   TempDir dir("bifilar_option_checks");
   ExpectOneLineError(dir, "plan --tensor --pitch=-95:0 --sigma 0.1",
-                     "plan --tensor: pitch_min_deg = -95; must be in [-90, 90]");
+                     "plan --tensor: --pitch: pitch_min_deg = -95; must be in [-90, 90]");
   ExpectOneLineError(dir, "plan --tensor --roll=-45:45 --sigma 1e200",
-                     "plan --tensor: sigma_kg_m2 = 1e+200; must be in [0, 1e+100]");
+                     "plan --tensor: --sigma: sigma_kg_m2 = 1e+200; must be in [0, 1e+100]");
+  // A guess that is no tensor: the flags that set it, the derived value to 6 digits.
+  ExpectOneLineError(dir, "plan --tensor --sigma 0.1 --ixx 1 --iyy 1 --izz 1 --ixy 5",
+                     "plan --tensor: --ixx ... --iyz: smallest principal moment of guess_kg_m2 = "
+                     "-4; must be > 0 (check the products' signs and sizes)");
 }
 
 }  // namespace

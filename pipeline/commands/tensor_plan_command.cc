@@ -7,6 +7,7 @@
 #include <string>
 
 #include "base/json_number.h"
+#include "base/option_check.h"
 #include "base/text_format.h"
 #include "base/user_error.h"
 #include "fit/tensor.h"
@@ -15,6 +16,22 @@ namespace bifilar {
 namespace {
 
 using nlohmann::json;
+
+// The flag that sets a TensorPlanOptions field, for its messages ("" when no flag sets it).
+std::string FlagOfPlanField(const std::string& field) {
+  static const std::pair<const char*, const char*> kFlags[] = {
+      {"roll_min_deg", "--roll"},           {"roll_max_deg", "--roll"},
+      {"pitch_min_deg", "--pitch"},         {"pitch_max_deg", "--pitch"},
+      {"grid_step_deg", "--grid-step"},     {"n_orientations", "--orientations"},
+      {"sigma_kg_m2", "--sigma"},           {"sigma_relative", "--sigma-rel"},
+      {"attitude_std_deg", "--attitude-std"}, {"target_std_kg_m2", "--target"},
+      {"guess_kg_m2", "--ixx ... --iyz"}};
+  for (const auto& [name, flag] : kFlags) {
+    if (field.rfind(name, 0) == 0) return flag;  // "guess_kg_m2 Ixx", "target_std_kg_m2 (0: none)"
+  }
+  if (field.find("guess_kg_m2") != std::string::npos) return "--ixx ... --iyz";
+  return "";
+}
 
 // No "-0.000" in a table.
 double Clean(double v) { return std::fabs(v) < 5e-7 ? 0.0 : v; }
@@ -109,8 +126,11 @@ TensorPlanCommandResult RunTensorPlan(const TensorPlanCommandOptions& options) {
         "plan --tensor: --sigma-rel and --attitude-std need a guess of the tensor: "
         "give --ixx, --iyy, --izz (and --ixy, --ixz, --iyz when known)");
   }
-  std::string why;
-  if (!o.Check(&why)) throw UserError("plan --tensor: " + why);
+  CheckFailure failure;
+  if (!o.Check(&failure)) {
+    const std::string flag = FlagOfPlanField(failure.field);
+    throw UserError("plan --tensor: " + (flag.empty() ? "" : flag + ": ") + failure.Message());
+  }
   if (options.target_relative > 0) {
     if (!options.guess_given) {
       throw UserError(
@@ -120,6 +140,7 @@ TensorPlanCommandResult RunTensorPlan(const TensorPlanCommandOptions& options) {
     o.target_std_kg_m2 = options.target_relative * LargestPrincipal(o.guess_kg_m2);
   }
   TensorPlanCommandResult result;
+  std::string why;
   if (!PlanTensor(o, &result.plan, &why)) throw UserError("plan --tensor: " + why);
   result.options = o;
   return result;
