@@ -13,6 +13,7 @@ each with a `# reason`; an entry that is no longer needed is reported too, so th
 """
 import os, re, sys
 
+from allow_list import read_allow_list
 from cxx_text import blank_cxx
 
 LIMIT = 120
@@ -94,20 +95,8 @@ def source_files(src):
 
 
 def read_allow(path):
-    allow, problems = set(), []
-    if not os.path.exists(path):
-        return allow, problems
-    for k, line in enumerate(open(path, encoding="utf-8"), 1):
-        entry, _, reason = line.partition("#")
-        entry = entry.strip()
-        if not entry:
-            continue
-        if ":" not in entry or not reason.strip():
-            problems.append("%s:%d: want `path:function  # reason`, got %r"
-                            % (ALLOW_FILE, k, line.strip()))
-            continue
-        allow.add(entry)
-    return allow, problems
+    entries, problems = read_allow_list(path, ALLOW_FILE, "function")
+    return {entry for entry, _, _ in entries}, problems
 
 
 def long_functions(src):

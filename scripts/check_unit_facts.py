@@ -17,6 +17,7 @@ stay for now, one a line; an entry that matches nothing is reported too, so the 
 """
 import os, re, sys
 
+from allow_list import read_allow_list
 from cxx_text import blank_cxx
 
 ROOTS = ["base", "pendulum", "fit", "pipeline", os.path.join("python", "src"), "tests", "bench"]
@@ -71,21 +72,8 @@ def findings(src):
 
 
 def read_allow(path):
-    allow, problems = {}, []
-    if not os.path.exists(path):
-        return allow, problems
-    for k, line in enumerate(open(path, encoding="utf-8"), 1):
-        entry, _, reason = line.partition("#")
-        entry = entry.strip()
-        if not entry:
-            continue
-        rel, _, spelling = entry.partition(":")
-        if not spelling or not reason.strip():
-            problems.append("%s:%d: want `path:spelling  # reason`, got %r"
-                            % (ALLOW_FILE, k, line.strip()))
-            continue
-        allow[(rel, spelling)] = entry
-    return allow, problems
+    entries, problems = read_allow_list(path, ALLOW_FILE, "spelling")
+    return {(rel, spelling): entry for entry, rel, spelling in entries}, problems
 
 
 def main(src):
