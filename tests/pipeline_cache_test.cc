@@ -23,6 +23,17 @@ std::string ReadText(const std::string& path) {
   return s.str();
 }
 
+// An ok record with the few fields the cache tests look at.
+TraceRecord OkRecord() {
+  TraceRecord r;
+  r.file = "pitch_0/trial_1.csv";
+  r.status = TraceStatus::kOk;
+  r.inertia_total_kg_m2 = 4.1;
+  r.inertia_total_std_kg_m2 = 2e-5;
+  r.model = "full";
+  return r;
+}
+
 TEST(Cache, Fnv1a64MatchesReferenceVectors) {
   // Vectors from the FNV reference (isthe.com/chongo/tech/comp/fnv, test_fnv.c, FNV-1a 64).
   EXPECT_EQ(Fnv1a64(std::string("")), 0xcbf29ce484222325ULL);
@@ -131,12 +142,7 @@ TEST(Cache, EntryProvesItsKeyAndIntegrity) {
   char tmpl[] = "/tmp/bifilar_cache_test_XXXXXX";
   const std::string dir = mkdtemp(tmpl);
   const TraceCache cache(dir + "/cache");
-  TraceRecord r;
-  r.file = "pitch_0/trial_1.csv";
-  r.status = TraceStatus::kOk;
-  r.inertia_total_kg_m2 = 4.1;
-  r.inertia_total_std_kg_m2 = 2e-5;
-  r.model = "full";
+  const TraceRecord r = OkRecord();
   const std::string key = "00000000000000k1", other = "00000000000000k2", hash = "00000000000000aa";
   cache.Store(key, hash, r);
   cache.Store(other, "00000000000000bb", r);
@@ -174,19 +180,15 @@ TEST(Cache, EntryProvesItsKeyAndIntegrity) {
 }
 
 // An entry is read by the one reader of a trace record (TraceRecordFromJson): an entry that lacks
-// a key the writer writes (an older format), or holds a number beyond a double, is refused naming
-// the key even with its checksum fixed up, and refitted.
+// a key the writer writes (an older format) is refused naming the key even with its checksum
+// fixed up, and one holding a number beyond a double is refused as not valid JSON; both are
+// refitted.
 TEST(Cache, AnEntryLackingAKeyIsRefusedNamingIt) {
   char tmpl[] = "/tmp/bifilar_cache_test_XXXXXX";
   const std::string dir = mkdtemp(tmpl);
   const TraceCache cache(dir + "/cache");
-  TraceRecord r;
-  r.file = "pitch_0/trial_1.csv";
-  r.status = TraceStatus::kOk;
-  r.inertia_total_kg_m2 = 4.1;
-  r.inertia_total_std_kg_m2 = 2e-5;
+  TraceRecord r = OkRecord();
   r.period_s = 2.49;
-  r.model = "full";
   const std::string key = "00000000000000k1", hash = "00000000000000aa";
   cache.Store(key, hash, r);
   const nlohmann::json good = nlohmann::json::parse(ReadText(cache.EntryPath(key)));
