@@ -1,6 +1,8 @@
 #include "base/text_format.h"
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 namespace bifilar {
 
@@ -27,6 +29,13 @@ std::string Fmt(const char* format, double a, double b, double c) {
 }
 std::string Fmt(const char* format, double a, double b, double c, double d) {
   return FormatDoubles(format, a, b, c, d);
+}
+
+double RoundedToDigits(double v, int digits) {
+  if (!std::isfinite(v)) return v;
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*g", digits, v);
+  return std::strtod(buffer, nullptr);
 }
 
 std::string PrintableAscii(std::string_view s, size_t max_bytes) {

@@ -14,6 +14,10 @@ std::string Fmt(const char* format, double a, double b);
 std::string Fmt(const char* format, double a, double b, double c);
 std::string Fmt(const char* format, double a, double b, double c, double d);
 
+// `v` rounded to `digits` significant digits, the number "%.<digits>g" prints (NaN and
+// infinities as they are): a derived value shown in a message without its rounding noise.
+double RoundedToDigits(double v, int digits);
+
 // A file's own text echoed in a message: at most `max_bytes` bytes of `s`, every byte outside
 // printable ASCII (32-126) as '?', and "..." when cut.
 std::string PrintableAscii(std::string_view s, size_t max_bytes);

@@ -154,7 +154,7 @@ bool TensorPlanOptions::Check(CheckFailure* failure) const {
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(TensorMatrix(guess_kg_m2)).eigenvalues();
     // Shown to 6 digits: a derived value, its last digits are rounding.
     ok = eig[0] > 0 || CheckFail("smallest principal moment of guess_kg_m2",
-                                 std::stod(Fmt("%.6g", eig[0])),
+                                 RoundedToDigits(eig[0], 6),
                                  "> 0 (check the products' signs and sizes)", &f);
   }
   return ok;

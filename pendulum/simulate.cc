@@ -38,7 +38,7 @@ class Rng {
 };
 
 // An angle (rad) in degrees as a message shows it: 12 digits, so that 120 deg given reads 120.
-double ShownDeg(double rad) { return std::stod(Fmt("%.12g", rad / kRadPerDeg)); }
+double ShownDeg(double rad) { return RoundedToDigits(rad / kRadPerDeg, 12); }
 
 // A UniformRange [min, max] of `field`: both ends finite, min <= max, min above `lower`.
 bool CheckUniformRange(const UniformRange& r, const std::string& field, double lower,

@@ -52,6 +52,14 @@ TEST(TextFormat, FmtTakesOneToFourNumbersAndNeverCuts) {
   EXPECT_EQ(Fmt("%g %.3f", 1.0, 1e200), "1 " + huge);
 }
 
+TEST(TextFormat, RoundedToDigitsDropsRoundingNoise) {
+  EXPECT_EQ(RoundedToDigits(-3.9999999999999996, 6), -4.0);
+  EXPECT_EQ(RoundedToDigits(120.00000000000001, 12), 120.0);
+  EXPECT_EQ(RoundedToDigits(1.23456789, 3), 1.23);
+  EXPECT_TRUE(std::isnan(RoundedToDigits(NAN, 6)));
+  EXPECT_EQ(RoundedToDigits(-INFINITY, 6), -INFINITY);
+}
+
 TEST(TextFormat, PrintableAsciiEchoesAFilesTextSafely) {
   EXPECT_EQ(PrintableAscii("IMU", 64), "IMU");
   EXPECT_EQ(PrintableAscii(std::string("a\tb\x01\xc3\xa9", 6), 64), "a?b???");
