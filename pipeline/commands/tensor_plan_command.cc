@@ -24,11 +24,11 @@ std::string FlagOfPlanField(const std::string& field) {
       {"pitch_min_deg", "--pitch"},         {"pitch_max_deg", "--pitch"},
       {"grid_step_deg", "--grid-step"},     {"n_orientations", "--orientations"},
       {"sigma_kg_m2", "--sigma"},           {"sigma_relative", "--sigma-rel"},
-      {"attitude_std_deg", "--attitude-std"}, {"target_std_kg_m2", "--target"},
-      {"guess_kg_m2", "--ixx ... --iyz"}};
+      {"attitude_std_deg", "--attitude-std"}, {"target_std_kg_m2", "--target"}};
   for (const auto& [name, flag] : kFlags) {
-    if (field.rfind(name, 0) == 0) return flag;  // "guess_kg_m2 Ixx", "target_std_kg_m2 (0: none)"
+    if (field.rfind(name, 0) == 0) return flag;  // also "target_std_kg_m2 (0: none)"
   }
+  // "guess_kg_m2 Ixx", "smallest principal moment of guess_kg_m2"
   if (field.find("guess_kg_m2") != std::string::npos) return "--ixx ... --iyz";
   return "";
 }
