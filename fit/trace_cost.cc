@@ -39,8 +39,10 @@ bool TraceRateCost::Evaluate(const double* params, double* residuals, double* ja
       if (why != nullptr) *why = "parameters out of range";
       return false;
     }
-    if (!integrator_.Integrate(p, params[kTraceAngle0], params[kTraceRate0], *t_s_, true, &traj_,
-                               &local_why)) {
+    const bool integrated = integrator_.Integrate(p, params[kTraceAngle0], params[kTraceRate0],
+                                                  *t_s_, true, &traj_, &local_why);
+    integrator_steps_ += integrator_.last_stats().steps;
+    if (!integrated) {
       if (why != nullptr) *why = local_why;
       return false;
     }

@@ -47,6 +47,10 @@ class TraceRateCost {
   bool Evaluate(const double* params, double* residuals, double* jacobian_row_major,
                 std::string* why) const;
 
+  // Internal integrator steps of every integration this object has run (cache hits run none,
+  // failed integrations count the steps they took): the work the fit's budget counts.
+  long integrator_steps() const { return integrator_steps_; }
+
   // Trajectory (angle, rate, sensitivities) at the last evaluated point.
   const Trajectory& last_trajectory() const { return traj_; }
 
@@ -59,6 +63,7 @@ class TraceRateCost {
   mutable PendulumIntegrator integrator_;
   mutable Trajectory traj_;
   mutable bool cache_valid_ = false;
+  mutable long integrator_steps_ = 0;
   mutable double cache_params_[kNumTraceParams] = {0, 0, 0, 0, 0, 0};
 };
 

@@ -225,18 +225,30 @@ TraceFitResult AssembleResult(const TraceFitInput& input, const TraceFitOptions&
   return result;
 }
 
-// A fit stopped by its budget: rejected (a bound) or an error (interrupted), with no parameters.
+// A fit stopped by its budget, with no parameters: rejected at a work bound (iterations,
+// integrator steps), an error when abandoned by the time guard or interrupted.
 TraceFitResult Stopped(TraceFitResult result, const SolveBudget& budget) {
   result.iterations = budget.iterations();
+  result.integrator_steps = budget.integrator_steps();
   result.message = budget.Message();
-  if (budget.stop() == SolveBudget::Stop::kInterrupted) {
-    result.status = TraceFitStatus::kError;
-    result.interrupted = true;
-    result.flags.push_back("interrupted");
-  } else {
-    result.status = TraceFitStatus::kRejected;
-    result.solver_bound = true;
-    result.flags.push_back("solver_bound");
+  switch (budget.stop()) {
+    case SolveBudget::Stop::kInterrupted:
+      result.status = TraceFitStatus::kError;
+      result.interrupted = true;
+      result.flags.push_back("interrupted");
+      break;
+    case SolveBudget::Stop::kTimeGuard:
+      result.status = TraceFitStatus::kError;
+      result.time_guard = true;
+      result.flags.push_back("time_guard");
+      break;
+    case SolveBudget::Stop::kIterations:
+    case SolveBudget::Stop::kSteps:
+    case SolveBudget::Stop::kNone:
+      result.status = TraceFitStatus::kRejected;
+      result.solver_bound = true;
+      result.flags.push_back("solver_bound");
+      break;
   }
   return result;
 }
@@ -269,7 +281,8 @@ bool TraceFitOptions::Check(std::string* why) const {
   const bool ok =
       CheckGt("max_iterations", max_iterations, 0, &f) &&
       CheckGe("max_total_iterations", max_total_iterations, 1, &f) &&
-      CheckFiniteGt("max_fit_cpu_seconds", max_fit_cpu_seconds, 0, &f) &&
+      CheckGe("max_integrator_steps", static_cast<double>(max_integrator_steps), 1, &f) &&
+      CheckFiniteGt("time_guard_cpu_seconds", time_guard_cpu_seconds, 0, &f) &&
       CheckGt("max_rms_over_noise", max_rms_over_noise, 1, &f) &&
       CheckIn("max_residual_autocorr", max_residual_autocorr, 0, 1, Ends::kOpen, &f) &&
       CheckGe("whiteness_lags", whiteness_lags, 1, &f) &&
@@ -338,7 +351,8 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
   // 3. Levenberg-Marquardt from the guess, with an active set for K_D, C >= 0 and one retry.
   const TraceRateCost cost(&input.t_s, &input.rate_rad_per_s, options.model, input.geometry,
                            options.integrator, guess.params.inertia_kg_m2);
-  // Every solver step below spends from one budget (iterations, CPU time, interrupt).
+  // Every solver step below spends from one budget (iterations, integrator steps, the time
+  // guard, interrupt).
   SolveBudget solve_budget(options);
   const Params from_guess = StartFromGuess(guess);
   Minimum minimum = MinimizeLm(cost, from_guess, options.max_iterations, &solve_budget);
@@ -379,6 +393,7 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
         BandFittedRate(input, options, minimum.p.data(), cost.inertia_scale(),
                        sweep.bands[sweep.low_band], &result.band_first_index);
   }
+  result.integrator_steps = solve_budget.integrator_steps();
   return finish(std::move(result));
 }
 

@@ -32,15 +32,23 @@ struct TraceFitOptions {
   IntegratorOptions integrator = DefaultIntegrator();
   int max_iterations = 50;  // Levenberg-Marquardt iterations per solve (count); > 0.
   // Bounds of one FitTrace call, over all its solves (the window fit with its active-set rounds
-  // and retry, the NLopt refinement, the amplitude-sweep bands): at most max_total_iterations
-  // Levenberg-Marquardt iterations and max_fit_cpu_seconds of CPU time of the calling thread
-  // (CPU, not wall time, so a busy machine never changes a result). A fit stopped by either is
-  // rejected with flag `solver_bound` and the message "the solver was stopped after N
-  // iterations and T s ...". Fits of real and simulated logs take < 100 iterations and < 1 s
-  // (at most 65536 points, fit/block_mean.h), so neither bound changes a normal result; they
-  // stop a window that does not hold a free swing, which can otherwise drift for minutes.
-  int max_total_iterations = 500;     // (count) >= 1
-  double max_fit_cpu_seconds = 20.0;  // (s) > 0
+  // and retry, the NLopt refinement, the amplitude-sweep bands). They count work, never time, so
+  // the same log gives the same result on any machine, however slow or busy: at most
+  // max_total_iterations Levenberg-Marquardt iterations and max_integrator_steps internal steps
+  // of the integrator (summed over every integration of the window the solvers ask for; each
+  // integration is itself bounded by integrator.max_steps, and the window by 65536 points,
+  // fit/block_mean.h). A fit stopped by either is rejected with flag `solver_bound` and the
+  // message "the solver was stopped after N iterations and S integrator steps (bounds: ...)".
+  // Fits of real and simulated logs take < 100 iterations and < 1e6 steps, so neither bound
+  // changes a normal result; they stop a window that does not hold a free swing, which can
+  // otherwise drift for minutes.
+  int max_total_iterations = 500;           // (count) >= 1
+  long max_integrator_steps = 20000000;     // (count) >= 1
+  // Last resort only, far above any real fit (< 1 s): CPU time of the calling thread after which
+  // the fit is abandoned. Its outcome depends on the machine's speed, so it is not a judgement of
+  // the data: status kError, flag `time_guard`, a message of its own ("abandoned by the time
+  // guard ..."), and such a record is never cached (pipeline/store/cache.cc).
+  double time_guard_cpu_seconds = 600.0;    // (s) > 0
   // Set (by Ctrl-C, for example) to stop the fit between solver iterations: the result is then
   // kError with `interrupted` true. Not owned; nullptr: never interrupted.
   const std::atomic<bool>* interrupt = nullptr;
@@ -237,7 +245,9 @@ struct TraceFitResult {
   double final_cost = 0.0;
   bool nlopt_refined = false;  // NLopt refinement of I was run
   bool interrupted = false;    // stopped by TraceFitOptions::interrupt (status kError)
-  bool solver_bound = false;   // stopped by max_total_iterations or max_fit_cpu_seconds
+  bool solver_bound = false;   // stopped by max_total_iterations or max_integrator_steps
+  bool time_guard = false;     // abandoned by time_guard_cpu_seconds (status kError)
+  long integrator_steps = 0;   // integrator steps the solvers spent (what max_integrator_steps counts)
   double fit_seconds = 0.0;    // wall time of FitTrace
   TraceInitialGuess guess;
 

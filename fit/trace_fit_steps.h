@@ -74,30 +74,37 @@ bool ValidateTraceFit(const TraceFitInput& input, const TraceFitOptions& options
 
 // --- The bounds of one fit (trace_solve.cc).
 
-// What every solver step of one FitTrace may spend: Levenberg-Marquardt iterations over all its
-// solves (TraceFitOptions::max_total_iterations) and CPU time of the calling thread
-// (max_fit_cpu_seconds; CPU, not wall time, so that a busy machine cannot change a result), and
-// the caller's interrupt flag. Checked between solver iterations, before each cost evaluation
-// of a solve and each NLopt evaluation; once exhausted it stays so and every later solve
-// returns at once (not ok).
+// What every solver step of one FitTrace may spend, counted in work so that a result never
+// depends on the machine's speed: Levenberg-Marquardt iterations over all its solves
+// (TraceFitOptions::max_total_iterations) and internal integrator steps over all the
+// integrations the solvers ask for (max_integrator_steps). Besides, a last-resort time guard
+// (time_guard_cpu_seconds of CPU time of the calling thread, far above any real fit) and the
+// caller's interrupt flag. Checked between solver iterations, before each cost evaluation of a
+// solve and each NLopt evaluation; once exhausted it stays so and every later solve returns at
+// once (not ok).
 class SolveBudget {
  public:
-  enum class Stop { kNone, kIterations, kTime, kInterrupted };
+  enum class Stop { kNone, kIterations, kSteps, kTimeGuard, kInterrupted };
   explicit SolveBudget(const TraceFitOptions& options);
   // Counts one solver iteration.
   void CountIteration() { ++iterations_; }
+  // Counts the internal steps of one integration.
+  void CountSteps(long steps) { integrator_steps_ += steps; }
   // True (and stays true) once a bound is reached or the interrupt flag is set.
   bool Exhausted();
   Stop stop() const { return stop_; }
   int iterations() const { return iterations_; }
+  long integrator_steps() const { return integrator_steps_; }
   double cpu_seconds() const;
-  // "stopped after 1000 iterations and 3.2 s of CPU time (bound: ...)" / "interrupted ...".
+  // "the solver was stopped after 500 iterations and 1234 integrator steps (bounds: ...)",
+  // "abandoned by the time guard ...", "interrupted ...".
   std::string Message() const;
 
  private:
   const TraceFitOptions& options_;
   double start_cpu_s_ = 0.0;
   int iterations_ = 0;
+  long integrator_steps_ = 0;
   Stop stop_ = Stop::kNone;
 };
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include <ceres/ceres.h>
 #include <nlopt.hpp>
@@ -30,8 +31,11 @@ class TraceCeresCost : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     if (budget_->Exhausted()) return false;  // Ceres then stops (at the start) or the watch does
-    return cost_->Evaluate(parameters[0], residuals,
-                           jacobians != nullptr ? jacobians[0] : nullptr, nullptr);
+    const long before = cost_->integrator_steps();
+    const bool ok = cost_->Evaluate(parameters[0], residuals,
+                                    jacobians != nullptr ? jacobians[0] : nullptr, nullptr);
+    budget_->CountSteps(cost_->integrator_steps() - before);
+    return ok;
   }
 
  private:
@@ -160,14 +164,16 @@ bool SolveBudget::Exhausted() {
     stop_ = Stop::kInterrupted;
   } else if (iterations_ >= options_.max_total_iterations) {
     stop_ = Stop::kIterations;
-  } else if (cpu_seconds() > options_.max_fit_cpu_seconds) {
-    stop_ = Stop::kTime;
+  } else if (integrator_steps_ >= options_.max_integrator_steps) {
+    stop_ = Stop::kSteps;
+  } else if (cpu_seconds() > options_.time_guard_cpu_seconds) {
+    stop_ = Stop::kTimeGuard;
   }
   return stop_ != Stop::kNone;
 }
 
 std::string SolveBudget::Message() const {
-  char text[320];
+  char text[480];
   const double cpu = cpu_seconds();
   switch (stop_) {
     case Stop::kInterrupted:
@@ -175,12 +181,26 @@ std::string SolveBudget::Message() const {
                     cpu);
       break;
     case Stop::kIterations:
-    case Stop::kTime:
+    case Stop::kSteps: {
+      const std::string iterations = std::to_string(options_.max_total_iterations) + " iterations";
+      const std::string steps = std::to_string(options_.max_integrator_steps) + " integrator steps";
+      const bool by_steps = stop_ == Stop::kSteps;
       std::snprintf(text, sizeof(text),
-                    "the solver was stopped after %d iterations and %.1f s of CPU time (bounds: "
-                    "%d iterations, %g s per fit), before the fit settled; set a window on the "
-                    "free oscillation (fit.windows or --window)",
-                    iterations_, cpu, options_.max_total_iterations, options_.max_fit_cpu_seconds);
+                    "the solver was stopped after %d iterations and %ld integrator steps (bound "
+                    "reached: %s per fit; the other: %s), before the fit settled; set a window "
+                    "on the free oscillation (fit.windows or --window)",
+                    iterations_, integrator_steps_, (by_steps ? steps : iterations).c_str(),
+                    (by_steps ? iterations : steps).c_str());
+      break;
+    }
+    case Stop::kTimeGuard:
+      std::snprintf(text, sizeof(text),
+                    "abandoned by the time guard after %.1f s of CPU time (guard: %g s per fit; "
+                    "%d iterations and %ld integrator steps done), far beyond any real fit; "
+                    "this outcome depends on the machine's speed, so it is an error, not a "
+                    "judgement of the log, and it is not cached; set a window on the free "
+                    "oscillation (fit.windows or --window)",
+                    cpu, options_.time_guard_cpu_seconds, iterations_, integrator_steps_);
       break;
     case Stop::kNone:
       return "";
@@ -294,7 +314,9 @@ void RefineInertia(const TraceRateCost& cost, const Params& start, int max_itera
       return 1e300;
     }
     q[kTraceInertia] = inertia_scaled;
+    const long before = cost.integrator_steps();
     const double c = Cost(cost, q.data(), &rr);
+    budget->CountSteps(cost.integrator_steps() - before);
     return std::isfinite(c) ? c : 1e300;
   };
   global.set_lower_bounds(std::vector<double>{0.9});

@@ -1,8 +1,11 @@
-// The bounds of one trace fit (TraceFitOptions::max_total_iterations, max_fit_cpu_seconds) and
-// its interrupt flag (issue 23 item 5): a window over a whole simulated log (rest, twist, hold
-// and swing) that Levenberg-Marquardt cannot fit stops at the bound with a message saying so;
-// a raised flag stops a fit with an `interrupted` error; neither changes a normal fit. No
-// wall-clock assertion: the bounds are set so that they trip deterministically.
+// The bounds of one trace fit (TraceFitOptions::max_total_iterations, max_integrator_steps), its
+// last-resort time guard (time_guard_cpu_seconds) and its interrupt flag (issue 23 item 5, issue
+// 33 item 6): a window over a whole simulated log (rest, twist, hold and swing) that
+// Levenberg-Marquardt cannot fit stops at a work bound with a message saying so, after the same
+// work on any machine; the time guard is an error of its own; a raised flag stops a fit with an
+// `interrupted` error; none changes a normal fit. Nothing here depends on the machine's speed:
+// the work bounds count iterations and steps, and the guard's test sets it so low that it trips
+// before any work and checks only that it is reported as the guard.
 #include <atomic>
 #include <string>
 
@@ -46,30 +49,65 @@ TraceFitInput Simulated(bool whole) {
 TEST(TraceFitBounds, IterationBoundStopsAHostileWindowWithAMessage) {
   const TraceFitInput input = Simulated(true);
   TraceFitOptions options;
-  options.max_total_iterations = 5;
+  options.max_total_iterations = 3;
+  options.time_guard_cpu_seconds = 1e9;  // the work bound alone decides, however slow the machine
   const TraceFitResult r = FitTrace(input, options);
   EXPECT_EQ(r.status, TraceFitStatus::kRejected) << r.BriefReport();
   EXPECT_TRUE(r.solver_bound);
+  EXPECT_FALSE(r.time_guard);
   EXPECT_FALSE(r.interrupted);
   EXPECT_FALSE(r.HasFit()) << "a stopped fit reports no inertia";
-  EXPECT_EQ(r.iterations, 5);
-  EXPECT_EQ(r.message.rfind("sim.csv: the solver was stopped after 5 iterations and ", 0), 0u)
+  EXPECT_EQ(r.iterations, 3);
+  EXPECT_EQ(r.message.rfind("sim.csv: the solver was stopped after 3 iterations and ", 0), 0u)
       << r.message;
-  EXPECT_NE(r.message.find("(bounds: 5 iterations, 20 s per fit)"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find(" integrator steps (bound reached: 3 iterations per fit; the other: "
+                           "20000000 integrator steps)"),
+            std::string::npos)
+      << r.message;
   ASSERT_FALSE(r.flags.empty());
   EXPECT_EQ(r.flags.back(), "solver_bound");
 }
 
-TEST(TraceFitBounds, CpuTimeBoundStopsTheFit) {
+// The step bound counts work: the same fit stops at the same point twice, after at least the
+// bound's steps, and says so in the same words.
+TEST(TraceFitBounds, IntegratorStepBoundStopsTheFitAfterTheSameWork) {
   const TraceFitInput input = Simulated(true);
   TraceFitOptions options;
-  options.max_fit_cpu_seconds = 1e-9;  // spent before the first iteration ends
+  options.max_integrator_steps = 3000;
+  options.time_guard_cpu_seconds = 1e9;
   const TraceFitResult r = FitTrace(input, options);
   EXPECT_EQ(r.status, TraceFitStatus::kRejected) << r.BriefReport();
   EXPECT_TRUE(r.solver_bound);
-  EXPECT_NE(r.message.find("s of CPU time (bounds: 500 iterations, 1e-09 s per fit)"),
+  EXPECT_FALSE(r.time_guard);
+  EXPECT_GE(r.integrator_steps, 3000);
+  EXPECT_NE(r.message.find("integrator steps (bound reached: 3000 integrator steps per fit; the "
+                           "other: 500 iterations)"),
             std::string::npos)
       << r.message;
+  const TraceFitResult again = FitTrace(input, options);
+  EXPECT_EQ(again.iterations, r.iterations);
+  EXPECT_EQ(again.integrator_steps, r.integrator_steps);
+  EXPECT_EQ(again.message, r.message);
+}
+
+// The time guard is not a work bound: an error with its own flag and message, never
+// `solver_bound`. Set below any fit's CPU time, it trips at the first check; only that is
+// checked, never how far the fit got.
+TEST(TraceFitBounds, TimeGuardIsAnErrorOfItsOwn) {
+  const TraceFitInput input = Simulated(true);
+  TraceFitOptions options;
+  options.time_guard_cpu_seconds = 1e-12;
+  const TraceFitResult r = FitTrace(input, options);
+  EXPECT_EQ(r.status, TraceFitStatus::kError) << r.BriefReport();
+  EXPECT_TRUE(r.time_guard);
+  EXPECT_FALSE(r.solver_bound);
+  EXPECT_FALSE(r.interrupted);
+  EXPECT_FALSE(r.HasFit());
+  EXPECT_EQ(r.message.rfind("sim.csv: abandoned by the time guard after ", 0), 0u) << r.message;
+  EXPECT_NE(r.message.find("(guard: 1e-12 s per fit;"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("depends on the machine's speed"), std::string::npos) << r.message;
+  ASSERT_FALSE(r.flags.empty());
+  EXPECT_EQ(r.flags.back(), "time_guard");
 }
 
 TEST(TraceFitBounds, RaisedInterruptFlagStopsTheFitAsInterrupted) {
@@ -92,10 +130,12 @@ TEST(TraceFitBounds, BoundsAndFlagLeaveANormalFitUnchanged) {
   const TraceFitInput input = Simulated(false);
   TraceFitOptions loose;
   loose.max_total_iterations = 1000000;
-  loose.max_fit_cpu_seconds = 1e9;
+  loose.max_integrator_steps = 1L << 50;
+  loose.time_guard_cpu_seconds = 1e9;
   const TraceFitResult reference = FitTrace(input, loose);
   ASSERT_EQ(reference.status, TraceFitStatus::kOk) << reference.BriefReport();
   EXPECT_LT(reference.iterations, 100);
+  EXPECT_LT(reference.integrator_steps, 1000000) << "far below the default step bound";
   std::atomic<bool> flag{false};
   TraceFitOptions options;  // default bounds
   options.interrupt = &flag;
@@ -104,6 +144,7 @@ TEST(TraceFitBounds, BoundsAndFlagLeaveANormalFitUnchanged) {
   EXPECT_EQ(r.params.inertia_kg_m2, reference.params.inertia_kg_m2);
   EXPECT_EQ(r.inertia_std_kg_m2, reference.inertia_std_kg_m2);
   EXPECT_EQ(r.iterations, reference.iterations);
+  EXPECT_EQ(r.integrator_steps, reference.integrator_steps);
   EXPECT_FALSE(r.solver_bound);
   EXPECT_FALSE(r.interrupted);
 }
@@ -126,9 +167,13 @@ TEST(TraceFitBounds, OptionsCheckNamesTheBounds) {
   EXPECT_FALSE(options.Check(&why));
   EXPECT_EQ(why, "max_total_iterations = 0; must be >= 1");
   options = TraceFitOptions();
-  options.max_fit_cpu_seconds = NAN;
+  options.max_integrator_steps = 0;
   EXPECT_FALSE(options.Check(&why));
-  EXPECT_EQ(why, "max_fit_cpu_seconds = nan; must be finite and > 0");
+  EXPECT_EQ(why, "max_integrator_steps = 0; must be >= 1");
+  options = TraceFitOptions();
+  options.time_guard_cpu_seconds = NAN;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "time_guard_cpu_seconds = nan; must be finite and > 0");
   options = TraceFitOptions();
   options.min_amplitude_deg = 20;
   options.max_amplitude_deg = 10;

@@ -137,6 +137,31 @@ TEST(Cache, StoreAndLoadRoundTrip) {
   std::filesystem::remove_all(dir, ec);
 }
 
+// issue 33 item 6: a fit abandoned by the time guard depends on the machine's speed; it is
+// never stored, so a faster run fits the log again instead of replaying the error.
+TEST(Cache, TimeGuardRecordIsNotStored) {
+  char tmpl[] = "/tmp/bifilar_cache_test_XXXXXX";
+  const std::string dir = mkdtemp(tmpl);
+  const TraceCache cache(dir + "/cache");
+  TraceRecord r;
+  r.file = "pitch_0/trial_1.csv";
+  r.status = TraceStatus::kError;
+  r.message = "abandoned by the time guard after 600.1 s of CPU time";
+  r.flags = {"time_guard"};
+  cache.Store("0000000000000003", "00000000000000aa", r);
+  TraceRecord loaded;
+  std::string problem;
+  EXPECT_FALSE(cache.Load("0000000000000003", "00000000000000aa", &loaded, &problem));
+  EXPECT_TRUE(problem.empty()) << problem;
+  EXPECT_FALSE(std::filesystem::exists(cache.EntryPath("0000000000000003")));
+  r.flags = {"solver_bound"};  // a work bound is the same on every machine: stored
+  r.status = TraceStatus::kRejected;
+  cache.Store("0000000000000003", "00000000000000aa", r);
+  EXPECT_TRUE(cache.Load("0000000000000003", "00000000000000aa", &loaded, &problem)) << problem;
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+}
+
 // issue 9 item 6: the cache was trusted blindly. Each tampering is refused with its reason.
 TEST(Cache, EntryProvesItsKeyAndIntegrity) {
   char tmpl[] = "/tmp/bifilar_cache_test_XXXXXX";

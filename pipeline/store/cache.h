@@ -46,7 +46,9 @@ class TraceCache {
   // caller refits and warns; the entry is overwritten).
   bool Load(const std::string& key, const std::string& content_hash, TraceRecord* record,
             std::string* problem) const;
-  // Throws UserError when the folder cannot be written.
+  // Throws UserError when the folder cannot be written. A record whose fit was abandoned by the
+  // time guard (flag "time_guard", fit/trace_fit.h) is not stored: that outcome depends on the
+  // machine's speed, and a faster run must fit the log again rather than replay it.
   void Store(const std::string& key, const std::string& content_hash,
              const TraceRecord& record) const;
   std::string EntryPath(const std::string& key) const;
