@@ -214,6 +214,9 @@ void AddFitOptions(CLI::App* sub, FitCli* args) {
   sub->add_option("--plot", o.plot_dir,
                   "write fit figures DIR/<log>.svg and .png, and the amplitude sweep (I against "
                   "amplitude) DIR/<log>_sweep.svg and .png when the trace has one");
+  sub->add_flag("--force", o.force,
+                "with --plot: replace files of the figures' names that bifilar did not write in "
+                "DIR (never a symbolic link)");
   sub->add_flag("--repeats", o.repeats,
                 "combine repeats: logs whose paths differ only in the last number of the file "
                 "name (case ignored) are swings of one set-up; their scatter beyond their stds "
