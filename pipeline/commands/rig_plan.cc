@@ -535,6 +535,11 @@ RigPlanFloor FloorOf(const RigPlanOptions& o, const RigPlanTerms& t) {
   const double between = t.between_repeat / root, stat = t.statistical / root;
   RigPlanFloor f;
   f.rel_std = std::sqrt(t.mass * t.mass + between * between + stat * stat);
+  const std::string over = " %/sqrt(" + std::to_string(kMaxRepeats) + ") = ";
+  f.parts = "mass " + Fmt("%.3g", 100.0 * t.mass) + " %, between-repeat " +
+            Fmt("%.3g", 100.0 * t.between_repeat) + over + Fmt("%.2g", 100.0 * between) +
+            " %, statistical " + Fmt("%.2g", 100.0 * t.statistical) + over +
+            Fmt("%.2g", 100.0 * stat) + " %";
   if (t.mass >= between && t.mass >= stat) {
     f.term = "mass";
     f.flag = "--mass-std";
@@ -563,11 +568,12 @@ void NotMet(const GridModel& m, double target, const GridPoint& relaxed, RigPlan
   if (plan->below_floor) {
     plan->binding = plan->floor.flag;
     plan->advice = "no rig, reference object or wider constraint reaches " +
-                   Fmt("%g", m.o.target_percent) + " %: the " + plan->floor.term +
-                   " term sets a floor of " + Fmt("%.3g", 100.0 * plan->floor.rel_std) +
-                   " %, which only a measurement lowers: " + plan->floor.lift +
-                   "; within the constraints the largest term is " +
-                   BindingFlag(plan->recommended.terms) + "'s";
+                   Fmt("%g", m.o.target_percent) + " %: the floor " +
+                   Fmt("%.3g", 100.0 * plan->floor.rel_std) + " % (" + plan->floor.parts +
+                   ") is set mostly by the " + plan->floor.term +
+                   " term, which only a measurement lowers: " + plan->floor.lift +
+                   "; (within the constraints the largest term is " +
+                   BindingFlag(plan->recommended.terms) + "'s)";
     return;
   }
   plan->binding = BindingFlag(plan->recommended.terms);

@@ -121,6 +121,7 @@ struct RigPlanFloor {
   std::string term;      // "mass", "between-repeat" or "statistical"
   std::string flag;      // the flag that states it (--mass-std, --repeat-scatter, --gyro-noise)
   std::string lift;      // what would lower it
+  std::string parts;     // "mass 0.1 %, between-repeat 0.25 %/sqrt(10) = 0.079 %, ..."
 };
 
 struct RigPlan {

@@ -158,7 +158,8 @@ std::string RigPlanJson(const RigPlan& p) {
   j["floor"] = {{"std_percent", 100.0 * p.floor.rel_std},
                 {"term", p.floor.term},
                 {"flag", p.floor.flag},
-                {"lift", p.floor.lift}};
+                {"lift", p.floor.lift},
+                {"parts", p.floor.parts}};
   j["simulated_rate_hz"] = p.simulated_rate_hz;
   j["binding_constraint"] = p.binding.empty() ? nlohmann::json(nullptr) : nlohmann::json(p.binding);
   j["advice"] = p.advice;
