@@ -627,8 +627,20 @@ RigPlan RunRigPlan(const RigPlanOptions& options) {
   }
   plan.swing_s = model.SwingS(model.Period(best.d, best.l));
   plan.simulated_rate_hz = SimulatedRateHz(o, plan.swing_s);
-  plan.recommended = Evaluate(o, "recommended", best.d, best.l, inertia, plan.release_amplitude_deg,
-                              plan.swing_s, target);
+  try {
+    plan.recommended = Evaluate(o, "recommended", best.d, best.l, inertia,
+                                plan.release_amplitude_deg, plan.swing_s, target);
+  } catch (const UserError&) {
+    // A rig far outside the period window can swing too slowly to fit: its first-order terms
+    // then stand for it, and the window stays the cause named.
+    if (!plan.period_window_missed) throw;
+    plan.recommended.label = "recommended";
+    plan.recommended.separation_m = best.d;
+    plan.recommended.length_m = best.l;
+    plan.recommended.period_s = model.Period(best.d, best.l);
+    plan.recommended.terms = model.Terms(best.d, best.l, kMinRepeats);
+    plan.recommended.terms.repeats = RepeatsFor(plan.recommended.terms, target);
+  }
   const RigGeometry g{best.l, best.d, SuspendedMass(o), o.gravity_mps2};
   plan.small_angle_excess_percent =
       100.0 * (std::pow(plan.recommended.period_s / SmallAnglePeriod(g, inertia), 2) - 1.0);

@@ -36,7 +36,9 @@ std::vector<double> NiceLevels(double lo, double hi) {
        e <= static_cast<int>(std::ceil(std::log10(hi))) + 1; ++e) {
     for (double s : steps) {
       const double v = s * std::pow(10.0, e);
-      if (v > lo && v < hi) levels.push_back(v);
+      // Not crowding the ends' labels on the colour bar (within 6 % of the log span).
+      const double room = 0.06 * std::log10(hi / lo);
+      if (std::log10(v / lo) > room && std::log10(hi / v) > room) levels.push_back(v);
     }
   }
   // The ends: the lowest value, and the cap (everything above it in the last band).
