@@ -15,6 +15,7 @@
 #include "pipeline/config/config.h"
 #include "pipeline/config/config_template.h"
 #include "pipeline/logs/simulated_log.h"
+#include "base/units.h"
 #include "base/user_error.h"
 #include "test_support.h"
 
@@ -381,7 +382,7 @@ TEST(Overwrite, EllipsePlotReplacesOnlyItsOwnFigures) {
   TempDir dir("bifilar_overwrite");
   std::string table = "pitch_deg,inertia\n";
   for (int d = -80; d <= 90; d += 10) {
-    const double t = d * 3.14159265358979 / 180;
+    const double t = d * kRadPerDeg;
     table += std::to_string(d) + "," +
              std::to_string(2.85 * std::cos(t) * std::cos(t) + 2.36 * std::sin(t) * std::sin(t) +
                             0.002 * ((d / 10) % 3 - 1)) +

@@ -56,6 +56,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/gzip.h"
+#include "base/units.h"
 #include "pipeline/logs/dataflash_writer.h"
 #include "pipeline/store/cache.h"
 #include "pipeline/store/output_set.h"
@@ -1099,9 +1100,8 @@ void CasePlanNoReplace(const Args& args, const Workspace& w, int case_no, Failur
   fs::create_symlink(h + "/mine.png", h + "/link.png", ec);
   std::string table = "pitch_deg,inertia\n";
   for (int d = -80; d <= 90; d += 10) {
-    table += std::to_string(d) + "," + std::to_string(2.8 - 0.4 * std::sin(d * 0.0174533) *
-                                                                std::sin(d * 0.0174533) +
-                                                      0.001 * (d % 3)) + "\n";
+    const double s = std::sin(d * bifilar::kRadPerDeg);
+    table += std::to_string(d) + "," + std::to_string(2.8 - 0.4 * s * s + 0.001 * (d % 3)) + "\n";
   }
   WriteFile(h + "/table.csv", table);
   const std::vector<std::string> quad = {args.binary,       "plan",        "--rig",
