@@ -28,13 +28,8 @@ PlotFolder::PlotFolder(std::string dir, std::string what, bool force)
     : dir_(std::move(dir)), what_(std::move(what)), force_(force) {
   if (dir_.empty()) throw UserError(what_ + ": the folder name is empty");
   std::error_code ec;
-  if (fs::is_symlink(fs::symlink_status(dir_, ec))) {
-    throw UserError(what_ + " " + dir_ +
-                    ": is a symbolic link; bifilar writes figures only into a folder itself: give "
-                    "the folder's own path");
-  }
   fs::create_directories(dir_, ec);
-  if (!fs::is_directory(fs::symlink_status(dir_, ec))) {
+  if (!fs::is_directory(dir_, ec)) {  // a link to a folder the user named is that folder
     throw UserError(what_ + " " + dir_ + ": cannot create the folder" +
                     (ec ? " (" + ec.message() + ")" : std::string(" (a file has that name)")));
   }

@@ -18,8 +18,8 @@ class PlotFolder {
   static constexpr const char* kManifestName = ".bifilar-plots.json";
 
   // Creates `dir` (and its parents) when missing and reads its manifest. Throws UserError naming
-  // `what` (the flag, "fit --plot") when the folder cannot be made, is not a folder (or is a
-  // symbolic link), or its manifest is damaged.
+  // `what` (the flag, "fit --plot") when the folder cannot be made or is not a folder, or its
+  // manifest is damaged.
   PlotFolder(std::string dir, std::string what, bool force);
 
   // Before any of `names` (plain file names inside the folder) is written: throws UserError

@@ -414,6 +414,10 @@ TEST(Overwrite, EllipsePlotReplacesOnlyItsOwnFigures) {
     EXPECT_TRUE(fs::is_symlink(fs::symlink_status(plots + "/ellipse_moments.svg")));
     EXPECT_EQ(ReadFile(other), "my photo");
   }
+  // An empty folder name writes nothing: refused, not silently skipped (fit --plot the same).
+  r = Bifilar(dir, "ellipse " + csv + " --bootstrap 0 --plot ''");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("empty"), std::string::npos) << r.err;
 }
 
 TEST(Overwrite, FitPlotReplacesOnlyItsOwnFigures) {

@@ -213,7 +213,8 @@ void AddFitOptions(CLI::App* sub, FitCli* args) {
       ->check(CLI::Range(kMinMaxAmplitudeDeg, kMaxMaxAmplitudeDeg));  // as fit.max_amplitude_deg
   sub->add_option("--plot", o.plot_dir,
                   "write fit figures DIR/<log>.svg and .png, and the amplitude sweep (I against "
-                  "amplitude) DIR/<log>_sweep.svg and .png when the trace has one");
+                  "amplitude) DIR/<log>_sweep.svg and .png when the trace has one")
+      ->check(NonEmptyName());
   sub->add_flag("--force", o.force,
                 "with --plot: replace files of the figures' names that bifilar did not write in "
                 "DIR (never a symbolic link)");
