@@ -7,6 +7,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <filesystem>
+#include <sstream>
 #include <string>
 
 #include "base/user_error.h"
@@ -354,7 +355,10 @@ TEST(RigPlan, UnreachableTargetNamesTheFloorAndExitsNonZero) {
   EXPECT_NEAR(p.floor.rel_std, std::hypot(0.001, 0.0025 / std::sqrt(10.0)), 2e-5);
   EXPECT_NE(p.advice.find("measurement"), std::string::npos) << p.advice;
   EXPECT_EQ(RigPlanExitCode(p), 1);
-  EXPECT_NE(RigPlanText(p).find("TARGET UNREACHABLE"), std::string::npos);
+  const std::string text = RigPlanText(p);
+  EXPECT_NE(text.find("TARGET UNREACHABLE"), std::string::npos);
+  std::istringstream lines(text);  // issue 32 item 8: console lines of at most 160 characters
+  for (std::string line; std::getline(lines, line);) EXPECT_LE(line.size(), 160u) << line;
   // The between-repeat scatter sets it when the mass is weighed well.
   o.mass_std_kg = 1e-7;
   o.repeat_scatter_percent = 1.0;

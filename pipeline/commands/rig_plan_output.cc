@@ -79,6 +79,35 @@ std::string Headline(const RigPlan& p) {
          " is the best possible; binding: " + p.binding;
 }
 
+// Console lines of at most kMaxLine characters (issue 32 item 8): a longer line is broken after
+// its last "; " (else ", ", else a space) that fits, the rest indented 4 more than the line.
+constexpr size_t kMaxLine = 160;
+std::string WrapLines(const std::string& text) {
+  std::istringstream in(text);
+  std::string line, out;
+  while (std::getline(in, line)) {
+    const std::string indent(line.find_first_not_of(' ') == std::string::npos
+                                 ? 0
+                                 : line.find_first_not_of(' ') + 4,
+                             ' ');
+    while (line.size() > kMaxLine) {
+      size_t at = std::string::npos;
+      for (const char* sep : {"; ", ", ", " "}) {
+        const size_t k = line.rfind(sep, kMaxLine - std::string(sep).size());
+        if (k != std::string::npos && k > indent.size()) {
+          at = k + std::string(sep).size() - 1;  // keep ';' or ',' on the first line
+          break;
+        }
+      }
+      if (at == std::string::npos) break;  // one long word: left as it is
+      out += line.substr(0, at) + "\n";
+      line = indent + line.substr(at + 1);
+    }
+    out += line + "\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string RigPlanText(const RigPlan& p) {
@@ -143,7 +172,7 @@ std::string RigPlanText(const RigPlan& p) {
   }
   s << Defaults(o);
   s << "  planned in " << Fmt("%.2f", p.plan_seconds) << " s\n";
-  return s.str();
+  return WrapLines(s.str());
 }
 
 std::string RigPlanJson(const RigPlan& p) {
