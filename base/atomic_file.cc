@@ -121,8 +121,18 @@ void WriteFileAtomically(const std::string& path, const std::string& text) {
 
 void RefuseToReplace(const std::string& path, const std::string& what, bool force) {
   std::error_code ec;
-  if (force || !fs::exists(fs::symlink_status(path, ec))) return;
-  throw UserError(what + ": " + path + " exists; choose another name, or add --force to overwrite it");
+  if (path.empty()) throw UserError(what + ": the file name is empty");
+  if (!fs::exists(fs::symlink_status(path, ec))) return;
+  if (!force) {
+    throw UserError(what + ": " + path +
+                    " exists; choose another name, or add --force to overwrite it");
+  }
+  // --force replaces a regular file, never a link (nor writes through one), a folder or a device.
+  try {
+    CheckFileTarget(path);
+  } catch (const UserError& e) {
+    throw UserError(what + ": " + e.what());
+  }
 }
 
 }  // namespace bifilar

@@ -37,11 +37,16 @@ void WriteFileAtomically(const std::string& path, const std::string& text);
 // than the file system allows.
 void CheckFileTarget(const std::string& path);
 
-// The rule before writing a path the user named: when `path` exists (a file, a link, even a
-// dangling one, anything) and `force` is false, throws UserError
-// "<what>: <path> exists; choose another name, or add --force to overwrite it".
-// `init` (its PATH), `simulate` (--trace, --truth, the files of --out) and `export` (--out) use
-// it, so every command says the same thing.
+// The rule before writing a path the user named (the invariant "no command replaces a file it
+// did not create without --force, and none replaces a link"): when `path` exists (a file, a link,
+// even a dangling one, anything) and `force` is false, throws UserError
+// "<what>: <path> exists; choose another name, or add --force to overwrite it"; with `force`, a
+// link, folder, device, FIFO or socket is still refused (CheckFileTarget); an empty `path` is
+// refused. `init` (its PATH), `simulate` (--trace, --truth, the files of --out), `export` (--out)
+// and `plan --rig` (--write-config, --plot) use it, so every command says the same thing. A
+// folder of figures written by name (`fit --plot DIR`, `ellipse --plot DIR`) follows the same
+// rule through base/plot_folder.h; the output folder of `process` through its
+// manifest (pipeline/store/output_set.h).
 void RefuseToReplace(const std::string& path, const std::string& what, bool force);
 
 }  // namespace bifilar

@@ -15,6 +15,7 @@
 #include "pipeline/config/config.h"
 #include "pipeline/config/config_template.h"
 #include "pipeline/logs/simulated_log.h"
+#include "base/units.h"
 #include "base/user_error.h"
 #include "test_support.h"
 
@@ -372,6 +373,77 @@ TEST(Overwrite, StartingConfigKeepsHostileColumnNames) {
   EXPECT_EQ(c.imu.format.gyro_columns, f.gyro_columns);
   EXPECT_EQ(c.imu.format.accel_columns, f.accel_columns);
   EXPECT_EQ(c.rig_mass_kg, 0.0343);
+}
+
+// Issue 33 item 1: `ellipse --plot DIR` and `fit --plot DIR` replace only the figures they wrote
+// there (recorded in DIR/.bifilar-plots.json); a file of the user's under a figure's name is
+// refused before anything is written unless --force; a link is never replaced.
+TEST(Overwrite, EllipsePlotReplacesOnlyItsOwnFigures) {
+  TempDir dir("bifilar_overwrite");
+  std::string table = "pitch_deg,inertia\n";
+  for (int d = -80; d <= 90; d += 10) {
+    const double t = d * kRadPerDeg;
+    table += std::to_string(d) + "," +
+             std::to_string(2.85 * std::cos(t) * std::cos(t) + 2.36 * std::sin(t) * std::sin(t) +
+                            0.002 * ((d / 10) % 3 - 1)) +
+             "\n";
+  }
+  const std::string csv = WriteFile(dir.path + "/table.csv", table);
+  const std::string plots = dir.path + "/plots";
+  const std::string mine = WriteFile(plots + "/ellipse_polar.png", "my picture");
+  const std::string run = "ellipse " + csv + " --bootstrap 0 --plot " + plots;
+  CliRun r = Bifilar(dir, run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(mine), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--force"), std::string::npos) << r.err;
+  EXPECT_EQ(ReadFile(mine), "my picture");
+  EXPECT_FALSE(fs::exists(plots + "/ellipse_moments.png"));  // nothing written
+  // Its own figures, from an earlier run, are replaced; the user's only with --force.
+  r = Bifilar(dir, run + " --force");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(ReadFile(mine), "my picture");
+  r = Bifilar(dir, run);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  // A link under a figure's name: never replaced, not with --force either.
+  const std::string other = WriteFile(dir.path + "/photo.png", "my photo");
+  fs::remove(plots + "/ellipse_moments.svg");
+  fs::create_symlink(other, plots + "/ellipse_moments.svg");
+  for (const std::string force : {"", " --force"}) {
+    r = Bifilar(dir, run + force);
+    EXPECT_EQ(r.exit_code, 2) << force;
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(plots + "/ellipse_moments.svg")));
+    EXPECT_EQ(ReadFile(other), "my photo");
+  }
+  // An empty folder name writes nothing: refused, not silently skipped (fit --plot the same).
+  r = Bifilar(dir, "ellipse " + csv + " --bootstrap 0 --plot ''");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("empty"), std::string::npos) << r.err;
+}
+
+TEST(Overwrite, FitPlotReplacesOnlyItsOwnFigures) {
+  TempDir dir("bifilar_overwrite");
+  // The sample campaign's config (runs.root made absolute) and one of its logs.
+  const std::string source = BIFILAR_SOURCE_DIR;
+  std::string text = ReadFile(source + "/configs/prandtl_d.yaml");
+  for (size_t at = text.find("../sample_runs"); at != std::string::npos;
+       at = text.find("../sample_runs", at)) {
+    text.replace(at, 2, source);
+  }
+  const std::string config = WriteFile(dir.path + "/c.yaml", text);
+  const std::string log = dir.path + "/swing.csv.gz";
+  fs::copy_file(source + "/sample_runs/prandtl_d/logs/pitch_0/trial_1.csv.gz", log);
+  const std::string plots = dir.path + "/plots";
+  const std::string mine = WriteFile(plots + "/swing.png", "my picture");
+  const std::string run = "fit " + config + " " + log + " --plot " + plots;
+  CliRun r = Bifilar(dir, run);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.err.find(mine), std::string::npos) << r.err;
+  EXPECT_EQ(ReadFile(mine), "my picture");
+  EXPECT_FALSE(fs::exists(plots + "/swing.svg"));  // refused before any fit
+  r = Bifilar(dir, run + " --force");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(ReadFile(mine), "my picture");
+  EXPECT_EQ(Bifilar(dir, run).exit_code, 0);  // its own, from the earlier run
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <filesystem>
+#include <sstream>
 #include <string>
 
 #include "base/user_error.h"
@@ -264,6 +266,206 @@ TEST(RigPlan, CommandLineJsonAndFlagErrors) {
   r = Bifilar(dir, "plan --mass 1");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--rig"), std::string::npos) << r.err;
+}
+
+// Issue 33 item 1 and 7: `plan --rig` replaces no file of the user's without --force, never a
+// link, not one file twice, refuses an empty name, and makes the figure's folder (PLplot never
+// meets a path it cannot open: no "Can't open", no abort).
+TEST(RigPlan, WritesNoUserFileAndNeverALink) {
+  TempDir dir("rig_plan_files");
+  namespace fs = std::filesystem;
+  const std::string args =
+      "plan --rig --mass 0.0343 --inertia 1.6e-5 --max-length 0.594 --max-separation 0.030 "
+      "--length-std 0.0005 --separation-std 0.0005 --target-percent 1 --imu-rate 30";
+  const std::string config = WriteFile(dir.path + "/bifilar.yaml", "mine: 1\n");
+  test_support::CliRun r = Bifilar(dir, args + " --write-config " + config);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--write-config: " + config + " exists"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--force"), std::string::npos) << r.err;
+  EXPECT_EQ(test_support::ReadFile(config), "mine: 1\n");
+  r = Bifilar(dir, args + " --write-config " + config + " --force");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(test_support::ReadFile(config).find("filar_separation_m"), std::string::npos);
+
+  const std::string photo = WriteFile(dir.path + "/photo.png", "my photo");
+  r = Bifilar(dir, args + " --plot " + photo);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(test_support::ReadFile(photo), "my photo");
+  const std::string link = dir.path + "/link.png";
+  fs::create_symlink(photo, link);
+  for (const std::string force : {"", " --force"}) {
+    r = Bifilar(dir, args + " --plot " + link + force);
+    EXPECT_EQ(r.exit_code, 2) << force;
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link))) << force;
+    EXPECT_EQ(test_support::ReadFile(photo), "my photo");
+  }
+  // One file twice, however spelled.
+  r = Bifilar(dir, args + " --write-config " + dir.path + "/x.svg --plot " + dir.path + "/./x.svg");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("same file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir.path + "/x.svg"));
+  // An empty name is refused, not silently skipped.
+  r = Bifilar(dir, args + " --write-config ''");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("empty"), std::string::npos) << r.err;
+  // A missing folder is made (as --write-config's); one that cannot be is our message.
+  r = Bifilar(dir, args + " --plot " + dir.path + "/nodir/sub/p.png");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_GT(fs::file_size(dir.path + "/nodir/sub/p.png"), 1000u);
+  r = Bifilar(dir, args + " --plot " + photo + "/p.png");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("cannot create the folder"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("PLPLOT"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("Can't open"), std::string::npos) << r.err;
+}
+
+// Issue 33 item 4: a 10 kHz IMU on a long-period rig is planned on a bounded number of samples
+// (the block means the fit would take), with the same statistical term: it scales as
+// 1/sqrt(rate), so 100x the rate gives a tenth of the 100 Hz plan's.
+TEST(RigPlan, DenseImuIsPlannedOnBoundedSamples) {
+  RigPlanOptions o;
+  o.mass_kg = 2.5;
+  o.inertia_kg_m2 = 0.3;
+  o.max_length_m = 3.0;
+  o.max_separation_m = 0.4;
+  o.target_percent = 1.0;
+  o.gyro_noise_deg_per_s = 0.5;  // a statistical term well above rounding
+  o.imu_rate_hz = 100.0;
+  const RigPlan slow = RunRigPlan(o);
+  o.imu_rate_hz = 10000.0;
+  const RigPlan fast = RunRigPlan(o);
+  EXPECT_LE(fast.simulated_rate_hz * fast.swing_s, kMaxPlanSamples * 1.0001);
+  EXPECT_LT(fast.simulated_rate_hz, o.imu_rate_hz);
+  EXPECT_NEAR(fast.recommended.terms.statistical / (slow.recommended.terms.statistical / 10.0), 1.0,
+              0.1)
+      << fast.recommended.terms.statistical << " " << slow.recommended.terms.statistical;
+  EXPECT_NE(RigPlanText(fast).find("simulated at"), std::string::npos);
+}
+
+// Issue 32 item 7: a target below the floor (the mass and the per-swing terms, which no rig,
+// reference object or wider constraint lowers) names that term and what lowers it, and exits 1.
+TEST(RigPlan, UnreachableTargetNamesTheFloorAndExitsNonZero) {
+  RigPlanOptions o = Quadrotor();
+  o.target_percent = 0.01;
+  RigPlan p = RunRigPlan(o);
+  EXPECT_TRUE(p.below_floor);
+  EXPECT_EQ(p.floor.term, "mass");
+  EXPECT_EQ(p.binding, "--mass-std");
+  // mass 0.1 %, between-repeat 0.25 % / sqrt(10), the statistical term negligible.
+  EXPECT_NEAR(p.floor.rel_std, std::hypot(0.001, 0.0025 / std::sqrt(10.0)), 2e-5);
+  EXPECT_NE(p.advice.find("measurement"), std::string::npos) << p.advice;
+  EXPECT_EQ(RigPlanExitCode(p), 1);
+  const std::string text = RigPlanText(p);
+  EXPECT_NE(text.find("TARGET UNREACHABLE"), std::string::npos);
+  std::istringstream lines(text);  // issue 32 item 8: console lines of at most 160 characters
+  for (std::string line; std::getline(lines, line);) EXPECT_LE(line.size(), 160u) << line;
+  // The between-repeat scatter sets it when the mass is weighed well.
+  o.mass_std_kg = 1e-7;
+  o.repeat_scatter_percent = 1.0;
+  p = RunRigPlan(o);
+  EXPECT_EQ(p.floor.term, "between-repeat");
+  EXPECT_EQ(p.binding, "--repeat-scatter");
+  // Reachable with the reference object: exit 0; out of reach within the constraints: 1.
+  EXPECT_EQ(RigPlanExitCode(RunRigPlan(Quadrotor())), 0);
+  o = Quadrotor();
+  o.target_percent = 0.2;  // above the floor, below what the bar gives (0.26 %)
+  p = RunRigPlan(o);
+  EXPECT_FALSE(p.below_floor);
+  EXPECT_EQ(p.binding, "--max-separation");
+  EXPECT_EQ(RigPlanExitCode(p), 1);
+  TempDir dir("rig_plan_floor");
+  const test_support::CliRun r = Bifilar(
+      dir,
+      "plan --rig --mass 0.0343 --inertia 1.6e-5 --max-length 0.594 --max-separation 0.030 "
+      "--length-std 0.0005 --separation-std 0.0005 --target-percent 0.01 --imu-rate 30 --json");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("binding_constraint"), "--mass-std");
+  EXPECT_EQ(j.at("floor").at("term"), "mass");
+}
+
+// Issue 33 item 5: only bars a workshop makes (20 mm to 2 m long, at least 3 mm thick, no
+// thicker than wide), of the aircraft's radius of gyration; none: said so, with what it takes.
+TEST(RigPlan, ReferenceBarsAreBuildableOrSaySo) {
+  struct Case {
+    double mass, inertia;
+    bool buildable;
+  };
+  for (const Case& c : {Case{0.0343, 1.6e-5, true}, Case{0.03, 1e-5, true}, Case{3.0, 0.05, true},
+                        Case{2.5, 0.3, true}, Case{2.5, 1.0, false}, Case{2.5, 16.0, false}}) {
+    RigPlanOptions o;
+    o.mass_kg = c.mass;
+    o.inertia_kg_m2 = c.inertia;
+    o.max_length_m = 2.0;
+    o.max_separation_m = 0.3;  // D +-1 mm: 0.67 %, the reference object is needed
+    o.target_percent = 0.2;
+    o.length_std_m = o.separation_std_m = 0.001;
+    const RigPlan p = RunRigPlan(o);
+    const ReferenceBar& b = p.reference;
+    EXPECT_EQ(b.buildable, c.buildable) << c.inertia << ": " << RigPlanText(p);
+    if (b.buildable) {
+      EXPECT_GE(b.length_m, 0.02);
+      EXPECT_LE(b.length_m, 2.0);
+      EXPECT_GE(b.thickness_m, 0.003) << c.inertia;
+      EXPECT_LE(b.thickness_m, b.width_m) << c.inertia;
+      EXPECT_NEAR(b.inertia_kg_m2, b.mass_kg * (b.length_m * b.length_m + b.width_m * b.width_m) / 12,
+                  1e-12 * b.inertia_kg_m2);
+      // Its period is the aircraft's: the same radius of gyration.
+      EXPECT_NEAR(b.inertia_kg_m2 / b.mass_kg, c.inertia / c.mass, 1e-9 * c.inertia / c.mass);
+      EXPECT_GE(b.mass_kg, 0.5 * c.mass - 1e-12);
+      EXPECT_LE(b.mass_kg, 2.0 * c.mass + 1e-12);
+    } else {
+      EXPECT_NE(b.why_not.find("m long"), std::string::npos) << b.why_not;
+      EXPECT_NE(RigPlanText(p).find("none buildable"), std::string::npos);
+      EXPECT_EQ(RigPlanText(p).find(" x 0.0 mm"), std::string::npos);
+      EXPECT_EQ(RigPlanExitCode(p), 1);
+    }
+  }
+}
+
+// Issue 33 item 5: when no rig swings inside the period window, that is the cause named, not a
+// "best possible" std that beats the target.
+TEST(RigPlan, NoRigInThePeriodWindowIsTheNamedCause) {
+  RigPlanOptions o;
+  o.mass_kg = 2.5;
+  o.inertia_kg_m2 = 16.0;
+  o.max_length_m = 3.0;
+  o.max_separation_m = 1.0;
+  o.target_percent = 0.5;
+  const RigPlan p = RunRigPlan(o);
+  EXPECT_TRUE(p.period_window_missed);
+  EXPECT_FALSE(p.target_met);
+  EXPECT_EQ(p.binding, "--max-period");
+  // D <= 0.9 L: the fastest rig is D 1 m on L 1.11 m, about 10.8 s.
+  EXPECT_NEAR(p.periods_possible_s[0], 10.8, 0.3);
+  const std::string text = RigPlanText(p);
+  EXPECT_NE(text.find("NO RIG FITS THE PERIOD WINDOW"), std::string::npos) << text;
+  EXPECT_EQ(text.find("is the best possible"), std::string::npos) << text;
+  EXPECT_EQ(RigPlanExitCode(p), 1);
+}
+
+// Issue 32 item 7: the figure names only what it draws (the red target line only when the grid
+// reaches the target), has a colour bar, and its text stays inside the page.
+TEST(RigPlan, FigureDrawsWhatItsCaptionNames) {
+  TempDir dir("rig_plan_figure");
+  RigPlanOptions unreachable = Quadrotor();
+  unreachable.target_percent = 0.01;
+  RigPlanOptions reached = FixedWing();
+  reached.target_percent = 0.5;
+  for (const RigPlanOptions& o : {unreachable, reached}) {
+    const RigPlan p = RunRigPlan(o);
+    const std::string path = dir.path + "/plan.svg";
+    std::filesystem::remove(path);
+    std::string why;
+    ASSERT_TRUE(WriteRigPlanPlot(p, path, &why)) << why;
+    const std::string svg = test_support::ReadFile(path);
+    EXPECT_NE(svg.find("expected total std of I (%)"), std::string::npos);  // the colour bar
+    const bool red = svg.find("red line: the target") != std::string::npos;
+    EXPECT_EQ(red, o.target_percent == 0.5);
+    if (!red) {
+      EXPECT_NE(svg.find("below every rig shown"), std::string::npos);
+    }
+  }
 }
 
 }  // namespace

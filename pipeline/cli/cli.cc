@@ -58,6 +58,15 @@ CLI::Validator FiniteNumber() {
       "NUMBER", "finite number");
 }
 
+CLI::Validator NonEmptyName() {
+  return CLI::Validator(
+      [](std::string& input) {
+        return input.empty() ? std::string("the name is empty: nothing would be written")
+                             : std::string();
+      },
+      "NAME");
+}
+
 uint64_t ParseSeed(const std::string& text, const std::string& flag, uint64_t max) {
   const std::string range = "[0, " + std::to_string(max) + "]";
   bool digits = !text.empty() && text.size() <= 20;

@@ -19,6 +19,9 @@ namespace bifilar {
 // as doubles, and CLI::Range lets NaN through).
 CLI::Validator FiniteNumber();
 
+// A check for a file or folder flag: an empty name is refused (it would silently write nothing).
+CLI::Validator NonEmptyName();
+
 // A seed flag, read strictly: a decimal integer in [0, max]; anything else (-1, 2^64, 1e23, 1.5)
 // is a UserError naming the flag and the range, never a saturated or wrapped seed.
 uint64_t ParseSeed(const std::string& text, const std::string& flag, uint64_t max);

@@ -80,7 +80,11 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
                       "default) or imperial (slug ft^2); JSON is always SI");
   ellipse->add_flag("--json", opts->json, "print the result as JSON (SI)");
   ellipse->add_option("--plot", opts->plot_dir,
-                      "write ellipse_moments and ellipse_polar figures (.png, .svg) here");
+                      "write ellipse_moments and ellipse_polar figures (.png, .svg) here")
+      ->check(NonEmptyName());
+  ellipse->add_flag("--force", opts->force,
+                    "with --plot: replace files of the figures' names that bifilar did not write "
+                    "(never a symbolic link)");
   auto seed = std::make_shared<std::string>();
   ellipse->add_option("--seed", *seed, "bootstrap seed, an integer in [0, 2^64 - 1] (default 1)");
   ellipse->add_option("--bootstrap", opts->fit.bootstrap_replicates,

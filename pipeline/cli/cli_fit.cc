@@ -213,7 +213,11 @@ void AddFitOptions(CLI::App* sub, FitCli* args) {
       ->check(CLI::Range(kMinMaxAmplitudeDeg, kMaxMaxAmplitudeDeg));  // as fit.max_amplitude_deg
   sub->add_option("--plot", o.plot_dir,
                   "write fit figures DIR/<log>.svg and .png, and the amplitude sweep (I against "
-                  "amplitude) DIR/<log>_sweep.svg and .png when the trace has one");
+                  "amplitude) DIR/<log>_sweep.svg and .png when the trace has one")
+      ->check(NonEmptyName());
+  sub->add_flag("--force", o.force,
+                "with --plot: replace files of the figures' names that bifilar did not write in "
+                "DIR (never a symbolic link)");
   sub->add_flag("--repeats", o.repeats,
                 "combine repeats: logs whose paths differ only in the last number of the file "
                 "name (case ignored) are swings of one set-up; their scatter beyond their stds "

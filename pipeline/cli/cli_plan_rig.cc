@@ -1,7 +1,9 @@
 // `bifilar plan --rig`: the options of the rig plan on the `plan` subcommand (registered by
 // RegisterEllipseCommands), parsed into RigPlanOptions and run by RunRigPlan
 // (pipeline/commands/rig_plan.h). Printing and the files written live here.
+#include <filesystem>
 #include <iostream>
+#include <system_error>
 
 #include "base/atomic_file.h"
 #include "base/text_format.h"
@@ -15,6 +17,7 @@ struct RigPlanCli {
   bool rig = false;
   RigPlanOptions o;
   std::string plot, write_config;
+  bool force = false;                  // --force: replace an existing file (never a link)
   std::vector<CLI::Option*> rig_only;  // options that mean nothing without --rig
 };
 
@@ -70,10 +73,13 @@ std::shared_ptr<RigPlanCli> AddRigPlanOptions(CLI::App* plan) {
                                 "(.png or .svg)");
   auto* config = plan->add_option("--write-config", r->write_config,
                                   "with --rig: write a starting config (bifilar init's format)");
+  auto* force = plan->add_flag("--force", r->force,
+                               "with --rig: replace an existing --write-config or --plot file "
+                               "(never a symbolic link)");
   auto* mc = plan->add_option("--monte-carlo", o.monte_carlo_swings,
                               "with --rig: check the prediction on N simulated swings")
                  ->group("");  // hidden: a check, not a design input
-  r->rig_only.insert(r->rig_only.end(), {plot, config, mc});
+  r->rig_only.insert(r->rig_only.end(), {plot, config, force, mc});
   return r;
 }
 
@@ -87,6 +93,51 @@ bool RigPlanRequested(const RigPlanCli& r) {
   return false;
 }
 
+namespace {
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// The same file under two spellings: normalised absolute paths, links in the folders resolved.
+bool SamePath(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path pa = fs::weakly_canonical(fs::absolute(a), ec);
+  const fs::path pb = fs::weakly_canonical(fs::absolute(b), ec);
+  return ec ? fs::absolute(a).lexically_normal() == fs::absolute(b).lexically_normal() : pa == pb;
+}
+
+// Before the plan runs: the files it will write are named (not empty), do not replace a file
+// without --force nor a link ever (base/atomic_file.h), are not one file twice, and the figure's
+// folder exists or is made (as --write-config's is), so PLplot never meets a path it cannot open.
+void CheckRigPlanOutputs(const RigPlanCli& r, bool config, bool plot) {
+  if (config) RefuseToReplace(r.write_config, "plan --rig --write-config", r.force);
+  if (plot) {
+    RefuseToReplace(r.plot, "plan --rig --plot", r.force);
+    if (!EndsWith(r.plot, ".png") && !EndsWith(r.plot, ".svg")) {
+      throw UserError("plan --rig --plot " + r.plot +
+                      ": the figure's name must end in .png or .svg");
+    }
+  }
+  if (config && plot && SamePath(r.write_config, r.plot)) {
+    throw UserError("plan --rig: --write-config and --plot name the same file (" + r.plot +
+                    "); give each its own");
+  }
+  if (plot) {
+    const std::filesystem::path folder = std::filesystem::path(r.plot).parent_path();
+    std::error_code ec;
+    if (!folder.empty()) std::filesystem::create_directories(folder, ec);
+    if (!folder.empty() && !std::filesystem::is_directory(folder)) {
+      throw UserError("plan --rig --plot " + r.plot + ": cannot create the folder " +
+                      folder.string() + (ec ? " (" + ec.message() + ")" : ""));
+    }
+  }
+}
+
+}  // namespace
+
 int RunRigPlanCli(const RigPlanCli& r, const CLI::App& plan, bool json) {
   for (const char* name : {"--mass", "--max-length", "--max-separation", "--target-percent"}) {
     if (plan.count(name) == 0) throw UserError(std::string("plan --rig: ") + name + " is required");
@@ -96,18 +147,20 @@ int RunRigPlanCli(const RigPlanCli& r, const CLI::App& plan, bool json) {
       throw UserError(std::string("plan --rig: ") + name + " belongs to another plan");
     }
   }
+  const bool config = plan.count("--write-config") > 0, plot = plan.count("--plot") > 0;
+  CheckRigPlanOutputs(r, config, plot);
   const RigPlan p = RunRigPlan(r.o);
   std::cout << (json ? RigPlanJson(p) : RigPlanText(p));
-  if (!r.write_config.empty()) {
+  if (config) {
     WriteFileAtomically(r.write_config, RigPlanConfigText(p, r.write_config));
     if (!json) std::cout << "  wrote " << r.write_config << "\n";
   }
-  if (!r.plot.empty()) {
+  if (plot) {
     std::string why;
     if (!WriteRigPlanPlot(p, r.plot, &why)) throw UserError("plan --rig: --plot: " + why);
     if (!json) std::cout << "  wrote " << r.plot << "\n";
   }
-  return 0;
+  return RigPlanExitCode(p);
 }
 
 }  // namespace bifilar

@@ -7,6 +7,7 @@
 #include "base/text_format.h"
 #include "base/user_error.h"
 #include "pipeline/figures/ellipse_plot.h"
+#include "base/plot_folder.h"
 #include "pipeline/records/ellipse_json.h"
 
 namespace bifilar {
@@ -143,11 +144,20 @@ void PrintEllipseReport(const EllipseResult& r, DisplayUnits units, std::ostream
   for (const auto& w : r.warnings) out << "warning: " << w << "\n";
 }
 
+namespace {
+
+// The figures `ellipse --plot DIR` writes, by name.
+std::vector<std::string> EllipseFigureNames() {
+  return {"ellipse_moments.png", "ellipse_polar.png", "ellipse_moments.svg", "ellipse_polar.svg"};
+}
+
+}  // namespace
+
 std::vector<std::string> WriteEllipsePlots(const EllipseResult& result, DisplayUnits units,
-                                           const std::string& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw UserError(dir + ": cannot create the plot directory: " + ec.message());
+                                           const std::string& dir, bool force) {
+  // No file bifilar did not write there is replaced without --force, no link ever
+  // (base/plot_folder.h); refused before any figure is drawn.
+  PlotFolder(dir, "ellipse --plot", force).Claim(EllipseFigureNames());
   EllipsePlotOptions plot;
   plot.unit_scale = 1.0 / InertiaToSi(units);
   plot.unit_label = InertiaUnitPlotLabel(units);
@@ -167,13 +177,17 @@ std::vector<std::string> WriteEllipsePlots(const EllipseResult& result, DisplayU
 EllipseCommandResult RunEllipse(const EllipseCommandOptions& options) {
   std::string why;
   if (!options.fit.Check(&why)) throw UserError("ellipse options: " + why);
+  if (!options.plot_dir.empty()) {  // refused before the fit, as when the figures are written
+    PlotFolder(options.plot_dir, "ellipse --plot", options.force).Claim(EllipseFigureNames());
+  }
   const std::vector<EllipsePoint> points = ReadEllipseTable(options.table_path, options.units);
   EllipseCommandResult result;
   if (!FitEllipse(points, options.fit, &result.fit, &why)) {
     throw UserError(options.table_path + ": " + why);
   }
   if (!options.plot_dir.empty()) {
-    result.figures = WriteEllipsePlots(result.fit, options.units, options.plot_dir);
+    result.figures =
+        WriteEllipsePlots(result.fit, options.units, options.plot_dir, options.force);
   }
   return result;
 }

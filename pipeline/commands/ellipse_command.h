@@ -17,6 +17,7 @@ struct EllipseCommandOptions {
   DisplayUnits units = DisplayUnits::kSi;       // units of the table and of the console output
   bool json = false;                            // print JSON (SI) instead of tables
   std::string plot_dir;                         // write figures here when non-empty
+  bool force = false;  // --force: replace files of the figures' names bifilar did not write
   EllipseOptions fit;                           // seed, bootstrap, covariance, ...
 };
 
@@ -42,9 +43,11 @@ int EllipseExitCode(const EllipseCommandResult& result);
 void PrintEllipseReport(const EllipseResult& result, DisplayUnits units, std::ostream& out);
 
 // Writes ellipse_moments.{png,svg} and ellipse_polar.{png,svg} into dir (created if missing);
-// returns the paths written. Throws UserError if a figure cannot be written.
+// returns the paths written. Throws UserError if a figure cannot be written, or, before any is
+// written, when a file of those names there was not written by bifilar (without `force`) or is a
+// link (base/plot_folder.h).
 std::vector<std::string> WriteEllipsePlots(const EllipseResult& result, DisplayUnits units,
-                                           const std::string& dir);
+                                           const std::string& dir, bool force = false);
 
 struct PlanCommandOptions {
   std::vector<double> pitch_deg;                // proposed angles (deg)

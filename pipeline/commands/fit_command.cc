@@ -18,6 +18,7 @@
 #include "pipeline/campaign/campaign_inputs.h"
 #include "pipeline/campaign/run_discovery.h"
 #include "pipeline/records/results_json.h"
+#include "base/plot_folder.h"
 #include "pipeline/trace/trace_process.h"
 
 namespace bifilar {
@@ -207,6 +208,18 @@ TraceProcessOptions BaseTraceOptions(const FitCommandOptions& o) {
   return options;
 }
 
+// --plot DIR: the figures' names, claimed before any fit: a file there that bifilar did not write
+// is refused without --force, a link always (base/plot_folder.h).
+void ClaimFitFigures(const FitCommandOptions& o, const std::vector<std::string>& logs) {
+  std::vector<std::string> names;
+  for (const std::string& stem : FigureStems(logs)) {
+    for (const char* suffix : {".svg", ".png", "_sweep.svg", "_sweep.png"}) {
+      names.push_back(stem + suffix);
+    }
+  }
+  PlotFolder(o.plot_dir, "fit --plot", o.force).Claim(names);
+}
+
 // rig.calibration: the reference swings fix the geometry first (pipeline/campaign/calibration.h).
 void CalibrateIfConfigured(const FitCommandOptions& o, FitCommandResult* result) {
   if (!result->config.calibration.enabled) return;
@@ -321,6 +334,7 @@ FitCommandResult RunFit(const FitCommandOptions& options) {
       options.on_groups(RepeatGroupsText(result.groups, result.distinct.kept, result.grouping));
     }
   }
+  if (!options.plot_dir.empty()) ClaimFitFigures(options, result.distinct.kept);
   FitLogs(options, trace_options, &result);
   if (result.interrupted) {
     result.groups.clear();

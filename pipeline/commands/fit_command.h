@@ -33,6 +33,9 @@ struct FitCommandOptions {
   std::string integrator;          // "" (the config's), "rk853" or "cvodes"
   std::string window;              // "" or "T0:T1" (s, the log's own time)
   std::string plot_dir;            // write DIR/<log>.svg|.png (+ _sweep) when non-empty
+  // --force: with plot_dir, replace files of the figures' names bifilar did not write there
+  // (never a link; base/plot_folder.h). Without it they are refused before any fit.
+  bool force = false;
   double max_amplitude_deg = NAN;  // upper end of the amplitude band; NaN: the config's
   // Install the Ctrl-C handler before the first fit (base/interrupt.h); an interrupt then stops
   // the run between logs or between solver iterations, and the result says so.

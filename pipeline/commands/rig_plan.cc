@@ -274,6 +274,11 @@ TraceFitOptions FitOptionsFor(const RigPlanOptions& o, bool with_budget) {
   return f;
 }
 
+// The rate a swing of `swing_s` is simulated at: --imu-rate, or kMaxPlanSamples over the swing.
+double SimulatedRateHz(const RigPlanOptions& o, double swing_s) {
+  return std::min(o.imu_rate_hz, kMaxPlanSamples / swing_s);
+}
+
 SyntheticTraceOptions SwingFor(const RigPlanOptions& o, const RigGeometry& g, double inertia,
                                double amplitude_deg, double swing_s, uint64_t seed) {
   SyntheticTraceOptions s;
@@ -284,8 +289,12 @@ SyntheticTraceOptions SwingFor(const RigPlanOptions& o, const RigGeometry& g, do
   s.params.viscous_coeff_kg_m2_per_s = 2.0 * inertia / (o.decay_periods * period);
   s.amplitude_deg = amplitude_deg;
   s.duration_s = swing_s;
-  s.sample_rate_hz = o.imu_rate_hz;
-  s.noise_deg_per_s = o.gyro_noise_deg_per_s;
+  // A dense log is fitted as block means (fit/block_mean.h): k samples averaged carry the same
+  // information as the k samples, at noise / sqrt(k). The plan simulates those means directly, so
+  // its time and memory stay bounded at any --imu-rate (issue 33 item 4: 10 kHz on a 300 s swing
+  // took 1.1 GB and 40 s).
+  s.sample_rate_hz = SimulatedRateHz(o, swing_s);
+  s.noise_deg_per_s = o.gyro_noise_deg_per_s * std::sqrt(s.sample_rate_hz / o.imu_rate_hz);
   s.seed = seed;
   return s;
 }
@@ -324,26 +333,20 @@ RigCandidate Evaluate(const RigPlanOptions& o, const std::string& label, double 
 
 // --- The reference object.
 
-// A flat bar, swung flat and centred: I = M (a^2 + b^2) / 12 with b = a / 8, of the aircraft's
-// inertia and mass; aluminium when that gives a bar at least 3 mm thick and no thicker than it
-// is wide, else steel. Its inertia's std from the machining tolerance of a and b and the weighing.
-ReferenceBar DesignReference(double inertia, double mass) {
+// Bounds of a bar a workshop makes and a rig carries (m): length, thickness (a flat bar at least
+// 3 mm thick, no thicker than wide, so that it stays flat and rigid).
+constexpr double kMinBarLengthM = 0.02, kMaxBarLengthM = 2.0, kMinBarThicknessM = 0.003;
+
+// One candidate: a flat bar of `mass` with the aircraft's radius of gyration r (so its period
+// matches the aircraft's), b = a / aspect, I = M (a^2 + b^2) / 12 = M r^2, of `density`.
+ReferenceBar BarFor(double r, double mass, double aspect, const char* material, double density) {
   ReferenceBar bar;
-  const double a = std::sqrt(12.0 * inertia / mass / (1.0 + 1.0 / 64.0)), b = a / 8.0;
-  struct Material {
-    const char* name;
-    double density;
-  };
-  const Material materials[] = {{"aluminium", 2700.0}, {"steel", 7850.0}};
-  for (const Material& m : materials) {
-    const double t = mass / (m.density * a * b);
-    bar.material = m.name;
-    bar.density_kg_m3 = m.density;
-    bar.thickness_m = t;
-    if (t >= 0.003 && t <= b) break;
-  }
+  const double a = std::sqrt(12.0 * r * r / (1.0 + 1.0 / (aspect * aspect))), b = a / aspect;
+  bar.material = material;
+  bar.density_kg_m3 = density;
   bar.length_m = a;
   bar.width_m = b;
+  bar.thickness_m = mass / (density * a * b);
   bar.mass_kg = mass;
   bar.inertia_kg_m2 = mass * (a * a + b * b) / 12.0;
   bar.tolerance_m = kBarToleranceM;
@@ -351,6 +354,45 @@ ReferenceBar DesignReference(double inertia, double mass) {
   const double s2 = a * a + b * b;
   const double da = 2.0 * a * kBarToleranceM / s2, db = 2.0 * b * kBarToleranceM / s2;
   bar.inertia_rel_std = std::sqrt(da * da + db * db + kBarWeighingRelStd * kBarWeighingRelStd);
+  bar.buildable = a >= kMinBarLengthM && a <= kMaxBarLengthM &&
+                  bar.thickness_m >= kMinBarThicknessM && bar.thickness_m <= b;
+  return bar;
+}
+
+// A flat bar, swung flat and centred, with the aircraft's radius of gyration (its period) and a
+// mass close to the aircraft's (the wires then stretch alike; docs/method.md §15): the
+// aircraft's mass first, then 1.5x, 2x, 0.75x, 0.5x; b = a/8, then a/6, a/4; aluminium, then
+// steel. The first that a workshop can make (kMinBarLengthM..kMaxBarLengthM long, at least
+// kMinBarThicknessM thick and no thicker than wide); none: `buildable` false and why.
+ReferenceBar DesignReference(double inertia, double mass) {
+  const double r = std::sqrt(inertia / mass);
+  struct Material {
+    const char* name;
+    double density;
+  };
+  const Material materials[] = {{"aluminium", 2700.0}, {"steel", 7850.0}};
+  for (double factor : {1.0, 1.5, 2.0, 0.75, 0.5}) {
+    for (double aspect : {8.0, 6.0, 4.0}) {
+      for (const Material& m : materials) {
+        const ReferenceBar bar = BarFor(r, factor * mass, aspect, m.name, m.density);
+        if (bar.buildable) return bar;
+      }
+    }
+  }
+  ReferenceBar bar = BarFor(r, mass, 8.0, "steel", 7850.0);  // what it would take
+  if (bar.length_m > kMaxBarLengthM) {
+    bar.why_not = "the aircraft's radius of gyration " + Fmt("%.3g", r) + " m needs a bar " +
+                  Fmt("%.3g", bar.length_m) + " m long (at most " + Fmt("%g", kMaxBarLengthM) +
+                  " m is planned)";
+  } else if (bar.length_m < kMinBarLengthM) {
+    bar.why_not = "the aircraft's radius of gyration " + Fmt("%.3g", 1e3 * r) +
+                  " mm needs a bar shorter than " + Fmt("%g", 1e3 * kMinBarLengthM) + " mm";
+  } else {
+    bar.why_not = "a bar of the aircraft's radius of gyration (" + Fmt("%.3g", r) +
+                  " m) and within 0.5-2x its mass would be " +
+                  (bar.thickness_m < kMinBarThicknessM ? "thinner than 3 mm"
+                                                       : "thicker than it is wide, even in steel");
+  }
   return bar;
 }
 
@@ -440,7 +482,126 @@ void Alternatives(const RigPlanOptions& o, const GridModel& m, double inertia, R
   }
 }
 
+// The periods the constraints allow (D <= 0.9 L inside the L and D bounds), both ends of the
+// inertia range: what a period window must overlap.
+void PossiblePeriods(const GridModel& m, const RigPlanGrid& grid, double out[2]) {
+  const RigPlanOptions& o = m.o;
+  const double hi_factor =
+      std::isnan(o.inertia_max_kg_m2) ? 1.0 : std::sqrt(o.inertia_max_kg_m2 / m.inertia_kg_m2);
+  out[0] = INFINITY;
+  out[1] = 0.0;
+  for (double d : grid.separation_m) {
+    for (double l : grid.length_m) {
+      if (d > kMaxSeparationOverLength * l) continue;
+      const double t = m.Period(d, l);
+      out[0] = std::min(out[0], t);
+      out[1] = std::max(out[1], t * hi_factor);
+    }
+  }
+  if (!(out[1] > 0.0)) out[0] = out[1] = NAN;  // no D <= 0.9 L at all
+}
+
+// No rig swings inside the period window: which end binds, and the advice.
+void MissedPeriodWindow(const GridModel& m, RigPlan* plan) {
+  const RigPlanOptions& o = m.o;
+  plan->period_window_missed = true;
+  PossiblePeriods(m, plan->grid, plan->periods_possible_s);
+  const double fast = plan->periods_possible_s[0], slow = plan->periods_possible_s[1];
+  if (o.min_period_s > o.max_period_s) {
+    plan->binding = "--min-period";
+    plan->advice = "the period range is empty (--min-period " + Fmt("%g", o.min_period_s) +
+                   " s above --max-period " + Fmt("%g", o.max_period_s) + " s)";
+  } else {
+    plan->binding = std::isfinite(fast) && fast > o.max_period_s ? "--max-period" : "--min-period";
+    plan->advice =
+        "no rig within --min-length..--max-length and --min-separation.."
+        "--max-separation (D <= 0.9 L) swings with a period in [" +
+        Fmt("%g", o.min_period_s) + ", " + Fmt("%g", o.max_period_s) + "] s";
+    if (std::isfinite(fast)) {
+      plan->advice +=
+          "; the periods possible span " + Fmt("%.3g", fast) + " to " + Fmt("%.3g", slow) + " s";
+    }
+    plan->advice += plan->binding == "--max-period"
+                        ? ": a wider D (--max-separation), a shorter L or a longer --max-period"
+                        : ": a narrower D, a longer L (--max-length) or a shorter --min-period";
+  }
+  plan->advice += "; the rig shown is the widest D on the longest L, outside the window";
+}
+
+// The floor no rig and no reference object lowers (RigPlanFloor): the mass and the per-swing terms
+// at kMaxRepeats, at the recommended rig.
+RigPlanFloor FloorOf(const RigPlanOptions& o, const RigPlanTerms& t) {
+  const double root = std::sqrt(static_cast<double>(kMaxRepeats));
+  const double between = t.between_repeat / root, stat = t.statistical / root;
+  RigPlanFloor f;
+  f.rel_std = std::sqrt(t.mass * t.mass + between * between + stat * stat);
+  const std::string over = " %/sqrt(" + std::to_string(kMaxRepeats) + ") = ";
+  f.parts = "mass " + Fmt("%.3g", 100.0 * t.mass) + " %, between-repeat " +
+            Fmt("%.3g", 100.0 * t.between_repeat) + over + Fmt("%.2g", 100.0 * between) +
+            " %, statistical " + Fmt("%.2g", 100.0 * t.statistical) + over +
+            Fmt("%.2g", 100.0 * stat) + " %";
+  if (t.mass >= between && t.mass >= stat) {
+    f.term = "mass";
+    f.flag = "--mass-std";
+    f.lift = "a better weighing of everything that hangs (now " + Fmt("%.3g", o.mass_std_kg * 1e3) +
+             " g, " + Fmt("%.3g", 100.0 * t.mass) + " %; --mass-std)";
+  } else if (between >= stat) {
+    f.term = "between-repeat";
+    f.flag = "--repeat-scatter";
+    f.lift = "a rig that hangs up the same way each time (" + Fmt("%g", o.repeat_scatter_percent) +
+             " % between repeats assumed, over sqrt(" + std::to_string(kMaxRepeats) +
+             ") repeats, the most planned; measure yours: --repeat-scatter)";
+  } else {
+    f.term = "statistical";
+    f.flag = "--gyro-noise";
+    f.lift = "a quieter gyro or a faster IMU (--gyro-noise, --imu-rate)";
+  }
+  return f;
+}
+
+// Target not met within the constraints: the floor, or else the constraint that binds, the
+// reference object and the relaxed rig.
+void NotMet(const GridModel& m, double target, const GridPoint& relaxed, RigPlan* plan) {
+  plan->floor = FloorOf(m.o, plan->recommended.terms);
+  plan->below_floor = target < plan->floor.rel_std;
+  if (plan->period_window_missed) return;  // binding and advice said already
+  if (plan->below_floor) {
+    plan->binding = plan->floor.flag;
+    plan->advice = "no rig, reference object or wider constraint reaches " +
+                   Fmt("%g", m.o.target_percent) + " %: the floor " +
+                   Fmt("%.3g", 100.0 * plan->floor.rel_std) + " % (" + plan->floor.parts +
+                   ") is set mostly by the " + plan->floor.term +
+                   " term, which only a measurement lowers: " + plan->floor.lift +
+                   "; (within the constraints the largest term is " +
+                   BindingFlag(plan->recommended.terms) + "'s)";
+    return;
+  }
+  plan->binding = BindingFlag(plan->recommended.terms);
+  const ReferenceBar& bar = plan->reference;
+  if (!bar.buildable) {
+    plan->advice = "no buildable reference bar (" + bar.why_not + ")";
+  } else {
+    plan->advice = plan->calibrated.Total() <= target
+                       ? "a reference object (below) brings it to " +
+                             Fmt("%.2f", 100.0 * plan->calibrated.Total()) + " %"
+                       : "even a reference object leaves " +
+                             Fmt("%.2f", 100.0 * plan->calibrated.Total()) + " %";
+  }
+  if (relaxed.found) {
+    plan->advice += "; without one, D >= " + Fmt("%.3f", relaxed.d) + " m on L " +
+                    Fmt("%.3f", relaxed.l) + " m meets the target";
+  }
+}
+
 }  // namespace
+
+int RigPlanExitCode(const RigPlan& p) {
+  if (p.target_met) return 0;
+  const bool by_reference = !p.period_window_missed && !p.below_floor && p.reference.needed &&
+                            p.reference.buildable &&
+                            p.calibrated.Total() <= p.options.target_percent / 100.0;
+  return by_reference ? 0 : 1;
+}
 
 RigPlan RunRigPlan(const RigPlanOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -461,32 +622,30 @@ RigPlan RunRigPlan(const RigPlanOptions& options) {
   const GridModel model{o, inertia, plan.release_amplitude_deg * kRadPerDeg};
   GridPoint best = SearchGrid(model, &plan.grid);
   if (!best.found) {  // the period range excludes every rig: say which end binds
-    const double t_fast = model.Period(o.max_separation_m, o.min_length_m);
-    plan.binding = o.min_period_s > o.max_period_s ? "--min-period"
-                   : t_fast > o.max_period_s       ? "--max-period"
-                                                   : "--min-period";
-    plan.advice = o.min_period_s > o.max_period_s
-                      ? "the period range is empty (--min-period " + Fmt("%g", o.min_period_s) +
-                            " s above --max-period " + Fmt("%g", o.max_period_s) + " s)"
-                      : "no rig within --min-length..--max-length and --min-separation.."
-                        "--max-separation swings with a period in [" +
-                            Fmt("%g", o.min_period_s) + ", " + Fmt("%g", o.max_period_s) +
-                            "] s; the periods possible span " + Fmt("%.3g", t_fast) + " to " +
-                            Fmt("%.3g", model.Period(o.min_separation_m, o.max_length_m)) + " s";
-    plan.advice += "; the rig shown is the widest D on the longest L";
+    MissedPeriodWindow(model, &plan);
     best = {o.max_separation_m, o.max_length_m, 0.0, true};  // evaluated anyway, marked
   }
   plan.swing_s = model.SwingS(model.Period(best.d, best.l));
-  plan.recommended = Evaluate(o, "recommended", best.d, best.l, inertia, plan.release_amplitude_deg,
-                              plan.swing_s, target);
+  plan.simulated_rate_hz = SimulatedRateHz(o, plan.swing_s);
+  try {
+    plan.recommended = Evaluate(o, "recommended", best.d, best.l, inertia,
+                                plan.release_amplitude_deg, plan.swing_s, target);
+  } catch (const UserError&) {
+    // A rig far outside the period window can swing too slowly to fit: its first-order terms
+    // then stand for it, and the window stays the cause named.
+    if (!plan.period_window_missed) throw;
+    plan.recommended.label = "recommended";
+    plan.recommended.separation_m = best.d;
+    plan.recommended.length_m = best.l;
+    plan.recommended.period_s = model.Period(best.d, best.l);
+    plan.recommended.terms = model.Terms(best.d, best.l, kMinRepeats);
+    plan.recommended.terms.repeats = RepeatsFor(plan.recommended.terms, target);
+  }
   const RigGeometry g{best.l, best.d, SuspendedMass(o), o.gravity_mps2};
   plan.small_angle_excess_percent =
       100.0 * (std::pow(plan.recommended.period_s / SmallAnglePeriod(g, inertia), 2) - 1.0);
   plan.best_std_percent = 100.0 * plan.recommended.terms.Total();
-  if (plan.binding.empty()) {
-    plan.target_met = plan.recommended.terms.Total() <= target;
-    if (!plan.target_met) plan.binding = BindingFlag(plan.recommended.terms);
-  }
+  plan.target_met = !plan.period_window_missed && plan.recommended.terms.Total() <= target;
   Alternatives(o, model, inertia, &plan);
   const GridPoint relaxed = RelaxedForTarget(model, target);
   if (relaxed.found) {
@@ -496,17 +655,7 @@ RigPlan RunRigPlan(const RigPlanOptions& options) {
   plan.reference = DesignReference(inertia, o.mass_kg);
   plan.calibrated = Calibrated(plan.recommended.terms, plan.reference, target);
   plan.reference.needed = !plan.target_met;
-  if (!plan.target_met && plan.advice.empty()) {
-    plan.advice = plan.calibrated.Total() <= target
-                      ? "a reference object (below) brings it to " +
-                            Fmt("%.2f", 100.0 * plan.calibrated.Total()) + " %"
-                      : "even a reference object leaves " +
-                            Fmt("%.2f", 100.0 * plan.calibrated.Total()) + " %";
-    if (relaxed.found) {
-      plan.advice += "; without one, D >= " + Fmt("%.3f", relaxed.d) + " m on L " +
-                     Fmt("%.3f", relaxed.l) + " m meets the target";
-    }
-  }
+  if (!plan.target_met) NotMet(model, target, relaxed, &plan);
   if (o.monte_carlo_swings > 0) plan.monte_carlo = MonteCarlo(plan, inertia);
   plan.plan_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

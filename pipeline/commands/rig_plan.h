@@ -86,6 +86,10 @@ struct RigCandidate {
 // The reference object: a flat bar swung flat, centred, I = M (a^2 + b^2) / 12.
 struct ReferenceBar {
   bool needed = false;
+  // Within the bounds a workshop can make (length 20 mm to 2 m, at least 3 mm thick and no
+  // thicker than wide); false: none fits, `why_not` says what it would take.
+  bool buildable = true;
+  std::string why_not;
   std::string material;  // "steel" or "aluminium"
   double density_kg_m3 = 0.0;
   double length_m = 0.0, width_m = 0.0, thickness_m = 0.0, mass_kg = 0.0;
@@ -109,12 +113,33 @@ struct RigPlanGrid {
   std::vector<int> feasible;                   // 1 inside every constraint
 };
 
+// The floor no rig and no reference object lowers: the mass and the per-swing terms at the most
+// repeats planned (kMaxRepeats). A target below it is unreachable; `term` sets it, `lift` says
+// what would lower it (a measurement: a better weighing, a steadier rig, a quieter gyro).
+struct RigPlanFloor {
+  double rel_std = 0.0;  // fraction
+  std::string term;      // "mass", "between-repeat" or "statistical"
+  std::string flag;      // the flag that states it (--mass-std, --repeat-scatter, --gyro-noise)
+  std::string lift;      // what would lower it
+  std::string parts;     // "mass 0.1 %, between-repeat 0.25 %/sqrt(10) = 0.079 %, ..."
+};
+
 struct RigPlan {
   RigPlanOptions options;  // with the defaults resolved (mass_std_kg)
   bool target_met = false;
+  // No rig within the constraints swings inside [--min-period, --max-period]: the rig shown is
+  // only the widest D on the longest L; `periods_possible_s` the span the constraints allow.
+  bool period_window_missed = false;
+  double periods_possible_s[2] = {NAN, NAN};
+  // The target is below the floor: no rig, reference object or relaxed constraint reaches it.
+  bool below_floor = false;
+  RigPlanFloor floor;
   std::string binding;            // flag of the constraint that binds ("" when met)
   std::string advice;             // one sentence: what would meet the target
   double best_std_percent = 0.0;  // the best total possible within the constraints
+  // The rate the swings were simulated at: --imu-rate, or fewer samples (at most
+  // kMaxPlanSamples per swing) with the noise of the fit's block means (the same information).
+  double simulated_rate_hz = 0.0;
   RigCandidate recommended;
   std::vector<RigCandidate> alternatives;
   double release_amplitude_deg = 0.0;          // largest release keeping the rig departure small
@@ -133,6 +158,14 @@ struct RigPlan {
 // Plans the rig. Throws UserError naming the flag on a non-physical value; constraints that no
 // rig can meet are an answer (target_met false, binding, best_std_percent), not an error.
 RigPlan RunRigPlan(const RigPlanOptions& options);
+
+// The exit code of `bifilar plan --rig`: 0 when the plan meets the target (with the reference
+// object it designs, when one is needed and buildable), 1 when nothing it offers does (a target
+// below the floor, no rig in the period window, constraints too tight).
+int RigPlanExitCode(const RigPlan& plan);
+
+// The most samples of one simulated swing (the cost of the plan is bounded whatever --imu-rate).
+constexpr double kMaxPlanSamples = 30000.0;
 
 // The console text, the JSON (SI) and the starting config (the format `bifilar init` writes,
 // pipeline/config/config_template.h, with the rig, rig.uncertainties, aircraft and, when the

@@ -59,6 +59,55 @@ std::string Defaults(const RigPlanOptions& o) {
   return s.str();
 }
 
+// The first line under the title: met, or why not (no rig in the period window; a target below
+// the floor no rig lowers; the constraints), with the binding flag.
+std::string Headline(const RigPlan& p) {
+  const RigPlanOptions& o = p.options;
+  const std::string total = Fmt("%.3g", 100.0 * p.recommended.terms.Total()) + " %";
+  if (p.target_met) return "  target met: expected total std " + total;
+  if (p.period_window_missed) {
+    return "  NO RIG FITS THE PERIOD WINDOW [" + Fmt("%g", o.min_period_s) + ", " +
+           Fmt("%g", o.max_period_s) + "] s within the constraints (binding: " + p.binding +
+           "); the rig shown, outside it, would give " + total;
+  }
+  if (p.below_floor) {
+    return "  TARGET UNREACHABLE: " + Fmt("%g", o.target_percent) + " % is below the floor of " +
+           Fmt("%.3g", 100.0 * p.floor.rel_std) + " % set by the " + p.floor.term +
+           " term (binding: " + p.binding + "); the best within the constraints is " + total;
+  }
+  return "  TARGET NOT MET within the constraints: expected total std " + total +
+         " is the best possible; binding: " + p.binding;
+}
+
+// Console lines of at most kMaxLine characters (issue 32 item 8): a longer line is broken after
+// its last "; " (else ", ", else a space) that fits, the rest indented 4 more than the line.
+constexpr size_t kMaxLine = 160;
+std::string WrapLines(const std::string& text) {
+  std::istringstream in(text);
+  std::string line, out;
+  while (std::getline(in, line)) {
+    const std::string indent(line.find_first_not_of(' ') == std::string::npos
+                                 ? 0
+                                 : line.find_first_not_of(' ') + 4,
+                             ' ');
+    while (line.size() > kMaxLine) {
+      size_t at = std::string::npos;
+      for (const char* sep : {"; ", ", ", " "}) {
+        const size_t k = line.rfind(sep, kMaxLine - std::string(sep).size());
+        if (k != std::string::npos && k > indent.size()) {
+          at = k + std::string(sep).size() - 1;  // keep ';' or ',' on the first line
+          break;
+        }
+      }
+      if (at == std::string::npos) break;  // one long word: left as it is
+      out += line.substr(0, at) + "\n";
+      line = indent + line.substr(at + 1);
+    }
+    out += line + "\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string RigPlanText(const RigPlan& p) {
@@ -70,10 +119,7 @@ std::string RigPlanText(const RigPlan& p) {
   s << ", I " << Fmt("%.4g", o.inertia_kg_m2);
   if (std::isfinite(o.inertia_max_kg_m2)) s << " to " << Fmt("%.4g", o.inertia_max_kg_m2);
   s << " kg m^2, target " << o.target_percent << " %\n";
-  s << (p.target_met ? "  target met: " : "  TARGET NOT MET within the constraints: ")
-    << "expected total std " << Fmt("%.3g", 100.0 * r.terms.Total()) << " %";
-  if (!p.target_met) s << " is the best possible; binding: " << p.binding;
-  s << "\n";
+  s << Headline(p) << "\n";
   if (!p.advice.empty()) s << "  " << p.advice << "\n";
   s << "  recommended: L " << Fmt("%.3f", r.length_m) << " m, D " << Fmt("%.4f", r.separation_m)
     << " m, period " << Fmt("%.3g", r.period_s) << " s\n";
@@ -87,6 +133,11 @@ std::string RigPlanText(const RigPlan& p) {
     << Fmt("%.2g", p.small_angle_excess_percent) << " % high there)\n";
   s << "  log " << Fmt("%.0f", p.swing_s) << " s of free swing, " << r.terms.repeats
     << " repeats per set-up (fit them with --repeats)\n";
+  if (p.simulated_rate_hz < o.imu_rate_hz) {
+    s << "  note: the swings were simulated at " << Fmt("%.3g", p.simulated_rate_hz)
+      << " Hz with the noise of the fit's block means (the same information as "
+      << Fmt("%g", o.imu_rate_hz) << " Hz), which bounds the plan's time and memory\n";
+  }
   for (const RigCandidate& a : p.alternatives) {
     s << "  alternative (" << a.label << "): L " << Fmt("%.3f", a.length_m) << " m, D "
       << Fmt("%.4f", a.separation_m) << " m, period " << Fmt("%.3g", a.period_s) << " s, total "
@@ -98,15 +149,21 @@ std::string RigPlanText(const RigPlan& p) {
       << " m\n";
   }
   const ReferenceBar& b = p.reference;
-  s << "  reference object " << (b.needed ? "NEEDED" : "not needed") << ": "
-    << (b.material == "aluminium" ? "an " : "a ") << b.material << " bar "
-    << Fmt("%.1f", b.length_m * 1e3) << " x " << Fmt("%.1f", b.width_m * 1e3) << " x "
-    << Fmt("%.1f", b.thickness_m * 1e3) << " mm, " << Fmt("%.4g", b.mass_kg)
-    << " kg, swung flat: I "
-    << "= M (a^2 + b^2)/12 = " << Fmt("%.4g", b.inertia_kg_m2) << " kg m^2 +- "
-    << Pct(b.inertia_rel_std) << " (+-" << Fmt("%.2g", b.tolerance_m * 1e3)
-    << " mm on a and b, weighed to 0.02 %), " << b.swings << " swings -> total "
-    << Fmt("%.3g", 100.0 * p.calibrated.Total()) << " % (" << TermsLine(p.calibrated) << ")\n";
+  if (!b.buildable) {
+    s << "  reference object "
+      << (b.needed ? "NEEDED, but none buildable: " : "not needed (none buildable: ") << b.why_not
+      << (b.needed ? "\n" : ")\n");
+  } else {
+    s << "  reference object " << (b.needed ? "NEEDED" : "not needed") << ": "
+      << (b.material == "aluminium" ? "an " : "a ") << b.material << " bar "
+      << Fmt("%.1f", b.length_m * 1e3) << " x " << Fmt("%.1f", b.width_m * 1e3) << " x "
+      << Fmt("%.1f", b.thickness_m * 1e3) << " mm, " << Fmt("%.4g", b.mass_kg)
+      << " kg, swung flat: I "
+      << "= M (a^2 + b^2)/12 = " << Fmt("%.4g", b.inertia_kg_m2) << " kg m^2 +- "
+      << Pct(b.inertia_rel_std) << " (+-" << Fmt("%.2g", b.tolerance_m * 1e3)
+      << " mm on a and b, weighed to 0.02 %), " << b.swings << " swings -> total "
+      << Fmt("%.3g", 100.0 * p.calibrated.Total()) << " % (" << TermsLine(p.calibrated) << ")\n";
+  }
   if (p.monte_carlo.swings > 0) {
     const RigMonteCarlo& m = p.monte_carlo;
     s << "  Monte-Carlo: " << m.usable << "/" << m.swings << " swings fitted, scatter of I "
@@ -115,7 +172,7 @@ std::string RigPlanText(const RigPlan& p) {
   }
   s << Defaults(o);
   s << "  planned in " << Fmt("%.2f", p.plan_seconds) << " s\n";
-  return s.str();
+  return WrapLines(s.str());
 }
 
 std::string RigPlanJson(const RigPlan& p) {
@@ -123,6 +180,16 @@ std::string RigPlanJson(const RigPlan& p) {
   nlohmann::json j;
   j["target_percent"] = p.options.target_percent;
   j["target_met"] = p.target_met;
+  j["exit_code"] = RigPlanExitCode(p);
+  j["period_window_missed"] = p.period_window_missed;
+  j["periods_possible_s"] = {Nullable(p.periods_possible_s[0]), Nullable(p.periods_possible_s[1])};
+  j["below_floor"] = p.below_floor;
+  j["floor"] = {{"std_percent", 100.0 * p.floor.rel_std},
+                {"term", p.floor.term},
+                {"flag", p.floor.flag},
+                {"lift", p.floor.lift},
+                {"parts", p.floor.parts}};
+  j["simulated_rate_hz"] = p.simulated_rate_hz;
   j["binding_constraint"] = p.binding.empty() ? nlohmann::json(nullptr) : nlohmann::json(p.binding);
   j["advice"] = p.advice;
   j["best_std_percent"] = p.best_std_percent;
@@ -149,6 +216,8 @@ std::string RigPlanJson(const RigPlan& p) {
   j["alternatives"] = alts;
   const ReferenceBar& b = p.reference;
   j["reference_object"] = {{"needed", b.needed},
+                           {"buildable", b.buildable},
+                           {"why_not", b.why_not},
                            {"material", b.material},
                            {"length_m", b.length_m},
                            {"width_m", b.width_m},
@@ -205,7 +274,7 @@ std::string RigLines(const RigPlan& p, bool cradle) {
     << "\n    filar_separation_std_m: " << Fmt("%.6g", o.separation_std_m)
     << "\n    mass_std_kg: " << Fmt("%.6g", cradle ? 0.0 : o.mass_std_kg)
     << "\n    gravity_std_mps2: " << Fmt("%.6g", o.gravity_std_mps2) << "\n";
-  if (p.reference.needed) {
+  if (p.reference.needed && p.reference.buildable) {
     const ReferenceBar& b = p.reference;
     y << "  # The rig alone (cradle, thread, clips): weigh it for rig.mass_kg; its inertia here "
          "is\n"
@@ -237,7 +306,7 @@ std::string RigPlanConfigText(const RigPlan& p, const std::string& path) {
   // A thread rig (no cradle) without a reference object: everything that hangs is rig.mass_kg
   // (as configs/crazyflie_basemodel.yaml). With a cradle, or a reference object (whose swings
   // need a rig of its own), the aircraft has its own section.
-  const bool split = o.cradle_mass_kg > 0.0 || p.reference.needed;
+  const bool split = o.cradle_mass_kg > 0.0 || (p.reference.needed && p.reference.buildable);
   StartingConfigOptions start;
   start.filar_length_m = p.recommended.length_m;
   start.filar_separation_m = p.recommended.separation_m;

@@ -1,15 +1,20 @@
 #include "pipeline/figures/figure.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <mutex>
 #include <sstream>
 
 #include <plplot.h>
 
+#include "base/atomic_file.h"
+#include "base/user_error.h"
 #include "pipeline/figures/svg_compact.h"
 
 namespace bifilar {
@@ -59,10 +64,26 @@ bool WriteFigure(const std::string& path, const FigureOptions& options,
     *why = "figure size must be positive";
     return false;
   }
+  // Never replace a link, folder or device (base/atomic_file.h): the rename below would.
+  try {
+    CheckFileTarget(path);
+  } catch (const UserError& e) {
+    *why = e.what();
+    return false;
+  }
   const std::string temporary = path + ".tmp";
   // PLplot opens the name as given: a stale temporary, or a link planted under its name, is
-  // removed first so the figure never writes through a link to a file elsewhere.
+  // removed first so the figure never writes through a link to a file elsewhere. The temporary
+  // is then created here, exclusively and without following a link: PLplot, unable to open a
+  // file (a missing or read-only folder), asks for another name ten times and exits the process.
   ::unlink(temporary.c_str());
+  const int probe =
+      ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+  if (probe < 0) {
+    *why = path + ": cannot write the figure (" + std::strerror(errno) + ")";
+    return false;
+  }
+  ::close(probe);
   {
     std::lock_guard<std::mutex> lock(PlplotMutex());
     PLINT stream = 0;

@@ -56,6 +56,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/gzip.h"
+#include "base/units.h"
 #include "pipeline/logs/dataflash_writer.h"
 #include "pipeline/store/cache.h"
 #include "pipeline/store/output_set.h"
@@ -1084,6 +1085,77 @@ void CaseDataflash(const Args& args, const Workspace& w, int case_no, std::mt199
 }
 
 // Runs the cases above once each; returns how many ran.
+// ---- Issue 33 items 1, 4, 5, 7 and issue 32 item 7 (`plan` helper): no user file replaced by
+// `plan --rig`, `fit --plot` or `ellipse --plot`, never a link; the figure's folder checked before
+// PLplot runs; a 10 kHz IMU on a long-period rig answered within the bound; an unreachable target
+// exits 1 naming the floor. The sentinel asserts nothing outside the harness folder changed.
+void CasePlanNoReplace(const Args& args, const Workspace& w, int case_no, Failures* failures) {
+  const std::string h = w.harness + "/plan";
+  std::error_code ec;
+  fs::remove_all(h, ec);
+  fs::create_directories(h + "/plots", ec);
+  WriteFile(h + "/mine.png", "mine");
+  WriteFile(h + "/plots/ellipse_polar.png", "mine");
+  WriteFile(h + "/file", "mine");
+  fs::create_symlink(h + "/mine.png", h + "/link.png", ec);
+  std::string table = "pitch_deg,inertia\n";
+  for (int d = -80; d <= 90; d += 10) {
+    const double s = std::sin(d * bifilar::kRadPerDeg);
+    table += std::to_string(d) + "," + std::to_string(2.8 - 0.4 * s * s + 0.001 * (d % 3)) + "\n";
+  }
+  WriteFile(h + "/table.csv", table);
+  const std::vector<std::string> quad = {args.binary,       "plan",        "--rig",
+                                         "--mass",          "0.0343",      "--inertia",
+                                         "1.6e-5",          "--max-length", "0.594",
+                                         "--max-separation", "0.030",      "--target-percent"};
+  const auto plan = [&](const std::string& target, std::vector<std::string> extra) {
+    std::vector<std::string> argv = quad;
+    argv.push_back(target);
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return argv;
+  };
+  struct Run {
+    std::vector<std::string> argv;
+    std::vector<int> codes;
+    std::string message;
+  };
+  const std::vector<Run> runs = {
+      {plan("1", {"--write-config", w.thesis}), {2}, "exists"},
+      {plan("1", {"--plot", h + "/mine.png"}), {2}, "exists"},
+      {plan("1", {"--plot", h + "/link.png", "--force"}), {2}, "is a symbolic link"},
+      {plan("1", {"--write-config", h + "/x.svg", "--plot", h + "/./x.svg"}), {2}, "same file"},
+      {plan("1", {"--write-config", ""}), {2}, "empty"},
+      {plan("1", {"--plot", h + "/file/p.png"}), {2}, "cannot create the folder"},
+      {plan("0.01", {}), {1}, "TARGET UNREACHABLE"},
+      {{args.binary, "plan", "--rig", "--mass", "2.5", "--inertia", "16", "--max-length", "3",
+        "--max-separation", "1", "--target-percent", "0.5", "--imu-rate", "10000"},
+       {1},
+       "NO RIG FITS THE PERIOD WINDOW"},
+      {{args.binary, "ellipse", h + "/table.csv", "--bootstrap", "0", "--plot", h + "/plots"},
+       {2},
+       "will not replace"},
+  };
+  for (const Run& run : runs) {
+    const std::string kind = "plan/figures: bifilar " + run.argv[1] + " ... " + run.argv.back();
+    const Outcome o = Wait(Start(run.argv, w.harness + "/hostile"), args.run_timeout_s);
+    CheckOutside(o, case_no, kind, failures);
+    ExpectStop(o, case_no, kind, run.codes, run.codes[0] == 1 ? o.out : o.err, run.message,
+               failures);
+    if (o.err.find("PLPLOT") != std::string::npos || o.err.find("Can't open") != std::string::npos) {
+      failures->Add(case_no, kind, "PLplot reached a path it cannot open:\n" + o.err);
+    }
+    for (const std::string& path : {h + "/mine.png", h + "/plots/ellipse_polar.png"}) {
+      if (ReadFile(path) != "mine") {
+        failures->Add(case_no, kind, path + ": a user's file was replaced");
+      }
+    }
+    if (!fs::is_symlink(fs::symlink_status(h + "/link.png", ec))) {
+      failures->Add(case_no, kind, h + "/link.png: a link was replaced");
+    }
+  }
+  fs::remove_all(h, ec);
+}
+
 int RunHostileInputCases(const Args& args, Workspace& w, int first_case_no, Failures* failures) {
   int c = first_case_no;
   CaseSpecialFileAmongLogs(args, w, c++, /*fifo=*/true, failures);
@@ -1097,6 +1169,7 @@ int RunHostileInputCases(const Args& args, Workspace& w, int first_case_no, Fail
   CaseNoOverwrite(args, w, c++, failures);
   std::mt19937_64 rng(26);
   CaseDataflash(args, w, c++, rng, failures);
+  CasePlanNoReplace(args, w, c++, failures);  // `plan` helper, issue 33
   return c - first_case_no;
 }
 
