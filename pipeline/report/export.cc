@@ -665,7 +665,7 @@ std::string FormatArdupilotFrame(const ExportInertia& in) {
   }
   const std::string dropped = DroppedProducts(in, ExportFormat::kArdupilot);
   s += "    \"dropped\": " + str(dropped) + ",\n";
-  s += "    \"mass\": " + str(CgText(in, "SITL puts the CG at the body origin.")) + "\n";
+  s += "    \"not_measured\": " + str(CgText(in, "SITL puts the CG at the body origin.")) + "\n";
   s += "  },\n";
   s += "  \"mass\": " + Num(in.mass_kg) + ",\n";
   s += "  \"moment_inertia\": [" + Num(v[kIxx]) + ", " + Num(v[kIyy]) + ", " + Num(v[kIzz]) + "]\n";
