@@ -345,7 +345,7 @@ const char kX500Sdf[] = R"(<?xml version="1.0" encoding="UTF-8"?>
       <gravity>true</gravity>
       <velocity_decay/>
       <visual name="base_link_visual">
-        <pose>0 0 .025 0 0 3.141592654</pose>
+        <pose>0 0 .025 0 0 1.5707</pose>
         <geometry>
           <mesh>
             <uri>model://x500_base/meshes/NXP-HGD-CF.dae</uri>
