@@ -227,14 +227,18 @@ bool WrittenByExport(const std::string& path) {
          start.rfind("results_file,section,frame,mass_kg,", 0) == 0;
 }
 
-// Throws UserError when --out is the input or a file of its output folder (see RunExport).
-void RefuseCampaignFile(const std::string& out_path, const std::string& results_path) {
+// Throws UserError when --out (or --into: `option`) is the input or a file of its output folder
+// (see RunExport).
+void RefuseCampaignFile(const std::string& out_path, const std::string& results_path,
+                        const char* option = "--out") {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path out = fs::weakly_canonical(fs::absolute(out_path, ec), ec);
   const fs::path input = fs::weakly_canonical(fs::absolute(results_path, ec), ec);
-  const std::string refused = "export: --out " + out_path + " is ";
-  const std::string advice = "; export writes a new file: choose a name outside it";
+  const std::string refused = std::string("export: ") + option + " " + out_path + " is ";
+  const std::string advice = std::string(option) == "--out"
+                                 ? "; export writes a new file: choose a name outside it"
+                                 : "; --into rewrites a model file, not a campaign's";
   if (out == input || (fs::exists(out_path, ec) && fs::equivalent(out_path, results_path, ec))) {
     throw UserError(refused + "the input " + results_path + " itself" + advice);
   }
@@ -822,7 +826,7 @@ int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err
     }
   }
   if (!options.into_path.empty()) {
-    RefuseCampaignFile(options.into_path, path);
+    RefuseCampaignFile(options.into_path, path, "--into");
     CheckFileTarget(options.into_path);
   }
   std::string text;
