@@ -2,10 +2,11 @@
 // urdf::parseURDF (ROS), SDFormat's sdf::Root (Gazebo) and MuJoCo's mj_loadXML. A set of known
 // tensors (planar, full, products of both signs, near-degenerate principal moments, FLU and FRD)
 // is written by the exporter, loaded by the parser, and the tensor the simulator will use is
-// compared with the truth in the file's frame; one campaign goes through `process`'s own code (config
-// with aircraft.cg_m, tensor fit, results.json) into each parser. Then `--into` on model files in the shape the
-// simulators ship (a PX4-style x500 SDF, a URDF with several links, an MJCF with nested bodies):
-// the bytes outside the rewritten block are identical, and the parser reads the new numbers.
+// compared with the truth in the file's frame; one campaign goes through `process`'s own code
+// (a config with aircraft.cg_m, the tensor fit, results.json) into each parser. Then `--into` on
+// model files in the shape the simulators ship (a PX4-style x500 SDF, a URDF with several links,
+// an MJCF with nested bodies): the bytes outside the rewritten block are identical, and the
+// parser reads the new numbers.
 //
 // The parsers are test dependencies only: this one program links them (tests/CMakeLists.txt,
 // BIFILAR_SIMULATOR_PARSERS), the bifilar program does not.
