@@ -137,15 +137,15 @@ TEST(ExportWorkedExample, Csv) {
       "0.08,0.001,measured,0.12,0.0015,measured,-0.06,0.0012,measured,";
   EXPECT_EQ(row.substr(0, values.size()), values);
   // No total_uncertainty, covariance or CG in this results.json: empty; then the provenance.
-  EXPECT_EQ(row.substr(values.size()),
-            std::string(6 + 21 + 6 - 1, ',') + ",0.2.0,," + ProgramVersion() +
-                ",2026-11-28T12:00:00Z\n");
+  EXPECT_EQ(row.substr(values.size()), std::string(6 + 21 + 6 - 1, ',') + ",0.2.0,," +
+                                           ProgramVersion() + ",2026-11-28T12:00:00Z\n");
   const std::string header = csv.substr(0, csv.find('\n'));
   EXPECT_EQ(header.rfind("results_file,section,frame,mass_kg,mass_std_kg,mass_source,"
-            "Ixx_kg_m2,Ixx_std_kg_m2,Ixx_source,Iyy_kg_m2,Iyy_std_kg_m2,Iyy_source,"
-            "Izz_kg_m2,Izz_std_kg_m2,Izz_source,Ixy_kg_m2,Ixy_std_kg_m2,Ixy_source,"
-            "Ixz_kg_m2,Ixz_std_kg_m2,Ixz_source,Iyz_kg_m2,Iyz_std_kg_m2,Iyz_source,"
-            "Ixx_total_std_kg_m2,", 0),
+                         "Ixx_kg_m2,Ixx_std_kg_m2,Ixx_source,Iyy_kg_m2,Iyy_std_kg_m2,Iyy_source,"
+                         "Izz_kg_m2,Izz_std_kg_m2,Izz_source,Ixy_kg_m2,Ixy_std_kg_m2,Ixy_source,"
+                         "Ixz_kg_m2,Ixz_std_kg_m2,Ixz_source,Iyz_kg_m2,Iyz_std_kg_m2,Iyz_source,"
+                         "Ixx_total_std_kg_m2,",
+                         0),
             0u)
       << header;
   EXPECT_NE(header.find(",cov_Ixx_Ixx_kg2_m4,cov_Ixx_Iyy_kg2_m4,"), std::string::npos);
@@ -160,8 +160,9 @@ TEST(ExportWorkedExample, Mjcf) {
             "<body name=\"aircraft\">\n"
             "  <inertial pos=\"0 0 0\" mass=\"1.25\" fullinertia=\"2 3 4.5 0.08 0.12 0.06\"/>\n"
             "</body>\n");
-  EXPECT_NE(FormatMjcfBody(Example(), ExportFrame::kFrd).find("fullinertia=\"2 3 4.5 -0.08 -0.12 0.06\""),
-            std::string::npos);
+  EXPECT_NE(
+      FormatMjcfBody(Example(), ExportFrame::kFrd).find("fullinertia=\"2 3 4.5 -0.08 -0.12 0.06\""),
+      std::string::npos);
 }
 
 TEST(ExportWorkedExample, ArdupilotKeepsTheDiagonalAndNamesTheProductsItDrops) {
@@ -439,13 +440,16 @@ TEST(ExportCli, WritesEachFormatAndRefusesBadInputNamingTheFile) {
       {"export " + dir.path + "/missing.json --format csv", "missing.json: cannot open"},
       {"export " + results + " --format stl",
        "--format must be urdf, sdf, jsbsim, csv, mjcf or ardupilot"},
-      {"export " + results + " --format jsbsim --frame flu", "--frame applies to urdf, sdf and mjcf"},
-      {"export " + results + " --format ardupilot --frame frd", "--frame applies to urdf, sdf and mjcf"},
+      {"export " + results + " --format jsbsim --frame flu",
+       "--frame applies to urdf, sdf and mjcf"},
+      {"export " + results + " --format ardupilot --frame frd",
+       "--frame applies to urdf, sdf and mjcf"},
       {"export " + results + " --format urdf --into " + dir.path + "/m.urdf",
        "given together (--into MODEL --link NAME)"},
       {"export " + results + " --format jsbsim --into m.xml --link a", "urdf, sdf or mjcf"},
       {"export " + results + " --format urdf --set Ixx=1", "--set Ixx: " + results + " measured"},
-      {"export " + results + " --format urdf --set Ixq=1", "--set = \"Ixq\"; must be Ixx, Iyy, Izz, Ixy, Ixz or Iyz (unknown component)"},
+      {"export " + results + " --format urdf --set Ixq=1",
+       "--set = \"Ixq\"; must be Ixx, Iyy, Izz, Ixy, Ixz or Iyz (unknown component)"},
       {"export " + results + " --format urdf --set Iyy", "expected NAME=VALUE"},
       {"export " + no_mass + " --format urdf", no_mass + ": URDF needs the mass"},
   };
@@ -473,7 +477,6 @@ TEST(ExportCli, WritesEachFormatAndRefusesBadInputNamingTheFile) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find(",,,missing,2,"), std::string::npos) << r.out;
 }
-
 
 // issue 35 item 7: a tensor that is not physical is refused by every simulator format with the
 // one message (NonPhysicalRefusal), nothing written; --force writes it, the numbers as they are
@@ -511,12 +514,13 @@ TEST(ExportRefusal, EveryFormatRefusesANonPhysicalTensorWithOneMessage) {
   EXPECT_EQ(NonPhysicalRefusal(in, ExportFormat::kSdf, true), "");
   EXPECT_EQ(NonPhysicalRefusal(in, ExportFormat::kCsv, false), "");
   EXPECT_EQ(NonPhysicalRefusal(Example(), ExportFormat::kUrdf, false), "");
-  const std::string model = WriteFile(dir.path + "/m.urdf",
-                                      "<robot name=\"r\"><link name=\"a\"></link></robot>\n");
+  const std::string model =
+      WriteFile(dir.path + "/m.urdf", "<robot name=\"r\"><link name=\"a\"></link></robot>\n");
   const CliRun r =
       Bifilar(dir, "export " + bad + " --format urdf --into " + model + " --link a --force");
   EXPECT_EQ(r.exit_code, 0) << r.err;  // --force: written
-  const CliRun refused = Bifilar(dir, "export " + bad + " --format urdf --into " + model + " --link a");
+  const CliRun refused =
+      Bifilar(dir, "export " + bad + " --format urdf --into " + model + " --link a");
   EXPECT_EQ(refused.exit_code, 1);
   EXPECT_EQ(refused.err, "bifilar: error: " + bad + expected_tail + "urdf" + expected_end);
 }
@@ -591,7 +595,7 @@ TEST(ExportCli, IntoRewritesALinkKeepsABackupAndRefusesWithoutForce) {
   CliRun r = Bifilar(dir, args + "base_link");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find(model + ": link 'base_link''s <inertial> was not written by bifilar "
-                       "export; add --force"),
+                               "export; add --force"),
             std::string::npos)
       << r.err;
   EXPECT_EQ(ReadFile(model), original);
@@ -601,7 +605,8 @@ TEST(ExportCli, IntoRewritesALinkKeepsABackupAndRefusesWithoutForce) {
       << r.err;
   r = Bifilar(dir, "export " + results + " --format sdf --into " + model + " --link base_link");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find(model + " is urdf, not sdf; give --format urdf"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(model + " is urdf, not sdf; give --format urdf"), std::string::npos)
+      << r.err;
   WriteFile(model + ".bak", "an older backup\n");
   r = Bifilar(dir, args + "base_link --force");
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -85,8 +85,7 @@ void RequireComplete(const ExportInertia& in, const char* format, bool moments_o
     throw UserError(
         in.results_name + ": " + format +
         (moments_only ? " needs the three moments" : " needs all six components") + ", and " +
-        names +
-        (missing.size() == 1 ? " is" : " are") + " not in this result" +
+        names + (missing.size() == 1 ? " is" : " are") + " not in this result" +
         (planar ? " (a pitch-only campaign measures Ixx, Izz and Ixz)" : "") + "; give " +
         (missing.size() == 1 ? "it" : "them") +
         " with --set NAME=VALUE (kg m^2, body axes, products positive)" +
@@ -109,7 +108,8 @@ void RequireComplete(const ExportInertia& in, const char* format, bool moments_o
 std::string ComponentText(const ExportInertia& in, int k) {
   if (in.source[k] != "measured") {
     return Num(in.value_kg_m2[k]) + " (not measured: " +
-           (in.source[k] == "set" ? "given by the user" : "assumed 0, aircraft symmetric about x-z") +
+           (in.source[k] == "set" ? "given by the user"
+                                  : "assumed 0, aircraft symmetric about x-z") +
            ")";
   }
   std::string s = Num(in.value_kg_m2[k]) + " +- " +
@@ -129,11 +129,11 @@ std::string ProvenanceText(const ExportInertia& in) {
 
 // The CG line: where the origin of the file is, and what the bifilar does not measure.
 std::string CgText(const ExportInertia& in, const std::string& origin_text) {
-  std::string s = "NOT MEASURED by the bifilar: the mass (" + Num(in.mass_kg) + " kg" +
-                  (std::isfinite(in.mass_std_kg) ? " +- " + Num(in.mass_std_kg) : std::string()) +
-                  ", from " +
-                  (in.mass_source == "--mass-kg" ? std::string("the command line") : in.mass_source) +
-                  ") and the CG: ";
+  std::string s =
+      "NOT MEASURED by the bifilar: the mass (" + Num(in.mass_kg) + " kg" +
+      (std::isfinite(in.mass_std_kg) ? " +- " + Num(in.mass_std_kg) : std::string()) + ", from " +
+      (in.mass_source == "--mass-kg" ? std::string("the command line") : in.mass_source) +
+      ") and the CG: ";
   if (in.cg.Given()) {
     s += "aircraft.cg_m = " + Num(in.cg.cg_m[0]) + " " + Num(in.cg.cg_m[1]) + " " +
          Num(in.cg.cg_m[2]) + " m (body x forward, y right, z down)";
@@ -143,7 +143,8 @@ std::string CgText(const ExportInertia& in, const std::string& origin_text) {
     }
     s += ", measured apart; " + origin_text;
   } else {
-    s += origin_text + " Move it to the measured CG (or give aircraft.cg_m in the config); the "
+    s += origin_text +
+         " Move it to the measured CG (or give aircraft.cg_m in the config); the "
          "inertia is about the CG.";
   }
   return s;
@@ -271,12 +272,10 @@ void RefuseCampaignFile(const std::string& out_path, const std::string& results_
 
 namespace {
 
-constexpr EnumName<ExportFormat> kExportFormatNames[] = {{ExportFormat::kUrdf, "urdf"},
-                                                         {ExportFormat::kSdf, "sdf"},
-                                                         {ExportFormat::kJsbsim, "jsbsim"},
-                                                         {ExportFormat::kCsv, "csv"},
-                                                         {ExportFormat::kMjcf, "mjcf"},
-                                                         {ExportFormat::kArdupilot, "ardupilot"}};
+constexpr EnumName<ExportFormat> kExportFormatNames[] = {
+    {ExportFormat::kUrdf, "urdf"},     {ExportFormat::kSdf, "sdf"},
+    {ExportFormat::kJsbsim, "jsbsim"}, {ExportFormat::kCsv, "csv"},
+    {ExportFormat::kMjcf, "mjcf"},     {ExportFormat::kArdupilot, "ardupilot"}};
 constexpr EnumName<ExportFrame> kExportFrameNames[] = {{ExportFrame::kFlu, "flu"},
                                                        {ExportFrame::kFrd, "frd"}};
 
@@ -315,8 +314,7 @@ bool ExportOptions::Check(std::string* why) const {
       (into_path.empty() || format == ExportFormat::kUrdf || format == ExportFormat::kSdf ||
        format == ExportFormat::kMjcf ||
        CheckFailText("--format (with --into)", ExportFormatName(format),
-                     "urdf, sdf or mjcf (the formats of a model file with links or bodies)",
-                     &f)) &&
+                     "urdf, sdf or mjcf (the formats of a model file with links or bodies)", &f)) &&
       (std::isnan(mass_kg) || CheckFiniteGt("--mass-kg", mass_kg, 0, &f));
   for (auto it = set_kg_m2.begin(); ok && it != set_kg_m2.end(); ++it) {
     const std::string& name = it->first;
@@ -530,7 +528,8 @@ namespace {
 
 // The frame texts of URDF, SDF and MJCF.
 std::string LinkFrameText(ExportFormat format, ExportFrame frame) {
-  if (frame == ExportFrame::kFrd) return "the body axes as measured, x forward, y right, z down (FRD)";
+  if (frame == ExportFrame::kFrd)
+    return "the body axes as measured, x forward, y right, z down (FRD)";
   return format == ExportFormat::kUrdf
              ? "the link frame as ROS REP 103 takes it, x forward, y left, z up (FLU)"
          : format == ExportFormat::kSdf
@@ -568,18 +567,21 @@ InertialOrigin DefaultOrigin(const ExportInertia& in, ExportFormat format, Expor
 
 std::string InertialBlock(const ExportInertia& in, ExportFormat format, ExportFrame frame,
                           const InertialOrigin& origin) {
-  const char* label = format == ExportFormat::kUrdf ? "URDF" : format == ExportFormat::kSdf ? "SDF" : "MJCF";
+  const char* label = format == ExportFormat::kUrdf  ? "URDF"
+                      : format == ExportFormat::kSdf ? "SDF"
+                                                     : "MJCF";
   RequireComplete(in, label);
   const std::array<double, 6> e = UrdfElements(in, frame);
-  const char* where = format == ExportFormat::kUrdf ? "the <origin>"
+  const char* where = format == ExportFormat::kUrdf  ? "the <origin>"
                       : format == ExportFormat::kSdf ? "the <pose>"
                                                      : "the inertial pos";
   const std::string origin_text =
       !origin.note.empty() ? origin.note
-      : in.cg.Given()      ? std::string(where) + " is that CG in this file's frame, " + Xyz(origin.xyz) + "."
-                           : std::string(where) + " is the link origin, 0 0 0.";
-  std::string s = XmlHeader(in, LinkFrameText(format, frame), LinkSignText(format, frame),
-                            origin_text);
+      : in.cg.Given()
+          ? std::string(where) + " is that CG in this file's frame, " + Xyz(origin.xyz) + "."
+          : std::string(where) + " is the link origin, 0 0 0.";
+  std::string s =
+      XmlHeader(in, LinkFrameText(format, frame), LinkSignText(format, frame), origin_text);
   if (format == ExportFormat::kUrdf) {
     s += "<inertial>\n";
     s += "  <origin xyz=\"" + Xyz(origin.xyz) + "\" rpy=\"0 0 0\"/>\n";
@@ -608,14 +610,16 @@ std::string InertialBlock(const ExportInertia& in, ExportFormat format, ExportFr
 }
 
 std::string FormatUrdfInertial(const ExportInertia& in, ExportFrame frame) {
-  return InertialBlock(in, ExportFormat::kUrdf, frame, DefaultOrigin(in, ExportFormat::kUrdf, frame));
+  return InertialBlock(in, ExportFormat::kUrdf, frame,
+                       DefaultOrigin(in, ExportFormat::kUrdf, frame));
 }
 
 std::string FormatSdfInertial(const ExportInertia& in, ExportFrame frame) {
   return InertialBlock(in, ExportFormat::kSdf, frame, DefaultOrigin(in, ExportFormat::kSdf, frame));
 }
 
-std::string FormatMjcfBody(const ExportInertia& in, ExportFrame frame, const std::string& body_name) {
+std::string FormatMjcfBody(const ExportInertia& in, ExportFrame frame,
+                           const std::string& body_name) {
   const std::string block =
       InertialBlock(in, ExportFormat::kMjcf, frame, DefaultOrigin(in, ExportFormat::kMjcf, frame));
   const size_t at = block.find("-->\n") + 4;  // the comment stays above the body
@@ -632,7 +636,8 @@ std::string FormatJsbsimMassBalance(const ExportInertia& in) {
                 "negated_crossproduct_inertia=\"true\": <ixy> etc. are the matrix elements, "
                 "-integral x y dm in the structural frame: ixy = +I_xy, ixz = -I_xz, iyz = +I_yz",
                 in.cg.Given() ? "the <location name=\"CG\"> is that CG in the structural frame "
-                                "(x aft, y right, z up), " + Xyz(origin.xyz) + "."
+                                "(x aft, y right, z up), " +
+                                    Xyz(origin.xyz) + "."
                               : "the <location name=\"CG\"> is 0 0 0 of the structural frame.");
   const auto element = [](const char* tag, double value) {
     return std::string("  <") + tag + " unit=\"KG*M2\"> " + Num(value) + " </" + tag + ">\n";
@@ -665,7 +670,8 @@ std::string FormatArdupilotFrame(const ExportInertia& in) {
   s += "    \"frame\": \"body FRD (x forward, y right, z down), about the CG; SITL's multicopter "
        "model takes its CG at the body origin\",\n";
   for (int k = 0; k < 3; ++k) {
-    s += std::string("    \"") + TensorComponentName(k) + "\": " + str(ComponentText(in, k)) + ",\n";
+    s +=
+        std::string("    \"") + TensorComponentName(k) + "\": " + str(ComponentText(in, k)) + ",\n";
   }
   const std::string dropped = DroppedProducts(in, ExportFormat::kArdupilot);
   s += "    \"dropped\": " + str(dropped) + ",\n";
@@ -704,8 +710,7 @@ std::string DroppedProducts(const ExportInertia& in, ExportFormat format) {
 
 std::string NonPhysicalRefusal(const ExportInertia& in, ExportFormat format, bool force) {
   if (in.nonphysical.empty() || force || format == ExportFormat::kCsv) return "";
-  return in.results_name + ": " + in.nonphysical + "; not written: a " +
-         ExportFormatName(format) +
+  return in.results_name + ": " + in.nonphysical + "; not written: a " + ExportFormatName(format) +
          " file must be physically valid (simulators refuse such a tensor or silently replace it;"
          " --force writes it anyway)";
 }
@@ -747,8 +752,8 @@ std::string FormatInertiaCsv(const ExportInertia& in) {
   }
   for (int a = 0; a < 6; ++a) {
     for (int b = a; b < 6; ++b) {
-      header += ",cov_" + std::string(TensorComponentName(a)) + "_" + TensorComponentName(b) +
-                "_kg2_m4";
+      header +=
+          ",cov_" + std::string(TensorComponentName(a)) + "_" + TensorComponentName(b) + "_kg2_m4";
       row += "," + CsvNum(in.covariance_kg2_m4[a][b]);
     }
   }
@@ -773,8 +778,8 @@ namespace {
 std::string FreeBackupName(const std::string& path) {
   std::error_code ec;
   std::string name = path + ".bak";
-  for (int i = 1; std::filesystem::symlink_status(name, ec).type() !=
-                      std::filesystem::file_type::not_found;
+  for (int i = 1;
+       std::filesystem::symlink_status(name, ec).type() != std::filesystem::file_type::not_found;
        ++i) {
     name = path + ".bak." + std::to_string(i);
   }
@@ -858,10 +863,10 @@ int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err
               ? "the mass written (" + Num(in.mass_kg) + " kg) is from " + in.mass_source + ", and "
               : std::string())
       << "the inertia is about the CG, which the "
-      << (options.format == ExportFormat::kCsv ? "CSV does not locate"
+      << (options.format == ExportFormat::kCsv         ? "CSV does not locate"
           : options.format == ExportFormat::kArdupilot ? "ArduPilot SITL takes at the body origin"
-          : in.cg.Given() ? "file puts at aircraft.cg_m of the config"
-                          : "file puts at its origin")
+          : in.cg.Given()                              ? "file puts at aircraft.cg_m of the config"
+                                                       : "file puts at its origin")
       << "\n";
   if (options.out_path.empty()) {
     out << body;

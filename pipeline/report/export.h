@@ -36,9 +36,10 @@
 //   "moment_inertia" ([x, y, z], body FRD, kg m^2) and ignores every other key; a zero component
 //   makes it estimate all three from mass and diagonal_size. It holds no products: export names
 //   the products it drops and their size against the diagonal.
-// - Mass: results.json `aircraft.mass_kg` (older files: the stored config; or --mass-kg); CG: the origin
-//   of the link (URDF/SDF) or of the structural frame (JSBSim). The bifilar measures neither the
-//   mass nor the CG: the files say so, and the CG must be moved to where it was measured.
+// - Mass: results.json `aircraft.mass_kg` (older files: the stored config; or --mass-kg); CG:
+//   aircraft.cg_m of the stored config (body FRD, from the model origin) in each file's frame,
+//   else the origin of the link (URDF/SDF/MJCF) or of the structural frame (JSBSim). The bifilar
+//   measures neither the mass nor the CG: the files say so.
 #pragma once
 
 #include <array>
@@ -179,8 +180,7 @@ std::string NonPhysicalRefusal(const ExportInertia& inertia, ExportFormat format
 // or is there twice, or its inertial was not written by export and `force` is false.
 std::string RewriteModelInertial(const std::string& model, const std::string& model_name,
                                  const std::string& link, const ExportInertia& inertia,
-                                 ExportFrame frame, bool force,
-                                 std::vector<std::string>* warnings);
+                                 ExportFrame frame, bool force, std::vector<std::string>* warnings);
 // The format of a model's text: its root element (robot: urdf, sdf: sdf, mujoco: mjcf); false
 // for any other.
 bool DetectModelFormat(const std::string& model, ExportFormat* format);

@@ -19,11 +19,11 @@ namespace {
 // One element of the scanned document: byte offsets into the text.
 struct XmlElement {
   std::string name;
-  size_t begin = 0;      // its '<'
-  size_t open_end = 0;   // just after the '>' of its start tag
-  size_t end = 0;        // just after its end tag (== open_end when self-closing)
-  int parent = -1;       // index in the element list; -1 for the root
-  std::string start_tag; // the start tag's text, "<name a="1">"
+  size_t begin = 0;       // its '<'
+  size_t open_end = 0;    // just after the '>' of its start tag
+  size_t end = 0;         // just after its end tag (== open_end when self-closing)
+  int parent = -1;        // index in the element list; -1 for the root
+  std::string start_tag;  // the start tag's text, "<name a="1">"
 };
 
 struct XmlScan {
@@ -141,7 +141,8 @@ bool Numbers(const std::string& text, size_t n, std::vector<double>* out) {
 // The element of `scan` that is a direct child of `parent` named `tag` (-1: none).
 int Child(const XmlScan& scan, int parent, const std::string& tag) {
   for (size_t k = 0; k < scan.elements.size(); ++k) {
-    if (scan.elements[k].parent == parent && scan.elements[k].name == tag) return static_cast<int>(k);
+    if (scan.elements[k].parent == parent && scan.elements[k].name == tag)
+      return static_cast<int>(k);
   }
   return -1;
 }
@@ -154,8 +155,9 @@ InertialOrigin KeptOrigin(const std::string& text, const XmlScan& scan, int iner
   InertialOrigin o;
   o.note = "the inertial position is the model's own, kept as it was (no aircraft.cg_m given).";
   if (inertial < 0) {
-    o.note = "the inertial position is the link origin, 0 0 0 (the model had no inertial and no "
-             "aircraft.cg_m was given).";
+    o.note =
+        "the inertial position is the link origin, 0 0 0 (the model had no inertial and no "
+        "aircraft.cg_m was given).";
     return o;
   }
   std::vector<double> v;
@@ -180,7 +182,8 @@ InertialOrigin KeptOrigin(const std::string& text, const XmlScan& scan, int iner
     if (pose >= 0) {
       const XmlElement& e = scan.elements[pose];
       const size_t close = text.rfind('<', e.end - 1);
-      const std::string inner = close > e.open_end ? text.substr(e.open_end, close - e.open_end) : "";
+      const std::string inner =
+          close > e.open_end ? text.substr(e.open_end, close - e.open_end) : "";
       if (Numbers(inner, 6, &v)) {
         o.xyz = {v[0], v[1], v[2]};
         rotated = v[3] != 0 || v[4] != 0 || v[5] != 0;
@@ -194,7 +197,8 @@ InertialOrigin KeptOrigin(const std::string& text, const XmlScan& scan, int iner
     }
   }
   if (rotated) {
-    warnings->push_back(where + ": the model's inertial frame was rotated; the measured tensor "
+    warnings->push_back(where +
+                        ": the model's inertial frame was rotated; the measured tensor "
                         "is written in the link's own axes, so the rotation is dropped");
   }
   return o;
@@ -229,10 +233,14 @@ bool DetectModelFormat(const std::string& model, ExportFormat* format) {
     return false;
   }
   const std::string& root = scan.elements[0].name;
-  if (root == "robot") *format = ExportFormat::kUrdf;
-  else if (root == "sdf") *format = ExportFormat::kSdf;
-  else if (root == "mujoco") *format = ExportFormat::kMjcf;
-  else return false;
+  if (root == "robot")
+    *format = ExportFormat::kUrdf;
+  else if (root == "sdf")
+    *format = ExportFormat::kSdf;
+  else if (root == "mujoco")
+    *format = ExportFormat::kMjcf;
+  else
+    return false;
   return true;
 }
 
@@ -288,23 +296,24 @@ std::string RewriteModelInertial(const std::string& model, const std::string& mo
     }
   }
   if (!ours && !force) {
-    throw UserError("export --into: " + where +
-                    (inertial >= 0 ? "'s <inertial> was not written by bifilar export"
-                                   : " has no <inertial>") +
-                    "; add --force to replace it (the file as it was is kept as a backup)");
+    throw UserError(
+        "export --into: " + where +
+        (inertial >= 0 ? "'s <inertial> was not written by bifilar export" : " has no <inertial>") +
+        "; add --force to replace it (the file as it was is kept as a backup)");
   }
   if (format == ExportFormat::kMjcf) {
     for (const XmlElement& e : scan.elements) {
       std::string v;
       if (e.name == "compiler" && Attribute(e.start_tag, "inertiafromgeom", &v) && v == "true") {
-        warnings->push_back(model_name + ": <compiler inertiafromgeom=\"true\"> makes MuJoCo "
+        warnings->push_back(model_name +
+                            ": <compiler inertiafromgeom=\"true\"> makes MuJoCo "
                             "compute every body's inertia from its geoms and ignore <inertial>");
       }
     }
   }
-  const InertialOrigin origin =
-      inertia.cg.Given() ? DefaultOrigin(inertia, format, frame)
-                         : KeptOrigin(model, scan, inertial, format, where, warnings);
+  const InertialOrigin origin = inertia.cg.Given()
+                                    ? DefaultOrigin(inertia, format, frame)
+                                    : KeptOrigin(model, scan, inertial, format, where, warnings);
   const std::string block = InertialBlock(inertia, format, frame, origin);
   if (inertial >= 0) {
     return model.substr(0, begin) + Indented(block, LineIndent(model, begin)) + model.substr(end);

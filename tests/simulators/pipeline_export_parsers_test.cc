@@ -16,6 +16,7 @@
 // convention JSBSim documents.
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
+#include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Dense>
 #include <cmath>
@@ -24,7 +25,6 @@
 #include <sdf/sdf.hh>
 #include <sstream>
 #include <string>
-#include <urdf_parser/urdf_parser.h>
 #include <vector>
 
 #include "base/user_error.h"
@@ -106,9 +106,9 @@ std::vector<Truth> Truths() {
   }
   for (int i = 0; i < 30; ++i) {  // random principal moments and axes; a few scaled to a drone
     const double scale = i % 3 == 0 ? 0.01 : i % 3 == 1 ? 1.0 : 50.0;
-    Truth t{"random " + std::to_string(i),
-            FromPrincipal(scale * Eigen::Vector3d(moment(rng), moment(rng), moment(rng)),
-                          rotation())};
+    Truth t{
+        "random " + std::to_string(i),
+        FromPrincipal(scale * Eigen::Vector3d(moment(rng), moment(rng), moment(rng)), rotation())};
     if (i % 2 == 0) {
       t.cg = true;
       t.cg_m = {0.1 * axis(rng), 0.05 * axis(rng), 0.02 * axis(rng)};
@@ -133,8 +133,11 @@ std::string ResultsJson(const Truth& t) {
       << "  cg_std_m: [0.001, 0.001, 0.002]\n";
     config += s.str();
   }
-  json j = {{"program", "bifilar"}, {"version", "0.3.0"}, {"config_file", "configs/x500.yaml"},
-            {"config", config}, {"tensor", tensor},
+  json j = {{"program", "bifilar"},
+            {"version", "0.3.0"},
+            {"config_file", "configs/x500.yaml"},
+            {"config", config},
+            {"tensor", tensor},
             {"total_uncertainty", {{"common_mode_relative_std", 0.002}}}};
   return j.dump(2);
 }
@@ -172,7 +175,8 @@ Parsed FromUrdfLink(const urdf::LinkConstSharedPtr& link) {
 
 Parsed ParseUrdf(const std::string& xml, const std::string& link) {
   const urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(xml);
-  if (!model) return Parsed{Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero(), NAN, "parseURDF failed"};
+  if (!model)
+    return Parsed{Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero(), NAN, "parseURDF failed"};
   const urdf::LinkConstSharedPtr l = model->getLink(link);
   if (!l) return Parsed{Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero(), NAN, "no link " + link};
   return FromUrdfLink(l);
@@ -257,10 +261,10 @@ TEST(ExportParsers, EveryTensorReadBackByUrdfdomSdformatAndMujoco) {
       const Parsed urdf = ParseUrdf("<robot name=\"r\">\n<link name=\"base_link\">\n" +
                                         FormatUrdfInertial(in, frame) + "</link>\n</robot>\n",
                                     "base_link");
-      const Parsed sdf = ParseSdf(
-          "<sdf version=\"1.9\">\n<model name=\"m\">\n<link name=\"base_link\">\n" +
-              FormatSdfInertial(in, frame) + "</link>\n</model>\n</sdf>\n",
-          "m", "base_link");
+      const Parsed sdf =
+          ParseSdf("<sdf version=\"1.9\">\n<model name=\"m\">\n<link name=\"base_link\">\n" +
+                       FormatSdfInertial(in, frame) + "</link>\n</model>\n</sdf>\n",
+                   "m", "base_link");
       const Parsed mjcf = ParseMjcf(
           "<mujoco>\n<worldbody>\n" + FormatMjcfBody(in, frame) + "</worldbody>\n</mujoco>\n",
           "aircraft", dir);
@@ -279,9 +283,10 @@ TEST(ExportParsers, EveryTensorReadBackByUrdfdomSdformatAndMujoco) {
     }
   }
   // The measure of issue 35, printed for the note: the worst relative error of each parser.
-  std::printf("export parsers: %zu tensors x 2 frames, %d loads; worst |parsed - truth| / largest "
-              "moment: urdf %.2e, sdf %.2e, mjcf %.2e\n",
-              truths.size(), loaded, worst[0], worst[1], worst[2]);
+  std::printf(
+      "export parsers: %zu tensors x 2 frames, %d loads; worst |parsed - truth| / largest "
+      "moment: urdf %.2e, sdf %.2e, mjcf %.2e\n",
+      truths.size(), loaded, worst[0], worst[1], worst[2]);
 }
 
 TEST(ExportParsers, ArdupilotFrameJsonHoldsTheDiagonalUnderItsOwnKeys) {
@@ -330,10 +335,11 @@ TEST(ExportParsers, ANonPhysicalTensorIsRefusedByTheParsersToo) {
 // by each parser: the simulator gets the truth, the CG of the config and the mass.
 TEST(ExportParsers, ACampaignReachesEachSimulatorWithItsTensorMassAndCg) {
   TempDir dir("bifilar_export_campaign");
-  const Truth truth{"campaign", {0.20, 0.30, 0.45, 0.008, -0.010, -0.009}, {0.03, -0.01, 0.02}, true};
-  const std::vector<std::array<double, 2>> attitudes = {
-      {0, 0}, {0, 45}, {0, -45}, {0, -90}, {45, 0}, {-45, 0},
-      {90, 0}, {45, 45}, {-45, 45}, {45, -45}, {-45, -45}, {90, 45}};
+  const Truth truth{
+      "campaign", {0.20, 0.30, 0.45, 0.008, -0.010, -0.009}, {0.03, -0.01, 0.02}, true};
+  const std::vector<std::array<double, 2>> attitudes = {{0, 0},    {0, 45},   {0, -45},   {0, -90},
+                                                        {45, 0},   {-45, 0},  {90, 0},    {45, 45},
+                                                        {-45, 45}, {45, -45}, {-45, -45}, {90, 45}};
   std::string table = "path,roll_deg,pitch_deg\n";
   int k = 0;
   for (const auto& a : attitudes) {
@@ -348,12 +354,12 @@ TEST(ExportParsers, ACampaignReachesEachSimulatorWithItsTensorMassAndCg) {
     }
   }
   WriteFile(dir.path + "/runs.csv", table);
-  const std::string config = WriteFile(
-      dir.path + "/campaign.yaml",
-      "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: "
-      "{inertia_kg_m2: 0.02}}\naircraft: {mass_kg: 2.0, cg_m: [0.03, -0.01, 0.02], "
-      "cg_std_m: [0.001, 0.001, 0.002]}\nruns: {root: logs, table: runs.csv}\n"
-      "ellipse: {bootstrap: 0}\n");
+  const std::string config =
+      WriteFile(dir.path + "/campaign.yaml",
+                "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: "
+                "{inertia_kg_m2: 0.02}}\naircraft: {mass_kg: 2.0, cg_m: [0.03, -0.01, 0.02], "
+                "cg_std_m: [0.001, 0.001, 0.002]}\nruns: {root: logs, table: runs.csv}\n"
+                "ellipse: {bootstrap: 0}\n");
   CampaignOptions options;
   options.out_dir = dir.path + "/out";
   options.jobs = 2;
@@ -392,7 +398,8 @@ TEST(ExportParsers, ACampaignReachesEachSimulatorWithItsTensorMassAndCg) {
       // The fit recovers the truth to 1e-9 kg m^2 (exact means), the files add 5e-10 relative.
       EXPECT_LE(MaxDiff(parsed[f].j, MatrixIn(truth, frame)) / Largest(truth),
                 f == 2 ? kMujocoRelTol : 1e-8)
-          << f << "\n" << parsed[f].j;
+          << f << "\n"
+          << parsed[f].j;
       EXPECT_LE((parsed[f].cg - CgIn(truth, frame)).cwiseAbs().maxCoeff(), 1e-12) << f;
       EXPECT_EQ(parsed[f].mass, 2.0) << f;
     }
@@ -620,20 +627,29 @@ const char kQuadMjcfBlock[] =
     R"(<inertial pos="0 0 0" mass="0.8" diaginertia="0.005 0.005 0.009"/>)";
 
 struct ModelCase {
-  const char* file;     // name written in the temp folder
-  const char* text;     // the model as shipped
-  const char* block;    // the inertial block of `link` in it
+  const char* file;   // name written in the temp folder
+  const char* text;   // the model as shipped
+  const char* block;  // the inertial block of `link` in it
   const char* link;
   ExportFormat format;
   std::vector<std::string> others;  // other links whose inertia must not change
 };
 
 std::vector<ModelCase> Models() {
-  return {{"model.sdf", kX500Sdf, kX500Block, "base_link", ExportFormat::kSdf, {"rotor_0", "rotor_1"}},
-          {"quad.urdf", kQuadUrdf, kQuadBlock, "base_link", ExportFormat::kUrdf,
-           {"arm_front_right", "camera_link"}},
-          {"quad.xml", kQuadMjcf, kQuadMjcfBlock, "frame", ExportFormat::kMjcf,
-           {"rotor_fl", "payload", "rotor_br"}}};
+  return {
+      {"model.sdf", kX500Sdf, kX500Block, "base_link", ExportFormat::kSdf, {"rotor_0", "rotor_1"}},
+      {"quad.urdf",
+       kQuadUrdf,
+       kQuadBlock,
+       "base_link",
+       ExportFormat::kUrdf,
+       {"arm_front_right", "camera_link"}},
+      {"quad.xml",
+       kQuadMjcf,
+       kQuadMjcfBlock,
+       "frame",
+       ExportFormat::kMjcf,
+       {"rotor_fl", "payload", "rotor_br"}}};
 }
 
 Parsed ParseModel(const ModelCase& c, const std::string& text, const std::string& link,
@@ -646,7 +662,10 @@ Parsed ParseModel(const ModelCase& c, const std::string& text, const std::string
 TEST(ExportInto, RewritesOneInertialBlockAndLeavesEveryOtherByte) {
   TempDir dir("bifilar_export_into");
   // A full tensor with products of both signs and a CG, FLU (the models' frames).
-  Truth t{"x500 measured", {0.0231, 0.0252, 0.0431, 0.0004, -0.0011, 0.0002}, {0.004, -0.001, 0.012}, true};
+  Truth t{"x500 measured",
+          {0.0231, 0.0252, 0.0431, 0.0004, -0.0011, 0.0002},
+          {0.004, -0.001, 0.012},
+          true};
   const std::string results = WriteFile(dir.path + "/out/results.json", ResultsJson(t));
   for (const ModelCase& c : Models()) {
     SCOPED_TRACE(c.file);
@@ -717,9 +736,8 @@ TEST(ExportInto, KeepsTheModelsCgWhenNoneIsGivenAndNamesWhatIsWrong) {
   Truth t{"no cg", {0.0231, 0.0252, 0.0431, 0.0004, -0.0011, 0.0002}};
   const ModelCase c = Models()[1];  // the URDF: base_link's origin is 0.002 0 -0.01
   std::vector<std::string> warnings;
-  const std::string text =
-      RewriteModelInertial(c.text, "quad.urdf", "base_link", Inertia(t), ExportFrame::kFlu, true,
-                           &warnings);
+  const std::string text = RewriteModelInertial(c.text, "quad.urdf", "base_link", Inertia(t),
+                                                ExportFrame::kFlu, true, &warnings);
   const Parsed p = ParseUrdf(text, "base_link");
   ASSERT_EQ(p.error, "");
   EXPECT_LE((p.cg - Eigen::Vector3d(0.002, 0, -0.01)).cwiseAbs().maxCoeff(), 1e-12);
