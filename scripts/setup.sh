@@ -14,6 +14,7 @@ packages=(cmake g++ make pkg-config libeigen3-dev libsundials-dev libceres-dev l
           libyaml-cpp-dev libcli11-dev libplplot-dev plplot-driver-cairo libfast-float-dev
           nlohmann-json3-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev
           pybind11-dev python3-dev python3-numpy python3-pytest
+          liburdfdom-dev libsdformat-dev libmujoco-dev
           python3-pip python3-setuptools python3-wheel python3-venv)
 missing=()
 for p in "${packages[@]}"; do

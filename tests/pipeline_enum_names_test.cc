@@ -81,7 +81,8 @@ TEST(EnumNames, EveryTableReadsBackAndListsWhatItParses) {
                               [](PitchSource v) { return ToString(v); }, ParsePitchSource,
                               PitchSourceAllowedValues());
   ExpectOneTable<ExportFormat>(
-      {ExportFormat::kUrdf, ExportFormat::kSdf, ExportFormat::kJsbsim, ExportFormat::kCsv},
+      {ExportFormat::kUrdf, ExportFormat::kSdf, ExportFormat::kJsbsim, ExportFormat::kCsv,
+       ExportFormat::kMjcf, ExportFormat::kArdupilot},
       ExportFormatName, ParseExportFormat, ExportFormatAllowedValues());
   ExpectOneTable<IntegratorMethod>({IntegratorMethod::kRungeKutta, IntegratorMethod::kCvodes},
                                    [](IntegratorMethod v) { return ToString(v); },

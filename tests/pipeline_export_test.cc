@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "base/user_error.h"
+#include "base/version.h"
 #include "pipeline/report/export.h"
 #include "test_support.h"
 
@@ -93,6 +94,13 @@ TEST(ExportWorkedExample, Sdf) {
 }
 
 TEST(ExportWorkedExample, Jsbsim) {
+  // JSBSim has no packaged parser to load this in a test; its convention is documented in
+  // JSBSim's own source, the class comment of FGMassBalance (src/models/FGMassBalance.h: the
+  // <mass_balance> element, <ixx> .. <iyz>, and the attribute negated_crossproduct_inertia,
+  // default "true") and implemented in FGMassBalance::Load (src/models/FGMassBalance.cpp), which
+  // reads the elements in the structural frame and builds the body-axes matrix shown below; the
+  // JSBSim Reference Manual's mass_balance section says the same. The point-mass test below
+  // computes each element from that definition.
   // JSBSim's structural frame: x_s = -x, y_s = y, z_s = -z. negated_crossproduct_inertia="true":
   // <ixy> = -integral x_s y_s dm = +I_xy = 0.08, <ixz> = -integral x_s z_s dm = -I_xz = -0.12,
   // <iyz> = -integral y_s z_s dm = +I_yz = -0.06. Its loader builds the body matrix
@@ -116,19 +124,67 @@ TEST(ExportWorkedExample, Jsbsim) {
 }
 
 TEST(ExportWorkedExample, Csv) {
-  // The CSV keeps results.json's own convention (body FRD, products positive) and the stds.
-  const std::string csv = FormatInertiaCsv(Example());
+  // The CSV keeps results.json's own convention (body FRD, products positive) and the stds; then
+  // the total stds, the full covariance (upper triangle), the CG and the provenance.
+  ExportOptions o;
+  o.date_utc = "2026-11-28T12:00:00Z";
+  const std::string csv = FormatInertiaCsv(Example(o));
   const std::string row = csv.substr(csv.find('\n') + 1);
-  EXPECT_EQ(row,
-            "example.json,tensor,body FRD (x forward y right z down) products +integral x y dm,"
-            "1.25,0.01,config aircraft.mass_kg,"
-            "2,0.002,measured,3,0.003,measured,4.5,0.004,measured,"
-            "0.08,0.001,measured,0.12,0.0015,measured,-0.06,0.0012,measured\n");
-  EXPECT_EQ(csv.substr(0, csv.find('\n')),
-            "results_file,section,frame,mass_kg,mass_std_kg,mass_source,"
-            "Ixx_kg_m2,Ixx_std_kg_m2,Ixx_source,Iyy_kg_m2,Iyy_std_kg_m2,Iyy_source,"
-            "Izz_kg_m2,Izz_std_kg_m2,Izz_source,Ixy_kg_m2,Ixy_std_kg_m2,Ixy_source,"
-            "Ixz_kg_m2,Ixz_std_kg_m2,Ixz_source,Iyz_kg_m2,Iyz_std_kg_m2,Iyz_source");
+  const std::string values =
+      "example.json,tensor,body FRD (x forward y right z down) products +integral x y dm,"
+      "1.25,0.01,config aircraft.mass_kg,"
+      "2,0.002,measured,3,0.003,measured,4.5,0.004,measured,"
+      "0.08,0.001,measured,0.12,0.0015,measured,-0.06,0.0012,measured,";
+  EXPECT_EQ(row.substr(0, values.size()), values);
+  // No total_uncertainty, covariance or CG in this results.json: empty; then the provenance.
+  EXPECT_EQ(row.substr(values.size()), std::string(6 + 21 + 6 - 1, ',') + ",0.2.0,," +
+                                           ProgramVersion() + ",2026-11-28T12:00:00Z\n");
+  const std::string header = csv.substr(0, csv.find('\n'));
+  EXPECT_EQ(header.rfind("results_file,section,frame,mass_kg,mass_std_kg,mass_source,"
+                         "Ixx_kg_m2,Ixx_std_kg_m2,Ixx_source,Iyy_kg_m2,Iyy_std_kg_m2,Iyy_source,"
+                         "Izz_kg_m2,Izz_std_kg_m2,Izz_source,Ixy_kg_m2,Ixy_std_kg_m2,Ixy_source,"
+                         "Ixz_kg_m2,Ixz_std_kg_m2,Ixz_source,Iyz_kg_m2,Iyz_std_kg_m2,Iyz_source,"
+                         "Ixx_total_std_kg_m2,",
+                         0),
+            0u)
+      << header;
+  EXPECT_NE(header.find(",cov_Ixx_Ixx_kg2_m4,cov_Ixx_Iyy_kg2_m4,"), std::string::npos);
+  EXPECT_NE(header.find(",cov_Ixz_Iyz_kg2_m4,cov_Iyz_Iyz_kg2_m4,cg_x_m,"), std::string::npos);
+  EXPECT_NE(header.find(",results_version,campaign,export_version,date_utc"), std::string::npos);
+}
+
+TEST(ExportWorkedExample, Mjcf) {
+  // MJCF fullinertia = "ixx iyy izz ixy ixz iyz", the matrix elements in the body frame (FLU by
+  // default): the same numbers as URDF's, in MuJoCo's order.
+  EXPECT_EQ(AfterComment(FormatMjcfBody(Example(), ExportFrame::kFlu)),
+            "<body name=\"aircraft\">\n"
+            "  <inertial pos=\"0 0 0\" mass=\"1.25\" fullinertia=\"2 3 4.5 0.08 0.12 0.06\"/>\n"
+            "</body>\n");
+  EXPECT_NE(
+      FormatMjcfBody(Example(), ExportFrame::kFrd).find("fullinertia=\"2 3 4.5 -0.08 -0.12 0.06\""),
+      std::string::npos);
+}
+
+TEST(ExportWorkedExample, ArdupilotKeepsTheDiagonalAndNamesTheProductsItDrops) {
+  // SIM_Frame.cpp reads "mass" and "moment_inertia" (body FRD); the rest is ignored by SITL.
+  const std::string text = FormatArdupilotFrame(Example());
+  const json j = json::parse(text);
+  EXPECT_EQ(j["mass"].get<double>(), 1.25);
+  EXPECT_EQ(j["moment_inertia"], json({2.0, 3.0, 4.5}));
+  EXPECT_EQ(text.rfind("{\n  \"bifilar_export\": ", 0), 0u) << text;
+  // |Ixy| / sqrt(Ixx Iyy) = 0.08 / sqrt(6) = 3.27 %, 0.12 / sqrt(9) = 4 %, 0.06 / sqrt(13.5) =
+  // 1.63 %.
+  const std::string dropped = DroppedProducts(Example(), ExportFormat::kArdupilot);
+  EXPECT_NE(dropped.find("Ixy = 0.08 kg m^2 (3.27 % of sqrt(Ixx Iyy))"), std::string::npos)
+      << dropped;
+  EXPECT_NE(dropped.find("Ixz = 0.12 kg m^2 (4 % of sqrt(Ixx Izz))"), std::string::npos);
+  EXPECT_NE(dropped.find("Iyz = -0.06 kg m^2 (1.63 % of sqrt(Iyy Izz))"), std::string::npos);
+  EXPECT_EQ(j["bifilar_export"]["dropped"].get<std::string>(), dropped);
+  // Every other format holds the products: no warning.
+  for (ExportFormat f : {ExportFormat::kUrdf, ExportFormat::kSdf, ExportFormat::kJsbsim,
+                         ExportFormat::kMjcf, ExportFormat::kCsv}) {
+    EXPECT_EQ(DroppedProducts(Example(), f), "");
+  }
 }
 
 // The attribute values of `tag` in `xml` (URDF) or the element texts (SDF, JSBSim), as numbers.
@@ -382,10 +438,18 @@ TEST(ExportCli, WritesEachFormatAndRefusesBadInputNamingTheFile) {
       {"export " + other + " --format csv", other + ": not a results.json written by bifilar"},
       {"export " + empty + " --format csv", empty + ": holds no inertia to export"},
       {"export " + dir.path + "/missing.json --format csv", "missing.json: cannot open"},
-      {"export " + results + " --format stl", "--format must be urdf, sdf, jsbsim or csv"},
-      {"export " + results + " --format jsbsim --frame flu", "--frame applies to urdf and sdf"},
+      {"export " + results + " --format stl",
+       "--format must be urdf, sdf, jsbsim, csv, mjcf or ardupilot"},
+      {"export " + results + " --format jsbsim --frame flu",
+       "--frame applies to urdf, sdf and mjcf"},
+      {"export " + results + " --format ardupilot --frame frd",
+       "--frame applies to urdf, sdf and mjcf"},
+      {"export " + results + " --format urdf --into " + dir.path + "/m.urdf",
+       "given together (--into MODEL --link NAME)"},
+      {"export " + results + " --format jsbsim --into m.xml --link a", "urdf, sdf or mjcf"},
       {"export " + results + " --format urdf --set Ixx=1", "--set Ixx: " + results + " measured"},
-      {"export " + results + " --format urdf --set Ixq=1", "--set = \"Ixq\"; must be Ixx, Iyy, Izz, Ixy, Ixz or Iyz (unknown component)"},
+      {"export " + results + " --format urdf --set Ixq=1",
+       "--set = \"Ixq\"; must be Ixx, Iyy, Izz, Ixy, Ixz or Iyz (unknown component)"},
       {"export " + results + " --format urdf --set Iyy", "expected NAME=VALUE"},
       {"export " + no_mass + " --format urdf", no_mass + ": URDF needs the mass"},
   };
@@ -412,6 +476,150 @@ TEST(ExportCli, WritesEachFormatAndRefusesBadInputNamingTheFile) {
   r = Bifilar(dir, "export " + no_mass + " --format csv");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find(",,,missing,2,"), std::string::npos) << r.out;
+}
+
+// issue 35 item 7: a tensor that is not physical is refused by every simulator format with the
+// one message (NonPhysicalRefusal), nothing written; --force writes it, the numbers as they are
+// (never zeroed), and the warning stays.
+TEST(ExportRefusal, EveryFormatRefusesANonPhysicalTensorWithOneMessage) {
+  TempDir dir("bifilar_export_refusal");
+  // Principal moments 1, 1, 3: 3 > 1 + 1 breaks the triangle inequality.
+  const std::string bad =
+      WriteFile(dir.path + "/bad.json", TensorResults({1, 1, 3, 0, 0, 0}, {0, 0, 0, 0, 0, 0}));
+  const std::string expected_tail =
+      ": the principal moments 1, 1, 3 kg m^2 break the triangle inequality (largest > sum of "
+      "the others): no rigid body has them; check the products; not written: a ";
+  const std::string expected_end =
+      " file must be physically valid (simulators refuse such a tensor or silently replace it; "
+      "--force writes it anyway)\n";
+  for (const char* format : {"urdf", "sdf", "jsbsim", "mjcf", "ardupilot"}) {
+    SCOPED_TRACE(format);
+    const std::string out = dir.path + "/bad." + format;
+    CliRun r = Bifilar(dir, "export " + bad + " --format " + format + " --out " + out);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.err, "bifilar: error: " + bad + expected_tail + format + expected_end);
+    EXPECT_FALSE(std::filesystem::exists(out));
+    r = Bifilar(dir, "export " + bad + " --format " + format + " --force");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: " + bad + ": the principal moments 1, 1, 3"), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.out.find("3"), std::string::npos);
+  }
+  // The same function for --into, and the CSV (not a simulator's) carries the warning instead.
+  ExportOptions o;
+  o.results_path = bad;
+  const ExportInertia in = ReadExportInertia(ReadFile(bad), bad, o);
+  EXPECT_EQ(NonPhysicalRefusal(in, ExportFormat::kSdf, false),
+            bad + expected_tail + "sdf" + expected_end.substr(0, expected_end.size() - 1));
+  EXPECT_EQ(NonPhysicalRefusal(in, ExportFormat::kSdf, true), "");
+  EXPECT_EQ(NonPhysicalRefusal(in, ExportFormat::kCsv, false), "");
+  EXPECT_EQ(NonPhysicalRefusal(Example(), ExportFormat::kUrdf, false), "");
+  const std::string model =
+      WriteFile(dir.path + "/m.urdf", "<robot name=\"r\"><link name=\"a\"></link></robot>\n");
+  const CliRun r =
+      Bifilar(dir, "export " + bad + " --format urdf --into " + model + " --link a --force");
+  EXPECT_EQ(r.exit_code, 0) << r.err;  // --force: written
+  const CliRun refused =
+      Bifilar(dir, "export " + bad + " --format urdf --into " + model + " --link a");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_EQ(refused.err, "bifilar: error: " + bad + expected_tail + "urdf" + expected_end);
+}
+
+// issue 35 items 5 and 6: the CG of the config (aircraft.cg_m, body FRD) is written as each
+// format's inertial origin in its own frame; every file carries stat and total std and the
+// provenance.
+TEST(ExportCg, ConfigCgIsTheInertialOriginInEachFormatsFrame) {
+  json j = json::parse(TensorResults(
+      kExample, kExampleStd,
+      "aircraft:\n  mass_kg: 1.25\n  cg_m: [0.1, -0.02, 0.03]\n  cg_std_m: [0.001, 0.001, "
+      "0.002]\n"));
+  j["config_file"] = "configs/x500.yaml";
+  j["total_uncertainty"] = {{"common_mode_relative_std", 0.01}};
+  ExportOptions o;
+  o.results_path = "r.json";
+  o.date_utc = "2026-11-28T12:00:00Z";
+  const ExportInertia in = ReadExportInertia(j.dump(), "r.json", o);
+  ASSERT_TRUE(in.cg.Given());
+  // FLU (x, -y, -z): 0.1 0.02 -0.03; FRD as measured; JSBSim structural (-x, y, -z).
+  EXPECT_NE(FormatUrdfInertial(in, ExportFrame::kFlu).find("<origin xyz=\"0.1 0.02 -0.03\""),
+            std::string::npos);
+  EXPECT_NE(FormatUrdfInertial(in, ExportFrame::kFrd).find("<origin xyz=\"0.1 -0.02 0.03\""),
+            std::string::npos);
+  EXPECT_NE(FormatSdfInertial(in, ExportFrame::kFlu).find("<pose>0.1 0.02 -0.03 0 0 0</pose>"),
+            std::string::npos);
+  EXPECT_NE(FormatMjcfBody(in, ExportFrame::kFlu).find("<inertial pos=\"0.1 0.02 -0.03\""),
+            std::string::npos);
+  const std::string jsb = FormatJsbsimMassBalance(in);
+  EXPECT_NE(jsb.find("<x> -0.1 </x>\n    <y> -0.02 </y>\n    <z> -0.03 </z>"), std::string::npos)
+      << jsb;
+  // Stat and total std (sqrt(0.002^2 + (0.01 * 2)^2) = 0.0201 for Ixx) and the provenance.
+  const std::string urdf = FormatUrdfInertial(in, ExportFrame::kFlu);
+  EXPECT_NE(urdf.find("Ixx 2 +- 0.002 (stat) +- 0.02009975124 (total)"), std::string::npos) << urdf;
+  EXPECT_NE(urdf.find("Provenance: bifilar " + std::string(ProgramVersion()) +
+                      " (results.json written by bifilar 0.2.0), campaign configs/x500.yaml, "
+                      "exported 2026-11-28T12:00:00Z"),
+            std::string::npos)
+      << urdf;
+  EXPECT_NE(urdf.find("+- 0.001 0.001 0.002 m"), std::string::npos);
+  const std::string csv = FormatInertiaCsv(in);
+  EXPECT_NE(csv.find(",0.1,-0.02,0.03,0.001,0.001,0.002,0.2.0,configs/x500.yaml,"),
+            std::string::npos)
+      << csv;
+  // A CG that is not 3 numbers: the config names the key and line.
+  try {
+    ReadAircraftCgText("aircraft:\n  mass_kg: 1\n  cg_m: [0.1, 0.2]\n", "c.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("c.yaml:3:9: 'aircraft.cg_m' must be a list of 3 numbers"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(ReadAircraftCgText("aircraft:\n  cg_m: [0, 0, 0]\n  cg_std_m: [0, -1, 0]\n", "c"),
+               UserError);
+  EXPECT_THROW(ReadAircraftCgText("aircraft:\n  cg_std_m: [0, 1, 0]\n", "c"), UserError);
+  EXPECT_FALSE(ReadAircraftCgText("aircraft:\n  mass_kg: 1\n", "c").Given());
+}
+
+// --into through the real binary: refused without --force on a model export did not write,
+// then a backup beside the model, never replacing one that exists.
+TEST(ExportCli, IntoRewritesALinkKeepsABackupAndRefusesWithoutForce) {
+  TempDir dir("bifilar_export_into_cli");
+  const std::string results =
+      WriteFile(dir.path + "/out/results.json", TensorResults(kExample, kExampleStd));
+  const std::string original =
+      "<?xml version=\"1.0\"?>\n<robot name=\"r\">\n  <link name=\"base_link\">\n"
+      "    <inertial>\n      <mass value=\"1\"/>\n      <inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" "
+      "iyy=\"1\" iyz=\"0\" izz=\"1\"/>\n    </inertial>\n  </link>\n</robot>\n";
+  const std::string model = WriteFile(dir.path + "/r.urdf", original);
+  const std::string args = "export " + results + " --format urdf --into " + model + " --link ";
+  CliRun r = Bifilar(dir, args + "base_link");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(model + ": link 'base_link''s <inertial> was not written by bifilar "
+                               "export; add --force"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(ReadFile(model), original);
+  r = Bifilar(dir, args + "base --force");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("has no link named 'base' (its links: base_link)"), std::string::npos)
+      << r.err;
+  r = Bifilar(dir, "export " + results + " --format sdf --into " + model + " --link base_link");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(model + " is urdf, not sdf; give --format urdf"), std::string::npos)
+      << r.err;
+  WriteFile(model + ".bak", "an older backup\n");
+  r = Bifilar(dir, args + "base_link --force");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("the file as it was: " + model + ".bak.1"), std::string::npos) << r.err;
+  EXPECT_EQ(ReadFile(model + ".bak"), "an older backup\n");
+  EXPECT_EQ(ReadFile(model + ".bak.1"), original);
+  const std::string now = ReadFile(model);
+  EXPECT_EQ(now.substr(0, now.find("<!--")), original.substr(0, original.find("<inertial>")));
+  EXPECT_EQ(now.substr(now.find("</inertial>")), original.substr(original.find("</inertial>")));
+  EXPECT_NE(now.find("\n      <inertia ixx=\"2\" ixy=\"0.08\" ixz=\"0.12\" iyy=\"3\" iyz=\"0.06\" "
+                     "izz=\"4.5\"/>\n"),
+            std::string::npos)
+      << now;
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// `bifilar export RESULTS --format urdf|sdf|jsbsim|csv [--out FILE]`: parse options, call
-// RunExport (pipeline/report/export.h).
+// `bifilar export RESULTS --format urdf|sdf|jsbsim|csv|mjcf|ardupilot [--out FILE | --into MODEL
+// --link NAME]`: parse options, call RunExport (pipeline/report/export.h).
 #include <fast_float/fast_float.h>
 
 #include <cmath>
@@ -14,7 +14,8 @@ void RegisterExportCommand(CLI::App& app, int* exit_code) {
   auto* cmd = app.add_subcommand(
       "export",
       "Write the inertia of a results.json for a simulator: URDF or SDF <inertial>, JSBSim "
-      "<mass_balance>, or a flat CSV, each in its own frame and sign convention");
+      "<mass_balance>, MuJoCo <body>, ArduPilot SITL frame JSON, or a flat CSV, each in its own "
+      "frame and sign convention; or rewrite one link's inertial in a model file (--into)");
   auto opts = std::make_shared<ExportOptions>();
   auto format = std::make_shared<std::string>();
   auto frame = std::make_shared<std::string>("flu");
@@ -24,10 +25,15 @@ void RegisterExportCommand(CLI::App& app, int* exit_code) {
       ->required();
   cmd->add_option("--format", *format, ExportFormatAllowedValues())->required();
   cmd->add_option("--out", opts->out_path, "write this file (default: print to stdout)");
+  cmd->add_option("--into", opts->into_path,
+                  "rewrite the inertial block of --link in this URDF, SDF or MJCF model, every "
+                  "other byte unchanged; the file as it was is kept as MODEL.bak (or .bak.N)");
+  cmd->add_option("--link", opts->link_name,
+                  "with --into: the link (URDF, SDF) or body (MJCF) whose inertial is rewritten");
   auto* frame_option = cmd->add_option(
       "--frame", *frame,
-      "urdf/sdf: flu (x forward, y left, z up: ROS REP 103, Gazebo; default) or frd (the body "
-      "axes as measured, x forward, y right, z down)");
+      "urdf/sdf/mjcf: flu (x forward, y left, z up: ROS REP 103, Gazebo; default) or frd (the "
+      "body axes as measured, x forward, y right, z down)");
   cmd->add_option("--mass-kg", opts->mass_kg,
                   "mass to write (default: aircraft.mass_kg of the config stored in the result)")
       ->check(FiniteNumber());
@@ -35,8 +41,9 @@ void RegisterExportCommand(CLI::App& app, int* exit_code) {
                   "NAME=VALUE: a component the result does not hold, in kg m^2, body axes, "
                   "products positive (I_xy = integral x y dm), e.g. --set Iyy=0.42; repeatable");
   cmd->add_flag("--force", opts->force,
-                "replace an --out file that export did not write, and write a urdf/sdf/jsbsim "
-                "file of a tensor that is not physical (the warning stays)");
+                "replace an --out file that export did not write, rewrite an --into inertial "
+                "export did not write, and write a simulator file of a tensor that is not "
+                "physical (the warning stays)");
   cmd->add_flag("--symmetric", opts->symmetric,
                 "take Ixy = Iyz = 0 when the result does not hold them (aircraft symmetric about "
                 "its x-z plane)");

@@ -735,6 +735,34 @@ void ReadRig(YamlMap& root, const std::string& path, const ConfigLoadOptions& op
   rig.Finish();
 }
 
+// `aircraft.cg_m` and `aircraft.cg_std_m`: 3 finite numbers each (m), the std >= 0.
+AircraftCg ReadAircraftCg(YamlMap& aircraft) {
+  AircraftCg cg;
+  const YAML::Node at = aircraft.Optional("cg_m");
+  if (aircraft.Given(at, "cg_m", "a list of 3 numbers (m)")) {
+    const Eigen::Vector3d v = ThreeVector(aircraft, at, "cg_m");
+    for (int i = 0; i < 3; ++i) cg.cg_m[i] = v[i];
+  }
+  const YAML::Node std_node = aircraft.Optional("cg_std_m");
+  if (aircraft.Given(std_node, "cg_std_m", "a list of 3 numbers (m)")) {
+    const Eigen::Vector3d v = ThreeVector(aircraft, std_node, "cg_std_m");
+    if (!cg.Given()) {
+      throw UserError(aircraft.Where(std_node) + ": 'aircraft.cg_std_m' without aircraft.cg_m");
+    }
+    for (int i = 0; i < 3; ++i) cg.cg_std_m[i] = v[i];
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (cg.Given() && (!std::isfinite(cg.cg_m[i]) || std::abs(cg.cg_m[i]) > 1e3)) {
+      throw UserError(aircraft.Where(at) + ": 'aircraft.cg_m' must be 3 finite numbers within "
+                      "1000 m of the model origin");
+    }
+    if (!std::isnan(cg.cg_std_m[i]) && !(std::isfinite(cg.cg_std_m[i]) && cg.cg_std_m[i] >= 0)) {
+      throw UserError(aircraft.Where(std_node) + ": 'aircraft.cg_std_m' must be 3 numbers >= 0");
+    }
+  }
+  return cg;
+}
+
 // `aircraft` (mass and its std) and `gravity_mps2`.
 void ReadAircraftAndGravity(YamlMap& root, const std::string& path,
                             const ConfigLoadOptions& options, CampaignConfig* config) {
@@ -747,6 +775,7 @@ void ReadAircraftAndGravity(YamlMap& root, const std::string& path,
     const YAML::Node std_node = aircraft.Optional("mass_std_kg");
     config->aircraft_mass_std_given = std_node.IsDefined() && !std_node.IsNull();
     config->aircraft_mass_std_kg = NonNegative(aircraft, "mass_std_kg", 0.0);
+    config->aircraft_cg = ReadAircraftCg(aircraft);
   } else if (options.require_runs && config->rig_inertia_given) {
     throw UserError(path + ": missing required key 'aircraft' (or leave out 'rig.inertia' too: "
                     "then rig.mass_kg is everything that hangs and no rig inertia is subtracted)");
@@ -1009,6 +1038,16 @@ CampaignConfig LoadCampaignConfigText(const std::string& text, const std::string
   std::string why;
   if (!config.Check(&why)) throw UserError(path + ": " + why);
   return config;
+}
+
+}  // namespace bifilar
+
+namespace bifilar {
+
+AircraftCg ReadAircraftCgText(const std::string& text, const std::string& name) {
+  YamlMap root = YamlMap::LoadText(text, name);
+  YamlMap aircraft = Sub(root, "aircraft");
+  return ReadAircraftCg(aircraft);
 }
 
 }  // namespace bifilar

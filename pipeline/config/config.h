@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <string>
@@ -209,6 +210,17 @@ struct InputLimits {
 };
 constexpr double kMaxLimitMb = 1e6;  // 1 TB: the largest limits.* accepted
 
+// `aircraft.cg_m` and `aircraft.cg_std_m` (configs/README.md): read by the loader and, from the
+// config text stored in results.json, by `bifilar export`.
+struct AircraftCg {
+  std::array<double, 3> cg_m = {NAN, NAN, NAN};      // body FRD (m); NaN: not given
+  std::array<double, 3> cg_std_m = {NAN, NAN, NAN};  // its std (m); NaN: not given
+  bool Given() const { return !std::isnan(cg_m[0]); }
+};
+// The centre of mass of a config's text (`name` names it in messages): throws UserError naming
+// the key and line when aircraft.cg_m or cg_std_m is not a list of 3 finite numbers (std >= 0).
+AircraftCg ReadAircraftCgText(const std::string& text, const std::string& name);
+
 struct CampaignConfig {
   std::string file;          // absolute path of the config file
   std::string folder;        // its folder: relative paths are resolved against it
@@ -230,6 +242,10 @@ struct CampaignConfig {
   double aircraft_mass_kg = 0.0;      // aircraft mass (kg); 0 when only tare logs are fitted
   double aircraft_mass_std_kg = 0.0;  // its standard uncertainty (kg)
   bool aircraft_mass_std_given = false;  // aircraft.mass_std_kg written in the config
+  // aircraft.cg_m: the centre of mass in body axes (x forward, y right, z down; m, from the
+  // origin of the simulator model's body/link frame), measured apart from the bifilar; export
+  // writes it as the inertial origin. NaN when not given; cg_std_m NaN when not given.
+  AircraftCg aircraft_cg;
   // Local gravity (m/s^2); in [9.76, 9.84] (Earth) unless
   double gravity_mps2 = kStandardGravityMps2;
   bool gravity_off_earth = false;     // `gravity_off_earth: true`: then in (0, 100]

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -16,8 +17,11 @@
 #include "base/json_error.h"
 #include "base/option_check.h"
 #include "base/user_error.h"
+#include "base/version.h"
 #include "fit/tensor.h"
 #include "pipeline/records/results_reader.h"
+#include "pipeline/records/total_uncertainty.h"
+#include "pipeline/report/export_steps.h"
 #include "pipeline/store/output_set.h"
 
 namespace bifilar {
@@ -66,16 +70,22 @@ std::array<double, 6> UrdfElements(const ExportInertia& in, ExportFrame frame) {
 }
 
 // Missing components or mass: an error naming them and how to supply them.
-void RequireComplete(const ExportInertia& in, const char* format) {
-  const std::vector<std::string> missing = in.Missing();
+void RequireComplete(const ExportInertia& in, const char* format, bool moments_only = false) {
+  std::vector<std::string> missing = in.Missing();
+  if (moments_only) {  // ArduPilot: the diagonal only ("Ixy": a product, dropped anyway)
+    missing.erase(std::remove_if(missing.begin(), missing.end(),
+                                 [](const std::string& m) { return m[1] != m[2]; }),
+                  missing.end());
+  }
   if (!missing.empty()) {
     std::string names;
     for (const std::string& m : missing) names += (names.empty() ? "" : ", ") + m;
     const bool planar = in.section == "ellipse" ||
                         (missing.size() == 3 && missing[0] == "Iyy" && missing[1] == "Ixy");
     throw UserError(
-        in.results_name + ": " + format + " needs all six components, and " + names +
-        (missing.size() == 1 ? " is" : " are") + " not in this result" +
+        in.results_name + ": " + format +
+        (moments_only ? " needs the three moments" : " needs all six components") + ", and " +
+        names + (missing.size() == 1 ? " is" : " are") + " not in this result" +
         (planar ? " (a pitch-only campaign measures Ixx, Izz and Ixz)" : "") + "; give " +
         (missing.size() == 1 ? "it" : "them") +
         " with --set NAME=VALUE (kg m^2, body axes, products positive)" +
@@ -94,28 +104,66 @@ void RequireComplete(const ExportInertia& in, const char* format) {
   }
 }
 
-// The comment every XML file starts with: source, frame and sign, what is not measured.
-std::string XmlHeader(const ExportInertia& in, const std::string& frame_text,
-                      const std::string& sign_text, const char* cg_text) {
-  std::string s = "bifilar export of " + in.results_name + " (section '" + in.section + "').\n";
-  s += "     Frame: " + frame_text + "\n     Signs: " + sign_text + "\n";
-  s += "     Inertia about the CG in body axes (x forward, y right, z down; products positive, "
-       "I_xy = integral x y dm), kg m^2, value +- std:\n";
-  for (int k = 0; k < 6; ++k) {
-    s += "       " + std::string(TensorComponentName(k)) + " ";
-    if (in.source[k] == "measured") {
-      s += Num(in.value_kg_m2[k]) + " +- " +
-           (std::isfinite(in.std_kg_m2[k]) ? Num(in.std_kg_m2[k]) : std::string("unknown")) + "\n";
-    } else {
-      s += Num(in.value_kg_m2[k]) + " (not measured: " +
+// A component's line of the comments: "value +- stat (stat) +- total (total)", or what set it.
+std::string ComponentText(const ExportInertia& in, int k) {
+  if (in.source[k] != "measured") {
+    return Num(in.value_kg_m2[k]) + " (not measured: " +
            (in.source[k] == "set" ? "given by the user"
                                   : "assumed 0, aircraft symmetric about x-z") +
-           ")\n";
-    }
+           ")";
   }
-  s += "     NOT MEASURED by the bifilar: the mass (" + Num(in.mass_kg) + " kg, from " +
-       (in.mass_source == "--mass-kg" ? std::string("the command line") : in.mass_source) +
-       ") and the CG: " + cg_text + " Move it to the measured CG; the inertia is about the CG.";
+  std::string s = Num(in.value_kg_m2[k]) + " +- " +
+                  (std::isfinite(in.std_kg_m2[k]) ? Num(in.std_kg_m2[k]) : std::string("unknown")) +
+                  " (stat)";
+  if (std::isfinite(in.total_std_kg_m2[k])) s += " +- " + Num(in.total_std_kg_m2[k]) + " (total)";
+  return s;
+}
+
+// Provenance: "bifilar 0.3.0 (results.json by bifilar 0.3.0), campaign configs/x.yaml, exported
+// 2026-11-28".
+std::string ProvenanceText(const ExportInertia& in) {
+  return "bifilar " + in.export_version + " (results.json written by bifilar " +
+         (in.results_version.empty() ? std::string("?") : in.results_version) + "), campaign " +
+         (in.campaign.empty() ? std::string("?") : in.campaign) + ", exported " + in.date_utc;
+}
+
+// The CG line: where the origin of the file is, and what the bifilar does not measure.
+std::string CgText(const ExportInertia& in, const std::string& origin_text) {
+  std::string s =
+      "NOT MEASURED by the bifilar: the mass (" + Num(in.mass_kg) + " kg" +
+      (std::isfinite(in.mass_std_kg) ? " +- " + Num(in.mass_std_kg) : std::string()) + ", from " +
+      (in.mass_source == "--mass-kg" ? std::string("the command line") : in.mass_source) +
+      ") and the CG: ";
+  if (in.cg.Given()) {
+    s += "aircraft.cg_m = " + Num(in.cg.cg_m[0]) + " " + Num(in.cg.cg_m[1]) + " " +
+         Num(in.cg.cg_m[2]) + " m (body x forward, y right, z down)";
+    if (!std::isnan(in.cg.cg_std_m[0])) {
+      s += " +- " + Num(in.cg.cg_std_m[0]) + " " + Num(in.cg.cg_std_m[1]) + " " +
+           Num(in.cg.cg_std_m[2]) + " m";
+    }
+    s += ", measured apart; " + origin_text;
+  } else {
+    s += origin_text +
+         " Move it to the measured CG (or give aircraft.cg_m in the config); the "
+         "inertia is about the CG.";
+  }
+  return s;
+}
+
+// The comment every XML file starts with: source, frame and sign, uncertainty, provenance, what
+// is not measured.
+std::string XmlHeader(const ExportInertia& in, const std::string& frame_text,
+                      const std::string& sign_text, const std::string& origin_text) {
+  std::string s = "bifilar export of " + in.results_name + " (section '" + in.section + "').\n";
+  s += "     Provenance: " + ProvenanceText(in) + "\n";
+  s += "     Frame: " + frame_text + "\n     Signs: " + sign_text + "\n";
+  s += "     Inertia about the CG in body axes (x forward, y right, z down; products positive, "
+       "I_xy = integral x y dm), kg m^2, value +- std (stat: the fit; total: with the "
+       "campaign's common-mode scale):\n";
+  for (int k = 0; k < 6; ++k) {
+    s += "       " + std::string(TensorComponentName(k)) + " " + ComponentText(in, k) + "\n";
+  }
+  s += "     " + CgText(in, origin_text);
   return "<!-- " + CommentSafe(s) + " -->\n";
 }
 
@@ -176,18 +224,22 @@ bool WrittenByExport(const std::string& path) {
   char head[64] = {};
   file.read(head, sizeof(head));
   const std::string start(head, static_cast<size_t>(file.gcount()));
-  return start.rfind("<!-- bifilar export of ", 0) == 0 ||
+  return start.rfind(kExportMark, 0) == 0 || start.rfind("{\n  \"bifilar_export\": ", 0) == 0 ||
          start.rfind("results_file,section,frame,mass_kg,", 0) == 0;
 }
 
-// Throws UserError when --out is the input or a file of its output folder (see RunExport).
-void RefuseCampaignFile(const std::string& out_path, const std::string& results_path) {
+// Throws UserError when --out (or --into: `option`) is the input or a file of its output folder
+// (see RunExport).
+void RefuseCampaignFile(const std::string& out_path, const std::string& results_path,
+                        const char* option = "--out") {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path out = fs::weakly_canonical(fs::absolute(out_path, ec), ec);
   const fs::path input = fs::weakly_canonical(fs::absolute(results_path, ec), ec);
-  const std::string refused = "export: --out " + out_path + " is ";
-  const std::string advice = "; export writes a new file: choose a name outside it";
+  const std::string refused = std::string("export: ") + option + " " + out_path + " is ";
+  const std::string advice = std::string(option) == "--out"
+                                 ? "; export writes a new file: choose a name outside it"
+                                 : "; --into rewrites a model file, not a campaign's";
   if (out == input || (fs::exists(out_path, ec) && fs::equivalent(out_path, results_path, ec))) {
     throw UserError(refused + "the input " + results_path + " itself" + advice);
   }
@@ -220,10 +272,10 @@ void RefuseCampaignFile(const std::string& out_path, const std::string& results_
 
 namespace {
 
-constexpr EnumName<ExportFormat> kExportFormatNames[] = {{ExportFormat::kUrdf, "urdf"},
-                                                         {ExportFormat::kSdf, "sdf"},
-                                                         {ExportFormat::kJsbsim, "jsbsim"},
-                                                         {ExportFormat::kCsv, "csv"}};
+constexpr EnumName<ExportFormat> kExportFormatNames[] = {
+    {ExportFormat::kUrdf, "urdf"},     {ExportFormat::kSdf, "sdf"},
+    {ExportFormat::kJsbsim, "jsbsim"}, {ExportFormat::kCsv, "csv"},
+    {ExportFormat::kMjcf, "mjcf"},     {ExportFormat::kArdupilot, "ardupilot"}};
 constexpr EnumName<ExportFrame> kExportFrameNames[] = {{ExportFrame::kFlu, "flu"},
                                                        {ExportFrame::kFrd, "frd"}};
 
@@ -248,10 +300,21 @@ bool ExportOptions::Check(std::string* why) const {
       (!results_path.empty() ||
        CheckFailText("results_path", results_path, "a results.json", &f)) &&
       (!frame_given || format == ExportFormat::kUrdf || format == ExportFormat::kSdf ||
+       format == ExportFormat::kMjcf ||
        CheckFailText("--frame (with --format)", ExportFormatName(format),
-                     "urdf or sdf (--frame applies to urdf and sdf only; the others have a fixed "
-                     "frame)",
+                     "urdf, sdf or mjcf (--frame applies to urdf, sdf and mjcf only; the others "
+                     "have a fixed frame)",
                      &f)) &&
+      (into_path.empty() == link_name.empty() ||
+       CheckFailText("--into/--link", into_path.empty() ? link_name : into_path,
+                     "given together (--into MODEL --link NAME)", &f)) &&
+      (into_path.empty() || out_path.empty() ||
+       CheckFailText("--out (with --into)", out_path,
+                     "absent: --into rewrites MODEL itself (and keeps a backup)", &f)) &&
+      (into_path.empty() || format == ExportFormat::kUrdf || format == ExportFormat::kSdf ||
+       format == ExportFormat::kMjcf ||
+       CheckFailText("--format (with --into)", ExportFormatName(format),
+                     "urdf, sdf or mjcf (the formats of a model file with links or bodies)", &f)) &&
       (std::isnan(mass_kg) || CheckFiniteGt("--mass-kg", mass_kg, 0, &f));
   for (auto it = set_kg_m2.begin(); ok && it != set_kg_m2.end(); ++it) {
     const std::string& name = it->first;
@@ -335,6 +398,48 @@ void ReadExportMass(const ResultsReader& results, const json& j, const std::stri
   }
 }
 
+// The total stds (the stat std and the common-mode scale in quadrature), the covariance, the
+// provenance and the CG of the stored config.
+void ReadExportUncertaintyAndProvenance(const ResultsReader& results, const std::string& name,
+                                        const ExportOptions& options, ExportInertia* in) {
+  const double common_mode = NamedRead(name, [&] {
+    return results.Get("total_uncertainty").NumOrNull("common_mode_relative_std", name);
+  });
+  for (int k = 0; k < 6; ++k) {
+    in->total_std_kg_m2[k] =
+        in->source[k] == "measured" && std::isfinite(common_mode)
+            ? WithCommonModeScale(in->value_kg_m2[k], in->std_kg_m2[k], common_mode)
+            : kNaN;
+    in->covariance_kg2_m4[k].fill(kNaN);
+  }
+  if (in->section == "tensor") {
+    const std::vector<std::vector<double>> rows = results.Get("tensor").Rows("covariance_kg2_m4");
+    for (size_t a = 0; a < rows.size() && a < 6; ++a) {
+      for (size_t b = 0; b < rows[a].size() && b < 6; ++b) in->covariance_kg2_m4[a][b] = rows[a][b];
+    }
+  }
+  in->results_version = NamedRead(name, [&] { return results.Str("version"); });
+  in->campaign = NamedRead(name, [&] { return results.Str("config_file"); });
+  in->export_version = ProgramVersion();
+  in->date_utc = options.date_utc;
+  if (in->date_utc.empty()) {
+    const std::time_t now = std::time(nullptr);
+    std::tm tm = {};
+    gmtime_r(&now, &tm);
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    in->date_utc = buf;
+  }
+  const std::string config = NamedRead(name, [&] { return results.Str("config"); });
+  if (!config.empty()) {
+    try {
+      in->cg = ReadAircraftCgText(config, name + " (its stored config)");
+    } catch (const UserError& e) {
+      in->warnings.push_back(std::string(e.what()) + "; the CG is not written");
+    }
+  }
+}
+
 }  // namespace
 
 ExportInertia ReadExportInertia(const std::string& text, const std::string& name,
@@ -413,67 +518,127 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
     }
   }
   ReadExportMass(results, j, name, options, &in);
+  ReadExportUncertaintyAndProvenance(results, name, options, &in);
   in.nonphysical = NonPhysical(in);
   if (!in.nonphysical.empty()) in.warnings.push_back(name + ": " + in.nonphysical);
   return in;
 }
 
-std::string FormatUrdfInertial(const ExportInertia& in, ExportFrame frame) {
-  RequireComplete(in, "URDF");
+namespace {
+
+// The frame texts of URDF, SDF and MJCF.
+std::string LinkFrameText(ExportFormat format, ExportFrame frame) {
+  if (frame == ExportFrame::kFrd)
+    return "the body axes as measured, x forward, y right, z down (FRD)";
+  return format == ExportFormat::kUrdf
+             ? "the link frame as ROS REP 103 takes it, x forward, y left, z up (FLU)"
+         : format == ExportFormat::kSdf
+             ? "the link frame as Gazebo takes it, x forward, y left, z up (FLU)"
+             : "the body frame, x forward, y left, z up (FLU, as URDF and Gazebo)";
+}
+
+std::string LinkSignText(ExportFormat format, ExportFrame frame) {
+  const std::string signs = frame == ExportFrame::kFlu ? "ixy = +I_xy, ixz = +I_xz, iyz = -I_yz"
+                                                       : "ixy = -I_xy, ixz = -I_xz, iyz = -I_yz";
+  if (format == ExportFormat::kUrdf) return "URDF elements of the inertia matrix: " + signs;
+  if (format == ExportFormat::kSdf) return "SDFormat products are -m x y (not +m x y): " + signs;
+  return "MJCF fullinertia = ixx iyy izz ixy ixz iyz, the inertia matrix elements: " + signs;
+}
+
+std::string Xyz(const std::array<double, 3>& v) {
+  return Num(v[0]) + " " + Num(v[1]) + " " + Num(v[2]);
+}
+
+}  // namespace
+
+InertialOrigin DefaultOrigin(const ExportInertia& in, ExportFormat format, ExportFrame frame) {
+  InertialOrigin o;
+  if (!in.cg.Given()) return o;
+  const auto& c = in.cg.cg_m;
+  if (format == ExportFormat::kJsbsim) {
+    o.xyz = {-c[0], c[1], -c[2]};  // structural: x aft, y right, z up
+  } else if (frame == ExportFrame::kFlu) {
+    o.xyz = {c[0], -c[1], -c[2]};
+  } else {
+    o.xyz = c;
+  }
+  return o;
+}
+
+std::string InertialBlock(const ExportInertia& in, ExportFormat format, ExportFrame frame,
+                          const InertialOrigin& origin) {
+  const char* label = format == ExportFormat::kUrdf  ? "URDF"
+                      : format == ExportFormat::kSdf ? "SDF"
+                                                     : "MJCF";
+  RequireComplete(in, label);
   const std::array<double, 6> e = UrdfElements(in, frame);
+  const char* where = format == ExportFormat::kUrdf  ? "the <origin>"
+                      : format == ExportFormat::kSdf ? "the <pose>"
+                                                     : "the inertial pos";
+  const std::string origin_text =
+      !origin.note.empty() ? origin.note
+      : in.cg.Given()
+          ? std::string(where) + " is that CG in this file's frame, " + Xyz(origin.xyz) + "."
+          : std::string(where) + " is the link origin, 0 0 0.";
   std::string s =
-      XmlHeader(in,
-                frame == ExportFrame::kFlu
-                    ? "the link frame as ROS REP 103 takes it, x forward, y left, z up (FLU)"
-                    : "the body axes as measured, x forward, y right, z down (FRD)",
-                frame == ExportFrame::kFlu
-                    ? "URDF elements of the inertia matrix: ixy = +I_xy, ixz = +I_xz, iyz = -I_yz"
-                    : "URDF elements of the inertia matrix: ixy = -I_xy, ixz = -I_xz, iyz = -I_yz",
-                "the <origin> is the link origin, 0 0 0.");
-  s += "<inertial>\n";
-  s += "  <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n";
-  s += "  <mass value=\"" + Num(in.mass_kg) + "\"/>\n";
-  s += "  <inertia ixx=\"" + Num(e[0]) + "\" ixy=\"" + Num(e[3]) + "\" ixz=\"" + Num(e[4]) +
-       "\" iyy=\"" + Num(e[1]) + "\" iyz=\"" + Num(e[5]) + "\" izz=\"" + Num(e[2]) + "\"/>\n";
-  s += "</inertial>\n";
+      XmlHeader(in, LinkFrameText(format, frame), LinkSignText(format, frame), origin_text);
+  if (format == ExportFormat::kUrdf) {
+    s += "<inertial>\n";
+    s += "  <origin xyz=\"" + Xyz(origin.xyz) + "\" rpy=\"0 0 0\"/>\n";
+    s += "  <mass value=\"" + Num(in.mass_kg) + "\"/>\n";
+    s += "  <inertia ixx=\"" + Num(e[0]) + "\" ixy=\"" + Num(e[3]) + "\" ixz=\"" + Num(e[4]) +
+         "\" iyy=\"" + Num(e[1]) + "\" iyz=\"" + Num(e[5]) + "\" izz=\"" + Num(e[2]) + "\"/>\n";
+    s += "</inertial>\n";
+  } else if (format == ExportFormat::kSdf) {
+    s += "<inertial>\n";
+    s += "  <pose>" + Xyz(origin.xyz) + " 0 0 0</pose>\n";
+    s += "  <mass>" + Num(in.mass_kg) + "</mass>\n";
+    s += "  <inertia>\n";
+    const char* tags[6] = {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"};
+    const int order[6] = {0, 3, 4, 1, 5, 2};
+    for (int i = 0; i < 6; ++i) {
+      s += std::string("    <") + tags[i] + ">" + Num(e[order[i]]) + "</" + tags[i] + ">\n";
+    }
+    s += "  </inertia>\n";
+    s += "</inertial>\n";
+  } else {
+    s += "<inertial pos=\"" + Xyz(origin.xyz) + "\" mass=\"" + Num(in.mass_kg) +
+         "\" fullinertia=\"" + Num(e[0]) + " " + Num(e[1]) + " " + Num(e[2]) + " " + Num(e[3]) +
+         " " + Num(e[4]) + " " + Num(e[5]) + "\"/>\n";
+  }
   return s;
 }
 
+std::string FormatUrdfInertial(const ExportInertia& in, ExportFrame frame) {
+  return InertialBlock(in, ExportFormat::kUrdf, frame,
+                       DefaultOrigin(in, ExportFormat::kUrdf, frame));
+}
+
 std::string FormatSdfInertial(const ExportInertia& in, ExportFrame frame) {
-  RequireComplete(in, "SDF");
-  const std::array<double, 6> e = UrdfElements(in, frame);
-  std::string s = XmlHeader(
-      in,
-      frame == ExportFrame::kFlu
-          ? "the link frame as Gazebo takes it, x forward, y left, z up (FLU)"
-          : "the body axes as measured, x forward, y right, z down (FRD)",
-      frame == ExportFrame::kFlu
-          ? "SDFormat products are -m x y (not +m x y): ixy = +I_xy, ixz = +I_xz, iyz = -I_yz"
-          : "SDFormat products are -m x y (not +m x y): ixy = -I_xy, ixz = -I_xz, iyz = -I_yz",
-      "the <pose> is the link origin, 0 0 0.");
-  s += "<inertial>\n";
-  s += "  <pose>0 0 0 0 0 0</pose>\n";
-  s += "  <mass>" + Num(in.mass_kg) + "</mass>\n";
-  s += "  <inertia>\n";
-  s += "    <ixx>" + Num(e[0]) + "</ixx>\n";
-  s += "    <ixy>" + Num(e[3]) + "</ixy>\n";
-  s += "    <ixz>" + Num(e[4]) + "</ixz>\n";
-  s += "    <iyy>" + Num(e[1]) + "</iyy>\n";
-  s += "    <iyz>" + Num(e[5]) + "</iyz>\n";
-  s += "    <izz>" + Num(e[2]) + "</izz>\n";
-  s += "  </inertia>\n";
-  s += "</inertial>\n";
-  return s;
+  return InertialBlock(in, ExportFormat::kSdf, frame, DefaultOrigin(in, ExportFormat::kSdf, frame));
+}
+
+std::string FormatMjcfBody(const ExportInertia& in, ExportFrame frame,
+                           const std::string& body_name) {
+  const std::string block =
+      InertialBlock(in, ExportFormat::kMjcf, frame, DefaultOrigin(in, ExportFormat::kMjcf, frame));
+  const size_t at = block.find("-->\n") + 4;  // the comment stays above the body
+  return block.substr(0, at) + "<body name=\"" + body_name + "\">\n  " + block.substr(at) +
+         "</body>\n";
 }
 
 std::string FormatJsbsimMassBalance(const ExportInertia& in) {
   RequireComplete(in, "JSBSim");
   const auto& v = in.value_kg_m2;
+  const InertialOrigin origin = DefaultOrigin(in, ExportFormat::kJsbsim, ExportFrame::kFlu);
   std::string s =
       XmlHeader(in, "JSBSim's structural frame, x aft, y right, z up",
                 "negated_crossproduct_inertia=\"true\": <ixy> etc. are the matrix elements, "
                 "-integral x y dm in the structural frame: ixy = +I_xy, ixz = -I_xz, iyz = +I_yz",
-                "the <location name=\"CG\"> is 0 0 0 of the structural frame.");
+                in.cg.Given() ? "the <location name=\"CG\"> is that CG in the structural frame "
+                                "(x aft, y right, z up), " +
+                                    Xyz(origin.xyz) + "."
+                              : "the <location name=\"CG\"> is 0 0 0 of the structural frame.");
   const auto element = [](const char* tag, double value) {
     return std::string("  <") + tag + " unit=\"KG*M2\"> " + Num(value) + " </" + tag + ">\n";
   };
@@ -486,10 +651,86 @@ std::string FormatJsbsimMassBalance(const ExportInertia& in) {
   s += element("iyz", v[kIyz]);
   s += "  <emptywt unit=\"KG\"> " + Num(in.mass_kg) + " </emptywt>\n";
   s += "  <location name=\"CG\" unit=\"M\">\n";
-  s += "    <x> 0 </x>\n    <y> 0 </y>\n    <z> 0 </z>\n";
+  s += "    <x> " + Num(origin.xyz[0]) + " </x>\n    <y> " + Num(origin.xyz[1]) +
+       " </y>\n    <z> " + Num(origin.xyz[2]) + " </z>\n";
   s += "  </location>\n";
   s += "</mass_balance>\n";
   return s;
+}
+
+std::string FormatArdupilotFrame(const ExportInertia& in) {
+  RequireComplete(in, "ArduPilot", /*moments_only=*/true);
+  const auto& v = in.value_kg_m2;
+  const auto str = [](const std::string& t) { return json(t).dump(); };
+  // The keys SITL reads ("mass", "moment_inertia"), and one it ignores ("bifilar_export", first:
+  // the mark that export wrote the file) with the uncertainty and provenance.
+  std::string s = "{\n  \"bifilar_export\": {\n";
+  s += "    \"results_file\": " + str(in.results_name) + ",\n";
+  s += "    \"provenance\": " + str(ProvenanceText(in)) + ",\n";
+  s += "    \"frame\": \"body FRD (x forward, y right, z down), about the CG; SITL's multicopter "
+       "model takes its CG at the body origin\",\n";
+  for (int k = 0; k < 3; ++k) {
+    s +=
+        std::string("    \"") + TensorComponentName(k) + "\": " + str(ComponentText(in, k)) + ",\n";
+  }
+  const std::string dropped = DroppedProducts(in, ExportFormat::kArdupilot);
+  s += "    \"dropped\": " + str(dropped) + ",\n";
+  s += "    \"not_measured\": " + str(CgText(in, "SITL puts the CG at the body origin.")) + "\n";
+  s += "  },\n";
+  s += "  \"mass\": " + Num(in.mass_kg) + ",\n";
+  s += "  \"moment_inertia\": [" + Num(v[kIxx]) + ", " + Num(v[kIyy]) + ", " + Num(v[kIzz]) + "]\n";
+  s += "}\n";
+  return s;
+}
+
+bool ExportFormatHoldsProducts(ExportFormat format) { return format != ExportFormat::kArdupilot; }
+
+std::string DroppedProducts(const ExportInertia& in, ExportFormat format) {
+  if (ExportFormatHoldsProducts(format)) return "";
+  const auto& v = in.value_kg_m2;
+  const int pairs[3][3] = {{kIxy, kIxx, kIyy}, {kIxz, kIxx, kIzz}, {kIyz, kIyy, kIzz}};
+  std::string s = std::string(ExportFormatName(format)) +
+                  " holds the three moments only and drops the products:";
+  for (const auto& pr : pairs) {
+    const std::string n = TensorComponentName(pr[0]);
+    if (in.source[pr[0]] == "missing") {
+      s += " " + n + " (not measured),";
+      continue;
+    }
+    const double scale = std::sqrt(v[pr[1]] * v[pr[2]]);
+    char pct[32];
+    std::snprintf(pct, sizeof pct, "%.3g", 100.0 * std::abs(v[pr[0]]) / scale);
+    s += " " + n + " = " + Num(v[pr[0]]) + " kg m^2 (" + pct + " % of sqrt(" +
+         TensorComponentName(pr[1]) + " " + TensorComponentName(pr[2]) + "))" + ",";
+  }
+  s.back() = ';';
+  s += " the simulated body's principal axes are its body axes";
+  return s;
+}
+
+std::string NonPhysicalRefusal(const ExportInertia& in, ExportFormat format, bool force) {
+  if (in.nonphysical.empty() || force || format == ExportFormat::kCsv) return "";
+  return in.results_name + ": " + in.nonphysical + "; not written: a " + ExportFormatName(format) +
+         " file must be physically valid (simulators refuse such a tensor or silently replace it;"
+         " --force writes it anyway)";
+}
+
+std::string FormatExport(const ExportInertia& in, ExportFormat format, ExportFrame frame) {
+  switch (format) {
+    case ExportFormat::kUrdf:
+      return FormatUrdfInertial(in, frame);
+    case ExportFormat::kSdf:
+      return FormatSdfInertial(in, frame);
+    case ExportFormat::kJsbsim:
+      return FormatJsbsimMassBalance(in);
+    case ExportFormat::kMjcf:
+      return FormatMjcfBody(in, frame);
+    case ExportFormat::kArdupilot:
+      return FormatArdupilotFrame(in);
+    case ExportFormat::kCsv:
+      break;
+  }
+  return FormatInertiaCsv(in);
 }
 
 std::string FormatInertiaCsv(const ExportInertia& in) {
@@ -503,8 +744,75 @@ std::string FormatInertiaCsv(const ExportInertia& in) {
     header += "," + n + "_kg_m2," + n + "_std_kg_m2," + n + "_source";
     row += "," + CsvNum(in.value_kg_m2[k]) + "," + CsvNum(in.std_kg_m2[k]) + "," + in.source[k];
   }
+  // The total stds, the full covariance (upper triangle, results.json tensor.covariance_kg2_m4),
+  // the CG and the provenance.
+  for (int k = 0; k < 6; ++k) {
+    header += "," + std::string(TensorComponentName(k)) + "_total_std_kg_m2";
+    row += "," + CsvNum(in.total_std_kg_m2[k]);
+  }
+  for (int a = 0; a < 6; ++a) {
+    for (int b = a; b < 6; ++b) {
+      header +=
+          ",cov_" + std::string(TensorComponentName(a)) + "_" + TensorComponentName(b) + "_kg2_m4";
+      row += "," + CsvNum(in.covariance_kg2_m4[a][b]);
+    }
+  }
+  const char* axes[3] = {"x", "y", "z"};
+  for (int i = 0; i < 3; ++i) {
+    header += ",cg_" + std::string(axes[i]) + "_m";
+    row += "," + CsvNum(in.cg.cg_m[i]);
+  }
+  for (int i = 0; i < 3; ++i) {
+    header += ",cg_" + std::string(axes[i]) + "_std_m";
+    row += "," + CsvNum(in.cg.cg_std_m[i]);
+  }
+  header += ",results_version,campaign,export_version,date_utc";
+  row += "," + CsvField(in.results_version) + "," + CsvField(in.campaign) + "," +
+         CsvField(in.export_version) + "," + CsvField(in.date_utc);
   return header + "\n" + row + "\n";
 }
+
+namespace {
+
+// A backup name beside `path` that does not exist: PATH.bak, else PATH.bak.1, .2, ...
+std::string FreeBackupName(const std::string& path) {
+  std::error_code ec;
+  std::string name = path + ".bak";
+  for (int i = 1;
+       std::filesystem::symlink_status(name, ec).type() != std::filesystem::file_type::not_found;
+       ++i) {
+    name = path + ".bak." + std::to_string(i);
+  }
+  return name;
+}
+
+// --into: rewrites the model in place after writing its backup; the warnings go to `err`.
+void RunExportInto(const ExportOptions& options, const ExportInertia& in, std::ostream& err) {
+  std::string model, why;
+  if (!ReadRegularFile(options.into_path, OutputFileCap(), &model, &why)) throw UserError(why);
+  ExportFormat model_format;
+  if (!DetectModelFormat(model, &model_format)) {
+    throw UserError("export --into: " + options.into_path +
+                    " is not a URDF (<robot>), SDF (<sdf>) or MJCF (<mujoco>) model");
+  }
+  if (model_format != options.format) {
+    throw UserError("export --into: " + options.into_path + " is " +
+                    ExportFormatName(model_format) + ", not " + ExportFormatName(options.format) +
+                    "; give --format " + ExportFormatName(model_format));
+  }
+  std::vector<std::string> warnings;
+  const std::string text = RewriteModelInertial(model, options.into_path, options.link_name, in,
+                                                options.frame, options.force, &warnings);
+  CheckFileTarget(options.into_path);
+  const std::string backup = FreeBackupName(options.into_path);
+  WriteFileAtomically(backup, model);
+  WriteFileAtomically(options.into_path, text);
+  for (const std::string& w : warnings) err << "bifilar: warning: " << w << "\n";
+  err << "wrote " << options.into_path << " (the inertial of " << options.link_name << ", "
+      << ExportFormatName(model_format) << "); the file as it was: " << backup << "\n";
+}
+
+}  // namespace
 
 int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err) {
   std::string why;
@@ -522,33 +830,29 @@ int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err
       RefuseToReplace(options.out_path, "export --out", options.force);
     }
   }
+  if (!options.into_path.empty()) {
+    RefuseCampaignFile(options.into_path, path, "--into");
+    CheckFileTarget(options.into_path);
+  }
   std::string text;
   if (!ReadRegularFile(path, OutputFileCap(), &text, &why)) throw UserError(why);
   const ExportInertia in = ReadExportInertia(text, path, options);
-  if (!in.nonphysical.empty() && options.format != ExportFormat::kCsv && !options.force) {
-    err << "bifilar: error: " << path << ": " << in.nonphysical << "; not written: a "
-        << ExportFormatName(options.format)
-        << " file must be physically valid (--force writes it anyway)\n";
+  // The one refusal of a tensor that is not physical, for every format and --into.
+  const std::string refusal = NonPhysicalRefusal(in, options.format, options.force);
+  if (!refusal.empty()) {
+    err << "bifilar: error: " << refusal << "\n";
     return 1;
   }
-  std::string body;
-  switch (options.format) {
-    case ExportFormat::kUrdf:
-      body = FormatUrdfInertial(in, options.frame);
-      break;
-    case ExportFormat::kSdf:
-      body = FormatSdfInertial(in, options.frame);
-      break;
-    case ExportFormat::kJsbsim:
-      body = FormatJsbsimMassBalance(in);
-      break;
-    case ExportFormat::kCsv:
-      body = FormatInertiaCsv(in);
-      break;
-  }
   for (const std::string& w : in.warnings) err << "bifilar: warning: " << w << "\n";
+  if (!options.into_path.empty()) {
+    RunExportInto(options, in, err);
+    return 0;
+  }
+  const std::string body = FormatExport(in, options.format, options.frame);
+  const std::string dropped = DroppedProducts(in, options.format);
+  if (!dropped.empty()) err << "bifilar: warning: " << path << ": " << dropped << "\n";
   const std::vector<std::string> missing = in.Missing();
-  if (!missing.empty()) {  // CSV only: the XML formats refused above
+  if (!missing.empty() && options.format == ExportFormat::kCsv) {  // the others refused above
     std::string names;
     for (const std::string& m : missing) names += (names.empty() ? "" : ", ") + m;
     err << "bifilar: warning: " << path << ": " << names
@@ -559,7 +863,10 @@ int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err
               ? "the mass written (" + Num(in.mass_kg) + " kg) is from " + in.mass_source + ", and "
               : std::string())
       << "the inertia is about the CG, which the "
-      << (options.format == ExportFormat::kCsv ? "CSV does not locate" : "file puts at its origin")
+      << (options.format == ExportFormat::kCsv         ? "CSV does not locate"
+          : options.format == ExportFormat::kArdupilot ? "ArduPilot SITL takes at the body origin"
+          : in.cg.Given()                              ? "file puts at aircraft.cg_m of the config"
+                                                       : "file puts at its origin")
       << "\n";
   if (options.out_path.empty()) {
     out << body;
