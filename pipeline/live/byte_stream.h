@@ -37,5 +37,8 @@ std::unique_ptr<ByteStream> OpenSerial(const std::string& device, int baud, std:
 // an ephemeral port, which Describe() names). Each datagram's bytes are appended in arrival
 // order. An address in use or not local: nullptr, reason in *error.
 std::unique_ptr<ByteStream> OpenUdp(const std::string& bind_host, int port, std::string* error);
+// The same, and the port bound in *bound_port (the ephemeral one when port is 0: tests).
+std::unique_ptr<ByteStream> OpenUdp(const std::string& bind_host, int port, int* bound_port,
+                                    std::string* error);
 
 }  // namespace bifilar::live
