@@ -106,6 +106,34 @@ bool DecodeImu(const FrameHeader& h, const uint8_t* payload, const MavlinkDecode
 
 enum class Attempt { kNeedMore, kNotAFrame, kFrame };
 
+// An IMU frame at p (n bytes available, header h read): kFrame when whole with a good
+// checksum; kNotAFrame (and *bad_crc) when its checksum does not match.
+Attempt CheckImuFrame(const uint8_t* p, std::size_t n, const FrameHeader& h, bool* bad_crc) {
+  if (n < h.total_bytes) return Attempt::kNeedMore;
+  const std::size_t checked = h.header_bytes + h.payload_bytes;
+  *bad_crc = MavlinkCrc(p + 1, checked - 1, MavlinkCrcExtra(h.msgid)) != LittleEndian(p + checked, 2);
+  return *bad_crc ? Attempt::kNotAFrame : Attempt::kFrame;
+}
+
+// A frame of a message not read here, whose checksum cannot be checked: kFrame when the byte
+// after it starts a frame and no IMU frame with a good checksum starts inside it (so a false
+// start in garbage never swallows a real IMU frame).
+Attempt CheckOtherFrame(const uint8_t* p, std::size_t n, const FrameHeader& h) {
+  if (n < h.total_bytes + 1) return Attempt::kNeedMore;
+  if (!IsMagic(p[h.total_bytes])) return Attempt::kNotAFrame;
+  for (std::size_t q = 1; q < h.total_bytes; ++q) {
+    if (!IsMagic(p[q])) continue;
+    FrameHeader inner;
+    if (!ReadHeader(p + q, n - q, &inner)) return Attempt::kNeedMore;
+    if (inner.unknown_incompat || MavlinkCrcExtra(inner.msgid) < 0) continue;
+    bool bad_crc = false;
+    const Attempt a = CheckImuFrame(p + q, n - q, inner, &bad_crc);
+    if (a == Attempt::kNeedMore) return Attempt::kNeedMore;
+    if (a == Attempt::kFrame) return Attempt::kNotAFrame;
+  }
+  return Attempt::kFrame;
+}
+
 }  // namespace
 
 bool MavlinkDecoderOptions::Check(std::string* why) const {
@@ -118,10 +146,11 @@ bool MavlinkDecoderOptions::Check(std::string* why) const {
   return true;
 }
 
-uint16_t MavlinkCrc(const uint8_t* bytes, std::size_t size, uint16_t crc) {
-  // CRC-16/MCRF4XX: polynomial 0x1021 reflected, no final xor; `crc` is the running value.
-  boost::crc_optimal<16, 0x1021, 0xFFFF, 0, true, true> x25(crc);
+uint16_t MavlinkCrc(const uint8_t* bytes, std::size_t size, int crc_extra) {
+  // CRC-16/MCRF4XX: polynomial 0x1021, initial 0xFFFF, input and output reflected, no final xor.
+  boost::crc_optimal<16, 0x1021, 0xFFFF, 0, true, true> x25;
   x25.process_bytes(bytes, size);
+  if (crc_extra >= 0 && crc_extra <= 0xFF) x25.process_byte(static_cast<unsigned char>(crc_extra));
   return x25.checksum();
 }
 
@@ -143,8 +172,9 @@ std::vector<MavlinkImuSample> MavlinkDecoder::Feed(const std::string& bytes) {
   while (pos < size) {
     const uint8_t* p = data + pos;
     const std::size_t n = size - pos;
-    Attempt attempt = Attempt::kNotAFrame;
     FrameHeader h;
+    Attempt attempt = Attempt::kNotAFrame;
+    bool bad_crc = false;
     if (!IsMagic(p[0])) {
       attempt = Attempt::kNotAFrame;
     } else if (!ReadHeader(p, n, &h)) {
@@ -152,24 +182,12 @@ std::vector<MavlinkImuSample> MavlinkDecoder::Feed(const std::string& bytes) {
     } else if (h.unknown_incompat) {
       attempt = Attempt::kNotAFrame;
     } else if (MavlinkCrcExtra(h.msgid) < 0) {
-      // Another message: a frame when the next one starts right after it.
-      if (n < h.total_bytes + 1) {
-        attempt = Attempt::kNeedMore;
-      } else if (IsMagic(p[h.total_bytes])) {
-        attempt = Attempt::kFrame;
-        ++counters_.unknown_msgid;
-      }
-    } else if (n < h.total_bytes) {
-      attempt = Attempt::kNeedMore;
+      attempt = CheckOtherFrame(p, n, h);
+      if (attempt == Attempt::kFrame) ++counters_.unknown_msgid;
     } else {
-      const std::size_t checked = h.header_bytes + h.payload_bytes;
-      uint16_t crc = MavlinkCrc(p + 1, checked - 1);
-      const auto extra = static_cast<uint8_t>(MavlinkCrcExtra(h.msgid));
-      crc = MavlinkCrc(&extra, 1, crc);
-      if (crc != LittleEndian(p + checked, 2)) {
-        ++counters_.bad_crc;
-      } else {
-        attempt = Attempt::kFrame;
+      attempt = CheckImuFrame(p, n, h, &bad_crc);
+      if (bad_crc) ++counters_.bad_crc;
+      if (attempt == Attempt::kFrame) {
         ++counters_.frames_ok;
         uint8_t payload[kLongestPayload] = {};  // zero-filled: MAVLink 2 truncation
         std::memcpy(payload, p + h.header_bytes, h.payload_bytes);

@@ -83,9 +83,9 @@ struct MavlinkDecoderOptions {
   bool Check(std::string* why) const;
 };
 
-// The MAVLink X.25 checksum (CRC-16/MCRF4XX) of `size` bytes, continued from `crc`
-// (start: 0xFFFF). Boost.CRC's crc_optimal.
-uint16_t MavlinkCrc(const uint8_t* bytes, std::size_t size, uint16_t crc = 0xFFFF);
+// The MAVLink X.25 checksum (CRC-16/MCRF4XX, Boost.CRC's crc_optimal) of `size` bytes, then of
+// the byte crc_extra when it is 0..255 (a frame's checksum: its bytes after the start byte).
+uint16_t MavlinkCrc(const uint8_t* bytes, std::size_t size, int crc_extra = -1);
 
 // CRC_EXTRA of the IMU messages read here; -1 for any other msgid.
 int MavlinkCrcExtra(int msgid);

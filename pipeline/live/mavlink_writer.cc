@@ -49,9 +49,9 @@ std::string EncodeMavlinkFrame(int msgid, const std::string& payload, std::size_
              static_cast<char>((msgid >> 16) & 0xFF)};
   }
   frame += body;
-  uint16_t crc = MavlinkCrc(reinterpret_cast<const uint8_t*>(frame.data()) + 1, frame.size() - 1);
-  const auto extra = static_cast<uint8_t>(MavlinkCrcExtra(msgid) < 0 ? 0 : MavlinkCrcExtra(msgid));
-  crc = MavlinkCrc(&extra, 1, crc);
+  // A message not read here gets CRC_EXTRA 0: a frame the decoder cannot check anyway.
+  const uint16_t crc = MavlinkCrc(reinterpret_cast<const uint8_t*>(frame.data()) + 1,
+                                  frame.size() - 1, std::max(MavlinkCrcExtra(msgid), 0));
   frame += static_cast<char>(crc & 0xFF);
   frame += static_cast<char>(crc >> 8);
   if (o.version != 1 && o.signed_frame) {
