@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -36,13 +37,20 @@ class SerialStream : public ByteStream {
   bool Open(std::string* error) {
     std::error_code ec;
     port_.open(device_, ec);
-    if (!ec) port_.set_option(asio::serial_port::baud_rate(static_cast<unsigned>(baud_)), ec);
-    if (ec == std::errc::invalid_argument) {
+    if (ec) {
+      *error = Describe() + ": cannot open: " + ec.message() +
+               (ec.value() == EACCES
+                    ? " (add the user to the dialout group: sudo usermod -aG dialout $USER)"
+                    : "");
+      return false;
+    }
+    port_.set_option(asio::serial_port::baud_rate(static_cast<unsigned>(baud_)), ec);
+    if (ec) {
       *error = Describe() + ": the system does not know the baud rate " + std::to_string(baud_) +
                " (use a standard rate such as 57600, 115200, 921600)";
       return false;
     }
-    if (!ec) port_.set_option(asio::serial_port::character_size(8), ec);
+    port_.set_option(asio::serial_port::character_size(8), ec);
     if (!ec) port_.set_option(asio::serial_port::parity(asio::serial_port::parity::none), ec);
     if (!ec) {
       port_.set_option(asio::serial_port::stop_bits(asio::serial_port::stop_bits::one), ec);
@@ -51,10 +59,7 @@ class SerialStream : public ByteStream {
       port_.set_option(asio::serial_port::flow_control(asio::serial_port::flow_control::none), ec);
     }
     if (ec) {
-      *error = Describe() + ": cannot open: " + ec.message() +
-               (ec == std::errc::permission_denied
-                    ? " (add the user to the dialout group: sudo usermod -aG dialout $USER)"
-                    : "");
+      *error = Describe() + ": cannot set 8N1 without flow control: " + ec.message();
       return false;
     }
     return true;
@@ -114,7 +119,7 @@ class UdpStream : public ByteStream {
     if (!ec) socket_.bind(endpoint, ec);
     if (ec) {
       *error = "udp " + host + ":" + std::to_string(port) + ": cannot bind: " + ec.message() +
-               (ec == std::errc::address_in_use
+               (ec.value() == EADDRINUSE
                     ? " (another program, e.g. a ground station, holds the port)"
                     : "");
       return false;
