@@ -67,7 +67,7 @@ class SerialStream : public ByteStream {
 
   bool Read(std::string* chunk, double timeout_s, std::string* why) override {
     if (!port_.is_open()) {
-      *why = Describe() + ": closed";
+      *why = closed_why_;
       return false;
     }
     bool done = false;
@@ -84,9 +84,10 @@ class SerialStream : public ByteStream {
     });
     chunk->append(buffer_.data(), got);
     if (!result || result == asio::error::operation_aborted) return true;
-    *why = Describe() + ": " +
-           (result == asio::error::eof ? std::string("end of stream (device closed)")
-                                       : result.message() + " (device closed or unplugged?)");
+    closed_why_ = Describe() + ": " +
+                  (result == asio::error::eof ? std::string("end of stream (device closed)")
+                                              : result.message() + " (device closed or unplugged?)");
+    *why = closed_why_;
     std::error_code ignored;
     port_.close(ignored);
     return false;
@@ -99,6 +100,7 @@ class SerialStream : public ByteStream {
  private:
   std::string device_;
   int baud_;
+  std::string closed_why_;  // why the port was closed (a read after that repeats it)
   asio::io_context io_;
   asio::serial_port port_{io_};
   std::array<char, kByteStreamMaxReadBytes> buffer_;
