@@ -404,6 +404,33 @@ TEST(MavlinkDecoder, FramesSplitAnywhereGiveTheSameSamples) {
   }
 }
 
+// A frame cut before its last checksum byte, where the next frame's start byte happens to be
+// that byte (1 in 256): both checksums match, and the whole frame after it wins.
+TEST(MavlinkDecoder, ACutFrameWhoseChecksumCameRightDoesNotSwallowTheNext) {
+  const auto samples = AsMavlinkSamples(SimulatedSwing(20.0, 100.0, 8));
+  MavlinkFrameOptions v1;
+  v1.version = 1;
+  std::string cut;
+  for (const auto& s : samples) {
+    const std::string frame = EncodeScaledImu(s, v1);
+    if (static_cast<uint8_t>(frame.back()) == kMavlink2Magic) {
+      cut = frame.substr(0, frame.size() - 1);
+      break;
+    }
+  }
+  ASSERT_FALSE(cut.empty()) << "no frame of the swing has the checksum byte wanted";
+  const auto frames = HighresFrames(samples);
+  MavlinkDecoder decoder;
+  std::vector<MavlinkImuSample> got;
+  for (const char c : cut + frames[0] + frames[1]) {  // byte by byte: the worst case
+    for (const auto& s : decoder.Feed(std::string(1, c))) got.push_back(s);
+  }
+  ASSERT_EQ(got.size(), 2u);
+  ExpectHighresEqual(samples[0], got[0]);
+  ExpectHighresEqual(samples[1], got[1]);
+  EXPECT_EQ(decoder.counters().bytes_skipped, static_cast<long>(cut.size()));
+}
+
 TEST(MavlinkDecoder, HighresFieldsUpdatedMarksOldReadings) {
   MavlinkImuSample s{};
   s.t_s = 2.0;

@@ -115,23 +115,41 @@ Attempt CheckImuFrame(const uint8_t* p, std::size_t n, const FrameHeader& h, boo
   return *bad_crc ? Attempt::kNotAFrame : Attempt::kFrame;
 }
 
-// A frame of a message not read here, whose checksum cannot be checked: kFrame when the byte
-// after it starts a frame and no IMU frame with a good checksum starts inside it (so a false
-// start in garbage never swallows a real IMU frame).
-Attempt CheckOtherFrame(const uint8_t* p, std::size_t n, const FrameHeader& h) {
-  if (n < h.total_bytes + 1) return Attempt::kNeedMore;
-  if (!IsMagic(p[h.total_bytes])) return Attempt::kNotAFrame;
-  for (std::size_t q = 1; q < h.total_bytes; ++q) {
+// Whether an IMU frame with a good checksum starts inside the `total` bytes at p (n bytes
+// available): kFrame if one does, kNotAFrame if none, kNeedMore when one may but is not whole.
+Attempt CheckedFrameInside(const uint8_t* p, std::size_t n, std::size_t total) {
+  for (std::size_t q = 1; q < total; ++q) {
     if (!IsMagic(p[q])) continue;
     FrameHeader inner;
     if (!ReadHeader(p + q, n - q, &inner)) return Attempt::kNeedMore;
     if (inner.unknown_incompat || MavlinkCrcExtra(inner.msgid) < 0) continue;
     bool bad_crc = false;
     const Attempt a = CheckImuFrame(p + q, n - q, inner, &bad_crc);
-    if (a == Attempt::kNeedMore) return Attempt::kNeedMore;
-    if (a == Attempt::kFrame) return Attempt::kNotAFrame;
+    if (a != Attempt::kNotAFrame) return a;
   }
-  return Attempt::kFrame;
+  return Attempt::kNotAFrame;
+}
+
+// A frame of a message not read here, whose checksum cannot be checked: kFrame when the byte
+// after it starts a frame and no IMU frame with a good checksum starts inside it (so a false
+// start in garbage never swallows a real IMU frame).
+Attempt CheckOtherFrame(const uint8_t* p, std::size_t n, const FrameHeader& h) {
+  if (n < h.total_bytes + 1) return Attempt::kNeedMore;
+  if (!IsMagic(p[h.total_bytes])) return Attempt::kNotAFrame;
+  const Attempt inside = CheckedFrameInside(p, n, h.total_bytes);
+  if (inside == Attempt::kNeedMore) return Attempt::kNeedMore;
+  return inside == Attempt::kFrame ? Attempt::kNotAFrame : Attempt::kFrame;
+}
+
+// An IMU frame whose checksum matched is taken unless another IMU frame with a good checksum
+// starts inside it: a frame cut short whose checksum came right by chance (1 in 256 when only
+// the last byte is missing) would otherwise swallow the whole frame after it.
+Attempt CheckImuFrameAlone(const uint8_t* p, std::size_t n, const FrameHeader& h, bool* bad_crc) {
+  const Attempt a = CheckImuFrame(p, n, h, bad_crc);
+  if (a != Attempt::kFrame) return a;
+  const Attempt inside = CheckedFrameInside(p, n, h.total_bytes);
+  if (inside == Attempt::kNeedMore) return Attempt::kNeedMore;
+  return inside == Attempt::kFrame ? Attempt::kNotAFrame : Attempt::kFrame;
 }
 
 }  // namespace
@@ -185,7 +203,7 @@ std::vector<MavlinkImuSample> MavlinkDecoder::Feed(const std::string& bytes) {
       attempt = CheckOtherFrame(p, n, h);
       if (attempt == Attempt::kFrame) ++counters_.unknown_msgid;
     } else {
-      attempt = CheckImuFrame(p, n, h, &bad_crc);
+      attempt = CheckImuFrameAlone(p, n, h, &bad_crc);
       if (bad_crc) ++counters_.bad_crc;
       if (attempt == Attempt::kFrame) {
         ++counters_.frames_ok;

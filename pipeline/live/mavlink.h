@@ -19,7 +19,10 @@
 // and the search for a frame restarts one byte after the rejected start byte. Frames of other
 // messages cannot be checked (their CRC_EXTRA is not known here): one is taken as a frame when
 // the byte after it starts another frame, and counted as unknown_msgid; otherwise its start
-// byte is garbage. Bytes outside accepted frames are counted as bytes_skipped. Signed MAVLink 2
+// byte is garbage. No frame is taken (checked or not) when an IMU frame with a good checksum
+// starts inside it, so a false start in garbage, or a frame cut short whose checksum came
+// right by chance, never swallows a good frame; such a frame waits (in pending_bytes) until
+// the frame inside it is whole, a few frames' time in a live stream. Bytes outside accepted frames are counted as bytes_skipped. Signed MAVLink 2
 // frames (incompat flag 0x01) carry 13 signature bytes after the checksum: skipped, not
 // verified. A frame with an incompat flag this decoder does not know is not read (MAVLink's
 // rule), its bytes count as skipped.
@@ -99,7 +102,8 @@ class MavlinkDecoder {
   // in arrival order.
   std::vector<MavlinkImuSample> Feed(const std::string& bytes);
   const MavlinkCounters& counters() const { return counters_; }
-  // Bytes held back: the start of a frame not yet whole (at most one frame, <= 280 bytes + 1).
+  // Bytes held back: the start of a frame not yet whole, or of one that waits for a frame
+  // starting inside it (at most two frames, 2 x 280 bytes + 1).
   std::size_t pending_bytes() const { return pending_.size(); }
 
  private:
