@@ -18,6 +18,7 @@ COMPONENTS = collections.OrderedDict([
     ("fit", ("fit", ["pendulum", "base"])),
     ("figures", ("pipeline/figures", ["fit", "base"])),
     ("logs", ("pipeline/logs", ["pendulum", "base"])),
+    ("live", ("pipeline/live", ["base"])),
     ("config", ("pipeline/config", ["logs", "fit", "pendulum", "base"])),
     ("records", ("pipeline/records", ["config", "fit", "base"])),
     ("trace", ("pipeline/trace", ["records", "config", "logs", "figures", "fit", "base"])),
