@@ -317,5 +317,49 @@ TEST(RepeatSetups, CampaignWarnsPerAttitudeAndHonoursTheGroupColumn) {
   EXPECT_NE(two.out.find("Traces: 4 ok"), std::string::npos) << two.out << two.err;
 }
 
+// Issue 33 item 3: --group-by patterns that crashed std::regex (a stack overflow in its
+// recursive compiler and matcher) or ran for minutes (backtracking) are answered or refused by
+// RE2, which neither recurses nor backtracks. Each case must return; none may crash.
+TEST(RepeatGrouping, HostileGroupByPatternsAreAnsweredOrRefused) {
+  const std::vector<std::string> names = {"a/swing_1.csv", "a/swing_2.csv"};
+  const auto refused = [&](const std::string& pattern, const std::string& why) {
+    RepeatGroupingOptions by;
+    by.group_by = pattern;
+    try {
+      GroupRepeats(names, by);
+      ADD_FAILURE() << pattern.size() << "-byte pattern accepted";
+    } catch (const UserError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+      EXPECT_LT(std::string(e.what()).size(), 400u) << "the pattern is quoted short";
+    }
+  };
+  refused(std::string(100000, 'a'), "longer than 4096 bytes");
+  refused(std::string(20000, '(') + "a" + std::string(20000, ')'), "longer than 4096 bytes");
+  refused("(a)\\1", "not a regular expression RE2 accepts");  // a backreference
+  // 2000 nested groups fit in 4 kB: compiled and matched (the whole match when the first
+  // group is the same text).
+  RepeatGroupingOptions nested;
+  nested.group_by = std::string(2000, '(') + "swing" + std::string(2000, ')');
+  const std::vector<RepeatGroup> g = GroupRepeats(names, nested);
+  ASSERT_EQ(g.size(), 1u);
+  EXPECT_EQ(g[0].name, "swing");
+  // '/((.|/)*)x' on a 16 kB path: no 'x' after a '/', so no key; both logs alone.
+  std::string deep = "/";
+  for (int i = 0; i < 8000; ++i) deep += "a/";
+  RepeatGroupingOptions path;
+  path.group_by = "/((.|/)*)x";
+  const std::vector<RepeatGroup> p = GroupRepeats({deep + "swing_1.csv", deep + "swing_2.csv"}, path);
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_NE(p[0].alone.find("does not match --group-by '/((.|/)*)x'"), std::string::npos);
+  // (a+)+$ on 28 a's and a b: no match (std::regex took minutes); on a's alone, the a's.
+  RepeatGroupingOptions nested_plus;
+  nested_plus.group_by = "(a+)+$";
+  const std::string a28(28, 'a');
+  EXPECT_EQ(GroupRepeats({a28 + "b", a28 + "ab"}, nested_plus).size(), 2u);
+  const std::vector<RepeatGroup> a = GroupRepeats({"x/" + a28, "y/" + a28}, nested_plus);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(a[0].name, a28);
+}
+
 }  // namespace
 }  // namespace bifilar
