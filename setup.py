@@ -4,11 +4,16 @@ The extension `bifilar._core` is the CMake target bifilar_python (python/CMakeLi
 is built by CMake exactly as in a normal build, for the interpreter running pip; the pure-Python
 part is python/bifilar/. Environment:
 
-  BIFILAR_CMAKE_BUILD_DIR  CMake build folder to use (default: build/pip in the clone). Give an
-                           existing build (e.g. `build`) to reuse its already-built extension;
-                           it must have been configured for the same Python interpreter.
+  BIFILAR_CMAKE_BUILD_DIR  CMake build folder to use. Default: the clone's `build` when it is
+                           a Release build configured for this Python with the module on (what
+                           scripts/run_sample.sh and scripts/test.sh make): its libraries and
+                           extension are reused, and pip only builds what is missing (seconds);
+                           else build/pip in the clone, configured once and reused.
   BIFILAR_CMAKE_ARGS       Extra arguments for the CMake configure step (split on spaces).
   CMAKE_BUILD_PARALLEL_LEVEL  Parallel build jobs (default: the number of cores).
+
+A fresh build/pip is configured with ccache as the compiler launcher when ccache is installed
+(unless BIFILAR_CMAKE_ARGS names a launcher), so a rebuild recompiles nothing unchanged.
 """
 import glob
 import os
@@ -32,22 +37,41 @@ def _version():
     return match.group(1)
 
 
-def _cached_python(build_dir):
-    """Python3_EXECUTABLE of an existing CMake build folder, or None."""
+def _cached(build_dir, key):
+    """The value of KEY:TYPE=VALUE in an existing CMake build folder's cache, or None."""
     cache = os.path.join(build_dir, "CMakeCache.txt")
     if not os.path.exists(cache):
         return None
     with open(cache, encoding="utf-8", errors="replace") as f:
         for line in f:
-            if line.startswith("Python3_EXECUTABLE:"):
+            if line.startswith(key + ":"):
                 return line.split("=", 1)[1].strip()
     return None
 
 
+def _reusable(build_dir):
+    """True when build_dir is a Release build for this Python with the module on and no
+    sanitizer (an extension built with AddressSanitizer would not load in a plain Python)."""
+    python = _cached(build_dir, "Python3_EXECUTABLE")
+    return (python is not None
+            and os.path.realpath(python) == os.path.realpath(sys.executable)
+            and _cached(build_dir, "CMAKE_BUILD_TYPE") == "Release"
+            and _cached(build_dir, "BIFILAR_PYTHON") in ("ON", "TRUE", "1")
+            and _cached(build_dir, "BIFILAR_SANITIZE") in (None, "OFF", "FALSE", "0"))
+
+
+def _build_dir():
+    """BIFILAR_CMAKE_BUILD_DIR, else the clone's `build` when reusable, else build/pip."""
+    given = os.environ.get("BIFILAR_CMAKE_BUILD_DIR")
+    if given:
+        return os.path.abspath(given)
+    main = os.path.join(HERE, "build")
+    return main if _reusable(main) else os.path.join(HERE, "build", "pip")
+
+
 # The CMake build folder; setuptools' own scratch files go into it too (under setuptools/), so
 # nothing is written beside the sources and two builds with different folders do not meet.
-BUILD_DIR = os.path.abspath(
-    os.environ.get("BIFILAR_CMAKE_BUILD_DIR") or os.path.join(HERE, "build", "pip"))
+BUILD_DIR = _build_dir()
 SCRATCH = os.path.join(BUILD_DIR, "setuptools")
 
 
@@ -57,7 +81,7 @@ class CMakeBuild(build_ext):
     def build_extension(self, ext):
         build_dir = BUILD_DIR
         python = os.path.realpath(sys.executable)
-        cached = _cached_python(build_dir)
+        cached = _cached(build_dir, "Python3_EXECUTABLE")
         if cached is not None and os.path.realpath(cached) != python:
             raise RuntimeError(
                 f"setup.py: the CMake build folder {build_dir} was configured for {cached}, "
@@ -66,8 +90,12 @@ class CMakeBuild(build_ext):
         if cached is None:
             configure = ["cmake", "-S", HERE, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release",
                          f"-DPython3_EXECUTABLE={sys.executable}", "-DBIFILAR_PYTHON=ON"]
-            configure += os.environ.get("BIFILAR_CMAKE_ARGS", "").split()
-            subprocess.check_call(configure)
+            extra = os.environ.get("BIFILAR_CMAKE_ARGS", "").split()
+            if (shutil.which("ccache") and "CMAKE_CXX_COMPILER_LAUNCHER" not in os.environ
+                    and not any("COMPILER_LAUNCHER" in a for a in extra)):
+                configure.append("-DCMAKE_CXX_COMPILER_LAUNCHER=ccache")
+            subprocess.check_call(configure + extra)
+        print(f"setup.py: building bifilar._core in {build_dir}", flush=True)
         jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL") or str(os.cpu_count() or 1)
         subprocess.check_call(["cmake", "--build", build_dir, "--target", "bifilar_python",
                                "-j", jobs])

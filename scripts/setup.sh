@@ -12,7 +12,7 @@ targets=()
 for t in "$@"; do targets+=(--target "$t"); done
 packages=(cmake g++ make pkg-config libeigen3-dev libsundials-dev libceres-dev libnlopt-cxx-dev
           libyaml-cpp-dev libcli11-dev libplplot-dev plplot-driver-cairo libfast-float-dev
-          nlohmann-json3-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev
+          nlohmann-json3-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev libre2-dev
           pybind11-dev python3-dev python3-numpy python3-pytest
           liburdfdom-dev libsdformat-dev libmujoco-dev
           python3-pip python3-setuptools python3-wheel python3-venv

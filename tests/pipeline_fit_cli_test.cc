@@ -101,13 +101,49 @@ TEST(FitCli, DropIdenticalLogsComparesBytesNotNames) {
   const std::string d = WriteFile(dir.path + "/a-4.csv", "t,w\n0,1\n\n");
   const std::string dot = dir.path + "/./a-1.csv";  // the same file written otherwise
   const std::string missing = dir.path + "/a-5.csv";
-  EXPECT_EQ(FindIdenticalLogs({a, b, c, d, dot, missing, missing}),
-            (std::vector<int>{-1, 0, -1, -1, 0, -1, -1}));
-  const DistinctLogs distinct = DropIdenticalLogs({a, b, c, dot});
+  // Not logs of this format (no gx column): compared by their bytes.
+  const ImuFormat format;
+  const std::vector<IdenticalLog> same =
+      FindIdenticalLogs({a, b, c, d, dot, missing, missing}, format, ImuLogOptions());
+  std::vector<int> first;
+  for (const IdenticalLog& s : same) first.push_back(s.first);
+  EXPECT_EQ(first, (std::vector<int>{-1, 0, -1, -1, 0, -1, -1}));
+  const DistinctLogs distinct = DropIdenticalLogs({a, b, c, dot}, format, ImuLogOptions());
   EXPECT_EQ(distinct.kept, (std::vector<std::string>{a, c}));
   ASSERT_EQ(distinct.warnings.size(), 2u);
   EXPECT_NE(distinct.warnings[0].find("the same bytes as " + a), std::string::npos);
   EXPECT_NE(distinct.warnings[1].find("the same file as " + a), std::string::npos);
+}
+
+// issue 33 item 5: the same swing saved with CRLF line ends, an extra newline or a comment line
+// above the header is the same repeat (judged on the samples), named as such; a log whose
+// samples differ in one digit is not.
+TEST(FitCli, DropIdenticalLogsComparesSamplesNotBytes) {
+  TempDir dir("bifilar_fit_cli");
+  const std::string body = "0,0.1,0.2,0.3\n0.01,0.11,0.21,0.31\n0.02,0.12,0.22,0.32\n";
+  const std::string a = WriteFile(dir.path + "/s-1.csv", "t,gx,gy,gz\n" + body);
+  std::string crlf = "t,gx,gy,gz\r\n" + body;
+  for (size_t at = crlf.find("\n", crlf.find("\r\n") + 2); at != std::string::npos;
+       at = crlf.find("\n", at + 2)) {
+    crlf.replace(at, 1, "\r\n");
+  }
+  const std::string b = WriteFile(dir.path + "/s-2.csv", crlf);
+  const std::string c = WriteFile(dir.path + "/s-3.csv", "t,gx,gy,gz\n" + body + "\n");
+  const std::string d = WriteFile(dir.path + "/s-4.csv", "# saved again\nt,gx,gy,gz\n" + body);
+  const std::string e = WriteFile(dir.path + "/s-5.csv",
+                                  "t,gx,gy,gz\n0,0.1,0.2,0.3\n0.01,0.11,0.21,0.31\n0.02,0.12,0.22,0.33\n");
+  ImuFormat format;
+  format.accel_columns = {"", "", ""};
+  const DistinctLogs distinct = DropIdenticalLogs({a, b, c, d, e}, format, ImuLogOptions());
+  EXPECT_EQ(distinct.kept, (std::vector<std::string>{a, e}));
+  ASSERT_EQ(distinct.warnings.size(), 3u);
+  for (const std::string& w : distinct.warnings) {
+    EXPECT_NE(w.find(": the same samples as " + a + " (the files differ only in what the reader "
+                     "skips"),
+              std::string::npos)
+        << w;
+  }
+  EXPECT_EQ(distinct.warnings[0].rfind(b + ": ", 0), 0u) << distinct.warnings[0];
 }
 
 // The figure files a run's "figures:" lines name, one set per log line.

@@ -87,5 +87,15 @@ TEST(OptionChecks, PlanTensorNamesFieldValueAndBound) {
                      "-4; must be > 0 (check the products' signs and sizes)");
 }
 
+// Issue 33 item 5: `plan --rig --repeat-scatter 1e308` printed "inf %"; a scatter between
+// repeats beyond 50 % of I is refused, naming the flag and the interval.
+TEST(OptionChecks, PlanRigRefusesAnOutOfRangeRepeatScatter) {
+  TempDir dir("bifilar_option_checks");
+  ExpectOneLineError(dir,
+                     "plan --rig --inertia 1e-5 --target-percent 1 --mass 1 --max-length 0.5 "
+                     "--max-separation 0.03 --repeat-scatter 1e308",
+                     "plan --rig: --repeat-scatter = 1e+308; must be in [0, 50]");
+}
+
 }  // namespace
 }  // namespace bifilar

@@ -14,6 +14,7 @@
 
 #include "base/units.h"
 #include "base/user_error.h"
+#include "pipeline/campaign/run_discovery.h"
 #include "pipeline/commands/fit_command.h"
 #include "pipeline/trace/repeats.h"
 #include "test_support.h"
@@ -315,6 +316,95 @@ TEST(RepeatSetups, CampaignWarnsPerAttitudeAndHonoursTheGroupColumn) {
       test_support::Bifilar(dir, "process " + dir.path + "/campaign.yaml --out " + dir.path + "/out2");
   EXPECT_EQ(two.out.find("two set-ups"), std::string::npos) << two.out;
   EXPECT_NE(two.out.find("Traces: 4 ok"), std::string::npos) << two.out << two.err;
+}
+
+// Issue 33 item 3: --group-by patterns that crashed std::regex (a stack overflow in its
+// recursive compiler and matcher) or ran for minutes (backtracking) are answered or refused by
+// RE2, which neither recurses nor backtracks. Each case must return; none may crash.
+TEST(RepeatGrouping, HostileGroupByPatternsAreAnsweredOrRefused) {
+  const std::vector<std::string> names = {"a/swing_1.csv", "a/swing_2.csv"};
+  const auto refused = [&](const std::string& pattern, const std::string& why) {
+    RepeatGroupingOptions by;
+    by.group_by = pattern;
+    try {
+      GroupRepeats(names, by);
+      ADD_FAILURE() << pattern.size() << "-byte pattern accepted";
+    } catch (const UserError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+      EXPECT_LT(std::string(e.what()).size(), 400u) << "the pattern is quoted short";
+    }
+  };
+  refused(std::string(100000, 'a'), "longer than 4096 bytes");
+  refused(std::string(20000, '(') + "a" + std::string(20000, ')'), "longer than 4096 bytes");
+  refused("(a)\\1", "not a regular expression RE2 accepts");  // a backreference
+  // 2000 nested groups fit in 4 kB: compiled and matched (the whole match when the first
+  // group is the same text).
+  RepeatGroupingOptions nested;
+  nested.group_by = std::string(2000, '(') + "swing" + std::string(2000, ')');
+  const std::vector<RepeatGroup> g = GroupRepeats(names, nested);
+  ASSERT_EQ(g.size(), 1u);
+  EXPECT_EQ(g[0].name, "swing");
+  // '/((.|/)*)x' on a 16 kB path: no 'x' after a '/', so no key; both logs alone.
+  std::string deep = "/";
+  for (int i = 0; i < 8000; ++i) deep += "a/";
+  RepeatGroupingOptions path;
+  path.group_by = "/((.|/)*)x";
+  const std::vector<RepeatGroup> p = GroupRepeats({deep + "swing_1.csv", deep + "swing_2.csv"}, path);
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_NE(p[0].alone.find("does not match --group-by '/((.|/)*)x'"), std::string::npos);
+  // (a+)+$ on 28 a's and a b: no match (std::regex took minutes); on a's alone, the a's.
+  RepeatGroupingOptions nested_plus;
+  nested_plus.group_by = "(a+)+$";
+  const std::string a28(28, 'a');
+  EXPECT_EQ(GroupRepeats({a28 + "b", a28 + "ab"}, nested_plus).size(), 2u);
+  const std::vector<RepeatGroup> a = GroupRepeats({"x/" + a28, "y/" + a28}, nested_plus);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(a[0].name, a28);
+}
+
+// Issue 33 items 4 and 5: a --runs-table names -0 and 0 as one attitude (and 10 and 10.0 as one
+// group); a table beyond its bounds (size, line length, rows) is refused naming the bound,
+// without being read whole.
+TEST(RepeatGrouping, RunsTableKeysAreNumbersAndTheTableIsBounded) {
+  const TempDir dir("bifilar_setups_bounds");
+  const std::string attitudes = WriteFile(
+      dir.path + "/attitudes.csv",
+      "path,roll_deg,pitch_deg\nr1.csv,-0,0\nr2.csv,0,-0.0\nr3.csv,0.0,10\n");
+  const RunsTableGroups by_attitude = ReadRunsTableGroups(attitudes);
+  ASSERT_EQ(by_attitude.groups.size(), 3u);
+  EXPECT_EQ(by_attitude.groups[0], "roll 0 pitch 0");
+  EXPECT_EQ(by_attitude.groups[1], "roll 0 pitch 0");
+  EXPECT_EQ(by_attitude.groups[2], "roll 0 pitch 10");
+  const std::string numbered = WriteFile(
+      dir.path + "/numbered.csv", "path,group\nr1.csv,10\nr2.csv,10.0\nr3.csv,-0\nr4.csv,0\nr5.csv,A\n");
+  EXPECT_EQ(ReadRunsTableGroups(numbered).groups,
+            (std::vector<std::string>{"10", "10", "0", "0", "A"}));
+  const auto refused = [](const std::string& table, const std::string& why) {
+    try {
+      ReadRunsTableGroups(table);
+      ADD_FAILURE() << table << " accepted";
+    } catch (const UserError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  };
+  refused(WriteFile(dir.path + "/line.csv", "path,group\n" + std::string(100000, 'x') + ",A\n"),
+          "line.csv:2: a line of 100002 bytes, over 65536");
+  std::string rows = "path,group\n";
+  for (int i = 0; i <= 100000; ++i) rows += "l" + std::to_string(i) + ".csv,A\n";
+  refused(WriteFile(dir.path + "/rows.csv", rows), "more than 100000 rows");
+  std::string big(17000000, 'x');
+  refused(WriteFile(dir.path + "/big.csv", "path,group\n" + big), "too large");
+  // Matching logs to rows is by file name first: 20,000 logs against 20,000 rows at once.
+  RunsTableGroups table;
+  std::vector<std::string> logs;
+  for (int i = 0; i < 20000; ++i) {
+    table.paths.push_back("run/l" + std::to_string(i) + ".csv");
+    table.groups.push_back(std::to_string(i % 7));
+    logs.push_back("/data/run/l" + std::to_string(i) + ".csv");
+  }
+  const std::vector<std::string> groups = GroupsOfLogs(logs, table);
+  ASSERT_EQ(groups.size(), logs.size());
+  EXPECT_EQ(groups[12345], std::to_string(12345 % 7));
 }
 
 }  // namespace

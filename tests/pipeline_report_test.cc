@@ -267,5 +267,59 @@ TEST(Report, CommittedSampleReportLoadsInChromium) {
   fs::remove_all(work);
 }
 
+// issue 33 item 2: a results.json from someone else names figures outside its folder (`../`, an
+// absolute path, a link leading out): `report` refuses it naming the key and the value, and no
+// file outside is read, embedded or rewritten; the folder's own figures still work.
+TEST(Report, FigureNamesOutsideTheFolderAreRefusedAndNothingIsTouched) {
+  const std::string out = MakeCampaign();
+  const std::string base = fs::path(out).parent_path().string();
+  const std::string outside_svg =
+      "<?xml version=\"1.0\"?>\n<!-- the user's own -->\n<svg xmlns=\"http://www.w3.org/2000/svg\" "
+      "width=\"10\" height=\"10\"><text>outside</text></svg>\n";
+  WriteFile(base + "/outside.svg", outside_svg);
+  WriteFile(base + "/secret.txt", "the reader's secret");
+  const std::string report_before = ReadFile(out + "/report.html");
+  nlohmann::json results;
+  {
+    std::ifstream in(out + "/results.json");
+    results = nlohmann::json::parse(in);
+  }
+  fs::create_symlink(base + "/outside.svg", out + "/figures/leaving.svg");
+  struct Case {
+    std::string key, value;
+  };
+  const std::vector<Case> cases = {{"figures.moments", "../../outside.svg"},
+                                   {"figures.polar", base + "/secret.txt"},
+                                   {"traces[0].figure", "leaving.svg"},
+                                   {"traces[1].sweep_figure", "../report.html"}};
+  for (const Case& c : cases) {
+    nlohmann::json hostile = results;
+    if (c.key == "figures.moments") hostile["figures"]["moments"] = c.value;
+    if (c.key == "figures.polar") hostile["figures"]["polar"] = c.value;
+    if (c.key == "traces[0].figure") hostile["traces"][0]["figure"] = c.value;
+    if (c.key == "traces[1].sweep_figure") hostile["traces"][1]["sweep_figure"] = c.value;
+    WriteFile(out + "/results.json", hostile.dump(1));
+    try {
+      RunReport(out);
+      ADD_FAILURE() << c.key << " = " << c.value << " was accepted";
+    } catch (const UserError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(c.key + " = \"" + c.value + "\""), std::string::npos) << message;
+      EXPECT_NE(message.find("refused"), std::string::npos) << message;
+    }
+    EXPECT_EQ(ReadFile(base + "/outside.svg"), outside_svg) << c.key;
+    EXPECT_EQ(ReadFile(base + "/secret.txt"), "the reader's secret") << c.key;
+    EXPECT_EQ(ReadFile(out + "/report.html"), report_before) << c.key;
+    EXPECT_TRUE(fs::is_symlink(out + "/figures/leaving.svg"));
+    // The page built in `process` refuses the same names (no read through BuildReportHtml).
+    EXPECT_THROW(BuildReportHtml(hostile, out), UserError) << c.key;
+  }
+  // The folder's own names: the report is built as before.
+  WriteFile(out + "/results.json", results.dump(1));
+  EXPECT_NO_THROW(RunReport(out));
+  EXPECT_NE(ReadFile(out + "/report.html").find("<svg class=\"trace\""), std::string::npos);
+  fs::remove_all(base);
+}
+
 }  // namespace
 }  // namespace bifilar

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "base/bounded_read.h"
+#include "base/option_check.h"
 #include "base/user_error.h"
 
 namespace bifilar {
@@ -432,13 +433,45 @@ std::vector<RunFile> DiscoverRuns(const CampaignConfig& config) {
   return OncePerPath(std::move(runs));
 }
 
+namespace {
+
+// The bounds of a --runs-table (it names the logs of one `fit` command line, so a few thousand
+// rows at most): its size, its rows and the length of one line. A table beyond them is refused
+// before it is parsed, with what was found and the bound, never read into memory whole at any
+// size (issue 33 item 4: a 4-million-row table took 160 s and 885 MB, a 50 MB line 1.16 GB).
+constexpr uint64_t kMaxRunsTableGroupsBytes = 16'000'000;
+constexpr size_t kMaxRunsTableRows = 100000;
+constexpr size_t kMaxRunsTableLineBytes = 65536;
+
+// A set-up named by a number ("-0", "10", "10.0") is the number: -0 and 0 are one set-up, as are
+// 10 and 10.0. A cell that is not wholly a finite number stays as written.
+std::string NumericKey(const std::string& cell) {
+  if (cell.empty() || cell.find_first_not_of("0123456789+-.eE") != std::string::npos) return cell;
+  char* end = nullptr;
+  const double value = std::strtod(cell.c_str(), &end);
+  if (end != cell.c_str() + cell.size() || !std::isfinite(value)) return cell;
+  return FormatCheckValue(value + 0.0);  // + 0.0: -0 becomes 0; the shortest exact form
+}
+
+}  // namespace
+
 RunsTableGroups ReadRunsTableGroups(const std::string& table) {
-  std::istringstream in(ReadRegularFileOrThrow(table, TableCap("runs table (--runs-table)")));
+  const std::string text =
+      ReadRegularFileOrThrow(table, InputCap{kMaxRunsTableGroupsBytes, "runs table (--runs-table)",
+                                             "a runs table names one log per row"});
   RunsTableGroups out;
-  std::string line;
   int line_no = 0, path_col = -1, group_col = -1, pitch_col = -1, roll_col = -1;
-  while (std::getline(in, line)) {
+  for (size_t at = 0; at < text.size();) {
+    const size_t end = std::min(text.find('\n', at), text.size());
     ++line_no;
+    if (end - at > kMaxRunsTableLineBytes) {
+      throw UserError(table + ":" + std::to_string(line_no) + ": a line of " +
+                      std::to_string(end - at) + " bytes, over " +
+                      std::to_string(kMaxRunsTableLineBytes) +
+                      ": not a runs table (one row per log: path,group)");
+    }
+    std::string line = text.substr(at, end - at);
+    at = end + 1;
     if (line_no == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
     const size_t first = line.find_first_not_of(" \r\t");
     if (first == std::string::npos || line[first] == '#') continue;
@@ -461,7 +494,12 @@ RunsTableGroups ReadRunsTableGroups(const std::string& table) {
       out.source = table + (group_col >= 0 ? " (its group column)" : " (its roll_deg and pitch_deg)");
       continue;
     }
-    std::string group = cell(group_col);
+    if (out.paths.size() >= kMaxRunsTableRows) {
+      throw UserError(table + ":" + std::to_string(line_no) + ": more than " +
+                      std::to_string(kMaxRunsTableRows) +
+                      " rows: a runs table names the logs of one fit, one row per log");
+    }
+    std::string group = NumericKey(cell(group_col));
     if (group_col < 0) {
       double pitch = 0.0, roll = 0.0;
       if (!ParsePitchText(cell(pitch_col), &pitch) ||
@@ -469,9 +507,9 @@ RunsTableGroups ReadRunsTableGroups(const std::string& table) {
         throw UserError(table + ":" + std::to_string(line_no) + ": the attitude of '" +
                         cell(path_col) + "' is not a number in [-180, 180] (pitch_deg, roll_deg)");
       }
-      char text[64];
-      std::snprintf(text, sizeof(text), "roll %g pitch %g", roll, pitch);
-      group = text;
+      char attitude[64];  // -0 and 0 are one attitude: + 0.0 turns -0 into 0
+      std::snprintf(attitude, sizeof(attitude), "roll %g pitch %g", roll + 0.0, pitch + 0.0);
+      group = attitude;
     }
     if (cell(path_col).empty()) {
       throw UserError(table + ":" + std::to_string(line_no) + ": empty path in runs table");
@@ -485,17 +523,28 @@ RunsTableGroups ReadRunsTableGroups(const std::string& table) {
 
 std::vector<std::string> GroupsOfLogs(const std::vector<std::string>& logs,
                                       const RunsTableGroups& table) {
+  // The rows by their file name (their last component): a log is compared only with the rows
+  // that end in its file name, so the work is near-linear in logs + rows, not their product.
+  std::map<std::string, std::vector<size_t>> rows_of_name;
+  std::vector<std::vector<std::string>> rows(table.paths.size());
+  for (size_t r = 0; r < table.paths.size(); ++r) {
+    rows[r] = SplitPath(fs::path(table.paths[r]).lexically_normal().string());
+    if (!rows[r].empty()) rows_of_name[rows[r].back()].push_back(r);
+  }
   std::vector<std::string> groups;
   for (const std::string& log : logs) {
     const std::vector<std::string> parts = SplitPath(fs::path(log).lexically_normal().string());
     std::string group;
     size_t longest = 0;
-    for (size_t r = 0; r < table.paths.size(); ++r) {
-      const std::vector<std::string> row = SplitPath(fs::path(table.paths[r]).lexically_normal().string());
-      if (row.empty() || row.size() > parts.size() || row.size() <= longest) continue;
-      if (std::equal(row.begin(), row.end(), parts.end() - row.size())) {
-        longest = row.size();
-        group = table.groups[r];
+    const auto named = parts.empty() ? rows_of_name.end() : rows_of_name.find(parts.back());
+    if (named != rows_of_name.end()) {
+      for (size_t r : named->second) {
+        const std::vector<std::string>& row = rows[r];
+        if (row.size() > parts.size() || row.size() <= longest) continue;
+        if (std::equal(row.begin(), row.end(), parts.end() - row.size())) {
+          longest = row.size();
+          group = table.groups[r];
+        }
       }
     }
     groups.push_back(group);

@@ -320,7 +320,8 @@ FitCommandResult RunFit(const FitCommandOptions& options) {
   CalibrateIfConfigured(options, &result);
   // --repeats: identical data is one repeat; the copies are named and dropped before fitting.
   if (options.repeats) {
-    result.distinct = DropIdenticalLogs(options.logs);
+    result.distinct = DropIdenticalLogs(options.logs, result.config.imu.format,
+                                        result.config.LogOptions());
   } else {
     result.distinct.kept = options.logs;
   }

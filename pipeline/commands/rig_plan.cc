@@ -96,7 +96,7 @@ bool RigPlanOptions::Check(std::string* why) const {
       CheckLt("--gravity-std", gravity_std_mps2, "--gravity", gravity_mps2, &f) &&
       CheckIn("--imu-rate", imu_rate_hz, 5, 10000, Ends::kClosed, &f) &&
       CheckFiniteGt("--gyro-noise", gyro_noise_deg_per_s, 0, &f) &&
-      CheckFiniteGe("--repeat-scatter", repeat_scatter_percent, 0, &f) &&
+      CheckIn("--repeat-scatter", repeat_scatter_percent, 0, 50, Ends::kClosed, &f) &&
       CheckIn("--rig-departure", rig_departure_percent, 0, 50, Ends::kClosed, &f) &&
       CheckIn("--target-percent", target_percent, 0, 100, Ends::kOpen, &f) &&
       CheckGt("decay_periods", decay_periods, 1, &f) &&

@@ -14,6 +14,7 @@
 #include "base/bounded_read.h"
 #include "base/hash.h"
 #include "base/json_error.h"
+#include "base/text_format.h"
 #include "base/units.h"
 #include "base/user_error.h"
 #include "base/version.h"
@@ -135,11 +136,17 @@ constexpr const char* kCompactMark = "<!-- bifilar: compact svg for report.html 
 // A figure file as page content: an SVG inline (its ids prefixed, so the glyph and clip ids that
 // every cairo SVG names alike do not collide; a third smaller than base64), a PNG as a base64
 // data URI.
+// Names outside OUT/figures never reach here (CheckFigureNames refuses the page first); the
+// check is repeated so that no name is read unchecked. A figure that is a symbolic link (inside
+// the folder) is embedded but never replaced by its compact form.
 std::string Figure(const std::string& out_dir, const std::string& name, const std::string& alt,
                    const std::string& css_class, int* counter) {
   if (name.empty()) return "<p class=\"note\">(no figure)</p>";
-  std::string bytes, why;
-  const std::string path = (fs::path(out_dir) / "figures" / name).string();
+  std::string bytes, why, path;
+  if (!ResolveInsideFolder(out_dir, "figures", name, &path, &why)) {
+    return "<p class=\"note\">(figure " + Escape(PrintableAscii(name, 200)) + " refused: " +
+           Escape(why) + ")</p>";
+  }
   if (!ReadRegularFile(path, FigureCap(), &bytes, &why)) {
     return "<p class=\"note\">(figure " + Escape(name) + " missing)</p>";
   }
@@ -155,8 +162,9 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
       svg = CompactSvg(bytes.substr(start));
       // The figure's name is keyed by its content, so its compact form serves every later report:
       // stored in its place (atomically; best effort, a read-only folder only costs the time).
+      std::error_code ec;
       try {
-        WriteFileAtomically(path, kCompactMark + svg);
+        if (!fs::is_symlink(path, ec)) WriteFileAtomically(path, kCompactMark + svg);
       } catch (const std::exception&) {
       }
     }
@@ -191,6 +199,38 @@ std::string SweepFigure(const TraceRecord& t, const std::string& out_dir, int* c
                       "</sup>) and a ring on the band the result is taken from"
                 : "") +
          "</figcaption></figure>\n";
+}
+
+// Every figure name results.json gives (figures.*, traces[i].figure, traces[i].sweep_figure)
+// must name a file inside OUT/figures (ResolveInsideFolder): anything else (`../x`, an absolute
+// path, a link leading out of OUT) throws UserError naming the key and the value, before any
+// figure is read, embedded or rewritten (issue 33 item 2).
+void CheckFigureNames(const json& results, const std::string& out_dir) {
+  const auto check = [&](const std::string& key, const json& value) {
+    if (!value.is_string() || value.get<std::string>().empty()) return;
+    std::string path, why;
+    if (!ResolveInsideFolder(out_dir, "figures", value.get<std::string>(), &path, &why)) {
+      throw UserError((fs::path(out_dir) / "results.json").string() + ": " + key + " = \"" +
+                      PrintableAscii(value.get<std::string>(), 200) + "\" is " + why +
+                      ", not a figure in " + (fs::path(out_dir) / "figures").string() +
+                      "; refused, no file was read or written (a results.json from elsewhere? "
+                      "rerun `bifilar process` to rewrite it)");
+    }
+  };
+  if (results.contains("figures") && results["figures"].is_object()) {
+    for (const auto& [kind, name] : results["figures"].items()) check("figures." + kind, name);
+  }
+  if (results.contains("traces") && results["traces"].is_array()) {
+    const json& traces = results["traces"];
+    for (size_t i = 0; i < traces.size(); ++i) {
+      if (!traces[i].is_object()) continue;
+      for (const char* field : {"figure", "sweep_figure"}) {
+        if (traces[i].contains(field)) {
+          check("traces[" + std::to_string(i) + "]." + field, traces[i][field]);
+        }
+      }
+    }
+  }
 }
 
 const char* kStyle = R"(
@@ -914,6 +954,7 @@ std::string Base64(const std::string& bytes) {
 namespace {
 
 std::string BuildPage(const json& results, const std::string& out_dir, KeyLog* keys_read) {
+  CheckFigureNames(results, out_dir);
   ReportPage page(results, out_dir, keys_read);
   std::ostringstream h;
   WriteHeader(page, h);
@@ -962,6 +1003,7 @@ void RunReport(const std::string& out_dir) {
   if (!results.is_object() || !results.contains("traces")) {
     throw UserError(path + ": not a bifilar results file (no 'traces')");
   }
+  CheckFigureNames(results, out_dir);  // before anything reads a file results.json names
   // A mixed set (a run killed between two renames) is reported, not turned into a page.
   const std::vector<std::string> problems = CheckOutputSet(out_dir, false);
   if (!problems.empty()) {

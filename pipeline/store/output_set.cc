@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cassert>
 #include <cerrno>
 #include <cstring>
@@ -14,6 +15,7 @@
 #include "base/atomic_file.h"
 #include "base/bounded_read.h"
 #include "base/hash.h"
+#include "base/text_format.h"
 #include "base/json_error.h"
 #include "base/user_error.h"
 
@@ -423,6 +425,39 @@ void WriteOutputSet(const std::string& out_dir, nlohmann::json results,
   WriteFileAtomically((out / "results.json").string(), results_text);
 }
 
+bool ResolveInsideFolder(const std::string& folder, const std::string& sub,
+                         const std::string& name, std::string* path, std::string* why) {
+  const fs::path relative(name);
+  why->clear();
+  if (name.empty()) {
+    *why = "an empty name";
+  } else if (name.find('\0') != std::string::npos) {
+    *why = "a name holding a NUL byte";
+  } else if (relative.is_absolute() || relative.has_root_name() || relative.has_root_directory()) {
+    *why = "an absolute path";
+  } else if (std::any_of(relative.begin(), relative.end(),
+                         [](const fs::path& part) { return part == ".."; })) {
+    *why = "a '..' component";
+  }
+  if (!why->empty()) return false;
+  const fs::path full = fs::path(folder) / sub / relative;
+  std::error_code ec_root, ec_target;
+  const fs::path root = fs::weakly_canonical(folder, ec_root);
+  const fs::path target = fs::weakly_canonical(full, ec_target);
+  if (ec_root || ec_target) {
+    *why = "a name whose links cannot be followed (" + (ec_root ? ec_root : ec_target).message() + ")";
+    return false;
+  }
+  // Component by component: /out2/x is not inside /out.
+  const auto [root_end, unused] = std::mismatch(root.begin(), root.end(), target.begin(), target.end());
+  if (root_end != root.end()) {
+    *why = "a link leading out of " + folder;
+    return false;
+  }
+  *path = full.string();
+  return true;
+}
+
 std::vector<std::string> CheckOutputSet(const std::string& out_dir, bool check_report) {
   std::vector<std::string> problems;
   const fs::path out(out_dir);
@@ -438,7 +473,12 @@ std::vector<std::string> CheckOutputSet(const std::string& out_dir, bool check_r
   }
   if (!results.is_object() || !results.contains("outputs")) return problems;  // older bifilar
   for (const auto& [name, hash] : results["outputs"].items()) {
-    const std::string path = (out / name).string();
+    std::string path, why;
+    if (!ResolveInsideFolder(out_dir, "", name, &path, &why)) {
+      problems.push_back(results_path + ": outputs names \"" + PrintableAscii(name, 200) +
+                         "\", " + why + ", not a file of " + out_dir + " (not read)");
+      continue;
+    }
     if (!fs::exists(path, ec)) {
       problems.push_back(path + " is missing");
     } else if (!hash.is_string() || FileHash(path) != hash.get<std::string>()) {
@@ -457,9 +497,13 @@ std::vector<std::string> CheckOutputSet(const std::string& out_dir, bool check_r
   }
   auto check_figure = [&](const nlohmann::json& name) {
     if (!name.is_string() || name.get<std::string>().empty()) return;
-    const fs::path path = out / "figures" / name.get<std::string>();
-    if (!fs::exists(path, ec)) {
-      problems.push_back(path.string() + " (named in results.json) is missing");
+    std::string path, why;
+    if (!ResolveInsideFolder(out_dir, "figures", name.get<std::string>(), &path, &why)) {
+      problems.push_back(results_path + ": a figure named \"" +
+                         PrintableAscii(name.get<std::string>(), 200) + "\", " + why +
+                         ", not a file of " + out_dir + "/figures (not read)");
+    } else if (!fs::exists(path, ec)) {
+      problems.push_back(path + " (named in results.json) is missing");
     }
   };
   if (results.contains("traces") && results["traces"].is_array()) {

@@ -94,6 +94,15 @@ std::string StampReport(const std::string& html, const std::string& results_hash
 // results.json. Empty when consistent (or when results.json predates the hashes).
 std::vector<std::string> CheckOutputSet(const std::string& out_dir, bool check_report);
 
+// A file name read from results.json (a figure, under OUT/figures; an output, under OUT) as the
+// path to read: true with *path = folder/sub/name when `name` is a plain relative name (not
+// empty, no NUL, not absolute, no '..' component) whose file (or where it would be), once every
+// symbolic link is followed, lies inside `folder`; else false with *why ("an absolute path", "a
+// '..' component", "a link leading out of OUT"). A results.json from someone else can then
+// neither read nor change a file outside its folder (issue 33 item 2).
+bool ResolveInsideFolder(const std::string& folder, const std::string& sub,
+                         const std::string& name, std::string* path, std::string* why);
+
 // Throws UserError naming the first of the result files, the manifest and the entries of cache/
 // and figures/ that exists and is not a regular file (a FIFO, device, socket or folder, also
 // behind a symlink): bifilar reads and writes only regular files there, and a FIFO would block

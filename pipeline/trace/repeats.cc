@@ -4,8 +4,6 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <map>
 #include <string>
 
@@ -384,68 +382,6 @@ RepeatsAmplitudeCorrection CorrectAmplitude(const std::vector<RepeatGroup>& grou
 bool IsRepeatScatterWarning(const std::string& warning) {
   return warning.rfind("the ", 0) == 0 &&
          warning.find(" scatter beyond their own stds (Q = ") != std::string::npos;
-}
-
-namespace {
-
-// True when the two files hold the same bytes (both readable, read in 1 MiB blocks).
-bool SameBytes(const std::string& a, const std::string& b) {
-  std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
-  if (!fa || !fb) return false;
-  std::vector<char> ba(1 << 20), bb(1 << 20);
-  while (fa && fb) {
-    fa.read(ba.data(), static_cast<std::streamsize>(ba.size()));
-    fb.read(bb.data(), static_cast<std::streamsize>(bb.size()));
-    if (fa.gcount() != fb.gcount()) return false;
-    if (!std::equal(ba.begin(), ba.begin() + fa.gcount(), bb.begin())) return false;
-  }
-  return fa.eof() && fb.eof() && !fa.bad() && !fb.bad();
-}
-
-}  // namespace
-
-std::vector<int> FindIdenticalLogs(const std::vector<std::string>& paths) {
-  namespace fs = std::filesystem;
-  std::vector<int> same(paths.size(), -1);
-  std::map<std::uintmax_t, std::vector<size_t>> by_size;  // distinct contents of each size
-  for (size_t i = 0; i < paths.size(); ++i) {
-    std::error_code ec;
-    if (!fs::is_regular_file(paths[i], ec)) continue;
-    const std::uintmax_t size = fs::file_size(paths[i], ec);
-    if (ec) continue;
-    std::vector<size_t>& firsts = by_size[size];
-    for (size_t j : firsts) {
-      std::error_code ec2;
-      if (fs::equivalent(paths[i], paths[j], ec2) || SameBytes(paths[i], paths[j])) {
-        same[i] = static_cast<int>(j);
-        break;
-      }
-    }
-    if (same[i] < 0) firsts.push_back(i);
-  }
-  return same;
-}
-
-DistinctLogs DropIdenticalLogs(const std::vector<std::string>& paths) {
-  DistinctLogs d;
-  const std::vector<int> same = FindIdenticalLogs(paths);
-  for (size_t i = 0; i < paths.size(); ++i) {
-    if (same[i] < 0) {
-      d.kept.push_back(paths[i]);
-      continue;
-    }
-    const std::string& first = paths[same[i]];
-    d.dropped.emplace_back(paths[i], first);
-    std::error_code ec;
-    d.warnings.push_back(
-        paths[i] + ": " +
-        (paths[i] == first                                ? std::string("given again")
-         : std::filesystem::equivalent(paths[i], first, ec) ? "the same file as " + first
-                                                            : "the same bytes as " + first) +
-        ": one swing is one repeat, so it is dropped from the repeats (counted twice it would "
-        "shrink the std by sqrt(2) and hide the scatter between repeats)");
-  }
-  return d;
 }
 
 RepeatsAmplitudeCorrection CombineRepeats(std::vector<RepeatGroup>* groups,

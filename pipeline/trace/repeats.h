@@ -27,6 +27,8 @@
 #include <utility>
 #include <vector>
 
+#include "pipeline/logs/imu_format.h"
+#include "pipeline/logs/imu_log_options.h"
 #include "pipeline/records/trace_record.h"
 #include "pipeline/trace/repeat_setups.h"
 
@@ -112,12 +114,23 @@ bool IsRepeatScatterWarning(const std::string& warning);
 // path without a number is a group of its own (the default RepeatGroupingOptions).
 std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths);
 
-// One swing is one repeat: a log given twice (the same file under one or two names) or a
-// byte-identical copy under another name would count twice, give Q = 0 and shrink the std by
-// sqrt(2). For each path, the index of the first earlier path with the same bytes, or -1 (also
-// for a file that cannot be read: its fit reports that). Files are compared byte for byte, only
-// those of equal size.
-std::vector<int> FindIdenticalLogs(const std::vector<std::string>& paths);
+// One swing is one repeat: a log given twice (the same file under one or two names), a copy
+// under another name, or the same swing saved again with other line ends (CRLF), an extra
+// newline or comment line, would count twice, give Q = 0 and shrink the std by sqrt(2). So
+// identity is judged on the samples the reader gives (times, gyro and accelerometer in SI, read
+// with `format` and `options` as the fit reads them), not on the bytes: for each path, the index
+// of the first earlier path with the same samples, or -1. A file that cannot be read as a log
+// (its fit reports why) is compared by its bytes; one that is not a regular file is -1. Each log
+// is read once and its samples hashed (FNV-1a 64); only logs whose hashes meet are compared in
+// full, so the scan is linear in the logs, whatever their sizes.
+struct IdenticalLog {
+  int first = -1;         // index of the first earlier path with the same content, or -1
+  std::string relation;   // "given again", "the same file as", "the same bytes as",
+                          // "the same samples as" (empty for -1)
+};
+std::vector<IdenticalLog> FindIdenticalLogs(const std::vector<std::string>& paths,
+                                            const ImuFormat& format,
+                                            const ImuLogOptions& options);
 
 // The logs of `paths` that FindIdenticalLogs keeps (first of each content, in order), and one
 // warning per dropped log naming it and the log it repeats.
@@ -126,7 +139,8 @@ struct DistinctLogs {
   std::vector<std::pair<std::string, std::string>> dropped;  // (dropped log, the kept one)
   std::vector<std::string> warnings;
 };
-DistinctLogs DropIdenticalLogs(const std::vector<std::string>& paths);
+DistinctLogs DropIdenticalLogs(const std::vector<std::string>& paths, const ImuFormat& format,
+                               const ImuLogOptions& options);
 
 // The amplitude correction pooled over the groups (fit/amplitude_trend.h,
 // FitPooledAmplitudeTrend on each usable log's I, std and result amplitude: the lowest band's

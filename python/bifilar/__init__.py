@@ -35,7 +35,21 @@ import math as _math
 import operator as _operator
 import os as _os
 
-from . import _core
+try:
+    from . import _core
+except ImportError:  # the compiled part was never built here (or for another Python)
+    _here = _os.path.dirname(_os.path.abspath(__file__))
+    _build = _os.path.dirname(_os.path.dirname(_here))  # BUILD/python/bifilar -> BUILD
+    if not _os.path.exists(_os.path.join(_build, "CMakeCache.txt")):
+        _build = "build"
+    raise ImportError(
+        f"bifilar: the compiled part bifilar._core (a _core*.so for this Python) is not in "
+        f"{_here}. Build the Python module with\n"
+        f"    cmake --build {_build} --target bifilar_python\n"
+        "(scripts/run_sample.sh and scripts/test.sh do it when pybind11-dev, python3-dev and "
+        "python3-numpy are installed) and keep PYTHONPATH=build/python, or install it with "
+        "`python3 -m pip install --no-build-isolation .` (README, \"Python\")"
+    ) from None
 
 try:  # needed by every function; `import bifilar` itself works without it
     import numpy as _np

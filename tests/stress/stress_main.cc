@@ -1175,6 +1175,189 @@ int RunHostileInputCases(const Args& args, Workspace& w, int first_case_no, Fail
   return c - first_case_no;
 }
 
+// ---- Issue 33: the fourth hostile-input sweep (report paths, regexes, repeats, runs tables) ------
+//
+// Once each, after the hostile inputs above. Asserted as everywhere: no hang, no crash, the
+// expected exit code and message, nothing outside OUT changed (the sentinel).
+
+// Runs `argv` once as a hostile case: bounded, checked for the files outside OUT, the exit code
+// and the message.
+Outcome RunSweep4(const Args& args, const Workspace& w, int case_no, const std::string& kind,
+                  const std::vector<std::string>& argv, const std::vector<int>& codes,
+                  const std::string& message, Failures* failures) {
+  const Outcome o = Wait(Start(argv, w.harness + "/sweep4"), args.run_timeout_s);
+  CheckOutside(o, case_no, kind, failures);
+  ExpectStop(o, case_no, kind, codes, o.out + o.err, message, failures);
+  return o;
+}
+
+// Item 2: a results.json naming figures outside OUT (`../`, an absolute path, a link out of OUT):
+// `report` refuses naming the key and the value; the files outside stay as they were.
+void CaseReportFiguresOutside(const Args& args, const Workspace& w, int case_no,
+                              Failures* failures) {
+  const std::string kind = "report: figure outside OUT";
+  const Outcome fresh = Wait(Start(ProcessArgv(args, w, true), w.harness + "/sweep4"),
+                             args.run_timeout_s);
+  CheckRun(fresh, w, case_no, kind + " (process first)", failures);
+  const std::string results_path = w.out + "/results.json";
+  const std::string text = ResultsText(w);
+  nlohmann::json results = nlohmann::json::parse(text, nullptr, false);
+  if (results.is_discarded() || !results.contains("traces") || results["traces"].empty()) {
+    failures->Add(case_no, kind, "no results.json to start from");
+    return;
+  }
+  const std::string drawing = w.dir + "/precious/drawing.svg";
+  WriteFile(drawing, "<?xml version=\"1.0\"?>\n<!-- mine -->\n<svg width=\"1\" height=\"1\"></svg>\n");
+  const std::string link = w.out + "/figures/leaving.svg";
+  std::error_code ec;
+  fs::create_symlink(drawing, link, ec);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"figures.moments", "../../precious/drawing.svg"},
+      {"figures.polar", w.thesis},
+      {"traces[0].figure", "leaving.svg"},
+      {"traces[0].sweep_figure", "../../precious/thesis.txt"}};
+  for (const auto& [key, value] : cases) {
+    nlohmann::json hostile = results;
+    if (key == "figures.moments") hostile["figures"]["moments"] = value;
+    if (key == "figures.polar") hostile["figures"]["polar"] = value;
+    if (key == "traces[0].figure") hostile["traces"][0]["figure"] = value;
+    if (key == "traces[0].sweep_figure") hostile["traces"][0]["sweep_figure"] = value;
+    WriteFile(results_path, hostile.dump(1));
+    RunSweep4(args, w, case_no, kind + " " + key, {args.binary, "report", w.out}, {2},
+              key + " = \"" + value + "\"", failures);
+    if (!fs::is_symlink(fs::symlink_status(link, ec))) {
+      failures->Add(case_no, kind + " " + key, link + " (a link) was replaced");
+    }
+  }
+  WriteFile(results_path, text);
+  fs::remove(link, ec);
+  fs::remove(drawing, ec);
+}
+
+// Item 3: --group-by patterns that crashed std::regex or ran for minutes: refused or answered.
+void CaseGroupByPatterns(const Args& args, const Workspace& w, int case_no, Failures* failures) {
+  const std::string l1 = w.logs + "/pitch_0/trial_1.csv", l2 = w.logs + "/pitch_0/trial_2.csv";
+  std::string deep = w.harness + "/";
+  for (int i = 0; i < 8000; ++i) deep += "a/";
+  const std::string a28 = w.harness + "/" + std::string(28, 'a');
+  struct Pattern {
+    std::string what, pattern;
+    std::vector<std::string> logs;
+    std::vector<int> codes;
+    std::string message;
+  };
+  const std::vector<Pattern> patterns = {
+      {"100 kB", std::string(100000, 'a'), {l1, l2}, {2}, "longer than 4096 bytes"},
+      {"20,000 nested groups", std::string(20000, '(') + "a" + std::string(20000, ')'), {l1, l2},
+       {2}, "longer than 4096 bytes"},
+      {"2,000 nested groups", std::string(2000, '(') + "trial" + std::string(2000, ')'),
+       {l1, l2}, {0, 1}, "repeats: 2 log(s) in 1 group(s)"},
+      {"'/((.|/)*)x' on a 16 kB path", "/((.|/)*)x", {deep + "s-1.csv", deep + "s-2.csv"}, {1},
+       "repeats: 2 log(s) in 2 group(s)"},
+      {"'(a+)+$' on 28 a's and a b", "(a+)+$", {a28 + "b", a28 + "ab"}, {1},
+       "repeats: 2 log(s) in 2 group(s)"},
+      {"a backreference", "(a)\\1", {l1, l2}, {2}, "not a regular expression RE2 accepts"}};
+  double slowest_s = 0.0;
+  for (const Pattern& p : patterns) {
+    std::vector<std::string> argv = {args.binary, "fit", w.config_path};
+    argv.insert(argv.end(), p.logs.begin(), p.logs.end());
+    argv.insert(argv.end(), {"--repeats", "--group-by", p.pattern});
+    const Outcome o = RunSweep4(args, w, case_no, "--group-by " + p.what, argv, p.codes,
+                                p.message, failures);
+    slowest_s = std::max(slowest_s, o.seconds);
+  }
+  std::cout << "bifilar_stress: --group-by patterns of issue 33: slowest run " << slowest_s
+            << " s (fits included)\n";
+}
+
+// Item 5: the same swing with CRLF line ends, an extra newline and a comment line is one repeat:
+// the three copies are dropped, each named.
+void CaseRepeatsJudgedOnSamples(const Args& args, const Workspace& w, int case_no,
+                                Failures* failures) {
+  const std::string kind = "repeats: the same samples";
+  const std::string dir = w.harness + "/same_samples";
+  fs::create_directories(dir);
+  const std::string text = ReadFile(w.logs + "/pitch_0/trial_1.csv");
+  std::string crlf;
+  for (char c : text) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  const std::vector<std::pair<std::string, std::string>> copies = {
+      {dir + "/swing-1.csv", text}, {dir + "/swing-2.csv", crlf},
+      {dir + "/swing-3.csv", text + "\n"}, {dir + "/swing-4.csv", "# saved again\n" + text}};
+  std::vector<std::string> argv = {args.binary, "fit", w.config_path};
+  for (const auto& [path, bytes] : copies) {
+    WriteFile(path, bytes);
+    argv.push_back(path);
+  }
+  argv.insert(argv.end(), {"--repeats", "--json"});
+  const Outcome o = RunSweep4(args, w, case_no, kind, argv, {0, 1}, "identical_logs_dropped",
+                              failures);
+  const nlohmann::json j = nlohmann::json::parse(o.out, nullptr, false);
+  if (j.is_discarded() || !j.contains("identical_logs_dropped") ||
+      j["identical_logs_dropped"].size() != 3) {
+    failures->Add(case_no, kind, "not 3 copies dropped:\n" + o.out.substr(0, 2000));
+  }
+}
+
+// Items 4 and 5: a runs table naming roll -0 and 0 makes one group; tables beyond their bounds
+// (size, line length) are refused by the bound; 300 same-size files are grouped at once.
+void CaseRunsTablesAndManyLogs(const Args& args, const Workspace& w, int case_no,
+                               Failures* failures) {
+  const std::string dir = w.harness + "/tables";
+  fs::create_directories(dir);
+  const std::string l1 = w.logs + "/pitch_0/trial_1.csv", l2 = w.logs + "/pitch_0/trial_2.csv";
+  WriteFile(dir + "/zero.csv", "path,roll_deg,pitch_deg\npitch_0/trial_1.csv,-0,0\n"
+                               "pitch_0/trial_2.csv,0,-0\n");
+  const Outcome zero = RunSweep4(
+      args, w, case_no, "runs table: roll -0 and 0",
+      {args.binary, "fit", w.config_path, l1, l2, "--repeats", "--runs-table", dir + "/zero.csv"},
+      {0, 1}, "repeats: 2 log(s) in 1 group(s)", failures);
+  (void)zero;
+  WriteFile(dir + "/big.csv", "path,group\n" + std::string(17000000, 'x') + ",A\n");
+  RunSweep4(args, w, case_no, "runs table: 17 MB",
+            {args.binary, "fit", w.config_path, l1, l2, "--repeats", "--runs-table",
+             dir + "/big.csv"},
+            {2}, "too large for a runs table", failures);
+  WriteFile(dir + "/line.csv", "path,group\n" + std::string(100000, 'x') + ",A\n");
+  RunSweep4(args, w, case_no, "runs table: a 100 kB line",
+            {args.binary, "fit", w.config_path, l1, l2, "--repeats", "--runs-table",
+             dir + "/line.csv"},
+            {2}, "line.csv:2: a line of 100002 bytes", failures);
+  fs::remove(dir + "/big.csv");
+  std::vector<std::string> argv = {args.binary, "fit", w.config_path};
+  for (int k = 0; k < 300; ++k) {
+    char text[64];
+    std::snprintf(text, sizeof(text), "t,gx,gy,gz\n0,0,0,0.%03d\n", k);
+    const std::string path = dir + "/same-" + std::to_string(k) + ".csv";
+    WriteFile(path, text);
+    argv.push_back(path);
+  }
+  argv.push_back("--repeats");
+  RunSweep4(args, w, case_no, "300 same-size files", argv, {1}, "repeats: 300 log(s)", failures);
+}
+
+// Item 5 (messages): `plan --rig --repeat-scatter 1e308` is refused, never "inf %".
+void CasePlanRepeatScatter(const Args& args, const Workspace& w, int case_no, Failures* failures) {
+  const Outcome o = RunSweep4(
+      args, w, case_no, "plan --repeat-scatter 1e308",
+      {args.binary, "plan", "--rig", "--inertia", "1e-5", "--target-percent", "1", "--mass", "1",
+       "--max-length", "0.5", "--max-separation", "0.03", "--repeat-scatter", "1e308"},
+      {2}, "--repeat-scatter = 1e+308; must be in [0, 50]", failures);
+  if ((o.out + o.err).find("inf %") != std::string::npos) {
+    failures->Add(case_no, "plan --repeat-scatter 1e308", "printed inf %:\n" + o.out + o.err);
+  }
+}
+
+// Runs the cases of issue 33 once each; returns how many ran.
+int RunSweep4Cases(const Args& args, const Workspace& w, int first_case_no, Failures* failures) {
+  int c = first_case_no;
+  CaseReportFiguresOutside(args, w, c++, failures);
+  CaseGroupByPatterns(args, w, c++, failures);
+  CaseRepeatsJudgedOnSamples(args, w, c++, failures);
+  CaseRunsTablesAndManyLogs(args, w, c++, failures);
+  CasePlanRepeatScatter(args, w, c++, failures);
+  return c - first_case_no;
+}
+
 // The command line into *args; false (after a message) when it is wrong.
 bool ParseArgs(int argc, char** argv, Args* args) {
   for (int i = 1; i < argc; ++i) {
@@ -1468,6 +1651,7 @@ int main(int argc, char** argv) {
       RunHostileInputCases(args, w, args.cases + 1, &failures);
   kinds_run["mavlink decoder (in-process)"] =
       RunMavlinkDecoderCases(args.seed, args.cases, &failures);
+  kinds_run["hostile input (issue 33)"] = RunSweep4Cases(args, w, args.cases + 101, &failures);
   return Summarize(args, w, start, forced_s, kinds_run, failures);
 }
 
