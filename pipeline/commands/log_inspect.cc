@@ -185,11 +185,21 @@ std::string Abbreviated(const std::string& s, size_t max_bytes = 80) {
   return s.substr(0, cut) + "\u2026 (" + std::to_string(s.size()) + " bytes)";
 }
 
-// Names joined with ", ", at most 400 bytes of them (a header of thousands of columns is cut).
+// A name of the file's own echoed in a message or on the terminal (EchoedName,
+// pipeline/logs/imu_format.h: escape sequences and line breaks as '?', at most 80 bytes).
+std::string PrintableName(const std::string& name) { return EchoedName(name, 80); }
+
+// Names joined with ", ", at most 400 bytes of them (a header of thousands of columns is cut),
+// each made printable.
 std::string JoinedNames(const std::vector<std::string>& names) {
   std::string list;
-  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
-  return Abbreviated(list, 400);
+  size_t shown = 0;
+  for (; shown < names.size() && list.size() <= 400; ++shown) {
+    list += (list.empty() ? "" : ", ") + PrintableName(names[shown]);
+  }
+  list = Abbreviated(list, 400);
+  if (shown < names.size()) list += " and " + std::to_string(names.size() - shown) + " more";
+  return list;
 }
 
 // Delimiter: the one that splits the header into the most cells, consistently with row 2.
@@ -266,7 +276,7 @@ void GuessTimeUnit(const ColumnName& name, const std::vector<double>& tc, Format
   } else {
     time_why = "default, no steps to judge by";
   }
-  guess->guesses.push_back("time column '" + guess->format.time_column + "' in " +
+  guess->guesses.push_back("time column '" + PrintableName(guess->format.time_column) + "' in " +
                            ToString(guess->format.time_unit) + " (" + time_why + ")");
 }
 
@@ -295,8 +305,9 @@ void GuessGyroUnit(const std::vector<ColumnName>& names, const std::array<int, 3
   } else {
     gyro_why = "default";
   }
-  guess->guesses.push_back("gyro columns " + guess->format.gyro_columns[0] + ", " +
-                           guess->format.gyro_columns[1] + ", " + guess->format.gyro_columns[2] +
+  guess->guesses.push_back("gyro columns " + PrintableName(guess->format.gyro_columns[0]) + ", " +
+                           PrintableName(guess->format.gyro_columns[1]) + ", " +
+                           PrintableName(guess->format.gyro_columns[2]) +
                            " in " + ToString(guess->format.gyro_unit) + " (" + gyro_why + ")");
 }
 
@@ -312,8 +323,9 @@ void GuessAccelUnit(const std::array<int, 3>& accel,
   const double norm = UpperMedian(norms, NAN);
   guess->format.accel_unit =
       std::isfinite(norm) && norm < 3.0 ? AccelUnit::kStandardGravity : AccelUnit::kMetresPerS2;
-  guess->guesses.push_back("accelerometer columns " + guess->format.accel_columns[0] + ", " +
-                           guess->format.accel_columns[1] + ", " + guess->format.accel_columns[2] +
+  guess->guesses.push_back("accelerometer columns " + PrintableName(guess->format.accel_columns[0]) + ", " +
+                           PrintableName(guess->format.accel_columns[1]) + ", " +
+                           PrintableName(guess->format.accel_columns[2]) +
                            " in " + ToString(guess->format.accel_unit) +
                            (std::isfinite(norm) ? Fmt(" (median |f| %.3g)", norm) : ""));
 }
@@ -322,15 +334,28 @@ void GuessAccelUnit(const std::array<int, 3>& accel,
 
 namespace {
 
-// The index of the header cell named `name` (case and surrounding blanks aside), or -1.
-int HeaderIndex(const std::vector<std::string>& header, const std::string& name) {
+// The index of the header cell named `name` (surrounding blanks and quotes aside): the cell of
+// exactly that name, else the one cell equal to it ignoring case; -1 when none (or when several
+// cells equal it ignoring case and none exactly: `bifilar fit` reads names as written, so a
+// case-insensitive guess between GX and gx would read other columns than the user named).
+int HeaderIndex(const std::vector<std::string>& header, const std::string& name,
+                std::vector<std::string>* ambiguous = nullptr) {
+  const std::string wanted = TrimAndUnquote(name);
+  std::vector<int> folded;
   for (size_t i = 0; i < header.size(); ++i) {
-    if (Lower(TrimAndUnquote(header[i])) == Lower(TrimAndUnquote(name))) return static_cast<int>(i);
+    const std::string cell = TrimAndUnquote(header[i]);
+    if (cell == wanted) return static_cast<int>(i);
+    if (Lower(cell) == Lower(wanted)) folded.push_back(static_cast<int>(i));
+  }
+  if (folded.size() == 1) return folded[0];
+  if (ambiguous != nullptr) {
+    for (int i : folded) ambiguous->push_back(TrimAndUnquote(header[i]));
   }
   return -1;
 }
 
-// The columns the user named (ColumnChoice) are in the header; otherwise false and why.
+// The columns the user named (ColumnChoice) are in the header, each once; otherwise false and
+// why (a name that matches several cells only ignoring case names them).
 bool ChosenColumnsPresent(const std::vector<std::string>& header, const ColumnChoice& choice,
                           std::string* why) {
   std::vector<std::string> wanted;
@@ -339,11 +364,19 @@ bool ChosenColumnsPresent(const std::vector<std::string>& header, const ColumnCh
     if (!g.empty()) wanted.push_back(g);
   }
   for (const std::string& w : wanted) {
-    if (HeaderIndex(header, w) < 0) {
-      *why = "no column '" + w + "' among the " + std::to_string(header.size()) +
-             " column(s) of the first line: " + JoinedNames(header);
+    std::vector<std::string> candidates;
+    if (HeaderIndex(header, w, &candidates) >= 0) continue;
+    if (!candidates.empty()) {
+      std::string list;
+      for (const std::string& c : candidates) list += (list.empty() ? "'" : "', '") + PrintableName(c);
+      *why = "column '" + PrintableName(w) + "' is ambiguous: no column is named exactly so, and " +
+             std::to_string(candidates.size()) + " differ from it only in case (" + list +
+             "'); name one of them as it is written";
       return false;
     }
+    *why = "no column '" + PrintableName(w) + "' among the " + std::to_string(header.size()) +
+           " column(s) of the first line: " + JoinedNames(header);
+    return false;
   }
   return true;
 }
@@ -712,16 +745,20 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config,
 }
 
 std::string InspectReportText(const InspectReport& r) {
+  // Every text that holds a part of the file (names, guesses, the reader's messages) is echoed
+  // through EchoedName: a header cell with an escape sequence prints as '?', not as a command to
+  // the terminal.
+  const auto clean = [](const std::string& text) { return EchoedName(text, 4000); };
   std::ostringstream out;
   char line[512];
-  out << r.file << ": " << r.kind << (r.compressed ? " (gzip)" : "") << "\n";
+  out << clean(r.file) << ": " << r.kind << (r.compressed ? " (gzip)" : "") << "\n";
   if (!r.columns.empty()) {
     out << "  columns (" << r.columns.size() << "): " << JoinedNames(r.columns) << "\n";
   }
   if (!r.topics.empty()) {
     out << "  topics (" << r.topics.size() << "):\n";
     for (const UlogTopicInfo& t : r.topics) {
-      std::snprintf(line, sizeof(line), "    %-32s multi_id %d  %7ld samples", t.topic.c_str(),
+      std::snprintf(line, sizeof(line), "    %-32s multi_id %d  %7ld samples", clean(t.topic).c_str(),
                     t.multi_id, t.samples);
       out << line;
       if (t.rate_hz > 0) out << Fmt("  %.1f Hz", t.rate_hz);
@@ -731,7 +768,7 @@ std::string InspectReportText(const InspectReport& r) {
   if (!r.messages.empty()) {
     out << "  messages (" << r.messages.size() << "):\n";
     for (const DataflashMessageInfo& m : r.messages) {
-      std::snprintf(line, sizeof(line), "    %-6s %8ld", m.name.c_str(), m.count);
+      std::snprintf(line, sizeof(line), "    %-6s %8ld", clean(m.name).c_str(), m.count);
       out << line;
       if (m.rate_hz() > 0) out << Fmt("  %8.1f Hz", m.rate_hz());
       if (!m.instances.empty()) {
@@ -750,7 +787,7 @@ std::string InspectReportText(const InspectReport& r) {
     if (r.format_from_config) {
       out << "  format: from the config\n";
     } else {
-      for (const std::string& g : r.guesses) out << "  guessed: " << g << "\n";
+      for (const std::string& g : r.guesses) out << "  guessed: " << clean(g) << "\n";
     }
   }
   if (r.samples >= 2) {
@@ -791,8 +828,8 @@ std::string InspectReportText(const InspectReport& r) {
                   r.small_angle_inertia_kg_m2, r.mass_used_kg);
     out << line;
   }
-  for (const std::string& w : r.warnings) out << "  warning: " << w << "\n";
-  if (!r.error.empty()) out << "  error: " << r.error << "\n";
+  for (const std::string& w : r.warnings) out << "  warning: " << clean(w) << "\n";
+  if (!r.error.empty()) out << "  error: " << clean(r.error) << "\n";
   return out.str();
 }
 
