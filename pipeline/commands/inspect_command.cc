@@ -63,11 +63,18 @@ std::string RunInit(const InitCommandOptions& o) {
                       "read with the format " + (report.format_from_config ? "given" : "guessed") +
                       ": " + EchoedName(report.error, 4000));
     }
+    if (!report.format_problem.empty()) {
+      throw UserError("init: --log " + EchoedName(o.log) + ": no config written: " +
+                      EchoedName(report.format_problem, 4000));
+    }
     options.format = report.format;
     options.ulog = report.kind == "ulog";
     options.format_source = o.log;
     if (o.on_guess) {
       for (const std::string& g : report.guesses) o.on_guess(EchoedName(g, 4000));
+      for (const std::string& w : report.warnings) {
+        if (w.rfind("no unit makes", 0) == 0) o.on_guess("warning: " + EchoedName(w, 4000));
+      }
     }
   }
   CampaignConfig loaded;

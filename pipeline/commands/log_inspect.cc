@@ -17,6 +17,7 @@
 #include "fit/swing_axis.h"
 #include "fit/window.h"
 #include "pendulum/model.h"
+#include "pipeline/commands/log_unit_check.h"
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/logs/ulog.h"
 #include "pipeline/trace/trace_process.h"
@@ -263,9 +264,11 @@ void GuessTimeUnit(const ColumnName& name, const std::vector<double>& tc, Format
     time_why = "from its name";
   } else if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "us") == 0) {
     guess->format.time_unit = TimeUnit::kMicroseconds;
+    guess->time_unit_from_names = true;
     time_why = "from its name";
   } else if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "ms") == 0) {
     guess->format.time_unit = TimeUnit::kMilliseconds;
+    guess->time_unit_from_names = true;
     time_why = "from its name";
   } else if (std::isfinite(step)) {
     // IMU logs are sampled at 1 Hz - 2 kHz: a median step above 0.5 s is not seconds.
@@ -550,6 +553,46 @@ void RefineGyroUnitGuess(ImuData* data, InspectReport* report) {
   }
 }
 
+// The guessed time and gyro units checked against the swing (pipeline/commands/log_unit_check.h):
+// the series read again in the units that make it a pendulum, the guess lines saying so; angle
+// columns taken for rates are the report's format problem.
+void CheckGuessedUnits(const std::string& bytes, const std::string& path,
+                       const ImuLogOptions& options, const FormatGuess& guess, ImuData* data,
+                       InspectReport* report) {
+  const UnitCheck check = CheckUnitsAgainstSwing(*data, report->format, guess.time_unit_from_names,
+                                                 guess.gyro_unit_from_names);
+  const std::string columns = PrintableName(report->format.gyro_columns[0]) + ", " +
+                              PrintableName(report->format.gyro_columns[1]) + ", " +
+                              PrintableName(report->format.gyro_columns[2]);
+  if (!check.angles.empty()) {
+    report->format_problem = "the columns " + columns + " look like angles, not angular rates (" +
+                             check.angles + "); bifilar needs the gyro's rates: name those "
+                             "columns (bifilar init --gyro X,Y,Z, or imu.gyro.columns)";
+    return;
+  }
+  if (!check.warning.empty()) report->warnings.push_back(check.warning);
+  if (!check.swing_found || check.best < 0) return;
+  const UnitReading& best = check.readings[check.best];
+  if (check.changed) {
+    report->format.time_unit = best.time;
+    report->format.gyro_unit = best.gyro;
+    *data = ReadImuLogFromString(bytes, path, report->format, options);
+  }
+  for (std::string& g : report->guesses) {
+    if (g.rfind("time column", 0) == 0) {
+      g = "time column '" + PrintableName(report->format.time_column) + "' in " +
+          ToString(report->format.time_unit) +
+          (best.time != guess.format.time_unit ? Fmt(" (from the swing: period %.3g s", best.period_s) +
+                               "; the first rows alone suggested " +
+                               std::string(ToString(guess.format.time_unit)) + ")"
+                         : g.substr(std::min(g.size(), g.find(" ("))));
+    } else if (g.rfind("gyro columns", 0) == 0) {
+      g = "gyro columns " + columns + " in " + ToString(report->format.gyro_unit) + " (" +
+          check.note + ")";
+    }
+  }
+}
+
 void SeriesStatistics(const ImuData& data, InspectReport* report) {
   report->samples = static_cast<long>(data.size());
   report->has_accel = data.has_accel();
@@ -729,13 +772,18 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config,
         report.guesses = guess.guesses;
       }
       data = ReadImuLogFromString(bytes, path, report.format, log_options);
-      if (!report.format_from_config && !guess.gyro_unit_from_names) {
-        RefineGyroUnitGuess(&data, &report);
+      if (!report.format_from_config) {
+        if (!guess.gyro_unit_from_names) RefineGyroUnitGuess(&data, &report);
+        CheckGuessedUnits(bytes, path, log_options, guess, &data, &report);
       }
     }
     for (const std::string& w : data.warnings) report.warnings.push_back(w);
     SeriesStatistics(data, &report);
-    if (report.samples >= 2) SwingAndWindow(data, config, &report);
+    if (!report.format_problem.empty()) {
+      report.error = report.format_problem;
+    } else if (report.samples >= 2) {
+      SwingAndWindow(data, config, &report);
+    }
   } catch (const UserError& e) {
     report.error = e.what();
   } catch (const std::exception& e) {
