@@ -656,7 +656,12 @@ void SwingAndWindow(const ImuData& data, const CampaignConfig* config, InspectRe
     report->frequency_hz = 1.0 / window.period_s;
   }
   if (!window.IsUsable()) {
+    // No free oscillation (a flight log, a log of the rig at rest): no period and no pitch are
+    // given, whatever the axis search made of the data; the error says what was found.
     report->error = window.message;
+    report->period_s = NAN;
+    report->frequency_hz = NAN;
+    report->pitch_measured_deg.reset();
     return;
   }
   report->window_s = {window.t0_s, window.t1_s};
@@ -818,13 +823,17 @@ std::string InspectReportText(const InspectReport& r) {
     for (const DataflashMessageInfo& m : r.messages) {
       std::snprintf(line, sizeof(line), "    %-6s %8ld", clean(m.name).c_str(), m.count);
       out << line;
-      if (m.rate_hz() > 0) out << Fmt("  %8.1f Hz", m.rate_hz());
+      if (m.rate_hz() > 0) {
+        out << Fmt("  %8.1f Hz", m.rate_hz());
+      } else {
+        out << (m.time_field.empty() ? "  (no time field)" : "  (irregular)");
+      }
       if (!m.instances.empty()) {
         out << "  instances (" << m.instance_field << "):";
         const double span_s = m.last_time_s - m.first_time_s;
         for (const auto& [instance, count] : m.instances) {
           out << " " << instance << " (" << count;
-          if (span_s > 0 && count > 1) out << Fmt(", %.1f Hz", (count - 1) / span_s);
+          if (m.regular() && span_s > 0 && count > 1) out << Fmt(", %.1f Hz", (count - 1) / span_s);
           out << ")";
         }
       }
@@ -862,6 +871,10 @@ std::string InspectReportText(const InspectReport& r) {
                   r.release_s, r.window_s[0], r.window_s[1], r.window_end.c_str(), r.cycles,
                   r.amplitude_deg[0], r.amplitude_deg[1]);
     out << line;
+  }
+  if (r.is_log() && !r.window_status.empty() && r.window_status != "ok") {
+    out << "  no free oscillation found: no period, frequency or pitch is given (the error below "
+           "says what was found)\n";
   }
   if (std::isfinite(r.period_s)) {
     std::snprintf(line, sizeof(line), "  period %.4f s, frequency %.4f Hz, noise %.2g rad/s\n",

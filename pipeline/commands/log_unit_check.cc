@@ -208,7 +208,12 @@ UnitCheck CheckUnitsAgainstSwing(const ImuData& data, const ImuFormat& guessed, 
                    best.amplitude_deg);
   for (int k = 0; k < static_cast<int>(check.readings.size()); ++k) {
     const UnitReading& r = check.readings[k];
-    if (k == check.best || !r.plausible) continue;
+    // Only the readings nearly as likely as the one offered are named beside it.
+    if (k == check.best || !r.plausible ||
+        DistanceFromUsualRelease(r.amplitude_deg) >
+            DistanceFromUsualRelease(best.amplitude_deg) + std::log(3.0)) {
+      continue;
+    }
     check.note += "; in " + ReadingText(r) + ", also a pendulum: check imu.time.unit and imu.gyro.unit";
   }
   return check;
