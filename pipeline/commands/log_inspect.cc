@@ -326,11 +326,22 @@ void GuessAccelUnit(const std::array<int, 3>& accel,
   const double norm = UpperMedian(norms, NAN);
   guess->format.accel_unit =
       std::isfinite(norm) && norm < 3.0 ? AccelUnit::kStandardGravity : AccelUnit::kMetresPerS2;
+  // Gravity reads 1 in g and 9.81 in m/s^2; a reading far from both (gravity removed by the
+  // logger, another unit) is no ground for g: m/s^2 is kept, and the guess says so.
+  const bool gravity_in_g = std::isfinite(norm) && std::abs(norm - 1.0) <= 0.3;
+  const bool gravity_in_si = std::isfinite(norm) && std::abs(norm / kStandardGravityMps2 - 1.0) <= 0.3;
+  if (!gravity_in_g && !gravity_in_si) guess->format.accel_unit = AccelUnit::kMetresPerS2;
   guess->guesses.push_back("accelerometer columns " + PrintableName(guess->format.accel_columns[0]) + ", " +
                            PrintableName(guess->format.accel_columns[1]) + ", " +
                            PrintableName(guess->format.accel_columns[2]) +
                            " in " + ToString(guess->format.accel_unit) +
-                           (std::isfinite(norm) ? Fmt(" (median |f| %.3g)", norm) : ""));
+                           (std::isfinite(norm) ? Fmt(" (median |f| %.3g", norm) +
+                                                      (gravity_in_g || gravity_in_si
+                                                           ? std::string(")")
+                                                           : ": neither 1 g nor 9.81 m/s^2, "
+                                                             "gravity removed by the logger or "
+                                                             "another unit; check imu.accel.unit)")
+                                                : ""));
 }
 
 }  // namespace
@@ -624,6 +635,9 @@ void SeriesStatistics(const ImuData& data, InspectReport* report) {
 void SwingAndWindow(const ImuData& data, const CampaignConfig* config, InspectReport* report) {
   SwingAxisOptions axis_options =
       config != nullptr ? SwingAxisOptionsFor(config->imu) : SwingAxisOptions();
+  // The accelerometer unit in use (guessed or declared): the advice of a reading that is not
+  // gravity names the other one.
+  if (report->kind == "csv") axis_options.accel_unit_si = ToSi(report->format.accel_unit);
   SwingAxis axis;
   std::string why;
   if (!EstimateSwingAxis(data, axis_options, std::nullopt, &axis, &why)) {

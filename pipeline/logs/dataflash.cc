@@ -735,7 +735,8 @@ bool DataflashMessageInfo::regular() const {
   const double span = last_time_s - first_time_s;
   if (!(span > 0)) return false;
   const double mean_step = span / (count - 1);
-  return max_step_s <= kIrregularStepFactor * mean_step &&
+  const bool gap = max_step_s > kIrregularStepFactor * mean_step && max_step_s > kIrregularGapS;
+  return !gap &&
          backward_steps * 100 <= count;  // instances interleaved may step back a little
 }
 

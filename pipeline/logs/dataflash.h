@@ -38,8 +38,11 @@ inline constexpr unsigned char kDataflashHead1 = 0xA3;
 inline constexpr unsigned char kDataflashHead2 = 0x95;
 inline constexpr int kDataflashFmtType = 128;   // the FMT message
 inline constexpr int kDataflashFmtLength = 89;  // its length, header included
-// A stream with a step this many times its mean step is not regular (no rate is given).
+// A stream with a step this many times its mean step and longer than kIrregularGapS is not
+// regular (no rate is given): dropouts of a logging stream last a fraction of a second; a
+// PARM burst at the start and a change minutes later, or GPS time jumping at the fix, do not.
 inline constexpr double kIrregularStepFactor = 10.0;
+inline constexpr double kIrregularGapS = 1.0;
 // The largest instance value (imu.dataflash.instance is in [-1, 255]; ArduPilot logs 0-2).
 inline constexpr int kMaxDataflashInstance = 255;
 
@@ -88,7 +91,7 @@ struct DataflashMessageInfo {
   // a rate there would be a number without meaning.
   double rate_hz() const;
   // Every message timed, at least 3, time increasing, no step over kIrregularStepFactor times
-  // the mean step.
+  // the mean step and over kIrregularGapS.
   bool regular() const;
 };
 
