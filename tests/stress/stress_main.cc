@@ -1119,7 +1119,7 @@ void CaseLogGuessAndDamage(const Args& args, const Workspace& w, int case_no, st
   }
   std::string rows;
   for (int i = 0; i < 400; ++i) {
-    const double t = 0.01 * i, rate = 0.3 * std::sin(2 * M_PI * t / 1.5) * (i > 50);
+    const double t = 0.01 * i, rate = 0.3 * std::sin(4.19 * t) * (i > 50);  // a 1.5 s swing
     rows += std::to_string(t) + "," + std::to_string(rate * 0.01) + "," +
             std::to_string(rate * 0.02) + "," + std::to_string(rate) + "\n";
   }
