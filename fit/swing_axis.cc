@@ -236,12 +236,12 @@ std::string AccelNotGravityMessage(const ImuData& data, IndexPair range,
                   "the accelerometer reads %.3g g (%.3g m/s^2) %s instead of 1 g: gravity "
                   "removed by the logger?",
                   g_read, f_mean.norm(), where);
-  } else if (std::abs(g_read * kStandardGravityMps2 - 1.0) <= tol) {
+  } else if (options.accel_unit_si == 1.0 && std::abs(g_read * kStandardGravityMps2 - 1.0) <= tol) {
     std::snprintf(buf, sizeof(buf),
                   "the accelerometer reads %.3g m/s^2 %s, 1/9.81 of gravity: a log in g "
                   "declared m/s^2? (set imu.accel.unit: g)",
                   f_mean.norm(), where);
-  } else if (std::abs(g_read / kStandardGravityMps2 - 1.0) <= tol) {
+  } else if (options.accel_unit_si != 1.0 && std::abs(g_read / kStandardGravityMps2 - 1.0) <= tol) {
     std::snprintf(buf, sizeof(buf),
                   "the accelerometer reads %.3g g %s, 9.81 times gravity: a log in m/s^2 "
                   "declared g? (set imu.accel.unit: m/s^2)",

@@ -66,6 +66,10 @@ struct SwingAxisOptions {
   // vector). Default false: ignored with a warning (a swing about the vertical needs only the
   // gyro; a campaign with runs.pitch_source: measured makes such a trace an error row).
   bool accel_required = false;
+  // The SI value of one unit of the log's accelerometer as declared or guessed (1: m/s^2,
+  // 9.80665: g), so that the advice of a reading that is not gravity names the other unit, not
+  // the one already in use. Default 1 (m/s^2).
+  double accel_unit_si = 1.0;
 
   bool Check(std::string* why) const;
 };

@@ -104,7 +104,7 @@ TEST(DataflashReader, EveryFormatCharacterDecodes) {
   EXPECT_EQ(c2.values[1], std::ldexp(1.0, 63));
   EXPECT_EQ(c2.values[2], -3.0);  // after a[32] (64 bytes) and Z (64 bytes)
   EXPECT_TRUE(c2.warnings.empty());
-  // A string field is not a number: the error names the message and its fields.
+  // A string field is not a number: the error names the message, the field and its type.
   r2.fields = {"Z"};
   EXPECT_TRUE(Contains(ErrorOf(w.bytes(), "t.bin"), "without IMU"));
   try {
@@ -112,7 +112,7 @@ TEST(DataflashReader, EveryFormatCharacterDecodes) {
     ADD_FAILURE() << "no error";
   } catch (const UserError& e) {
     EXPECT_TRUE(Contains(e.what(), "t.bin: message TST2")) << e.what();
-    EXPECT_TRUE(Contains(e.what(), "q, Q, a, Z, f2")) << e.what();
+    EXPECT_TRUE(Contains(e.what(), "field 'Z' of type 'Z' (a string), not a number")) << e.what();
   }
 }
 
@@ -461,6 +461,39 @@ TEST(DataflashCampaign, SimulatedSwingAsBinGivesTheSameInertiaAsCsv) {
   EXPECT_EQ(shown.exit_code, 0) << shown.err;
   EXPECT_TRUE(Contains(shown.out, "s.bin: dataflash")) << shown.out;
   EXPECT_TRUE(Contains(shown.out, "instances (I): 0 (3770, 99.3 Hz)")) << shown.out;
+}
+
+// Issue 33 item 7: every gyro and accelerometer field's unit is checked (not only GyrX's); a
+// gyro field of string type is called so; an instance value no instance can have is named.
+TEST(DataflashReader, EveryFieldsUnitAndTypeAndDamagedInstancesAreNamed) {
+  for (const char* units : {"s#EoEooo--O--zz", "s#EEdooo--O--zz", "s#EEEoko--O--zz"}) {
+    DataflashWriter w;
+    w.UnitFormats();
+    w.Format(kImu, "IMU", kImuFormat, kImuLabels);
+    w.FormatUnits(kImu, units, "F-000000-----00");
+    for (int k = 0; k < 10; ++k) w.Message(kImu, ImuBody(10000 * k, 0, 0.1, 0, 0));
+    const std::string e = ErrorOf(w.bytes(), "units.bin");
+    EXPECT_TRUE(Contains(e, "is declared in")) << units << ": " << e;
+    EXPECT_TRUE(Contains(e, "not read as")) << units << ": " << e;
+  }
+  DataflashWriter z;
+  z.Format(kImu, "IMU", "QBZff", "TimeUS,I,GyrX,GyrY,GyrZ");
+  DataflashPayload p;
+  p.U64(1).U8(0).Text("x", 64).F32(0).F32(0);
+  z.Message(kImu, p.str());
+  z.Message(kImu, p.str());
+  const std::string typed = ErrorOf(z.bytes(), "typed.bin");
+  EXPECT_TRUE(Contains(typed, "field 'GyrX' of type 'Z' (a string), not a number")) << typed;
+  // Every IMU message with I = 200 + 1e6 style damage (here 255 + 1 does not fit a byte: a float).
+  DataflashWriter f;
+  f.Format(kImu, "IMU", "Qffff", "TimeUS,I,GyrX,GyrY,GyrZ");
+  for (int k = 0; k < 5; ++k) {
+    f.Message(kImu, DataflashPayload().U64(10000 * k).F32(1e6f).F32(0).F32(0).F32(0).str());
+  }
+  const std::string inst = ErrorOf(f.bytes(), "instance.bin");
+  EXPECT_TRUE(Contains(inst, "none with an instance the reader can use")) << inst;
+  EXPECT_TRUE(Contains(inst, "1e+06")) << inst;
+  EXPECT_FALSE(Contains(inst, "without IMU")) << inst;
 }
 
 }  // namespace

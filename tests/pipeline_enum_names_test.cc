@@ -68,7 +68,7 @@ TEST(EnumNames, EveryTableReadsBackAndListsWhatItParses) {
   ExpectOneTable<TimeUnit>(
       {TimeUnit::kSeconds, TimeUnit::kMilliseconds, TimeUnit::kMicroseconds},
       [](TimeUnit v) { return ToString(v); }, ParseTimeUnit, TimeUnitAllowedValues());
-  ExpectOneTable<RateUnit>({RateUnit::kRadPerS, RateUnit::kDegPerS},
+  ExpectOneTable<RateUnit>({RateUnit::kRadPerS, RateUnit::kDegPerS, RateUnit::kMilliradPerS},
                            [](RateUnit v) { return ToString(v); }, ParseRateUnit,
                            RateUnitAllowedValues());
   ExpectOneTable<AccelUnit>({AccelUnit::kMetresPerS2, AccelUnit::kStandardGravity},

@@ -6,6 +6,7 @@
 #include "base/atomic_file.h"
 #include "base/user_error.h"
 #include "pipeline/config/config.h"
+#include "pipeline/logs/imu_log.h"
 
 namespace bifilar {
 
@@ -53,16 +54,42 @@ std::string RunInit(const InitCommandOptions& o) {
   if (!o.log.empty()) {
     const InspectReport report = InspectLog(o.log, nullptr, o.columns);
     if (!report.is_log()) {
-      throw UserError("init: --log " + (report.error.empty() ? o.log : report.error));
+      throw UserError("init: --log " + EchoedName(report.error.empty() ? o.log : report.error, 4000));
+    }
+    // A log whose series could not be read (a .bin without messages, a header with the same
+    // name twice) would give a config `bifilar fit` cannot use with it: refused, with the reason.
+    if (report.samples < 2 && !report.error.empty()) {
+      throw UserError("init: --log " + EchoedName(o.log) + ": no config written, the log cannot be "
+                      "read with the format " + (report.format_from_config ? "given" : "guessed") +
+                      ": " + EchoedName(report.error, 4000));
+    }
+    if (!report.format_problem.empty()) {
+      throw UserError("init: --log " + EchoedName(o.log) + ": no config written: " +
+                      EchoedName(report.format_problem, 4000));
     }
     options.format = report.format;
     options.ulog = report.kind == "ulog";
     options.format_source = o.log;
     if (o.on_guess) {
-      for (const std::string& g : report.guesses) o.on_guess(g);
+      for (const std::string& g : report.guesses) o.on_guess(EchoedName(g, 4000));
+      for (const std::string& w : report.warnings) {
+        if (w.rfind("no unit makes", 0) == 0) o.on_guess("warning: " + EchoedName(w, 4000));
+      }
     }
   }
-  WriteFileAtomically(o.path, CheckedStartingConfigText(options, o.path));
+  CampaignConfig loaded;
+  const std::string text = CheckedStartingConfigText(options, o.path, &loaded);
+  if (!o.log.empty()) {
+    // The config read back reads the log as `bifilar fit` will (the same reader, the same
+    // names): a config init writes is never one fit rejects with this log.
+    ImuData data;
+    std::string why;
+    if (!TryReadImuLog(o.log, loaded.imu.format, loaded.LogOptions(), &data, &why)) {
+      throw UserError("init: " + o.path + ": not written: `bifilar fit` would not read " +
+                      EchoedName(o.log) + " with it: " + EchoedName(why, 4000));
+    }
+  }
+  WriteFileAtomically(o.path, text);
   return o.path;
 }
 

@@ -17,6 +17,7 @@
 #include "fit/swing_axis.h"
 #include "fit/window.h"
 #include "pendulum/model.h"
+#include "pipeline/commands/log_unit_check.h"
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/logs/ulog.h"
 #include "pipeline/trace/trace_process.h"
@@ -185,11 +186,21 @@ std::string Abbreviated(const std::string& s, size_t max_bytes = 80) {
   return s.substr(0, cut) + "\u2026 (" + std::to_string(s.size()) + " bytes)";
 }
 
-// Names joined with ", ", at most 400 bytes of them (a header of thousands of columns is cut).
+// A name of the file's own echoed in a message or on the terminal (EchoedName,
+// pipeline/logs/imu_format.h: escape sequences and line breaks as '?', at most 80 bytes).
+std::string PrintableName(const std::string& name) { return EchoedName(name, 80); }
+
+// Names joined with ", ", at most 400 bytes of them (a header of thousands of columns is cut),
+// each made printable.
 std::string JoinedNames(const std::vector<std::string>& names) {
   std::string list;
-  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
-  return Abbreviated(list, 400);
+  size_t shown = 0;
+  for (; shown < names.size() && list.size() <= 400; ++shown) {
+    list += (list.empty() ? "" : ", ") + PrintableName(names[shown]);
+  }
+  list = Abbreviated(list, 400);
+  if (shown < names.size()) list += " and " + std::to_string(names.size() - shown) + " more";
+  return list;
 }
 
 // Delimiter: the one that splits the header into the most cells, consistently with row 2.
@@ -253,9 +264,11 @@ void GuessTimeUnit(const ColumnName& name, const std::vector<double>& tc, Format
     time_why = "from its name";
   } else if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "us") == 0) {
     guess->format.time_unit = TimeUnit::kMicroseconds;
+    guess->time_unit_from_names = true;
     time_why = "from its name";
   } else if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "ms") == 0) {
     guess->format.time_unit = TimeUnit::kMilliseconds;
+    guess->time_unit_from_names = true;
     time_why = "from its name";
   } else if (std::isfinite(step)) {
     // IMU logs are sampled at 1 Hz - 2 kHz: a median step above 0.5 s is not seconds.
@@ -266,7 +279,7 @@ void GuessTimeUnit(const ColumnName& name, const std::vector<double>& tc, Format
   } else {
     time_why = "default, no steps to judge by";
   }
-  guess->guesses.push_back("time column '" + guess->format.time_column + "' in " +
+  guess->guesses.push_back("time column '" + PrintableName(guess->format.time_column) + "' in " +
                            ToString(guess->format.time_unit) + " (" + time_why + ")");
 }
 
@@ -295,8 +308,9 @@ void GuessGyroUnit(const std::vector<ColumnName>& names, const std::array<int, 3
   } else {
     gyro_why = "default";
   }
-  guess->guesses.push_back("gyro columns " + guess->format.gyro_columns[0] + ", " +
-                           guess->format.gyro_columns[1] + ", " + guess->format.gyro_columns[2] +
+  guess->guesses.push_back("gyro columns " + PrintableName(guess->format.gyro_columns[0]) + ", " +
+                           PrintableName(guess->format.gyro_columns[1]) + ", " +
+                           PrintableName(guess->format.gyro_columns[2]) +
                            " in " + ToString(guess->format.gyro_unit) + " (" + gyro_why + ")");
 }
 
@@ -312,25 +326,50 @@ void GuessAccelUnit(const std::array<int, 3>& accel,
   const double norm = UpperMedian(norms, NAN);
   guess->format.accel_unit =
       std::isfinite(norm) && norm < 3.0 ? AccelUnit::kStandardGravity : AccelUnit::kMetresPerS2;
-  guess->guesses.push_back("accelerometer columns " + guess->format.accel_columns[0] + ", " +
-                           guess->format.accel_columns[1] + ", " + guess->format.accel_columns[2] +
+  // Gravity reads 1 in g and 9.81 in m/s^2; a reading far from both (gravity removed by the
+  // logger, another unit) is no ground for g: m/s^2 is kept, and the guess says so.
+  const bool gravity_in_g = std::isfinite(norm) && std::abs(norm - 1.0) <= 0.3;
+  const bool gravity_in_si = std::isfinite(norm) && std::abs(norm / kStandardGravityMps2 - 1.0) <= 0.3;
+  if (!gravity_in_g && !gravity_in_si) guess->format.accel_unit = AccelUnit::kMetresPerS2;
+  guess->guesses.push_back("accelerometer columns " + PrintableName(guess->format.accel_columns[0]) + ", " +
+                           PrintableName(guess->format.accel_columns[1]) + ", " +
+                           PrintableName(guess->format.accel_columns[2]) +
                            " in " + ToString(guess->format.accel_unit) +
-                           (std::isfinite(norm) ? Fmt(" (median |f| %.3g)", norm) : ""));
+                           (std::isfinite(norm) ? Fmt(" (median |f| %.3g", norm) +
+                                                      (gravity_in_g || gravity_in_si
+                                                           ? std::string(")")
+                                                           : ": neither 1 g nor 9.81 m/s^2, "
+                                                             "gravity removed by the logger or "
+                                                             "another unit; check imu.accel.unit)")
+                                                : ""));
 }
 
 }  // namespace
 
 namespace {
 
-// The index of the header cell named `name` (case and surrounding blanks aside), or -1.
-int HeaderIndex(const std::vector<std::string>& header, const std::string& name) {
+// The index of the header cell named `name` (surrounding blanks and quotes aside): the cell of
+// exactly that name, else the one cell equal to it ignoring case; -1 when none (or when several
+// cells equal it ignoring case and none exactly: `bifilar fit` reads names as written, so a
+// case-insensitive guess between GX and gx would read other columns than the user named).
+int HeaderIndex(const std::vector<std::string>& header, const std::string& name,
+                std::vector<std::string>* ambiguous = nullptr) {
+  const std::string wanted = TrimAndUnquote(name);
+  std::vector<int> folded;
   for (size_t i = 0; i < header.size(); ++i) {
-    if (Lower(TrimAndUnquote(header[i])) == Lower(TrimAndUnquote(name))) return static_cast<int>(i);
+    const std::string cell = TrimAndUnquote(header[i]);
+    if (cell == wanted) return static_cast<int>(i);
+    if (Lower(cell) == Lower(wanted)) folded.push_back(static_cast<int>(i));
+  }
+  if (folded.size() == 1) return folded[0];
+  if (ambiguous != nullptr) {
+    for (int i : folded) ambiguous->push_back(TrimAndUnquote(header[i]));
   }
   return -1;
 }
 
-// The columns the user named (ColumnChoice) are in the header; otherwise false and why.
+// The columns the user named (ColumnChoice) are in the header, each once; otherwise false and
+// why (a name that matches several cells only ignoring case names them).
 bool ChosenColumnsPresent(const std::vector<std::string>& header, const ColumnChoice& choice,
                           std::string* why) {
   std::vector<std::string> wanted;
@@ -339,11 +378,19 @@ bool ChosenColumnsPresent(const std::vector<std::string>& header, const ColumnCh
     if (!g.empty()) wanted.push_back(g);
   }
   for (const std::string& w : wanted) {
-    if (HeaderIndex(header, w) < 0) {
-      *why = "no column '" + w + "' among the " + std::to_string(header.size()) +
-             " column(s) of the first line: " + JoinedNames(header);
+    std::vector<std::string> candidates;
+    if (HeaderIndex(header, w, &candidates) >= 0) continue;
+    if (!candidates.empty()) {
+      std::string list;
+      for (const std::string& c : candidates) list += (list.empty() ? "'" : "', '") + PrintableName(c);
+      *why = "column '" + PrintableName(w) + "' is ambiguous: no column is named exactly so, and " +
+             std::to_string(candidates.size()) + " differ from it only in case (" + list +
+             "'); name one of them as it is written";
       return false;
     }
+    *why = "no column '" + PrintableName(w) + "' among the " + std::to_string(header.size()) +
+           " column(s) of the first line: " + JoinedNames(header);
+    return false;
   }
   return true;
 }
@@ -517,6 +564,46 @@ void RefineGyroUnitGuess(ImuData* data, InspectReport* report) {
   }
 }
 
+// The guessed time and gyro units checked against the swing (pipeline/commands/log_unit_check.h):
+// the series read again in the units that make it a pendulum, the guess lines saying so; angle
+// columns taken for rates are the report's format problem.
+void CheckGuessedUnits(const std::string& bytes, const std::string& path,
+                       const ImuLogOptions& options, const FormatGuess& guess, ImuData* data,
+                       InspectReport* report) {
+  const UnitCheck check = CheckUnitsAgainstSwing(*data, report->format, guess.time_unit_from_names,
+                                                 guess.gyro_unit_from_names);
+  const std::string columns = PrintableName(report->format.gyro_columns[0]) + ", " +
+                              PrintableName(report->format.gyro_columns[1]) + ", " +
+                              PrintableName(report->format.gyro_columns[2]);
+  if (!check.angles.empty()) {
+    report->format_problem = "the columns " + columns + " look like angles, not angular rates (" +
+                             check.angles + "); bifilar needs the gyro's rates: name those "
+                             "columns (bifilar init --gyro X,Y,Z, or imu.gyro.columns)";
+    return;
+  }
+  if (!check.warning.empty()) report->warnings.push_back(check.warning);
+  if (!check.swing_found || check.best < 0) return;
+  const UnitReading& best = check.readings[check.best];
+  if (check.changed) {
+    report->format.time_unit = best.time;
+    report->format.gyro_unit = best.gyro;
+    *data = ReadImuLogFromString(bytes, path, report->format, options);
+  }
+  for (std::string& g : report->guesses) {
+    if (g.rfind("time column", 0) == 0) {
+      g = "time column '" + PrintableName(report->format.time_column) + "' in " +
+          ToString(report->format.time_unit) +
+          (best.time != guess.format.time_unit ? Fmt(" (from the swing: period %.3g s", best.period_s) +
+                               "; the first rows alone suggested " +
+                               std::string(ToString(guess.format.time_unit)) + ")"
+                         : g.substr(std::min(g.size(), g.find(" ("))));
+    } else if (g.rfind("gyro columns", 0) == 0) {
+      g = "gyro columns " + columns + " in " + ToString(report->format.gyro_unit) + " (" +
+          check.note + ")";
+    }
+  }
+}
+
 void SeriesStatistics(const ImuData& data, InspectReport* report) {
   report->samples = static_cast<long>(data.size());
   report->has_accel = data.has_accel();
@@ -548,6 +635,9 @@ void SeriesStatistics(const ImuData& data, InspectReport* report) {
 void SwingAndWindow(const ImuData& data, const CampaignConfig* config, InspectReport* report) {
   SwingAxisOptions axis_options =
       config != nullptr ? SwingAxisOptionsFor(config->imu) : SwingAxisOptions();
+  // The accelerometer unit in use (guessed or declared): the advice of a reading that is not
+  // gravity names the other one.
+  if (report->kind == "csv") axis_options.accel_unit_si = ToSi(report->format.accel_unit);
   SwingAxis axis;
   std::string why;
   if (!EstimateSwingAxis(data, axis_options, std::nullopt, &axis, &why)) {
@@ -580,7 +670,12 @@ void SwingAndWindow(const ImuData& data, const CampaignConfig* config, InspectRe
     report->frequency_hz = 1.0 / window.period_s;
   }
   if (!window.IsUsable()) {
+    // No free oscillation (a flight log, a log of the rig at rest): no period and no pitch are
+    // given, whatever the axis search made of the data; the error says what was found.
     report->error = window.message;
+    report->period_s = NAN;
+    report->frequency_hz = NAN;
+    report->pitch_measured_deg.reset();
     return;
   }
   report->window_s = {window.t0_s, window.t1_s};
@@ -696,13 +791,18 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config,
         report.guesses = guess.guesses;
       }
       data = ReadImuLogFromString(bytes, path, report.format, log_options);
-      if (!report.format_from_config && !guess.gyro_unit_from_names) {
-        RefineGyroUnitGuess(&data, &report);
+      if (!report.format_from_config) {
+        if (!guess.gyro_unit_from_names) RefineGyroUnitGuess(&data, &report);
+        CheckGuessedUnits(bytes, path, log_options, guess, &data, &report);
       }
     }
     for (const std::string& w : data.warnings) report.warnings.push_back(w);
     SeriesStatistics(data, &report);
-    if (report.samples >= 2) SwingAndWindow(data, config, &report);
+    if (!report.format_problem.empty()) {
+      report.error = report.format_problem;
+    } else if (report.samples >= 2) {
+      SwingAndWindow(data, config, &report);
+    }
   } catch (const UserError& e) {
     report.error = e.what();
   } catch (const std::exception& e) {
@@ -712,16 +812,20 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config,
 }
 
 std::string InspectReportText(const InspectReport& r) {
+  // Every text that holds a part of the file (names, guesses, the reader's messages) is echoed
+  // through EchoedName: a header cell with an escape sequence prints as '?', not as a command to
+  // the terminal.
+  const auto clean = [](const std::string& text) { return EchoedName(text, 4000); };
   std::ostringstream out;
   char line[512];
-  out << r.file << ": " << r.kind << (r.compressed ? " (gzip)" : "") << "\n";
+  out << clean(r.file) << ": " << r.kind << (r.compressed ? " (gzip)" : "") << "\n";
   if (!r.columns.empty()) {
     out << "  columns (" << r.columns.size() << "): " << JoinedNames(r.columns) << "\n";
   }
   if (!r.topics.empty()) {
     out << "  topics (" << r.topics.size() << "):\n";
     for (const UlogTopicInfo& t : r.topics) {
-      std::snprintf(line, sizeof(line), "    %-32s multi_id %d  %7ld samples", t.topic.c_str(),
+      std::snprintf(line, sizeof(line), "    %-32s multi_id %d  %7ld samples", clean(t.topic).c_str(),
                     t.multi_id, t.samples);
       out << line;
       if (t.rate_hz > 0) out << Fmt("  %.1f Hz", t.rate_hz);
@@ -731,15 +835,19 @@ std::string InspectReportText(const InspectReport& r) {
   if (!r.messages.empty()) {
     out << "  messages (" << r.messages.size() << "):\n";
     for (const DataflashMessageInfo& m : r.messages) {
-      std::snprintf(line, sizeof(line), "    %-6s %8ld", m.name.c_str(), m.count);
+      std::snprintf(line, sizeof(line), "    %-6s %8ld", clean(m.name).c_str(), m.count);
       out << line;
-      if (m.rate_hz() > 0) out << Fmt("  %8.1f Hz", m.rate_hz());
+      if (m.rate_hz() > 0) {
+        out << Fmt("  %8.1f Hz", m.rate_hz());
+      } else {
+        out << (m.time_field.empty() ? "  (no time field)" : "  (irregular)");
+      }
       if (!m.instances.empty()) {
         out << "  instances (" << m.instance_field << "):";
         const double span_s = m.last_time_s - m.first_time_s;
         for (const auto& [instance, count] : m.instances) {
           out << " " << instance << " (" << count;
-          if (span_s > 0 && count > 1) out << Fmt(", %.1f Hz", (count - 1) / span_s);
+          if (m.regular() && span_s > 0 && count > 1) out << Fmt(", %.1f Hz", (count - 1) / span_s);
           out << ")";
         }
       }
@@ -750,7 +858,7 @@ std::string InspectReportText(const InspectReport& r) {
     if (r.format_from_config) {
       out << "  format: from the config\n";
     } else {
-      for (const std::string& g : r.guesses) out << "  guessed: " << g << "\n";
+      for (const std::string& g : r.guesses) out << "  guessed: " << clean(g) << "\n";
     }
   }
   if (r.samples >= 2) {
@@ -778,6 +886,10 @@ std::string InspectReportText(const InspectReport& r) {
                   r.amplitude_deg[0], r.amplitude_deg[1]);
     out << line;
   }
+  if (r.is_log() && !r.window_status.empty() && r.window_status != "ok") {
+    out << "  no free oscillation found: no period, frequency or pitch is given (the error below "
+           "says what was found)\n";
+  }
   if (std::isfinite(r.period_s)) {
     std::snprintf(line, sizeof(line), "  period %.4f s, frequency %.4f Hz, noise %.2g rad/s\n",
                   r.period_s, r.frequency_hz, r.noise_rad_per_s);
@@ -791,8 +903,8 @@ std::string InspectReportText(const InspectReport& r) {
                   r.small_angle_inertia_kg_m2, r.mass_used_kg);
     out << line;
   }
-  for (const std::string& w : r.warnings) out << "  warning: " << w << "\n";
-  if (!r.error.empty()) out << "  error: " << r.error << "\n";
+  for (const std::string& w : r.warnings) out << "  warning: " << clean(w) << "\n";
+  if (!r.error.empty()) out << "  error: " << clean(r.error) << "\n";
   return out.str();
 }
 

@@ -41,6 +41,7 @@ struct FormatGuess {
   // The gyro unit came from the column names; otherwise it is a guess from the first rows,
   // which InspectLog checks against the whole series.
   bool gyro_unit_from_names = false;
+  bool time_unit_from_names = false;  // the time unit came from the column's name ("TimeUS")
 };
 
 // What `inspect` found in one file. Numbers that do not apply are NaN (null in JSON).
@@ -56,6 +57,9 @@ struct InspectReport {
   std::vector<DataflashMessageInfo> messages;  // DataFlash messages: counts, rates, instances
   bool format_from_config = false;         // the format came from --config, not a guess
   std::vector<std::string> guesses;        // what was guessed without a config, and why
+  // The guessed format cannot be used as it is (the "rate" columns hold angles): why. `init`
+  // refuses to write it; `inspect` reports it as the error.
+  std::string format_problem;
   ImuFormat format;                        // the format used to read the series
 
   // Series (when read).

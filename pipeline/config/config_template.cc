@@ -2,6 +2,8 @@
 
 #include <cstdio>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "pendulum/model.h"
 #include "pipeline/config/config.h"
@@ -34,8 +36,8 @@ std::string Quoted(const std::string& text) {
       char hex[8];
       std::snprintf(hex, sizeof(hex), "\\x%02x", c);
       out += hex;
-    } else if (c == 0xc2 && next(1) == 0x85) {  // NEL
-      out += "\\N";
+    } else if (c == 0xc2 && next(1) == 0x85) {  // NEL: yaml-cpp 0.7 reads "\N" as one byte 0x85
+      out += "\\u0085";
       ++i;
     } else if (c == 0xe2 && next(1) == 0x80 && (next(2) == 0xa8 || next(2) == 0xa9)) {  // LS, PS
       out += next(2) == 0xa8 ? "\\L" : "\\P";
@@ -173,8 +175,49 @@ std::string StartingConfigText(const StartingConfigOptions& o) {
   return y.str();
 }
 
+namespace {
+
+// Every name init would write: at most kMaxStartingConfigNameBytes long; otherwise false and why.
+bool NamesBounded(const StartingConfigOptions& options, std::string* why) {
+  const ImuFormat format = options.format.value_or(ImuFormat());
+  std::vector<std::string> names = {format.time_column, format.ulog.topic, format.ulog.time_field};
+  for (int a = 0; a < 3; ++a) {
+    for (const std::string* n : {&format.gyro_columns[a], &format.accel_columns[a],
+                                 &format.ulog.gyro_fields[a], &format.ulog.accel_fields[a]}) {
+      names.push_back(*n);
+    }
+  }
+  for (const std::string& n : names) {
+    if (n.size() > kMaxStartingConfigNameBytes) {
+      *why = "a column, topic or field name of " + std::to_string(n.size()) + " bytes ('" +
+             EchoedName(n, 40) + "'): longer than the " +
+             std::to_string(kMaxStartingConfigNameBytes) +
+             " bytes of any logger's header; rename the column in the log, or write the config "
+             "by hand";
+      return false;
+    }
+  }
+  return true;
+}
+
+// Which name the YAML did not keep, and what in it: "'gx?' (holds U+0085 (NEL, a line break) at
+// byte 2)".
+std::string FirstChangedName(const std::vector<std::pair<std::string, std::string>>& meant_read) {
+  for (const auto& [meant, read] : meant_read) {
+    if (meant == read) continue;
+    const std::string what = DescribeUnprintable(meant);
+    return "'" + EchoedName(meant, 60) + "'" + (what.empty() ? "" : " (holds " + what + ")") +
+           " reads back as '" + EchoedName(read, 60) + "'";
+  }
+  return "";
+}
+
+}  // namespace
+
 std::string CheckedStartingConfigText(const StartingConfigOptions& options,
-                                      const std::string& path) {
+                                      const std::string& path, CampaignConfig* loaded) {
+  std::string why;
+  if (!NamesBounded(options, &why)) throw UserError("init: " + path + ": " + why);
   const std::string text = StartingConfigText(options);
   ConfigLoadOptions load;
   load.require_runs = false;  // what `bifilar fit` asks of a config
@@ -189,19 +232,31 @@ std::string CheckedStartingConfigText(const StartingConfigOptions& options,
   // wrong columns, or none).
   const ImuFormat meant = options.format.value_or(ImuFormat());
   const ImuFormat& read = config.imu.format;
-  const bool same =
-      options.ulog
-          ? read.ulog.topic == meant.ulog.topic && read.ulog.time_field == meant.ulog.time_field &&
-                read.ulog.gyro_fields == meant.ulog.gyro_fields &&
-                (meant.ulog.accel_fields[0].empty() ? read.ulog.accel_fields[0].empty()
-                                                    : read.ulog.accel_fields == meant.ulog.accel_fields)
-          : read.time_column == meant.time_column && read.gyro_columns == meant.gyro_columns &&
-                (meant.has_accel() ? read.accel_columns == meant.accel_columns : !read.has_accel());
-  if (!same) {
-    throw UserError("init: " + path + ": a column, topic or field name of the log" +
-                    (options.format_source.empty() ? std::string() : " " + options.format_source) +
-                    " does not survive in YAML (invalid UTF-8?); write the config by hand");
+  std::vector<std::pair<std::string, std::string>> pairs;
+  if (options.ulog) {
+    pairs = {{meant.ulog.topic, read.ulog.topic}, {meant.ulog.time_field, read.ulog.time_field}};
+    for (int a = 0; a < 3; ++a) {
+      pairs.push_back({meant.ulog.gyro_fields[a], read.ulog.gyro_fields[a]});
+      if (!meant.ulog.accel_fields[0].empty() || !read.ulog.accel_fields[0].empty()) {
+        pairs.push_back({meant.ulog.accel_fields[a], read.ulog.accel_fields[a]});
+      }
+    }
+  } else {
+    pairs = {{meant.time_column, read.time_column}};
+    for (int a = 0; a < 3; ++a) {
+      pairs.push_back({meant.gyro_columns[a], read.gyro_columns[a]});
+      pairs.push_back({meant.has_accel() ? meant.accel_columns[a] : std::string(),
+                       read.has_accel() ? read.accel_columns[a] : std::string()});
+    }
   }
+  const std::string changed = FirstChangedName(pairs);
+  if (!changed.empty()) {
+    throw UserError("init: " + path + ": a name of the log" +
+                    (options.format_source.empty() ? std::string()
+                                                   : " " + EchoedName(options.format_source)) +
+                    " does not survive in YAML: " + changed + "; write the config by hand");
+  }
+  if (loaded != nullptr) *loaded = std::move(config);
   return text;
 }
 

@@ -11,6 +11,10 @@
 #include "pipeline/logs/imu_format.h"
 
 namespace bifilar {
+struct CampaignConfig;
+}  // namespace bifilar
+
+namespace bifilar {
 
 struct StartingConfigOptions {
   double filar_length_m = 0.0;      // L (m); > D
@@ -33,8 +37,15 @@ std::string StartingConfigText(const StartingConfigOptions& options);
 // The config init writes at `path`, checked before anything is written: the text is loaded with
 // the loader `fit` uses (LoadCampaignConfigText, pipeline/config/config.h: one set of bounds), and the
 // log format read back must be the one meant (a name no YAML scalar carries intact is refused).
-// Throws UserError "init: <path>: the config would be rejected: <the loader's message>".
-std::string CheckedStartingConfigText(const StartingConfigOptions& options, const std::string& path);
+// Names are bounded (kMaxStartingConfigNameBytes: a 4 MB header cell would make a config over the
+// loader's size cap). Throws UserError "init: <path>: the config it would write is one `bifilar
+// fit` rejects: <the loader's message>". `loaded` (optional) receives the config read back.
+std::string CheckedStartingConfigText(const StartingConfigOptions& options, const std::string& path,
+                                      CampaignConfig* loaded = nullptr);
+
+// The longest column, topic or field name init writes (bytes). Loggers name columns in a few
+// dozen bytes; a longer cell is a broken header, refused with its length.
+constexpr size_t kMaxStartingConfigNameBytes = 256;
 
 // Parses "L,D,MASS" (m, m, kg) as given to `--rig`; false with *why otherwise.
 bool ParseRigSpec(const std::string& text, StartingConfigOptions* options, std::string* why);

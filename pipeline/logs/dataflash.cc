@@ -425,12 +425,28 @@ void DataflashParser::Count(const DataflashFormat& f, const unsigned char* body)
     const double t = DecodeNumber(body + f.offsets[f.time_index], f.format[f.time_index]) *
                      (f.labels[f.time_index] == "TimeUS" ? 1e-6 : 1e-3);
     if (info.count == 1 || !std::isfinite(info.first_time_s)) info.first_time_s = t;
+    if (info.timed > 0 && std::isfinite(t) && std::isfinite(info.last_time_s)) {
+      const double step = t - info.last_time_s;
+      if (step < 0) ++info.backward_steps;
+      info.max_step_s = std::max(info.max_step_s, step);
+    }
+    ++info.timed;
+    info.time_field = f.labels[f.time_index];
     info.last_time_s = t;
   }
   if (f.instance_index >= 0) {
     if (info.instance_field.empty()) info.instance_field = f.labels[f.instance_index];
     const double v = DecodeNumber(body + f.offsets[f.instance_index], f.format[f.instance_index]);
-    if (std::isfinite(v) && std::abs(v) < 1e6) ++info.instances[static_cast<int>(v)];
+    if (std::isfinite(v) && v >= 0 && v <= kMaxDataflashInstance && v == std::floor(v)) {
+      ++info.instances[static_cast<int>(v)];
+    } else {
+      ++info.invalid_instances;
+      if (info.invalid_instance_example.empty()) {
+        char text[40];
+        std::snprintf(text, sizeof(text), "%g", v);
+        info.invalid_instance_example = text;
+      }
+    }
   }
 }
 
@@ -443,7 +459,13 @@ void DataflashParser::Decode(size_t pos, const DataflashFormat& f, const unsigne
     out_.field_chars.clear();
     for (const std::string& label : request_.fields) {
       const int i = LabelIndex(f, label);
-      if (i < 0 || IsStringChar(f.format[i]) || f.format[i] == 'a') {
+      if (i >= 0 && (IsStringChar(f.format[i]) || f.format[i] == 'a')) {
+        Fail("message " + f.name + " (FMT at byte " + std::to_string(f.byte_offset) +
+             ") has a field '" + label + "' of type '" + std::string(1, f.format[i]) + "' (" +
+             (f.format[i] == 'a' ? "an array" : "a string") +
+             "), not a number: the FMT is damaged or not an IMU message's");
+      }
+      if (i < 0) {
         std::string list;
         for (const std::string& l : f.labels)
           list += (list.empty() ? "" : ", ") + PrintableAscii(l, kDataflashTextEcho);
@@ -556,6 +578,7 @@ std::string ListMessages(const DataflashContents& log) {
 struct SourceSeries {
   std::vector<double> t_s;
   std::vector<double> xyz;  // 3 per sample
+  std::vector<uint64_t> byte_offset;  // of each message in the file
   double time_scale = 1e-6;
 };
 
@@ -578,18 +601,36 @@ SourceSeries ReadSource(std::string_view bytes, const std::string& name,
   SourceSeries s;
   const double mult0 = log.field_multipliers.empty() ? NAN : log.field_multipliers[0];
   s.time_scale = std::isfinite(mult0) && mult0 > 0 ? mult0 : (time == "TimeMS" ? 1e-3 : 1e-6);
-  double scale = 1.0;
-  if (log.field_units.size() > 1 && log.field_units[1] == "deg/s") scale = kRadPerDeg;
-  if (log.field_multipliers.size() > 1 && std::isfinite(log.field_multipliers[1]) &&
-      log.field_multipliers[1] > 0 && !IsScaledChar(log.field_chars[1])) {
-    scale *= log.field_multipliers[1];
+  // Each of the three fields its own unit (FMTU) and multiplier; a unit that is not a rate (a
+  // gyro) or a specific force (an accelerometer) is refused, not read as one.
+  double scale[3];
+  const bool rate = prefix == "Gyr";
+  for (int a = 0; a < 3; ++a) {
+    const size_t k = 1 + a;
+    const std::string unit = k < log.field_units.size() ? log.field_units[k] : "";
+    const bool known = rate ? (unit.empty() || unit == "rad/s" || unit == "deg/s")
+                            : (unit.empty() || unit == "m/s/s" || unit == "m/s^2");
+    if (!known) {
+      throw UserError(name + ": field " + request.fields[k] + " of " + src.message +
+                      " is declared in '" + PrintableAscii(unit, kDataflashTextEcho) +
+                      "' (FMTU), not " + (rate ? "an angular rate (rad/s or deg/s)" :
+                                                 "a specific force (m/s/s)") +
+                      ": the log's units are damaged; it is not read as " +
+                      (rate ? "rad/s" : "m/s^2"));
+    }
+    scale[a] = unit == "deg/s" ? kRadPerDeg : 1.0;
+    if (k < log.field_multipliers.size() && std::isfinite(log.field_multipliers[k]) &&
+        log.field_multipliers[k] > 0 && !IsScaledChar(log.field_chars[k])) {
+      scale[a] *= log.field_multipliers[k];
+    }
   }
   const size_t rows = log.value_offsets.size();
+  s.byte_offset = log.value_offsets;
   s.t_s.resize(rows);
   s.xyz.resize(3 * rows);
   for (size_t r = 0; r < rows; ++r) {
     s.t_s[r] = log.values[4 * r] * s.time_scale;
-    for (int a = 0; a < 3; ++a) s.xyz[3 * r + a] = log.values[4 * r + 1 + a] * scale;
+    for (int a = 0; a < 3; ++a) s.xyz[3 * r + a] = log.values[4 * r + 1 + a] * scale[a];
   }
   return s;
 }
@@ -622,48 +663,81 @@ ImuSource ChooseSource(const std::vector<ImuSource>& sources, int instance,
                   " (imu.dataflash.instance) in the log; its instances are: " + list);
 }
 
-// The rows FinishImuLog takes (t, gyro x y z, then accel x y z when `with_accel`), each value
-// finite and within a sensor's range (imu_log_options.h), else an error naming the message.
+// The rows FinishImuLog takes (t, gyro x y z, then accel x y z when `with_accel`). A message
+// with a value that is not finite or beyond any sensor (imu_log_options.h: a flipped bit in a
+// float, -9.2e36) is a glitch: dropped, counted and named (message index and byte offset) in a
+// warning, as a gap. More than `max_dropped_fraction` of the messages so damaged is an error
+// naming the first.
 void PackRows(const SourceSeries& gyro, const std::vector<double>& accel, bool with_accel,
-              const std::string& name, const std::string& what, std::vector<double>* values_out,
-              std::vector<int>* row_number_out) {
+              const std::string& name, const std::string& what, double max_dropped_fraction,
+              std::vector<double>* values_out, std::vector<int>* row_number_out,
+              std::vector<std::string>* warnings) {
   const size_t rows = gyro.t_s.size();
   const int needed = with_accel ? 7 : 4;
   std::vector<double>& values = *values_out;
-  values.resize(rows * needed);
+  values.clear();
+  values.reserve(rows * needed);
   std::vector<int>& row_number = *row_number_out;
-  row_number.resize(rows);
+  row_number.clear();
+  row_number.reserve(rows);
+  long damaged = 0;
+  std::string first;
   for (size_t r = 0; r < rows; ++r) {
-    double* v = &values[r * needed];
+    double v[7];
     v[0] = gyro.t_s[r];
     for (int a = 0; a < 3; ++a) v[1 + a] = gyro.xyz[3 * r + a];
     if (with_accel)
       for (int a = 0; a < 3; ++a) v[4 + a] = accel[3 * r + a];
-    for (int k = 0; k < needed; ++k) {
+    int bad = -1;
+    for (int k = 0; k < needed && bad < 0; ++k) {
       const double bound = k == 0 ? INFINITY : (k <= 3 ? kMaxGyroRateRadPerS : kMaxAccelMps2);
-      if (!std::isfinite(v[k]) || std::abs(v[k]) > bound) {
-        char value[32];
-        std::snprintf(value, sizeof(value), "%g", v[k]);
-        throw UserError(name + ": message " + std::to_string(r + 1) + " of " + what + " has " +
-                        (k == 0   ? "time"
-                         : k <= 3 ? "a gyro rate"
-                                  : "a specific force") +
-                        " = " + value +
-                        (k == 0   ? ""
-                         : k <= 3 ? " rad/s (|rate| <= 1e4 rad/s expected)"
-                                  : " m/s^2 (|f| <= 1e5 m/s^2 expected)"));
-      }
+      if (!std::isfinite(v[k]) || std::abs(v[k]) > bound) bad = k;
     }
-    row_number[r] = static_cast<int>(std::min<size_t>(r + 1, 2147483647));
+    if (bad >= 0) {
+      if (++damaged == 1) {
+        char value[32];
+        std::snprintf(value, sizeof(value), "%g", v[bad]);
+        first = "message " + std::to_string(r + 1) + " of " + what +
+                (r < gyro.byte_offset.size() ? " (byte " + std::to_string(gyro.byte_offset[r]) + ")"
+                                             : std::string()) +
+                " has " + (bad == 0 ? "time" : bad <= 3 ? "a gyro rate" : "a specific force") +
+                " = " + value +
+                (bad == 0   ? " s"
+                 : bad <= 3 ? " rad/s (|rate| <= 1e4 rad/s: a gyro logs no more)"
+                            : " m/s^2 (|f| <= 1e5 m/s^2: an accelerometer logs no more)");
+      }
+      continue;
+    }
+    values.insert(values.end(), v, v + needed);
+    row_number.push_back(static_cast<int>(std::min<size_t>(r + 1, 2147483647)));
   }
+  if (damaged == 0) return;
+  if (static_cast<double>(damaged) > std::max(1.0, max_dropped_fraction * rows)) {
+    throw UserError(name + ": " + std::to_string(damaged) + " of " + std::to_string(rows) + " " +
+                    what + " messages hold a value no sensor gives (more than the " +
+                    Fmt("%g", 100 * max_dropped_fraction) +
+                    " % that are dropped as glitches); the first: " + first);
+  }
+  warnings->push_back(std::to_string(damaged) + " " + what + " message(s) with a damaged value " +
+                      "dropped as glitches (a gap in the series): " + first);
 }
 
 }  // namespace
 
 double DataflashMessageInfo::rate_hz() const {
-  if (count < 2 || !std::isfinite(first_time_s) || !std::isfinite(last_time_s)) return 0.0;
+  if (!regular()) return 0.0;
+  return (count - 1) / (last_time_s - first_time_s);
+}
+
+bool DataflashMessageInfo::regular() const {
+  if (timed < 3 || timed != count || !std::isfinite(first_time_s) || !std::isfinite(last_time_s))
+    return false;
   const double span = last_time_s - first_time_s;
-  return span > 0 ? (count - 1) / span : 0.0;
+  if (!(span > 0)) return false;
+  const double mean_step = span / (count - 1);
+  const bool gap = max_step_s > kIrregularStepFactor * mean_step && max_step_s > kIrregularGapS;
+  return !gap &&
+         backward_steps * 100 <= count;  // instances interleaved may step back a little
 }
 
 const DataflashMessageInfo* DataflashContents::Find(const std::string& name) const {
@@ -756,6 +830,19 @@ ImuData ReadDataflashImu(std::string_view bytes, const std::string& name,
         FailFormat(name, log, m);
       }
     }
+    for (const char* m : {"IMU", "GYR"}) {
+      const DataflashMessageInfo* info = log.Find(m);
+      if (info == nullptr || info->count == 0 || info->invalid_instances == 0) continue;
+      throw UserError(name + ": " + std::to_string(info->count) + " " + m + " messages, but " +
+                      "none with an instance the reader can use: their " + info->instance_field +
+                      " field reads " + info->invalid_instance_example + " (an instance is 0-" +
+                      std::to_string(kMaxDataflashInstance) + "), in " +
+                      std::to_string(info->invalid_instances) + " of them: the log is damaged; " +
+                      (options.dataflash_instance < 0
+                           ? std::string("no instance is present")
+                           : "instance " + std::to_string(options.dataflash_instance) +
+                                 " (imu.dataflash.instance) is not present"));
+    }
     throw UserError(name +
                     ": an ArduPilot DataFlash log without IMU (or GYR) messages: is IMU "
                     "logging on (LOG_BITMASK)? Messages found: " +
@@ -794,12 +881,19 @@ ImuData ReadDataflashImu(std::string_view bytes, const std::string& name,
   const int needed = with_accel ? 7 : 4;
   std::vector<double> values;
   std::vector<int> row_number;
-  PackRows(gyro, accel, with_accel, name, what, &values, &row_number);
   ImuData data;
   data.warnings = log.warnings;
+  PackRows(gyro, accel, with_accel, name, what, options.max_dropped_fraction, &values, &row_number,
+           &data.warnings);
   if (sources.size() > 1 && options.dataflash_instance < 0) {
     data.warnings.push_back(std::to_string(sources.size()) + " IMU instances in the log; read " +
                             what + " (the lowest; imu.dataflash.instance chooses another)");
+  }
+  if (const DataflashMessageInfo* info = log.Find(src.message);
+      info != nullptr && info->invalid_instances > 0) {
+    data.warnings.push_back(std::to_string(info->invalid_instances) + " " + src.message +
+                            " message(s) skipped: their " + info->instance_field + " field is no "
+                            "instance (" + info->invalid_instance_example + ", a damaged value)");
   }
   if (gyr)
     data.warnings.push_back("no IMU messages: read " + what +

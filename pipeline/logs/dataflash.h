@@ -38,6 +38,13 @@ inline constexpr unsigned char kDataflashHead1 = 0xA3;
 inline constexpr unsigned char kDataflashHead2 = 0x95;
 inline constexpr int kDataflashFmtType = 128;   // the FMT message
 inline constexpr int kDataflashFmtLength = 89;  // its length, header included
+// A stream with a step this many times its mean step and longer than kIrregularGapS is not
+// regular (no rate is given): dropouts of a logging stream last a fraction of a second; a
+// PARM burst at the start and a change minutes later, or GPS time jumping at the fix, do not.
+inline constexpr double kIrregularStepFactor = 10.0;
+inline constexpr double kIrregularGapS = 1.0;
+// The largest instance value (imu.dataflash.instance is in [-1, 255]; ArduPilot logs 0-2).
+inline constexpr int kMaxDataflashInstance = 255;
 
 // True when `bytes` starts with the header of a FMT message (A3 95 80), as every log does.
 bool LooksLikeDataflash(std::string_view bytes);
@@ -69,9 +76,23 @@ struct DataflashMessageInfo {
   std::string name;
   long count = 0;
   double first_time_s = NAN, last_time_s = NAN;  // from TimeUS or TimeMS; NaN when none
+  std::string time_field;                        // "TimeUS", "TimeMS"; "" when none
+  long timed = 0;                                // messages with a time field
+  double max_step_s = 0.0;                       // largest step between consecutive ones
+  long backward_steps = 0;                       // steps back in time
   std::string instance_field;                    // "I" or "Instance"; "" when none
   std::map<int, long> instances;                 // messages per instance value
-  double rate_hz() const;                        // (count - 1) / span; 0 when unknown
+  // Messages whose instance field is not an instance (NaN, negative, fractional or beyond
+  // kMaxDataflashInstance: a damaged value), and the first such value as text ("1e+06", "nan").
+  long invalid_instances = 0;
+  std::string invalid_instance_example;
+  // (count - 1) / span for a regular stream; 0 when the messages carry no time or are not
+  // regular (a burst of PARM at the start and a few more later, GPS time jumping at the fix):
+  // a rate there would be a number without meaning.
+  double rate_hz() const;
+  // Every message timed, at least 3, time increasing, no step over kIrregularStepFactor times
+  // the mean step and over kIrregularGapS.
+  bool regular() const;
 };
 
 // Which message to decode: `fields` by label, each as stored with the format character's scale

@@ -5,11 +5,12 @@
 
 #include <array>
 #include <string>
+#include <string_view>
 
 namespace bifilar {
 
 enum class TimeUnit { kSeconds, kMilliseconds, kMicroseconds };  // "s", "ms", "us"
-enum class RateUnit { kRadPerS, kDegPerS };                      // "rad/s", "deg/s"
+enum class RateUnit { kRadPerS, kDegPerS, kMilliradPerS };      // "rad/s", "deg/s", "mrad/s"
 enum class AccelUnit { kMetresPerS2, kStandardGravity };          // "m/s^2", "g"
 
 // Parse the unit names above; false for anything else. One name table per enum
@@ -21,13 +22,26 @@ const char* ToString(TimeUnit unit);
 const char* ToString(RateUnit unit);
 const char* ToString(AccelUnit unit);
 std::string TimeUnitAllowedValues();   // "s, ms or us"
-std::string RateUnitAllowedValues();   // "rad/s or deg/s"
+std::string RateUnitAllowedValues();   // "rad/s, deg/s or mrad/s"
 std::string AccelUnitAllowedValues();  // "m/s^2 or g"
 
 // Multiply a file value by this to get SI (s, rad/s, m/s^2).
 double ToSi(TimeUnit unit);
 double ToSi(RateUnit unit);
 double ToSi(AccelUnit unit);
+
+// A name from a log's header (a CSV column, a topic) echoed in a message or on a terminal: at
+// most `max_bytes` bytes of `s`, then "..."; printable ASCII and valid UTF-8 letters kept as they
+// are (a column "ω_x" or "Gyro (°/s)" stays readable), and every byte that could act on the
+// terminal or break the line replaced by '?': C0 and C1 controls (ESC of an escape sequence, NEL
+// U+0085), DEL, the line and paragraph separators, the bidirectional and zero-width controls,
+// and any byte that is not valid UTF-8. The DataFlash reader's PrintableAscii
+// (base/text_format.h) does the same for its ASCII-only names.
+std::string EchoedName(std::string_view s, size_t max_bytes = 80);
+
+// What a name holds that YAML or a terminal may not keep as it is: "U+0085 (NEL) at byte 2",
+// "byte 0xff at byte 3 (invalid UTF-8)", "" when every character is printable.
+std::string DescribeUnprintable(std::string_view s);
 
 // Which topic and fields of a PX4 ULog (.ulg) log hold the IMU data (pipeline/logs/ulog.h). PX4
 // logs are SI already: timestamps in us (ms for a uint8_t field), rates in rad/s, specific force in

@@ -77,12 +77,8 @@ void Split(std::string_view line, char delim, std::vector<std::string_view>* fie
   }
 }
 
-std::string Printable(std::string_view s, size_t max_len = 40) {
-  std::string out;
-  for (char c : s.substr(0, max_len)) out += (static_cast<unsigned char>(c) < 32) ? '?' : c;
-  if (s.size() > max_len) out += "...";
-  return out;
-}
+// A cell or a name of the file's echoed in a message (EchoedName, pipeline/logs/imu_format.h).
+std::string Printable(std::string_view s, size_t max_len = 40) { return EchoedName(s, max_len); }
 
 std::string ListColumns(const std::vector<std::string>& names) {
   std::string out;
@@ -168,8 +164,8 @@ void RefuseBinary(const std::string& name, const ImuFormat& format, std::string_
     text->remove_prefix(3);  // UTF-8 byte-order mark
   }
   if (IsBlank(*text) || text->find_first_not_of(" \t\r\n") == std::string_view::npos) {
-    Fail(name + ": the file is empty (expected a CSV header with columns " + format.time_column +
-         ", " + format.gyro_columns[0] + ", ...)");
+    Fail(name + ": the file is empty (expected a CSV header with columns " +
+         Printable(format.time_column) + ", " + Printable(format.gyro_columns[0]) + ", ...)");
   }
   if (const void* nul = std::memchr(text->data(), '\0', text->size())) {
     Fail(name + ": not a text CSV file (binary data at byte " +
@@ -234,8 +230,9 @@ std::vector<std::string> ReadHeaderRow(LineReader* reader, const std::string& na
   if (all_numeric) {
     Fail(name + ":" + std::to_string(*header_line) +
          ": no header row (the first line holds numbers); expected a header naming the columns " +
-         format.time_column + ", " + format.gyro_columns[0] + ", " + format.gyro_columns[1] +
-         ", " + format.gyro_columns[2] + (format.has_accel() ? ", ..." : ""));
+         Printable(format.time_column) + ", " + Printable(format.gyro_columns[0]) + ", " +
+         Printable(format.gyro_columns[1]) + ", " + Printable(format.gyro_columns[2]) +
+         (format.has_accel() ? ", ..." : ""));
   }
   return header;
 }
@@ -247,7 +244,7 @@ int FindColumn(const std::vector<std::string>& header, const std::string& col,
   for (size_t i = 0; i < header.size(); ++i) {
     if (header[i] == col) {
       if (found >= 0) {
-        Fail(name + ":" + std::to_string(header_line) + ": column '" + col +
+        Fail(name + ":" + std::to_string(header_line) + ": column '" + Printable(col) +
              "' appears twice in the header (columns " + std::to_string(found + 1) + " and " +
              std::to_string(i + 1) + ")");
       }
@@ -271,7 +268,7 @@ int FindColumn(const std::vector<std::string>& header, const std::string& col,
       }
     }
   }
-  Fail(name + ":" + std::to_string(header_line) + ": missing column '" + col +
+  Fail(name + ":" + std::to_string(header_line) + ": missing column '" + Printable(col) +
        "' (columns found: " + ListColumns(header) + hint + ")");
 }
 
@@ -299,9 +296,9 @@ CsvColumns ParseHeader(LineReader* reader, const std::string& name, const ImuFor
       present += accel_col[k] >= 0;
     }
     if (present == 0 && !options.require_accel) {
-      data->warnings.push_back("no accelerometer columns (" + format.accel_columns[0] + ", " +
-                               format.accel_columns[1] + ", " + format.accel_columns[2] +
-                               ") in the file; read as gyro-only");
+      data->warnings.push_back("no accelerometer columns (" + Printable(format.accel_columns[0]) +
+                               ", " + Printable(format.accel_columns[1]) + ", " +
+                               Printable(format.accel_columns[2]) + ") in the file; read as gyro-only");
     } else {
       for (int k = 0; k < 3; ++k) {
         if (accel_col[k] < 0) MissingColumn(header, format.accel_columns[k], name, c.header_line, format);
@@ -327,7 +324,7 @@ std::string ReadRowCells(const std::vector<std::string_view>& fields, std::strin
     int k = 0;
     while (c.column[k] < static_cast<int>(fields.size())) ++k;
     return name + ":" + std::to_string(line_number) + ": the row has only " +
-           std::to_string(fields.size()) + " field(s); column '" + c.names[k] + "' is field " +
+           std::to_string(fields.size()) + " field(s); column '" + Printable(c.names[k]) + "' is field " +
            std::to_string(c.column[k] + 1) + " ('" + Printable(Trim(line)) + "')";
   }
   bool non_finite = false;
@@ -335,7 +332,7 @@ std::string ReadRowCells(const std::vector<std::string_view>& fields, std::strin
     const std::string_view cell = fields[c.column[k]];
     if (!ParseCell(cell, &row[k])) {
       return name + ":" + std::to_string(line_number) + ":" + std::to_string(c.column[k] + 1) +
-             ": column '" + c.names[k] + "' holds '" + Printable(Trim(cell)) +
+             ": column '" + Printable(c.names[k]) + "' holds '" + Printable(Trim(cell)) +
              "', which is not a number";
     }
     if (!std::isfinite(row[k]) && !non_finite) {

@@ -603,6 +603,7 @@ SwingAxisOptions SwingAxisOptionsFor(const ImuConfig& imu) {
   options.mode = imu.swing_axis_auto ? SwingAxisMode::kAuto : SwingAxisMode::kFixed;
   options.fixed_axis_in_imu = imu.swing_axis_in_imu;
   options.imu_to_body = imu.imu_to_body;
+  options.accel_unit_si = ToSi(imu.format.accel_unit);  // the advice names the other unit
   return options;
 }
 

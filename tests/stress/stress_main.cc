@@ -1086,6 +1086,84 @@ void CaseDataflash(const Args& args, const Workspace& w, int case_no, std::mt199
   ExpectStop(o, case_no, "DataFlash damaged copies (inspect)", {0, 1}, o.out, "dataflash", failures);
 }
 
+// ---- Issue 33 items 5 and 7 (helper `logs`): what `inspect` and `init` make of a log. ----
+// A flipped bit in one DataFlash gyro float is a glitch, named; CSV header names are echoed
+// without terminal controls; `init` writes no config `fit` rejects (names that collide once
+// trimmed, an unreadable .bin, a 300-byte name) and takes an exact-case column as named.
+void CaseLogGuessAndDamage(const Args& args, const Workspace& w, int case_no, std::mt19937_64& rng,
+                           Failures* failures) {
+  const std::string dir = w.harness + "/log_guess";
+  fs::create_directories(dir);
+  const std::string sim = dir + "/sim.bin";
+  fs::remove(sim);
+  const Outcome made = Wait(Start({args.binary, "simulate", "--trace", sim, "--inertia-kg-m2",
+                                   "0.4", "--mass-kg", "6", "-L", "2", "-D", "1", "--duration-s",
+                                   "20", "--seed", "33"},
+                                  dir),
+                            args.run_timeout_s);
+  ExpectStop(made, case_no, "log guess: simulate .bin", {0}, made.out, "wrote", failures);
+  const std::string clean = ReadFile(sim);
+  // Every IMU message (header a3 95 30): GyrZ at byte 20 of it (TimeUS 8, I 1, GyrX, GyrY 4 each).
+  std::vector<size_t> imu;
+  for (size_t at = clean.find("\xA3\x95\x30"); at != std::string::npos;
+       at = clean.find("\xA3\x95\x30", at + 1)) {
+    if (at + 24 <= clean.size()) imu.push_back(at);
+  }
+  for (int k = 0; k < 6 && imu.size() > 100; ++k) {
+    std::string bytes = clean;
+    const float damage[] = {-9.2e36f, NAN, INFINITY, 3e5f};
+    const float value = damage[k % 4];
+    std::memcpy(&bytes[imu[imu.size() - 1 - rng() % 50] + 20], &value, 4);  // near the end
+    const std::string path = dir + "/flipped_" + std::to_string(k) + ".bin";
+    WriteFile(path, bytes);
+    const Outcome o = Wait(Start({args.binary, "inspect", path}, dir), args.run_timeout_s);
+    ExpectStop(o, case_no, "log guess: damaged DataFlash gyro float", {0}, o.out,
+               "dropped as glitches", failures);
+  }
+  std::string rows;
+  for (int i = 0; i < 400; ++i) {
+    const double t = 0.01 * i, rate = 0.3 * std::sin(4.19 * t) * (i > 50);  // a 1.5 s swing
+    rows += std::to_string(t) + "," + std::to_string(rate * 0.01) + "," +
+            std::to_string(rate * 0.02) + "," + std::to_string(rate) + "\n";
+  }
+  const std::string esc = dir + "/esc.csv";
+  WriteFile(esc, "t,g\x1b[2Jx,gy,gz\x1b]0;owned\x07\n" + rows);
+  const Outcome shown = Wait(Start({args.binary, "inspect", esc}, dir), args.run_timeout_s);
+  if (shown.out.find('\x1b') != std::string::npos || shown.err.find('\x1b') != std::string::npos) {
+    failures->Add(case_no, "log guess: escape sequence in a header", "echoed raw");
+  }
+  struct Refused {
+    std::string file, text, message;
+  };
+  const std::vector<Refused> refused = {
+      {"padded.csv", "t, gx,gy,gz,gx \n" + rows, "appears twice"},
+      {"noise.bin", std::string(3000, '\x01'), "no config written"},
+      {"long.csv", "time" + std::string(300, 'x') + ",gx,gy,gz\n" + rows, "of 304 bytes"},
+  };
+  for (const Refused& r : refused) {
+    const std::string log = dir + "/" + r.file, config = log + ".yaml";
+    WriteFile(log, r.text);
+    fs::remove(config);
+    const Outcome o = Wait(Start({args.binary, "init", config, "--log", log, "--rig", "2,1,6"}, dir),
+                           args.run_timeout_s);
+    ExpectStop(o, case_no, "log guess: init refuses " + r.file, {1, 2}, o.err, r.message, failures);
+    if (fs::exists(config)) failures->Add(case_no, "log guess: init " + r.file, "wrote a config");
+  }
+  const std::string cased = dir + "/cased.csv", cased_yaml = dir + "/cased.yaml";
+  std::string both = "t,GX,GY,GZ,gx,gy,gz\n";
+  for (int i = 0; i < 400; ++i) both += std::to_string(0.01 * i) + ",0,0,0,0,0,0.1\n";
+  WriteFile(cased, both);
+  fs::remove(cased_yaml);
+  const Outcome init = Wait(Start({args.binary, "init", cased_yaml, "--log", cased, "--gyro",
+                                   "gx,gy,gz", "--rig", "2,1,6"},
+                                  dir),
+                            args.run_timeout_s);
+  ExpectStop(init, case_no, "log guess: init --gyro gx,gy,gz", {0}, init.out, "wrote", failures);
+  if (ReadFile(cased_yaml).find("[\"gx\", \"gy\", \"gz\"]") == std::string::npos) {
+    failures->Add(case_no, "log guess: init --gyro gx,gy,gz", "config:\n" + ReadFile(cased_yaml));
+  }
+}
+
 // Runs the cases above once each; returns how many ran.
 // ---- Issue 33 items 1, 4, 5, 7 and issue 32 item 7 (`plan` helper): no user file replaced by
 // `plan --rig`, `fit --plot` or `ellipse --plot`, never a link; the figure's folder checked before
@@ -1171,6 +1249,7 @@ int RunHostileInputCases(const Args& args, Workspace& w, int first_case_no, Fail
   CaseNoOverwrite(args, w, c++, failures);
   std::mt19937_64 rng(26);
   CaseDataflash(args, w, c++, rng, failures);
+  CaseLogGuessAndDamage(args, w, c++, rng, failures);
   CasePlanNoReplace(args, w, c++, failures);  // `plan` helper, issue 33
   return c - first_case_no;
 }
