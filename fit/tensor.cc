@@ -648,6 +648,17 @@ void FillPrincipal(const Solution& solved, const Covariance& cov,
 bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& options,
                TensorResult* result, std::string* why) {
   const auto start = std::chrono::steady_clock::now();
+  if (!FitTensorOnce(points, options, result, why)) return false;
+  CheckTensorPhysical(points, options, result);
+  result->time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return true;
+}
+
+namespace tensor {
+
+bool FitTensorOnce(const std::vector<TensorPoint>& points, const TensorOptions& options,
+                   TensorResult* result, std::string* why) {
+  const auto start = std::chrono::steady_clock::now();
   QuietSolverLogging();
   if (!options.Check(why)) return false;
   Prepared data;
@@ -687,4 +698,5 @@ bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& opti
   return true;
 }
 
+}  // namespace tensor
 }  // namespace bifilar

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "fit/ellipse.h"  // EllipseCovariance, EllipseSolverSummary
+#include "fit/physical_check.h"
 #include "fit/tensor_components.h"
 
 namespace bifilar {
@@ -159,6 +160,14 @@ struct TensorResult {
   std::vector<TensorPointResidual> residuals;
   std::vector<TensorOrientation> orientations;
   int n_outliers = 0;
+
+  // Can a body have these moments (fit/physical.h): the triangle inequalities and positive
+  // definiteness against the combined std, at the fit's dof. When flagged or borderline,
+  // `physical.orientation` is the orientation whose removal restores the inequality most (a
+  // refit without each in turn) or, when no refit determines the same components, the one nearest
+  // the axis of the largest moment of the broken inequality; `physical.attitude` names its axis
+  // (a campaign names the roll and pitch instead).
+  PhysicalCheck physical;
 
   EllipseSolverSummary ceres;       // the primary fit ("ceres")
   double closed_form_max_relative_difference = 0.0;  // Ceres vs closed form (QR), parity

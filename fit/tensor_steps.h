@@ -114,5 +114,13 @@ TensorIntervalSet TensorIntervals(const Prepared& data, const Design& design, co
                                   const Covariance& cov, const TensorOptions& options,
                                   bool principal);
 
+// FitTensor without naming the attitude that drives a non-physical result (no refits).
+bool FitTensorOnce(const std::vector<TensorPoint>& points, const TensorOptions& options,
+                   TensorResult* result, std::string* why);
+// Fills result->physical (fit/physical.h) and, when it is not physical or borderline, names the
+// orientation that drives it by refitting without each (tensor_physical.cc).
+void CheckTensorPhysical(const std::vector<TensorPoint>& points, const TensorOptions& options,
+                         TensorResult* result);
+
 }  // namespace tensor
 }  // namespace bifilar

@@ -21,9 +21,11 @@
 #include "base/option_check.h"
 #include "base/parallel_runner.h"
 #include "base/statistics.h"
+#include "base/text_format.h"
 #include "base/units.h"
 #include "base/user_error.h"
 #include "base/version.h"
+#include "fit/physical.h"
 #include "fit/tensor.h"
 #include "pipeline/campaign/calibration.h"
 #include "pipeline/campaign/campaign_inputs.h"
@@ -719,6 +721,41 @@ void FitCampaignEllipse(const CampaignConfig& config, const CampaignOptions& opt
   result->ellipse_fit = std::move(fit);
 }
 
+// The planar ellipse's physical check (fit/physical.h); when it is not physical or borderline,
+// the pitch whose removal restores it most is named (a refit without each pitch in turn).
+PhysicalCheck CheckPlanarPhysical(const CampaignConfig& config, const CampaignResult& result) {
+  PhysicalCheck check = CheckPhysicalEllipse(*result.ellipse_fit, {});
+  if (check.status != PhysicalStatus::kNotPhysical && check.status != PhysicalStatus::kBorderline) {
+    return check;
+  }
+  std::vector<double> pitches;
+  for (const AngleStats& a : result.angles) pitches.push_back(a.pitch_deg);
+  EllipseOptions options = MakeEllipseOptions(config, result.rig_inertia_std_kg_m2);
+  options.bootstrap_replicates = 0;
+  double best_z = -std::numeric_limits<double>::infinity(), best_pitch = NAN;
+  for (const double pitch : pitches) {
+    std::vector<TraceRecord> rest;
+    for (const TraceRecord& r : result.traces) {
+      const double p = r.pitch_nominal_deg ? *r.pitch_nominal_deg : r.pitch_used_deg;
+      if (std::fabs(p - pitch) > 0.25) rest.push_back(r);
+    }
+    EllipseResult refit;
+    std::string why;
+    if (!FitEllipse(EllipsePoints(rest), options, &refit, &why) || !refit.IsUsable()) continue;
+    const PhysicalCheck without = CheckPhysicalEllipse(refit, {});
+    if (without.Worst() != nullptr && without.Worst()->z > best_z) {
+      best_z = without.Worst()->z;
+      best_pitch = pitch;
+    }
+  }
+  if (std::isfinite(best_pitch)) {
+    check.attitude = "pitch " + Fmt("%g", best_pitch) + " deg";
+    check.z_without_attitude = best_z;
+    check.message = PhysicalCheckMessage(check);
+  }
+  return check;
+}
+
 // ---- Step 6: write ----------------------------------------------------------------------------
 
 // The result files, each atomically, results.json last with its siblings' hashes
@@ -804,9 +841,13 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   FitCampaignTensor(config, options.figures ? out.figures().string() : "",
                     [&out](const std::string& name) { out.manifest.Record({"figures/" + name}); },
                     &result);
+  if (result.ellipse_fit && IsPlanarCampaign(result.traces)) {
+    result.physical = CheckPlanarPhysical(config, result);
+  }
   if (result.summary.n_rejected + result.summary.n_error > 0 ||
       (!result.summary.ellipse_fitted && !result.summary.tensor_fitted) ||
-      (result.ellipse_fit && !result.ellipse_fit->physical)) {
+      (result.ellipse_fit && !result.ellipse_fit->physical) ||
+      (result.physical && result.physical->Flagged())) {
     result.summary.exit_code = 1;
   }
   result.summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
