@@ -126,6 +126,10 @@ struct TensorResult {
   // A design that is not full: the relative scatter of the moments beyond their stds instead
   // (fraction, e.g. 0.002), 0 when the stds explain it.
   double relative_scatter = 0.0;
+  // Per orientation (same order as `orientations`), a design that is not full: the relative
+  // scatter its points were weighed with. An orientation whose logs scatter beyond the others'
+  // (F test, p < 0.01) has its own; the others share relative_scatter. Empty when not used.
+  std::vector<double> orientation_relative_scatter;
   bool full = false;               // rank == 6: principal moments and axes below are defined
   double condition_number = 0.0;   // largest / smallest non-zero singular value of the design
   std::array<double, kTensorComponents> design_singular_values = {};  // descending

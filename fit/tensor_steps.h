@@ -44,6 +44,10 @@ struct Prepared {
   std::vector<Eigen::Vector3d> group_axis;  // the first member's nominal axis (unit)
   EllipseCovariance covariance = EllipseCovariance::kPointResiduals;  // resolved after the rank
   std::vector<std::string> warnings;
+  // Per-orientation scatter (designs that are not full): the weights already hold each
+  // orientation's scatter, so the covariance takes them as they are (variance factor 1) with
+  // `scale_dof` degrees of freedom (those of the pooled scatter). 0: not used.
+  double scale_dof = 0.0;
 };
 
 bool PrepareTensorData(const std::vector<TensorPoint>& points, const TensorOptions& options,
