@@ -169,6 +169,9 @@ json OrientationsJson(const TensorResult& r, const TensorJsonContext& c) {
               {"residual_std_kg_m2", JsonNumber(o.residual_std_kg_m2)},
               {"z", JsonNumber(o.z)},
               {"scatter_kg_m2", JsonNumber(o.scatter_kg_m2)}};
+    if (g < r.orientation_relative_scatter.size()) {
+      e["relative_scatter"] = JsonNumber(r.orientation_relative_scatter[g]);
+    }
     if (g < c.orientations.size()) {
       e["roll_deg"] = JsonNumber(c.orientations[g].roll_deg);
       e["pitch_deg"] = JsonNumber(c.orientations[g].pitch_deg);
