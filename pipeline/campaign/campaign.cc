@@ -505,8 +505,8 @@ struct SetupGroup {
   std::vector<int> members;    // trace indices
 };
 
-// "group 'A' (a.csv, b.csv): I = 0.3001 +- 0.0002 kg m^2" for each set-up, the weighted mean of
-// its logs' aircraft moments with the std of a weighted mean (Birge-scaled when they scatter).
+// "group 'A' (a.csv, b.csv): I_total = 0.3201 +- 0.0002 kg m^2" for each set-up, the weighted mean
+// of its logs' total moments (rig + aircraft, as the test's text) with the std of a weighted mean (Birge-scaled when they scatter).
 std::string SetupGroupsText(const std::vector<SetupGroup>& setups,
                             const std::vector<TraceRecord>& traces) {
   std::string text;
@@ -515,11 +515,11 @@ std::string SetupGroupsText(const std::vector<SetupGroup>& setups,
     for (int i : s.members) {
       const double w = 1.0 / (traces[i].inertia_total_std_kg_m2 * traces[i].inertia_total_std_kg_m2);
       sw += w;
-      swy += w * traces[i].inertia_kg_m2;
+      swy += w * traces[i].inertia_total_kg_m2;
     }
     const double mean = swy / sw;
     for (int i : s.members) {
-      const double d = (traces[i].inertia_kg_m2 - mean) / traces[i].inertia_total_std_kg_m2;
+      const double d = (traces[i].inertia_total_kg_m2 - mean) / traces[i].inertia_total_std_kg_m2;
       chi2 += d * d;
     }
     const double birge =
@@ -528,7 +528,7 @@ std::string SetupGroupsText(const std::vector<SetupGroup>& setups,
     for (size_t k = 0; k < s.members.size(); ++k) {
       files += (k ? ", " : "") + traces[s.members[k]].file;
     }
-    text += (text.empty() ? "" : "; ") + s.name + " (" + files + "): I = " + Fmt("%.5g", mean) +
+    text += (text.empty() ? "" : "; ") + s.name + " (" + files + "): I_total = " + Fmt("%.5g", mean) +
             " +- " + Fmt("%.2g", birge / std::sqrt(sw)) + " kg m^2";
   }
   return text;
@@ -586,7 +586,8 @@ void WithholdTwoSetups(const std::vector<RunFile>& runs, CampaignResult* result)
     result->setup_warnings.push_back(text);
     for (int i : members) {
       traces[i].status = TraceStatus::kRejected;
-      traces[i].message = traces[i].file + ": " + text;
+      traces[i].message = traces[i].file + ": withheld: " + std::to_string(setups.size()) +
+                          " set-ups at " + where + ", not averaged (see the warning on set-ups)";
       traces[i].warnings.push_back(text);
     }
   }

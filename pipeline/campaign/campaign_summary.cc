@@ -11,17 +11,10 @@
 
 namespace bifilar {
 
-void PrintPhysicalCheck(const CampaignResult& result, std::ostream& out) {
-  if (!result.physical) return;
-  const PhysicalCheck& p = *result.physical;
-  const char* head = p.status == PhysicalStatus::kNotPhysical  ? "Error: "
-                     : p.status == PhysicalStatus::kBorderline ? "Warning: "
-                                                               : nullptr;
-  if (head == nullptr) return;
-  // Word-wrapped at 150 characters, continuation lines indented.
+// `head` then `text` word-wrapped at 150 characters, continuation lines indented by two.
+void PrintWrapped(const std::string& head, const std::string& text, std::ostream& out) {
   std::string line = head;
   size_t start = 0;
-  const std::string& text = p.message;
   while (start < text.size()) {
     size_t end = text.find(' ', start);
     if (end == std::string::npos) end = text.size();
@@ -34,6 +27,13 @@ void PrintPhysicalCheck(const CampaignResult& result, std::ostream& out) {
     start = end + 1;
   }
   out << line << "\n";
+}
+
+void PrintPhysicalCheck(const CampaignResult& result, std::ostream& out) {
+  if (!result.physical) return;
+  const PhysicalCheck& p = *result.physical;
+  if (p.status == PhysicalStatus::kNotPhysical) PrintWrapped("Error: ", p.message, out);
+  if (p.status == PhysicalStatus::kBorderline) PrintWrapped("Warning: ", p.message, out);
 }
 
 void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& result,
@@ -131,7 +131,7 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     }
     out << "  " << ToString(r.status) << ": " << r.message << "\n";
   }
-  for (const std::string& w : result.setup_warnings) out << "Warning: " << w << "\n";
+  for (const std::string& w : result.setup_warnings) PrintWrapped("Warning: ", w, out);
   if (!result.assumed_inputs_note.empty()) out << result.assumed_inputs_note << "\n";
   if (rig_unknown > 0) {
     out << "  error: " << rig_unknown << " aircraft trace" << (rig_unknown == 1 ? "" : "s")
