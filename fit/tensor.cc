@@ -273,7 +273,9 @@ bool FitTensorClosedForm(const Prepared& data, const Design& design, Solution* s
 bool EstimateTensorCovariance(const Prepared& data, const Design& design, const Solution& s,
                               const TensorOptions& options, Covariance* c, std::string* why) {
   const int n = data.n, m = static_cast<int>(data.groups.size()), r = design.rank;
-  switch (data.covariance) {
+  switch (data.scale_dof > 0 && data.covariance == EllipseCovariance::kPointResiduals
+              ? EllipseCovariance::kAbsolute
+              : data.covariance) {
     case EllipseCovariance::kPointResiduals:
       if (n <= r) {
         *why = std::to_string(n) + " moments for " + std::to_string(r) +
@@ -307,7 +309,7 @@ bool EstimateTensorCovariance(const Prepared& data, const Design& design, const 
     }
     default:
       c->variance_factor = 1.0;
-      c->dof = kInf;
+      c->dof = data.scale_dof > 0 ? data.scale_dof : kInf;
       break;
   }
   c->cov_gamma = s.normal_inv * c->variance_factor;
@@ -453,6 +455,9 @@ Eigen::VectorXd AttitudeSensitivity(const Prepared& data, const Vec6& beta) {
   return g;
 }
 
+double ReweighPerOrientation(const Design& design, Prepared* data, Solution* fit,
+                             std::vector<double>* by_group);
+
 // A swing axis is known only to within the attitude the aircraft hung at (set by hand, or
 // measured by an accelerometer with a bias): an error of sigma_a rad about a horizontal axis moves
 // the moment by g_i sigma_a, far above a trace fit's own std (1e-4 of I against ~1e-3 for 0.5
@@ -465,10 +470,15 @@ Eigen::VectorXd AttitudeSensitivity(const Prepared& data, const Vec6& beta) {
 // real rig scatter by 0.2-0.3 % (release amplitude, hanging) where each log's std says 0.02-0.15 %.
 // *relative receives sigma_r (0 when not used).
 double ReweighForAttitudeScatter(const Design& design, const TensorOptions& options,
-                                 Prepared* data, Solution* fit, double* relative) {
+                                 Prepared* data, Solution* fit, double* relative,
+                                 std::vector<double>* by_group) {
   *relative = 0.0;
   if (!options.attitude_scatter || !data->weighted || data->n <= design.rank) return 0.0;
   const bool full = design.rank == 6;
+  if (!full) {
+    *relative = ReweighPerOrientation(design, data, fit, by_group);
+    return std::isfinite(*relative) ? 0.0 : NAN;
+  }
   const Eigen::VectorXd s2 = data->w.cwiseInverse();  // the stated variances
   double sigma2 = 0.0;
   for (int iteration = 0; iteration < 8; ++iteration) {
@@ -501,6 +511,88 @@ double ReweighForAttitudeScatter(const Design& design, const TensorOptions& opti
     return 0.0;
   }
   return std::sqrt(sigma2);
+}
+
+// Designs that are not full (three axes, say): a scatter of the moments beyond their stds is
+// sought where it is. Each orientation's points have n_g - h_g degrees of freedom (h_g its share of
+// the hat matrix); an orientation whose chi^2 per dof exceeds the others' at p < 0.01 (F test)
+// gets a relative scatter of its own, solved on its points alone (sum r^2 / (s^2 + (sigma_g
+// I)^2) = its dof); the others share one (the Paule-Mandel equation over their points). So an
+// attitude whose logs scatter widens its own components only. *by_group: each orientation's
+// relative scatter (0 when none); returns the shared one; the dof of the shared one go to
+// data->scale_dof. NaN when a refit fails.
+double ReweighPerOrientation(const Design& design, Prepared* data, Solution* fit,
+                             std::vector<double>* by_group) {
+  const int m = static_cast<int>(data->groups.size());
+  const Eigen::VectorXd s2 = data->w.cwiseInverse();
+  std::vector<bool> own(m, false);
+  std::vector<double> sigma2(m, 0.0);
+  double shared2 = 0.0, shared_dof = 0.0;
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    const Eigen::MatrixXd z = data->x * design.basis;
+    const Eigen::VectorXd r2 = fit->resid.array().square();
+    const Eigen::VectorXd i2 = fit->fitted.array().square();
+    std::vector<double> dof(m, 0.0), chi2(m, 0.0);
+    for (int g = 0; g < m; ++g) {
+      for (int i : data->groups[g]) {
+        dof[g] += 1.0 - data->w(i) * z.row(i) * fit->normal_inv * z.row(i).transpose();
+        chi2[g] += r2(i) / s2(i);
+      }
+    }
+    // Which orientations scatter beyond the others (on the stated stds alone).
+    double chi2_all = 0.0, dof_all = 0.0;
+    for (int g = 0; g < m; ++g) {
+      chi2_all += chi2[g];
+      dof_all += dof[g];
+    }
+    for (int g = 0; g < m; ++g) {
+      const double rest_dof = dof_all - dof[g], rest_chi2 = chi2_all - chi2[g];
+      own[g] = dof[g] > 0.5 && rest_dof > 0.5 && rest_chi2 > 0 && chi2[g] / dof[g] > 1.0 &&
+               FDistributionUpperTail((chi2[g] / dof[g]) / (rest_chi2 / rest_dof), dof[g],
+                                      rest_dof) < 0.01;
+    }
+    // Solve sum r^2 / (s^2 + v I^2) = target over `members` for v >= 0.
+    const auto solve = [&](const std::vector<int>& members, double target) {
+      auto excess = [&](double v) {
+        double sum = 0.0;
+        for (int i : members) sum += r2(i) / (s2(i) + v * i2(i));
+        return sum - target;
+      };
+      if (!(target > 0) || excess(0.0) <= 0.0) return 0.0;
+      double lo = 0.0, hi = 1e-8;
+      while (excess(hi) > 0.0 && hi < 1.0) hi *= 4.0;
+      for (int k = 0; k < 100; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (excess(mid) > 0.0 ? lo : hi) = mid;
+      }
+      return 0.5 * (lo + hi);
+    };
+    std::vector<int> shared_members;
+    shared_dof = 0.0;
+    for (int g = 0; g < m; ++g) {
+      if (own[g]) {
+        sigma2[g] = solve(data->groups[g], dof[g]);
+      } else {
+        shared_members.insert(shared_members.end(), data->groups[g].begin(), data->groups[g].end());
+        shared_dof += dof[g];
+      }
+    }
+    const double next_shared = solve(shared_members, shared_dof);
+    const bool settled = std::fabs(next_shared - shared2) <= 1e-4 * std::max(next_shared, 1e-300);
+    shared2 = next_shared;
+    for (int g = 0; g < m; ++g) {
+      const double v = own[g] ? sigma2[g] : shared2;
+      for (int i : data->groups[g]) data->w(i) = 1.0 / (s2(i) + v * i2(i));
+    }
+    data->sqrt_w = data->w.cwiseSqrt();
+    std::string why;
+    if (!FitTensorClosedForm(*data, design, fit, &why)) return NAN;
+    if (settled && iteration > 0) break;
+  }
+  by_group->assign(m, 0.0);
+  for (int g = 0; g < m; ++g) (*by_group)[g] = std::sqrt(own[g] ? sigma2[g] : shared2);
+  data->scale_dof = std::max(shared_dof, 1.0);
+  return std::sqrt(shared2);
 }
 
 // Lack-of-fit F test at 5 %: do the orientations' means scatter about the fit more than their
@@ -648,6 +740,17 @@ void FillPrincipal(const Solution& solved, const Covariance& cov,
 bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& options,
                TensorResult* result, std::string* why) {
   const auto start = std::chrono::steady_clock::now();
+  if (!FitTensorOnce(points, options, result, why)) return false;
+  CheckTensorPhysical(points, options, result);
+  result->time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return true;
+}
+
+namespace tensor {
+
+bool FitTensorOnce(const std::vector<TensorPoint>& points, const TensorOptions& options,
+                   TensorResult* result, std::string* why) {
+  const auto start = std::chrono::steady_clock::now();
   QuietSolverLogging();
   if (!options.Check(why)) return false;
   Prepared data;
@@ -658,8 +761,9 @@ bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& opti
   if (!FitTensorClosedForm(data, design, &closed, why)) return false;
   // Each axis is known to within an attitude error: weights 1/(s_i^2 + sigma_a^2 g_i^2).
   double relative_scatter = 0.0;
-  const double attitude_scatter_rad =
-      ReweighForAttitudeScatter(design, options, &data, &closed, &relative_scatter);
+  std::vector<double> scatter_by_orientation;
+  const double attitude_scatter_rad = ReweighForAttitudeScatter(
+      design, options, &data, &closed, &relative_scatter, &scatter_by_orientation);
   if (!std::isfinite(attitude_scatter_rad)) {
     *why = "the refit with the attitude scatter failed (singular fit)";
     return false;
@@ -672,6 +776,7 @@ bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& opti
   FillFitSummary(data, design, solved, cov, &r);
   r.attitude_scatter_deg = attitude_scatter_rad * kDegPerRad;
   r.relative_scatter = relative_scatter;
+  r.orientation_relative_scatter = scatter_by_orientation;
   CompareWithClosedForm(closed, solved, &r);
   const TensorIntervalSet intervals =
       TensorIntervals(data, design, solved, cov, options, r.full);
@@ -687,4 +792,5 @@ bool FitTensor(const std::vector<TensorPoint>& points, const TensorOptions& opti
   return true;
 }
 
+}  // namespace tensor
 }  // namespace bifilar

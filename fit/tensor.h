@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "fit/ellipse.h"  // EllipseCovariance, EllipseSolverSummary
+#include "fit/physical_check.h"
 #include "fit/tensor_components.h"
 
 namespace bifilar {
@@ -125,6 +126,10 @@ struct TensorResult {
   // A design that is not full: the relative scatter of the moments beyond their stds instead
   // (fraction, e.g. 0.002), 0 when the stds explain it.
   double relative_scatter = 0.0;
+  // Per orientation (same order as `orientations`), a design that is not full: the relative
+  // scatter its points were weighed with. An orientation whose logs scatter beyond the others'
+  // (F test, p < 0.01) has its own; the others share relative_scatter. Empty when not used.
+  std::vector<double> orientation_relative_scatter;
   bool full = false;               // rank == 6: principal moments and axes below are defined
   double condition_number = 0.0;   // largest / smallest non-zero singular value of the design
   std::array<double, kTensorComponents> design_singular_values = {};  // descending
@@ -159,6 +164,14 @@ struct TensorResult {
   std::vector<TensorPointResidual> residuals;
   std::vector<TensorOrientation> orientations;
   int n_outliers = 0;
+
+  // Can a body have these moments (fit/physical.h): the triangle inequalities and positive
+  // definiteness against the combined std, at the fit's dof. When flagged or borderline,
+  // `physical.orientation` is the orientation whose removal restores the inequality most (a
+  // refit without each in turn) or, when no refit determines the same components, the one nearest
+  // the axis of the largest moment of the broken inequality; `physical.attitude` names its axis
+  // (a campaign names the roll and pitch instead).
+  PhysicalCheck physical;
 
   EllipseSolverSummary ceres;       // the primary fit ("ceres")
   double closed_form_max_relative_difference = 0.0;  // Ceres vs closed form (QR), parity

@@ -44,6 +44,10 @@ struct Prepared {
   std::vector<Eigen::Vector3d> group_axis;  // the first member's nominal axis (unit)
   EllipseCovariance covariance = EllipseCovariance::kPointResiduals;  // resolved after the rank
   std::vector<std::string> warnings;
+  // Per-orientation scatter (designs that are not full): the weights already hold each
+  // orientation's scatter, so the covariance takes them as they are (variance factor 1) with
+  // `scale_dof` degrees of freedom (those of the pooled scatter). 0: not used.
+  double scale_dof = 0.0;
 };
 
 bool PrepareTensorData(const std::vector<TensorPoint>& points, const TensorOptions& options,
@@ -113,6 +117,14 @@ struct TensorIntervalSet {
 TensorIntervalSet TensorIntervals(const Prepared& data, const Design& design, const Solution& s,
                                   const Covariance& cov, const TensorOptions& options,
                                   bool principal);
+
+// FitTensor without naming the attitude that drives a non-physical result (no refits).
+bool FitTensorOnce(const std::vector<TensorPoint>& points, const TensorOptions& options,
+                   TensorResult* result, std::string* why);
+// Fills result->physical (fit/physical.h) and, when it is not physical or borderline, names the
+// orientation that drives it by refitting without each (tensor_physical.cc).
+void CheckTensorPhysical(const std::vector<TensorPoint>& points, const TensorOptions& options,
+                         TensorResult* result);
 
 }  // namespace tensor
 }  // namespace bifilar

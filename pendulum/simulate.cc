@@ -911,6 +911,24 @@ bool CampaignSpec::Check(std::string* why) const {
                "true_filar_separation_m (0: filar_separation_m)", TrueSeparationM(), &f)) {
     return FailWith(f, why);
   }
+  for (const AttitudeOverride& o : attitude_overrides) {
+    const double length = o.true_filar_length_m > 0 ? o.true_filar_length_m : TrueLengthM();
+    const double separation =
+        o.true_filar_separation_m > 0 ? o.true_filar_separation_m : TrueSeparationM();
+    if (std::find(attitudes_deg.begin(), attitudes_deg.end(), o.attitude_deg) == attitudes_deg.end()) {
+      return fail("attitude_overrides.attitude_deg (roll)", o.attitude_deg[0],
+                  "an attitude of attitudes_deg");
+    }
+    if (!CheckFiniteGe("attitude_overrides.true_filar_length_m", o.true_filar_length_m, 0.0, &f) ||
+        !CheckFiniteGe("attitude_overrides.true_filar_separation_m", o.true_filar_separation_m,
+                       0.0, &f) ||
+        !CheckGt("attitude_overrides.true_filar_length_m", length,
+                 "attitude_overrides.true_filar_separation_m", separation, &f) ||
+        !CheckIn("attitude_overrides.inertia_scatter", o.inertia_scatter, 0.0, 0.5, Ends::kClosed,
+                 &f)) {
+      return FailWith(f, why);
+    }
+  }
   if (calibration_logs > 0) {
     if (!CheckIn("calibration.reference_inertia_kg_m2", reference_inertia_kg_m2, 0.0, 1e9,
                  Ends::kOpenClosed, &f) ||
@@ -1075,6 +1093,19 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
     TraceSetup& s = ct.setup;
     s.geometry.filar_length_m = spec.TrueLengthM();
     s.geometry.filar_separation_m = spec.TrueSeparationM();
+    for (const AttitudeOverride& o : spec.attitude_overrides) {
+      if (kind != kAircraftLog || !nominal_roll_deg || o.attitude_deg[0] != *nominal_roll_deg ||
+          o.attitude_deg[1] != nominal_deg ||
+          (!o.trials.empty() && std::find(o.trials.begin(), o.trials.end(), trial) == o.trials.end())) {
+        continue;
+      }
+      if (o.true_filar_length_m > 0) s.geometry.filar_length_m = o.true_filar_length_m;
+      if (o.true_filar_separation_m > 0) s.geometry.filar_separation_m = o.true_filar_separation_m;
+      if (o.inertia_scatter > 0) {
+        Rng scatter_rng(DeriveSeed(seed, path + "#scatter"));
+        ct.inertia_aircraft_kg_m2 *= std::max(0.05, 1.0 + o.inertia_scatter * scatter_rng.Normal(1.0));
+      }
+    }
     s.geometry.gravity_mps2 = spec.gravity_mps2;
     s.geometry.mass_kg = spec.rig.mass_kg + spec.rig.imu_mass_kg +
                          (kind == kAircraftLog ? spec.aircraft.mass_kg : 0.0) +

@@ -268,6 +268,17 @@ struct RigTruth {
   bool Check(std::string* why) const;
 };
 
+// Logs of one attitude made otherwise than the rest (a survey's faulty campaign): on another
+// rig (true L, D; 0 = the campaign's), and/or with a per-log scatter of the true moment beyond
+// what the logs' fits see (a relative std: a hanging that changes between repeats).
+struct AttitudeOverride {
+  std::array<double, 2> attitude_deg = {0, 0};  // [roll, pitch], one of attitudes_deg
+  double true_filar_length_m = 0.0;             // 0: the campaign's
+  double true_filar_separation_m = 0.0;         // 0: the campaign's
+  std::vector<int> trials;                      // 1-based trials it applies to; empty: all
+  double inertia_scatter = 0.0;                 // relative std of the true moment per log, >= 0
+};
+
 struct CampaignSpec {
   AircraftTruth aircraft;
   RigTruth rig;
@@ -302,6 +313,8 @@ struct CampaignSpec {
   double reference_inertia_kg_m2 = 0.0;      // > 0 when calibration_logs > 0
   double reference_mass_kg = 0.0;            // > 0 when calibration_logs > 0
   UniformRange calibration_amplitude_deg = {0.0, 0.0};
+  // Attitudes whose logs were made otherwise (AttitudeOverride); each names one of attitudes_deg.
+  std::vector<AttitudeOverride> attitude_overrides;
 
   double TrueLengthM() const { return true_filar_length_m > 0 ? true_filar_length_m : filar_length_m; }
   double TrueSeparationM() const {

@@ -21,9 +21,11 @@
 #include "base/option_check.h"
 #include "base/parallel_runner.h"
 #include "base/statistics.h"
+#include "base/text_format.h"
 #include "base/units.h"
 #include "base/user_error.h"
 #include "base/version.h"
+#include "fit/physical.h"
 #include "fit/tensor.h"
 #include "pipeline/campaign/calibration.h"
 #include "pipeline/campaign/campaign_inputs.h"
@@ -492,12 +494,49 @@ void SubtractRig(const CampaignConfig& config, const TareEstimate& tare,
 
 // ---- Step 4: group ----------------------------------------------------------------------------
 
-// The logs of one attitude (and of one group of runs.table's `group` column, when it has one)
-// are repeats of one set-up: when they look like two (pipeline/trace/repeat_setups.h), each gets
-// a warning naming the clusters, and the campaign says it once. Numbers are not changed.
-void WarnIfTwoSetups(const std::vector<RunFile>& runs, CampaignResult* result) {
+// The logs of one attitude are repeats of one set-up. When they form two, found by the test
+// (pipeline/trace/repeat_setups.h) or named by the user (two values of runs.table's `group`
+// column at one attitude), the attitude's result is withheld: each set-up is reported on its own
+// (its logs, weighted mean and std) and its logs are marked rejected, so neither the ellipse nor
+// the tensor averages them, until the user keeps one set-up (comments out the other's rows in
+// runs.table with '#'). docs/guide.md, "Two set-ups at one attitude".
+struct SetupGroup {
+  std::string name;            // the group column's value, or "set-up 1" / "set-up 2"
+  std::vector<int> members;    // trace indices
+};
+
+// "group 'A' (a.csv, b.csv): I_total = 0.3201 +- 0.0002 kg m^2" for each set-up, the weighted mean
+// of its logs' total moments (rig + aircraft, as the test's text) with the std of a weighted mean (Birge-scaled when they scatter).
+std::string SetupGroupsText(const std::vector<SetupGroup>& setups,
+                            const std::vector<TraceRecord>& traces) {
+  std::string text;
+  for (const SetupGroup& s : setups) {
+    double sw = 0, swy = 0, chi2 = 0;
+    for (int i : s.members) {
+      const double w = 1.0 / (traces[i].inertia_total_std_kg_m2 * traces[i].inertia_total_std_kg_m2);
+      sw += w;
+      swy += w * traces[i].inertia_total_kg_m2;
+    }
+    const double mean = swy / sw;
+    for (int i : s.members) {
+      const double d = (traces[i].inertia_total_kg_m2 - mean) / traces[i].inertia_total_std_kg_m2;
+      chi2 += d * d;
+    }
+    const double birge =
+        s.members.size() > 1 ? std::max(1.0, std::sqrt(chi2 / (s.members.size() - 1))) : 1.0;
+    std::string files;
+    for (size_t k = 0; k < s.members.size(); ++k) {
+      files += (k ? ", " : "") + traces[s.members[k]].file;
+    }
+    text += (text.empty() ? "" : "; ") + s.name + " (" + files + "): I_total = " + Fmt("%.5g", mean) +
+            " +- " + Fmt("%.2g", birge / std::sqrt(sw)) + " kg m^2";
+  }
+  return text;
+}
+
+void WithholdTwoSetups(const std::vector<RunFile>& runs, CampaignResult* result) {
   std::vector<TraceRecord>& traces = result->traces;
-  std::map<std::tuple<double, double, std::string>, std::vector<int>> groups;
+  std::map<std::pair<double, double>, std::vector<int>> attitudes;
   for (size_t i = 0; i < traces.size(); ++i) {
     const TraceRecord& r = traces[i];
     if (r.role != TraceRole::kAircraft || !r.ok() || !std::isfinite(r.inertia_total_kg_m2) ||
@@ -508,26 +547,49 @@ void WarnIfTwoSetups(const std::vector<RunFile>& runs, CampaignResult* result) {
         r.pitch_nominal_deg ? *r.pitch_nominal_deg : std::round(r.pitch_used_deg * 2.0) / 2.0;
     const double roll = r.pitch_nominal_deg ? r.roll_nominal_deg.value_or(0.0)
                                             : std::round(r.roll_used_deg * 2.0) / 2.0;
-    groups[{roll, pitch, i < runs.size() ? runs[i].group : ""}].push_back(static_cast<int>(i));
+    attitudes[{roll, pitch}].push_back(static_cast<int>(i));
   }
-  for (const auto& [key, members] : groups) {
-    std::vector<const TraceRecord*> records;
-    std::vector<std::string> names;
-    for (int i : members) {
-      records.push_back(&traces[i]);
-      names.push_back(traces[i].file);
+  for (const auto& [attitude, members] : attitudes) {
+    // Named set-ups: the group column's values at this attitude.
+    std::map<std::string, std::vector<int>> named;
+    for (int i : members) named[static_cast<size_t>(i) < runs.size() ? runs[i].group : ""].push_back(i);
+    std::vector<SetupGroup> setups;
+    std::string found;
+    if (named.size() > 1) {
+      for (const auto& [name, logs] : named) {
+        setups.push_back({name.empty() ? "no group" : "group '" + name + "'", logs});
+      }
+      found = "are named as " + std::to_string(named.size()) + " set-ups in runs.table's group column";
+    } else {
+      std::vector<const TraceRecord*> records;
+      std::vector<std::string> names;
+      for (int i : members) {
+        records.push_back(&traces[i]);
+        names.push_back(traces[i].file);
+      }
+      const SetupSplit split = TestTwoSetups(records);
+      if (!split.two_setups) continue;
+      for (int c = 0; c < 2; ++c) {
+        SetupGroup g{"set-up " + std::to_string(c + 1), {}};
+        for (int k : split.clusters[c]) g.members.push_back(members[k]);
+        setups.push_back(g);
+      }
+      found = "look like " + TwoSetupsText(split, names);
     }
-    const SetupSplit split = TestTwoSetups(records);
-    if (!split.two_setups) continue;
-    char where[160];
-    std::snprintf(where, sizeof(where), "the %zu logs at roll %g, pitch %g deg%s look like ",
-                  members.size(), std::get<0>(key), std::get<1>(key),
-                  std::get<2>(key).empty() ? "" : (" of group '" + std::get<2>(key) + "'").c_str());
-    const std::string text = where + TwoSetupsText(split, names) +
-                             ". Check the hanging; if it changed, name each set-up in a group "
-                             "column of runs.table";
+    char where[96];
+    std::snprintf(where, sizeof(where), "roll %g, pitch %g deg", attitude.first, attitude.second);
+    const std::string text =
+        std::string("result withheld at ") + where + ": its " + std::to_string(members.size()) +
+        " logs " + found + ": " + SetupGroupsText(setups, traces) +
+        ". They are not averaged. Keep the set-up you trust: comment out the other's rows in "
+        "runs.table with '#' (with runs.pattern, list the logs in a runs.table first) and rerun";
     result->setup_warnings.push_back(text);
-    for (int i : members) traces[i].warnings.push_back(text);
+    for (int i : members) {
+      traces[i].status = TraceStatus::kRejected;
+      traces[i].message = traces[i].file + ": withheld: " + std::to_string(setups.size()) +
+                          " set-ups at " + where + ", not averaged (see the warning on set-ups)";
+      traces[i].warnings.push_back(text);
+    }
   }
 }
 
@@ -719,6 +781,41 @@ void FitCampaignEllipse(const CampaignConfig& config, const CampaignOptions& opt
   result->ellipse_fit = std::move(fit);
 }
 
+// The planar ellipse's physical check (fit/physical.h); when it is not physical or borderline,
+// the pitch whose removal restores it most is named (a refit without each pitch in turn).
+PhysicalCheck CheckPlanarPhysical(const CampaignConfig& config, const CampaignResult& result) {
+  PhysicalCheck check = CheckPhysicalEllipse(*result.ellipse_fit, {});
+  if (check.status != PhysicalStatus::kNotPhysical && check.status != PhysicalStatus::kBorderline) {
+    return check;
+  }
+  std::vector<double> pitches;
+  for (const AngleStats& a : result.angles) pitches.push_back(a.pitch_deg);
+  EllipseOptions options = MakeEllipseOptions(config, result.rig_inertia_std_kg_m2);
+  options.bootstrap_replicates = 0;
+  double best_z = -std::numeric_limits<double>::infinity(), best_pitch = NAN;
+  for (const double pitch : pitches) {
+    std::vector<TraceRecord> rest;
+    for (const TraceRecord& r : result.traces) {
+      const double p = r.pitch_nominal_deg ? *r.pitch_nominal_deg : r.pitch_used_deg;
+      if (std::fabs(p - pitch) > 0.25) rest.push_back(r);
+    }
+    EllipseResult refit;
+    std::string why;
+    if (!FitEllipse(EllipsePoints(rest), options, &refit, &why) || !refit.IsUsable()) continue;
+    const PhysicalCheck without = CheckPhysicalEllipse(refit, {});
+    if (without.Worst() != nullptr && without.Worst()->z > best_z) {
+      best_z = without.Worst()->z;
+      best_pitch = pitch;
+    }
+  }
+  if (std::isfinite(best_pitch)) {
+    check.attitude = "pitch " + Fmt("%g", best_pitch) + " deg";
+    check.z_without_attitude = best_z;
+    check.message = PhysicalCheckMessage(check);
+  }
+  return check;
+}
+
 // ---- Step 6: write ----------------------------------------------------------------------------
 
 // The result files, each atomically, results.json last with its siblings' hashes
@@ -790,7 +887,7 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   const TareEstimate tare = EstimateTare(&result.traces);
   SetRigInertia(config, tare, &result);
   SubtractRig(config, tare, &result.traces);
-  WarnIfTwoSetups(inputs.runs, &result);
+  WithholdTwoSetups(inputs.runs, &result);
   // 4. Group: counts, per-angle statistics, the systematic uncertainty.
   CountStatuses(result.traces, &result.summary);
   result.angles = GroupByAngle(result.traces);
@@ -804,9 +901,13 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   FitCampaignTensor(config, options.figures ? out.figures().string() : "",
                     [&out](const std::string& name) { out.manifest.Record({"figures/" + name}); },
                     &result);
+  if (result.ellipse_fit && IsPlanarCampaign(result.traces)) {
+    result.physical = CheckPlanarPhysical(config, result);
+  }
   if (result.summary.n_rejected + result.summary.n_error > 0 ||
       (!result.summary.ellipse_fitted && !result.summary.tensor_fitted) ||
-      (result.ellipse_fit && !result.ellipse_fit->physical)) {
+      (result.ellipse_fit && !result.ellipse_fit->physical) ||
+      (result.physical && result.physical->Flagged())) {
     result.summary.exit_code = 1;
   }
   result.summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();

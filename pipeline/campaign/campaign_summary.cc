@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <ostream>
 
 #include "pipeline/campaign/campaign_tensor.h"
@@ -9,6 +10,31 @@
 #include "pipeline/records/total_uncertainty.h"
 
 namespace bifilar {
+
+// `head` then `text` word-wrapped at 150 characters, continuation lines indented by two.
+void PrintWrapped(const std::string& head, const std::string& text, std::ostream& out) {
+  std::string line = head;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = text.find(' ', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string word = text.substr(start, end - start);
+    if (line.size() + word.size() + 1 > 150 && line.size() > 2) {
+      out << line << "\n";
+      line = "  ";
+    }
+    line += (line.empty() || line.back() == ' ' ? "" : " ") + word;
+    start = end + 1;
+  }
+  out << line << "\n";
+}
+
+void PrintPhysicalCheck(const CampaignResult& result, std::ostream& out) {
+  if (!result.physical) return;
+  const PhysicalCheck& p = *result.physical;
+  if (p.status == PhysicalStatus::kNotPhysical) PrintWrapped("Error: ", p.message, out);
+  if (p.status == PhysicalStatus::kBorderline) PrintWrapped("Warning: ", p.message, out);
+}
 
 void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& result,
                           std::ostream& out) {
@@ -19,6 +45,7 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
   const CampaignSummary& s = result.summary;
   // The one cause that fails every aircraft trace comes first, once.
   if (!result.rig_problem.empty()) out << "Error: " << result.rig_problem << "\n";
+  PrintPhysicalCheck(result, out);  // a body that cannot exist: said before its numbers
   if (result.ellipse_fit) {
     const EllipseResult& e = *result.ellipse_fit;
     // Each moment: its std (stat: the trials' scatter, the rig offset) and the total, which adds
@@ -104,7 +131,7 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     }
     out << "  " << ToString(r.status) << ": " << r.message << "\n";
   }
-  for (const std::string& w : result.setup_warnings) out << "Warning: " << w << "\n";
+  for (const std::string& w : result.setup_warnings) PrintWrapped("Warning: ", w, out);
   if (!result.assumed_inputs_note.empty()) out << result.assumed_inputs_note << "\n";
   if (rig_unknown > 0) {
     out << "  error: " << rig_unknown << " aircraft trace" << (rig_unknown == 1 ? "" : "s")

@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "base/hash.h"
+#include "base/text_format.h"
+#include "fit/physical.h"
 #include "base/version.h"
 #include "pipeline/figures/tensor_plot.h"
 #include "pipeline/records/tensor_json.h"
@@ -59,6 +61,17 @@ void DrawTensorFigure(const CampaignConfig& config, const TensorResult& fit,
   if (fs::exists(path, ec) || WriteTensorFigure(fit, path.string(), plot, &why)) {
     result->tensor_figure = name;
   }
+}
+
+// The orientation the fit named (fit/tensor.h, TensorResult::physical) by its roll and pitch.
+void NamePhysicalAttitude(const TensorJsonContext& context, PhysicalCheck* check) {
+  if (check->orientation < 0 ||
+      check->orientation >= static_cast<int>(context.orientations.size())) {
+    return;
+  }
+  const TensorJsonContext::Orientation& o = context.orientations[check->orientation];
+  check->attitude = "roll " + Fmt("%g", o.roll_deg) + ", pitch " + Fmt("%g", o.pitch_deg) + " deg";
+  check->message = PhysicalCheckMessage(*check);
 }
 
 }  // namespace
@@ -127,6 +140,8 @@ void FitCampaignTensor(const CampaignConfig& config, const std::string& figures_
     return;
   }
   context.mode = fit.full ? "full_3d" : "partial";
+  NamePhysicalAttitude(context, &fit.physical);
+  result->physical = fit.physical;
   result->tensor = TensorResultToJson(fit, context);
   summary.tensor_fitted = true;
   if (!figures_dir.empty()) DrawTensorFigure(config, fit, figures_dir, record_figure, result);
@@ -182,6 +197,17 @@ void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& resu
     std::snprintf(line, sizeof(line),
                   "  (the moments scatter by %.2f %% beyond their logs' stds: weighed by that, "
                   "docs/method.md)\n", 100.0 * t.relative_scatter);
+    out << line;
+  }
+  // Attitudes whose logs scatter beyond the others': their own scatter widens their axes only.
+  for (size_t g = 0; g < t.orientation_relative_scatter.size(); ++g) {
+    const double own = t.orientation_relative_scatter[g];
+    if (!(own > t.relative_scatter) || g >= result.tensor["orientations"].size()) continue;
+    const nlohmann::json& o = result.tensor["orientations"][g];
+    std::snprintf(line, sizeof(line),
+                  "  (the logs at roll %g, pitch %g deg scatter by %.2f %% beyond their stds: "
+                  "weighed by that, that axis alone; docs/method.md)\n",
+                  o.value("roll_deg", NAN), o.value("pitch_deg", NAN), 100.0 * own);
     out << line;
   }
   std::vector<std::pair<std::string, double>> logs;

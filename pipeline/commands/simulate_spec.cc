@@ -445,6 +445,35 @@ void ReadRig(YamlMap rig, CampaignSpec* c) {
   rig.Finish();
 }
 
+// `campaign.attitude_overrides`: attitudes whose logs were made otherwise (pendulum/simulate.h,
+// AttitudeOverride): [{attitude_deg: [roll, pitch], true_filar_length_m, true_filar_separation_m,
+// trials: [1, 2], inertia_scatter}], each key but attitude_deg optional.
+void ReadAttitudeOverrides(YamlMap& campaign, CampaignSpec* c) {
+  const YAML::Node list = campaign.Optional("attitude_overrides");
+  if (!list.IsDefined() || list.IsNull()) return;
+  if (!list.IsSequence()) {
+    throw UserError(campaign.Where(list) + ": '" + campaign.KeyPath("attitude_overrides") +
+                    "' must be a list of {attitude_deg: [roll, pitch], ...}");
+  }
+  for (size_t k = 0; k < list.size(); ++k) {
+    YamlMap item(list[k], campaign.file(),
+                 campaign.KeyPath("attitude_overrides") + "[" + std::to_string(k) + "]");
+    AttitudeOverride o;
+    const std::vector<double> attitude = item.OptionalDoubleList("attitude_deg", {});
+    if (attitude.size() != 2) {
+      throw UserError(item.Where(item.Optional("attitude_deg")) + ": '" +
+                      item.KeyPath("attitude_deg") + "' must be [roll_deg, pitch_deg]");
+    }
+    o.attitude_deg = {attitude[0], attitude[1]};
+    o.true_filar_length_m = ReadValue(item, "true_filar_length_m", 0.0, 0.0, false, 1000.0);
+    o.true_filar_separation_m = ReadValue(item, "true_filar_separation_m", 0.0, 0.0, false, 1000.0);
+    o.inertia_scatter = ReadValue(item, "inertia_scatter", 0.0, 0.0, false, 0.5);
+    for (double t : item.OptionalDoubleList("trials", {})) o.trials.push_back(static_cast<int>(t));
+    item.Finish();
+    c->attitude_overrides.push_back(o);
+  }
+}
+
 // `campaign`: the attitudes (pitch_deg, or attitudes_deg for a tensor campaign) and trials.
 void ReadCampaignPlan(YamlMap campaign, CampaignSpec* c) {
   // attitudes_deg: [[roll, pitch], ...] (a tensor campaign) instead of pitch_deg.
@@ -484,6 +513,7 @@ void ReadCampaignPlan(YamlMap campaign, CampaignSpec* c) {
       ReadValue(campaign, "pitch_error_sigma_deg", c->pitch_error_sigma_deg, 0, false, 10);
   c->roll_error_sigma_deg =
       ReadValue(campaign, "roll_error_sigma_deg", c->pitch_error_sigma_deg, 0, false, 10);
+  ReadAttitudeOverrides(campaign, c);
   campaign.Finish();
 }
 

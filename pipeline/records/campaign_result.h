@@ -85,6 +85,9 @@ struct CampaignResult {
   // Attitudes whose logs look like two set-ups (pipeline/trace/repeat_setups.h), one sentence
   // each; also a warning on each of their traces.
   std::vector<std::string> setup_warnings;
+  // Can a body have the result's moments (fit/physical.h): the tensor's check, or the planar
+  // ellipse's; the attitude named by roll and pitch. Empty when neither was fitted.
+  std::optional<PhysicalCheck> physical;
   // Table 1 of the paper (kg m^2): mean of per-angle std, mean CV (%), regression RMSE.
   double raw_sigma_kg_m2 = NAN, cv_percent = NAN, regression_rmse_kg_m2 = NAN;
   CampaignSummary summary;

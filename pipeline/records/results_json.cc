@@ -13,6 +13,7 @@
 #include "base/json_number.h"
 #include "base/user_error.h"
 #include "base/version.h"
+#include "pipeline/records/tensor_json.h"
 #include "pipeline/records/total_uncertainty.h"
 
 namespace bifilar {
@@ -713,6 +714,7 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   j["angles"] = angles;
   j["ellipse"] = result.ellipse;
   j["tensor"] = result.tensor;
+  if (result.physical) j["physical"] = PhysicalCheckToJson(*result.physical);
   j["figures"] = {{"moments", result.moments_figure}, {"polar", result.polar_figure},
                   {"tensor", result.tensor_figure}};
   return j;

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "base/json_number.h"
+#include "fit/physical.h"
 
 namespace bifilar {
 namespace {
@@ -168,6 +169,9 @@ json OrientationsJson(const TensorResult& r, const TensorJsonContext& c) {
               {"residual_std_kg_m2", JsonNumber(o.residual_std_kg_m2)},
               {"z", JsonNumber(o.z)},
               {"scatter_kg_m2", JsonNumber(o.scatter_kg_m2)}};
+    if (g < r.orientation_relative_scatter.size()) {
+      e["relative_scatter"] = JsonNumber(r.orientation_relative_scatter[g]);
+    }
     if (g < c.orientations.size()) {
       e["roll_deg"] = JsonNumber(c.orientations[g].roll_deg);
       e["pitch_deg"] = JsonNumber(c.orientations[g].pitch_deg);
@@ -221,6 +225,28 @@ std::string ScatterLogsText(const std::vector<std::pair<std::string, double>>& l
   return out;
 }
 
+json PhysicalCheckToJson(const PhysicalCheck& check) {
+  const auto one = [](const PhysicalInequality& q) {
+    return json{{"inequality", q.name},
+                {"margin_kg_m2", JsonNumber(q.margin_kg_m2)},
+                {"std_kg_m2", JsonNumber(q.std_kg_m2)},
+                {"z", std::isfinite(q.z) ? JsonNumber(q.z) : json(nullptr)}};
+  };
+  json j;
+  j["status"] = PhysicalStatusName(check.status);
+  j["checked"] = check.checked;
+  j["worst"] = check.Worst() ? one(*check.Worst()) : json(nullptr);
+  j["threshold_z"] = std::isfinite(check.threshold_z) ? JsonNumber(check.threshold_z) : json(nullptr);
+  j["attitude"] = check.attitude;
+  j["z_without_attitude"] =
+      std::isfinite(check.z_without_attitude) ? JsonNumber(check.z_without_attitude) : json(nullptr);
+  j["message"] = check.message;
+  json all = json::array();
+  for (const PhysicalInequality& q : check.inequalities) all.push_back(one(q));
+  j["inequalities"] = all;
+  return j;
+}
+
 json TensorResultToJson(const TensorResult& r, const TensorJsonContext& c) {
   json j;
   PutCommon(c, &j);
@@ -235,6 +261,7 @@ json TensorResultToJson(const TensorResult& r, const TensorJsonContext& c) {
   j["closed_form_max_relative_difference"] = JsonNumber(r.closed_form_max_relative_difference);
   j["warnings"] = r.warnings;
   j["scatter_logs"] = TensorScatterLogs(r, c);
+  j["physical"] = PhysicalCheckToJson(r.physical);
   j["time_s"] = JsonNumber(r.time_s);
   return j;
 }

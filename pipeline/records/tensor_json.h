@@ -51,6 +51,12 @@ nlohmann::json TensorScatterLogs(const TensorResult& result, const TensorJsonCon
 std::string ScatterLogsText(const std::vector<std::pair<std::string, double>>& logs);
 nlohmann::json TensorResultToJson(const TensorResult& result, const TensorJsonContext& context);
 
+// The `physical` object of results.json (fit/physical.h): status ("physical", "borderline",
+// "not_physical", "not_checked"), checked, worst {inequality, margin_kg_m2, std_kg_m2, z},
+// threshold_z, attitude ("" when none named), z_without_attitude (null: no refit), message, and
+// every inequality as {inequality, margin_kg_m2, std_kg_m2, z}. Infinite z is null.
+nlohmann::json PhysicalCheckToJson(const PhysicalCheck& check);
+
 // The tensor section of a planar x-z campaign: the ellipse's I_x, I_z, I_xz (the same numbers)
 // as Ixx, Izz, Ixz; Iyy, Ixy, Iyz unobservable (a pitch-only rig never swings about y).
 nlohmann::json PlanarTensorJson(const EllipseResult& ellipse, const TensorJsonContext& context);

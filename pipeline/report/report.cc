@@ -415,6 +415,28 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
     << " (&plusmn; stat std; inertia tensor below).</p>\n";
 }
 
+// results.json's `physical` (fit/physical.h) beside the result box: not physical in red with the
+// worst inequality's numbers, borderline as a warning; nothing when physical or not checked.
+void WritePhysicalBox(const ReportPage& p, std::ostream& h) {
+  const R physical = p.results.Get("physical");
+  if (!physical.IsObject()) return;
+  const std::string status = physical.Str("status");
+  if (status != "not_physical" && status != "borderline") return;
+  const R worst = physical.Get("worst");
+  const bool bad = status == "not_physical";
+  h << "<p class=\"result " << (bad ? "bad" : "warn") << "\""
+    << (bad ? " style=\"border-color:#b42318;background:#fde8e8\"" : "") << "><b>"
+    << (bad ? "Not physical" : "Borderline") << "</b>";
+  if (worst.IsObject()) {
+    h << ": " << Escape(worst.Str("inequality")) << " = " << Fmt(worst.Num("margin_kg_m2"), "%.4g")
+      << " &plusmn; " << Fmt(worst.Num("std_kg_m2"), "%.2g") << " kg m&sup2; (z = "
+      << Fmt(worst.Num("z"), "%.2f") << ", not physical at z &le; "
+      << Fmt(physical.Num("threshold_z"), "%.2f") << ")";
+  }
+  if (!physical.Str("attitude").empty()) h << "; attitude " << Escape(physical.Str("attitude"));
+  h << ". " << Escape(physical.Str("message")) << "</p>\n";
+}
+
 // Title, version, config, the campaign kind and the trace counts, then the main result.
 void WriteHeader(const ReportPage& p, std::ostream& h) {
   const CampaignSummary& summary = p.summary;
@@ -452,6 +474,7 @@ void WriteHeader(const ReportPage& p, std::ostream& h) {
       << ").</p>\n";
   }
   WriteHeadline(p, h);
+  WritePhysicalBox(p, h);
 }
 
 // A warning's line (LineOfWarning, pipeline/records/trace_record.h: the console's line) as page
