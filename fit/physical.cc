@@ -125,10 +125,9 @@ void CheckPlanar(const PhysicalVec& c, const PhysicalCov& cov, PhysicalCheck* ch
 
 }  // namespace physical
 
-using namespace physical;
 
 const char* PhysicalStatusName(PhysicalStatus status) {
-  return EnumToString(kPhysicalStatusNames, status, "?");
+  return EnumToString(physical::kPhysicalStatusNames, status, "?");
 }
 
 PhysicalCheck CheckPhysical(const std::array<double, kTensorComponents>& components,
@@ -136,8 +135,8 @@ PhysicalCheck CheckPhysical(const std::array<double, kTensorComponents>& compone
                                              kTensorComponents>& covariance,
                             const PhysicalOptions& options) {
   PhysicalCheck check;
-  PhysicalVec c;
-  PhysicalCov cov;
+  physical::PhysicalVec c;
+  physical::PhysicalCov cov;
   std::array<bool, 6> known = {};
   for (int k = 0; k < 6; ++k) {
     c(k) = components[k];
@@ -155,11 +154,11 @@ PhysicalCheck CheckPhysical(const std::array<double, kTensorComponents>& compone
   const bool diagonal = known[kIxx] && known[kIyy] && known[kIzz];
   const bool products = known[kIxy] && known[kIxz] && known[kIyz];
   if (diagonal && products) {
-    CheckFull(c, cov, &check);
+    physical::CheckFull(c, cov, &check);
   } else if (diagonal) {
-    CheckDiagonal(c, cov, &check);
+    physical::CheckDiagonal(c, cov, &check);
   } else if (known[kIxx] && known[kIzz] && known[kIxz] && !known[kIyy]) {
-    CheckPlanar(c, cov, &check);
+    physical::CheckPlanar(c, cov, &check);
   } else {
     return check;
   }
@@ -191,8 +190,8 @@ PhysicalCheck CheckPhysicalEllipse(const EllipseResult& fit, const PhysicalOptio
   const Eigen::Matrix3d xz = t * abc * t.transpose();  // (I_x, I_z, I_xz)
   std::array<double, kTensorComponents> c;
   std::array<std::array<double, kTensorComponents>, kTensorComponents> cov;
-  c.fill(kPhysicalUnknown);
-  for (auto& row : cov) row.fill(kPhysicalUnknown);
+  c.fill(physical::kPhysicalUnknown);
+  for (auto& row : cov) row.fill(physical::kPhysicalUnknown);
   const int index[3] = {kIxx, kIzz, kIxz};
   const double value[3] = {fit.ix.value, fit.iz.value, fit.ixz.value};
   for (int i = 0; i < 3; ++i) {

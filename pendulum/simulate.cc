@@ -890,6 +890,39 @@ bool RigTruth::Check(std::string* why) const {
   return true;
 }
 
+namespace {
+
+// Each attitude override names an attitude of the campaign and keeps the wires taut.
+bool CheckAttitudeOverrides(const CampaignSpec& spec, std::string* why) {
+  CheckFailure f;
+  const auto fail = [&](const std::string& field, double value, const std::string& allowed) {
+    CheckFail(field, value, allowed, &f);
+    return FailWith(f, why);
+  };
+  for (const AttitudeOverride& o : spec.attitude_overrides) {
+    const double length = o.true_filar_length_m > 0 ? o.true_filar_length_m : spec.TrueLengthM();
+    const double separation =
+        o.true_filar_separation_m > 0 ? o.true_filar_separation_m : spec.TrueSeparationM();
+    const auto& all = spec.attitudes_deg;
+    if (std::find(all.begin(), all.end(), o.attitude_deg) == all.end()) {
+      return fail("attitude_overrides.attitude_deg (roll)", o.attitude_deg[0],
+                  "an attitude of attitudes_deg");
+    }
+    if (!CheckFiniteGe("attitude_overrides.true_filar_length_m", o.true_filar_length_m, 0.0, &f) ||
+        !CheckFiniteGe("attitude_overrides.true_filar_separation_m", o.true_filar_separation_m,
+                       0.0, &f) ||
+        !CheckGt("attitude_overrides.true_filar_length_m", length,
+                 "attitude_overrides.true_filar_separation_m", separation, &f) ||
+        !CheckIn("attitude_overrides.inertia_scatter", o.inertia_scatter, 0.0, 0.5, Ends::kClosed,
+                 &f)) {
+      return FailWith(f, why);
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 bool CampaignSpec::Check(std::string* why) const {
   if (!aircraft.Check(why) || !rig.Check(why)) return false;
   CheckFailure f;
@@ -911,24 +944,7 @@ bool CampaignSpec::Check(std::string* why) const {
                "true_filar_separation_m (0: filar_separation_m)", TrueSeparationM(), &f)) {
     return FailWith(f, why);
   }
-  for (const AttitudeOverride& o : attitude_overrides) {
-    const double length = o.true_filar_length_m > 0 ? o.true_filar_length_m : TrueLengthM();
-    const double separation =
-        o.true_filar_separation_m > 0 ? o.true_filar_separation_m : TrueSeparationM();
-    if (std::find(attitudes_deg.begin(), attitudes_deg.end(), o.attitude_deg) == attitudes_deg.end()) {
-      return fail("attitude_overrides.attitude_deg (roll)", o.attitude_deg[0],
-                  "an attitude of attitudes_deg");
-    }
-    if (!CheckFiniteGe("attitude_overrides.true_filar_length_m", o.true_filar_length_m, 0.0, &f) ||
-        !CheckFiniteGe("attitude_overrides.true_filar_separation_m", o.true_filar_separation_m,
-                       0.0, &f) ||
-        !CheckGt("attitude_overrides.true_filar_length_m", length,
-                 "attitude_overrides.true_filar_separation_m", separation, &f) ||
-        !CheckIn("attitude_overrides.inertia_scatter", o.inertia_scatter, 0.0, 0.5, Ends::kClosed,
-                 &f)) {
-      return FailWith(f, why);
-    }
-  }
+  if (!CheckAttitudeOverrides(*this, why)) return false;
   if (calibration_logs > 0) {
     if (!CheckIn("calibration.reference_inertia_kg_m2", reference_inertia_kg_m2, 0.0, 1e9,
                  Ends::kOpenClosed, &f) ||

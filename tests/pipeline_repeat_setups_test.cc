@@ -286,8 +286,9 @@ TEST(RepeatSetups, NoFalseTwoSetupsOnIdealGroups) {
   EXPECT_EQ(two, 0);
 }
 
-// A campaign does the same for the logs of one attitude; a runs.table `group` column that puts
-// each hanging in its own group silences it (2 logs per group are not tested).
+// A campaign does the same for the logs of one attitude and withholds it (issue 32: never pooled);
+// a runs.table `group` column that names each hanging withholds it too; commenting out one
+// group's rows (the advice) keeps the other.
 TEST(RepeatSetups, CampaignWarnsPerAttitudeAndHonoursTheGroupColumn) {
   const TempDir dir("bifilar_setups_campaign");
   Simulate(dir, "p_1.csv", 0.100, 41, 20);
@@ -304,18 +305,24 @@ TEST(RepeatSetups, CampaignWarnsPerAttitudeAndHonoursTheGroupColumn) {
             "path,pitch_deg\np_1.csv,0\np_2.csv,0\np_3.csv,0\np_4.csv,0\n");
   const test_support::CliRun one =
       test_support::Bifilar(dir, "process " + dir.path + "/campaign.yaml --out " + dir.path + "/out1");
-  EXPECT_NE(one.out.find("Warning: the 4 logs at roll 0, pitch 0 deg look like two set-ups, not "
-                         "one: p_1.csv, p_2.csv at I = "),
+  EXPECT_NE(one.out.find("Warning: result withheld at roll 0, pitch 0 deg: its 4 logs look like two"),
             std::string::npos)
       << one.out << one.err;
+  EXPECT_NE(one.out.find("p_1.csv, p_2.csv at I = "), std::string::npos) << one.out;
   EXPECT_NE(test_support::ReadFile(dir.path + "/out1/results.json").find("look like two set-ups"),
             std::string::npos);
   WriteFile(dir.path + "/runs.csv", "path,pitch_deg,group\np_1.csv,0,A\np_2.csv,0,A\n"
                                     "p_3.csv,0,B\np_4.csv,0,B\n");
   const test_support::CliRun two =
       test_support::Bifilar(dir, "process " + dir.path + "/campaign.yaml --out " + dir.path + "/out2");
-  EXPECT_EQ(two.out.find("two set-ups"), std::string::npos) << two.out;
-  EXPECT_NE(two.out.find("Traces: 4 ok"), std::string::npos) << two.out << two.err;
+  EXPECT_NE(two.out.find("are named as 2 set-ups"), std::string::npos) << two.out;
+  EXPECT_NE(two.out.find("Traces: 0 ok, 4 rejected"), std::string::npos) << two.out << two.err;
+  WriteFile(dir.path + "/runs.csv", "path,pitch_deg,group\np_1.csv,0,A\np_2.csv,0,A\n"
+                                    "#p_3.csv,0,B\n#p_4.csv,0,B\n");
+  const test_support::CliRun three = test_support::Bifilar(
+      dir, "process " + dir.path + "/campaign.yaml --out " + dir.path + "/out3");
+  EXPECT_EQ(three.out.find("set-ups"), std::string::npos) << three.out;
+  EXPECT_NE(three.out.find("Traces: 2 ok"), std::string::npos) << three.out << three.err;
 }
 
 // Issue 33 item 3: --group-by patterns that crashed std::regex (a stack overflow in its

@@ -350,7 +350,13 @@ TEST(TensorCampaign, CrazyflieAirframeGivesItsThreeMoments) {
     EXPECT_GT(t.components[k].std, 0.0004 * t.components[k].value) << k;
     EXPECT_LT(t.components[k].std, 0.02 * t.components[k].value) << k;
   }
-  EXPECT_EQ(result.summary.exit_code, 0);
+  // I_zz exceeds I_xx + I_yy by 2.5 % (the authors' script: 31.96 > 15.78 + 15.26 too), 25 std:
+  // no rigid body does that (issue 32). The level (yaw) swings are named; their rig geometry
+  // likely differs from the side-hung ones'. Marked not physical, exit 1.
+  ASSERT_TRUE(result.physical.has_value());
+  EXPECT_EQ(result.physical->status, PhysicalStatus::kNotPhysical) << result.physical->message;
+  EXPECT_EQ(result.physical->attitude, "roll 0, pitch 0 deg");
+  EXPECT_EQ(result.summary.exit_code, 1);
 }
 
 }  // namespace

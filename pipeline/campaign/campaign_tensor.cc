@@ -152,6 +152,25 @@ void FitCampaignTensor(const CampaignConfig& config, const std::string& figures_
 
 namespace bifilar {
 
+namespace {
+
+// Attitudes whose logs scatter beyond the others': their own scatter widens their axes only.
+void PrintOwnScatter(const TensorResult& t, const CampaignResult& result, std::ostream& out) {
+  char line[256];
+  for (size_t g = 0; g < t.orientation_relative_scatter.size(); ++g) {
+    const double own = t.orientation_relative_scatter[g];
+    if (!(own > t.relative_scatter) || g >= result.tensor["orientations"].size()) continue;
+    const nlohmann::json& o = result.tensor["orientations"][g];
+    std::snprintf(line, sizeof(line),
+                  "  (the logs at roll %g, pitch %g deg scatter by %.2f %% beyond their stds: "
+                  "weighed by that, that axis alone; docs/method.md)\n",
+                  o.value("roll_deg", NAN), o.value("pitch_deg", NAN), 100.0 * own);
+    out << line;
+  }
+}
+
+}  // namespace
+
 void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& result,
                         std::ostream& out) {
   const TensorResult& t = *result.tensor_fit;
@@ -199,17 +218,7 @@ void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& resu
                   "docs/method.md)\n", 100.0 * t.relative_scatter);
     out << line;
   }
-  // Attitudes whose logs scatter beyond the others': their own scatter widens their axes only.
-  for (size_t g = 0; g < t.orientation_relative_scatter.size(); ++g) {
-    const double own = t.orientation_relative_scatter[g];
-    if (!(own > t.relative_scatter) || g >= result.tensor["orientations"].size()) continue;
-    const nlohmann::json& o = result.tensor["orientations"][g];
-    std::snprintf(line, sizeof(line),
-                  "  (the logs at roll %g, pitch %g deg scatter by %.2f %% beyond their stds: "
-                  "weighed by that, that axis alone; docs/method.md)\n",
-                  o.value("roll_deg", NAN), o.value("pitch_deg", NAN), 100.0 * own);
-    out << line;
-  }
+  PrintOwnScatter(t, result, out);
   std::vector<std::pair<std::string, double>> logs;
   if (result.tensor.is_object() && result.tensor.contains("scatter_logs")) {
     for (const nlohmann::json& l : result.tensor["scatter_logs"]) {
