@@ -103,7 +103,7 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
         plvpor(0.1, 0.97, 0.42, 0.9);
         plwind(0, t_end, -y_max, y_max);
         plcol0(1);
-        plbox("bct", 0, 0, "bcntv", 0, 0);
+        LabelledBox("bct", "bcntv");
         pllab("", "deg/s", top_title.c_str());
         // The measured rate first (thin, grey), the fit on top of it (blue): where the two agree
         // the fit's line stays visible.
@@ -117,7 +117,7 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
         plvpor(0.1, 0.97, 0.1, 0.32);
         plwind(0, t_end, -r_max, r_max);
         plcol0(1);
-        plbox("bcnt", 0, 0, "bcntv", 0, 0);
+        LabelledBox("bcnt", "bcntv");
         pllab("s", "deg/s", bottom_title.c_str());
         plcol0(kFigureGrey);
         plline(static_cast<PLINT>(tr.size()), tr.data(), yr.data());

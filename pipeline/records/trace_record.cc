@@ -29,7 +29,18 @@ std::string WarningSummary(const std::string& warning, size_t max_chars) {
     }
   }
   if (summary.size() <= max_chars || max_chars < 8) return summary;
-  size_t cut = summary.rfind(' ', max_chars - 4);
+  // Cut after a whole clause (", ", "; ", ": "), so that no action is cut mid-sentence ("steady
+  // the rig before release, and swing ..."); at a word only when no clause ends in the last two
+  // thirds of the room.
+  size_t cut = std::string::npos;
+  for (size_t k = 0; k + 1 < summary.size() && k + 4 <= max_chars; ++k) {
+    if ((summary[k] == ',' || summary[k] == ';' || summary[k] == ':') && summary[k + 1] == ' ' &&
+        k >= max_chars / 3) {
+      cut = k;
+    }
+  }
+  if (cut != std::string::npos) return summary.substr(0, cut) + " ...";
+  cut = summary.rfind(' ', max_chars - 4);
   if (cut == std::string::npos || cut < max_chars / 2) cut = max_chars - 4;
   return summary.substr(0, cut) + " ...";
 }
