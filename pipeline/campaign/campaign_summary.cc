@@ -19,6 +19,8 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
   const CampaignSummary& s = result.summary;
   // The one cause that fails every aircraft trace comes first, once.
   if (!result.rig_problem.empty()) out << "Error: " << result.rig_problem << "\n";
+  // Attitudes whose logs look like two set-ups: the most important warning, before the numbers.
+  for (const std::string& w : result.setup_warnings) out << "Warning: " << w << "\n";
   if (result.ellipse_fit) {
     const EllipseResult& e = *result.ellipse_fit;
     // Each moment: its std (stat: the trials' scatter, the rig offset) and the total, which adds
@@ -104,7 +106,6 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     }
     out << "  " << ToString(r.status) << ": " << r.message << "\n";
   }
-  for (const std::string& w : result.setup_warnings) out << "Warning: " << w << "\n";
   if (!result.assumed_inputs_note.empty()) out << result.assumed_inputs_note << "\n";
   if (rig_unknown > 0) {
     out << "  error: " << rig_unknown << " aircraft trace" << (rig_unknown == 1 ? "" : "s")
