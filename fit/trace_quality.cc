@@ -108,9 +108,9 @@ void WarnResidualAboveNoise(const TraceFitInput& input, const TraceFitOptions& o
       return;
     case ResidualShape::Cause::kModel:
       findings->Warn("rms_above_noise",
-                     level + ", coherent (rho_1 " + Fmt("%.2f", rho1) +
-                         "), growing with amplitude: the rig departs from the model; " +
-                         AmplitudeAction(options) + "." + detail);
+                     level + ", growing with amplitude: the rig departs from the model; " +
+                         AmplitudeAction(options) + ". Coherent (rho_1 " + Fmt("%.2f", rho1) +
+                         ")." + detail);
       findings->flags.push_back("residual_model");
       return;
     case ResidualShape::Cause::kNoise:
@@ -132,7 +132,7 @@ void WarnAtBounds(const Minimum& minimum, const TraceFitOptions& options, Findin
   const std::string longer =
       options.longer_window_available
           ? "fit a longer window (fit.windows or --window)"
-          : "log a longer swing (the window already runs to the end of this log's free swing)";
+          : "log a longer swing (this window runs to the log's end)";
   if (drag && viscous) {
     findings->Warn("damping_at_bound",
                    "K_D = C = 0 (both damping terms at their bound): the swing does not decay in "

@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "base/text_format.h"
+#include "base/units.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/commands/simulate_spec.h"
 #include "pipeline/config/config.h"
@@ -41,7 +42,7 @@ struct ScaledCampaign {
 ScaledCampaign ScaledSpec(double inertia, const std::string& logs, int trials) {
   const double mass = std::min(800.0, std::max(0.02, 2.5 * std::pow(inertia / 0.3, 0.6)));
   const double length = inertia < 10 ? 1.5 : 6.0, period = inertia < 10 ? 2.2 : 3.5;
-  const double g = 9.80665, pi = std::acos(-1.0);
+  const double g = kStandardGravityMps2, pi = kPi;
   const double separation =
       std::sqrt(16 * pi * pi * inertia * length / (mass * g * period * period));
   const double rig_mass = 0.2 * mass, rig_inertia = 0.05 * inertia;
@@ -49,7 +50,7 @@ ScaledCampaign ScaledSpec(double inertia, const std::string& logs, int trials) {
   ScaledCampaign c;
   c.spec = "seed: 5\nmodel: full\n"
            "geometry: {filar_length_m: " + n(length) + ", filar_separation_m: " + n(separation) +
-           ", gravity_mps2: 9.80665}\n"
+           ", gravity_mps2: " + n(kStandardGravityMps2) + "}\n"
            "aircraft: {mass_kg: " + n(mass) + ", ix_kg_m2: " + n(0.67 * inertia) +
            ", iy_kg_m2: " + n(inertia) + ", iz_kg_m2: " + n(1.5 * inertia) +
            ", ixy_kg_m2: 0, ixz_kg_m2: 0, iyz_kg_m2: 0}\n"
@@ -71,7 +72,7 @@ ScaledCampaign ScaledSpec(double inertia, const std::string& logs, int trials) {
            "format: {time_column: t, time_unit: s, gyro_columns: [gx, gy, gz], gyro_unit: rad/s, "
            "accel_columns: [ax, ay, az], accel_unit: m/s^2, significant_digits: 7, gzip: false}\n";
   const std::string config =
-      "gravity_mps2: 9.80665\n"
+      "gravity_mps2: " + n(kStandardGravityMps2) + "\n"
       "rig:\n  filar_length_m: " + n(length) + "\n  filar_separation_m: " + n(separation) +
       "\n  mass_kg: " + n(rig_mass + 0.01 * mass) + "\n  inertia: {inertia_kg_m2: " +
       n(rig_inertia) + ", inertia_std_kg_m2: " + n(0.001 * rig_inertia) +

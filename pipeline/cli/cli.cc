@@ -91,7 +91,12 @@ class ConsoleWrapBuffer : public std::streambuf {
       line_.pop_back();
     }
     std::string text = line_;
-    if (text.size() > kConsoleWidth) {
+    // An error stays on one line, as scripts and users grep it ("bifilar: error: FILE: ...",
+    // "FILE: error: ..." or "  error: FILE: ..." in a list).
+    const bool error = text.rfind("bifilar: ", 0) == 0 ||
+                       text.rfind("error: ", text.find_first_not_of(' ')) != std::string::npos ||
+                       text.find(": error: ") != std::string::npos;
+    if (text.size() > kConsoleWidth && !error) {
       const size_t lead = std::min<size_t>(text.find_first_not_of(' '), 8);
       text = WrapText(text, kConsoleWidth, std::string(lead + 4, ' '));
     }
