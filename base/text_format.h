@@ -22,4 +22,13 @@ double RoundedToDigits(double v, int digits);
 // printable ASCII (32-126) as '?', and "..." when cut.
 std::string PrintableAscii(std::string_view s, size_t max_bytes);
 
+// File names in the order a reader expects: case ignored, runs of digits compared as numbers
+// ("trial_2" before "Trial_10"); ties broken by the plain byte order, so the order is total.
+bool NaturalLess(std::string_view a, std::string_view b);
+
+// `text` wrapped at blanks into lines of at most `width` characters (a word longer than that
+// stays whole on its own line), every line after the first starting with `indent`: the one way
+// the console keeps a long message readable (issue 32: lines of 744 characters).
+std::string WrapText(std::string_view text, size_t width, std::string_view indent);
+
 }  // namespace bifilar

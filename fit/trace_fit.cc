@@ -378,7 +378,7 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
                                                   guess.period_s, &solve_budget)
                               : AmplitudeSweep();
   if (solve_budget.Exhausted()) return finish(Stopped(std::move(result), solve_budget));
-  const SweepRule rule = ApplySweepRule(sweep, solution, stat);
+  const SweepRule rule = ApplySweepRule(sweep, solution, stat, options);
 
   // 9. Whiteness of the residuals against their own AR(1) noise, 10. quality.
   const WhitenessStats whiteness = ComputeWhiteness(minimum.residuals, options.whiteness_lags);

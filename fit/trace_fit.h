@@ -95,6 +95,10 @@ struct TraceFitOptions {
   double min_amplitude_deg = 0.5;   // >= 0.
   // The window must hold at least this many periods of oscillation (count); >= 2.
   double min_periods = 2.0;
+  // What the log holds beyond the fitted window (the caller's knowledge, for the advice the
+  // warnings give): false when the window already runs to the end of the free swing, so that a
+  // damping term at its bound is not answered with "fit a longer window" (issue 32).
+  bool longer_window_available = true;
 
   // NLopt one-dimensional global refinement of I when the first fit is poor (residual RMS above
   // refine_rms_over_noise times the noise), then Levenberg-Marquardt again.

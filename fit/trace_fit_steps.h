@@ -241,7 +241,12 @@ struct SweepRule {
 // The statistical std scaled by the Birge ratio when the bands scatter; on a trend, I from the
 // lowest-amplitude band with the trend's bias left there as the model-inadequacy term.
 SweepRule ApplySweepRule(const AmplitudeSweep& sweep, const Solution& solution,
-                         const StatisticalUncertainty& stat);
+                         const StatisticalUncertainty& stat, const TraceFitOptions& options);
+
+// The action against an I that depends on the amplitude, for the options in force: "swing lower,
+// or set fit.max_amplitude_deg (--max-amplitude)", or, when a band is set already (below 90
+// deg), "swing lower, or lower fit.max_amplitude_deg (--max-amplitude, now 15 deg)".
+std::string AmplitudeAction(const TraceFitOptions& options);
 
 // --- Step 10: quality (trace_quality.cc).
 

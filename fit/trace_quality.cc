@@ -108,9 +108,9 @@ void WarnResidualAboveNoise(const TraceFitInput& input, const TraceFitOptions& o
       return;
     case ResidualShape::Cause::kModel:
       findings->Warn("rms_above_noise",
-                     level + ", coherent (rho_1 " + Fmt("%.2f", rho1) +
-                         "), growing with amplitude: the rig departs from the model; swing "
-                         "lower or set fit.max_amplitude_deg (--max-amplitude)." + detail);
+                     level + ", growing with amplitude: the rig departs from the model; " +
+                         AmplitudeAction(options) + ". Coherent (rho_1 " + Fmt("%.2f", rho1) +
+                         ")." + detail);
       findings->flags.push_back("residual_model");
       return;
     case ResidualShape::Cause::kNoise:
@@ -124,27 +124,31 @@ void WarnResidualAboveNoise(const TraceFitInput& input, const TraceFitOptions& o
 
 // A damping coefficient held at its bound 0 by the active set (fit/trace_solve.cc): the decay
 // asked for a negative value, so the fit is the best with that term off.
-void WarnAtBounds(const Minimum& minimum, Findings* findings) {
+// The advice says "fit a longer window" only when the log holds one (the window does not run to
+// the end of the free swing already); else a longer log is what separates the terms.
+void WarnAtBounds(const Minimum& minimum, const TraceFitOptions& options, Findings* findings) {
   const bool drag = minimum.fixed[0] || minimum.p[kTraceDrag] <= 0.0;
   const bool viscous = minimum.fixed[1] || minimum.p[kTraceViscous] <= 0.0;
+  const std::string longer =
+      options.longer_window_available
+          ? "fit a longer window (fit.windows or --window)"
+          : "log a longer swing (this window runs to the log's end)";
   if (drag && viscous) {
     findings->Warn("damping_at_bound",
                    "K_D = C = 0 (both damping terms at their bound): the swing does not decay in "
-                   "this window; fit a longer window (fit.windows or --window), and check that "
-                   "nothing drives the swing. The fit holds both at 0, where the data asked for "
-                   "negative damping.");
+                   "this window; " + longer + ", and check that nothing drives the swing. The "
+                   "fit holds both at 0, where the data asked for negative damping.");
   } else if (drag) {
     findings->Warn("drag_at_bound",
-                   "K_D = 0 (air drag at its bound): the damping is all in C here; fit a longer "
-                   "window (fit.windows or --window) to separate them. "
-                   "The fit holds K_D at 0, where the data asked for a negative air drag; I "
-                   "depends little on how the damping is split.");
+                   "K_D = 0 (air drag at its bound): the damping is all in C here; " + longer +
+                       " to separate them. The fit holds K_D at 0, where the data asked for a "
+                       "negative air drag; I depends little on how the damping is split.");
   } else if (viscous) {
     findings->Warn("viscous_at_bound",
-                   "C = 0 (linear damping at its bound): the damping is all in K_D here; fit a "
-                   "longer window (fit.windows or --window) to "
-                   "separate them. The fit holds C at 0, where the data asked for a negative "
-                   "linear damping; I depends little on how the damping is split.");
+                   "C = 0 (linear damping at its bound): the damping is all in K_D here; " +
+                       longer + " to separate them. The fit holds C at 0, where the data asked "
+                       "for a negative linear damping; I depends little on how the damping is "
+                       "split.");
   }
 }
 
@@ -204,16 +208,16 @@ Quality JudgeQuality(const TraceFitInput& input, const TraceFitOptions& options,
   }
   if (whiteness.prewhitened_autocorr_max > options.max_residual_autocorr) {
     warn("residuals_not_white",
-         "residuals have structure the model misses: look at the residual panel (--plot) for "
-         "sway or a second oscillation, steady the rig before release, and swing lower if it "
-         "grows with amplitude. Max |autocorrelation| " +
+         "residuals have structure the model misses: steady the rig before release, swing "
+         "lower if it grows with amplitude, and look at the residual panel (--plot). Sway or a "
+         "second oscillation leaves this mark. Max |autocorrelation| " +
              Fmt("%.2f", whiteness.prewhitened_autocorr_max) + " at lags 1.." +
              std::to_string(options.whiteness_lags) +
              " after prewhitening with the residuals' own AR(1) noise (warning above " +
              Fmt("%.2f", options.max_residual_autocorr) +
              "); the std of I is robust to correlated residuals (HAC), not to a wrong model.");
   }
-  WarnAtBounds(minimum, &q.findings);
+  WarnAtBounds(minimum, options, &q.findings);
   if (solution.amplitude_start_deg > options.max_amplitude_deg + 1.0) {
     warn("amplitude_above_band", "amplitude " + Fmt("%.1f", solution.amplitude_start_deg) +
                                      " deg above the band max " +

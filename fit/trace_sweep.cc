@@ -187,8 +187,16 @@ std::vector<double> BandFittedRate(const TraceFitInput& input, const TraceFitOpt
   return r;
 }
 
+std::string AmplitudeAction(const TraceFitOptions& options) {
+  if (options.max_amplitude_deg < 90.0) {
+    return "swing lower, or lower fit.max_amplitude_deg (--max-amplitude, now " +
+           Fmt("%g", options.max_amplitude_deg) + " deg)";
+  }
+  return "swing lower, or set fit.max_amplitude_deg (--max-amplitude)";
+}
+
 SweepRule ApplySweepRule(const AmplitudeSweep& sweep, const Solution& solution,
-                         const StatisticalUncertainty& stat) {
+                         const StatisticalUncertainty& stat, const TraceFitOptions& options) {
   SweepRule rule;
   rule.inertia_kg_m2 = solution.params.inertia_kg_m2;
   rule.inertia_stat_std_kg_m2 = stat.inertia_std_kg_m2;
@@ -211,8 +219,8 @@ SweepRule ApplySweepRule(const AmplitudeSweep& sweep, const Solution& solution,
       "amplitude_trend",
       "I changes with amplitude (" + Fmt("%+.3g", sweep.trend_percent_per_10deg) +
           " % per 10 deg, z = " + Fmt("%.1f", sweep.trend_z) +
-          "): the rig departs from the model; swing lower, or set fit.max_amplitude_deg "
-          "(--max-amplitude). I depends on the amplitude beyond its statistical error between " +
+          "): the rig departs from the model; " + AmplitudeAction(options) +
+          ". I depends on the amplitude beyond its statistical error between " +
           Fmt("%.1f", sweep.bands.back().amplitude_mean_deg) + " and " +
           Fmt("%.1f", sweep.bands.front().amplitude_mean_deg) + " deg (I_0 (1 + c A^" +
           Fmt("%g", sweep.trend_exponent) +

@@ -57,7 +57,8 @@ TEST(ResidualCause, CoherentAndGrowingWithAmplitudeIsTheModelAndSaysSwingLower) 
   ASSERT_TRUE(r.HasFit()) << r.message;
   EXPECT_GT(r.amplitude_start_deg, 2.0 * r.amplitude_end_deg) << r.BriefReport();
   EXPECT_TRUE(HasFlag(r, "residual_model")) << r.BriefReport();
-  const std::string summary = WarningSummary(ResidualWarning(r));
+  // The line the console and the report show: the summary, and the action when it was cut.
+  const std::string summary = LineOfWarning(ResidualWarning(r)).Text();
   EXPECT_NE(summary.find("the rig departs from the model"), std::string::npos) << summary;
   EXPECT_NE(summary.find("fit.max_amplitude_deg (--max-amplitude)"), std::string::npos) << summary;
   EXPECT_EQ(summary.find("raise fit.quality"), std::string::npos) << summary;

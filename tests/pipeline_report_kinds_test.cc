@@ -140,12 +140,12 @@ void ExpectCommonDetails(const Page& p) {
   // the clause that says what to do), the full text on click.
   EXPECT_NE(Find(page,
                  "<details><summary>I depends on the amplitude beyond its statistical error "
-                 "(trend 0.3 % per 10 deg); I is taken ... &rarr; <b>lower the release "
+                 "(trend 0.3 % per 10 deg); ... &rarr; <b>lower the release "
                  "amplitude or set fit.max_amplitude_deg</b></summary><p>I depends"),
             std::string::npos);
   EXPECT_EQ(LineOfWarning(kWarning).Text(),
-            "I depends on the amplitude beyond its statistical error (trend 0.3 % per 10 deg); I "
-            "is taken ... -> lower the release amplitude or set fit.max_amplitude_deg");
+            "I depends on the amplitude beyond its statistical error (trend 0.3 % per 10 deg); "
+            "... -> lower the release amplitude or set fit.max_amplitude_deg");
 }
 
 // The traces table's pitch cells in page order.

@@ -46,6 +46,8 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
   // The one cause that fails every aircraft trace comes first, once.
   if (!result.rig_problem.empty()) out << "Error: " << result.rig_problem << "\n";
   PrintPhysicalCheck(result, out);  // a body that cannot exist: said before its numbers
+  // Attitudes whose logs look like two set-ups: the most important warning, before the numbers.
+  for (const std::string& w : result.setup_warnings) PrintWrapped("Warning: ", w, out);
   if (result.ellipse_fit) {
     const EllipseResult& e = *result.ellipse_fit;
     // Each moment: its std (stat: the trials' scatter, the rig offset) and the total, which adds
@@ -131,7 +133,6 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     }
     out << "  " << ToString(r.status) << ": " << r.message << "\n";
   }
-  for (const std::string& w : result.setup_warnings) PrintWrapped("Warning: ", w, out);
   if (!result.assumed_inputs_note.empty()) out << result.assumed_inputs_note << "\n";
   if (rig_unknown > 0) {
     out << "  error: " << rig_unknown << " aircraft trace" << (rig_unknown == 1 ? "" : "s")

@@ -13,6 +13,7 @@
 #include "base/version.h"
 #include "pipeline/figures/tensor_plot.h"
 #include "pipeline/records/tensor_json.h"
+#include "pipeline/records/total_uncertainty.h"
 
 namespace bifilar {
 namespace {
@@ -179,17 +180,21 @@ void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& resu
   auto inertia = [&](double kg_m2) { return InertiaToDisplay(kg_m2, units); };
   char line[320];
   std::snprintf(line, sizeof(line),
-                "Inertia tensor (%s, +- 1 std; %d moments about %d axes, rank %d of 6, design "
-                "condition number %.3g, covariance %s):\n",
+                "Inertia tensor (%s, +- 1 std: stat, then total; %d moments about %d axes, "
+                "rank %d of 6, design condition number %.3g, covariance %s):\n",
                 unit, t.n_points, t.n_orientations, t.rank, t.condition_number,
                 EllipseCovarianceName(t.covariance_used));
   out << line;
   static const char* const kLabels[] = {"I_xx", "I_yy", "I_zz", "I_xy", "I_xz", "I_yz"};
+  // The total: the stat std and the common-mode scale terms in quadrature, as Table 2's
+  // (pipeline/records/total_uncertainty.h).
+  const double common = result.common_mode_relative_std;
+  auto total = [&](double value, double std) { return WithCommonModeScale(value, std, common); };
   for (int k = 0; k < kTensorComponents; ++k) {
     const TensorEstimate& e = t.components[k];
     if (e.observable) {
-      std::snprintf(line, sizeof(line), "  %-5s %#11.5g +- %.2g  (%.3g %%)\n", kLabels[k],
-                    inertia(e.value), inertia(e.std),
+      std::snprintf(line, sizeof(line), "  %-5s %#11.5g +- %#.2g (stat) +- %#.2g (total)  (%.3g %% stat)\n",
+                    kLabels[k], inertia(e.value), inertia(e.std), inertia(total(e.value, e.std)),
                     e.value != 0 ? 100.0 * e.std / std::fabs(e.value) : 0.0);
     } else {
       std::snprintf(line, sizeof(line), "  %-5s not observable from these swing axes\n",
@@ -199,11 +204,11 @@ void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& resu
   }
   out << "  (products positive: I_xy = integral x y dm; the tensor holds -I_xy; "
          "docs/physics.md 3.5)\n";
-  if (std::isfinite(result.systematic_relative_std) && result.systematic_relative_std > 0) {
-    std::snprintf(
-        line, sizeof(line),
-        "  (+- %.2f %% systematic, common to all moments, from the configured uncertainties)\n",
-        100.0 * result.systematic_relative_std);
+  if (std::isfinite(common) && common > 0) {
+    std::snprintf(line, sizeof(line),
+                  "  (total: stat and +- %.2f %% common to all moments in quadrature, from the "
+                  "configured uncertainties)\n",
+                  100.0 * common);
     out << line;
   }
   if (t.attitude_scatter_deg > 0) {
@@ -230,9 +235,12 @@ void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& resu
   if (t.full) {
     out << "Principal moments (ascending) and axes in body axes (x, y, z):\n";
     for (int k = 0; k < 3; ++k) {
-      std::snprintf(line, sizeof(line), "  %d: %#11.5g +- %.2g  axis (%+.4f, %+.4f, %+.4f) +- %.2g deg\n",
-                    k + 1, inertia(t.principal_moments[k].value),
-                    inertia(t.principal_moments[k].std), t.principal_axes[k][0],
+      const TensorEstimate& m = t.principal_moments[k];
+      std::snprintf(line, sizeof(line),
+                    "  %d: %#11.5g +- %#.2g (stat) +- %#.2g (total)  axis (%+.4f, %+.4f, %+.4f) +- "
+                    "%.2g deg\n",
+                    k + 1, inertia(m.value), inertia(m.std), inertia(total(m.value, m.std)),
+                    t.principal_axes[k][0],
                     t.principal_axes[k][1], t.principal_axes[k][2], t.principal_axes_std_deg[k]);
       out << line;
     }

@@ -1,15 +1,20 @@
 #include "pipeline/cli/cli.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <memory>
+#include <mutex>
 #include <new>
 #include <iostream>
+#include <streambuf>
 #include <string>
 
 #include "base/json_error.h"
+#include "base/text_format.h"
 #include "base/version.h"
 #include "fit/solver_logging.h"
 #include "pipeline/cli/cli_commands.h"
@@ -35,6 +40,118 @@ std::string CommandAndInputs(int argc, char** argv) {
   }
   return command + (files.empty() ? std::string() : " on " + files);
 }
+
+// The console's width: every line a command prints to stdout is at most this long (issue 32:
+// `fit --repeats` printed lines of 744 characters).
+constexpr size_t kConsoleWidth = 160;
+
+// A console buffer that passes text through line by line and wraps a line longer than
+// kConsoleWidth at its blanks (WrapText), each continuation under the line's own indent plus
+// four blanks: one place keeps every command's lines readable, whatever printed them. stdout
+// passes a partial line on at a flush (a prompt before input); stderr, flushed after every
+// insertion, waits for the line's end. Writers on several threads are serialised.
+class ConsoleWrapBuffer : public std::streambuf {
+ public:
+  ConsoleWrapBuffer(std::streambuf* target, bool flush_partial)
+      : target_(target), flush_partial_(flush_partial) {}
+  ~ConsoleWrapBuffer() override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Emit();
+    target_->pubsync();
+  }
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (traits_type::eq_int_type(c, traits_type::eof())) return traits_type::not_eof(c);
+    std::lock_guard<std::mutex> lock(mutex_);
+    Put(traits_type::to_char_type(c));
+    return c;
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (std::streamsize i = 0; i < n; ++i) Put(s[i]);
+    return n;
+  }
+  int sync() override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (flush_partial_) Emit();
+    return target_->pubsync();
+  }
+
+ private:
+  void Put(char c) {
+    line_ += c;
+    if (c == '\n' || c == '\r') Emit();
+  }
+  void Emit() {
+    if (line_.empty()) return;
+    std::string end;
+    while (!line_.empty() && (line_.back() == '\n' || line_.back() == '\r')) {
+      end.insert(end.begin(), line_.back());
+      line_.pop_back();
+    }
+    std::string text = line_;
+    // An error stays on one line, as scripts and users grep it ("bifilar: error: FILE: ...",
+    // "FILE: error: ..." or "  error: FILE: ..." in a list).
+    const bool error = text.rfind("bifilar: ", 0) == 0 ||
+                       text.rfind("error: ", text.find_first_not_of(' ')) != std::string::npos ||
+                       text.find(": error: ") != std::string::npos;
+    if (text.size() > kConsoleWidth && !error) {
+      const size_t lead = std::min<size_t>(text.find_first_not_of(' '), 8);
+      text = WrapText(text, kConsoleWidth, std::string(lead + 4, ' '));
+    }
+    text += end;
+    target_->sputn(text.data(), static_cast<std::streamsize>(text.size()));
+    line_.clear();
+  }
+
+  std::streambuf* target_;
+  bool flush_partial_;
+  std::mutex mutex_;
+  std::string line_;
+};
+
+// Output read by programs is not wrapped: --json, and `export` (a URDF, SDF, JSBSim or CSV
+// document on stdout).
+bool MachineReadOutput(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--json" || (i == 1 && arg == "export")) return true;
+  }
+  return false;
+}
+
+// Installs ConsoleWrapBuffer on std::cout (unless its output is read by programs) and std::cerr
+// for the run; restores the streams' buffers after.
+class ConsoleWrap {
+ public:
+  explicit ConsoleWrap(bool wrap_stdout) {
+    if (wrap_stdout) Install(std::cout, true, &out_, &previous_out_);
+    Install(std::cerr, false, &err_, &previous_err_);
+  }
+  ~ConsoleWrap() {
+    Restore(std::cout, &out_, previous_out_);
+    Restore(std::cerr, &err_, previous_err_);
+  }
+
+ private:
+  static void Install(std::ostream& stream, bool flush_partial,
+                      std::unique_ptr<ConsoleWrapBuffer>* buffer, std::streambuf** previous) {
+    *buffer = std::make_unique<ConsoleWrapBuffer>(stream.rdbuf(), flush_partial);
+    *previous = stream.rdbuf(buffer->get());
+  }
+  static void Restore(std::ostream& stream, std::unique_ptr<ConsoleWrapBuffer>* buffer,
+                      std::streambuf* previous) {
+    if (!*buffer) return;
+    stream.flush();
+    stream.rdbuf(previous);
+    buffer->reset();  // passes on a last partial line
+  }
+
+  std::unique_ptr<ConsoleWrapBuffer> out_, err_;
+  std::streambuf* previous_out_ = nullptr;
+  std::streambuf* previous_err_ = nullptr;
+};
 
 }  // namespace
 
@@ -86,6 +203,7 @@ uint64_t ParseSeed(const std::string& text, const std::string& flag, uint64_t ma
 
 int RunCommandLine(int argc, char** argv) {
   QuietSolverLogging();  // fit/solver_logging.h: no glog preamble or solver chatter
+  const ConsoleWrap wrap(!MachineReadOutput(argc, argv));
   CLI::App app{"bifilar: aircraft mass properties from bifilar pendulum IMU logs"};
   app.set_version_flag("--version", std::string("bifilar ") + ProgramVersion());
   app.require_subcommand(1);

@@ -128,7 +128,12 @@ std::string WarningLines(const TraceRecord& r, DisplayUnits units, bool* folded)
         r.message.rfind(prefix, 0) == 0 ? r.message.substr(prefix.size()) : r.message, units);
     lines += "\n    " + std::string(ToString(r.status)) + ": " + message;
   }
-  for (const std::string& w : r.warnings) {
+  // The most important first: a two-set-up finding before the record's other warnings.
+  std::vector<std::string> warnings = r.warnings;
+  std::stable_partition(warnings.begin(), warnings.end(), [](const std::string& w) {
+    return w.find("two set-ups") != std::string::npos;
+  });
+  for (const std::string& w : warnings) {
     if (IsAssumedInputsWarning(w)) continue;
     const std::string shown = SiTextInDisplayUnits(w, units);
     const WarningLine line = LineOfWarning(shown);  // the report's line too
@@ -173,16 +178,30 @@ void PrintRepeats(const FitCommandResult& result, bool* folded) {  // *folded: a
   }
   std::cout << AmplitudeCorrectionLine(result.correction) << std::endl;
   for (const RepeatGroup& g : result.groups) {
-    std::cout << RepeatGroupLine(g) << std::endl;
+    // The group's result line, then its two-set-up finding (the most important: the mean is of
+    // two set-ups), then its other lines and the scatter warning.
+    const std::string group_text = RepeatGroupLine(g);
+    const size_t first_end = group_text.find('\n');
+    std::cout << group_text.substr(0, first_end) << std::endl;
     const std::string of = " repeats of " + g.name + " scatter beyond";
+    const std::string setups = "; they look like two set-ups";
+    std::vector<std::string> later;
     for (const std::string& w : scatter_warnings) {
       if (w.find(of) == std::string::npos) continue;
       std::string text = w;
       const std::string per_log = "this log's std";
       const size_t at = text.find(per_log);
       if (at != std::string::npos) text.replace(at, per_log.size(), "each log's std");
-      std::cout << "    warning: " << text << std::endl;  // once per group: in full
+      const size_t split = text.find(setups);
+      if (split != std::string::npos) {  // once per group, in full
+        std::cout << "    warning: they look like two set-ups" << text.substr(split + setups.size())
+                  << std::endl;
+        text.erase(split);
+      }
+      later.push_back(text);
     }
+    if (first_end != std::string::npos) std::cout << group_text.substr(first_end + 1) << std::endl;
+    for (const std::string& text : later) std::cout << "    warning: " << text << std::endl;
   }
 }
 

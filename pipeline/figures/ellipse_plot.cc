@@ -177,9 +177,9 @@ bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
     plvsta();
     plwind(p.x_lo, p.x_hi, p.y_lo, p.y_hi);
     plcol0(kFigureLight);
-    plbox("g", 30, 0, "g", 0, 0);
+    LabelledBox("g", "g", 30);
     plcol0(kFigureBlack);
-    plbox("bcnst", 30, 3, "bcnstv", 0, 0);
+    LabelledBox("bcnst", "bcnstv", 30);
     pllab("pitch #gh (deg, nose up)", ("moment of inertia (" + options.unit_label + ")").c_str(),
           "Moments against pitch and the fitted ellipse of inertia");
     DrawPrincipalLines(r, p);
@@ -245,7 +245,7 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
     plcol0(kFigureBlack);
     plvpas(vx0, vx1, 0.2, 0.86, 1.0);
     plwind(-lim, lim, -lim, lim);
-    plbox("bcnst", 0, 0, "bcnstv", 0, 0);
+    LabelledBox("bcnst", "bcnstv");
     // (slug ft^2)^-1/2 written slug^-1/2 ft^-1: a superscript inside a superscript is garbled.
     const std::string unit = ScaledUnit(inverse_sqrt ? InverseSqrtUnit(options.unit_label)
                                                      : "(" + options.unit_label + ")",

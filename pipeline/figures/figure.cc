@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +11,7 @@
 #include <fstream>
 #include <mutex>
 #include <sstream>
+#include <string>
 
 #include <plplot.h>
 
@@ -152,6 +154,55 @@ std::string ScaledUnit(const std::string& unit, int power) {
     return "(" + ten + unit.substr(1);
   }
   return "(" + ten + unit + ")";
+}
+
+double TickStep(double lo, double hi, int max_ticks) {
+  const double range = std::fabs(hi - lo);
+  if (!(range > 0) || !std::isfinite(range)) return 1.0;
+  const double raw = range / std::max(1, max_ticks);
+  const double ten = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (m * ten >= raw * (1.0 - 1e-9)) return m * ten;
+  }
+  return 10.0 * ten;
+}
+
+int TickDecimals(double step) {
+  if (!(step > 0) || !std::isfinite(step)) return 0;
+  // The decimals of the step's first significant digit (2.5e-3 as 1, 2 or 5 x 10^n: 3).
+  const int d = -static_cast<int>(std::floor(std::log10(step) + 1e-9));
+  return std::clamp(d, 0, 15);
+}
+
+std::string TickLabel(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
+  std::string text = buffer;
+  if (text[0] == '-' && text.find_first_not_of("-0.") == std::string::npos) text.erase(0, 1);
+  return text;
+}
+
+namespace {
+
+// plslabelfunc's callback: the decimals of the x and y axes in `data` (int[2]).
+void TickLabelCallback(PLINT axis, PLFLT value, char* label, PLINT length, PLPointer data) {
+  const int* decimals = static_cast<const int*>(data);
+  const std::string text = TickLabel(value, decimals[axis == PL_Y_AXIS ? 1 : 0]);
+  std::snprintf(label, static_cast<size_t>(std::max<PLINT>(length, 1)), "%s", text.c_str());
+}
+
+}  // namespace
+
+void LabelledBox(const char* x_opt, const char* y_opt, double x_step, double y_step) {
+  PLFLT x0 = 0, x1 = 1, y0 = 0, y1 = 1;
+  plgvpw(&x0, &x1, &y0, &y1);
+  if (!(x_step > 0)) x_step = TickStep(x0, x1);
+  if (!(y_step > 0)) y_step = TickStep(y0, y1, 6);
+  int decimals[2] = {TickDecimals(x_step), TickDecimals(y_step)};
+  plslabelfunc(TickLabelCallback, decimals);
+  const std::string x = std::string(x_opt) + "o", y = std::string(y_opt) + "o";
+  plbox(x.c_str(), x_step, 0, y.c_str(), y_step, 0);
+  plslabelfunc(nullptr, nullptr);
 }
 
 }  // namespace bifilar

@@ -52,4 +52,19 @@ int PowerOfTenFor(double r_max);
 // "(slug ft^2)" for values drawn in units of 10^power: "(10^power slug ft^2)".
 std::string ScaledUnit(const std::string& unit, int power);
 
+// Axis ticks that stay true at any scale (issue 32: every y tick of a sweep read "0.1"). The
+// step of ticks over [lo, hi]: 1, 2 or 5 x 10^n, the smallest giving at most `max_ticks` ticks.
+double TickStep(double lo, double hi, int max_ticks = 7);
+
+// The decimals that tell ticks `step` apart ("%.<d>f"): 0.25 -> 2, 0.5 -> 1, 20 -> 0.
+int TickDecimals(double step);
+
+// A tick value as its label: fixed notation to `decimals`, never "-0".
+std::string TickLabel(double value, int decimals);
+
+// plbox over the current window (plwind) with ticks at TickStep of each axis (or `x_step`,
+// `y_step` when > 0) and labels of TickLabel at TickDecimals (PLplot's custom labels,
+// plslabelfunc): no two ticks of an axis share a label. `x_opt`, `y_opt` as plbox's.
+void LabelledBox(const char* x_opt, const char* y_opt, double x_step = 0.0, double y_step = 0.0);
+
 }  // namespace bifilar

@@ -89,8 +89,11 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
                                 ValueWithStd(k * fit.params.inertia_kg_m2, k * std_kg_m2) + " " +
                                 options.unit_label + " (1σ " + std_label + "), " +
                                 (d.from_band ? "lowest-amplitude band" : "whole window");
+  // The rms of the fit drawn (the band's or the window's), named as such: a warning's "residual
+  // 10.3x noise" is the whole window's.
   char label[256];
-  std::snprintf(label, sizeof(label), "measured − fit: rms = %.2f × noise", d.rms_over_noise);
+  std::snprintf(label, sizeof(label), "measured − fit (%s): rms = %.2f × gyro noise",
+                d.from_band ? "lowest band" : "window", d.rms_over_noise);
   const std::string bottom_title = label;
   FigureOptions figure;
   figure.width_px = width_px;
@@ -103,21 +106,22 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
         plvpor(0.1, 0.97, 0.42, 0.9);
         plwind(0, t_end, -y_max, y_max);
         plcol0(1);
-        plbox("bct", 0, 0, "bcntv", 0, 0);
+        LabelledBox("bct", "bcntv");
         pllab("", "deg/s", top_title.c_str());
-        // The measured rate first (thin, grey), the fit on top of it (blue): where the two agree
-        // the fit's line stays visible.
-        plcol0(kFigureGrey);
-        plwidth(2.0);
-        plline(static_cast<PLINT>(tm.size()), tm.data(), ym.data());
-        plcol0(kFigureBlue);
-        plwidth(1.2);
+        // The fit first (a light blue line), the measured samples on top of it (black dots), as
+        // the report's caption says: both stay visible where they agree.
+        plscol0(11, 120, 170, 230);
+        plcol0(11);
+        plwidth(2.5);
         plline(static_cast<PLINT>(tm.size()), tm.data(), yf.data());
+        plcol0(kFigureBlack);
+        plwidth(2.2);
+        plpoin(static_cast<PLINT>(tm.size()), tm.data(), ym.data(), -1);  // a point: a round dot
         plwidth(1.0);
         plvpor(0.1, 0.97, 0.1, 0.32);
         plwind(0, t_end, -r_max, r_max);
         plcol0(1);
-        plbox("bcnt", 0, 0, "bcntv", 0, 0);
+        LabelledBox("bcnt", "bcntv");
         pllab("s", "deg/s", bottom_title.c_str());
         plcol0(kFigureGrey);
         plline(static_cast<PLINT>(tr.size()), tr.data(), yr.data());

@@ -70,6 +70,28 @@ std::string SimplifySvgNumbers(const std::string& svg) {
   return out;
 }
 
+// SimplifySvgNumbers inside the tags of `svg` (attributes: coordinates, path data) and never in
+// the words drawn: a title "0.05018 ± 0.00066" or a tick "3.5221" shortened to one decimal read
+// "0.1 ± 0" and "3.5" (issue 32). A figure compacted twice (by WriteFigure, then by the report)
+// keeps its text.
+std::string SimplifyTagNumbers(const std::string& svg) {
+  std::string out;
+  out.reserve(svg.size());
+  for (size_t at = 0; at < svg.size();) {
+    const size_t open = svg.find('<', at);
+    if (open == std::string::npos) {
+      out.append(svg, at, std::string::npos);
+      break;
+    }
+    out.append(svg, at, open - at);
+    const size_t close = svg.find('>', open);
+    const size_t end = close == std::string::npos ? svg.size() : close + 1;
+    out += SimplifySvgNumbers(svg.substr(open, end - open));
+    at = end;
+  }
+  return out;
+}
+
 // A number as short as SVG allows at 0.1 px: "12.3", "-4", ".5".
 std::string ShortNumber(double value) {
   char buffer[64];
@@ -244,11 +266,13 @@ std::string DecodeCharacterReferences(const std::string& text) {
   return out;
 }
 
-// The text's content: default font attributes dropped (the <svg> sets the family), numbers
-// shortened, references decoded.
+// The text's content: default font attributes dropped (the <svg> sets the family), the numbers
+// of its <tspan> attributes shortened, references decoded. The words drawn keep every digit: a
+// title "0.05018 ± 0.00066" or a tick "3.5221" shortened to one decimal read "0.1 ± 0" and "3.5"
+// (issue 32).
 std::string CompactTextContent(std::string content) {
   content = ReplaceAll(content, " font-family=\"sans-serif\" font-style=\"normal\" font-weight=\"normal\"", "");
-  return DecodeCharacterReferences(SimplifySvgNumbers(content));
+  return DecodeCharacterReferences(SimplifyTagNumbers(content));
 }
 
 // One <text ...>content</text> of the flipped frame, in the page's frame.
@@ -386,7 +410,7 @@ std::string CompactPlplotSvg(const std::string& svg) {
 std::string CompactSvg(const std::string& svg) {
   if (svg.find("<polyline") != std::string::npos || svg.find("dominant-baseline") != std::string::npos)
     return CompactPlplotSvg(svg);
-  return SimplifySvgNumbers(CompactSvgPaths(svg));
+  return SimplifyTagNumbers(CompactSvgPaths(svg));
 }
 
 std::string PrefixSvgIds(std::string svg, const std::string& prefix) {

@@ -180,10 +180,10 @@ void DrawBands(const AmplitudeSweep& sweep, const SweepPage& p) {
 // Axes: I on the left, its deviation from the result in % on the right.
 void DrawAxes(const SweepPage& p) {
   plcol0(kFigureBlack);
-  plbox("bnt", 0, 0, "bntv", 0, 0);  // no minor ticks: the grid is the reference
+  LabelledBox("bnt", "bntv");  // no minor ticks: the grid is the reference
   plmtex("b", 2.9, 0.5, 0.5, "amplitude (deg)");
   plwind(p.x_lo, p.x_hi, 100.0 * (p.y_lo / p.y_ref - 1.0), 100.0 * (p.y_hi / p.y_ref - 1.0));
-  plbox("c", 0, 0, "cmtv", 0, 0);
+  LabelledBox("c", "cmtv");
 }
 
 // Titles on the whole page (the viewport left there for the legend).
@@ -289,7 +289,7 @@ bool WriteAmplitudeSweepFigure(const AmplitudeSweep& sweep, double inertia_kg_m2
     plwind(p.x_lo, p.x_hi, p.y_lo, p.y_hi);
     plsyax(7, 0);  // up to 7 digits before PLplot switches to its own "x10^n"
     plcol0(kFigureLight);
-    plbox("g", 0, 0, "g", 0, 0);
+    LabelledBox("g", "g");
     DrawReportedBand(p);
     DrawBands(sweep, p);
     DrawAxes(p);

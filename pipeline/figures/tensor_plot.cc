@@ -103,7 +103,7 @@ void ViewPanel(const TensorResult& r, const std::array<double, kTensorComponents
   plcol0(kFigureBlack);
   plvpas(x0, x1, y0, y1, 1.0);
   plwind(-lim, lim, -lim, lim);
-  plbox("bcnst", 0, 0, "bcnstv", 0, 0);
+  LabelledBox("bcnst", "bcnstv");
   const std::string unit = InverseSqrtUnit(options.unit_label);
   pllab((std::string(view.h_label) + "  " + unit).c_str(),
         (std::string(view.v_label) + "  " + unit).c_str(), view.title);
@@ -124,7 +124,7 @@ void ResidualPanel(const TensorResult& r, double x0, double x1, double y0, doubl
   plcol0(kFigureBlack);
   plvpor(x0, x1, y0, y1);
   plwind(0.0, m + 1.0, -z_max, z_max);
-  plbox("bcnst", 1, 0, "bcnstv", 0, 0);
+  LabelledBox("bcnst", "bcnstv", 1);
   pllab("orientation (as listed in the report)", "residual / expected scatter",
         "Per-orientation residuals");
   plcol0(kFigureLight);

@@ -204,9 +204,9 @@ void Samples(const TracePage& p, const std::vector<double>& t, const std::vector
 
 void Axes(const char* x_opt, const char* y_label) {
   plcol0(kFigureLight);
-  plbox("g", 0, 0, "g", 0, 0);
+  LabelledBox("g", "g");
   plcol0(kFigureBlack);
-  plbox(x_opt, 0, 0, "bcnstv", 0, 0);
+  LabelledBox(x_opt, "bcnstv");
   plmtex("l", 5.0, 0.5, 0.5, y_label);
 }
 

@@ -19,6 +19,31 @@ constexpr EnumName<TraceRole> kTraceRoleNames[] = {{TraceRole::kAircraft, "aircr
 
 }  // namespace
 
+namespace {
+
+// The verbs a warning's action starts with (WarningAction's, and those of clauses that carry
+// an action without being the warning's last one).
+constexpr const char* kActionVerbs[] = {
+    "raise",   "lower",    "set",       "swing",   "check", "give",    "rerun",    "use",
+    "add",     "remove",   "release",   "hang",    "fix",   "measure", "increase", "decrease",
+    "shorten", "lengthen", "reprocess", "replace", "move",  "weigh",   "repeat",   "steady",
+    "log",     "fit",      "look",      "start",   "end",   "name"};
+
+// True when `clause` (after an optional "and " or "or ") starts with an action verb.
+bool StartsWithAction(std::string clause) {
+  for (const char* joint : {"and ", "or "}) {
+    if (clause.rfind(joint, 0) == 0) clause.erase(0, std::string(joint).size());
+  }
+  std::string word = clause.substr(0, clause.find(' '));
+  std::transform(word.begin(), word.end(), word.begin(), ::tolower);
+  for (const char* verb : kActionVerbs) {
+    if (word == verb) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 std::string WarningSummary(const std::string& warning, size_t max_chars) {
   std::string summary = warning;
   for (size_t k = 0; k + 2 < warning.size(); ++k) {
@@ -31,6 +56,17 @@ std::string WarningSummary(const std::string& warning, size_t max_chars) {
   if (summary.size() <= max_chars || max_chars < 8) return summary;
   size_t cut = summary.rfind(' ', max_chars - 4);
   if (cut == std::string::npos || cut < max_chars / 2) cut = max_chars - 4;
+  // Never an action cut mid-sentence ("steady the rig before release, and swing ..."): a cut
+  // inside a clause that says what to do moves to that clause's start.
+  size_t clause = std::string::npos;
+  for (const char* mark : {", ", "; ", ": "}) {
+    const size_t at = summary.rfind(mark, cut);
+    if (at != std::string::npos && (clause == std::string::npos || at > clause)) clause = at;
+  }
+  if (clause != std::string::npos && clause >= max_chars / 4 &&
+      StartsWithAction(summary.substr(clause + 2, cut - clause - 2))) {
+    cut = clause;
+  }
   return summary.substr(0, cut) + " ...";
 }
 

@@ -128,12 +128,16 @@ struct TraceRecord {
   bool ok() const { return status == TraceStatus::kOk; }
 };
 
+// The longest warning line: with the console's "    warning: " before it, within the console's
+// 160 characters.
+constexpr size_t kWarningLineChars = 146;
+
 // A warning's one-line summary. Warnings (TraceRecord::warnings, TraceFitResult::warnings) state
 // the finding and what to do in their first sentence and give the detail after it: the summary
 // is that first sentence (up to ". " or "? " before a capital letter), cut at a word to at most
 // max_chars with " ..." when longer. The console and the report show it through LineOfWarning;
 // the full text is in results.json, `bifilar fit --json` and the report's expanded warning.
-std::string WarningSummary(const std::string& warning, size_t max_chars = 160);
+std::string WarningSummary(const std::string& warning, size_t max_chars = kWarningLineChars);
 
 // The clause of a warning that says what to do: the last clause (the text split at ". " and
 // "; ") whose first word is a verb of action ("raise ...", "swing ...", "set ..."); "" when none.
@@ -148,7 +152,7 @@ struct WarningLine {
   bool folded = false;       // the line leaves out part of the warning (the rest is on click)
   std::string Text() const;  // "summary -> action" (the console's form)
 };
-WarningLine LineOfWarning(const std::string& warning, size_t max_chars = 160);
+WarningLine LineOfWarning(const std::string& warning, size_t max_chars = kWarningLineChars);
 
 // The geometry (L, D, suspended mass, g) a trace of `role` is fitted with.
 RigGeometry GeometryForRole(const CampaignConfig& config, TraceRole role);

@@ -342,7 +342,7 @@ struct ReportPage {
       const double pa = std::isfinite(a.pitch) ? a.pitch : 1e9, pb = std::isfinite(b.pitch) ? b.pitch : 1e9;
       if (a.roll != b.roll) return a.roll < b.roll;
       if (pa != pb) return pa < pb;
-      return a.t.file < b.t.file;
+      return NaturalLess(a.t.file, b.t.file);  // case ignored, numbers as numbers
     });
     // A campaign whose tensor fit failed is still not planar when its logs roll.
     if (kind == CampaignKind::kPlanar && rolls) kind = CampaignKind::kPartialTensor;
@@ -381,12 +381,15 @@ const char* KindName(CampaignKind kind) {
 void WriteHeadline(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
   std::string items;
+  // Each moment with its stat and its total std, labelled (the total adds the common-mode terms,
+  // pipeline/records/total_uncertainty.h).
   const auto add = [&](const std::string& label, const Estimate& e, double total) {
     if (!e.defined) return;
-    const double shown_std = std::isfinite(total) ? total : e.std;
-    items += (items.empty() ? "" : ", ") + label + " = " + u.Value(e.value, shown_std) +
-             " &plusmn; " + u.Std(shown_std);
+    items += (items.empty() ? "" : ", ") + label + " = " + u.Value(e.value, e.std) +
+             " &plusmn; " + u.Std(e.std) + " (stat)" +
+             (std::isfinite(total) ? " &plusmn; " + u.Std(total) + " (total)" : std::string());
   };
+  const double common = p.results.Get("total_uncertainty").Num("common_mode_relative_std");
   if (p.Planar()) {
     if (!p.ellipse.IsObject()) {
       h << "<p class=\"bad\">" << Escape(p.summary.ellipse_message) << "</p>\n";
@@ -399,7 +402,7 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
       add(label, GetEstimate(p.ellipse, key), total.Num(key));
     }
     h << "<p class=\"result\">Result: " << items << " " << u.name
-      << " (&plusmn; total std; Table 2).</p>\n";
+      << " (&plusmn; 1 std: stat, then total; Table 2).</p>\n";
     return;
   }
   if (!p.tensor.IsObject()) {
@@ -408,11 +411,11 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
   }
   for (int k = 0; k < kTensorComponents; ++k) {
     const char* name = TensorComponentName(k);
-    add(std::string("I<sub>") + (name + 1) + "</sub>", GetEstimate(p.tensor, std::string(name) + "_kg_m2"),
-        NAN);
+    const Estimate e = GetEstimate(p.tensor, std::string(name) + "_kg_m2");
+    add(std::string("I<sub>") + (name + 1) + "</sub>", e, WithCommonModeScale(e.value, e.std, common));
   }
   h << "<p class=\"result\">Result: " << items << " " << u.name
-    << " (&plusmn; stat std; inertia tensor below).</p>\n";
+    << " (&plusmn; 1 std: stat, then total; inertia tensor below).</p>\n";
 }
 
 // results.json's `physical` (fit/physical.h) beside the result box: not physical in red with the
@@ -617,15 +620,22 @@ void WriteTable1AndRig(const ReportPage& p, std::ostream& h) {
   h << "<tr><td class=\"l\">regression RMSE" << (p.Planar() ? "" : " (tensor fit)") << "</td><td>"
     << u.Inertia(rmse, "%.3g") << "</td><td class=\"l\">" << u.name << "</td></tr>\n</table>\n";
   const R rig = p.results.Get("rig");
+  // A mass or rig inertia the config does not give reads "not configured", never 0.0000.
+  const double aircraft_mass = rig.Num("aircraft_mass_kg");
+  const std::string source = rig.Str("inertia_source");
+  const double rig_inertia = rig.Num("inertia_kg_m2");
   h << "<p>Rig: L = " << Fmt(rig.Num("filar_length_m"), "%.4f") << " m, D = "
     << Fmt(rig.Num("filar_separation_m"), "%.4f") << " m, rig mass "
-    << Fmt(rig.Num("mass_kg"), "%.4f") << " kg, aircraft mass "
-    << Fmt(rig.Num("aircraft_mass_kg"), "%.4f") << " kg, g = "
-    << Fmt(rig.Num("gravity_mps2"), "%.5f") << " m/s<sup>2</sup>. Rig inertia ("
-    << Escape(rig.Str("inertia_source")) << "): "
-    << u.Value(rig.Num("inertia_kg_m2"), rig.Num("inertia_std_kg_m2")) << " &plusmn; "
-    << u.Std(rig.Num("inertia_std_kg_m2")) << " " << u.name;
-  if (rig.Str("inertia_source") == "tare") h << " from " << rig.Int("tare_n") << " tare log(s)";
+    << Fmt(rig.Num("mass_kg"), "%.4g") << " kg, aircraft mass "
+    << (aircraft_mass > 0 ? Fmt(aircraft_mass, "%.4g") + " kg" : std::string("not configured"))
+    << ", g = " << Fmt(rig.Num("gravity_mps2"), "%.5f") << " m/s<sup>2</sup>. Rig inertia";
+  if (source.empty() || source == "none" || !std::isfinite(rig_inertia)) {
+    h << ": not configured (the moments are of everything that hangs)";
+  } else {
+    h << " (" << Escape(source) << "): " << u.Value(rig_inertia, rig.Num("inertia_std_kg_m2"))
+      << " &plusmn; " << u.Std(rig.Num("inertia_std_kg_m2")) << " " << u.name;
+    if (source == "tare") h << " from " << rig.Int("tare_n") << " tare log(s)";
+  }
   h << ".</p>\n";
   WriteCalibration(p, h);
 }
@@ -669,11 +679,13 @@ void WritePrincipal(const ReportPage& p, std::ostream& h) {
   const std::vector<double> axes_std = tensor.Nums("principal_axes_std_deg");
   const std::vector<std::vector<double>> axes = tensor.Rows("principal_axes");
   const auto at = [](const std::vector<double>& a, size_t i) { return i < a.size() ? a[i] : NAN; };
-  h << kScrollOpen << "<table><tr><th>principal</th><th>moment</th><th>std</th><th>axis x</th><th>axis y</th>"
-       "<th>axis z</th><th>axis std (deg)</th></tr>\n";
+  const double common = p.results.Get("total_uncertainty").Num("common_mode_relative_std");
+  h << kScrollOpen << "<table><tr><th>principal</th><th>moment</th><th>std (stat)</th><th>std (total)</th>"
+       "<th>axis x</th><th>axis y</th><th>axis z</th><th>axis std (deg)</th></tr>\n";
   for (size_t k = 0; k < 3; ++k) {
     h << "<tr><td>" << k + 1 << "</td><td>" << u.Value(moments[k], at(stds, k)) << "</td><td>"
-      << u.Std(at(stds, k));
+      << u.Std(at(stds, k)) << "</td><td>"
+      << u.Std(WithCommonModeScale(moments[k], at(stds, k), common));
     const std::vector<double> a = k < axes.size() ? axes[k] : std::vector<double>();
     for (size_t c = 0; c < 3; ++c) h << "</td><td>" << Fmt(at(a, c), "%+.4f");
     h << "</td><td>" << Fmt(at(axes_std, k), "%.2f") << "</td></tr>\n";
@@ -732,24 +744,29 @@ void WriteTensorSection(ReportPage& p, std::ostream& h) {
   if (scatter > 0) h << "; attitude scatter " << Fmt(scatter, "%.2f") << " deg";
   h << ". Products are positive (I<sub>xy</sub> = &int; x y dm); the tensor holds their negatives "
        "(docs/physics.md &sect;3.5). Values are given to the digits their std supports.</p>\n";
+  const double common = p.results.Get("total_uncertainty").Num("common_mode_relative_std");
   h << kScrollOpen << "<table><tr><th class=\"l\">component</th><th>value</th><th>std (stat)</th>"
-       "<th>interval (stat)</th><th class=\"l\">unit</th></tr>\n";
+       "<th>std (total)</th><th>interval (stat)</th><th class=\"l\">unit</th></tr>\n";
   for (int k = 0; k < kTensorComponents; ++k) {
     const char* name = TensorComponentName(k);
     const Estimate e = GetEstimate(tensor, std::string(name) + "_kg_m2");
     h << "<tr><td class=\"l\">I<sub>" << (name + 1) << "</sub></td>";
     if (!e.defined) {
-      h << "<td colspan=\"3\" class=\"note\">not observable from these swing axes</td>";
+      h << "<td colspan=\"4\" class=\"note\">not observable from these swing axes</td>";
     } else {
-      h << "<td>" << u.Value(e.value, e.std) << "</td><td>" << u.Std(e.std) << "</td><td>["
+      h << "<td>" << u.Value(e.value, e.std) << "</td><td>" << u.Std(e.std) << "</td><td>"
+        << u.Std(WithCommonModeScale(e.value, e.std, common)) << "</td><td>["
         << u.Value(e.lo, e.std) << ", " << u.Value(e.hi, e.std) << "]</td>";
     }
     h << "<td class=\"l\">" << u.name << "</td></tr>\n";
   }
   h << "</table>" << kScrollClose;
-  h << "<p>Uncertainties are statistical; the configured uncertainties add a systematic &plusmn;"
-    << Fmt(100.0 * tensor.Num("systematic_relative_std"), "%.2f")
-    << " % that scales every component alike.</p>\n";
+  h << "<p><b>std (stat)</b>: the logs' own errors and their scatter; <b>std (total)</b> adds in "
+       "quadrature the common-mode terms (the configured uncertainties of L, D, g, the masses "
+       "and the gyro scale, or the rig calibration), &plusmn;"
+    << Fmt(100.0 * common, "%.2f")
+    << " % of each component, one error that scales every component alike. Read the total when "
+       "you use a number.</p>\n";
   const double relative = tensor.Num("relative_scatter");
   std::vector<std::pair<std::string, double>> logs;
   for (const R& l : tensor.Items("scatter_logs")) logs.emplace_back(l.Str("file"), l.Num("residual_over_std"));
@@ -924,9 +941,11 @@ void WriteTraceFigures(ReportPage& p, std::ostream& h) {
             << SweepFigure(row.t, p.out_dir, &p.figures_drawn);
   }
   if (figures.tellp() == 0) return;  // no figures drawn (process --no-figures): no section
-  h << "<h2>Fit and residual of every trace</h2>\n<p>Left, each trace: the measured swing rate "
-       "(black) over the fit (light blue), and beneath them the residual (grey) with the "
-       "&plusmn;1&sigma; noise estimate (red). Its caption gives the record's I<sub>total</sub> with "
+  h << "<h2>Fit and residual of every trace</h2>\n<p>Left, each trace: the measured samples of the "
+       "swing rate (black dots) on the fit that gave I (light blue line), and beneath them that "
+       "fit's residual (grey) with the &plusmn;1&sigma; gyro noise (red) and its rms, labelled with "
+       "the part of the log it belongs to (the lowest-amplitude band or the whole window; a "
+       "warning's &ldquo;residual N&times; noise&rdquo; is the whole window's). Its caption gives the record's I<sub>total</sub> with "
        "its stat and total std (the numbers of the tables), the measured period T "
        "and the small-angle inertia m g D<sup>2</sup> T<sup>2</sup> / (16 &pi;<sup>2</sup> L) of "
        "everything suspended, the hand check of the fitted I<sub>total</sub>. Right: I against "

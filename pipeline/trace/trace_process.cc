@@ -506,6 +506,12 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
                                      &series);
   TraceFitOptions fit_options = TraceFitOptionsFor(config, options.role);
   fit_options.keep_series = true;
+  // A longer window exists when the amplitude band ended the fit before the free swing's end, or
+  // a given window ends a period or more before the log does (the damping advice's condition).
+  const double period_s = std::max(0.0, window.period_s);
+  fit_options.longer_window_available =
+      band.t1_s < window.t1_s - period_s ||
+      (window.overridden && !data.t_s.empty() && window.t1_s < data.t_s.back() - period_s);
   fit_options.interrupt = options.interrupt;
   TraceFitResult fit = FitWithResidualGlitchPass(config, fit_options, &input, &record);
   if (options.figure_paths.empty() && fit_out == nullptr) {
