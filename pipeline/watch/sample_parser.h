@@ -80,6 +80,8 @@ class SampleParser {
   // The last time is kept, so a new stream that starts at an earlier time is rejected as
   // time_back rather than misread.
   void Restart();
+  // A new log starts: forget the last time (its clock may start again from zero).
+  void ResetClock() { last_t_ = -1e300; }
 
   const InputCounters& counters() const { return counters_; }
   InputCounters& counters() { return counters_; }

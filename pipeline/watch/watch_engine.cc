@@ -131,7 +131,17 @@ bool WatchEngine::Add(double t_s, const Eigen::Vector3d& gyro, const Eigen::Vect
       pending_n_ = 0;
     }
   }
-  if (static_cast<int>(points_.size()) > options_.max_fit_samples) MergePairs();
+  if (static_cast<int>(points_.size()) > options_.max_fit_samples) {
+    // Merge while a point stays shorter than 1/32 of a period (its mean keeps the swing's shape
+    // to 0.2 %); beyond, keep only the recent half of the points.
+    const size_t n = points_.size();
+    const double spacing = (points_.t_s.back() - points_.t_s.front()) / static_cast<double>(n - 1);
+    if (std::isfinite(last_.period_s) && 2.0 * spacing > last_.period_s / 32.0) {
+      DropOldestHalf();
+    } else {
+      MergePairs();
+    }
+  }
   if (std::isnan(next_update_t_)) next_update_t_ = t_s + options_.update_interval_s;
   return t_s >= next_update_t_;
 }
@@ -158,6 +168,15 @@ void WatchEngine::MergePairs() {
   }
   points_ = std::move(merged);
   block_ *= 2;
+}
+
+void WatchEngine::DropOldestHalf() {
+  const size_t half = points_.size() / 2;
+  points_.t_s.erase(points_.t_s.begin(), points_.t_s.begin() + half);
+  points_.gyro_in_imu.erase(points_.gyro_in_imu.begin(), points_.gyro_in_imu.begin() + half);
+  if (has_accel_) {
+    points_.accel_in_imu.erase(points_.accel_in_imu.begin(), points_.accel_in_imu.begin() + half);
+  }
 }
 
 void WatchEngine::Recent(WatchUpdate* u) const {

@@ -11,7 +11,9 @@
 // point stands for 2, 4, 8, ... samples: the fit then sees block means whose noise is lower by
 // the square root of the block size, so its statistical std stays close to the full-rate one,
 // and the work per update and the memory stay constant however long the stream (a benchmark,
-// bench/watch_bench.cc, measures it at 1 kHz). The final result is never from block means: it is
+// bench/watch_bench.cc, measures it at 1 kHz). Points are merged only while a point spans less
+// than 1/32 of the period (the block mean then keeps the swing's amplitude to 0.2 %); past that,
+// the oldest half of the points is dropped instead, and the fit is of a bounded recent window. The final result is never from block means: it is
 // the fit of the saved log (pipeline/watch/watch_run.h).
 //
 // Updates are scheduled by the samples' own time (not the wall clock), so the same stream always
@@ -110,6 +112,7 @@ class WatchEngine {
 
  private:
   void MergePairs();
+  void DropOldestHalf();
   void CloseSwingIfEnded();
   void Recent(WatchUpdate* u) const;
   void Judge(WatchUpdate* u);

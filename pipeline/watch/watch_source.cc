@@ -43,14 +43,13 @@ class DescriptorSource : public WatchSource {
     parser_.Feed(std::string(buffer, static_cast<size_t>(n)), samples, rejected);
     return true;
   }
-  void ResetClock() override { parser_ = SampleParser(ParserOptions()); }
+  void ResetClock() override { parser_.ResetClock(); }
   const InputCounters& counters() const override { return parser_.counters(); }
   std::string Describe() const override { return name_; }
   std::string simulated_marker() const override { return parser_.simulated_marker(); }
   std::string format_description() const override { return parser_.description(); }
 
  private:
-  WatchInputOptions ParserOptions() const { return options_; }
   int fd_;
   std::string name_;
   WatchInputOptions options_;
@@ -91,6 +90,7 @@ class FollowedFile : public WatchSource {
         fd_ = -1;
         restarted_ = true;
         parser_.Restart();
+        return true;  // the caller sees the restart (TakeRestart) before any byte of the new file
       }
     }
     if (fd_ < 0) {
@@ -121,7 +121,7 @@ class FollowedFile : public WatchSource {
     return r;
   }
   void ResetClock() override {
-    parser_ = SampleParser(input_);
+    parser_.ResetClock();
     last_t_ = -1e300;
   }
   const InputCounters& counters() const override { return binary_ ? binary_counters_ : parser_.counters(); }
