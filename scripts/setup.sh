@@ -14,7 +14,8 @@ packages=(cmake g++ make pkg-config libeigen3-dev libsundials-dev libceres-dev l
           libyaml-cpp-dev libcli11-dev libplplot-dev plplot-driver-cairo libfast-float-dev
           nlohmann-json3-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev
           pybind11-dev python3-dev python3-numpy python3-pytest
-          python3-pip python3-setuptools python3-wheel python3-venv)
+          python3-pip python3-setuptools python3-wheel python3-venv
+          libcpp-httplib-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

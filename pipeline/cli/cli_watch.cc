@@ -87,6 +87,9 @@ void RegisterWatchCommand(CLI::App& app, int* exit_code) {
       ->check(FiniteNumber());
   sub->add_flag("--append", cli->o.append_on_reconnect,
                 "after a disconnect or a restarted file, append to the same log (default: a new log)");
+  sub->add_option("--serve", cli->o.serve_port,
+                  "serve the live page on http://127.0.0.1:PORT/ (0: any free port)")
+      ->check(CLI::Range(0, 65535));
   sub->add_option("--feed", cli->feed, "replay this log as CSV on standard output (a feeder)");
   sub->add_option("--speed", cli->speed, "--feed: times real time (default 1; 0: at once)")
       ->check(FiniteNumber());

@@ -11,6 +11,7 @@
 #include "pipeline/commands/log_inspect.h"
 #include "pipeline/records/results_json.h"
 #include "pipeline/watch/saved_log.h"
+#include "pipeline/watch/watch_server.h"
 #include "pipeline/watch/watch_source.h"
 
 namespace bifilar {
@@ -213,6 +214,20 @@ WatchCommandResult RunWatch(const WatchCommandOptions& options) {
   input.counter_column = options.counter_column;
   input.guess_format = options.guess_format ? options.guess_format : GuessFormat;
   WatchCommandOptions o = options;
+  std::unique_ptr<WatchServer> server;
+  if (options.serve_port >= 0) {
+    server = std::make_unique<WatchServer>(options.serve_port);
+    WatchServer* page = server.get();
+    o.on_update = [page, user = options.on_update](const WatchUpdate& u) {
+      page->Publish(u);
+      if (user) user(u);
+    };
+    o.on_event = [page, user = options.on_event](const std::string& text) {
+      page->Event(text);
+      if (user) user(text);
+    };
+    if (o.on_event) o.on_event("the live page is at " + server->url());
+  }
   if (o.engine.log_name == "watch") {
     o.engine.log_name = options.source == "-" ? "stdin" : options.source;
   }

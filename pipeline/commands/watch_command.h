@@ -40,6 +40,9 @@ struct WatchCommandOptions {
   // one.
   bool append_on_reconnect = false;
   bool handle_interrupt = false;  // install the Ctrl-C handler (CLI)
+  // >= 0: serve the live page on 127.0.0.1:serve_port (0: any free port; the URL is told as an
+  // event) (pipeline/watch/watch_server.h). -1: no page.
+  int serve_port = -1;
   // Called for each update, each event (a line for the user: saved file, restart, disconnect,
   // idle), and each final result (one per saved log). Any may be empty.
   std::function<void(const WatchUpdate&)> on_update;
