@@ -67,6 +67,7 @@ struct Watch {
     bool go_on = true;
     for (const WatchSample& s : samples) {
       const WatchSample back = log->Write(s);
+      if (!go_on) continue;  // the watch ends, but every sample received is saved
       if (!engine->Add(back.t_s, back.gyro_rad_per_s, back.has_accel ? &back.accel_mps2 : nullptr)) {
         continue;
       }
@@ -84,7 +85,6 @@ struct Watch {
         result->end_reason = "target reached";
         go_on = false;
       }
-      if (!go_on) break;  // the rest of this batch is already in the log
     }
     if (log != nullptr) log->Flush();
     return go_on;

@@ -22,6 +22,8 @@ constexpr EnumName<WatchVerdict> kWatchVerdictNames[] = {
 
 constexpr size_t kRecentSamples = 256;  // the ring behind the rate and noise before release
 constexpr int kMinPointsToFit = 20;
+// A swing has started when the recent rate's std exceeds this many times the one at rest.
+constexpr double kReleaseNoiseRatio = 5.0;
 
 bool HasFlag(const TraceRecord& r, const std::string& flag) {
   return std::find(r.flags.begin(), r.flags.end(), flag) != r.flags.end();
@@ -239,6 +241,19 @@ WatchUpdate WatchEngine::Update() {
 void WatchEngine::Judge(WatchUpdate* u) {
   const double min_cycles = config_.fit.quality.min_periods + 1.0;
   if (record_.status == TraceStatus::kError || !std::isfinite(u->inertia_kg_m2)) {
+    // Released, but too little of the swing for a fit yet: the rate is far above the noise
+    // measured at rest.
+    if (std::isfinite(rest_noise_) && u->rate_noise_rad_per_s > kReleaseNoiseRatio * rest_noise_) {
+      u->verdict = WatchVerdict::kSwinging;
+      u->reason = "released; the first fit needs " + Fmt("%g", min_cycles - 1.0) +
+                  " cycles of free swing" +
+                  (record_.message.empty() ? "" : " (" + WarningSummary(record_.message, 100) + ")");
+      return;
+    }
+    if (std::isfinite(u->rate_noise_rad_per_s)) {
+      rest_noise_ = std::isfinite(rest_noise_) ? std::min(rest_noise_, u->rate_noise_rad_per_s)
+                                               : u->rate_noise_rad_per_s;
+    }
     u->verdict = WatchVerdict::kWaiting;
     u->reason = "waiting for release: rate noise " + Fmt("%.2g", u->rate_noise_rad_per_s) +
                 " rad/s at " + Fmt("%.0f", u->rate_hz) + " Hz" +
@@ -316,6 +331,7 @@ void WatchEngine::CloseSwingIfEnded() {
                                points_.accel_in_imu.begin() + first_after);
   }
   history_.clear();
+  rest_noise_ = NAN;
 }
 
 }  // namespace bifilar

@@ -135,6 +135,7 @@ class WatchEngine {
   WatchUpdate last_;
   std::vector<WatchSwing> swings_;
   std::vector<std::pair<double, double>> history_;  // (cycles, relative std) of this swing
+  double rest_noise_ = NAN;  // the smallest recent rate std seen while waiting (rad/s)
 };
 
 }  // namespace bifilar
