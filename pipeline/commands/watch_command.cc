@@ -78,7 +78,7 @@ struct Watch {
       if (o.on_update) o.on_update(u);
       if (o.stop_after_cycles > 0 && u.verdict != WatchVerdict::kWaiting &&
           u.cycles >= o.stop_after_cycles) {
-        result->end_reason = Fmt("%d cycles reached", o.stop_after_cycles);
+        result->end_reason = std::to_string(o.stop_after_cycles) + " cycles reached";
         go_on = false;
       }
       if (o.stop_at_target && u.verdict == WatchVerdict::kEnough) {
@@ -252,12 +252,18 @@ std::string WatchStatusLine(const WatchUpdate& u) {
   switch (u.verdict) {
     case WatchVerdict::kWaiting:
       return head + "waiting for release  noise " + Fmt("%.2g", u.rate_noise_rad_per_s) +
-             " rad/s  " + Fmt("%.0f", u.rate_hz) + " Hz";
+             " rad/s  " + Fmt("%.0f", u.rate_hz) + " Hz" +
+             (u.earlier_swings_kg_m2.empty()
+                  ? ""
+                  : Fmt("  (last swing I %.6g kg m^2)", u.earlier_swings_kg_m2.back()));
     default:
       break;
   }
-  std::string line = head + Fmt("swing %d  ", u.swing) + Fmt("%5.1f cycles  ", u.cycles) +
-                     Fmt("A %5.1f deg  ", u.amplitude_deg) + Fmt("T %.4f s  ", u.period_s);
+  std::string line = head + "swing " + std::to_string(u.swing) + "  ";
+  if (std::isfinite(u.period_s)) {
+    line += Fmt("%5.1f cycles  ", u.cycles) + Fmt("A %5.1f deg  ", u.amplitude_deg) +
+            Fmt("T %.4f s  ", u.period_s);
+  }
   if (std::isfinite(u.inertia_kg_m2)) {
     line += Fmt("I %.6g", u.inertia_kg_m2) + Fmt(" +- %.2g", u.inertia_std_stat_kg_m2) +
             Fmt(" (total %.2g) kg m^2  ", u.inertia_std_total_kg_m2);

@@ -255,8 +255,12 @@ void WatchEngine::Judge(WatchUpdate* u) {
                                                : u->rate_noise_rad_per_s;
     }
     u->verdict = WatchVerdict::kWaiting;
+    for (const WatchSwing& s : swings_) u->earlier_swings_kg_m2.push_back(s.inertia_kg_m2);
     u->reason = "waiting for release: rate noise " + Fmt("%.2g", u->rate_noise_rad_per_s) +
                 " rad/s at " + Fmt("%.0f", u->rate_hz) + " Hz" +
+                (swings_.empty() ? ""
+                                 : "; last swing I = " + Fmt("%.6g", swings_.back().inertia_kg_m2) +
+                                       Fmt(" +- %.2g kg m^2", swings_.back().inertia_std_stat_kg_m2)) +
                 (record_.message.empty() ? "" : " (" + WarningSummary(record_.message, 100) + ")");
     return;
   }
