@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <thread>
 
 #include "base/interrupt.h"
 #include "base/text_format.h"
@@ -113,6 +114,37 @@ bool GuessFormat(const std::string& text, ImuFormat* format, std::string* why) {
   return true;
 }
 
+// After a disconnect: tries to open the source again every second until it opens (true), or
+// Ctrl-C, the caller's stop or --idle-end (false, with the end reason).
+bool Reconnect(Watch* w, Clock::time_point since) {
+  const WatchCommandOptions& o = w->o;
+  bool said = false;
+  while (true) {
+    if (ProcessInterruptFlag().load() || (o.keep_going && !o.keep_going())) {
+      w->result->interrupted = ProcessInterruptFlag().load();
+      w->result->end_reason = w->result->interrupted ? "interrupted (Ctrl-C)" : "stopped";
+      return false;
+    }
+    const double waited = std::chrono::duration<double>(Clock::now() - since).count();
+    if (o.idle_end_s > 0 && waited > o.idle_end_s) {
+      w->result->end_reason = "disconnected for " + Fmt("%g", o.idle_end_s) + " s";
+      return false;
+    }
+    std::string why;
+    if (w->source->Reconnect(&why)) break;
+    if (!said) w->Event("reconnecting to " + w->source->Describe() + " every second (" + why + ")");
+    said = true;
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+  }
+  w->Event("reconnected to " + w->source->Describe() +
+           (o.append_on_reconnect ? ": appending to the same log" : ": starting a new log"));
+  if (!o.append_on_reconnect) {
+    w->FinishLog();
+    w->source->ResetClock();
+  }
+  return true;
+}
+
 void Loop(Watch* w) {
   const WatchCommandOptions& o = w->o;
   WatchCommandResult* result = w->result;
@@ -145,13 +177,11 @@ void Loop(Watch* w) {
     if (!w->Take(samples, rejected)) return;
     if (!open) {
       w->Event(why + (w->log ? "; the log " + w->log->path() + " keeps every sample received" : ""));
-      std::string again;
-      if (!w->source->Reconnect(&again)) {
-        result->end_reason = "end of stream";
+      if (!w->source->CanReconnect() || !Reconnect(w, Clock::now())) {
+        result->end_reason = w->source->CanReconnect() ? result->end_reason : "end of stream";
         return;
       }
-      w->Event("reconnected to " + w->source->Describe());
-      if (!o.append_on_reconnect) w->FinishLog();
+      last_data = Clock::now();
       continue;
     }
     const double idle = std::chrono::duration<double>(Clock::now() - last_data).count();

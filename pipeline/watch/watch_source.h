@@ -34,6 +34,9 @@ class WatchSource {
   virtual bool TakeRestart() { return false; }
   // Forget the last time (a new log starts: its clock may start again from zero).
   virtual void ResetClock() = 0;
+  // A stream that may come back after a disconnect (a serial port, a WebSocket, UDP); standard
+  // input and files end for good.
+  virtual bool CanReconnect() const { return false; }
   // Open again after a disconnect; false (and *why) when it cannot be opened now.
   virtual bool Reconnect(std::string* why) {
     *why = "this source cannot reconnect";
