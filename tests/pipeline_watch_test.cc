@@ -261,6 +261,42 @@ TEST(Watch, FollowsAGrowingFileAndARotation) {
   EXPECT_TRUE(said);
 }
 
+// A PX4 ULog and an ArduPilot DataFlash log being written: re-read as they grow, every sample
+// saved once, and the saved CSV gives `fit`'s numbers on the binary log itself.
+TEST(Watch, FollowsGrowingUlogAndDataflashLogs) {
+  for (const char* name : {"sw.ulg", "sw.bin"}) {
+    TempDir dir("watch_binary");
+    const std::string config = SimulateSwing(dir, 20.0, 19, 100.0, name);
+    const std::string bytes = ReadFile(dir.path + "/" + name);
+    const std::string live = dir.path + "/live_" + name;
+    std::thread writer([&] {
+      std::ofstream out(live, std::ios::binary);
+      for (size_t at = 0; at < bytes.size(); at += 7919) {  // cuts inside messages
+        out << bytes.substr(at, 7919) << std::flush;
+        std::this_thread::sleep_for(std::chrono::milliseconds(30));
+      }
+    });
+    WatchCommandOptions o;
+    o.config_path = config;
+    o.source = live;
+    o.save_path = dir.path + "/saved.csv";
+    o.idle_end_s = 1.0;
+    const WatchCommandResult r = RunWatch(o);
+    writer.join();
+    ASSERT_EQ(r.logs.size(), 1u) << name;
+    const TraceRecord on_binary = FitLog(config, dir.path + "/" + name);
+    const TraceRecord on_saved = FitLog(config, dir.path + "/saved.csv");
+    ASSERT_TRUE(on_binary.ok()) << name << ": " << on_binary.message;
+    ConfigLoadOptions load;
+    load.require_runs = false;
+    const ImuData data = ReadImuLog(dir.path + "/" + name, LoadCampaignConfig(config, load).imu.format);
+    EXPECT_EQ(r.logs[0].samples, static_cast<long>(data.size())) << name;
+    ASSERT_TRUE(r.logs[0].record.has_value());
+    ExpectRelativelyEqual(r.logs[0].record->inertia_total_kg_m2, on_saved.inertia_total_kg_m2, 1e-12);
+    ExpectRelativelyEqual(on_saved.inertia_total_kg_m2, on_binary.inertia_total_kg_m2, 1e-12);
+  }
+}
+
 // "enough" at the first update where `fit` on the log so far reaches the target: within one
 // period of the first cut (on a grid of an eighth of a period) where it does.
 TEST(Watch, EnoughWithinOneCycleOfFitOnTheLogSoFar) {
