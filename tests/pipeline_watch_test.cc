@@ -297,6 +297,27 @@ TEST(Watch, FollowsGrowingUlogAndDataflashLogs) {
   }
 }
 
+// Ctrl-C: the watch ends (exit 130), fits what it saved and says so.
+TEST(Watch, CtrlCEndsWithTheFitOfTheSavedLog) {
+  TempDir dir("watch_sigint");
+  const std::string config = SimulateSwing(dir, 60.0, 23);
+  const std::string b = BIFILAR_BINARY;
+  const std::string script = b + " watch " + config + " --feed " + dir.path +
+                             "/sw.csv --speed 4 | " + b + " watch " + config + " - --json --save " +
+                             dir.path + "/saved.csv > " + dir.path + "/out.jsonl 2> " + dir.path +
+                             "/err.txt & w=$!; sleep 4; kill -INT $w; wait $w; echo $? > " +
+                             dir.path + "/rc.txt";
+  ASSERT_EQ(std::system(("sh -c '" + script + "'").c_str()), 0);
+  EXPECT_EQ(ReadFile(dir.path + "/rc.txt"), "130\n") << ReadFile(dir.path + "/err.txt");
+  const nlohmann::json final = JsonLines(ReadFile(dir.path + "/out.jsonl")).back();
+  EXPECT_TRUE(final["interrupted"].get<bool>());
+  const TraceRecord fit = FitLog(config, dir.path + "/saved.csv");
+  ASSERT_TRUE(final["logs"][0]["record"].is_object());
+  ExpectRelativelyEqual(final["logs"][0]["record"]["inertia_total_kg_m2"].get<double>(),
+                        fit.inertia_total_kg_m2, 1e-12);
+  EXPECT_LT(final["logs"][0]["samples"].get<long>(), 5500);  // stopped before the end
+}
+
 // "enough" at the first update where `fit` on the log so far reaches the target: within one
 // period of the first cut (on a grid of an eighth of a period) where it does.
 TEST(Watch, EnoughWithinOneCycleOfFitOnTheLogSoFar) {

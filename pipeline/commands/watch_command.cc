@@ -271,6 +271,8 @@ WatchCommandResult RunWatch(const WatchCommandOptions& options) {
     throw;
   }
   result.counters = w.source->counters();
+  // Ctrl-C ended the watch, not the fit of what it saved (a second Ctrl-C still kills at once).
+  if (result.interrupted) ProcessInterruptFlag().store(false);
   w.FinishLog();
   if (result.logs.empty()) w.Event("no sample received: no log saved");
   result.json = ResultJson(result);
