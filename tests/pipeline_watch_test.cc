@@ -318,6 +318,61 @@ TEST(Watch, CtrlCEndsWithTheFitOfTheSavedLog) {
   EXPECT_LT(final["logs"][0]["samples"].get<long>(), 5500);  // stopped before the end
 }
 
+// A rig that sways (a strong second oscillation about another axis): `fit` rejects the swing,
+// and the watch says "fix the rig" with fit's reason.
+TEST(Watch, SwayIsFixTheRigWithFitsReason) {
+  TempDir dir("watch_sway");
+  const std::string config_path = SimulateSwing(dir, 25.0, 29);
+  ConfigLoadOptions load;
+  load.require_runs = false;
+  const CampaignConfig config = LoadCampaignConfig(config_path, load);
+  ImuData data = ReadImuLog(dir.path + "/sw.csv", config.imu.format);
+  for (size_t i = 0; i < data.size(); ++i) {
+    data.gyro_in_imu[i][0] += 0.5 * std::sin(2 * 3.0 * data.t_s[i]);  // ~1 Hz sway, 0.5 rad/s
+  }
+  WatchEngine engine(config, WatchEngineOptions());
+  int fix_rig = 0;
+  std::string reason;
+  for (size_t i = 0; i < data.size(); ++i) {
+    if (!engine.Add(data.t_s[i], data.gyro_in_imu[i], &data.accel_in_imu[i])) continue;
+    const WatchUpdate u = engine.Update();
+    if (u.verdict == WatchVerdict::kFixRig) {
+      ++fix_rig;
+      reason = u.reason;
+    }
+    EXPECT_NE(u.verdict, WatchVerdict::kEnough) << u.t_s << ": " << u.reason;
+  }
+  EXPECT_GT(fix_rig, 3);
+  EXPECT_NE(reason.find("secondary motion"), std::string::npos) << reason;
+}
+
+// Two swings of one set-up in one stream: the first is closed when it has died out, and the
+// second is compared with it.
+TEST(Watch, SecondSwingIsComparedWithTheFirst) {
+  TempDir dir("watch_repeat");
+  const std::string config_path = SimulateSwing(dir, 30.0, 31);
+  ConfigLoadOptions load;
+  load.require_runs = false;
+  const CampaignConfig config = LoadCampaignConfig(config_path, load);
+  const ImuData data = ReadImuLog(dir.path + "/sw.csv", config.imu.format);
+  const double span = data.t_s.back() - data.t_s.front() + 0.01;
+  WatchEngine engine(config, WatchEngineOptions());
+  WatchUpdate last_of_second;
+  for (int swing = 0; swing < 2; ++swing) {
+    for (size_t i = 0; i < data.size(); ++i) {
+      if (!engine.Add(data.t_s[i] + swing * span, data.gyro_in_imu[i], &data.accel_in_imu[i])) {
+        continue;
+      }
+      const WatchUpdate u = engine.Update();
+      if (swing == 1 && u.swing == 2 && std::isfinite(u.inertia_kg_m2)) last_of_second = u;
+    }
+  }
+  ASSERT_EQ(engine.swings().size(), 2u);  // both died out before the stream ended
+  EXPECT_NEAR(engine.swings()[0].inertia_kg_m2, kTrueInertia, 0.001);
+  ASSERT_EQ(last_of_second.earlier_swings_kg_m2.size(), 1u);
+  EXPECT_EQ(last_of_second.repeat_agreement, "agrees");  // the same data: the same I
+}
+
 // "enough" at the first update where `fit` on the log so far reaches the target: within one
 // period of the first cut (on a grid of an eighth of a period) where it does.
 TEST(Watch, EnoughWithinOneCycleOfFitOnTheLogSoFar) {
