@@ -1360,7 +1360,7 @@ int RunWatchStressCases(const Args& args, const Workspace& w, int case_no, std::
   int runs = 0;
   std::vector<std::string> logs;
   for (const auto& [path, text] : w.pristine) logs.push_back(path);
-  for (int k = 0; k < 12 && !logs.empty(); ++k, ++runs) {
+  for (int k = 0; k < 8 && !logs.empty(); ++k, ++runs) {
     const std::string kind = "watch bad input " + std::to_string(k);
     std::istringstream in(w.pristine.at(logs[Uniform(rng, 0, static_cast<int>(logs.size()) - 1)]));
     std::string fed, line;
