@@ -13,6 +13,7 @@
 #include "base/user_error.h"
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/logs/simulated_log.h"
+#include "pipeline/watch/live_source.h"
 
 namespace bifilar {
 namespace {
@@ -199,13 +200,7 @@ std::unique_ptr<WatchSource> OpenWatchSource(const std::string& spec, const Camp
   if (spec == "-" || spec == "stdin") {
     return std::make_unique<DescriptorSource>(0, "standard input", input);
   }
-  for (const char* prefix : {"serial:", "ws://", "wss://", "mavlink:", "mavlink-udp:"}) {
-    if (StartsWith(spec, prefix)) {
-      throw UserError("watch: source '" + PrintableAscii(spec, 200) +
-                      "': the serial, WebSocket and MAVLink transports (pipeline/live/) are not "
-                      "built into this bifilar; use a log file being written or standard input");
-    }
-  }
+  if (std::unique_ptr<WatchSource> live = OpenLiveSource(spec, input)) return live;
   const std::string path = StartsWith(spec, "file:") ? spec.substr(5) : spec;
   return std::make_unique<FollowedFile>(path, config, input);
 }

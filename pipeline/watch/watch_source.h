@@ -6,8 +6,8 @@
 //   "ws://HOST:PORT/PATH"     a WebSocket sending one JSON object per message
 //   "mavlink:DEVICE@BAUD"     MAVLink 2 (HIGHRES_IMU, SCALED_IMU, RAW_IMU) over a serial port
 //   "mavlink-udp:HOST:PORT"   MAVLink 2 over UDP (bound on HOST:PORT)
-// The serial, WebSocket and MAVLink transports live in pipeline/live/; a build without them
-// refuses those specs with a clear "not built" error.
+// The serial, WebSocket and MAVLink transports are pipeline/live/'s
+// (pipeline/watch/live_source.h).
 //
 // A followed file that shrinks (truncated) or is replaced (a new file under the name: rotation)
 // is read again from its start and the source says so (restarted()); the CSV header is read

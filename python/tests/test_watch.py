@@ -50,7 +50,7 @@ def test_watch_closed_early_keeps_the_log(tmp_path):
     assert saved.read_text().splitlines()[1].startswith("t,gx,gy,gz")
 
 
-def test_watch_transport_not_built(tmp_path):
+def test_watch_serial_port_that_does_not_open(tmp_path):
     _, config = _swing(tmp_path)
-    with pytest.raises(ValueError, match="not built"):
-        list(bifilar.watch("serial:/dev/ttyACM0@115200", str(config)))
+    with pytest.raises(ValueError, match="bifilar_no_such_port"):
+        list(bifilar.watch("serial:/dev/bifilar_no_such_port@115200", str(config)))

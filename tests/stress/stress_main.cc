@@ -59,6 +59,8 @@
 #include "pipeline/logs/dataflash_writer.h"
 #include "pipeline/store/cache.h"
 #include "pipeline/store/output_set.h"
+#include "pipeline/live/mavlink.h"         // issue 34 block at the end
+#include "pipeline/live/mavlink_writer.h"
 
 namespace {
 
@@ -1436,6 +1438,10 @@ int RunWatchStressCases(const Args& args, const Workspace& w, int case_no, std::
 
 }  // namespace
 
+namespace {
+int RunMavlinkDecoderCases(uint64_t seed, int cases, Failures* failures);  // issue 34, at the end
+}  // namespace
+
 // ParseArgs -> the baseline run -> RealLogs -> per case: OutsideOutCase (every tenth) or
 // RunRandomCase -> RunHostileInputCases -> Summarize.
 int main(int argc, char** argv) {
@@ -1474,5 +1480,142 @@ int main(int argc, char** argv) {
   kinds_run["hostile input (bounded reads)"] =
       RunHostileInputCases(args, w, args.cases + 1, &failures);
   kinds_run["watch bad input"] = RunWatchStressCases(args, w, args.cases + 2, rng, &failures);
+  kinds_run["mavlink decoder (in-process)"] =
+      RunMavlinkDecoderCases(args.seed, args.cases, &failures);
   return Summarize(args, w, start, forced_s, kinds_run, failures);
 }
+
+// ---- Issue 34: the MAVLink decoder (pipeline/live/mavlink.h) fed hostile bytes, in-process ----
+// Per case, from the seed: a stream of good IMU frames (HIGHRES_IMU, SCALED_IMU, RAW_IMU;
+// MAVLink 1 and 2, signed, truncated payloads) mixed with random bytes, frames cut short,
+// frames with a flipped bit (both before the signature, which no checksum covers), frames of other messages with random lengths and random start
+// bytes, fed in random chunks (1 byte to 4 kB). Asserted: every good frame's sample comes out,
+// in order (a sample that is not one is allowed only as a checksum collision of a cut frame,
+// counted: about 1 in 2500 cases; more than 3 + cases / 500 fails); the decoder never holds more than two frames'
+// bytes; every value is finite. Also, once per run, 4 MB of pure random bytes.
+namespace {
+
+// The samples of good frames, and the bytes; `rng` draws the mix.
+std::string MavlinkHostileStream(std::mt19937_64& rng,
+                                 std::vector<bifilar::live::MavlinkImuSample>* good) {
+  using namespace bifilar::live;
+  std::uniform_real_distribution<double> value(-30.0, 30.0);
+  std::string stream;
+  const int pieces = Uniform(rng, 10, 120);
+  for (int k = 0; k < pieces; ++k) {
+    MavlinkImuSample s{};
+    s.t_s = 1e-3 * k + 1e-6 * Uniform(rng, 0, 999);
+    for (int i = 0; i < 3; ++i) {
+      s.gyro_rad_per_s[i] = value(rng);
+      s.accel_m_per_s2[i] = value(rng);
+    }
+    MavlinkFrameOptions o;
+    o.version = Uniform(rng, 0, 3) == 0 ? 1 : 2;
+    o.signed_frame = Uniform(rng, 0, 4) == 0;
+    o.seq = Uniform(rng, 0, 255);
+    o.sysid = Uniform(rng, 0, 255);
+    const int msgid = std::vector<int>{kMavlinkMsgidHighresImu, kMavlinkMsgidScaledImu,
+                                       kMavlinkMsgidRawImu}[Uniform(rng, 0, 2)];
+    const std::string frame =
+        msgid == kMavlinkMsgidHighresImu ? EncodeHighresImu(s, 0x3F, o)
+        : msgid == kMavlinkMsgidScaledImu ? EncodeScaledImu(s, o)
+                                          : EncodeRawImu(s, MavlinkDecoderOptions(), o);
+    // The bytes the checksum covers (a signature is not checked: a cut or a flipped bit
+    // there leaves a good sample, and a cut signature takes the next bytes as its own).
+    const int checked = static_cast<int>(frame.size()) -
+                        (o.version == 2 && o.signed_frame ? 13 : 0);
+    const int kind = Uniform(rng, 0, 9);
+    if (kind <= 4) {  // a good frame
+      stream += frame;
+      s.msgid = msgid;
+      good->push_back(s);
+    } else if (kind == 5) {  // random bytes
+      for (int i = Uniform(rng, 1, 300); i > 0; --i) stream += static_cast<char>(Uniform(rng, 0, 255));
+    } else if (kind == 6) {  // a frame cut short
+      stream += frame.substr(0, Uniform(rng, 1, checked - 1));
+    } else if (kind == 7) {  // a flipped bit
+      std::string bad = frame;
+      const int bit = Uniform(rng, 8, 8 * checked - 1);
+      bad[bit / 8] = static_cast<char>(bad[bit / 8] ^ (1 << (bit % 8)));
+      stream += bad;
+    } else if (kind == 8) {  // another message, any length
+      const int length = Uniform(rng, 0, 255);
+      std::string payload;
+      for (int i = 0; i < length; ++i) payload += static_cast<char>(Uniform(rng, 0, 255));
+      const int other = Uniform(rng, 0, 1) ? Uniform(rng, 0, 25) : Uniform(rng, 200, 255);
+      stream += EncodeMavlinkFrame(other, payload, payload.size(), o);
+    } else {  // start bytes with nothing behind them
+      for (int i = Uniform(rng, 1, 20); i > 0; --i) {
+        stream += static_cast<char>(Uniform(rng, 0, 1) ? kMavlink2Magic : kMavlink1Magic);
+      }
+    }
+  }
+  stream += std::string(600, '\0');  // resolves what waits at the end
+  return stream;
+}
+
+// The decoder fed `stream` in random chunks: its samples; a failure for unbounded pending
+// bytes or a non-finite value.
+std::vector<bifilar::live::MavlinkImuSample> FeedInChunks(const std::string& stream,
+                                                          std::mt19937_64& rng,
+                                                          std::string* problem) {
+  bifilar::live::MavlinkDecoder decoder;
+  std::vector<bifilar::live::MavlinkImuSample> out;
+  for (std::size_t at = 0; at < stream.size();) {
+    const std::size_t n = static_cast<std::size_t>(Uniform(rng, 0, 3) == 0 ? 1 : Uniform(rng, 1, 4096));
+    for (const auto& s : decoder.Feed(stream.substr(at, n))) {
+      for (int i = 0; i < 3; ++i) {
+        if (!std::isfinite(s.gyro_rad_per_s[i]) || !std::isfinite(s.accel_m_per_s2[i])) {
+          *problem = "a non-finite value decoded";
+        }
+      }
+      out.push_back(s);
+    }
+    if (decoder.pending_bytes() > 2 * 281) {
+      *problem = "the decoder holds " + std::to_string(decoder.pending_bytes()) + " bytes";
+    }
+    at += n;
+  }
+  return out;
+}
+
+int RunMavlinkDecoderCases(uint64_t seed, int cases, Failures* failures) {
+  std::mt19937_64 rng(seed + 34);
+  const std::string kind = "mavlink decoder";
+  int collisions = 0;
+  for (int c = 1; c <= cases; ++c) {
+    std::vector<bifilar::live::MavlinkImuSample> good;
+    const std::string stream = MavlinkHostileStream(rng, &good);
+    std::string problem;
+    const auto got = FeedInChunks(stream, rng, &problem);
+    if (!problem.empty()) failures->Add(c, kind, problem);
+    // The good samples, in order, as a subsequence of what came out (by time and msgid).
+    std::size_t next = 0;
+    for (const auto& s : got) {
+      if (next < good.size() && s.msgid == good[next].msgid &&
+          std::abs(s.t_s - good[next].t_s) <= 1e-3 + 1e-9) {  // SCALED_IMU: whole ms
+        ++next;
+      } else {
+        ++collisions;
+      }
+    }
+    if (next != good.size()) {
+      failures->Add(c, kind, "good frame " + std::to_string(next) + " of " +
+                                 std::to_string(good.size()) + " was lost");
+    }
+  }
+  std::string noise;
+  for (int i = 0; i < (4 << 20); ++i) noise += static_cast<char>(rng() & 0xFF);
+  std::string problem;
+  collisions += static_cast<int>(FeedInChunks(noise, rng, &problem).size());
+  if (!problem.empty()) failures->Add(cases + 1, kind, problem + " (random bytes)");
+  if (collisions > 3 + cases / 500) {  // seeds 1-11, 500 cases each: 2 in all
+    failures->Add(cases + 1, kind, std::to_string(collisions) +
+                                       " samples from no good frame (checksum collisions?)");
+  }
+  std::cout << "mavlink decoder: " << cases << " hostile streams and 4 MB of noise, "
+            << collisions << " checksum collisions\n";
+  return cases + 1;
+}
+
+}  // namespace
