@@ -8,7 +8,8 @@
 #include <memory>
 #include <string>
 
-#include "pipeline/watch/watch_source.h"
+#include "pipeline/watch/sample_parser.h"
+#include "pipeline/watch/source.h"
 
 namespace bifilar {
 
