@@ -26,9 +26,11 @@ COMPONENTS = collections.OrderedDict([
     ("report", ("pipeline/report", ["store", "records", "figures", "base"])),
     ("campaign", ("pipeline/campaign", ["report", "store", "trace", "records", "config",
                                         "figures", "fit", "base"])),
-    ("commands", ("pipeline/commands", ["campaign", "trace", "records", "config", "logs",
+    ("watch", ("pipeline/watch", ["trace", "records", "config", "live", "logs", "pendulum",
+                                  "base"])),
+    ("commands", ("pipeline/commands", ["watch", "campaign", "trace", "records", "config", "logs",
                                         "figures", "fit", "pendulum", "base"])),
-    ("cli", ("pipeline/cli", ["commands", "campaign", "report", "trace", "records", "config",
+    ("cli", ("pipeline/cli", ["commands", "watch", "campaign", "report", "trace", "records", "config",
                               "logs", "fit", "base"])),
 ])
 # Clients: may include any component, but take part in the cycle check.

@@ -214,6 +214,7 @@ int RunCommandLine(int argc, char** argv) {
   RegisterSimulateCommand(app, &exit_code);
   RegisterInspectCommands(app, &exit_code);
   RegisterExportCommand(app, &exit_code);
+  RegisterWatchCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -32,6 +32,7 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code);  // `ellipse` and `
 void RegisterProcessCommands(CLI::App& app, int* exit_code);  // `process` and `report`
 void RegisterInspectCommands(CLI::App& app, int* exit_code);  // `inspect` and `init`
 void RegisterExportCommand(CLI::App& app, int* exit_code);    // `export`
+void RegisterWatchCommand(CLI::App& app, int* exit_code);     // `watch`
 
 // `plan --tensor` (pipeline/cli/cli_plan_tensor.cc): its options on the `plan` subcommand, whether
 // it was asked for (throws UserError when a tensor-only option comes without --tensor), and the

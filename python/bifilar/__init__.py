@@ -57,7 +57,7 @@ except ImportError:  # pragma: no cover - depends on the interpreter
     _np = None
 
 __all__ = ["Record", "Columns", "fit_trace", "read_log", "fit_ellipse", "fit_tensor",
-           "down_in_body", "process", "simulate"]
+           "down_in_body", "process", "simulate", "watch"]
 __version__ = _core.version
 
 
@@ -708,3 +708,58 @@ def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=No
         settings[key] = _number("simulate", key, settings[key])
     settings["seed"] = None if seed is None else _seed("simulate", seed)
     return Record(_calling([settings["spec"]], _core.simulate, **settings))
+
+
+def watch(source, config, *, save=None, target_percent=0.5, counter_rate_hz=None,
+          counter_column="count", cycles=None, stop_at_target=False, idle_end_s=None,
+          append=False, serve_port=None):
+    """Watch the moment of inertia converge while the body swings, as ``bifilar watch``.
+
+    A generator: each item is a dict, as ``bifilar watch --json`` prints one per line. An update
+    has ``t_s``, ``cycles``, ``amplitude_deg``, ``period_s``, ``inertia_kg_m2``,
+    ``inertia_std_stat_kg_m2``, ``inertia_std_total_kg_m2``, ``cycles_needed``, ``verdict``
+    (``waiting``, ``swinging``, ``enough``, ``swing_again``, ``fix_rig``) and ``reason``; an
+    event has ``event`` (a line of news: the saved file, a restart, a disconnect); the last item
+    has ``final`` True and the fit of each saved log (``logs[i].record``, the numbers
+    ``bifilar fit`` gives on it) and the input counters. Closing the generator (or Ctrl-C) stops
+    the watch; the saved log keeps every sample received.
+
+    Parameters
+    ----------
+    source : str
+        A log file being written (followed), ``"-"`` for standard input, or a transport spec
+        (``serial:DEV@BAUD``, ``ws://...``, ``mavlink:DEV@BAUD``, ``mavlink-udp:HOST:PORT``).
+    config : str
+        The config (YAML), as for ``bifilar fit``.
+    save : str, optional
+        The new CSV every sample is written to (default: time-stamped, beside the config).
+    target_percent : float
+        Target of the per-swing std of I, in % of I (default 0.5).
+    counter_rate_hz : float, optional
+        The stream carries a sample counter (``counter_column``) instead of a time, at this rate.
+    cycles : int, optional
+        End once the fit holds this many cycles.
+    stop_at_target : bool
+        End at the first ``enough``.
+    idle_end_s : float, optional
+        End when no sample came for this long (default: keep waiting).
+    append : bool
+        After a restarted stream, append to the same log (default: start a new one).
+    serve_port : int, optional
+        Also serve the live page on http://127.0.0.1:PORT/ (0: any free port).
+    """
+    run = _calling([config], _core.watch_start, _path("watch", "source", source) if source != "-" else "-",
+                   _path("watch", "config", config), _path("watch", "save", save) or "",
+                   _number("watch", "target_percent", target_percent),
+                   _number("watch", "counter_rate_hz", counter_rate_hz) or 0.0,
+                   str(counter_column), int(cycles or 0), bool(stop_at_target),
+                   _number("watch", "idle_end_s", idle_end_s) or 0.0, bool(append),
+                   -1 if serve_port is None else int(serve_port))
+    try:
+        while True:
+            item = run.next()
+            if item is None:
+                return
+            yield Record(item)
+    finally:
+        run.close()

@@ -51,6 +51,7 @@ void BindEllipse(py::module_& m);   // fit_ellipse
 void BindTensor(py::module_& m);    // fit_tensor
 void BindCampaign(py::module_& m);  // process
 void BindSimulate(py::module_& m);  // simulate
+void BindWatch(py::module_& m);     // watch (python/src/watch.cc)
 
 }  // namespace python
 }  // namespace bifilar

@@ -42,6 +42,7 @@ PYBIND11_MODULE(_core, m) {
   BindTensor(m);
   BindCampaign(m);
   BindSimulate(m);
+  BindWatch(m);
   m.attr("version") = ProgramVersion();
   // The ranges of the whole-number arguments, from the constants the C++ checks use:
   // bifilar/__init__.py refuses a value outside them by name, before a cast to int could fail

@@ -1685,6 +1685,92 @@ int Summarize(const Args& args, const Workspace& w, Clock::time_point start, dou
   return failures.count == 0 ? 0 : 1;
 }
 
+// ---- issue 34: `bifilar watch` fed bad input through standard input ----
+// A log of the campaign with garbage lines, binary bytes, NaN and infinite values, a clock that
+// jumps back, a line cut short, fed to `bifilar watch CONFIG - --json --save FILE` (the saved
+// log in the harness folder, outside the campaign). Asserted: no crash or hang, exit 0 or 1 (2
+// only with an error message: a header destroyed), every line counted (samples saved + lines
+// rejected = the data lines fed), the saved log read by `bifilar fit` without any repaired row
+// and giving the watch's final I to 1e-12.
+int RunWatchStressCases(const Args& args, const Workspace& w, int case_no, std::mt19937_64& rng,
+                        Failures* failures) {
+  int runs = 0;
+  std::vector<std::string> logs;
+  for (const auto& [path, text] : w.pristine) logs.push_back(path);
+  for (int k = 0; k < 8 && !logs.empty(); ++k, ++runs) {
+    const std::string kind = "watch bad input " + std::to_string(k);
+    std::istringstream in(w.pristine.at(logs[Uniform(rng, 0, static_cast<int>(logs.size()) - 1)]));
+    std::string fed, line;
+    long data_lines = 0;
+    bool header = false;
+    static const char* kBad[] = {"garbage here", "\x01\x02\xfe\xff", "nan,0,0,0,0,0,0",
+                                 "0,inf,0,0,0,0,0", "1,2", "-5,0,0,0,0,0,0", "{\"t\": 1}"};
+    while (std::getline(in, line)) {
+      fed += line + "\n";
+      if (line.empty() || line[0] == '#') continue;
+      if (!header) {
+        header = true;
+        continue;
+      }
+      ++data_lines;
+      if (Uniform(rng, 0, 40) == 0) {
+        fed += std::string(kBad[Uniform(rng, 0, 6)]) + "\n";
+        ++data_lines;
+      }
+    }
+    if (Uniform(rng, 0, 1) == 0) fed += "0.5,0.1,0.";  // cut short at the end (a last line)
+    const std::string input = w.harness + "/watch_in.csv", saved = w.harness + "/watch_saved.csv";
+    std::error_code ec;
+    fs::remove(saved, ec);
+    fs::remove(saved + ".rejected.txt", ec);
+    WriteFile(input, fed);
+    const Outcome o = Wait(Start({"/bin/sh", "-c", args.binary + " watch " + w.config_path +
+                                  " - --json --save " + saved + " < " + input},
+                                 w.harness + "/watch"), args.run_timeout_s);
+    if (o.timed_out || o.signal || o.exit_code < 0 || o.exit_code > 2 ||
+        (o.exit_code == 2 && o.err.find("error") == std::string::npos)) {
+      failures->Add(case_no, kind, "exit " + std::to_string(o.exit_code) + ", signal " +
+                    std::to_string(o.signal) + (o.timed_out ? ", hung" : "") + "\n" + o.err);
+      continue;
+    }
+    if (o.exit_code == 2) continue;
+    const size_t last = o.out.rfind("{\"counters\"");
+    const nlohmann::json final = nlohmann::json::parse(
+        last == std::string::npos ? std::string("{}") : o.out.substr(last, o.out.find('\n', last) - last),
+        nullptr, false);
+    if (final.is_discarded() || !final.contains("logs") || final["logs"].empty()) {
+      failures->Add(case_no, kind, "no final result line:\n" + o.out.substr(0, 2000));
+      continue;
+    }
+    const nlohmann::json& log = final["logs"][0];
+    const long counted = log["samples"].get<long>() + log["rejected"].get<long>();
+    if (counted + (fed.back() == '.' ? -1 : 0) != data_lines && counted != data_lines) {
+      failures->Add(case_no, kind, "lines fed " + std::to_string(data_lines) + ", counted " +
+                    std::to_string(counted));
+    }
+    const Outcome fit = Wait(Start({args.binary, "fit", w.config_path, saved, "--json"},
+                                   w.harness + "/watch_fit"), args.run_timeout_s);
+    const nlohmann::json records = nlohmann::json::parse(fit.out, nullptr, false);
+    if (records.is_discarded() || !records.is_array() || records.empty()) {
+      failures->Add(case_no, kind, "fit on the saved log: " + fit.err);
+      continue;
+    }
+    for (const auto& warning : records[0].value("warnings", nlohmann::json::array())) {
+      if (warning.get<std::string>().find("line") != std::string::npos) {
+        failures->Add(case_no, kind, "the saved log needed a repair: " + warning.get<std::string>());
+      }
+    }
+    const nlohmann::json& mine = log["record"]["inertia_total_kg_m2"];
+    const nlohmann::json& theirs = records[0]["inertia_total_kg_m2"];
+    if (mine.is_number() != theirs.is_number() ||
+        (mine.is_number() &&
+         std::abs(mine.get<double>() - theirs.get<double>()) > 1e-12 * std::abs(theirs.get<double>()))) {
+      failures->Add(case_no, kind, "watch's final I " + mine.dump() + " != fit's " + theirs.dump());
+    }
+  }
+  return runs;
+}
+
 }  // namespace
 
 namespace {
@@ -1728,6 +1814,7 @@ int main(int argc, char** argv) {
   }
   kinds_run["hostile input (bounded reads)"] =
       RunHostileInputCases(args, w, args.cases + 1, &failures);
+  kinds_run["watch bad input"] = RunWatchStressCases(args, w, args.cases + 2, rng, &failures);
   kinds_run["mavlink decoder (in-process)"] =
       RunMavlinkDecoderCases(args.seed, args.cases, &failures);
   kinds_run["hostile input (issue 33)"] = RunSweep4Cases(args, w, args.cases + 101, &failures);
