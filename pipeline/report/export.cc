@@ -18,6 +18,7 @@
 #include "base/option_check.h"
 #include "base/user_error.h"
 #include "base/version.h"
+#include "fit/physical_check.h"
 #include "fit/tensor.h"
 #include "pipeline/records/results_reader.h"
 #include "pipeline/records/total_uncertainty.h"
@@ -520,6 +521,15 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
   ReadExportMass(results, j, name, options, &in);
   ReadExportUncertaintyAndProvenance(results, name, options, &in);
   in.nonphysical = NonPhysical(in);
+  // The campaign's own physical check (fit/physical.h: the triangle inequalities and positive
+  // definiteness against the components' combined std) refuses what is only clearly broken
+  // within its std, not just exactly broken: the same verdict as `process` printed.
+  if (in.nonphysical.empty() && j.contains("physical") && j["physical"].is_object() &&
+      j["physical"].value("status", std::string()) ==
+          PhysicalStatusName(PhysicalStatus::kNotPhysical)) {
+    in.nonphysical = "the campaign's physical check says not physical: " +
+                     j["physical"].value("message", std::string("(no message)"));
+  }
   if (!in.nonphysical.empty()) in.warnings.push_back(name + ": " + in.nonphysical);
   return in;
 }
