@@ -223,18 +223,24 @@ TEST(SwingAxis, GravityRemovedAccelerometerIsIgnoredWithAWarning) {
 TEST(SwingAxis, AccelerometerThatDoesNotReadGravityIsIgnored) {
   const Eigen::Matrix3d mount = MountingFromRollPitchYawDeg(0, 10, 30);
   Synthetic s = MakeSynthetic(15.0, mount, true, 33);
+  // The advice names the other unit than the one declared (accel_unit_si), never the same.
   const struct {
     double scale;
     const char* says;
-  } cases[] = {{0.27, "neither gravity"},
-               {1.0 / kStandardGravityMps2, "set imu.accel.unit: g"},
-               {kStandardGravityMps2, "set imu.accel.unit: m/s^2"}};
+    double declared_unit_si;
+  } cases[] = {{0.27, "neither gravity", 1.0},
+               {1.0 / kStandardGravityMps2, "set imu.accel.unit: g", 1.0},
+               {kStandardGravityMps2, "set imu.accel.unit: m/s^2", kStandardGravityMps2},
+               {1.0 / kStandardGravityMps2, "neither gravity", kStandardGravityMps2},
+               {kStandardGravityMps2, "neither gravity", 1.0}};
   for (const auto& c : cases) {
     ImuData odd = s.data;
     for (auto& f : odd.accel_in_imu) f *= c.scale;
     SwingAxis axis;
     std::string why;
-    ASSERT_TRUE(EstimateSwingAxis(odd, SwingAxisOptions(), std::nullopt, &axis, &why)) << why;
+    SwingAxisOptions declared;
+    declared.accel_unit_si = c.declared_unit_si;
+    ASSERT_TRUE(EstimateSwingAxis(odd, declared, std::nullopt, &axis, &why)) << why;
     EXPECT_TRUE(axis.accel_ignored) << c.says;
     EXPECT_EQ(axis.source, SwingAxisSource::kGyroPrincipal) << c.says;
     EXPECT_FALSE(axis.pitch_measured_deg.has_value()) << c.says;
@@ -246,7 +252,7 @@ TEST(SwingAxis, AccelerometerThatDoesNotReadGravityIsIgnored) {
                        AngleDeg(-axis.axis_in_imu, s.down_in_imu)),
               1.0)
         << c.says;
-    SwingAxisOptions required;
+    SwingAxisOptions required = declared;
     required.accel_required = true;
     EXPECT_FALSE(EstimateSwingAxis(odd, required, std::nullopt, &axis, &why)) << c.says;
     EXPECT_NE(why.find(c.says), std::string::npos) << why;
