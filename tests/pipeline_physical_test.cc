@@ -16,6 +16,7 @@
 #include "pipeline/campaign/campaign_summary.h"
 #include "pipeline/commands/simulate_spec.h"
 #include "pipeline/config/config.h"
+#include "pipeline/report/export.h"
 #include "test_support.h"
 
 namespace bifilar {
@@ -62,6 +63,28 @@ TEST(PhysicalCampaign, OtherRigForOneAttitudeIsNotPhysical) {
   }
   const std::string html = ReadFile(dir.path + "/out/report.html");
   EXPECT_NE(html.find("<b>Not physical</b>: I_xx + I_yy - I_zz"), std::string::npos);
+  // Every simulator format refuses it with the one message (and writes nothing); --force writes.
+  std::string first_message;
+  for (ExportFormat format : {ExportFormat::kUrdf, ExportFormat::kSdf, ExportFormat::kJsbsim,
+                              ExportFormat::kMjcf, ExportFormat::kArdupilot}) {
+    ExportOptions o;
+    o.results_path = dir.path + "/out/results.json";
+    o.format = format;
+    o.symmetric = true;             // a three-axis campaign holds no products:
+    o.set_kg_m2 = {{"Ixz", 0.0}};  // Ixy, Iyz by symmetry, Ixz given
+    std::ostringstream out, err;
+    EXPECT_NE(RunExport(o, out, err), 0) << ExportFormatName(format);
+    EXPECT_EQ(out.str(), "") << ExportFormatName(format);
+    const std::string message = err.str();
+    EXPECT_NE(message.find("physical check says not physical"), std::string::npos) << message;
+    const std::string reason = message.substr(0, message.find("; not written"));
+    if (first_message.empty()) first_message = reason;
+    EXPECT_EQ(reason, first_message) << ExportFormatName(format);
+    o.force = true;
+    std::ostringstream forced_out, forced_err;
+    EXPECT_EQ(RunExport(o, forced_out, forced_err), 0) << forced_err.str();
+    EXPECT_FALSE(forced_out.str().empty());
+  }
 }
 
 TEST(PhysicalCampaign, HealthyThreeAxesArePhysical) {

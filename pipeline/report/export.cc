@@ -520,15 +520,17 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
   }
   ReadExportMass(results, j, name, options, &in);
   ReadExportUncertaintyAndProvenance(results, name, options, &in);
-  in.nonphysical = NonPhysical(in);
   // The campaign's own physical check (fit/physical.h: the triangle inequalities and positive
-  // definiteness against the components' combined std) refuses what is only clearly broken
-  // within its std, not just exactly broken: the same verdict as `process` printed.
-  if (in.nonphysical.empty() && j.contains("physical") && j["physical"].is_object() &&
+  // definiteness against the components' combined std) comes first: it refuses what is clearly
+  // broken within its std, not only exactly broken, and names the attitude that drives it, as
+  // `process` printed. Then the exact conditions on the values written.
+  if (j.contains("physical") && j["physical"].is_object() &&
       j["physical"].value("status", std::string()) ==
           PhysicalStatusName(PhysicalStatus::kNotPhysical)) {
     in.nonphysical = "the campaign's physical check says not physical: " +
                      j["physical"].value("message", std::string("(no message)"));
+  } else {
+    in.nonphysical = NonPhysical(in);
   }
   if (!in.nonphysical.empty()) in.warnings.push_back(name + ": " + in.nonphysical);
   return in;
