@@ -1,6 +1,9 @@
 // `bifilar watch` over the transports of pipeline/live/: MAVLink 2 HIGHRES_IMU frames over UDP
-// (with a frame whose checksum is wrong, counted and never a sample) and CSV text over a serial
-// port (a pseudo-terminal), each a simulated swing; the final result is `fit` on the saved log.
+// (with a frame whose checksum is wrong, counted and never a sample), CSV text over a serial
+// port (a pseudo-terminal) and the ESP32 logger's JSON over a WebSocket (a websocketpp server,
+// tests/fake_ws_logger.h), each a simulated swing; the final result is `fit` on the saved log.
+#include "tests/fake_ws_logger.h"  // first: Asio standalone (Debian libasio-dev, no Boost)
+
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <pty.h>
@@ -19,9 +22,11 @@
 #include "pipeline/commands/fit_command.h"
 #include "pipeline/commands/simulate_spec.h"
 #include "pipeline/commands/watch_command.h"
+#include "pipeline/config/config.h"
 #include "pipeline/live/mavlink.h"
 #include "pipeline/live/mavlink_writer.h"
 #include "pipeline/logs/imu_log.h"
+#include "pipeline/watch/watch_engine.h"
 #include "tests/test_support.h"
 
 namespace bifilar {
@@ -162,6 +167,126 @@ TEST(WatchLive, CsvOverASerialPort) {
   const TraceRecord fit = FitLog(config, dir.path + "/saved.csv");
   EXPECT_LE(std::abs(r.logs[0].record->inertia_total_kg_m2 - fit.inertia_total_kg_m2),
             1e-12 * fit.inertia_total_kg_m2);
+}
+
+// The ESP32 bifilar logger over a WebSocket: {"count", "ax", "ay", "az", "gyrox", "gyroy",
+// "gyroz"} per message (g, deg/s, a counter at 40 Hz and no time), sent as fast as the server can
+// (the whole swing in well under its 30 s). The watch on ws://127.0.0.1:PORT/ with
+// --counter-rate-hz 40 saves every sample (t = count / 40, the rates in rad/s), updates with the
+// documented JSON keys, and ends with `fit`'s numbers on the saved log. A logger that vanishes
+// mid-stream (no close frame, no reconnect) leaves a readable log of what it sent, fitted, and
+// an event naming the WebSocket and the lost connection.
+TEST(WatchLive, Esp32LoggerOverAWebSocketGivesFitsNumbersAndSurvivesADisconnect) {
+  TempDir dir("watch_websocket");
+  SimulateCommandOptions sim;
+  sim.trace_csv = dir.path + "/sw.csv";
+  sim.o.seed = 41;
+  sim.o.inertia_kg_m2 = 0.05;
+  sim.o.mass_kg = 2.0;
+  sim.o.length_m = 1.0;
+  sim.o.separation_m = 0.3;
+  sim.o.amplitude_deg = 15.0;
+  sim.o.duration_s = 30.0;
+  sim.sample_rate = 40.0;
+  RunSimulate(sim);
+  const ImuData data = ReadImuLog(sim.trace_csv, ImuFormat());
+  // The logger's keys and units named in the config (the watch reads a stream that has the
+  // config's columns with the config's units): the guess from the first rows cannot tell deg/s
+  // from rad/s while the body still hangs at rest.
+  const std::string config = WriteFile(
+      dir.path + "/c.yaml",
+      "rig: {filar_length_m: 1.0, filar_separation_m: 0.3, mass_kg: 2}\n"
+      "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [gyrox, gyroy, gyroz], unit: deg/s}\n"
+      "  accel: {columns: [ax, ay, az], unit: g}\n");
+  ConfigLoadOptions load;
+  load.require_runs = false;
+  const ImuFormat format = LoadCampaignConfig(config, load).imu.format;
+  std::vector<long> counts;
+  std::vector<std::string> messages;
+  for (size_t i = 0; i < data.size(); ++i) {  // the logger's counter; a dropped sample skips one
+    counts.push_back(std::lround(data.t_s[i] * 40.0));
+    messages.push_back(live::testing::LoggerMessage(static_cast<size_t>(counts.back()),
+                                                    data.accel_in_imu[i], data.gyro_in_imu[i]));
+  }
+  using live::testing::FakeLogger;
+  const auto watch = [&](const FakeLogger& logger, const std::string& save,
+                         std::vector<std::string>* events) {
+    WatchCommandOptions o;
+    o.config_path = config;
+    o.source = logger.Url("/");
+    o.counter_rate_hz = 40.0;
+    o.save_path = dir.path + "/" + save;
+    o.idle_end_s = 1.5;  // the logger is gone: the reconnects are refused, then the watch ends
+    o.on_event = [events](const std::string& e) { events->push_back(e); };
+    return RunWatch(o);
+  };
+  // The saved log (in the config's format) holds the first n samples sent: the counter's time,
+  // the rates to the logger's 0.001 deg/s.
+  const auto expect_saved = [&](const std::string& path, size_t n) {
+    const ImuData saved = ReadImuLog(path, format);
+    ASSERT_EQ(saved.size(), n) << path;
+    for (size_t i = 0; i < n; ++i) {
+      ASSERT_NEAR(saved.t_s[i], counts[i] / 40.0, 1e-12) << i;
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_NEAR(saved.gyro_in_imu[i][k], data.gyro_in_imu[i][k], 0.0006 / kDegPerRad) << i;
+      }
+    }
+  };
+
+  std::vector<std::string> events;
+  FakeLogger whole(messages, 0.0, FakeLogger::Ending::kCloseFrame, true);
+  const WatchCommandResult r = watch(whole, "saved.csv", &events);
+  ASSERT_EQ(r.logs.size(), 1u) << r.end_reason;
+  EXPECT_EQ(r.logs[0].samples, static_cast<long>(data.size()));
+  EXPECT_EQ(r.counters.Rejected(), 0) << r.counters.Text();
+  expect_saved(dir.path + "/saved.csv", data.size());
+  ASSERT_TRUE(r.logs[0].record.has_value());
+  const TraceRecord fit = FitLog(config, dir.path + "/saved.csv");
+  ASSERT_TRUE(fit.ok()) << fit.message;
+  EXPECT_LE(std::abs(r.logs[0].record->inertia_total_kg_m2 - fit.inertia_total_kg_m2),
+            1e-12 * fit.inertia_total_kg_m2);
+  EXPECT_LE(std::abs(r.logs[0].record->inertia_total_std_kg_m2 - fit.inertia_total_std_kg_m2),
+            1e-12 * fit.inertia_total_std_kg_m2);
+  EXPECT_NEAR(fit.inertia_total_kg_m2, 0.05, 5 * fit.inertia_total_std_total_kg_m2);
+  // At least one update per half-cycle (~1 s) over the 30 s, each with the documented keys; the
+  // swing is seen.
+  EXPECT_GT(r.updates.size(), 20u);
+  int swinging = 0;
+  for (const WatchUpdate& u : r.updates) {
+    const nlohmann::json j = WatchUpdateToJson(u);
+    for (const char* key : {"t_s", "cycles", "amplitude_deg", "period_s", "inertia_kg_m2",
+                            "inertia_std_stat_kg_m2", "inertia_std_total_kg_m2", "verdict",
+                            "reason"}) {
+      ASSERT_TRUE(j.contains(key)) << key << " in " << j.dump();
+    }
+    WatchVerdict verdict;
+    EXPECT_TRUE(ParseWatchVerdict(j["verdict"].get<std::string>(), &verdict)) << j.dump();
+    if (u.verdict != WatchVerdict::kWaiting) ++swinging;
+  }
+  EXPECT_GT(swinging, 5);
+
+  // The logger loses power half-way: the connection ends without a close frame.
+  const size_t half = data.size() / 2;
+  events.clear();
+  FakeLogger cut(std::vector<std::string>(messages.begin(), messages.begin() + half), 0.0,
+                 FakeLogger::Ending::kVanish, true);
+  const WatchCommandResult c = watch(cut, "cut.csv", &events);
+  ASSERT_EQ(c.logs.size(), 1u) << c.end_reason;
+  EXPECT_EQ(c.logs[0].samples, static_cast<long>(half));
+  expect_saved(dir.path + "/cut.csv", half);
+  ASSERT_TRUE(c.logs[0].record.has_value());
+  const TraceRecord cut_fit = FitLog(config, dir.path + "/cut.csv");
+  ASSERT_TRUE(cut_fit.ok()) << cut_fit.message;
+  EXPECT_LE(std::abs(c.logs[0].record->inertia_total_kg_m2 - cut_fit.inertia_total_kg_m2),
+            1e-12 * cut_fit.inertia_total_kg_m2);
+  bool said = false;
+  for (const std::string& e : events) {
+    said = said || (e.find("websocket " + cut.Url("/")) != std::string::npos &&
+                    e.find("connection lost") != std::string::npos &&
+                    e.find("keeps every sample received") != std::string::npos);
+  }
+  EXPECT_TRUE(said) << ::testing::PrintToString(events);
+  EXPECT_NE(c.end_reason.find("disconnected"), std::string::npos) << c.end_reason;
 }
 
 }  // namespace
