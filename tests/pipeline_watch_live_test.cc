@@ -196,7 +196,7 @@ TEST(WatchLive, Esp32LoggerOverAWebSocketGivesFitsNumbersAndSurvivesADisconnect)
   const std::string config = WriteFile(
       dir.path + "/c.yaml",
       "rig: {filar_length_m: 1.0, filar_separation_m: 0.3, mass_kg: 2}\n"
-      "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [gyrox, gyroy, gyroz], unit: deg/s}\n"
+      "imu:\n  gyro: {columns: [gyrox, gyroy, gyroz], unit: deg/s}\n"
       "  accel: {columns: [ax, ay, az], unit: g}\n");
   ConfigLoadOptions load;
   load.require_runs = false;
