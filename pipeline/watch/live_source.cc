@@ -62,7 +62,8 @@ class TextLiveSource : public WatchSource {
     if (!chunk.empty()) parser_.Feed(chunk, samples, rejected);
     if (!open) {
       parser_.Finish(samples, rejected);
-      *why = Describe() + ": " + *why;
+      // The source named once: a WebSocket's reason already starts with its name.
+      if (why->rfind(Describe() + ": ", 0) != 0) *why = Describe() + ": " + *why;
     }
     return open;
   }
