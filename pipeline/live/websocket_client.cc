@@ -90,7 +90,9 @@ class WebSocketStream : public MessageStream {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait_for(lock, Seconds(kHandshakeTimeoutS + 1),
                       [this] { return state_ != State::kConnecting; });
-    if (state_ == State::kOpen) return true;
+    // Opened, even when the server closed again at once: the messages it sent are read, then
+    // Next reports the close.
+    if (state_ == State::kOpen || opened_) return true;
     *error = Describe() + ": " + (why_.empty() ? "no answer to the handshake" : why_);
     return false;
   }
@@ -118,6 +120,7 @@ class WebSocketStream : public MessageStream {
   void SetState(State state, const std::string& why) {
     std::lock_guard<std::mutex> lock(mutex_);
     state_ = state;
+    if (state == State::kOpen) opened_ = true;
     if (state == State::kClosed && why_.empty()) why_ = why;
     changed_.notify_all();
   }
@@ -150,6 +153,7 @@ class WebSocketStream : public MessageStream {
   std::condition_variable changed_;
   std::deque<std::string> messages_;
   State state_ = State::kConnecting;
+  bool opened_ = false;  // the handshake completed once (guarded by mutex_)
   std::string why_;
 };
 

@@ -1,6 +1,7 @@
 #include "pipeline/watch/sample_parser.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 
@@ -119,6 +120,7 @@ void SampleParser::Restart() {
   header_.clear();
   held_.clear();
   resolved_ = false;
+  next_guess_rows_ = 0;
   index_ = 0;
   ++counters_.restarts;
 }
@@ -176,7 +178,15 @@ void SampleParser::Line(std::string line, std::vector<WatchSample>* samples,
   }
   if (!resolved_) {
     held_.emplace_back(line, cells);
-    if (static_cast<int>(held_.size()) < std::max(1, options_.rows_to_guess)) return;
+    const size_t first = static_cast<size_t>(std::max(1, options_.rows_to_guess));
+    if (held_.size() < first) return;
+    // A guess of the units waits for motion (see WatchInputOptions::rows_to_guess).
+    if (!ColumnsAreTheConfigs() && options_.guess_format &&
+        held_.size() < static_cast<size_t>(std::max(options_.max_rows_held, options_.rows_to_guess))) {
+      if (held_.size() < std::max(first, next_guess_rows_)) return;
+      next_guess_rows_ = 2 * held_.size();
+      if (!HeldRowsShowMotion()) return;
+    }
     Resolve();
     auto held = std::move(held_);
     held_.clear();
@@ -186,35 +196,86 @@ void SampleParser::Line(std::string line, std::vector<WatchSample>* samples,
   Row(line, cells, samples, rejected);
 }
 
-void SampleParser::Resolve() {
+bool SampleParser::ColumnsAreTheConfigs() const {
   const ImuFormat& config = options_.format;
-  const bool counter = options_.counter_rate_hz > 0;
-  counter_index_ = counter ? IndexOf(header_, options_.counter_column) : -1;
-  bool all = counter || IndexOf(header_, config.time_column) >= 0;
+  bool all = options_.counter_rate_hz > 0 || IndexOf(header_, config.time_column) >= 0;
   for (int k = 0; k < 3; ++k) {
     all = all && IndexOf(header_, config.gyro_columns[k]) >= 0;
     if (config.has_accel()) all = all && IndexOf(header_, config.accel_columns[k]) >= 0;
   }
+  return all;
+}
+
+// The guess reads a CSV text: the header and the rows held, with a time column made from the
+// counter when the stream has none.
+std::string SampleParser::HeldText() const {
+  const bool counter = options_.counter_rate_hz > 0;
+  std::string text = counter ? "t" : "";
+  for (size_t i = 0; i < header_.size(); ++i) text += (i || counter ? "," : "") + header_[i];
+  text += "\n";
+  for (size_t r = 0; r < held_.size(); ++r) {
+    if (counter) text += Fmt("%.9g", static_cast<double>(r) / options_.counter_rate_hz);
+    for (size_t i = 0; i < held_[r].second.size(); ++i) {
+      text += (i || counter ? "," : "") + held_[r].second[i];
+    }
+    text += "\n";
+  }
+  return text;
+}
+
+// True when the gyro columns that the guess names on the rows held show rates 20 times the
+// noise of the first rows_to_guess rows (a ratio, so true whatever the unit) in enough rows: the
+// swing has started and the unit guess can see it.
+bool SampleParser::HeldRowsShowMotion() const {
+  ImuFormat guessed;
+  std::string why;
+  if (!options_.guess_format(HeldText(), &guessed, &why)) return false;
+  int index[3];
+  for (int k = 0; k < 3; ++k) {
+    index[k] = IndexOf(header_, guessed.gyro_columns[k]);
+    if (index[k] < 0) return false;
+  }
+  const size_t first = static_cast<size_t>(std::max(1, options_.rows_to_guess));
+  double mean[3] = {0, 0, 0}, noise2 = 0.0;
+  std::vector<std::array<double, 3>> rates;
+  for (const auto& row : held_) {
+    std::array<double, 3> w{};
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) {
+      ok = ok && static_cast<size_t>(index[k]) < row.second.size() &&
+           Number(row.second[index[k]], &w[k]) && std::isfinite(w[k]);
+    }
+    if (ok) rates.push_back(w);
+  }
+  if (rates.size() < first) return false;
+  for (size_t r = 0; r < first; ++r) {
+    for (int k = 0; k < 3; ++k) mean[k] += rates[r][k] / static_cast<double>(first);
+  }
+  std::vector<double> d2(rates.size(), 0.0);
+  for (size_t r = 0; r < rates.size(); ++r) {
+    for (int k = 0; k < 3; ++k) d2[r] += (rates[r][k] - mean[k]) * (rates[r][k] - mean[k]);
+    if (r < first) noise2 += d2[r] / static_cast<double>(first);
+  }
+  // Enough of it for the guess, which reads the 99th percentile of |rate|: a tenth of the rows
+  // held, and at least rows_to_guess, move.
+  size_t moving = 0;
+  for (double v : d2) moving += v > 400.0 * noise2 && v > 0.0 ? 1 : 0;
+  return moving >= std::max(first, rates.size() / 10);
+}
+
+void SampleParser::Resolve() {
+  const ImuFormat& config = options_.format;
+  const bool counter = options_.counter_rate_hz > 0;
+  counter_index_ = counter ? IndexOf(header_, options_.counter_column) : -1;
   input_format_ = config;
   description_ = "the config's columns";
-  if (!all) {
+  if (!ColumnsAreTheConfigs()) {
     if (!options_.guess_format) {
       throw UserError("watch: the stream's columns (" + std::to_string(header_.size()) + ": " +
                       Excerpt(header_.empty() ? "" : header_[0]) +
                       ", ...) are not the config's imu columns, and no guess is available");
     }
-    // The guess reads a CSV text: the header and the rows held, with a time column made from
-    // the counter when the stream has none.
-    std::string text = counter ? "t" : "";
-    for (size_t i = 0; i < header_.size(); ++i) text += (i || counter ? "," : "") + header_[i];
-    text += "\n";
-    for (size_t r = 0; r < held_.size(); ++r) {
-      if (counter) text += Fmt("%.9g", static_cast<double>(r) / options_.counter_rate_hz);
-      for (size_t i = 0; i < held_[r].second.size(); ++i) {
-        text += (i || counter ? "," : "") + held_[r].second[i];
-      }
-      text += "\n";
-    }
+    const std::string text = HeldText();
     std::string why;
     if (!options_.guess_format(text, &input_format_, &why)) {
       throw UserError("watch: cannot tell the stream's columns: " + why);

@@ -59,7 +59,12 @@ struct WatchInputOptions {
   double counter_rate_hz = 0.0;
   std::string counter_column = "count";
   // Rows read before the columns and units are fixed (the guess looks at them). >= 1, default 25.
+  // When the config's columns are not the stream's, the units are guessed from the data, and
+  // rows of a body at rest say nothing of the unit (a gyro in deg/s at rest reads as rad/s): the
+  // rows are then held until they hold motion (a rate 20 times the first rows' noise), up to
+  // max_rows_held, and guessed again as they double.
   int rows_to_guess = 25;
+  int max_rows_held = 262144;  // (count) >= rows_to_guess
   // The format guessed from a CSV text (header + first rows): true and *format, or false and
   // *why. Empty: only the config's columns are accepted.
   std::function<bool(const std::string& text, ImuFormat* format, std::string* why)> guess_format;
@@ -99,6 +104,9 @@ class SampleParser {
             std::vector<RejectedLine>* rejected);
   bool Cells(const std::string& line, std::vector<std::string>* cells) const;
   void Resolve();
+  bool ColumnsAreTheConfigs() const;
+  std::string HeldText() const;
+  bool HeldRowsShowMotion() const;
   void Row(const std::string& line, const std::vector<std::string>& cells,
            std::vector<WatchSample>* samples, std::vector<RejectedLine>* rejected);
 
@@ -109,6 +117,7 @@ class SampleParser {
   std::vector<std::string> header_;
   std::vector<std::pair<std::string, std::vector<std::string>>> held_;  // rows before Resolve
   bool resolved_ = false;
+  size_t next_guess_rows_ = 0;  // held rows at which the motion check runs again
   ImuFormat input_format_;
   std::string description_;
   int time_index_ = -1, counter_index_ = -1;
