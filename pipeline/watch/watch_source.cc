@@ -86,7 +86,14 @@ class FollowedFile : public WatchSource {
     if (fd_ >= 0) {
       struct stat open_file {};
       ::fstat(fd_, &open_file);
-      if (open_file.st_ino != by_name.st_ino || by_name.st_size < offset_) {
+      const bool rotated = open_file.st_ino != by_name.st_ino;
+      // Rotated: the old file's rest is still readable through fd_, and a busy machine may not
+      // have read it all yet: a text log is read to its end before the new one (a binary one is
+      // re-read by name, so what it had is what was read).
+      if (rotated && binary_known_ && !binary_ && open_file.st_size > offset_) {
+        return NextText(samples, rejected, timeout_s);
+      }
+      if (rotated || by_name.st_size < offset_) {
         ::close(fd_);  // rotated (a new file under the name) or truncated: start again
         fd_ = -1;
         restarted_ = true;
