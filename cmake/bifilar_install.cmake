@@ -2,7 +2,7 @@
 # bifilar::bifilar), its public headers under include/bifilar/, the CMake package
 # (lib/cmake/bifilar: bifilarConfig.cmake, bifilarConfigVersion.cmake, bifilarTargets.cmake) and
 # the `bifilar` program. A client writes
-#   find_package(bifilar 0.3 REQUIRED)
+#   find_package(bifilar REQUIRED)
 #   target_link_libraries(app PRIVATE bifilar::fit)
 # and includes "bifilar/fit/trace_fit.h" (docs/developers.md, "The installed library").
 #

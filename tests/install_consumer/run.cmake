@@ -1,9 +1,9 @@
 # CTest install/consumer: installs this build (`cmake --install`) into a fresh prefix, then
 # configures, builds and runs tests/install_consumer against it, as a client of the package would.
 # Arguments (-D): BUILD_DIR (the build to install), WORK_DIR (emptied), CONSUMER_DIR,
-# CXX_COMPILER, CXX_LAUNCHER and CXX_FLAGS (may be empty), BUILD_TYPE. The consumer builds one
+# CXX_COMPILER, CXX_LAUNCHER and CXX_FLAGS (may be empty), BUILD_TYPE, VERSION (the project's). The consumer builds one
 # file against the installed static libraries, so this takes seconds, not a rebuild.
-foreach(var BUILD_DIR WORK_DIR CONSUMER_DIR CXX_COMPILER BUILD_TYPE)
+foreach(var BUILD_DIR WORK_DIR CONSUMER_DIR CXX_COMPILER BUILD_TYPE VERSION)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "run.cmake: -D${var}=... missing")
   endif()
@@ -44,6 +44,7 @@ if(CXX_LAUNCHER)
 endif()
 run("configuring the consumer" "${CMAKE_COMMAND}" -S "${CONSUMER_DIR}" -B "${WORK_DIR}/build"
     "-DCMAKE_PREFIX_PATH=${prefix}" "-DCMAKE_BUILD_TYPE=${BUILD_TYPE}"
+    "-DBIFILAR_EXPECTED_VERSION=${VERSION}"
     "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}" "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}" ${launcher})
 run("building the consumer" "${CMAKE_COMMAND}" --build "${WORK_DIR}/build")
 run("running the consumer" "${WORK_DIR}/build/consumer")
