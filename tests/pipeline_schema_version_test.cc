@@ -32,8 +32,9 @@ TEST(SchemaVersion, ResultsJsonAndCacheEntriesCarryIt) {
   EXPECT_EQ(results.at("schema_version"), kResultsSchemaVersion);
   EXPECT_EQ(SchemaVersionOf(results), kResultsSchemaVersion);
   EXPECT_EQ(SchemaVersionOf(json{{"version", "0.3.0"}}), 0);  // written before the number
-  EXPECT_NE(ErrorOf([] { SchemaVersionOf(json{{"schema_version", "1"}}); })
-                .find("'schema_version' is not a whole number >= 0 (\"1\")"),
+  EXPECT_NE(ErrorOf([] {
+              SchemaVersionOf(json{{"schema_version", "1"}});
+            }).find("'schema_version' is not a whole number >= 0 (\"1\")"),
             std::string::npos);
   EXPECT_NE(ErrorOf([] { SchemaVersionOf(json{{"schema_version", -1}}); }), "");
   EXPECT_NE(ErrorOf([] { SchemaVersionOf(json{{"schema_version", 1.5}}); }), "");
@@ -63,8 +64,9 @@ TEST(SchemaVersion, ReportRefusesANewerResultsJson) {
   EXPECT_FALSE(std::filesystem::exists(dir.path + "/report.html"));
   results["schema_version"] = "two";
   WriteFile(path, results.dump(1));
-  EXPECT_NE(ErrorOf([&] { RunReport(dir.path); })
-                .find(path + ": 'schema_version' is not a whole number >= 0 (\"two\")"),
+  EXPECT_NE(ErrorOf([&] {
+              RunReport(dir.path);
+            }).find(path + ": 'schema_version' is not a whole number >= 0 (\"two\")"),
             std::string::npos);
 }
 
@@ -76,8 +78,7 @@ TEST(SchemaVersion, ExportRefusesANewerResultsJson) {
     tensor[std::string(name) + "_kg_m2"] = 1.0;
     tensor[std::string(name) + "_kg_m2_std"] = 0.01;
   }
-  json results = {{"program", "bifilar"}, {"version", "9.1.0"}, {"config", ""},
-                  {"tensor", tensor}};
+  json results = {{"program", "bifilar"}, {"version", "9.1.0"}, {"config", ""}, {"tensor", tensor}};
   ExportOptions options;
   options.results_path = "in/results.json";
   options.mass_kg = 1.0;

@@ -41,8 +41,7 @@ int main() {
   const double fitted = fit.params.inertia_kg_m2;
   const double std = fit.inertia_std_kg_m2;
   std::printf("bifilar %s (results schema %d): I = %.9f +- %.9f kg m^2, truth %.9f, status %s\n",
-              ProgramVersion(), kResultsSchemaVersion, fitted, std, truth,
-              ToString(fit.status));
+              ProgramVersion(), kResultsSchemaVersion, fitted, std, truth, ToString(fit.status));
   if (fit.status != TraceFitStatus::kOk) {
     std::printf("the fit is not ok: %s\n", fit.message.c_str());
     return 1;
