@@ -1049,6 +1049,7 @@ void RunReport(const std::string& out_dir) {
   if (!results.is_object() || !results.contains("traces")) {
     throw UserError(path + ": not a bifilar results file (no 'traces')");
   }
+  CheckResultsSchema(results, path);  // a newer schema: named before any key is read
   CheckFigureNames(results, out_dir);  // before anything reads a file results.json names
   // A mixed set (a run killed between two renames) is reported, not turned into a page.
   const std::vector<std::string> problems = CheckOutputSet(out_dir, false);
