@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <limits>
 
+#include "base/csv.h"
 #include "base/enum_names.h"
 #include "base/option_check.h"
 #include "base/statistics.h"
@@ -681,12 +682,12 @@ bool ParseWindowSpec(const std::string& text, double* t0_s, double* t1_s, std::s
   if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos) {
     return fail("expected T0:T1 in seconds, e.g. 12.5:48");
   }
+  // Each side is a whole finite number (base/csv.h), white space around it allowed.
   auto parse = [](const std::string& s, double* v) {
-    if (s.empty()) return false;
-    char* end = nullptr;
-    *v = std::strtod(s.c_str(), &end);
-    while (end && (*end == ' ' || *end == '\t')) ++end;
-    return end && *end == '\0' && std::isfinite(*v);
+    const size_t b = s.find_first_not_of(" \t\n\v\f\r");
+    if (b == std::string::npos) return false;
+    const size_t e = s.find_last_not_of(" \t");
+    return e != std::string::npos && e >= b && ParseNumber(std::string_view(s).substr(b, e - b + 1), v);
   };
   double a, b;
   if (!parse(text.substr(0, colon), &a) || !parse(text.substr(colon + 1), &b)) {

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "base/csv.h"
 #include "base/statistics.h"
 #include "base/text_format.h"
 #include "base/units.h"
@@ -35,6 +36,9 @@ std::string TrimAndUnquote(const std::string& s) {
   return t;
 }
 
+// Deliberately not base/csv.h's SplitCsvRecord: the guess splits a header as the log reader does
+// (pipeline/logs/imu_log.cc, Split: runs of white space as one separator, quotes trimmed off a
+// cell, not interpreted), so that the columns it names are the ones the reader finds.
 std::vector<std::string> SplitLine(const std::string& line, char delim) {
   std::vector<std::string> out;
   if (delim == ' ') {
@@ -56,12 +60,8 @@ std::vector<std::string> SplitLine(const std::string& line, char delim) {
   return out;
 }
 
-bool IsNumber(const std::string& cell, double* value) {
-  if (cell.empty()) return false;
-  char* end = nullptr;
-  *value = std::strtod(cell.c_str(), &end);
-  return end == cell.c_str() + cell.size() && std::isfinite(*value);
-}
+// The whole cell as a finite number (base/csv.h), as the reader reads it.
+bool IsNumber(const std::string& cell, double* value) { return ParseNumber(cell, value); }
 
 bool IsCommentLine(const std::string& line) {
   const std::string t = TrimAndUnquote(line);
