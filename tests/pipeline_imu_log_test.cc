@@ -16,9 +16,12 @@
 #include "base/user_error.h"
 #include "pendulum/simulate.h"
 #include "pipeline/logs/imu_log_writer.h"
+#include "test_support.h"
 
 namespace bifilar {
 namespace {
+
+using test_support::Contains;
 
 // The UserError message of reading `text`, or "" when it reads.
 std::string ErrorOf(const std::string& text, const ImuFormat& format = ImuFormat(),
@@ -30,8 +33,6 @@ std::string ErrorOf(const std::string& text, const ImuFormat& format = ImuFormat
   }
   return "";
 }
-
-bool Contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 std::string Rows(int n, double dt = 0.01) {
   std::string s;
