@@ -142,7 +142,8 @@ class Columns:
 
     def __init__(self, columns: _typing.Mapping[str, ArrayLike]) -> None:
         """From a dict of name -> 1-D array, all of one length."""
-        self._columns: Dict[str, npt.NDArray[Any]] = {str(k): _np.asarray(v) for k, v in dict(columns).items()}
+        self._columns: Dict[str, npt.NDArray[Any]] = {
+            str(k): _np.asarray(v) for k, v in dict(columns).items()}
         lengths = {len(v) for v in self._columns.values()}
         if len(lengths) > 1:
             raise ValueError("Columns: columns of different lengths " + str(sorted(lengths)))
