@@ -38,6 +38,7 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kSource = BIFILAR_SOURCE_DIR;
+using test_support::Contains;
 using test_support::LoadFitConfig;
 using test_support::ReadFile;
 using test_support::SimulateQuadrotor;
@@ -48,10 +49,6 @@ const std::string kQuadrotorFit = test_support::QuadrotorFitConfig();
 struct TempDir : test_support::TempDir {
   TempDir() : test_support::TempDir("bifilar_glitch_settings") {}
 };
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 // Expects loading `yaml` (a fit-only config) to fail with a UserError containing every part.
 void ExpectConfigError(const TempDir& dir, const std::string& yaml,
