@@ -26,7 +26,8 @@ namespace bifilar {
 
 // The fit's options: the solver's, the quality thresholds and the amplitude sweep (the two bases,
 // fit/trace_options.h: one struct per concept, each with its table and Check), the amplitude
-// band and the uncertainty budget.
+// band and the uncertainty budget. Bases rather than members `quality` and `sweep`, so that the
+// fit's code reads `options.sweep_trend_z` as before; the config holds the same two structs.
 struct TraceFitOptions : TraceQualityOptions, AmplitudeSweepOptions {
   PendulumModel model = PendulumModel::kFull;  // Equation of motion fitted (default: full).
   // Integrator inside the fit: the integrator's default method (DOP853 with forward
