@@ -23,12 +23,15 @@ set(BIFILAR_PUBLIC_HEADERS
   base/units.h
   base/user_error.h
   base/version.h
+  base/option_check.h
+  base/option_table.h
   pendulum/model.h
   pendulum/integrator.h
   pendulum/imu_data.h
   pendulum/simulate.h
   fit/trace_input.h
   fit/trace_fit.h
+  fit/trace_options.h
   fit/trace_guess.h
   fit/trace_synth.h
   fit/window.h
