@@ -17,6 +17,7 @@
 #pragma once
 
 #include "base/units.h"
+#include "fit/distributions.h"
 #include "fit/ellipse.h"
 
 #include <chrono>
@@ -169,10 +170,10 @@ CovarianceEstimate EstimateCovariance(const PreparedData& data, const ClosedForm
 
 // --- Step 7: intervals (ellipse_intervals.cc).
 
-// Standard normal and Student-t quantiles (t: Cornish-Fisher in 1/dof; dof = inf is normal);
-// also used by the tensor fit (fit/tensor_principal.cc).
-double NormalQuantile(double p);
-double StudentQuantile(double p, double dof);
+// TEMPORARY (issue 36, until fit/tensor*.cc include fit/distributions.h themselves): the
+// tensor fit's ellipse::NormalQuantile / ellipse::StudentQuantile are the shared ones.
+using ::bifilar::NormalQuantile;
+using ::bifilar::StudentQuantile;
 
 struct Intervals {
   Vec6 lo, hi;                   // at options.confidence, the six quantities
