@@ -19,14 +19,15 @@ namespace bifilar {
 namespace {
 
 namespace bm = boost::math;
+namespace bmp = boost::math::policies;
 // Overflow gives +-inf; domain and evaluation errors give Boost's value (NaN or its best
 // estimate) instead of throwing. The inputs are checked first, so a domain error cannot occur.
-using NoThrow = bm::policies::policy<bm::policies::domain_error<bm::policies::ignore_error>,
-                                     bm::policies::overflow_error<bm::policies::ignore_error>,
-                                     bm::policies::evaluation_error<bm::policies::ignore_error>>;
+using NoThrowPolicy = bmp::policy<bmp::domain_error<bmp::ignore_error>,
+                                  bmp::overflow_error<bmp::ignore_error>,
+                                  bmp::evaluation_error<bmp::ignore_error>>;
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kDistInf = std::numeric_limits<double>::infinity();
+constexpr double kDistNaN = std::numeric_limits<double>::quiet_NaN();
 
 // True for degrees of freedom that make a distribution: positive and finite (NaN fails both).
 bool ProperDof(double dof) { return dof > 0.0 && std::isfinite(dof); }
@@ -34,31 +35,31 @@ bool ProperDof(double dof) { return dof > 0.0 && std::isfinite(dof); }
 }  // namespace
 
 double NormalQuantile(double p) {
-  if (std::isnan(p)) return kNaN;
-  if (p <= 0.0) return -kInf;
-  if (p >= 1.0) return kInf;
-  return bm::quantile(bm::normal_distribution<double, NoThrow>(0.0, 1.0), p);
+  if (std::isnan(p)) return kDistNaN;
+  if (p <= 0.0) return -kDistInf;
+  if (p >= 1.0) return kDistInf;
+  return bm::quantile(bm::normal_distribution<double, NoThrowPolicy>(0.0, 1.0), p);
 }
 
 double StudentQuantile(double p, double dof) {
   if (!ProperDof(dof)) return NormalQuantile(p);
-  if (std::isnan(p)) return kNaN;
-  if (p <= 0.0) return -kInf;
-  if (p >= 1.0) return kInf;
-  return bm::quantile(bm::students_t_distribution<double, NoThrow>(dof), p);
+  if (std::isnan(p)) return kDistNaN;
+  if (p <= 0.0) return -kDistInf;
+  if (p >= 1.0) return kDistInf;
+  return bm::quantile(bm::students_t_distribution<double, NoThrowPolicy>(dof), p);
 }
 
 double ChiSquareQuantile(double p, double dof) {
-  if (std::isnan(p)) return kNaN;
-  if (!ProperDof(dof) || p >= 1.0) return kInf;
+  if (std::isnan(p)) return kDistNaN;
+  if (!ProperDof(dof) || p >= 1.0) return kDistInf;
   if (p <= 0.0) return 0.0;
-  return bm::quantile(bm::chi_squared_distribution<double, NoThrow>(dof), p);
+  return bm::quantile(bm::chi_squared_distribution<double, NoThrowPolicy>(dof), p);
 }
 
 double ChiSquareUpperTail(double x, double dof) {
   if (!ProperDof(dof) || !(x > 0.0)) return 1.0;
   if (std::isinf(x)) return 0.0;
-  return bm::cdf(bm::complement(bm::chi_squared_distribution<double, NoThrow>(dof), x));
+  return bm::cdf(bm::complement(bm::chi_squared_distribution<double, NoThrowPolicy>(dof), x));
 }
 
 double FUpperTail(double f, double d1, double d2) {
@@ -67,9 +68,9 @@ double FUpperTail(double f, double d1, double d2) {
   if (std::isinf(d1) && std::isinf(d2)) return f < 1.0 ? 1.0 : 0.0;  // F = 1
   if (std::isinf(d2)) return ChiSquareUpperTail(d1 * f, d1);          // F = chi^2_d1 / d1
   if (std::isinf(d1)) {                                               // F = d2 / chi^2_d2
-    return bm::cdf(bm::chi_squared_distribution<double, NoThrow>(d2), d2 / f);
+    return bm::cdf(bm::chi_squared_distribution<double, NoThrowPolicy>(d2), d2 / f);
   }
-  return bm::cdf(bm::complement(bm::fisher_f_distribution<double, NoThrow>(d1, d2), f));
+  return bm::cdf(bm::complement(bm::fisher_f_distribution<double, NoThrowPolicy>(d1, d2), f));
 }
 
 }  // namespace bifilar
