@@ -270,12 +270,44 @@ bool FitTensorClosedForm(const Prepared& data, const Design& design, Solution* s
   return true;
 }
 
+// Per-orientation scatter: component k's variance is sum_i a_ki^2 (s_i^2 + e_i) (+ the common
+// offset's), a_k its row of the solution operator, s_i^2 known and e_i estimated in pool p with
+// nu_p dof. Welch-Satterthwaite: nu_k = var_k^2 / sum_p (sum_{i in p} a_ki^2 e_i)^2 / nu_p. A
+// component that only orientations without scatter feed keeps many dof (its interval ~normal),
+// one fed by an orientation whose few logs scatter gets that orientation's few.
+namespace {
+void ComponentDof(const Prepared& data, const Design& design, const Solution& s,
+                  const TensorOptions& options, Covariance* c) {
+  const Eigen::MatrixXd z = data.x * design.basis;
+  // a = basis (Z^T W Z)^-1 Z^T W: 6 x n.
+  const Eigen::MatrixXd a = design.basis * s.normal_inv * z.transpose() * data.w.asDiagonal();
+  const int pools = static_cast<int>(data.pool_dof.size());
+  const double off2 = options.common_offset_std_kg_m2 * options.common_offset_std_kg_m2;
+  for (int k = 0; k < 6; ++k) {
+    std::vector<double> estimated(pools, 0.0);
+    double variance = 0.0;
+    for (int i = 0; i < data.n; ++i) {
+      const double a2 = a(k, i) * a(k, i);
+      variance += a2 / data.w(i);
+      estimated[data.scatter_pool[i]] += a2 * std::max(0.0, data.scatter_var(i));
+    }
+    variance += off2 * c->offset_direction(k) * c->offset_direction(k);
+    double denominator = 0.0;
+    for (int p = 0; p < pools; ++p) denominator += estimated[p] * estimated[p] / data.pool_dof[p];
+    c->component_dof(k) = denominator > 0.0 ? std::max(1.0, variance * variance / denominator)
+                                            : std::numeric_limits<double>::infinity();
+  }
+}
+}  // namespace
+
 bool EstimateTensorCovariance(const Prepared& data, const Design& design, const Solution& s,
                               const TensorOptions& options, Covariance* c, std::string* why) {
   const int n = data.n, m = static_cast<int>(data.groups.size()), r = design.rank;
-  switch (data.scale_dof > 0 && data.covariance == EllipseCovariance::kPointResiduals
-              ? EllipseCovariance::kAbsolute
-              : data.covariance) {
+  const EllipseCovariance mode = data.scale_dof > 0 &&
+                                         data.covariance == EllipseCovariance::kPointResiduals
+                                     ? EllipseCovariance::kAbsolute
+                                     : data.covariance;
+  switch (mode) {
     case EllipseCovariance::kPointResiduals:
       if (n <= r) {
         *why = std::to_string(n) + " moments for " + std::to_string(r) +
@@ -314,6 +346,9 @@ bool EstimateTensorCovariance(const Prepared& data, const Design& design, const 
   }
   c->cov_gamma = s.normal_inv * c->variance_factor;
   c->cov = design.basis * c->cov_gamma * design.basis.transpose();
+  c->component_dof.setConstant(c->dof);
+  const bool per_pool = mode == EllipseCovariance::kAbsolute && data.scale_dof > 0 &&
+                        data.scatter_var.size() == n;
   // A common offset c adds c to every moment: the components answer with S 1, S the solution
   // operator (for a full design exactly (1, 1, 1, 0, 0, 0)).
   const Eigen::MatrixXd z = data.x * design.basis;
@@ -322,6 +357,8 @@ bool EstimateTensorCovariance(const Prepared& data, const Design& design, const 
   c->offset_direction = design.basis * response;
   const double off = options.common_offset_std_kg_m2;
   c->cov += off * off * c->offset_direction * c->offset_direction.transpose();
+  c->per_pool = per_pool;
+  if (per_pool) ComponentDof(data, design, s, options, c);
   return true;
 }
 
@@ -592,6 +629,21 @@ double ReweighPerOrientation(const Design& design, Prepared* data, Solution* fit
   by_group->assign(m, 0.0);
   for (int g = 0; g < m; ++g) (*by_group)[g] = std::sqrt(own[g] ? sigma2[g] : shared2);
   data->scale_dof = std::max(shared_dof, 1.0);
+  // The estimated part of each point's variance and the pool it was estimated in (pool 0: the
+  // shared one; then one per orientation with its own scatter), for the components' dof.
+  data->scatter_var = data->w.cwiseInverse() - s2;
+  data->scatter_pool.assign(data->n, 0);
+  data->pool_dof.assign(1, data->scale_dof);
+  for (int g = 0; g < m; ++g) {
+    if (!own[g]) continue;
+    double dof = 0.0;
+    const Eigen::MatrixXd z = data->x * design.basis;
+    for (int i : data->groups[g]) {
+      dof += 1.0 - data->w(i) * z.row(i) * fit->normal_inv * z.row(i).transpose();
+    }
+    data->pool_dof.push_back(std::max(dof, 1.0));
+    for (int i : data->groups[g]) data->scatter_pool[i] = static_cast<int>(data->pool_dof.size()) - 1;
+  }
   return std::sqrt(shared2);
 }
 
@@ -676,6 +728,7 @@ void FillComponents(const Design& design, const Solution& solved, const Covarian
     e.std = e.observable ? std::sqrt(std::max(0.0, cov.cov(k, k))) : kNaN;
     e.ci_lo = e.observable ? intervals.lo(k) : kNaN;
     e.ci_hi = e.observable ? intervals.hi(k) : kNaN;
+    e.dof = cov.component_dof(k);
     for (int l = 0; l < 6; ++l) {
       r.covariance[k][l] = design.observable[k] && design.observable[l] ? cov.cov(k, l) : kNaN;
     }

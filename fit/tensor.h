@@ -22,6 +22,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,9 @@ struct TensorEstimate {
   double ci_lo = 0.0;
   double ci_hi = 0.0;
   bool observable = true;
+  // Degrees of freedom of the interval (inf: normal). Per component: a component fed by an
+  // orientation whose logs scatter has that orientation's few, the others keep theirs.
+  double dof = std::numeric_limits<double>::infinity();
 };
 
 struct TensorPointResidual {

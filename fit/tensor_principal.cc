@@ -81,6 +81,21 @@ double Quantile(std::vector<double>* v, double p) {
   return (*v)[lo] + (h - lo) * ((*v)[hi] - (*v)[lo]);
 }
 
+// The replicates' intervals: components (values 0-5) and principal moments (6-8).
+void SetQuantiles(std::vector<std::vector<double>>* values, double alpha, bool principal,
+                  TensorIntervalSet* in) {
+  for (int k = 0; k < 6; ++k) {
+    in->lo(k) = Quantile(&(*values)[k], alpha / 2);
+    in->hi(k) = Quantile(&(*values)[k], 1 - alpha / 2);
+  }
+  if (principal) {
+    for (int k = 0; k < 3; ++k) {
+      in->principal_lo(k) = Quantile(&(*values)[6 + k], alpha / 2);
+      in->principal_hi(k) = Quantile(&(*values)[6 + k], 1 - alpha / 2);
+    }
+  }
+}
+
 }  // namespace
 
 Eigen::Vector3d PrincipalMoments(const Vec6& beta) {
@@ -143,6 +158,51 @@ Principal ComputePrincipal(const Vec6& beta, const Mat6& cov) {
   return p;
 }
 
+namespace {
+
+// Replicates when the scatter is estimated per orientation (Prepared::scatter_var): each point's
+// noise has its stated variance s_i^2 (known) plus its pool's estimated part, drawn with that
+// pool's dof (scaled inverse chi^2), so a component fed by a scattering orientation with few logs
+// gets its wide interval and the others keep theirs; beta* = beta + A eps, A the solution
+// operator.
+TensorIntervalSet PooledReplicates(const Prepared& data, const Design& design, const Solution& s,
+                                   const Covariance& cov, const TensorOptions& options,
+                                   bool principal, TensorIntervalSet in) {
+  const double alpha = 1.0 - options.confidence;
+  const int nb = options.bootstrap_replicates;
+  const Eigen::MatrixXd z = data.x * design.basis;
+  const Eigen::MatrixXd a = design.basis * s.normal_inv * z.transpose() * data.w.asDiagonal();
+  const Eigen::VectorXd known = data.w.cwiseInverse() - data.scatter_var;
+  std::mt19937_64 rng(options.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<std::chi_squared_distribution<double>> chi2;
+  for (double dof : data.pool_dof) chi2.emplace_back(dof);
+  std::vector<std::vector<double>> values(9, std::vector<double>(nb));
+  std::vector<double> scale(data.pool_dof.size());
+  Eigen::VectorXd eps(data.n);
+  for (int b = 0; b < nb; ++b) {
+    for (size_t p = 0; p < scale.size(); ++p) scale[p] = data.pool_dof[p] / chi2[p](rng);
+    for (int i = 0; i < data.n; ++i) {
+      const double v = std::max(0.0, known(i)) +
+                       std::max(0.0, data.scatter_var(i)) * scale[data.scatter_pool[i]];
+      eps(i) = std::sqrt(v) * normal(rng);
+    }
+    Vec6 beta = s.beta + a * eps;
+    if (options.common_offset_std_kg_m2 > 0.0) {
+      beta += cov.offset_direction * (options.common_offset_std_kg_m2 * normal(rng));
+    }
+    for (int k = 0; k < 6; ++k) values[k][b] = beta(k);
+    if (principal) {
+      const Eigen::Vector3d m = PrincipalMoments(beta);
+      for (int k = 0; k < 3; ++k) values[6 + k][b] = m(k);
+    }
+  }
+  SetQuantiles(&values, alpha, principal, &in);
+  return in;
+}
+
+}  // namespace
+
 TensorIntervalSet TensorIntervals(const Prepared& data, const Design& design, const Solution& s,
                                   const Covariance& cov, const TensorOptions& options,
                                   bool principal) {
@@ -153,19 +213,22 @@ TensorIntervalSet TensorIntervals(const Prepared& data, const Design& design, co
   in.principal_lo.setConstant(NAN);
   in.principal_hi.setConstant(NAN);
   if (nb == 0) {
-    const double t = ellipse::StudentQuantile(1 - alpha / 2, cov.dof);
     for (int k = 0; k < 6; ++k) {
+      const double t = ellipse::StudentQuantile(1 - alpha / 2, cov.component_dof(k));
       const double sd = std::sqrt(std::max(0.0, cov.cov(k, k)));
       in.lo(k) = s.beta(k) - t * sd;
       in.hi(k) = s.beta(k) + t * sd;
     }
     if (principal) {
+      // A principal moment mixes the diagonal: the fewest of their dof (conservative).
+      const double t = ellipse::StudentQuantile(1 - alpha / 2, cov.component_dof.head<3>().minCoeff());
       const Principal p = ComputePrincipal(s.beta, cov.cov);
       in.principal_lo = p.moments - t * p.moments_std;
       in.principal_hi = p.moments + t * p.moments_std;
     }
     return in;
   }
+  if (cov.per_pool) return PooledReplicates(data, design, s, cov, options, principal, in);
   // Replicates beta* = beta + (noise solved through the fit): with a scale estimated from the
   // data each replicate first draws its variance factor from the scaled inverse chi^2 of the
   // estimate; orientation-means mode draws one error per orientation, shared by its points.
@@ -212,16 +275,7 @@ TensorIntervalSet TensorIntervals(const Prepared& data, const Design& design, co
       for (int k = 0; k < 3; ++k) values[6 + k][b] = m(k);
     }
   }
-  for (int k = 0; k < 6; ++k) {
-    in.lo(k) = Quantile(&values[k], alpha / 2);
-    in.hi(k) = Quantile(&values[k], 1 - alpha / 2);
-  }
-  if (principal) {
-    for (int k = 0; k < 3; ++k) {
-      in.principal_lo(k) = Quantile(&values[6 + k], alpha / 2);
-      in.principal_hi(k) = Quantile(&values[6 + k], 1 - alpha / 2);
-    }
-  }
+  SetQuantiles(&values, alpha, principal, &in);
   return in;
 }
 

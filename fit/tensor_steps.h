@@ -17,6 +17,7 @@
 
 #include "fit/tensor.h"
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,13 @@ struct Prepared {
   // orientation's scatter, so the covariance takes them as they are (variance factor 1) with
   // `scale_dof` degrees of freedom (those of the pooled scatter). 0: not used.
   double scale_dof = 0.0;
+  // With per-orientation scatter: each point's variance 1/w is its stated s^2 (known) plus the
+  // estimated part scatter_var = sigma^2 I^2 of its pool (an orientation with a scatter of its
+  // own, or the shared pool of the others), estimated with pool_dof[scatter_pool] degrees of
+  // freedom. Empty when not used.
+  Eigen::VectorXd scatter_var;
+  std::vector<int> scatter_pool;
+  std::vector<double> pool_dof;
 };
 
 bool PrepareTensorData(const std::vector<TensorPoint>& points, const TensorOptions& options,
@@ -84,6 +92,11 @@ Solution FitTensorCeres(const Prepared& data, const Design& design, const Soluti
 
 struct Covariance {
   double variance_factor = 1.0, dof = 0.0;
+  // Each component's own degrees of freedom (Welch-Satterthwaite over the pools of estimated
+  // scatter that feed it; inf when none does); equal to `dof` unless the scatter is per
+  // orientation.
+  Vec6 component_dof = Vec6::Constant(std::numeric_limits<double>::infinity());
+  bool per_pool = false;  // component_dof from the pools of Prepared::scatter_var
   Mat6 cov = Mat6::Zero();           // of the six components, common offset included
   Eigen::MatrixXd cov_gamma;         // rank x rank, without the offset (bootstrap)
   Vec6 offset_direction = Vec6::Zero();  // the components' response to a unit common offset
@@ -110,7 +123,7 @@ Principal ComputePrincipal(const Vec6& beta, const Mat6& cov);
 Eigen::Vector3d PrincipalMoments(const Vec6& beta);
 
 struct TensorIntervalSet {
-  Vec6 lo, hi;                       // components
+  Vec6 lo = Vec6::Zero(), hi = Vec6::Zero();  // components
   Eigen::Vector3d principal_lo, principal_hi;
   int replicates = 0;
 };

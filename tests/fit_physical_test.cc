@@ -1,6 +1,7 @@
 // The physical check of fitted moments (fit/physical.h) and the tensor fit's use of it
 // (fit/tensor.h: TensorResult::physical, the orientation that drives a break, and the scatter
 // sought per orientation). Known bodies, known noise: issue 32.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
@@ -148,27 +149,42 @@ TEST(PhysicalCheck, FullTensorFitNamesTheAttitudeWhoseRemovalRestoresIt) {
   EXPECT_GT(r.physical.z_without_attitude, 0.0);
 }
 
-// Scatter where it is: the y logs scattered by 2 % beyond their 0.05 % stds widen I_yy only.
+// Scatter where it is: the y logs scattered by 2 % beyond their 0.05 % stds widen I_yy only, and
+// I_yy's interval takes the few dof of its own logs.
 // Over 60 campaigns the 95 % intervals of I_xx and I_zz cover the truth 53-60 times (binomial
 // 95 % range of 60 draws at 0.95 is 54-60; one less for the intervals' own approximations).
 TEST(PhysicalCheck, ScatterOfOneAxisWidensThatAxisAlone) {
   std::mt19937_64 rng(11);
   TensorOptions options;
   options.bootstrap_replicates = 0;
-  int covered_x = 0, covered_z = 0, n = 60;
+  int covered_x = 0, covered_y = 0, covered_z = 0, n = 60;
   double ratio_y = 0.0;
+  std::vector<double> dof_y;
   for (int k = 0; k < n; ++k) {
     TensorResult r;
     std::string why;
     ASSERT_TRUE(FitTensor(ThreeAxes(4, 5e-4, 1, 1.0, 0.02, &rng), options, &r, &why)) << why;
     covered_x += r.components[kIxx].ci_lo <= 0.2 && 0.2 <= r.components[kIxx].ci_hi;
     covered_z += r.components[kIzz].ci_lo <= 0.45 && 0.45 <= r.components[kIzz].ci_hi;
+    covered_y += r.components[kIyy].ci_lo <= 0.3 && 0.3 <= r.components[kIyy].ci_hi;
+    // Each component has the dof of its own scatter: I_yy about the 3 of its 4 scattered logs
+    // (more when they happen to agree, and their stated stds weigh in), I_xx and I_zz far more
+    // (their logs agree within their stds: the estimated part is small).
+    dof_y.push_back(r.components[kIyy].dof);
+    EXPECT_GE(r.components[kIyy].dof, 3.0) << k;
+    EXPECT_GT(r.components[kIxx].dof, 6.0) << k;
+    EXPECT_GT(r.components[kIzz].dof, 6.0) << k;
     // I_xx's std stays that of its own logs (0.05 % / sqrt(4)), within its scale's spread.
     EXPECT_LT(r.components[kIxx].std, 3.0 * 0.2 * 5e-4 / 2.0) << k;
     ratio_y += r.components[kIyy].std / (0.3 * 5e-4 / 2.0) / n;
   }
   EXPECT_GE(covered_x, 53);
   EXPECT_GE(covered_z, 53);
+  // I_yy's interval takes its 3 dof (t = 3.18, not the 6 dof of the pooled logs' 2.45): its
+  // coverage holds too.
+  EXPECT_GE(covered_y, 54);
+  std::nth_element(dof_y.begin(), dof_y.begin() + n / 2, dof_y.end());
+  EXPECT_NEAR(dof_y[n / 2], 3.0, 0.3);
   EXPECT_GT(ratio_y, 5.0);  // I_yy widened by its own scatter (2 % / 0.05 % = 40 before sqrt(4))
 }
 

@@ -237,6 +237,19 @@ TEST(ConsoleWidth, SimulatedCampaignLinesAtMost160) {
   }
 }
 
+// Every command's --help, `export`'s included (its documents on stdout are not wrapped, its help
+// is): no line over 160 characters.
+TEST(ConsoleWidth, EveryHelpAtMost160) {
+  TempDir dir("bifilar_help_width");
+  for (const char* command : {"", "process", "report", "fit", "ellipse", "plan", "simulate",
+                              "inspect", "init", "export", "watch"}) {
+    const test_support::CliRun run = Bifilar(dir, std::string(command) + " --help");
+    EXPECT_EQ(run.exit_code, 0) << command << "\n" << run.err;
+    std::string line;
+    EXPECT_LE(LongestLine(run.out, &line), 160u) << command << ":\n" << line;
+  }
+}
+
 // The same on the real quadrotor logs: `fit --repeats` over all 24 and `process` of the BaseModel
 // campaign (configs/crazyflie_basemodel.yaml).
 TEST(ConsoleWidth, RealLogsLinesAtMost160) {

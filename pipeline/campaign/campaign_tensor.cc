@@ -170,6 +170,57 @@ void PrintOwnScatter(const TensorResult& t, const CampaignResult& result, std::o
   }
 }
 
+// Per orientation: logs, the total (rig + aircraft) and aircraft moments with the mean's std
+// (stat, then total), the fit's residual.
+void PrintPerAxis(const CampaignConfig& config, const CampaignResult& result, std::ostream& out) {
+  const TensorResult& t = *result.tensor_fit;
+  const DisplayUnits units = config.units;
+  const char* unit = InertiaUnitName(units);
+  auto inertia = [&](double kg_m2) { return InertiaToDisplay(kg_m2, units); };
+  char line[320];
+  const bool rig = config.rig_inertia_given;
+  out << "Per axis (" << unit << "; mean of its logs, its std: stat, then total; the fit, the "
+         "residual over its expected scatter):\n";
+  std::snprintf(line, sizeof(line), "  %7s %7s %4s %11s %11s %9s %9s %11s %8s\n", "roll", "pitch",
+                "logs", rig ? "I_total" : "I", rig ? "I_aircraft" : "", "sd(stat)", "sd(total)",
+                "fitted", "resid/sd");
+  out << line;
+  std::vector<const TraceRecord*> usable;
+  for (const TraceRecord& r : result.traces) {
+    if (UsableAircraft(r)) usable.push_back(&r);
+  }
+  for (size_t g = 0; g < t.orientations.size(); ++g) {
+    const TensorOrientation& o = t.orientations[g];
+    double roll = NAN, pitch = NAN, rig_kg_m2 = 0.0;
+    if (g < result.tensor["orientations"].size()) {
+      const nlohmann::json& j = result.tensor["orientations"][g];
+      if (j.contains("roll_deg") && j["roll_deg"].is_number()) roll = j["roll_deg"];
+      if (j.contains("pitch_deg") && j["pitch_deg"].is_number()) pitch = j["pitch_deg"];
+    }
+    // Points are the usable aircraft traces in order: the orientation's mean rig inertia.
+    double rig_sum = 0.0;
+    for (const int i : o.members) {
+      const double v = usable[i]->rig_inertia_kg_m2;
+      rig_sum += std::isfinite(v) ? v : 0.0;
+    }
+    rig_kg_m2 = o.members.empty() ? 0.0 : rig_sum / o.members.size();
+    const int members = static_cast<int>(o.members.size());
+    char total[32] = "", aircraft[32] = "";
+    std::snprintf(total, sizeof(total), "%#11.5g", inertia(o.mean_kg_m2 + rig_kg_m2));
+    if (rig) std::snprintf(aircraft, sizeof(aircraft), "%#11.5g", inertia(o.mean_kg_m2));
+    std::snprintf(line, sizeof(line), "  %7.1f %7.1f %4d %s %11s %#9.2g %#9.2g %#11.5g %+8.2f\n",
+                  roll, pitch, members, total, aircraft, inertia(o.residual_std_kg_m2),
+                  inertia(WithCommonModeScale(o.mean_kg_m2, o.residual_std_kg_m2,
+                                                      result.common_mode_relative_std)), inertia(o.fitted_kg_m2),
+                  o.z);
+    out << line;
+  }
+  if (!rig) {
+    out << "  (no rig.inertia and no aircraft section: the moments are of everything that "
+           "hangs, rig.mass_kg)\n";
+  }
+}
+
 }  // namespace
 
 void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& result,
@@ -251,44 +302,7 @@ void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& resu
                   t.euler_deg[1].std, t.euler_deg[2].value, t.euler_deg[2].std);
     out << line;
   }
-  // Per orientation: logs, the total (rig + aircraft) and aircraft moments, the fit's residual.
-  const bool rig = config.rig_inertia_given;
-  out << "Per axis (" << unit << "; mean of its logs, the fit, the residual over its expected "
-         "scatter):\n";
-  std::snprintf(line, sizeof(line), "  %7s %7s %4s %11s %11s %11s %8s\n", "roll", "pitch", "logs",
-                rig ? "I_total" : "I", rig ? "I_aircraft" : "", "fitted", "resid/sd");
-  out << line;
-  std::vector<const TraceRecord*> usable;
-  for (const TraceRecord& r : result.traces) {
-    if (UsableAircraft(r)) usable.push_back(&r);
-  }
-  for (size_t g = 0; g < t.orientations.size(); ++g) {
-    const TensorOrientation& o = t.orientations[g];
-    double roll = NAN, pitch = NAN, rig_kg_m2 = 0.0;
-    if (g < result.tensor["orientations"].size()) {
-      const nlohmann::json& j = result.tensor["orientations"][g];
-      if (j.contains("roll_deg") && j["roll_deg"].is_number()) roll = j["roll_deg"];
-      if (j.contains("pitch_deg") && j["pitch_deg"].is_number()) pitch = j["pitch_deg"];
-    }
-    // Points are the usable aircraft traces in order: the orientation's mean rig inertia.
-    double rig_sum = 0.0;
-    for (const int i : o.members) {
-      const double v = usable[i]->rig_inertia_kg_m2;
-      rig_sum += std::isfinite(v) ? v : 0.0;
-    }
-    rig_kg_m2 = o.members.empty() ? 0.0 : rig_sum / o.members.size();
-    const int members = static_cast<int>(o.members.size());
-    char total[32] = "", aircraft[32] = "";
-    std::snprintf(total, sizeof(total), "%#11.5g", inertia(o.mean_kg_m2 + rig_kg_m2));
-    if (rig) std::snprintf(aircraft, sizeof(aircraft), "%#11.5g", inertia(o.mean_kg_m2));
-    std::snprintf(line, sizeof(line), "  %7.1f %7.1f %4d %s %11s %#11.5g %+8.2f\n", roll, pitch,
-                  members, total, aircraft, inertia(o.fitted_kg_m2), o.z);
-    out << line;
-  }
-  if (!rig) {
-    out << "  (no rig.inertia and no aircraft section: the moments are of everything that "
-           "hangs, rig.mass_kg)\n";
-  }
+  PrintPerAxis(config, result, out);
   for (const std::string& w : t.warnings) out << "  warning: " << w << "\n";
 }
 

@@ -112,8 +112,11 @@ class ConsoleWrapBuffer : public std::streambuf {
 };
 
 // Output read by programs is not wrapped: --json, and `export` (a URDF, SDF, JSBSim or CSV
-// document on stdout).
+// document on stdout); its --help is read by people.
 bool MachineReadOutput(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") return false;
+  }
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--json" || (i == 1 && arg == "export")) return true;

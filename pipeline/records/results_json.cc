@@ -625,6 +625,7 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   json j;
   j["program"] = "bifilar";
   j["version"] = ProgramVersion();
+  j["schema_version"] = kResultsSchemaVersion;
   // Relative to the working folder when below it (results do not carry the machine's layout).
   std::error_code ec;
   const std::string relative =
@@ -778,6 +779,35 @@ std::string AnglesCsv(const CampaignResult& result) {
         << Cell(a.roll_deg) << '\n';
   }
   return out.str();
+}
+
+int SchemaVersionOf(const json& document) {
+  const auto it = document.is_object() ? document.find("schema_version") : document.end();
+  if (it == document.end()) return 0;
+  if (!it->is_number_integer() || it->get<long long>() < 0 ||
+      it->get<long long>() > std::numeric_limits<int>::max()) {
+    throw UserError("'schema_version' is not a whole number >= 0 (" + it->dump() + ")");
+  }
+  return it->get<int>();
+}
+
+void CheckResultsSchema(const json& results, const std::string& name) {
+  int schema = 0;
+  try {
+    schema = SchemaVersionOf(results);
+  } catch (const UserError& e) {
+    throw UserError(name + ": " + e.what() + "; rerun `bifilar process` to rewrite it");
+  }
+  if (schema <= kResultsSchemaVersion) return;
+  const auto version = results.find("version");
+  const std::string writer = version != results.end() && version->is_string()
+                                 ? "bifilar " + version->get<std::string>()
+                                 : std::string("a bifilar of an unknown version");
+  throw UserError(name + ": results schema " + std::to_string(schema) + ", written by " + writer +
+                  "; this is bifilar " + ProgramVersion() + ", which reads schema " +
+                  std::to_string(kResultsSchemaVersion) +
+                  " and older: use that version or a newer one, or rerun `bifilar process` "
+                  "with this one to rewrite the file");
 }
 
 }  // namespace bifilar

@@ -51,6 +51,16 @@ CampaignSummary CampaignSummaryFromJson(const nlohmann::json& json, KeyLog* keys
 // The whole results.json document.
 nlohmann::json ResultsToJson(const CampaignConfig& config, const CampaignResult& result);
 
+// The "schema_version" of results.json or of a cache entry (kResultsSchemaVersion of
+// base/version.h when this bifilar wrote it): 0 when absent, as in files written before the
+// number existed. Throws UserError when it is present but not a whole number >= 0.
+int SchemaVersionOf(const nlohmann::json& document);
+
+// The schema check of a results.json reader (`report`, `export`): throws UserError naming `name`,
+// the file's schema and the version that wrote it, and this bifilar's, when the file is of a
+// newer schema than this bifilar reads. An older file is read as before (a key it lacks is named).
+void CheckResultsSchema(const nlohmann::json& results, const std::string& name);
+
 std::string TracesCsv(const CampaignResult& result);  // one row per trace
 std::string AnglesCsv(const CampaignResult& result);  // one row per pitch angle
 

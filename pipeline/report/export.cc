@@ -20,6 +20,7 @@
 #include "base/version.h"
 #include "fit/physical_check.h"
 #include "fit/tensor.h"
+#include "pipeline/records/results_json.h"
 #include "pipeline/records/results_reader.h"
 #include "pipeline/records/total_uncertainty.h"
 #include "pipeline/report/export_steps.h"
@@ -460,6 +461,7 @@ ExportInertia ReadExportInertia(const std::string& text, const std::string& name
                     ": not a results.json written by bifilar (no \"program\": "
                     "\"bifilar\"); export reads the results.json of `bifilar process`");
   }
+  CheckResultsSchema(j, name);  // a newer schema: named before any key is read
   ExportInertia in;
   in.results_name = name;
   in.value_kg_m2.fill(kNaN);

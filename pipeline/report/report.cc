@@ -703,10 +703,11 @@ void WritePrincipal(const ReportPage& p, std::ostream& h) {
 // The per-orientation residuals of the tensor fit, roll and pitch of each.
 void WriteOrientations(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
+  const double common = p.results.Get("total_uncertainty").Num("common_mode_relative_std");
   h << "<h2>Per-orientation residuals</h2>\n" << kScrollOpen
     << "<table><tr><th>#</th><th>roll (deg)</th><th>pitch (deg)</th><th>axis in body</th>"
-       "<th>logs</th><th>mean (" << u.name << ")</th><th>fitted</th><th>residual</th>"
-       "<th>residual / expected</th></tr>\n";
+       "<th>logs</th><th>mean (" << u.name << ")</th><th>std (stat)</th><th>std (total)</th>"
+       "<th>fitted</th><th>residual</th><th>residual / expected</th></tr>\n";
   int index = 0;
   for (const R& o : p.tensor.Items("orientations")) {
     const std::vector<double> axis = o.Nums("axis_in_body");
@@ -716,10 +717,13 @@ void WriteOrientations(const ReportPage& p, std::ostream& h) {
     }
     const double z = o.Num("z"), scatter = o.Num("scatter_kg_m2");
     const double d_std = scatter > 0 ? scatter : std::fabs(o.Num("residual_kg_m2"));
+    // The mean's std: its expected scatter (the weights and variance factor of the fit).
+    const double mean_std = o.Num("residual_std_kg_m2");
     h << "<tr><td>" << ++index << "</td><td>" << Fmt(o.Num("roll_deg"), "%.1f") << "</td><td>"
       << Fmt(o.Num("pitch_deg"), "%.1f") << "</td><td>" << axis_text << "</td><td>" << o.Int("n")
-      << "</td><td>" << u.Value(o.Num("mean_kg_m2"), d_std) << "</td><td>"
-      << u.Value(o.Num("fitted_kg_m2"), d_std) << "</td><td>"
+      << "</td><td>" << u.Value(o.Num("mean_kg_m2"), d_std) << "</td><td>" << u.Std(mean_std)
+      << "</td><td>" << u.Std(WithCommonModeScale(o.Num("mean_kg_m2"), mean_std, common))
+      << "</td><td>" << u.Value(o.Num("fitted_kg_m2"), d_std) << "</td><td>"
       << u.Value(o.Num("residual_kg_m2"), d_std) << "</td><td"
       << (std::fabs(z) > 3 ? " class=\"bad\"" : "") << ">" << Fmt(z, "%+.2f") << "</td></tr>\n";
   }
@@ -1045,6 +1049,7 @@ void RunReport(const std::string& out_dir) {
   if (!results.is_object() || !results.contains("traces")) {
     throw UserError(path + ": not a bifilar results file (no 'traces')");
   }
+  CheckResultsSchema(results, path);  // a newer schema: named before any key is read
   CheckFigureNames(results, out_dir);  // before anything reads a file results.json names
   // A mixed set (a run killed between two renames) is reported, not turned into a page.
   const std::vector<std::string> problems = CheckOutputSet(out_dir, false);

@@ -149,6 +149,19 @@ bool TraceCache::Load(const std::string& key, const std::string& content_hash,
       !entry.contains("record") || !entry["record"].is_object()) {
     return refuse("not a bifilar cache entry of format " + std::to_string(kFormat));
   }
+  // The record's schema (base/version.h): an older entry is a miss (refitted and overwritten),
+  // a newer one refused.
+  int schema = 0;
+  try {
+    schema = SchemaVersionOf(entry);
+  } catch (const UserError& e) {
+    return refuse(e.what());
+  }
+  if (schema < kResultsSchemaVersion) return false;
+  if (schema > kResultsSchemaVersion) {
+    return refuse("schema " + std::to_string(schema) + ", newer than this bifilar's " +
+                  std::to_string(kResultsSchemaVersion));
+  }
   auto text = [&](const char* field) {
     return entry.contains(field) && entry[field].is_string() ? entry[field].get<std::string>()
                                                              : std::string();
@@ -196,6 +209,7 @@ void TraceCache::Store(const std::string& key, const std::string& content_hash,
   entry["key"] = key;
   entry["content_hash"] = content_hash;
   entry["version"] = ProgramVersion();
+  entry["schema_version"] = kResultsSchemaVersion;
   entry["record"] = TraceRecordToJson(record, false);
   entry["checksum"] = EntryChecksum(key, content_hash, ProgramVersion(), entry["record"]);
   // Invalid UTF-8 (a log's bytes in a message) is replaced, never a json exception.

@@ -42,8 +42,9 @@ class TraceCache {
   // True and fills *record (fit fields) when the entry of `key` exists, proves it belongs to
   // `key` and `content_hash` (and this program version), its checksum matches and its values
   // are plausible (an ok record has a finite inertia > 0 and a finite std >= 0). False
-  // otherwise: *problem empty when there is no entry, else why the entry was refused (the
-  // caller refits and warns; the entry is overwritten).
+  // otherwise: *problem empty when there is no entry or it is of an older schema_version
+  // (base/version.h), else why the entry was refused (the caller refits and warns; the entry is
+  // overwritten).
   bool Load(const std::string& key, const std::string& content_hash, TraceRecord* record,
             std::string* problem) const;
   // Throws UserError when the folder cannot be written. A record whose fit was abandoned by the
