@@ -17,7 +17,6 @@
 #pragma once
 
 #include "base/units.h"
-#include "fit/distributions.h"
 #include "fit/ellipse.h"
 
 #include <chrono>
@@ -169,11 +168,6 @@ CovarianceEstimate EstimateCovariance(const PreparedData& data, const ClosedForm
                                       const Eq7Fit& ceres, const EllipseOptions& options);
 
 // --- Step 7: intervals (ellipse_intervals.cc).
-
-// TEMPORARY (issue 36, until fit/tensor*.cc include fit/distributions.h themselves): the
-// tensor fit's ellipse::NormalQuantile / ellipse::StudentQuantile are the shared ones.
-using ::bifilar::NormalQuantile;
-using ::bifilar::StudentQuantile;
 
 struct Intervals {
   Vec6 lo, hi;                   // at options.confidence, the six quantities
