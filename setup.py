@@ -115,6 +115,7 @@ setup(
     version=_version(),
     packages=["bifilar"],
     package_dir={"": "python"},
+    package_data={"bifilar": ["py.typed", "*.pyi"]},  # type hints (PEP 561)
     ext_modules=[Extension("bifilar._core", sources=[])],
     cmdclass={"build_ext": CMakeBuild},
     zip_safe=False,

@@ -30,34 +30,25 @@
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/trace/trace_process.h"
 #include "pipeline/watch/watch_engine.h"
+#include "tests/watch_support.h"
 
 namespace bifilar {
 namespace {
 
-const char kConfig[] = "rig: {filar_length_m: 1.0, filar_separation_m: 0.3, mass_kg: 2}\n";
-
+// The watch tests' rig and swing (tests/watch_support.h).
 CampaignConfig Config() {
   ConfigLoadOptions load;
   load.require_runs = false;
-  return LoadCampaignConfigText(kConfig, "/tmp/bifilar_watch_bench.yaml", load);
+  return LoadCampaignConfigText(watch_support::kSwingConfig, "/tmp/bifilar_watch_bench.yaml", load);
 }
 
 ImuData Swing(uint64_t seed, double rate_hz, double duration_s) {
   char tmpl[] = "/tmp/bifilar_watch_bench_XXXXXX";
   const std::string dir = mkdtemp(tmpl);
-  SimulateCommandOptions s;
-  s.trace_csv = dir + "/sw.csv";
-  s.o.seed = seed;
-  s.o.inertia_kg_m2 = 0.05;
-  s.o.mass_kg = 2.0;
-  s.o.length_m = 1.0;
-  s.o.separation_m = 0.3;
-  s.o.amplitude_deg = 15.0;
-  s.o.duration_s = duration_s;
-  s.sample_rate = rate_hz;
-  RunSimulate(s);
-  ImuData data = ReadImuLog(s.trace_csv, ImuFormat());
-  std::remove(s.trace_csv.c_str());
+  const std::string csv = dir + "/sw.csv";
+  watch_support::SimulateSwing(csv, {seed, duration_s, 15.0, rate_hz});
+  ImuData data = ReadImuLog(csv, ImuFormat());
+  std::remove(csv.c_str());
   std::remove((dir + "/sw.truth.json").c_str());
   rmdir(dir.c_str());
   return data;

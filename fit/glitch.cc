@@ -24,21 +24,36 @@ void Neighbours(size_t k, size_t m, size_t n, size_t idx[4]) {
 
 }  // namespace
 
+const OptionFields<GlitchOptions>& GlitchOptions::Fields() {
+  using O = GlitchOptions;
+  static const OptionFields<O> fields = {
+      {"enabled", "enabled", &O::enabled, "search for glitches"},
+      {"threshold_sigmas", "threshold_sigmas", &O::threshold_sigmas,
+       RangeIn(3, 1000, Ends::kClosed), "residual threshold (robust sigmas)"},
+      {"range_factor", "range_factor", &O::range_factor, RangeIn(1, 100, Ends::kClosed),
+       "distance beyond the neighbours' range (x that range)"},
+      {"excursion_fraction", "excursion_fraction", &O::excursion_fraction,
+       RangeIn(0, 10, Ends::kClosed), "... and beyond the series' excursion (x it)"},
+      {"max_fraction", "max_fraction", &O::max_fraction, RangeIn(0, 0.1, Ends::kOpenClosed),
+       "more glitches than this fraction of the samples: none"},
+  };
+  return fields;
+}
+
+bool GlitchOptions::Check(CheckFailure* failure) const {
+  return CheckOptionFields(*this, Fields(), failure);
+}
+
 bool GlitchOptions::Check(std::string* why) const {
   CheckFailure f;
-  const bool ok =
-      CheckFiniteGe("threshold_sigmas (0 disables the search)", threshold_sigmas, 0, &f) &&
-      CheckFiniteGe("range_factor", range_factor, 0, &f) &&
-      CheckFiniteGe("excursion_fraction", excursion_fraction, 0, &f) &&
-      CheckIn("max_fraction", max_fraction, 0, 1, Ends::kOpenClosed, &f);
-  return ok || FailWith(f, why, "glitch: ");
+  return Check(&f) || FailWith(f, why, "glitch: ");
 }
 
 std::vector<size_t> FindGlitches(const std::vector<double>& t, const std::vector<double>& x,
                                  const GlitchOptions& options) {
   std::vector<size_t> out;
   const size_t n = t.size();
-  if (options.threshold_sigmas <= 0.0 || n < 6 || x.size() != n) return out;
+  if (!options.enabled || options.threshold_sigmas <= 0.0 || n < 6 || x.size() != n) return out;
   // Normalised residual of each sample against the cubic through its neighbours.
   std::vector<double> e(n, 0.0);
   size_t idx[4];

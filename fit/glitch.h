@@ -31,23 +31,29 @@
 #include <string>
 #include <vector>
 
+#include "base/option_table.h"
 #include "pendulum/imu_data.h"
 
 namespace bifilar {
 
+// `fit.glitch` of a config: one struct, its table (config keys, bounds) and Check.
 struct GlitchOptions {
-  // Residual threshold in robust noise sigmas (dimensionless); > 0, or 0 to disable the search.
-  // Default 10: Gaussian noise exceeds it once per ~1e23 samples, so clean logs are untouched.
+  bool enabled = true;  // the search runs (before the fit and on its residuals); default true
+  // Residual threshold in robust noise sigmas (dimensionless); [3, 1000]. Default 10: Gaussian
+  // noise exceeds it once per ~1e23 samples, so clean logs are untouched. (FindGlitches also
+  // finds none at 0 or below.)
   double threshold_sigmas = 10.0;
-  // Distance beyond the neighbours' range, in units of that range (dimensionless); >= 0.
+  // Distance beyond the neighbours' range, in units of that range (dimensionless); [1, 100].
   double range_factor = 2.0;
-  // ... and in units of the series' excursion (dimensionless); >= 0.
+  // ... and in units of the series' excursion (dimensionless); [0, 10].
   double excursion_fraction = 0.5;
   // The search is skipped when more than this fraction of the samples would be glitches
-  // (dimensionless, in (0, 1]): that is not a glitch but the signal. Default 0.01.
+  // (dimensionless, in (0, 0.1]): that is not a glitch but the signal. Default 0.01.
   double max_fraction = 0.01;
 
-  bool Check(std::string* why) const;
+  static const OptionFields<GlitchOptions>& Fields();  // config key, member, bound
+  bool Check(CheckFailure* failure) const;             // the table's bounds
+  bool Check(std::string* why) const;                  // *why = "glitch: <field> = ..."
 };
 
 // Indices (increasing) of the glitches of x at times t (same size, t increasing): isolated

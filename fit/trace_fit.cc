@@ -283,21 +283,12 @@ bool TraceFitOptions::Check(std::string* why) const {
       CheckGe("max_total_iterations", max_total_iterations, 1, &f) &&
       CheckGe("max_integrator_steps", static_cast<double>(max_integrator_steps), 1, &f) &&
       CheckFiniteGt("time_guard_cpu_seconds", time_guard_cpu_seconds, 0, &f) &&
-      CheckGt("max_rms_over_noise", max_rms_over_noise, 1, &f) &&
-      CheckIn("max_residual_autocorr", max_residual_autocorr, 0, 1, Ends::kOpen, &f) &&
-      CheckGe("whiteness_lags", whiteness_lags, 1, &f) &&
-      CheckGe("max_secondary_motion_ratio", max_secondary_motion_ratio, 0, &f) &&
+      TraceQualityOptions::Check(&f) &&
       CheckGe("min_amplitude_deg", min_amplitude_deg, 0, &f) &&
       CheckGt("max_amplitude_deg", max_amplitude_deg, "min_amplitude_deg", min_amplitude_deg, &f) &&
       CheckLe("max_amplitude_deg", max_amplitude_deg, 90, &f) &&
-      CheckGe("min_periods", min_periods, 2, &f) &&
       CheckGt("refine_rms_over_noise", refine_rms_over_noise, 1, &f) &&
-      CheckGe("reject_secondary_motion_ratio", reject_secondary_motion_ratio,
-              "max_secondary_motion_ratio", max_secondary_motion_ratio, &f) &&
-      CheckIn("reject_residual_fraction", reject_residual_fraction, 0, 1, Ends::kOpenClosed, &f) &&
-      CheckIn("sweep_min_cycles_per_band", sweep_min_cycles_per_band, 1, 1000, Ends::kClosed, &f) &&
-      CheckIn("sweep_max_bands", sweep_max_bands, 2, 20, Ends::kClosed, &f) &&
-      CheckIn("sweep_trend_z", sweep_trend_z, 0, 1e3, Ends::kOpen, &f) &&
+      AmplitudeSweepOptions::Check(&f) &&
       // The budget's uncertainties (geometry, gyro scale).
       CheckFiniteGe("filar_length_std_m", filar_length_std_m, 0, &f) &&
       CheckFiniteGe("filar_separation_std_m", filar_separation_std_m, 0, &f) &&

@@ -18,12 +18,17 @@
 #include <vector>
 
 #include "fit/trace_input.h"
+#include "fit/trace_options.h"
 #include "pendulum/integrator.h"
 #include "pendulum/model.h"
 
 namespace bifilar {
 
-struct TraceFitOptions {
+// The fit's options: the solver's, the quality thresholds and the amplitude sweep (the two bases,
+// fit/trace_options.h: one struct per concept, each with its table and Check), the amplitude
+// band and the uncertainty budget. Bases rather than members `quality` and `sweep`, so that the
+// fit's code reads `options.sweep_trend_z` as before; the config holds the same two structs.
+struct TraceFitOptions : TraceQualityOptions, AmplitudeSweepOptions {
   PendulumModel model = PendulumModel::kFull;  // Equation of motion fitted (default: full).
   // Integrator inside the fit: the integrator's default method (DOP853 with forward
   // sensitivities; kCvodes gives the same answer ~10x slower) at rel_tol 1e-8, abs_tol 1e-10.
@@ -53,48 +58,13 @@ struct TraceFitOptions {
   // kError with `interrupted` true. Not owned; nullptr: never interrupted.
   const std::atomic<bool>* interrupt = nullptr;
 
-  // Quality. Three outcomes (docs/method.md, "Quality"): `rejected` only for a fit that should
-  // not be used (no oscillation, a failed fit, a fit that does not follow the data, heavy
-  // secondary motion, i.e. the wrong axis); `ok` with warnings for the statistics below, whose
-  // defaults were set on real logs (a Crazyflie rig, 30 Hz) and on simulations with coloured
-  // noise (README, "Quality checks").
-  // Warn when the residual RMS over the noise estimate exceeds this (dimensionless), > 1. Noise:
-  // TraceFitInput::noise (from the rest segment) when given, else the window's own
-  // sample-to-sample scatter (which underestimates coloured noise).
-  double max_rms_over_noise = 3.0;
-  // Warn when the largest |autocorrelation| at lags 1..whiteness_lags of the residuals,
-  // prewhitened with their own AR(1) coefficient, exceeds this (dimensionless), in (0, 1).
-  // Coloured but structureless noise prewhitens to ~1/sqrt(N); a periodic misfit or sway does
-  // not.
-  double max_residual_autocorr = 0.35;
-  int whiteness_lags = 10;  // Lags used by the whiteness statistics (count); >= 1.
-  // Energy on the other gyro axes relative to the swing axis (dimensionless, computed upstream
-  // and passed in TraceFitInput::secondary_motion_ratio); >= 0. Above the first: a warning;
-  // above the second: rejected (heavy secondary motion, or the wrong swing axis).
-  double max_secondary_motion_ratio = 0.1;
-  double reject_secondary_motion_ratio = 0.5;
-  // Rejected when the residual RMS exceeds this fraction of the swing rate's RMS: the fit does
-  // not follow the data (dimensionless), in (0, 1].
-  double reject_residual_fraction = 0.3;
-
-  // Amplitude sweep (docs/method.md, "Amplitude sweep"): after the window fit, I is refitted in
-  // successive bands of the window, each holding the same number of cycles (at least
-  // sweep_min_cycles_per_band, at most sweep_max_bands bands), with K_D and C held at the window
-  // fit. A trend of I with amplitude beyond its statistical error (|z| > sweep_trend_z for the
-  // coefficient of I_0 (1 + c A^p), p in {1, 2} chosen by the data) means the rig departs
-  // from the model: a warning, the result taken from the lowest-amplitude band with its std
-  // scaled by the bands' scatter about the trend, and a model-inadequacy term (the trend's
-  // change from that band's amplitude to zero) added to its uncertainty.
-  bool amplitude_sweep = true;
-  double sweep_min_cycles_per_band = 2.0;  // (cycles) >= 1
-  int sweep_max_bands = 6;                 // (count) >= 2
-  double sweep_trend_z = 4.0;              // (dimensionless) > 0
+  // The quality thresholds (TraceQualityOptions: max_rms_over_noise, ..., min_periods) and the
+  // amplitude sweep (AmplitudeSweepOptions: amplitude_sweep, sweep_*) are the bases of this
+  // struct, declared once in fit/trace_options.h with their table, which the config reads.
   // Amplitude band of the fitted part (deg). The window code trims the trace to the band; here
   // the fitted amplitude is checked against it: start <= max + 1 deg and end >= min - 0.5 deg.
   double max_amplitude_deg = 90.0;  // > min_amplitude_deg, <= 90.
   double min_amplitude_deg = 0.5;   // >= 0.
-  // The window must hold at least this many periods of oscillation (count); >= 2.
-  double min_periods = 2.0;
   // What the log holds beyond the fitted window (the caller's knowledge, for the advice the
   // warnings give): false when the window already runs to the end of the free swing, so that a
   // damping term at its bound is not answered with "fit a longer window" (issue 32).
@@ -126,6 +96,7 @@ struct TraceFitOptions {
     return o;
   }
 
+  // Every bound: the solver's, the bases' Checks (their tables), the band, the budget.
   bool Check(std::string* why) const;
 };
 

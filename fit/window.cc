@@ -1,3 +1,6 @@
+// The free-oscillation window of one log (fit/window.h): the noise and bias from the rest, the
+// half-cycles of the rate, the runs of free oscillation and the longest one, a user's window
+// checked (ApplyWindowOverride, ParseWindowSpec). The amplitude band is amplitude_band.cc.
 #include "fit/window.h"
 
 #include <algorithm>
@@ -6,16 +9,85 @@
 #include <cstdlib>
 #include <limits>
 
+#include "base/csv.h"
 #include "base/enum_names.h"
 #include "base/option_check.h"
 #include "base/statistics.h"
 #include "base/text_format.h"
 #include "base/units.h"
+#include "fit/window_steps.h"
 
 namespace bifilar {
-namespace {
+namespace window {
 
 std::string Prefix(const std::string& name) { return name.empty() ? "" : name + ": "; }
+
+// Half-cycles with hysteresis h on x.
+std::vector<HalfCycle> HalfCycles(const std::vector<double>& t, const std::vector<double>& x,
+                                  size_t begin, size_t end, double h) {
+  std::vector<HalfCycle> out;
+  int state = 0;
+  for (size_t i = begin; i < end; ++i) {
+    const int s = x[i] > h ? 1 : (x[i] < -h ? -1 : 0);
+    if (s != 0 && s != state) {  // a new half-cycle; its start is set below
+      HalfCycle c;
+      c.sign = s;
+      c.start_s = t[i];
+      c.peak_index = i;
+      c.peak = s * x[i];
+      c.robust_peak = -HUGE_VAL;
+      c.robust_peak_index = i;
+      out.push_back(c);
+      state = s;
+    }
+    if (!out.empty() && s == state) ++out.back().samples_beyond;
+    if (!out.empty() && state * x[i] > out.back().peak) {
+      out.back().peak = state * x[i];
+      out.back().peak_index = i;
+    }
+    if (!out.empty()) {
+      double neighbour = -HUGE_VAL;
+      if (i > begin) neighbour = std::max(neighbour, state * x[i - 1]);
+      if (i + 1 < end) neighbour = std::max(neighbour, state * x[i + 1]);
+      const double capped = std::min(state * x[i], neighbour);
+      if (capped > out.back().robust_peak) {
+        out.back().robust_peak = capped;
+        out.back().robust_peak_index = i;
+      }
+    }
+  }
+  for (HalfCycle& c : out) c.robust_peak = std::max(c.robust_peak, 0.0);
+  if (!out.empty()) {
+    out.back().end_s = t[end - 1];
+    out.back().open = true;
+  }
+  // A half-cycle starts at the last zero crossing before its peak (not before its first threshold
+  // crossing): a tremor lobe of the same sign just before the release must not stretch it.
+  for (size_t j = 0; j < out.size(); ++j) {
+    const int s = out[j].sign;
+    const size_t lo = j > 0 ? out[j - 1].peak_index : begin;
+    for (size_t k = out[j].peak_index; k > lo; --k) {
+      if (s * x[k - 1] <= 0.0) {
+        const double x0 = x[k - 1], x1 = x[k];
+        const double f = (x1 != x0) ? -x0 / (x1 - x0) : 0.0;
+        out[j].start_s = t[k - 1] + std::clamp(f, 0.0, 1.0) * (t[k] - t[k - 1]);
+        break;
+      }
+    }
+    if (j > 0) out[j - 1].end_s = out[j].start_s;
+  }
+  return out;
+}
+
+size_t FirstAtOrAfter(const std::vector<double>& t, double t0) {
+  return std::lower_bound(t.begin(), t.end(), t0) - t.begin();
+}
+size_t LastAtOrBefore(const std::vector<double>& t, double t1) {
+  const size_t e = std::upper_bound(t.begin(), t.end(), t1) - t.begin();
+  return e == 0 ? 0 : e - 1;
+}
+
+namespace {
 
 // A window [first, last] of samples with a gap (a step between two samples) longer than
 // max_gap_periods periods cannot be fitted as one swing: the phase across it is not observed
@@ -42,22 +114,6 @@ bool GapFree(const std::vector<double>& t, size_t first, size_t last, double per
   return false;
 }
 
-// One half-cycle of x = rate - bias between zero crossings (with hysteresis).
-struct HalfCycle {
-  int sign = 0;
-  double start_s = 0.0;  // interpolated zero crossing where it begins
-  double end_s = 0.0;    // where the next begins (or the last sample time when open)
-  size_t peak_index = 0;
-  double peak = 0.0;     // max sign * x
-  bool open = false;     // the log ended before it did
-  double max_gap_s = 0.0;  // longest time step between samples inside it (dropped packets)
-  size_t samples_beyond = 0;  // samples with sign * x above the hysteresis threshold
-  // max sign * x over samples capped at their larger neighbour: one glitch sample cannot raise it
-  double robust_peak = 0.0;
-  size_t robust_peak_index = 0;
-  double duration() const { return end_s - start_s; }
-};
-
 // Noise, bias and half-cycles of a series.
 struct Analysis {
   double sigma = 0.0;
@@ -71,6 +127,7 @@ struct Analysis {
 };
 
 }  // namespace
+}  // namespace window
 
 double NeighbourCubicResidual(const std::vector<double>& t, const std::vector<double>& x, size_t k,
                               const size_t idx[4]) {
@@ -86,6 +143,7 @@ double NeighbourCubicResidual(const std::vector<double>& t, const std::vector<do
   return (x[k] - pred) / std::sqrt(1.0 + w2);
 }
 
+namespace window {
 namespace {
 
 // Noise of a smooth signal sampled at irregular times: each sample is predicted by the cubic
@@ -167,108 +225,6 @@ void FindRest(const std::vector<double>& t, const std::vector<double>& r, double
   a->rest_samples = static_cast<int>(rest_end);
 }
 
-// Half-cycles with hysteresis h on x.
-std::vector<HalfCycle> HalfCycles(const std::vector<double>& t, const std::vector<double>& x,
-                                  size_t begin, size_t end, double h) {
-  std::vector<HalfCycle> out;
-  int state = 0;
-  for (size_t i = begin; i < end; ++i) {
-    const int s = x[i] > h ? 1 : (x[i] < -h ? -1 : 0);
-    if (s != 0 && s != state) {  // a new half-cycle; its start is set below
-      HalfCycle c;
-      c.sign = s;
-      c.start_s = t[i];
-      c.peak_index = i;
-      c.peak = s * x[i];
-      c.robust_peak = -HUGE_VAL;
-      c.robust_peak_index = i;
-      out.push_back(c);
-      state = s;
-    }
-    if (!out.empty() && s == state) ++out.back().samples_beyond;
-    if (!out.empty() && state * x[i] > out.back().peak) {
-      out.back().peak = state * x[i];
-      out.back().peak_index = i;
-    }
-    if (!out.empty()) {
-      double neighbour = -HUGE_VAL;
-      if (i > begin) neighbour = std::max(neighbour, state * x[i - 1]);
-      if (i + 1 < end) neighbour = std::max(neighbour, state * x[i + 1]);
-      const double capped = std::min(state * x[i], neighbour);
-      if (capped > out.back().robust_peak) {
-        out.back().robust_peak = capped;
-        out.back().robust_peak_index = i;
-      }
-    }
-  }
-  for (HalfCycle& c : out) c.robust_peak = std::max(c.robust_peak, 0.0);
-  if (!out.empty()) {
-    out.back().end_s = t[end - 1];
-    out.back().open = true;
-  }
-  // A half-cycle starts at the last zero crossing before its peak (not before its first threshold
-  // crossing): a tremor lobe of the same sign just before the release must not stretch it.
-  for (size_t j = 0; j < out.size(); ++j) {
-    const int s = out[j].sign;
-    const size_t lo = j > 0 ? out[j - 1].peak_index : begin;
-    for (size_t k = out[j].peak_index; k > lo; --k) {
-      if (s * x[k - 1] <= 0.0) {
-        const double x0 = x[k - 1], x1 = x[k];
-        const double f = (x1 != x0) ? -x0 / (x1 - x0) : 0.0;
-        out[j].start_s = t[k - 1] + std::clamp(f, 0.0, 1.0) * (t[k] - t[k - 1]);
-        break;
-      }
-    }
-    if (j > 0) out[j - 1].end_s = out[j].start_s;
-  }
-  return out;
-}
-
-// A glitch sample of the other sign (one reading, too small for fit/glitch.h, e.g. 0.4 rad/s on
-// a 1 rad/s swing just after a long timestamp gap) splits a half-cycle in three: two pieces of
-// the same sign around a one-sample half-cycle. Such a blip (closed, a single sample beyond the
-// hysteresis, shorter than `blip_max_s`) is merged with its neighbours into one half-cycle when
-// `accept(joined, before, after, outer_before, outer_after)` says the joined one is a half-cycle
-// the pieces are not (the outer half-cycles around them, null at the ends, tell a swing from hand
-// tremor). A real swing half-cycle holds many samples (>= 10 at 30 Hz for the shortest period in
-// range), so only hand tremor and glitches make blips.
-template <typename Accept>
-std::vector<HalfCycle> MergeGlitchSplits(const std::vector<HalfCycle>& cycles, double blip_max_s,
-                                         Accept accept) {
-  std::vector<HalfCycle> out;
-  out.reserve(cycles.size());
-  for (size_t j = 0; j < cycles.size(); ++j) {
-    const HalfCycle& blip = cycles[j];
-    if (!out.empty() && j + 1 < cycles.size() && !blip.open && blip.samples_beyond == 1 &&
-        blip.duration() < blip_max_s) {
-      const HalfCycle& before = out.back();
-      const HalfCycle& after = cycles[j + 1];
-      HalfCycle joined = before;
-      joined.end_s = after.end_s;
-      joined.open = after.open;
-      joined.max_gap_s = std::max({before.max_gap_s, blip.max_gap_s, after.max_gap_s});
-      joined.samples_beyond = before.samples_beyond + after.samples_beyond;
-      if (after.peak > joined.peak) {
-        joined.peak = after.peak;
-        joined.peak_index = after.peak_index;
-      }
-      if (after.robust_peak > joined.robust_peak) {
-        joined.robust_peak = after.robust_peak;
-        joined.robust_peak_index = after.robust_peak_index;
-      }
-      const HalfCycle* outer_before = out.size() >= 2 ? &out[out.size() - 2] : nullptr;
-      const HalfCycle* outer_after = j + 2 < cycles.size() ? &cycles[j + 2] : nullptr;
-      if (accept(joined, before, after, outer_before, outer_after)) {
-        out.back() = joined;
-        ++j;  // `after` is inside `joined`
-        continue;
-      }
-    }
-    out.push_back(blip);
-  }
-  return out;
-}
-
 // Noise, bias, x and half-cycles of the whole series.
 bool Analyse(const std::vector<double>& t, const std::vector<double>& r, const WindowOptions& o,
              const std::string& name, Analysis* a, FreeOscillationWindow* w) {
@@ -342,14 +298,6 @@ double HalfPeriod(const std::vector<HalfCycle>& cycles, double min_peak, const W
   return Median(near);
 }
 
-size_t FirstAtOrAfter(const std::vector<double>& t, double t0) {
-  return std::lower_bound(t.begin(), t.end(), t0) - t.begin();
-}
-size_t LastAtOrBefore(const std::vector<double>& t, double t1) {
-  const size_t e = std::upper_bound(t.begin(), t.end(), t1) - t.begin();
-  return e == 0 ? 0 : e - 1;
-}
-
 void FillPeaks(const Analysis& a, FreeOscillationWindow* w) {
   bool first = true;
   for (const auto& c : a.cycles) {
@@ -362,6 +310,7 @@ void FillPeaks(const Analysis& a, FreeOscillationWindow* w) {
 }
 
 }  // namespace
+}  // namespace window
 
 constexpr EnumName<WindowStatus> kWindowStatusNames[] = {{WindowStatus::kOk, "ok"},
                                                          {WindowStatus::kRejected, "rejected"},
@@ -400,6 +349,7 @@ std::string FreeOscillationWindow::BriefReport() const {
          (noise_from_rest ? " (rest)" : " (no rest: high-frequency estimate)");
 }
 
+namespace window {
 namespace {
 
 // What a free half-cycle looks like at this half period and noise floor.
@@ -600,10 +550,12 @@ std::string TooShortMessage(const std::vector<double>& t, const std::vector<Half
 }
 
 }  // namespace
+}  // namespace window
 
 FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
                                                 const std::vector<double>& r,
                                                 const WindowOptions& o, const std::string& name) {
+  using namespace window;  // the shared steps (window_steps.h)
   FreeOscillationWindow w;
   Analysis a;
   if (!Analyse(t, r, o, name, &a, &w)) return w;
@@ -665,6 +617,7 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
 FreeOscillationWindow ApplyWindowOverride(const std::vector<double>& t,
                                           const std::vector<double>& r, double t0_s, double t1_s,
                                           const WindowOptions& o, const std::string& name) {
+  using namespace window;  // the shared steps (window_steps.h)
   FreeOscillationWindow w;
   w.overridden = true;
   w.end_reason = WindowEnd::kOverride;
@@ -729,12 +682,12 @@ bool ParseWindowSpec(const std::string& text, double* t0_s, double* t1_s, std::s
   if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos) {
     return fail("expected T0:T1 in seconds, e.g. 12.5:48");
   }
+  // Each side is a whole finite number (base/csv.h), white space around it allowed.
   auto parse = [](const std::string& s, double* v) {
-    if (s.empty()) return false;
-    char* end = nullptr;
-    *v = std::strtod(s.c_str(), &end);
-    while (end && (*end == ' ' || *end == '\t')) ++end;
-    return end && *end == '\0' && std::isfinite(*v);
+    const size_t b = s.find_first_not_of(" \t\n\v\f\r");
+    if (b == std::string::npos) return false;
+    const size_t e = s.find_last_not_of(" \t");
+    return e != std::string::npos && e >= b && ParseNumber(std::string_view(s).substr(b, e - b + 1), v);
   };
   double a, b;
   if (!parse(text.substr(0, colon), &a) || !parse(text.substr(colon + 1), &b)) {
@@ -744,131 +697,6 @@ bool ParseWindowSpec(const std::string& text, double* t0_s, double* t1_s, std::s
   *t0_s = a;
   *t1_s = b;
   return true;
-}
-
-// ---- Amplitude ----
-
-std::vector<AngleExtreme> AngleExtremes(const std::vector<double>& t, const std::vector<double>& r,
-                                        const FreeOscillationWindow& w) {
-  std::vector<AngleExtreme> out;
-  if (t.size() != r.size() || t.empty() || w.last_index >= t.size() || w.last_index <= w.first_index) return out;
-  const size_t b = w.first_index, e = w.last_index + 1;
-  std::vector<double> x(t.size(), 0.0);
-  for (size_t k = b; k < e; ++k) x[k] = r[k] - w.rest_bias_rad_per_s;
-  // Cumulative trapezoid angle.
-  std::vector<double> psi(t.size(), 0.0);
-  for (size_t k = b + 1; k < e; ++k) psi[k] = psi[k - 1] + 0.5 * (x[k] + x[k - 1]) * (t[k] - t[k - 1]);
-  double range = 0.0;
-  for (size_t k = b; k < e; ++k) range = std::max(range, std::abs(x[k]));
-  const double h = std::max(4.0 * w.noise_sigma_rad_per_s, 1e-6 * range);
-  std::vector<HalfCycle> cycles = HalfCycles(t, x, b, e, h);
-  // A glitch that splits a half-cycle (MergeGlitchSplits) would add two false extremes.
-  if (w.period_s > 0.0) {
-    const double half = 0.5 * w.period_s;
-    const double tol = WindowOptions().half_period_tolerance;
-    cycles = MergeGlitchSplits(cycles, WindowOptions().blip_fraction * half,
-                               [&](const HalfCycle&, const HalfCycle& before, const HalfCycle& after,
-                                   const HalfCycle*, const HalfCycle*) {
-                                 return before.duration() < (1.0 - tol) * half ||
-                                        after.duration() < (1.0 - tol) * half;
-                               });
-  }
-  // Angle at each interior zero crossing (start of every half-cycle but the first).
-  std::vector<std::pair<double, double>> ext;  // (t, psi)
-  for (size_t j = 1; j < cycles.size(); ++j) {
-    const double tc = cycles[j].start_s;
-    size_t k = std::upper_bound(t.begin() + b, t.begin() + e, tc) - t.begin();
-    if (k <= b || k >= e) continue;
-    const double f = (tc - t[k - 1]) / (t[k] - t[k - 1]);
-    ext.emplace_back(tc, psi[k - 1] + f * (psi[k] - psi[k - 1]));
-  }
-  if (ext.size() < 2) return out;
-  for (size_t j = 0; j < ext.size(); ++j) {
-    double ref;
-    if (j == 0) ref = ext[1].second;
-    else if (j + 1 == ext.size()) ref = ext[j - 1].second;
-    else ref = 0.5 * (ext[j - 1].second + ext[j + 1].second);
-    out.push_back({ext[j].first, 0.5 * std::abs(ext[j].second - ref) * kDegPerRad});
-  }
-  // The end extremes have one neighbour, so the value above is the mean of two successive
-  // extremes; with four or more, extrapolate the decay geometrically from the interior ones.
-  const size_t m = out.size();
-  if (m >= 4) {
-    auto extrapolate = [](double a1, double a2) { return a2 > 0.0 ? a1 * a1 / a2 : a1; };
-    out[0].amplitude_deg = extrapolate(out[1].amplitude_deg, out[2].amplitude_deg);
-    out[m - 1].amplitude_deg = extrapolate(out[m - 2].amplitude_deg, out[m - 3].amplitude_deg);
-  }
-  return out;
-}
-
-bool AmplitudeBandOptions::Check(std::string* why) const {
-  CheckFailure f;
-  const bool ok =
-      CheckGe("min_amplitude_deg", min_amplitude_deg, 0, &f) &&
-      CheckGt("max_amplitude_deg", max_amplitude_deg, "min_amplitude_deg", min_amplitude_deg, &f) &&
-      CheckGt("min_periods", min_periods, 0, &f);
-  return ok || FailWith(f, why, "amplitude band: ");
-}
-
-AmplitudeBand TrimToAmplitudeBand(const std::vector<double>& t, const std::vector<double>& r,
-                                  const FreeOscillationWindow& w, const AmplitudeBandOptions& o,
-                                  const std::string& name) {
-  AmplitudeBand band;
-  std::string why;
-  if (!o.Check(&why)) {
-    band.status = WindowStatus::kError;
-    band.message = Prefix(name) + why;
-    return band;
-  }
-  if (!w.IsUsable()) {
-    band.status = w.status;
-    band.message = w.message;
-    return band;
-  }
-  band.extremes = AngleExtremes(t, r, w);
-  const auto& ex = band.extremes;
-  if (ex.empty()) {
-    band.message = Prefix(name) + "amplitude: fewer than two swing extremes inside the window";
-    return band;
-  }
-  size_t first = 0, end = ex.size();
-  while (first < ex.size() && ex[first].amplitude_deg > o.max_amplitude_deg) ++first;
-  while (end > 0 && ex[end - 1].amplitude_deg < o.min_amplitude_deg) --end;
-  if (first >= end) {
-    band.message = Prefix(name) +
-                   Fmt("amplitude from %.2f to %.2f deg never inside the band [%g, %g] deg",
-                       ex.front().amplitude_deg, ex.back().amplitude_deg, o.min_amplitude_deg,
-                       o.max_amplitude_deg) +
-                   (ex.back().amplitude_deg > o.max_amplitude_deg
-                        ? " (twist less, log longer, or widen fit.max_amplitude_deg)"
-                        : " (twist more, or lower fit.min_amplitude_deg)");
-    return band;
-  }
-  const size_t last = end - 1;
-  band.t0_s = w.t0_s;
-  band.t1_s = w.t1_s;
-  if (first > 0) {
-    band.t0_s = ex[first].t_s;
-    band.trimmed_start = true;
-  }
-  if (last + 1 < ex.size()) {
-    band.t1_s = ex[last].t_s;
-    band.trimmed_end = true;
-  }
-  band.amplitude_start_deg = ex[first].amplitude_deg;
-  band.amplitude_end_deg = ex[last].amplitude_deg;
-  band.first_index = FirstAtOrAfter(t, band.t0_s);
-  band.last_index = LastAtOrBefore(t, band.t1_s);
-  if (band.t1_s - band.t0_s < o.min_periods * w.period_s) {
-    band.message = Prefix(name) +
-                   Fmt("only %.2f periods inside the amplitude band [%g, %g] deg", (band.t1_s - band.t0_s) / w.period_s,
-                       o.min_amplitude_deg, o.max_amplitude_deg) +
-                   Fmt(" (amplitude %.2f to %.2f deg over the window)", ex.front().amplitude_deg,
-                       ex.back().amplitude_deg);
-    return band;
-  }
-  band.status = WindowStatus::kOk;
-  return band;
 }
 
 }  // namespace bifilar

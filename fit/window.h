@@ -1,5 +1,6 @@
 // The free-oscillation window of one log, found on the swing rate (fit/swing_axis.h), its noise
-// and bias from the rest segment, and the amplitude band (issue 3 items 3 and 4).
+// and bias from the rest segment (window.cc), and the amplitude band (amplitude_band.cc; issue 3
+// items 3 and 4).
 //
 // A log (docs/physics.md §2): rest, a hand twisting and holding (with tremor), release, free
 // oscillation (a decaying near-sinusoid), and an end: the log ends, the amplitude sinks into the

@@ -1,4 +1,5 @@
-// Realistic bifilar-pendulum IMU logs with known truth: one trace or a whole campaign.
+// Realistic bifilar-pendulum IMU logs with known truth: one trace (simulate.cc) or a whole
+// campaign (simulate_campaign.cc).
 // Physics and IMU synthesis only (no files, no YAML): pipeline/commands/simulate_spec.h reads the
 // spec and writes the files.
 //

@@ -1,5 +1,8 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds everything, and runs the whole test suite (what CI runs):
+#   0. the format: every tracked *.cc and *.h as .clang-format says (scripts/check_format.sh,
+#      once setup.sh has installed clang-format and built; `scripts/check_format.sh --fix`
+#      formats them), else it stops there, before any test;
 #   1. the build, with any compiler warning in bifilar's own code an error (BIFILAR_WERROR);
 #   2. every test (ctest), the real-data ones on ../shared/data when it is beside the checkout
 #      (or on $BIFILAR_DATA_DIR), and a line saying how many real-data tests did not run and why;
@@ -24,6 +27,7 @@ data="${BIFILAR_DATA_DIR:-}"
 if [ -z "$data" ] && [ -d "$here/../shared/data" ]; then data="$(cd "$here/../shared/data" && pwd)"; fi
 if [ -n "$data" ]; then cmake_args="$cmake_args -DBIFILAR_DATA_DIR=$data"; fi
 BIFILAR_CMAKE_ARGS="$cmake_args" "$here/scripts/setup.sh" "$here/build"
+"$here/scripts/check_format.sh"
 
 cd "$here/build"
 log="$here/build/Testing/test_sh_ctest.log"

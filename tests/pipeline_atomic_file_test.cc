@@ -12,9 +12,12 @@
 
 #include "base/atomic_file.h"
 #include "base/user_error.h"
+#include "test_support.h"
 
 namespace bifilar {
 namespace {
+
+using test_support::ReadFile;
 
 namespace fs = std::filesystem;
 
@@ -27,13 +30,6 @@ struct TempDir {
   ~TempDir() { fs::remove_all(path); }
   fs::path path;
 };
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // The message of the UserError `fn` throws ("" when it throws none).
 template <typename Fn>

@@ -22,12 +22,9 @@ namespace bifilar {
 namespace {
 
 namespace fs = std::filesystem;
+using test_support::Contains;
 using test_support::TempDir;
 using test_support::WriteFile;
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 using test_support::ErrorOf;
 

@@ -204,8 +204,9 @@ TEST(Calibration, CacheKeyHoldsTheCalibratedGeometry) {
   EXPECT_NE(plain, applied);
   EXPECT_NE(applied, with_std);
   EXPECT_NE(with_std, other_factor);
-  // Uncalibrated keys are those of earlier versions: no calibration text in them.
-  EXPECT_EQ(plain.find("calibration"), std::string::npos);
+  // The key is the canonical text of the options (cache format 3): an uncalibrated key says so.
+  EXPECT_NE(plain.find("calibration=none;"), std::string::npos) << plain;
+  EXPECT_NE(applied.find("calibration=applied;"), std::string::npos) << applied;
 }
 
 TEST(Calibration, GivenRigInertiaIsUsedAsIs) {

@@ -17,9 +17,13 @@
 #include "base/user_error.h"
 #include "pipeline/campaign/rig_inertia.h"
 #include "pipeline/commands/simulate_spec.h"
+#include "test_support.h"
 
 namespace bifilar {
 namespace {
+
+using test_support::ReadFile;
+using test_support::WriteFile;
 
 namespace fs = std::filesystem;
 
@@ -39,18 +43,6 @@ double Truth(double pitch_deg) {
 std::string TempDir() {
   char tmpl[] = "/tmp/bifilar_campaign_test_XXXXXX";
   return mkdtemp(tmpl);
-}
-
-void WriteFile(const std::string& path, const std::string& text) {
-  fs::create_directories(fs::path(path).parent_path());
-  std::ofstream(path) << text;
-}
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 // A fake campaign: logs whose content is "I=<total inertia>".

@@ -342,9 +342,9 @@ TEST(ConfigCheck, FailureNamesFieldValueAndBound) {
   FitConfig fit;
   CheckFailure failure;
   EXPECT_TRUE(fit.Check(&failure));
-  fit.sweep.max_bands = 50;
+  fit.sweep.sweep_max_bands = 50;
   ASSERT_FALSE(fit.Check(&failure));
-  EXPECT_EQ(failure.field, "sweep.max_bands");
+  EXPECT_EQ(failure.field, "amplitude_sweep.max_bands");  // the YAML key below `fit`
   EXPECT_EQ(failure.value, 50);
   EXPECT_EQ(failure.allowed, "in [2, 20]");
   std::string why;

@@ -22,13 +22,10 @@ namespace bifilar {
 namespace {
 
 using test_support::Bifilar;
+using test_support::Contains;
 using test_support::ReadFile;
 using test_support::TempDir;
 using test_support::WriteFile;
-
-bool Contains(const std::string& s, const std::string& part) {
-  return s.find(part) != std::string::npos;
-}
 
 std::string ErrorOf(const std::string& bytes, const std::string& name,
                     const ImuLogOptions& options = ImuLogOptions()) {

@@ -228,5 +228,27 @@ TEST(EllipseTable, ParsesUnitsCommentsAndWhitespace) {
                UserError);
 }
 
+// The table's cells are split by base/csv.h (RFC 4180): a spreadsheet that quotes every cell
+// gives the same points as one that quotes none (the old splitter kept the quotes: "not a
+// number"), and a quoted comma stays inside its cell.
+TEST(EllipseTable, QuotedCellsAreReadAsRfc4180Says) {
+  const auto plain = ParseEllipseTable("pitch_deg,inertia\n-10,2.5\n20,2.6\n", "t.csv",
+                                       DisplayUnits::kSi);
+  const auto quoted = ParseEllipseTable(
+      "\"pitch_deg\",\"inertia\"\r\n\"-10\",\"2.5\"\r\n\"20\",\"2.6\"\r\n", "t.csv",
+      DisplayUnits::kSi);
+  ASSERT_EQ(quoted.size(), plain.size());
+  for (size_t i = 0; i < plain.size(); ++i) {
+    EXPECT_EQ(quoted[i].pitch_deg, plain[i].pitch_deg);
+    EXPECT_EQ(quoted[i].inertia_kg_m2, plain[i].inertia_kg_m2);
+  }
+  try {
+    ParseEllipseTable("pitch_deg,inertia\n\"1,5\",2.5\n", "t.csv", DisplayUnits::kSi);
+    FAIL() << "a cell '1,5' is no number";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("'1,5' is not a number"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace bifilar

@@ -91,7 +91,7 @@ TEST(GlitchRuns, RealCrazyflieLogsLoseNoSample) {
     if (entry.path().extension() != ".csv") continue;
     ++logs;
     const ImuData data = ReadImuLog(entry.path().string(), config.imu.format);
-    EXPECT_EQ(FindGyroGlitches(data, config.fit.glitch.Options()).size(), 0u) << entry.path();
+    EXPECT_EQ(FindGyroGlitches(data, config.fit.glitch).size(), 0u) << entry.path();
   }
   EXPECT_EQ(logs, 24);
 }

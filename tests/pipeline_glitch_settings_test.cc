@@ -38,6 +38,7 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kSource = BIFILAR_SOURCE_DIR;
+using test_support::Contains;
 using test_support::LoadFitConfig;
 using test_support::ReadFile;
 using test_support::SimulateQuadrotor;
@@ -48,10 +49,6 @@ const std::string kQuadrotorFit = test_support::QuadrotorFitConfig();
 struct TempDir : test_support::TempDir {
   TempDir() : test_support::TempDir("bifilar_glitch_settings") {}
 };
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 // Expects loading `yaml` (a fit-only config) to fail with a UserError containing every part.
 void ExpectConfigError(const TempDir& dir, const std::string& yaml,
@@ -73,8 +70,9 @@ TEST(GlitchSettings, ConfigKeysAreReadAndRangesChecked) {
   // Defaults: those of fit/glitch.h.
   const CampaignConfig d = LoadFitConfig(WriteFile(dir.path + "/d.yaml", base));
   EXPECT_TRUE(d.fit.glitch.enabled);
-  EXPECT_TRUE(d.fit.glitch.IsDefault());
-  EXPECT_DOUBLE_EQ(d.fit.glitch.Options().threshold_sigmas, GlitchOptions().threshold_sigmas);
+  for (const OptionField<GlitchOptions>& row : GlitchOptions::Fields()) {
+    EXPECT_EQ(row.Value(d.fit.glitch), row.Value(GlitchOptions())) << row.key;
+  }
   // Every key read.
   const CampaignConfig c = LoadFitConfig(WriteFile(
       dir.path + "/c.yaml",
@@ -85,7 +83,14 @@ TEST(GlitchSettings, ConfigKeysAreReadAndRangesChecked) {
   EXPECT_DOUBLE_EQ(c.fit.glitch.range_factor, 3.0);
   EXPECT_DOUBLE_EQ(c.fit.glitch.excursion_fraction, 0.25);
   EXPECT_DOUBLE_EQ(c.fit.glitch.max_fraction, 0.02);
-  EXPECT_EQ(c.fit.glitch.Options().threshold_sigmas, 0.0);  // disabled: the detector finds none
+  // Disabled: the detector finds none of the spikes it finds with the defaults.
+  std::vector<double> t, x;
+  for (int k = 0; k < 200; ++k) {
+    t.push_back(0.01 * k);
+    x.push_back(std::sin(0.2 * k) + (k == 100 ? 50.0 : 0.0));
+  }
+  EXPECT_EQ(FindGlitches(t, x, d.fit.glitch), std::vector<size_t>{100});
+  EXPECT_TRUE(FindGlitches(t, x, c.fit.glitch).empty());
   // Out of range: file, line (`fit:` is line 7) and key.
   ExpectConfigError(dir, base + "fit:\n  glitch:\n    threshold_sigmas: 2\n",
                     {"fit.glitch.threshold_sigmas = 2; must be in [3, 1000]", ":9:"});
@@ -103,9 +108,9 @@ TEST(GlitchSettings, ConfigKeysAreReadAndRangesChecked) {
   std::string why;
   EXPECT_FALSE(code.Check(&why));
   EXPECT_EQ(why, "fit.glitch.max_fraction = 0.5; must be in (0, 0.1]");
-  // Cache key: unchanged by default settings (entries of 0.2.0 stay valid), changed otherwise.
+  // Cache key: every glitch setting is in it, from the options' table.
   const std::string key_default = FitFingerprint(d, TraceRole::kAircraft, std::nullopt);
-  EXPECT_FALSE(Contains(key_default, "glitch")) << key_default;
+  EXPECT_TRUE(Contains(key_default, "fit.glitch.enabled=true;")) << key_default;
   CampaignConfig off = d;
   off.fit.glitch.enabled = false;
   CampaignConfig stricter = d;

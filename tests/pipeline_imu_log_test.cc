@@ -16,9 +16,12 @@
 #include "base/user_error.h"
 #include "pendulum/simulate.h"
 #include "pipeline/logs/imu_log_writer.h"
+#include "test_support.h"
 
 namespace bifilar {
 namespace {
+
+using test_support::Contains;
 
 // The UserError message of reading `text`, or "" when it reads.
 std::string ErrorOf(const std::string& text, const ImuFormat& format = ImuFormat(),
@@ -30,8 +33,6 @@ std::string ErrorOf(const std::string& text, const ImuFormat& format = ImuFormat
   }
   return "";
 }
-
-bool Contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 std::string Rows(int n, double dt = 0.01) {
   std::string s;
@@ -326,7 +327,21 @@ TEST_F(ImuLogFiles, GzipLogsReadLikePlainOnes) {
   const std::string text = kHeader + Rows(200);
   const std::string plain = Write("plain.csv", text);
   const std::string gz = Write("packed.csv.gz", GzipCompress(text));
-  EXPECT_EQ(GzipCompress(text), GzipCompress(text));  // same text, same bytes
+  // Reproducible: a gzip header (RFC 1952) with no name and no time, so the same text gives
+  // the same bytes on any day: ID1 ID2 CM (1f 8b 08), FLG 0 (no FNAME), MTIME (bytes 4..7) 0.
+  const std::string packed = GzipCompress(text);
+  ASSERT_GE(packed.size(), 18u);  // a 10-byte header and an 8-byte trailer at least
+  EXPECT_EQ(static_cast<unsigned char>(packed[0]), 0x1f);
+  EXPECT_EQ(static_cast<unsigned char>(packed[1]), 0x8b);
+  EXPECT_EQ(static_cast<unsigned char>(packed[2]), 8);  // deflate
+  EXPECT_EQ(static_cast<unsigned char>(packed[3]), 0) << "FLG: no file name, comment, extra";
+  for (int i = 4; i < 8; ++i) EXPECT_EQ(packed[i], '\0') << "MTIME byte " << i;
+  EXPECT_LT(packed.size(), text.size());  // it compresses
+  // And it is gzip: inflating gives the text back.
+  std::string unpacked, why;
+  ASSERT_TRUE(GzipDecompress(packed, &unpacked, &why, InputCap{kMaxConfigBytes, "test", ""}))
+      << why;
+  EXPECT_EQ(unpacked, text);
   const ImuData a = ReadImuLog(plain, ImuFormat());
   const ImuData b = ReadImuLog(gz, ImuFormat());
   ASSERT_EQ(a.size(), b.size());
@@ -342,7 +357,6 @@ TEST_F(ImuLogFiles, GzipLogsReadLikePlainOnes) {
   EXPECT_TRUE(LooksGzipped(head));
   EXPECT_EQ(ReadImuLog(written, ImuFormat()).size(), a.size());
   // Truncated in the middle of the stream.
-  const std::string packed = GzipCompress(text);
   const std::string cut = Write("cut.csv.gz", packed.substr(0, packed.size() / 2));
   const std::string e = ErrorOfFile(cut);
   EXPECT_TRUE(Contains(e, cut + ": not a valid gzip file")) << e;

@@ -22,13 +22,10 @@
 namespace bifilar {
 namespace {
 
+using test_support::Contains;
 using test_support::ReadFile;
 using test_support::TempDir;
 using test_support::WriteFile;
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 // The sample rig of pipeline_inspect_test: L 2.0 m, D 1.8 m, 6.75 kg, I 4 kg m^2 (period 2.42 s),
 // released at `amplitude_deg`, sampled at `rate_hz`.

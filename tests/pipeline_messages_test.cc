@@ -18,9 +18,13 @@
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/commands/ellipse_table.h"
 #include "pipeline/config/config.h"
+#include "test_support.h"
 
 namespace bifilar {
 namespace {
+
+using test_support::ReadFile;
+using test_support::WriteFile;
 
 namespace fs = std::filesystem;
 
@@ -35,18 +39,6 @@ struct TempDir {
     fs::remove_all(path, ec);
   }
 };
-
-void WriteFile(const std::string& path, const std::string& text) {
-  fs::create_directories(fs::path(path).parent_path());
-  std::ofstream(path, std::ios::binary) << text;
-}
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // Runs bifilar; returns the exit code, *output gets stdout and stderr.
 int Cli(const TempDir& dir, const std::string& args, std::string* output) {

@@ -23,23 +23,15 @@
 #include "base/user_error.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/report/report.h"
+#include "test_support.h"
 
 namespace bifilar {
 namespace {
 
+using test_support::ReadFile;
+using test_support::WriteFile;
+
 namespace fs = std::filesystem;
-
-void WriteFile(const std::string& path, const std::string& text) {
-  fs::create_directories(fs::path(path).parent_path());
-  std::ofstream(path) << text;
-}
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // Six angles, two trials each, of I(theta) = 3 cos^2 + 2 sin^2 + 0.1 sin 2theta plus a 0.5 rig.
 struct Campaign {

@@ -22,6 +22,7 @@
 namespace bifilar {
 namespace {
 
+using test_support::Contains;
 using test_support::LoadFitConfig;
 using test_support::QuadrotorFitConfig;
 using test_support::ReadFile;
@@ -29,10 +30,6 @@ using test_support::TempDir;
 using test_support::WriteFile;
 
 const std::string kSource = BIFILAR_SOURCE_DIR;
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 // The message of loading `yaml` as a `bifilar fit` config ("" when it loads).
 std::string FitConfigError(const TempDir& dir, const std::string& yaml) {

@@ -17,23 +17,15 @@
 #include "base/user_error.h"
 #include "pipeline/campaign/campaign.h"
 #include "pipeline/figures/figure.h"
+#include "test_support.h"
 
 namespace bifilar {
 namespace {
 
+using test_support::ReadFile;
+using test_support::WriteFile;
+
 namespace fs = std::filesystem;
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void WriteFile(const std::string& path, const std::string& text) {
-  fs::create_directories(fs::path(path).parent_path());
-  std::ofstream(path) << text;
-}
 
 TEST(Report, Base64MatchesRfc4648Vectors) {
   EXPECT_EQ(Base64(""), "");

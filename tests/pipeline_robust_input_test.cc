@@ -25,6 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kSource = BIFILAR_SOURCE_DIR;
+using test_support::Contains;
 using test_support::LoadFitConfig;
 using test_support::ReadFile;
 using test_support::SimulateQuadrotor;
@@ -43,10 +44,6 @@ int Cli(const TempDir& dir, const std::string& args, std::string* output) {
       std::system((std::string(BIFILAR_BINARY) + " " + args + " > " + log + " 2>&1").c_str());
   *output = ReadFile(log);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
 }
 
 std::string GlitchWarning(const TraceRecord& r) {

@@ -26,13 +26,10 @@
 namespace bifilar {
 namespace {
 
+using test_support::Contains;
 using test_support::ReadFile;
 using test_support::TempDir;
 using test_support::WriteFile;
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 std::string ErrorOf(const std::function<void()>& fn) {
   try {

@@ -25,14 +25,9 @@
 namespace bifilar {
 namespace {
 
-namespace fs = std::filesystem;
+using test_support::ReadFile;
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::stringstream ss;
-  ss << file.rdbuf();
-  return ss.str();
-}
+namespace fs = std::filesystem;
 
 fs::path TempDir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() /
@@ -172,19 +167,19 @@ TEST(SimulateCampaign, SameSeedSameBytesAndTruthConsistent) {
                                           "tare/tare_1.csv", "truth.json"};
   for (const auto& f : files) {
     ASSERT_TRUE(fs::exists(a / f)) << f;
-    EXPECT_EQ(ReadText(a / f), ReadText(b / f)) << f;
-    EXPECT_NE(ReadText(a / f), ReadText(c / f)) << f;
+    EXPECT_EQ(ReadFile(a / f), ReadFile(b / f)) << f;
+    EXPECT_NE(ReadFile(a / f), ReadFile(c / f)) << f;
   }
   // The mark of a simulated log with its seed (pipeline/logs/simulated_log.h), then the header in the
   // spec's format; no temporary files left behind.
   const std::string head =
       SimulatedCsvMarkerLine(SimulatedLogOrigin(spec.seed)) + "\nt,wx,wy,wz,ax,ay,az\n";
-  EXPECT_EQ(ReadText(a / files[0]).substr(0, head.size()), head);
+  EXPECT_EQ(ReadFile(a / files[0]).substr(0, head.size()), head);
   for (const auto& entry : fs::recursive_directory_iterator(a)) {
     EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
   }
 
-  const nlohmann::json truth = nlohmann::json::parse(ReadText(a / "truth.json"));
+  const nlohmann::json truth = nlohmann::json::parse(ReadFile(a / "truth.json"));
   const auto& ac = truth["aircraft"];
   const double ix = ac["ix_kg_m2"], iz = ac["iz_kg_m2"], ixz = ac["ixz_kg_m2"];
   EXPECT_NEAR(ix, 2.3596 * kKgM2PerSlugFt2, 1e-12);
@@ -205,7 +200,7 @@ TEST(SimulateCampaign, SameSeedSameBytesAndTruthConsistent) {
     EXPECT_NEAR(t["inertia_total_kg_m2"].get<double>(), expected + rig, 1e-12);
     EXPECT_NEAR(t["mass_kg"].get<double>(), 6.75, 1e-12);
     // The CSV rows and the truth agree; the release lies inside the log.
-    const std::string csv = ReadText(a / t["file"].get<std::string>());
+    const std::string csv = ReadFile(a / t["file"].get<std::string>());
     const long rows = std::count(csv.begin(), csv.end(), '\n') - 2;  // the mark and the header
     EXPECT_EQ(rows, t["samples"].get<long>());
     EXPECT_GT(t["t_release_s"].get<double>(), t["t_twist_s"].get<double>());
@@ -247,13 +242,13 @@ TEST(SimulateCli, EndToEnd) {
   EXPECT_TRUE(fs::exists(dir / "out/pitch_60/trial_2.csv"));
   EXPECT_TRUE(fs::exists(dir / "out/tare/tare_1.csv"));
   EXPECT_TRUE(fs::exists(dir / "out/truth.json"));
-  EXPECT_EQ(nlohmann::json::parse(ReadText(dir / "out/truth.json"))["seed"].get<int>(), 3);
+  EXPECT_EQ(nlohmann::json::parse(ReadFile(dir / "out/truth.json"))["seed"].get<int>(), 3);
 
   const std::string trace = (dir / "one.csv").string();
   EXPECT_EQ(RunCli("simulate --trace " + trace + " --inertia-kg-m2 4.1 --mass-kg 6.75 -L 2 -D 1.8 "
                    "--amplitude-deg 15 --duration-s 10 --seed 9"), 0);
   EXPECT_TRUE(fs::exists(trace));
-  const nlohmann::json truth = nlohmann::json::parse(ReadText(dir / "one.truth.json"));
+  const nlohmann::json truth = nlohmann::json::parse(ReadFile(dir / "one.truth.json"));
   EXPECT_NEAR(truth["traces"][0]["amplitude_deg"].get<double>(), 15.0, 1e-12);
   EXPECT_NEAR(truth["traces"][0]["inertia_total_kg_m2"].get<double>(), 4.1, 1e-15);
 
@@ -275,7 +270,6 @@ TEST(SimulateCli, EndToEnd) {
   fs::remove_all(dir);
 }
 
-
 // ---- Realism keys, footer, presets (issue 8) and output targets (issue 9) -------------------
 
 // Runs the CLI with stderr captured; returns the exit code, *err the message.
@@ -284,7 +278,7 @@ int RunCliCapture(const std::string& args, const fs::path& dir, std::string* err
   const std::string command =
       std::string(BIFILAR_BINARY) + " " + args + " >/dev/null 2>" + err_file.string();
   const int status = std::system(command.c_str());
-  *err = ReadText(err_file);
+  *err = ReadFile(err_file);
   fs::remove(err_file);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
@@ -356,7 +350,7 @@ TEST(SimulateTrace, FooterFollowsUnchangedData) {
   RunSimulateTrace(spec, (dir / "plain.csv").string());
   spec.footer = true;
   RunSimulateTrace(spec, (dir / "footer.csv").string());
-  const std::string plain = ReadText(dir / "plain.csv"), footer = ReadText(dir / "footer.csv");
+  const std::string plain = ReadFile(dir / "plain.csv"), footer = ReadFile(dir / "footer.csv");
   ASSERT_GT(footer.size(), plain.size());
   EXPECT_EQ(footer.substr(0, plain.size()), plain);  // the data before the footer is unchanged
   const std::string tail = footer.substr(plain.size());
@@ -381,14 +375,14 @@ TEST(SimulateTrace, FooterFollowsUnchangedData) {
   EXPECT_EQ(cells[0][0], "");
   EXPECT_EQ(cells[1][6], "Flip Data");
   EXPECT_EQ(cells[2][6], "Impact Data");
-  const nlohmann::json truth = nlohmann::json::parse(ReadText(dir / "footer.truth.json"));
+  const nlohmann::json truth = nlohmann::json::parse(ReadFile(dir / "footer.truth.json"));
   const auto& t = truth["traces"][0];
   EXPECT_NEAR(std::stod(cells[1][0]), 1e3 * (t["t_release_s"].get<double>() - t["start_time_s"].get<double>()), 1e-2);
   EXPECT_LT(std::stod(cells[1][0]), last_time_ms);
   EXPECT_EQ(std::stod(cells[2][0]), 0.0);
   EXPECT_EQ(t["footer_rows"].get<int>(), 4);
   EXPECT_TRUE(truth["options"]["format"]["footer"].get<bool>());
-  EXPECT_FALSE(nlohmann::json::parse(ReadText(dir / "plain.truth.json"))["options"]["format"].contains("footer"));
+  EXPECT_FALSE(nlohmann::json::parse(ReadFile(dir / "plain.truth.json"))["options"]["format"].contains("footer"));
   fs::remove_all(dir);
 }
 
@@ -440,7 +434,7 @@ TEST(SimulateCli, RefusesTargetsThatAreNotRegularFilesOrTheSameFile) {
   // Nothing was written: the FIFO is still a FIFO, the link still a link, no new files.
   EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir / "null_link")));
-  EXPECT_EQ(ReadText(dir / "c.csv"), "mine\n");
+  EXPECT_EQ(ReadFile(dir / "c.csv"), "mine\n");
   for (const char* name : {"a.csv", "b.csv", "a.truth.json", "b.truth.json", "nosuch"}) {
     EXPECT_FALSE(fs::exists(dir / name)) << name;
   }
@@ -472,7 +466,7 @@ TEST(SimulateCli, SampleRateFlagNamesWhatTheUserSet) {
   // set. The default jitter now follows the rate (at most 10 % of a sample period).
   EXPECT_EQ(RunCliCapture("simulate --trace " + (dir / "fast.csv").string() + good +
                               " --sample-rate-hz 2000", dir, &err), 0) << err;
-  const nlohmann::json truth = nlohmann::json::parse(ReadText(dir / "fast.truth.json"));
+  const nlohmann::json truth = nlohmann::json::parse(ReadFile(dir / "fast.truth.json"));
   EXPECT_EQ(truth["options"]["sensor"]["sample_rate_hz"].get<double>(), 2000);
   EXPECT_NEAR(truth["options"]["sensor"]["time_jitter_sigma_s"].get<double>(), 0.1 / 2000, 1e-18);
   // At 100 Hz and below the default stays 1 ms (the same bytes as before).
@@ -548,7 +542,7 @@ TEST(SimulatePresets, QuadrotorLooksLikeTheCrazyflieLogs) {
   const fs::path dir = TempDir("quadrotor");
   const SimulateRunSummary summary = RunSimulateCampaign(spec, dir.string());
   EXPECT_EQ(summary.files_written, 8);
-  const nlohmann::json truth = nlohmann::json::parse(ReadText(dir / "truth.json"));
+  const nlohmann::json truth = nlohmann::json::parse(ReadFile(dir / "truth.json"));
   std::vector<std::vector<double>> simulated;
   for (const auto& t : truth["traces"]) {
     const double inertia = t["inertia_total_kg_m2"];
@@ -561,7 +555,7 @@ TEST(SimulatePresets, QuadrotorLooksLikeTheCrazyflieLogs) {
     ASSERT_EQ(t["spikes"].size(), 1u);
     EXPECT_EQ(std::abs(t["spikes"][0]["rate_rad_per_s"].get<double>()), 5.0);
     EXPECT_GE(t["spikes"][0]["t_s"].get<double>(), t["t_release_s"].get<double>());
-    std::string csv = ReadText(dir / t["file"].get<std::string>());
+    std::string csv = ReadFile(dir / t["file"].get<std::string>());
     ASSERT_EQ(csv.rfind("# simulated by bifilar ", 0), 0u);  // the mark, then the real log's form
     csv.erase(0, csv.find('\n') + 1);
     EXPECT_EQ(csv.substr(0, 11), "t,wx,wy,wz\n");                       // no accelerometer
@@ -598,12 +592,12 @@ TEST(SimulatePresets, NonidealRigRecordsItsSoftening) {
   const fs::path a = TempDir("nonideal_a"), b = TempDir("nonideal_b");
   RunSimulateCampaign(spec, a.string());
   RunSimulateCampaign(spec, b.string());
-  const nlohmann::json truth = nlohmann::json::parse(ReadText(a / "truth.json"));
+  const nlohmann::json truth = nlohmann::json::parse(ReadFile(a / "truth.json"));
   EXPECT_EQ(truth["options"]["softening_percent_at_30deg"].get<double>(), 12);
   ASSERT_EQ(truth["traces"].size(), 8u);
   for (const auto& t : truth["traces"]) {
     const std::string file = t["file"];
-    EXPECT_EQ(ReadText(a / file), ReadText(b / file)) << file;  // same spec and seed, same bytes
+    EXPECT_EQ(ReadFile(a / file), ReadFile(b / file)) << file;  // same spec and seed, same bytes
     const double inertia = t["inertia_total_kg_m2"];
     const double expected = t["nominal_pitch_deg"].get<double>() == 0 ? 0.050 : 0.027;
     EXPECT_NEAR(inertia, expected, 1e-4 * expected);  // the TRUE inertia, softening or not
@@ -618,7 +612,7 @@ TEST(SimulatePresets, NonidealRigRecordsItsSoftening) {
     EXPECT_GE(error, 4.0);
     EXPECT_LE(error, 15.0);
     // Gravity removed: the mean accelerometer reading is 0.07-0.26 g, not 1 g.
-    std::istringstream csv(ReadText(a / file));
+    std::istringstream csv(ReadFile(a / file));
     std::string line;
     std::getline(csv, line);
     EXPECT_EQ(line.rfind("# simulated by bifilar ", 0), 0u) << line;

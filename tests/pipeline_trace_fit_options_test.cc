@@ -19,7 +19,7 @@ CampaignConfig Configured() {
   config.aircraft_mass_std_kg = 0.004;
   config.imu.gyro_scale_std = 0.002;
   config.fit.quality.min_periods = 7.0;
-  config.fit.sweep.max_bands = 5;
+  config.fit.sweep.sweep_max_bands = 5;
   config.fit.max_amplitude_deg = 25.0;
   config.fit.min_amplitude_deg = 3.0;
   return config;

@@ -19,12 +19,9 @@
 namespace bifilar {
 namespace {
 
+using test_support::Contains;
 using test_support::TempDir;
 using test_support::WriteFile;
-
-bool Contains(const std::string& s, const std::string& part) {
-  return s.find(part) != std::string::npos;
-}
 
 using test_support::ErrorOf;
 

@@ -26,21 +26,11 @@
 namespace bifilar {
 namespace {
 
+using test_support::Contains;
+using test_support::ReadFile;
+using test_support::WriteFile;
+
 namespace fs = std::filesystem;
-
-bool Contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void WriteFile(const std::string& path, const std::string& text) {
-  fs::create_directories(fs::path(path).parent_path());
-  std::ofstream(path, std::ios::binary) << text;
-}
 
 std::string TempDir() {
   char tmpl[] = "/tmp/bifilar_ulog_test_XXXXXX";

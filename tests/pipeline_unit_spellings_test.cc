@@ -25,12 +25,9 @@ namespace {
 
 using test_support::Bifilar;
 using test_support::CliRun;
+using test_support::Contains;
 using test_support::ErrorOf;
 using test_support::TempDir;
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 TEST(UnitSpellings, InertiaUnitPlotLabelIsThePlplotTextOfTheDisplayUnit) {
   EXPECT_STREQ(InertiaUnitPlotLabel(DisplayUnits::kSi), "kg m#u2#d");

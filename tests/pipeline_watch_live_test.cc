@@ -28,34 +28,21 @@
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/watch/watch_engine.h"
 #include "tests/test_support.h"
+#include "tests/watch_support.h"
 
 namespace bifilar {
 namespace {
 
 using test_support::ReadFile;
 using test_support::TempDir;
-using test_support::WriteFile;
+using watch_support::FitLog;
 
+// A 20 s swing on the watch rig (tests/watch_support.h) into dir/sw.csv, read into *data.
+// Returns the config path.
 std::string Simulate(const TempDir& dir, ImuData* data) {
-  SimulateCommandOptions s;
-  s.trace_csv = dir.path + "/sw.csv";
-  s.o.seed = 37;
-  s.o.inertia_kg_m2 = 0.05;
-  s.o.mass_kg = 2.0;
-  s.o.length_m = 1.0;
-  s.o.separation_m = 0.3;
-  s.o.duration_s = 20.0;
-  RunSimulate(s);
-  *data = ReadImuLog(s.trace_csv, ImuFormat());
-  return WriteFile(dir.path + "/c.yaml",
-                   "rig: {filar_length_m: 1.0, filar_separation_m: 0.3, mass_kg: 2}\n");
-}
-
-TraceRecord FitLog(const std::string& config, const std::string& log) {
-  FitCommandOptions fit;
-  fit.config_path = config;
-  fit.logs = {log};
-  return RunFit(fit).records.at(0);
+  watch_support::SimulateSwing(dir.path + "/sw.csv", {37, 20.0, {}, {}});
+  *data = ReadImuLog(dir.path + "/sw.csv", ImuFormat());
+  return watch_support::WriteSwingConfig(dir.path + "/c.yaml");
 }
 
 int FreeUdpPort() {
@@ -178,24 +165,13 @@ TEST(WatchLive, CsvOverASerialPort) {
 // an event naming the WebSocket and the lost connection.
 TEST(WatchLive, Esp32LoggerOverAWebSocketGivesFitsNumbersAndSurvivesADisconnect) {
   TempDir dir("watch_websocket");
-  SimulateCommandOptions sim;
-  sim.trace_csv = dir.path + "/sw.csv";
-  sim.o.seed = 41;
-  sim.o.inertia_kg_m2 = 0.05;
-  sim.o.mass_kg = 2.0;
-  sim.o.length_m = 1.0;
-  sim.o.separation_m = 0.3;
-  sim.o.amplitude_deg = 15.0;
-  sim.o.duration_s = 30.0;
-  sim.sample_rate = 40.0;
-  RunSimulate(sim);
-  const ImuData data = ReadImuLog(sim.trace_csv, ImuFormat());
+  watch_support::SimulateSwing(dir.path + "/sw.csv", {41, 30.0, 15.0, 40.0});
+  const ImuData data = ReadImuLog(dir.path + "/sw.csv", ImuFormat());
   // The logger's keys and units NOT named in the config: the watch guesses them, and holds the
   // guess until the rows show motion, since rows at rest cannot tell deg/s from rad/s (a guess
   // from them read this deg/s stream as rad/s: I 0.0427 against 0.05, marked ok). The truth
   // check below (5 sigma of 0.05) fails on such a misread.
-  const std::string config = WriteFile(
-      dir.path + "/c.yaml", "rig: {filar_length_m: 1.0, filar_separation_m: 0.3, mass_kg: 2}\n");
+  const std::string config = watch_support::WriteSwingConfig(dir.path + "/c.yaml");
   ConfigLoadOptions load;
   load.require_runs = false;
   const ImuFormat format = LoadCampaignConfig(config, load).imu.format;

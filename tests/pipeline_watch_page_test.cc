@@ -15,6 +15,7 @@
 #include "pipeline/commands/watch_command.h"
 #include "pipeline/watch/watch_server.h"
 #include "tests/test_support.h"
+#include "tests/watch_support.h"
 
 namespace bifilar {
 namespace {
@@ -34,17 +35,8 @@ TEST(WatchPage, SelfContained) {
 TEST(WatchPage, NumbersChangeInHeadlessChromiumAsTheFeederPlays) {
   if (!std::filesystem::exists("/usr/bin/chromium")) GTEST_SKIP() << "no /usr/bin/chromium";
   TempDir dir("watch_page");
-  SimulateCommandOptions s;
-  s.trace_csv = dir.path + "/sw.csv";
-  s.o.seed = 21;
-  s.o.inertia_kg_m2 = 0.05;
-  s.o.mass_kg = 2.0;
-  s.o.length_m = 1.0;
-  s.o.separation_m = 0.3;
-  s.o.duration_s = 20.0;
-  RunSimulate(s);
-  const std::string config =
-      WriteFile(dir.path + "/c.yaml", "rig: {filar_length_m: 1.0, filar_separation_m: 0.3, mass_kg: 2}\n");
+  watch_support::SimulateSwing(dir.path + "/sw.csv", {21, 20.0, {}, {}});
+  const std::string config = watch_support::WriteSwingConfig(dir.path + "/c.yaml");
   const std::string text = ReadFile(dir.path + "/sw.csv");
   const std::string live = dir.path + "/live.csv";
   WriteFile(live, "");

@@ -22,6 +22,7 @@
 #include "pipeline/watch/watch_engine.h"
 #include "pipeline/watch/watch_source.h"
 #include "tests/test_support.h"
+#include "tests/watch_support.h"
 
 namespace bifilar {
 namespace {
@@ -30,32 +31,16 @@ using test_support::Bifilar;
 using test_support::ReadFile;
 using test_support::TempDir;
 using test_support::WriteFile;
+using watch_support::FitLog;
 
-constexpr double kTrueInertia = 0.05;
+constexpr double kTrueInertia = watch_support::kSwingInertia;
 
-// A 1 m, 0.3 m rig with 2 kg: period ~2.1 s. Returns the config path; the log is dir/sw.csv.
+// A swing of 15 deg on the watch rig (tests/watch_support.h: period ~2.1 s) into dir/NAME.
+// Returns the config path.
 std::string SimulateSwing(const TempDir& dir, double duration_s, uint64_t seed,
                           double rate_hz = 100.0, const std::string& name = "sw.csv") {
-  SimulateCommandOptions s;
-  s.trace_csv = dir.path + "/" + name;
-  s.o.seed = seed;
-  s.o.inertia_kg_m2 = kTrueInertia;
-  s.o.mass_kg = 2.0;
-  s.o.length_m = 1.0;
-  s.o.separation_m = 0.3;
-  s.o.amplitude_deg = 15.0;
-  s.o.duration_s = duration_s;
-  s.sample_rate = rate_hz;
-  RunSimulate(s);
-  return WriteFile(dir.path + "/c.yaml",
-                   "rig: {filar_length_m: 1.0, filar_separation_m: 0.3, mass_kg: 2}\n");
-}
-
-TraceRecord FitLog(const std::string& config, const std::string& log) {
-  FitCommandOptions fit;
-  fit.config_path = config;
-  fit.logs = {log};
-  return RunFit(fit).records.at(0);
+  watch_support::SimulateSwing(dir.path + "/" + name, {seed, duration_s, 15.0, rate_hz});
+  return watch_support::WriteSwingConfig(dir.path + "/c.yaml");
 }
 
 std::vector<nlohmann::json> JsonLines(const std::string& text) {

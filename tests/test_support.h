@@ -22,6 +22,11 @@
 namespace bifilar {
 namespace test_support {
 
+// True when `text` holds `part` (messages, pages and files checked for a phrase).
+inline bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
 inline std::string ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;

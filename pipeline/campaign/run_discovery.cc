@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "base/bounded_read.h"
+#include "base/csv.h"
 #include "base/option_check.h"
 #include "base/user_error.h"
 
@@ -170,10 +171,8 @@ bool ParsePitchText(std::string text, double* pitch_deg) {
   } else if (!text.empty() && text[0] == 'p') {
     text = text.substr(1);
   }
-  if (text.empty()) return false;
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() + text.size() || !std::isfinite(value)) return false;
+  double value = 0.0;
+  if (!ParseNumber(text, &value)) return false;  // base/csv.h: the whole text, finite
   *pitch_deg = sign * value;
   return *pitch_deg >= -180.0 && *pitch_deg <= 180.0;
 }
@@ -189,21 +188,10 @@ std::string Display(const CampaignConfig& config, const std::string& path) {
   return path;
 }
 
+// The cells of a runs table's line (base/csv.h, RFC 4180: a quoted path may hold a comma, "" is
+// a quote), each without surrounding spaces.
 std::vector<std::string> SplitCsvLine(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  bool quoted = false;
-  for (char c : line) {
-    if (c == '"') {
-      quoted = !quoted;
-    } else if (c == ',' && !quoted) {
-      cells.push_back(cell);
-      cell.clear();
-    } else if (c != '\r') {
-      cell += c;
-    }
-  }
-  cells.push_back(cell);
+  std::vector<std::string> cells = SplitCsvRecord(line);
   for (std::string& s : cells) {
     while (!s.empty() && s.front() == ' ') s.erase(s.begin());
     while (!s.empty() && s.back() == ' ') s.pop_back();
@@ -446,10 +434,8 @@ constexpr size_t kMaxRunsTableLineBytes = 65536;
 // A set-up named by a number ("-0", "10", "10.0") is the number: -0 and 0 are one set-up, as are
 // 10 and 10.0. A cell that is not wholly a finite number stays as written.
 std::string NumericKey(const std::string& cell) {
-  if (cell.empty() || cell.find_first_not_of("0123456789+-.eE") != std::string::npos) return cell;
-  char* end = nullptr;
-  const double value = std::strtod(cell.c_str(), &end);
-  if (end != cell.c_str() + cell.size() || !std::isfinite(value)) return cell;
+  double value = 0.0;
+  if (!ParseNumber(cell, &value)) return cell;  // base/csv.h: the whole cell, finite
   return FormatCheckValue(value + 0.0);  // + 0.0: -0 becomes 0; the shortest exact form
 }
 

@@ -13,6 +13,7 @@
 #include <streambuf>
 #include <string>
 
+#include "base/csv.h"
 #include "base/json_error.h"
 #include "base/text_format.h"
 #include "base/version.h"
@@ -161,15 +162,14 @@ class ConsoleWrap {
 CLI::Validator FiniteNumber() {
   return CLI::Validator(
       [](std::string& input) {
-        // strtod, not stod: stod throws on underflow too, which called 1e-308 (a subnormal
-        // number) "not a number". A value beyond the double range is out of range.
-        char* end = nullptr;
-        errno = 0;
-        const double value = std::strtod(input.c_str(), &end);
-        if (input.empty() || end != input.c_str() + input.size()) {
+        // base/csv.h's ParseNumber, not stod: stod throws on underflow too, which called
+        // 1e-308 (a subnormal number) "not a number". A value beyond the double range (digits
+        // that read as infinity) is out of range; "inf" and "nan" are not finite.
+        double value = 0.0;
+        if (!ParseNumber(input, &value, NonFinite::kAccept)) {
           return "'" + input + "' is not a number";
         }
-        if (errno == ERANGE && std::fabs(value) > 1.0) {
+        if (std::isinf(value) && input.find_first_of("0123456789") != std::string::npos) {
           return "'" + input + "' is out of range (a finite number within +-1.8e308)";
         }
         if (!std::isfinite(value)) return "'" + input + "' is not a finite number";

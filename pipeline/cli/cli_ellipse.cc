@@ -5,8 +5,8 @@
 #include <limits>
 #include <sstream>
 
-#include <fast_float/fast_float.h>
 
+#include "base/csv.h"
 #include "pipeline/cli/cli_commands.h"
 #include "pipeline/commands/tensor_plan_command.h"
 #include "pipeline/commands/ellipse_command.h"
@@ -16,11 +16,7 @@ namespace {
 
 double ParseAngle(const std::string& text, const std::string& list) {
   double v = 0;
-  const char* first = text.data();
-  if (!text.empty() && *first == '+') ++first;
-  const auto res = fast_float::from_chars(first, text.data() + text.size(), v);
-  if (text.empty() || res.ec != std::errc() || res.ptr != text.data() + text.size() ||
-      !std::isfinite(v)) {
+  if (!ParseNumber(text, &v)) {  // base/csv.h: the whole text, finite
     throw UserError("--angles '" + list + "': '" + text + "' is not a number");
   }
   return v;

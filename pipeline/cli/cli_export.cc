@@ -1,10 +1,10 @@
 // `bifilar export RESULTS --format urdf|sdf|jsbsim|csv|mjcf|ardupilot [--out FILE | --into MODEL
 // --link NAME]`: parse options, call RunExport (pipeline/report/export.h).
-#include <fast_float/fast_float.h>
 
 #include <cmath>
 #include <iostream>
 
+#include "base/csv.h"
 #include "pipeline/cli/cli_commands.h"
 #include "pipeline/report/export.h"
 
@@ -60,12 +60,9 @@ void RegisterExportCommand(CLI::App& app, int* exit_code) {
     for (const std::string& s : *sets) {
       const size_t eq = s.find('=');
       double v = 0.0;
-      const char* first = eq == std::string::npos ? nullptr : s.data() + eq + 1;
-      if (first != nullptr && first < s.data() + s.size() && *first == '+') ++first;
-      const auto res = first == nullptr
-                           ? fast_float::from_chars_result{nullptr, std::errc::invalid_argument}
-                           : fast_float::from_chars(first, s.data() + s.size(), v);
-      if (eq == std::string::npos || res.ec != std::errc() || res.ptr != s.data() + s.size()) {
+      // base/csv.h; infinity and NaN pass here, as before, and the export's check names them.
+      if (eq == std::string::npos ||
+          !ParseNumber(std::string_view(s).substr(eq + 1), &v, NonFinite::kAccept)) {
         throw UserError("export: --set '" + s + "': expected NAME=VALUE, e.g. Iyy=0.42");
       }
       const std::string name = s.substr(0, eq);

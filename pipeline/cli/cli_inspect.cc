@@ -27,6 +27,8 @@ double AskNumber(const std::string& question) {
     std::cout << question << std::flush;
     std::string line;
     if (!std::getline(std::cin, line)) throw UserError("init: no answer to \"" + question + "\"");
+    // Deliberately not base/csv.h's whole-field ParseNumber: an answer at a prompt may carry its
+    // unit ("0.5 m"), so the number it starts with is read.
     char* end = nullptr;
     const double value = std::strtod(line.c_str(), &end);
     if (end != line.c_str() && std::isfinite(value) && value > 0) return value;

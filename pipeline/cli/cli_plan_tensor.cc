@@ -1,12 +1,12 @@
 // `bifilar plan --tensor`: the options of the tensor plan on the `plan` subcommand (registered by
 // RegisterEllipseCommands), parsed into TensorPlanCommandOptions and run by RunTensorPlan
 // (pipeline/commands/tensor_plan_command.h).
-#include <fast_float/fast_float.h>
 
 #include <cmath>
 #include <iostream>
 #include <sstream>
 
+#include "base/csv.h"
 #include "pipeline/cli/cli_commands.h"
 #include "pipeline/commands/tensor_plan_command.h"
 
@@ -15,11 +15,7 @@ namespace {
 
 double ParseDeg(const std::string& text, const std::string& option, const std::string& whole) {
   double v = 0;
-  const char* first = text.data();
-  if (!text.empty() && *first == '+') ++first;
-  const auto res = fast_float::from_chars(first, text.data() + text.size(), v);
-  if (text.empty() || res.ec != std::errc() || res.ptr != text.data() + text.size() ||
-      !std::isfinite(v)) {
+  if (!ParseNumber(text, &v)) {  // base/csv.h: the whole text, finite
     throw UserError(option + " '" + whole + "': '" + text + "' is not a number");
   }
   return v;

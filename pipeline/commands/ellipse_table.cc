@@ -4,9 +4,8 @@
 #include <fstream>
 #include <sstream>
 
-#include <fast_float/fast_float.h>
-
 #include "base/bounded_read.h"
+#include "base/csv.h"
 #include "base/gzip.h"
 #include "base/user_error.h"
 
@@ -20,22 +19,11 @@ std::string Trim(const std::string& s) {
   return s.substr(b, e - b + 1);
 }
 
+// The fields of a line (base/csv.h, RFC 4180: a quoted field may hold a comma), each trimmed.
 std::vector<std::string> SplitCsv(const std::string& line) {
-  std::vector<std::string> fields;
-  std::string field;
-  std::istringstream in(line);
-  while (std::getline(in, field, ',')) fields.push_back(Trim(field));
-  if (!line.empty() && line.back() == ',') fields.push_back("");
+  std::vector<std::string> fields = SplitCsvRecord(line);
+  for (std::string& field : fields) field = Trim(field);
   return fields;
-}
-
-// Whole-field number; false if empty, trailing junk or not a number.
-bool ParseNumber(const std::string& cell, double* value) {
-  if (cell.empty()) return false;
-  const char* first = cell.data();
-  if (*first == '+') ++first;  // fast_float rejects a leading '+'
-  const auto res = fast_float::from_chars(first, cell.data() + cell.size(), *value);
-  return res.ec == std::errc() && res.ptr == cell.data() + cell.size();
 }
 
 // A cell as it may appear in a message: printable ASCII only (other bytes as '?'), at most 40
@@ -92,7 +80,8 @@ std::vector<EllipsePoint> ParseEllipseTable(const std::string& text, const std::
     }
     auto get = [&](int col, const char* what) {
       double v = 0;
-      if (!ParseNumber(fields[col], &v)) {
+      // base/csv.h; infinity and NaN pass here and are refused below with the column's bound.
+      if (!ParseNumber(fields[col], &v, NonFinite::kAccept)) {
         throw UserError(where + "column '" + what + "': '" + Shown(fields[col]) +
                         "' is not a number");
       }

@@ -4,9 +4,10 @@
 // (docs/physics.md §2.3, the classical formula) beside it.
 //
 // Without a config the time and gyro columns and their units are guessed from the column names
-// and the data (GuessImuFormat); every guess is stated in InspectReport::guesses, and the same
-// guess is what `bifilar init --log` writes into a starting config. Nothing here fits the model:
-// it is the data, the window search (fit/window.h) and the swing axis (fit/swing_axis.h) only.
+// and the data (GuessCsvFormat, pipeline/logs/format_guess.h); every guess is stated in
+// InspectReport::guesses, and the same guess is what `bifilar init --log` writes into a starting
+// config. Nothing here fits the model: it is the data, the window search (fit/window.h) and the
+// swing axis (fit/swing_axis.h) only.
 #pragma once
 
 #include <array>
@@ -18,6 +19,7 @@
 
 #include "pipeline/config/config.h"
 #include "pipeline/logs/dataflash.h"
+#include "pipeline/logs/format_guess.h"
 #include "pipeline/logs/imu_format.h"
 
 namespace bifilar {
@@ -28,20 +30,6 @@ struct UlogTopicInfo {
   int multi_id = 0;
   long samples = 0;
   double rate_hz = 0.0;  // samples over the span of their timestamps; 0 when unknown
-};
-
-// The log format guessed from a file's own bytes (a CSV header and its first rows, or a ULog's
-// topics). `found` is false when no time or gyro column could be identified; `why` says what is
-// missing and `guesses` what was seen.
-struct FormatGuess {
-  bool found = false;
-  std::string why;
-  ImuFormat format;
-  std::vector<std::string> guesses;  // "time column 't' in s (median step 0.04 s)", ...
-  // The gyro unit came from the column names; otherwise it is a guess from the first rows,
-  // which InspectLog checks against the whole series.
-  bool gyro_unit_from_names = false;
-  bool time_unit_from_names = false;  // the time unit came from the column's name ("TimeUS")
 };
 
 // What `inspect` found in one file. Numbers that do not apply are NaN (null in JSON).
@@ -93,25 +81,6 @@ struct InspectReport {
   std::vector<std::string> warnings;  // reader warnings, window and axis notes
   std::string error;                  // why the series could not be read or searched; "" if fine
 };
-
-// Columns the user names (`bifilar init --time COL --gyro X,Y,Z`) instead of the guess; their
-// units are still guessed from the data. Empty: guess.
-struct ColumnChoice {
-  std::string time;
-  std::array<std::string, 3> gyro;
-};
-
-// Guesses the format of a CSV text from its header and first rows. Recognised, ignoring case,
-// separators and a unit in brackets: time as t, time, timestamp, TimeUS, TimeMS, "Time [ms]"
-// (or any name holding "time"); gyro and accelerometer triplets as word + axis (GyroX, gyr_x,
-// gyro[0], AngVelX) or axis + word (xGyro, ZGyro, xAcc), and the body rates p, q, r or
-// roll_rate, pitch_rate, yaw_rate. `choice` names columns instead.
-FormatGuess GuessCsvFormat(const std::string& text, const ColumnChoice& choice = {});
-
-// The message when no time or gyro columns are found (`what`): the columns, the config keys to
-// write, and the `bifilar init` command that writes them.
-std::string UnrecognisedColumnsMessage(const std::vector<std::string>& header,
-                                       const std::string& what);
 
 // Reads and looks at `path`. `config` (optional) gives the format and the rig for the
 // small-angle inertia; `choice` names CSV columns instead of guessing them. Never throws on bad

@@ -1,6 +1,7 @@
 // `bifilar simulate`: the YAML simulation spec (strict: an unknown key is an error with its path
 // and line) and the typed Run functions the CLI calls. The physics lives in pendulum/simulate.h;
-// this file reads specs, writes CSV logs (pipeline/logs/imu_log_writer.h) and truth.json.
+// simulate_spec.cc reads specs, simulate_run.cc runs them and writes the logs
+// (pipeline/logs/imu_log_writer.h), simulate_truth.cc writes truth.json.
 // Key by key documentation: README.md, section "simulate"; example: configs/simulate_prandtl_d.yaml.
 #pragma once
 

@@ -9,7 +9,7 @@
 #include "base/text_format.h"
 #include "base/user_error.h"
 #include "pipeline/commands/fit_command.h"
-#include "pipeline/commands/log_inspect.h"
+#include "pipeline/logs/format_guess.h"
 #include "pipeline/records/results_json.h"
 #include "pipeline/watch/saved_log.h"
 #include "pipeline/watch/watch_server.h"

@@ -19,6 +19,7 @@
 #include "base/units.h"
 #include "fit/ellipse.h"
 #include "fit/glitch.h"
+#include "fit/trace_options.h"
 #include "pendulum/integrator.h"
 #include "pendulum/model.h"
 #include "pipeline/logs/imu_format.h"
@@ -115,42 +116,12 @@ struct RunsConfig {
   double attitude_tolerance_deg = 3.0;
 };
 
-// Quality thresholds of the trace fit (fit/trace_fit.h TraceFitOptions, same names and
-// defaults): the max_* ones give warnings, the reject_* ones reject.
-struct QualityThresholds {
-  double max_rms_over_noise = 3.0;          // residual RMS / noise (dimensionless); > 1
-  double max_residual_autocorr = 0.35;      // prewhitened residual |autocorrelation|; (0,1)
-  int whiteness_lags = 10;                  // L (count); >= 1
-  double max_secondary_motion_ratio = 0.1;  // other-axes energy / swing-axis energy; >= 0
-  double reject_secondary_motion_ratio = 0.5;  // ... above this: rejected; >= the warning level
-  double reject_residual_fraction = 0.3;    // residual RMS / swing rate RMS above: rejected
-  double min_periods = 2.0;                 // periods the window must hold (count); >= 2
-};
-
-// The amplitude sweep (fit/trace_fit.h TraceFitOptions::amplitude_sweep and sweep_*).
-struct SweepConfig {
-  bool enabled = true;
-  double min_cycles_per_band = 2.0;  // [1, 1000]
-  int max_bands = 6;                 // [2, 20]
-  double trend_z = 4.0;              // (0, 1000)
-};
-
-// `fit.glitch`: isolated single-sample gyro glitches (fit/glitch.h), dropped before the swing
-// axis, window and fit, and again on the fit's residuals. Same defaults as GlitchOptions.
-struct GlitchConfig {
-  bool enabled = true;                                            // both passes
-  double threshold_sigmas = GlitchOptions().threshold_sigmas;     // [3, 1000] robust sigmas
-  double range_factor = GlitchOptions().range_factor;             // [1, 100] x neighbours' range
-  double excursion_fraction = GlitchOptions().excursion_fraction; // [0, 10] x series' excursion
-  double max_fraction = GlitchOptions().max_fraction;             // (0, 0.1] of the samples
-
-  GlitchOptions Options() const;  // the detector's options; threshold 0 (off) when !enabled
-  bool IsDefault() const;         // every value at its default (the cache key leaves it out)
-};
-constexpr double kMinGlitchSigmas = 3, kMaxGlitchSigmas = 1000;  // fit.glitch.threshold_sigmas
-constexpr double kMinGlitchRange = 1, kMaxGlitchRange = 100;     // fit.glitch.range_factor
-constexpr double kMaxGlitchExcursion = 10;                       // fit.glitch.excursion_fraction
-constexpr double kMaxGlitchFraction = 0.1;                       // fit.glitch.max_fraction
+// The fit's quality thresholds, amplitude sweep and glitch detector are the fit's own options
+// structs (fit/trace_options.h, fit/glitch.h), held by FitConfig as they are: each has one table
+// ({config key, member, bound}, base/option_table.h) from which the loader reads `fit.quality`,
+// `fit.amplitude_sweep` and `fit.glitch`, the checks take their bounds and the cache key its text.
+// The name the Python module (python/src/fit.cc) uses for fit.quality:
+using QualityThresholds = TraceQualityOptions;
 
 struct FitConfig {
   PendulumModel model = PendulumModel::kFull;  // `fit.model`: full | jardin | linear
@@ -161,24 +132,25 @@ struct FitConfig {
   std::map<std::string, std::array<double, 2>> windows_s;
   std::optional<double> max_amplitude_deg;  // amplitude band, upper (deg); default: fit's own
   std::optional<double> min_amplitude_deg;  // amplitude band, lower (deg); default: fit's own
-  QualityThresholds quality;
-  SweepConfig sweep;
-  GlitchConfig glitch;
+  TraceQualityOptions quality;   // `fit.quality` (fit/trace_options.h)
+  AmplitudeSweepOptions sweep;   // `fit.amplitude_sweep` (fit/trace_options.h)
+  // `fit.glitch`: isolated gyro glitches (fit/glitch.h), dropped before the swing axis, window
+  // and fit, and again on the fit's residuals.
+  GlitchOptions glitch;
 
-  // Every bound of the fields above (amplitude band, quality, sweep, glitch): the first field
-  // outside its bound in *failure.
+  // Every bound of the fields above (amplitude band, then quality, sweep and glitch by their own
+  // Checks): the first field outside its bound in *failure, named by its YAML key below `fit`
+  // ("max_amplitude_deg", "quality.whiteness_lags", "amplitude_sweep.max_bands", ...).
   bool Check(CheckFailure* failure) const;
   // The same; *why = "fit.<YAML key> = <value>; must be <allowed>" (base/option_check.h).
   bool Check(std::string* why) const;
 };
 
 // Options of the ellipse fit (fit/ellipse.h EllipseOptions, same defaults).
-// Limits of the count-like keys (configs/README.md); ellipse.bootstrap's are in fit/ellipse.h
+// Limits of the count-like keys (configs/README.md; fit.quality's in fit/trace_options.h); ellipse.bootstrap's are in fit/ellipse.h
 // (kMinBootstrapReplicates, kMaxBootstrapReplicates). One set of ranges, checked when the config
 // is loaded (naming the line) and by CampaignConfig::Check before any fit runs.
 constexpr int kMaxMinAngles = 1000;        // ellipse.min_angles in [3, 1000]
-constexpr int kMaxWhitenessLags = 1000;    // fit.quality.whiteness_lags in [1, 1000]
-constexpr double kMaxMinPeriods = 10000;   // fit.quality.min_periods in [2, 10000]
 constexpr double kMinMaxAmplitudeDeg = 1;  // fit.max_amplitude_deg in [1, 90]: the trace fit's
 constexpr double kMaxMaxAmplitudeDeg = 90; //   model holds to 90 deg; below 1 deg is noise
 constexpr double kMinSwingAxisLength = 1e-3;  // imu.swing_axis: a direction whose length lies
@@ -195,7 +167,8 @@ struct EllipseConfig {
   EllipseCovariance covariance = EllipseCovariance::kAuto;
   int min_angles = 3;             // distinct pitch angles needed to fit the ellipse; [3, 1000]
 
-  bool Check(CheckFailure* failure) const;  // the ranges above: the first field outside them
+  // The ranges above: the first field outside them (its name is its key below `ellipse`).
+  bool Check(CheckFailure* failure) const;
   bool Check(std::string* why) const;       // *why = "ellipse.<key> = <value>; must be .."
 };
 

@@ -643,11 +643,11 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   j["pitch_source"] = ToString(config.runs.pitch_source);
   // The fit settings in effect: the config's, with the command line's overrides (--integrator),
   // which the config text above does not show.
-  const GlitchConfig& glitch = config.fit.glitch;
+  const GlitchOptions& glitch = config.fit.glitch;
   j["fit_settings"] = {
       {"model", ToString(config.fit.model)},
       {"integrator", ToString(config.fit.integrator)},
-      {"amplitude_sweep", config.fit.sweep.enabled},
+      {"amplitude_sweep", config.fit.sweep.amplitude_sweep},
       {"glitch", {{"enabled", glitch.enabled},
                   {"threshold_sigmas", glitch.threshold_sigmas},
                   {"range_factor", glitch.range_factor},

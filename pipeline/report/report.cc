@@ -1,3 +1,6 @@
+// report.html as HTML (report.h): the sections written from the page's content (ReportPage,
+// report_content.cc), the figures embedded (inline SVG compacted, PNG as base64), the style, and
+// `bifilar report`.
 #include "pipeline/report/report.h"
 
 #include <algorithm>
@@ -25,31 +28,13 @@
 #include "pipeline/records/results_reader.h"
 #include "pipeline/records/tensor_json.h"
 #include "pipeline/records/total_uncertainty.h"
+#include "pipeline/report/report_steps.h"
 #include "pipeline/store/output_set.h"
 
 namespace bifilar {
-namespace {
+namespace report_page {
 
-using nlohmann::json;
-namespace fs = std::filesystem;
-using R = ResultsReader;
-
-std::string Escape(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
-std::string Fmt(double value, const char* format = "%.4f") {
+std::string Fmt(double value, const char* format) {
   if (!std::isfinite(value)) return "&ndash;";
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), format, value);
@@ -73,61 +58,23 @@ std::string Fixed(double value, int decimals) {
   return out;
 }
 
-// Trace `t`'s warnings as the report lists them: not the assumed +-1 mm on L and D (Table 2
-// states it once) nor the simulated-log mark (the page says it once, at the top).
-std::vector<std::string> TraceWarnings(const TraceRecord& t) {
-  std::vector<std::string> out;
-  for (const std::string& w : t.warnings) {
-    if (!IsAssumedInputsWarning(w) && !IsSimulatedLogWarning(w)) out.push_back(w);
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Escape(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
   }
   return out;
-}
-
-// The status a reader sees: "ok (warned)" for an ok trace with warnings, else the record's.
-std::string DisplayStatus(const TraceRecord& t) {
-  const std::string status = ToString(t.status);
-  return status == "ok" && !TraceWarnings(t).empty() ? "ok (warned)" : status;
-}
-
-struct Units {
-  bool imperial = false;
-  double scale = 1.0;  // display per kg m^2
-  std::string name = "kg m<sup>2</sup>";
-  std::string Inertia(double kg_m2, const char* format = "%.4f") const {
-    return Fmt(kg_m2 * scale, format);
-  }
-  // A moment and its std in display units, each to the digits the std supports.
-  std::string Value(double kg_m2, double std_kg_m2) const {
-    return Fixed(kg_m2 * scale, DecimalsFor(std_kg_m2 * scale));
-  }
-  std::string Std(double std_kg_m2) const {
-    return Fixed(std_kg_m2 * scale, DecimalsFor(std_kg_m2 * scale));
-  }
-};
-
-// A message or warning as the page shows it: in the page's units (the fit writes them in SI).
-std::string InDisplayUnits(const Units& u, const std::string& text) {
-  return SiTextInDisplayUnits(text, u.imperial ? DisplayUnits::kImperial : DisplayUnits::kSi);
-}
-
-// An estimate of the ellipse or tensor JSON: KEY, KEY_std, KEY_ci95 [lo, hi]; null when
-// undefined.
-struct Estimate {
-  bool defined = false;
-  double value = NAN, std = NAN, lo = NAN, hi = NAN;
-};
-Estimate GetEstimate(const R& section, const std::string& key) {
-  Estimate e;
-  if (!section.IsObject()) return e;
-  e.value = section.Num(key.c_str());
-  e.defined = std::isfinite(e.value);
-  e.std = section.Num((key + "_std").c_str());
-  const std::vector<double> ci = section.Nums((key + "_ci95").c_str());
-  if (ci.size() == 2) {
-    e.lo = ci[0];
-    e.hi = ci[1];
-  }
-  return e;
 }
 
 // The first line of a figure that the report has compacted (CompactSvg) and stored in its place.
@@ -257,125 +204,6 @@ pre { background: #f7f7f7; padding: .8em; overflow-x: auto; font-size: .85em; }
 // Tables wider than the text column scroll inside their own box.
 const char* kScrollOpen = "<div class=\"scroll\">";
 const char* kScrollClose = "</div>\n";
-
-// The kind of campaign, from its tensor section (pipeline/records/tensor_json.h): planar pitch
-// (the paper's ellipse), a full tensor, a partial one, or three separate axes (moments only).
-enum class CampaignKind { kPlanar, kFullTensor, kPartialTensor, kSeparateAxes };
-
-// A section of results.json read by its one typed reader (pipeline/records/results_json.h, the
-// one the cache uses for a trace record): a key missing or of another type (a file of another
-// version, or edited) throws UserError naming the section, the key and the version that wrote
-// the file; RunReport adds the file and what to do. The keys read go to `log` under `path`.
-template <typename Read>
-auto ReadSection(const R& results, const std::string& what, const std::string& path, KeyLog* log,
-                 const Read& read) {
-  KeyLog keys;
-  try {
-    auto value = read(&keys);
-    if (log != nullptr) {
-      for (const std::string& key : keys) log->insert(path + "." + key);
-    }
-    return value;
-  } catch (const UserError& e) {
-    const std::string version = results.Str("version");
-    throw UserError(what + ": " + e.what() + "; the file was written by bifilar " +
-                    (version.empty() ? std::string("of an unknown version") : version) +
-                    ", this is bifilar " + ProgramVersion());
-  }
-}
-
-// results.json's traces, each read by TraceRecordFromJson as the cache reads its entries.
-std::vector<TraceRecord> ReadTraces(const R& results, KeyLog* log) {
-  std::vector<TraceRecord> out;
-  const std::vector<R> items = results.Items("traces");
-  for (size_t i = 0; i < items.size(); ++i) {
-    const json& element = items[i].node();
-    const auto file = element.is_object() ? element.find("file") : element.end();
-    const std::string name =
-        file != element.end() && file->is_string() ? " (" + file->get<std::string>() + ")" : "";
-    out.push_back(
-        ReadSection(results, "traces[" + std::to_string(i) + "]" + name, "traces[]", log,
-                    [&](KeyLog* keys) { return TraceRecordFromJson(element, true, keys); }));
-  }
-  return out;
-}
-
-// The calibration section (null without rig.calibration).
-std::optional<RigCalibrationResult> ReadCalibration(const R& results, KeyLog* log) {
-  const R section = results.Get("calibration");
-  if (!section.IsObject()) return std::nullopt;
-  return ReadSection(results, "calibration", "calibration", log,
-                     [&](KeyLog* keys) { return CalibrationFromJson(section.node(), keys); });
-}
-
-// One trace in the order of the tables: by roll, pitch (numerically), then file.
-struct TraceRow {
-  TraceRecord t;
-  double roll = 0.0, pitch = NAN;
-};
-
-// What every section reads: the results document, its parts, the units, the campaign kind, and
-// the number of figures embedded so far (the inline SVGs' id prefixes).
-struct ReportPage {
-  ReportPage(const json& results_in, const std::string& out_dir_in, KeyLog* log)
-      : results(results_in, log), log_(log), out_dir(out_dir_in) {
-    if (results.Str("units") == "imperial") {
-      u.imperial = true;
-      u.scale = kSlugFt2PerKgM2;
-      u.name = "slug ft<sup>2</sup>";
-    }
-    const std::string mode = tensor.Str("mode");
-    const R observable = tensor.Get("observable");
-    const bool products = observable.Bool("Ixy") || observable.Bool("Ixz") || observable.Bool("Iyz");
-    kind = mode == "full_3d"   ? CampaignKind::kFullTensor
-           : mode == "partial" ? (products ? CampaignKind::kPartialTensor : CampaignKind::kSeparateAxes)
-                               : CampaignKind::kPlanar;
-    for (TraceRecord& t : ReadTraces(results, log_)) {
-      TraceRow row{std::move(t)};
-      const double roll = row.t.roll_used_deg;
-      row.roll = std::isfinite(roll) ? roll : 0.0;
-      row.pitch = row.t.pitch_used_deg;
-      if (row.roll != 0.0) rolls = true;
-      traces.push_back(row);
-    }
-    std::stable_sort(traces.begin(), traces.end(), [](const TraceRow& a, const TraceRow& b) {
-      const double pa = std::isfinite(a.pitch) ? a.pitch : 1e9, pb = std::isfinite(b.pitch) ? b.pitch : 1e9;
-      if (a.roll != b.roll) return a.roll < b.roll;
-      if (pa != pb) return pa < pb;
-      return NaturalLess(a.t.file, b.t.file);  // case ignored, numbers as numbers
-    });
-    // A campaign whose tensor fit failed is still not planar when its logs roll.
-    if (kind == CampaignKind::kPlanar && rolls) kind = CampaignKind::kPartialTensor;
-    summary = ReadSection(results, "summary", "summary", log_, [this](KeyLog* keys) {
-      return CampaignSummaryFromJson(results.Get("summary").node(), keys);
-    });
-    calibration = ReadCalibration(results, log_);
-  }
-  bool Planar() const { return kind == CampaignKind::kPlanar; }
-  R results;
-  KeyLog* log_;  // every key read (ReportKeysRead), or null
-  const std::string& out_dir;
-  Units u;
-  CampaignSummary summary;  // read after the traces (a broken trace is named first)
-  std::optional<RigCalibrationResult> calibration;
-  const R ellipse = results.Get("ellipse");
-  const R tensor = results.Get("tensor");
-  const R figures = results.Get("figures");
-  std::vector<TraceRow> traces;
-  bool rolls = false;
-  CampaignKind kind = CampaignKind::kPlanar;
-  int figures_drawn = 0;
-};
-
-const char* KindName(CampaignKind kind) {
-  switch (kind) {
-    case CampaignKind::kPlanar: return "planar pitch (the ellipse of inertia in the x-z plane)";
-    case CampaignKind::kFullTensor: return "full inertia tensor (swings about axes in every plane)";
-    case CampaignKind::kPartialTensor: return "partial inertia tensor";
-    case CampaignKind::kSeparateAxes: return "separate axes (one moment per body axis)";
-  }
-  return "";
-}
 
 // The main result in one box at the top: the moments with their total std.
 void WriteHeadline(const ReportPage& p, std::ostream& h) {
@@ -964,6 +792,7 @@ void WriteFooter(const ReportPage& p, std::ostream& h) {
 }
 
 }  // namespace
+}  // namespace report_page
 
 std::string Base64(const std::string& bytes) {
   static const char* kTable = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -997,6 +826,7 @@ std::string Base64(const std::string& bytes) {
 // campaign that rolls: the inertia tensor -> per-attitude table -> rejected traces -> warnings ->
 // trace table -> per-trace figures -> footer. The paper's order (Table 1 before Table 2); the main
 // result is first in the header's box.
+namespace report_page {
 namespace {
 
 std::string BuildPage(const json& results, const std::string& out_dir, KeyLog* keys_read) {
@@ -1021,27 +851,29 @@ std::string BuildPage(const json& results, const std::string& out_dir, KeyLog* k
 }
 
 }  // namespace
+}  // namespace report_page
 
-std::string BuildReportHtml(const json& results, const std::string& out_dir) {
-  return BuildPage(results, out_dir, nullptr);
+std::string BuildReportHtml(const nlohmann::json& results, const std::string& out_dir) {
+  return report_page::BuildPage(results, out_dir, nullptr);
 }
 
-KeyLog ReportKeysRead(const json& results, const std::string& out_dir) {
+KeyLog ReportKeysRead(const nlohmann::json& results, const std::string& out_dir) {
   KeyLog keys;
-  BuildPage(results, out_dir, &keys);
+  report_page::BuildPage(results, out_dir, &keys);
   return keys;
 }
 
 void RunReport(const std::string& out_dir) {
+  namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_directory(out_dir, ec)) throw UserError(out_dir + ": no such folder");
   const OutputFolderLock lock(out_dir);
   const std::string path = (fs::path(out_dir) / "results.json").string();
   std::string bytes, why;
   if (!ReadRegularFile(path, OutputFileCap(), &bytes, &why)) throw UserError(why);
-  json results;
+  nlohmann::json results;
   try {
-    results = json::parse(bytes);
+    results = nlohmann::json::parse(bytes);
   } catch (const std::exception& e) {
     throw UserError(path + ": not valid JSON (" + DescribeJsonError(e) +
                     "); rerun `bifilar process` to rewrite it");
@@ -1050,7 +882,7 @@ void RunReport(const std::string& out_dir) {
     throw UserError(path + ": not a bifilar results file (no 'traces')");
   }
   CheckResultsSchema(results, path);  // a newer schema: named before any key is read
-  CheckFigureNames(results, out_dir);  // before anything reads a file results.json names
+  report_page::CheckFigureNames(results, out_dir);  // before anything reads a file results.json names
   // A mixed set (a run killed between two renames) is reported, not turned into a page.
   const std::vector<std::string> problems = CheckOutputSet(out_dir, false);
   if (!problems.empty()) {
@@ -1062,7 +894,7 @@ void RunReport(const std::string& out_dir) {
   std::string html;
   try {
     html = BuildReportHtml(results, out_dir);
-  } catch (const json::exception& e) {  // a field of the wrong type: name the file, not json
+  } catch (const nlohmann::json::exception& e) {  // a field of the wrong type: name the file, not json
     throw UserError(path + ": not a results file bifilar can read (" + DescribeJsonError(e) +
                     "); rerun `bifilar process` to rewrite it");
   } catch (const UserError& e) {  // ResultsReader: a key of the wrong type, named

@@ -11,6 +11,7 @@
 #include "base/atomic_file.h"
 #include "base/bounded_read.h"
 #include "base/json_error.h"
+#include "base/option_table.h"
 #include "base/user_error.h"
 #include "base/version.h"
 #include "pipeline/records/results_json.h"
@@ -18,27 +19,68 @@
 namespace bifilar {
 
 namespace {
-void Put(std::ostringstream& out, const char* name, double value) {
+
+// "name=value;" with 17 significant digits (reads back to the same double): canonical text.
+void Put(std::ostringstream& out, const std::string& name, double value) {
   char buffer[40];
   std::snprintf(buffer, sizeof(buffer), "%.17g", value);
   out << name << '=' << buffer << ';';
 }
+
+void PutText(std::ostringstream& out, const std::string& name, const std::string& value) {
+  out << name << '=' << value << ';';
+}
+
+void PutOptional(std::ostringstream& out, const std::string& name,
+                 const std::optional<double>& value) {
+  if (value) {
+    Put(out, name, *value);
+  } else {
+    PutText(out, name, "none");
+  }
+}
+
+// The log as the fit reads it: format, ULog selection, DataFlash instance, the decompression cap
+// (a .csv.gz beyond it is an error record), swing axis and mounting.
+void PutLogReading(std::ostringstream& out, const CampaignConfig& config) {
+  const ImuFormat& f = config.imu.format;
+  PutText(out, "imu.format", ToString(f.container));
+  PutText(out, "imu.time", f.time_column + "," + ToString(f.time_unit));
+  PutText(out, "imu.gyro", f.gyro_columns[0] + "," + f.gyro_columns[1] + "," + f.gyro_columns[2] +
+                               "," + ToString(f.gyro_unit));
+  PutText(out, "imu.accel", f.accel_columns[0] + "," + f.accel_columns[1] + "," +
+                                f.accel_columns[2] + "," + ToString(f.accel_unit));
+  PutText(out, "imu.delimiter", std::string(1, f.delimiter));
+  const UlogSelection& u = f.ulog;
+  PutText(out, "imu.ulog", u.topic + "," + std::to_string(u.multi_id) + "," + u.time_field + "," +
+                               u.gyro_fields[0] + "," + u.gyro_fields[1] + "," + u.gyro_fields[2] +
+                               "," + u.accel_fields[0] + "," + u.accel_fields[1] + "," +
+                               u.accel_fields[2]);
+  Put(out, "imu.dataflash.instance", config.imu.dataflash_instance);
+  Put(out, "limits.max_decompressed_log_mb", config.limits.max_decompressed_log_mb);
+  PutText(out, "imu.swing_axis", config.imu.swing_axis_auto ? "auto" : "fixed");
+  for (int i = 0; i < 3; ++i) Put(out, "n", config.imu.swing_axis_in_imu[i]);
+  for (int i = 0; i < 9; ++i) Put(out, "R", config.imu.imu_to_body(i / 3, i % 3));
+}
+
 }  // namespace
 
 std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
                            const std::optional<std::array<double, 2>>& window_s) {
   std::ostringstream out;
-  const RigGeometry geometry = GeometryForRole(config, role);  // D: the calibrated one, if any
-  out << "version=" << ProgramVersion() << ';';
-  out << "role=" << ToString(role) << ';';
+  Put(out, "key_format", TraceCache::kFormat);
+  PutText(out, "version", ProgramVersion());
+  PutText(out, "role", ToString(role));
+  // The geometry of the fit (D: the calibrated one, if any) and the budget's stds in effect (the
+  // assumed 1 mm on L and D without rig.uncertainties, marked: the record then carries the
+  // assumption's warning).
+  const RigGeometry geometry = GeometryForRole(config, role);
   Put(out, "L", geometry.filar_length_m);
   Put(out, "D", geometry.filar_separation_m);
   Put(out, "m", geometry.mass_kg);
   Put(out, "g", geometry.gravity_mps2);
-  // The stds in effect (the assumed 1 mm on L and D without rig.uncertainties, marked: the
-  // record then carries the assumption's warning).
   const RigUncertainties uncertainties = config.uncertainties.InEffect();
-  if (config.uncertainties.Assumed()) out << "unc=assumed;";
+  PutText(out, "unc_assumed", config.uncertainties.Assumed() ? "true" : "false");
   Put(out, "L_std", uncertainties.filar_length_std_m);
   Put(out, "D_std", uncertainties.filar_separation_std_m);
   Put(out, "m_rig_std", uncertainties.mass_std_kg);
@@ -46,61 +88,26 @@ std::string FitFingerprint(const CampaignConfig& config, TraceRole role,
   Put(out, "g_std", uncertainties.gravity_std_mps2);
   Put(out, "gyro_scale_std", config.imu.gyro_scale_std);
   // A calibrated geometry (rig.calibration) changes D above, drops the L, D and g terms of the
-  // budget and adds its own; only then in the key, so uncalibrated keys stay those of 0.2.0.
-  if (config.geometry_calibration.applied) {
-    Put(out, "calibration_factor", config.geometry_calibration.factor);
-    Put(out, "calibration_rel_std", config.geometry_calibration.factor_rel_std);
-  }
-  out << "model=" << ToString(config.fit.model) << ';';
-  // Only a non-default integrator enters the key, so rk853 keys stay those of earlier versions.
-  if (config.fit.integrator != IntegratorMethod::kRungeKutta) {
-    out << "integrator=" << ToString(config.fit.integrator) << ';';
-  }
-  if (window_s) {
-    Put(out, "t0", (*window_s)[0]);
-    Put(out, "t1", (*window_s)[1]);
-  }
-  if (config.fit.max_amplitude_deg) Put(out, "amax", *config.fit.max_amplitude_deg);
-  if (config.fit.min_amplitude_deg) Put(out, "amin", *config.fit.min_amplitude_deg);
-  const ImuFormat& f = config.imu.format;
-  out << "time=" << f.time_column << ',' << ToString(f.time_unit) << ';';
-  out << "gyro=" << f.gyro_columns[0] << ',' << f.gyro_columns[1] << ',' << f.gyro_columns[2]
-      << ',' << ToString(f.gyro_unit) << ';';
-  out << "accel=" << f.accel_columns[0] << ',' << f.accel_columns[1] << ',' << f.accel_columns[2]
-      << ',' << ToString(f.accel_unit) << ';' << "delim=" << f.delimiter << ';';
-  out << "ulog=" << static_cast<int>(f.container) << ',' << f.ulog.topic << ',' << f.ulog.multi_id << ','
-      << f.ulog.time_field << ',' << f.ulog.gyro_fields[0] << ',' << f.ulog.gyro_fields[1] << ','
-      << f.ulog.gyro_fields[2] << ',' << f.ulog.accel_fields[0] << ',' << f.ulog.accel_fields[1] << ','
-      << f.ulog.accel_fields[2] << ';';
-  if (config.imu.dataflash_instance >= 0) out << "dataflash=" << config.imu.dataflash_instance << ';';
-  out << "axis=" << (config.imu.swing_axis_auto ? "auto" : "fixed") << ';';
-  for (int i = 0; i < 3; ++i) Put(out, "n", config.imu.swing_axis_in_imu[i]);
-  for (int i = 0; i < 9; ++i) Put(out, "R", config.imu.imu_to_body(i / 3, i % 3));
-  const QualityThresholds& q = config.fit.quality;
-  Put(out, "q_noise", q.max_rms_over_noise);
-  Put(out, "q_white", q.max_residual_autocorr);
-  Put(out, "q_lags", q.whiteness_lags);
-  Put(out, "q_secondary", q.max_secondary_motion_ratio);
-  Put(out, "q_periods", q.min_periods);
-  Put(out, "q_secondary_reject", q.reject_secondary_motion_ratio);
-  Put(out, "q_residual_reject", q.reject_residual_fraction);
-  const SweepConfig& sw = config.fit.sweep;
-  Put(out, "sweep", sw.enabled ? 1.0 : 0.0);
-  Put(out, "sweep_cycles", sw.min_cycles_per_band);
-  Put(out, "sweep_bands", sw.max_bands);
-  Put(out, "sweep_z", sw.trend_z);
-  // The sweep's trend rule (I_0 (1 + c A^p), p in {1, 2}; Birge scale about the trend): a
-  // record fitted under the earlier A^2-only rule is not replayed.
-  out << "sweep_rule=power12;";
-  // Only non-default glitch settings enter the key, so default keys stay those of 0.2.0.
-  const GlitchConfig& gl = config.fit.glitch;
-  if (!gl.IsDefault()) {
-    Put(out, "glitch", gl.enabled ? 1.0 : 0.0);
-    Put(out, "glitch_sigmas", gl.threshold_sigmas);
-    Put(out, "glitch_range", gl.range_factor);
-    Put(out, "glitch_excursion", gl.excursion_fraction);
-    Put(out, "glitch_fraction", gl.max_fraction);
-  }
+  // budget and adds its own.
+  PutText(out, "calibration", config.geometry_calibration.applied ? "applied" : "none");
+  Put(out, "calibration_factor", config.geometry_calibration.factor);
+  Put(out, "calibration_rel_std", config.geometry_calibration.factor_rel_std);
+  // The fit: model, integrator, this file's window override, the amplitude band.
+  PutText(out, "fit.model", ToString(config.fit.model));
+  PutText(out, "fit.integrator", ToString(config.fit.integrator));
+  PutOptional(out, "t0", window_s ? std::optional<double>((*window_s)[0]) : std::nullopt);
+  PutOptional(out, "t1", window_s ? std::optional<double>((*window_s)[1]) : std::nullopt);
+  PutOptional(out, "fit.max_amplitude_deg", config.fit.max_amplitude_deg);
+  PutOptional(out, "fit.min_amplitude_deg", config.fit.min_amplitude_deg);
+  // The fit's options structs, every field of their tables (base/option_table.h): a field added
+  // to a table enters the key without an edit here.
+  const FitConfig& fit = config.fit;
+  out << SerialiseOptionFields("fit.quality", fit.quality, TraceQualityOptions::Fields())
+      << SerialiseOptionFields("fit.amplitude_sweep", fit.sweep, AmplitudeSweepOptions::Fields())
+      << SerialiseOptionFields("fit.glitch", fit.glitch, GlitchOptions::Fields());
+  // The sweep's trend rule (I_0 (1 + c A^p), p in {1, 2}; Birge scale about the trend).
+  PutText(out, "sweep_rule", "power12");
+  PutLogReading(out, config);
   return out.str();
 }
 

@@ -1,11 +1,21 @@
 // Per-trace fit results cached in OUT/cache/, so that a rerun redoes only what changed.
 //
-// A cache entry is keyed by CacheKey = hash(content hash of the log bytes, fingerprint of every
-// config value that affects that trace's fit): L, D (the calibrated D and the calibration's std
-// when rig.calibration is applied), the suspended mass, g, their uncertainties (the budget), the model, the window override, the amplitude band, the IMU format, swing axis
-// and mounting, the quality thresholds, the program version. Not in the key: the rig inertia
-// (tare logs/value/table), the pitch source, the ellipse options, the units — changing those
-// refits no trace. The fit figure is stored beside it in OUT/figures/<key>.svg.
+// A cache entry is keyed by CacheKey = hash(content hash of the log bytes, FitFingerprint: the
+// canonical text of every config value that can change that trace's fit record). In the key: the
+// key format (TraceCache::kFormat) and program version; the role; L, D (the calibrated D, and the
+// calibration's factor and std), the suspended mass, g; the budget's stds in effect (and whether
+// they are the assumed ones), imu.gyro.scale_std; fit.model, fit.integrator, the file's
+// fit.windows entry, fit.max/min_amplitude_deg; every field of fit.quality, fit.amplitude_sweep
+// and fit.glitch, serialised from their option tables (base/option_table.h), so a new field
+// cannot be left out; the log reading (imu format, columns and units, ulog, dataflash.instance,
+// limits.max_decompressed_log_mb, swing axis, imu_to_body). Not in the key, because they change
+// no fitted record (they act after the fit, before it on which files are read, or only on
+// presentation): the rig inertia (value, table, tare, its std), rig.calibration's own keys (they
+// act through the calibrated geometry above), aircraft.mass_kg of a tare log, aircraft.cg_m and
+// cg_std_m, gravity_off_earth (a bound only), runs.* (which files; the pitch used and the
+// attitude warning are set after the cache), ellipse.*, units, limits.max_log_mb (a log beyond it
+// is not read, so has no key). tests/pipeline_cache_keys_test.cc changes every key in turn. The
+// fit figure is stored beside it in OUT/figures/<key>.svg.
 //
 // Hash: FNV-1a 64 (base/hash.h).
 #pragma once
@@ -36,7 +46,9 @@ std::string CacheKey(const std::string& content_hash_hex, const std::string& fin
 // checksum on purpose.
 class TraceCache {
  public:
-  static constexpr int kFormat = 2;  // "bifilar_cache" of the entries written now
+  // "bifilar_cache" of the entries written now; 3: the key is the canonical text of the options
+  // (format 2 entries have other keys and are never found).
+  static constexpr int kFormat = 3;
 
   explicit TraceCache(std::string folder);  // created on first Store
   // True and fills *record (fit fields) when the entry of `key` exists, proves it belongs to

@@ -160,7 +160,7 @@ bool Fail(TraceRecord* record, TraceStatus status, const std::string& message,
 // the data: the raw log when there are none, else *cleaned (filled here).
 const ImuData& DropRawGlitches(const CampaignConfig& config, const ImuData& raw, ImuData* cleaned,
                                TraceRecord* record) {
-  const std::vector<size_t> glitches = FindGyroGlitches(raw, config.fit.glitch.Options());
+  const std::vector<size_t> glitches = FindGyroGlitches(raw, config.fit.glitch);
   if (glitches.empty()) return raw;
   record->warnings.push_back(DescribeGlitches(raw, glitches));
   *cleaned = WithoutSamples(raw, glitches);
@@ -309,7 +309,7 @@ TraceFitResult FitWithResidualGlitchPass(const CampaignConfig& config,
   TraceFitResult fit = FitTrace(*input, fit_options);
   if (!fit.HasFit() || fit.residual_rad_per_s.size() != input->t_s.size()) return fit;
   const std::vector<size_t> more =
-      FindGlitches(fit.t_s, fit.residual_rad_per_s, config.fit.glitch.Options());
+      FindGlitches(fit.t_s, fit.residual_rad_per_s, config.fit.glitch);
   if (more.empty()) return fit;
   double largest = 0.0;
   for (size_t k : more) largest = std::max(largest, std::abs(fit.residual_rad_per_s[k]));
@@ -571,18 +571,9 @@ TraceFitOptions TraceFitOptionsFor(const CampaignConfig& config, TraceRole role)
   TraceFitOptions fit_options;
   fit_options.model = config.fit.model;
   fit_options.integrator = fit_options.integrator.WithMethod(config.fit.integrator);
-  const QualityThresholds& q = config.fit.quality;
-  fit_options.max_rms_over_noise = q.max_rms_over_noise;
-  fit_options.max_residual_autocorr = q.max_residual_autocorr;
-  fit_options.whiteness_lags = q.whiteness_lags;
-  fit_options.max_secondary_motion_ratio = q.max_secondary_motion_ratio;
-  fit_options.reject_secondary_motion_ratio = q.reject_secondary_motion_ratio;
-  fit_options.reject_residual_fraction = q.reject_residual_fraction;
-  fit_options.amplitude_sweep = config.fit.sweep.enabled;
-  fit_options.sweep_min_cycles_per_band = config.fit.sweep.min_cycles_per_band;
-  fit_options.sweep_max_bands = config.fit.sweep.max_bands;
-  fit_options.sweep_trend_z = config.fit.sweep.trend_z;
-  fit_options.min_periods = q.min_periods;
+  // The config holds the fit's own quality and sweep options (fit/trace_options.h).
+  static_cast<TraceQualityOptions&>(fit_options) = config.fit.quality;
+  static_cast<AmplitudeSweepOptions&>(fit_options) = config.fit.sweep;
   const AmplitudeBandOptions band_options = AmplitudeBandOptionsFor(config);
   fit_options.max_amplitude_deg = band_options.max_amplitude_deg;
   fit_options.min_amplitude_deg =

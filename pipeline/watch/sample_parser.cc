@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/csv.h"
 #include "base/text_format.h"
 #include "base/user_error.h"
 #include "pipeline/logs/imu_log_options.h"
@@ -36,6 +37,9 @@ char GuessDelimiter(const std::string& header) {
   return ' ';
 }
 
+// Deliberately not base/csv.h's SplitCsvRecord: a stream's line is split as a log's is
+// (pipeline/logs/imu_log.cc), runs of spaces as one separator, quotes (" or ') trimmed off a
+// cell rather than interpreted (a logger quotes names, never a delimiter inside one).
 std::vector<std::string> Split(const std::string& line, char delimiter) {
   std::vector<std::string> cells;
   std::string cell;
@@ -58,12 +62,11 @@ int IndexOf(const std::vector<std::string>& header, const std::string& name) {
   return -1;
 }
 
-// The whole cell as a number; false for anything else ("1.5x", "", "abc").
+// The whole cell as a number; false for anything else ("1.5x", "", "abc", "0x10"): base/csv.h's
+// ParseNumber, the rule the saved log is read back with (pipeline/logs/imu_log.cc). Infinity and
+// NaN are read, and counted as non_finite.
 bool Number(const std::string& cell, double* value) {
-  if (cell.empty()) return false;
-  char* end = nullptr;
-  *value = std::strtod(cell.c_str(), &end);
-  return end == cell.c_str() + cell.size();
+  return ParseNumber(cell, value, NonFinite::kAccept);
 }
 
 std::string Excerpt(const std::string& line) { return PrintableAscii(line, 120); }

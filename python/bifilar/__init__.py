@@ -28,12 +28,42 @@ FileNotFoundError (a subclass of ValueError too, so older ``except ValueError`` 
 catches it). Results are :class:`Record` objects: dicts
 whose keys are also attributes (``r.inertia_total_kg_m2 == r["inertia_total_kg_m2"]``).
 Conventions and the equations: docs/physics.md.
+Every function and result is typed (PEP 561: ``py.typed``, and ``_core.pyi`` for the
+compiled part); ``mypy --strict`` checks code that uses them (python/tests/test_typing.py).
 """
+
+from __future__ import annotations
 
 import errno as _errno
 import math as _math
 import operator as _operator
 import os as _os
+import typing as _typing
+from typing import (Any, Callable, Dict, Iterable, Iterator, List, Optional, Sequence, Tuple,
+                    TypeVar, Union, overload)
+
+if _typing.TYPE_CHECKING:  # names for the annotations only (they are never evaluated)
+    import numpy as np
+    import numpy.typing as npt
+    from typing_extensions import Literal
+
+    #: A path: str, bytes or os.PathLike, as the os functions take.
+    PathArg = Union[str, bytes, "_os.PathLike[str]", "_os.PathLike[bytes]"]
+    #: Anything numpy converts to an array of numbers (lists, tuples, arrays).
+    ArrayLike = npt.ArrayLike
+    FloatArray = npt.NDArray[np.float64]
+    Model = Literal["full", "jardin", "linear"]
+    Covariance = Literal["auto", "points", "angle_means", "absolute"]
+    #: fit_trace's window: None (detected), (t0, t1) or "T0:T1" (s).
+    Window = Union[None, Tuple[float, float], str]
+    #: process's progress: None/False (quiet), True or "bar" (a text bar), or a callable
+    #: progress(done, total, line).
+    Progress = Union[None, bool, str, Callable[[int, int, str], object]]
+    _RecordBase = Dict[str, Any]
+else:
+    _RecordBase = dict
+
+_T = TypeVar("_T")
 
 try:
     from . import _core
@@ -54,14 +84,14 @@ except ImportError:  # the compiled part was never built here (or for another Py
 try:  # needed by every function; `import bifilar` itself works without it
     import numpy as _np
 except ImportError:  # pragma: no cover - depends on the interpreter
-    _np = None
+    _np = None  # type: ignore[assignment]  # each use checks for None first
 
 __all__ = ["Record", "Columns", "fit_trace", "read_log", "fit_ellipse", "fit_tensor",
            "down_in_body", "process", "simulate", "watch"]
 __version__ = _core.version
 
 
-class Record(dict):
+class Record(_RecordBase):
     """A result: a dict (JSON-like, as the command line writes it) whose keys are attributes.
 
     Nested objects are Records too. ``dict(r)`` or ``json.dumps(r)`` give the plain form
@@ -70,31 +100,31 @@ class Record(dict):
 
     __slots__ = ()
 
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         """Like dict(...); nested dicts (also inside lists) become Records."""
         super().__init__(*args, **kwargs)
         for key, value in self.items():
             dict.__setitem__(self, key, _wrap(value))
 
-    def __getattr__(self, name):
+    def __getattr__(self, name: str) -> Any:
         """r.key is r["key"]; AttributeError for a key that is not there."""
         try:
             return self[name]
         except KeyError:
             raise AttributeError(name) from None
 
-    def __dir__(self):
+    def __dir__(self) -> List[str]:
         """The keys too, for tab completion in notebooks."""
         return list(self.keys()) + list(super().__dir__())
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         """A summary, not the whole record: the headline numbers first (status, inertia and
         its uncertainty, period, ...), then other short values until about 500 characters;
         arrays as their shape, nested records and long lists as their size; the rest counted.
         ``dict(r)`` (or ``r.keys()``) shows everything."""
         return _summary(self)
 
-    def _repr_pretty_(self, printer, cycle):
+    def _repr_pretty_(self, printer: Any, cycle: bool) -> None:
         """IPython/Jupyter show the same summary (not the dict pretty-printer's full dump)."""
         printer.text("Record(...)" if cycle else _summary(self))
 
@@ -110,22 +140,32 @@ class Columns:
 
     __slots__ = ("_columns", "_length")
 
-    def __init__(self, columns):
+    def __init__(self, columns: _typing.Mapping[str, ArrayLike]) -> None:
         """From a dict of name -> 1-D array, all of one length."""
-        self._columns = {str(k): _np.asarray(v) for k, v in dict(columns).items()}
+        self._columns: Dict[str, npt.NDArray[Any]] = {
+            str(k): _np.asarray(v) for k, v in dict(columns).items()}
         lengths = {len(v) for v in self._columns.values()}
         if len(lengths) > 1:
             raise ValueError("Columns: columns of different lengths " + str(sorted(lengths)))
         self._length = lengths.pop() if lengths else 0
 
-    def keys(self):
+    def keys(self) -> List[str]:
         """The column names."""
         return list(self._columns)
 
-    def __len__(self):
+    def __len__(self) -> int:
         return self._length
 
-    def __getitem__(self, key):
+    @overload
+    def __getitem__(self, key: str) -> npt.NDArray[Any]: ...
+
+    @overload
+    def __getitem__(self, key: slice) -> Columns: ...
+
+    @overload
+    def __getitem__(self, key: int) -> Record: ...
+
+    def __getitem__(self, key: Union[str, slice, int]) -> Union[npt.NDArray[Any], Columns, Record]:
         """A column by name, a row (Record) by integer index, a Columns by slice."""
         if isinstance(key, str):
             return self._columns[key]
@@ -134,21 +174,21 @@ class Columns:
         i = range(self._length)[key]  # IndexError and negative indices as a list
         return Record({k: v[i].item() for k, v in self._columns.items()})
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[Record]:
         for i in range(self._length):
             yield self[i]
 
-    def __getattr__(self, name):
+    def __getattr__(self, name: str) -> npt.NDArray[Any]:
         """c.name is the column c["name"]."""
         try:
             return self._columns[name]
         except KeyError:
             raise AttributeError(name) from None
 
-    def __dir__(self):
+    def __dir__(self) -> List[str]:
         return self.keys() + list(super().__dir__())
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return "Columns(%d rows: %s)" % (self._length, ", ".join(self._columns))
 
 
@@ -162,7 +202,7 @@ _HEADLINE = ("file", "status", "message", "warnings", "inertia_total_kg_m2",
 _SUMMARY_CHARS = 500  # about six lines of a terminal
 
 
-def _short(value):
+def _short(value: object) -> str:
     """A value in a few characters: numbers to 6 digits, strings cut to 60 characters, arrays as
     <array shape>, records and long or nested lists as their size."""
     if isinstance(value, bool) or value is None:
@@ -189,11 +229,12 @@ def _short(value):
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def _summary(record):
+def _summary(record: _typing.Mapping[str, Any]) -> str:
     """Record(key=value, ..., +N more keys: a, b, ...) within about _SUMMARY_CHARS."""
     keys = [k for k in _HEADLINE if k in record]
     keys += [k for k in record if k not in keys]
-    parts, length = [], 0
+    parts: List[str] = []
+    length = 0
     for key in keys:
         part = "%s=%s" % (key, _short(record[key]))
         if parts and length + len(part) > _SUMMARY_CHARS:
@@ -211,11 +252,11 @@ class _FileNotFoundError(FileNotFoundError, ValueError):
     """FileNotFoundError for a path given that does not exist; str() is the command line's
     message. Also a ValueError, as bifilar raised before."""
 
-    def __init__(self, message, filename):
+    def __init__(self, message: str, filename: str) -> None:
         super().__init__(_errno.ENOENT, message, filename)
         self.message = message
 
-    def __str__(self):
+    def __str__(self) -> str:
         return self.message
 
 
@@ -223,7 +264,8 @@ class _FileNotFoundError(FileNotFoundError, ValueError):
 _FileNotFoundError.__name__ = _FileNotFoundError.__qualname__ = "FileNotFoundError"
 
 
-def _calling(inputs, call, *args, **kwargs):
+def _calling(inputs: Sequence[Optional[PathArg]], call: Callable[..., _T], *args: Any,
+             **kwargs: Any) -> _T:
     """call(*args, **kwargs); a ValueError raised while one of `inputs` (paths the call reads,
     None skipped) does not exist becomes FileNotFoundError, with the command line's message
     when it names that file."""
@@ -239,7 +281,7 @@ def _calling(inputs, call, *args, **kwargs):
         raise
 
 
-def _wrap(value):
+def _wrap(value: Any) -> Any:
     """Dicts to Records, recursively through lists; anything else unchanged."""
     if isinstance(value, dict) and not isinstance(value, Record):
         return Record(value)
@@ -248,7 +290,7 @@ def _wrap(value):
     return value
 
 
-def _series(values, name):
+def _series(values: ArrayLike, name: str) -> FloatArray:
     """A float64 numpy view/copy of an array-like; ValueError naming the argument otherwise."""
     if _np is None:
         raise ImportError("bifilar needs numpy for this interpreter (Debian: python3-numpy, "
@@ -259,7 +301,19 @@ def _series(values, name):
         raise ValueError(f"{name} must be an array of numbers: {error}") from None
 
 
-def _path(function, name, value):
+@overload
+def _path(function: str, name: str, value: None) -> None: ...
+
+
+@overload
+def _path(function: str, name: str, value: PathArg) -> Union[str, bytes]: ...
+
+
+@overload
+def _path(function: str, name: str, value: Optional[PathArg]) -> Union[str, bytes, None]: ...
+
+
+def _path(function: str, name: str, value: Optional[PathArg]) -> Union[str, bytes, None]:
     """None, or the path for the core: a str, bytes or os.PathLike given (bytes decoded as the
     file system does, os.fsdecode); TypeError for anything else; ValueError when it holds a NUL
     (the C library would read only the part before it: another file, silently). A name that is
@@ -280,7 +334,7 @@ def _path(function, name, value):
     return text
 
 
-def _seed(function, value):
+def _seed(function: str, value: Any) -> int:
     """A seed: a whole number in [0, 2**64 - 1]; anything else (-1, 2**64, 1e23, 1.5) is a
     ValueError giving the range, never a wrapped or saturated seed."""
     message = f"{function}: seed must be a whole number in [0, 2**64 - 1], got {value!r}"
@@ -302,7 +356,29 @@ def _seed(function, value):
     return seed
 
 
-def _number(function, name, value, kind=float):
+@overload
+def _number(function: str, name: str, value: None, kind: type = ...) -> None: ...
+
+
+@overload
+def _number(function: str, name: str, value: float, kind: _typing.Type[int]) -> int: ...
+
+
+@overload
+def _number(function: str, name: str, value: float, kind: _typing.Type[float] = ...) -> float: ...
+
+
+@overload
+def _number(function: str, name: str, value: Optional[float],
+            kind: _typing.Type[int]) -> Optional[int]: ...
+
+
+@overload
+def _number(function: str, name: str, value: Optional[float],
+            kind: _typing.Type[float] = ...) -> Optional[float]: ...
+
+
+def _number(function: str, name: str, value: Any, kind: type = float) -> Union[int, float, None]:
     """None, or the value as a float (or int); ValueError naming the argument otherwise (NaN
     and infinities too: a number the computation cannot use is never passed on; a bool, which
     Python would take as 0 or 1, too). A whole number outside its range (_core.int_ranges, or
@@ -326,12 +402,18 @@ def _number(function, name, value, kind=float):
     return number
 
 
-def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None, model=None,
-              window=None, config=None, max_amplitude_deg=None, min_amplitude_deg=None,
-              length_std_m=None, separation_std_m=None, mass_std_kg=None, g_std=None,
-              gyro_scale_std=None, max_rms_over_noise=None, max_residual_autocorr=None,
-              whiteness_lags=None, max_secondary_motion_ratio=None, min_periods=None,
-              name="trace"):
+def fit_trace(t: ArrayLike, rate: ArrayLike, *, length_m: Optional[float] = None,
+              separation_m: Optional[float] = None, mass_kg: Optional[float] = None,
+              g: Optional[float] = None, model: Optional[Model] = None, window: Window = None,
+              config: Optional[PathArg] = None, max_amplitude_deg: Optional[float] = None,
+              min_amplitude_deg: Optional[float] = None, length_std_m: Optional[float] = None,
+              separation_std_m: Optional[float] = None, mass_std_kg: Optional[float] = None,
+              g_std: Optional[float] = None, gyro_scale_std: Optional[float] = None,
+              max_rms_over_noise: Optional[float] = None,
+              max_residual_autocorr: Optional[float] = None,
+              whiteness_lags: Optional[int] = None,
+              max_secondary_motion_ratio: Optional[float] = None,
+              min_periods: Optional[float] = None, name: str = "trace") -> Record:
     """Fit the moment of inertia to one swing-rate series, as ``bifilar fit`` does.
 
     The whole processing of ``bifilar fit`` after reading the log runs on the series: the
@@ -389,7 +471,8 @@ def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None
     FileNotFoundError
         ``config`` does not exist.
     """
-    settings = dict(length_m=length_m, separation_m=separation_m, mass_kg=mass_kg, g=g,
+    settings: Dict[str, Any] = dict(
+                    length_m=length_m, separation_m=separation_m, mass_kg=mass_kg, g=g,
                     model=model, window=window, config=config,
                     max_amplitude_deg=max_amplitude_deg, min_amplitude_deg=min_amplitude_deg,
                     length_std_m=length_std_m, separation_std_m=separation_std_m,
@@ -417,7 +500,7 @@ def fit_trace(t, rate, *, length_m=None, separation_m=None, mass_kg=None, g=None
     return result
 
 
-def read_log(path, config=None):
+def read_log(path: PathArg, config: Optional[PathArg] = None) -> Record:
     """Read an IMU log as ``bifilar fit`` does: the time series its fit uses.
 
     Parameters
@@ -451,13 +534,14 @@ def read_log(path, config=None):
         the file, line and column or key); without a config, a file that is not a log
         bifilar recognises (what it looks like instead, as ``bifilar inspect`` says).
     """
-    path = _path("read_log", "path", path)
-    config = _path("read_log", "config", config)
-    return Record(_calling([config, path], _core.read_log, path, config))
+    core_path = _path("read_log", "path", path)
+    core_config = _path("read_log", "config", config)
+    return Record(_calling([core_config, core_path], _core.read_log, core_path, core_config))
 
 
-def fit_ellipse(pitch_deg, inertia, std=None, *, bootstrap=2000, seed=1, confidence=0.95,
-                covariance="auto"):
+def fit_ellipse(pitch_deg: ArrayLike, inertia: ArrayLike, std: Optional[ArrayLike] = None, *,
+                bootstrap: int = 2000, seed: int = 1, confidence: float = 0.95,
+                covariance: Covariance = "auto") -> Record:
     """Fit the ellipse of inertia to moments measured at several pitch angles.
 
     I(theta) = I_z cos^2 theta + I_x sin^2 theta + I_xz sin 2 theta (docs/physics.md), as
@@ -509,7 +593,7 @@ def fit_ellipse(pitch_deg, inertia, std=None, *, bootstrap=2000, seed=1, confide
     return result
 
 
-def down_in_body(roll_deg, pitch_deg):
+def down_in_body(roll_deg: ArrayLike, pitch_deg: ArrayLike) -> FloatArray:
     """The down vertical in body axes of an aircraft hung at roll and pitch (deg), a numpy array.
 
     n = (-sin pitch, sin roll cos pitch, cos roll cos pitch) (docs/physics.md 3.5); scalars give
@@ -528,9 +612,11 @@ def down_in_body(roll_deg, pitch_deg):
                       _np.cos(roll) * _np.cos(pitch)], axis=-1)
 
 
-def fit_tensor(directions, inertias, stds=None, *, nominal=None, groups=None, bootstrap=2000,
-               seed=1, confidence=0.95, covariance="auto", common_offset_std=0.0,
-               attitude_scatter=True):
+def fit_tensor(directions: ArrayLike, inertias: ArrayLike, stds: Optional[ArrayLike] = None, *,
+               nominal: Optional[ArrayLike] = None, groups: Optional[Iterable[int]] = None,
+               bootstrap: int = 2000, seed: int = 1, confidence: float = 0.95,
+               covariance: Covariance = "auto", common_offset_std: float = 0.0,
+               attitude_scatter: bool = True) -> Record:
     """Fit the full inertia tensor to moments measured about swing axes in any body direction.
 
     I(n) = n^T J n with J = [[Ixx, -Ixy, -Ixz], [-Ixy, Iyy, -Iyz], [-Ixz, -Iyz, Izz]]
@@ -572,7 +658,7 @@ def fit_tensor(directions, inertias, stds=None, *, nominal=None, groups=None, bo
         Arrays of different lengths, not finite or of the wrong shape (naming the argument),
         non-positive inertia, nothing observable (naming the components), bad options.
     """
-    directions = _series(directions, "directions")
+    direction_array = _series(directions, "directions")
     nominal_array = None if nominal is None else _series(nominal, "nominal")
     std_array = None if stds is None else _series(stds, "stds")
     bootstrap = _number("fit_tensor", "bootstrap", bootstrap, int)
@@ -580,7 +666,7 @@ def fit_tensor(directions, inertias, stds=None, *, nominal=None, groups=None, bo
     if bootstrap < 0:
         raise ValueError("fit_tensor: bootstrap must be >= 0")
     group_list = None if groups is None else [int(g) for g in groups]
-    return Record(_core.fit_tensor(directions, _series(inertias, "inertias"), std_array,
+    return Record(_core.fit_tensor(direction_array, _series(inertias, "inertias"), std_array,
                                    nominal_array, group_list, bootstrap, seed,
                                    _number("fit_tensor", "confidence", confidence),
                                    str(covariance),
@@ -588,7 +674,8 @@ def fit_tensor(directions, inertias, stds=None, *, nominal=None, groups=None, bo
                                    bool(attitude_scatter)))
 
 
-def process(config_path, out=None, jobs=None, *, force=False, figures=True, progress=None):
+def process(config_path: PathArg, out: Optional[PathArg] = None, jobs: Optional[int] = None, *,
+            force: bool = False, figures: bool = True, progress: Progress = None) -> Record:
     """Process a campaign as ``bifilar process CONFIG --out OUT --jobs JOBS``.
 
     Fits every log (in parallel, with the cache in OUT/cache), subtracts the rig, fits the
@@ -636,16 +723,21 @@ def process(config_path, out=None, jobs=None, *, force=False, figures=True, prog
     if progress not in (None, False, True, "bar") and callback is None:
         raise ValueError("process: progress must be None, True, 'bar' or a callable "
                          "progress(done, total, line), got %r" % (progress,))
-    config_path = _path("process", "config_path", config_path)
-    return Record(_calling([config_path], _core.process, config_path,
+    core_config = _path("process", "config_path", config_path)
+    return Record(_calling([core_config], _core.process, core_config,
                            _path("process", "out", out), _number("process", "jobs", jobs, int),
                            bool(force), bool(figures), bar, callback))
 
 
-def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=None,
-             inertia_kg_m2=None, mass_kg=None, length_m=None, separation_m=None, g=None,
-             amplitude_deg=None, pitch_deg=None, duration_s=None, sample_rate_hz=None,
-             no_accel=False, force=False):
+def simulate(spec: Optional[PathArg] = None, *, out: Optional[PathArg] = None,
+             trace: Optional[PathArg] = None, truth: Optional[PathArg] = None,
+             seed: Optional[int] = None, model: Optional[Model] = None,
+             inertia_kg_m2: Optional[float] = None, mass_kg: Optional[float] = None,
+             length_m: Optional[float] = None, separation_m: Optional[float] = None,
+             g: Optional[float] = None, amplitude_deg: Optional[float] = None,
+             pitch_deg: Optional[float] = None, duration_s: Optional[float] = None,
+             sample_rate_hz: Optional[float] = None, no_accel: bool = False,
+             force: bool = False) -> Record:
     """Simulate realistic IMU logs with known truth, as ``bifilar simulate``.
 
     Three uses:
@@ -694,7 +786,8 @@ def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=No
     FileNotFoundError
         ``spec`` does not exist.
     """
-    settings = dict(spec=spec, out=out, trace=trace, truth=truth, seed=seed, model=model,
+    settings: Dict[str, Any] = dict(
+                    spec=spec, out=out, trace=trace, truth=truth, seed=seed, model=model,
                     inertia_kg_m2=inertia_kg_m2, mass_kg=mass_kg, length_m=length_m,
                     separation_m=separation_m, g=g, amplitude_deg=amplitude_deg,
                     pitch_deg=pitch_deg, duration_s=duration_s, sample_rate_hz=sample_rate_hz,
@@ -710,9 +803,11 @@ def simulate(spec=None, *, out=None, trace=None, truth=None, seed=None, model=No
     return Record(_calling([settings["spec"]], _core.simulate, **settings))
 
 
-def watch(source, config, *, save=None, target_percent=0.5, counter_rate_hz=None,
-          counter_column="count", cycles=None, stop_at_target=False, idle_end_s=None,
-          append=False, serve_port=None):
+def watch(source: PathArg, config: PathArg, *, save: Optional[PathArg] = None,
+          target_percent: float = 0.5, counter_rate_hz: Optional[float] = None,
+          counter_column: str = "count", cycles: Optional[int] = None,
+          stop_at_target: bool = False, idle_end_s: Optional[float] = None, append: bool = False,
+          serve_port: Optional[int] = None) -> Iterator[Record]:
     """Watch the moment of inertia converge while the body swings, as ``bifilar watch``.
 
     A generator: each item is a dict, as ``bifilar watch --json`` prints one per line. An update

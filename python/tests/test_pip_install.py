@@ -47,6 +47,9 @@ def test_pip_install_into_a_target_folder_and_import(tmp_path):
     installed = list((target / "bifilar").glob("_core*.so"))
     assert len(installed) == 1, sorted(os.listdir(target / "bifilar"))
     assert (target / "bifilar" / "__init__.py").exists()
+    # Typed (PEP 561): the marker and the extension's stubs are installed with it.
+    assert (target / "bifilar" / "py.typed").exists()
+    assert (target / "bifilar" / "_core.pyi").exists()
 
     # Imported from the target folder alone (not build/python), it fits a simulated trace with
     # known inertia 2.5 kg m^2 to within 5 sigma of the fit's statistical std, as
