@@ -22,9 +22,9 @@ namespace bm = boost::math;
 namespace bmp = boost::math::policies;
 // Overflow gives +-inf; domain and evaluation errors give Boost's value (NaN or its best
 // estimate) instead of throwing. The inputs are checked first, so a domain error cannot occur.
-using NoThrowPolicy = bmp::policy<bmp::domain_error<bmp::ignore_error>,
-                                  bmp::overflow_error<bmp::ignore_error>,
-                                  bmp::evaluation_error<bmp::ignore_error>>;
+using NoThrowPolicy =
+    bmp::policy<bmp::domain_error<bmp::ignore_error>, bmp::overflow_error<bmp::ignore_error>,
+                bmp::evaluation_error<bmp::ignore_error>>;
 
 constexpr double kDistInf = std::numeric_limits<double>::infinity();
 constexpr double kDistNaN = std::numeric_limits<double>::quiet_NaN();
@@ -66,8 +66,8 @@ double FUpperTail(double f, double d1, double d2) {
   if (!(d1 > 0.0) || !(d2 > 0.0) || !(f > 0.0)) return 1.0;
   if (std::isinf(f)) return 0.0;
   if (std::isinf(d1) && std::isinf(d2)) return f < 1.0 ? 1.0 : 0.0;  // F = 1
-  if (std::isinf(d2)) return ChiSquareUpperTail(d1 * f, d1);          // F = chi^2_d1 / d1
-  if (std::isinf(d1)) {                                               // F = d2 / chi^2_d2
+  if (std::isinf(d2)) return ChiSquareUpperTail(d1 * f, d1);         // F = chi^2_d1 / d1
+  if (std::isinf(d1)) {                                              // F = d2 / chi^2_d2
     return bm::cdf(bm::chi_squared_distribution<double, NoThrowPolicy>(d2), d2 / f);
   }
   return bm::cdf(bm::complement(bm::fisher_f_distribution<double, NoThrowPolicy>(d1, d2), f));
