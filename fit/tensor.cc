@@ -536,8 +536,7 @@ double ReweighPerOrientation(const Design& design, Prepared* data, Solution* fit
     for (int g = 0; g < m; ++g) {
       const double rest_dof = dof_all - dof[g], rest_chi2 = chi2_all - chi2[g];
       own[g] = dof[g] > 0.5 && rest_dof > 0.5 && rest_chi2 > 0 && chi2[g] / dof[g] > 1.0 &&
-               FUpperTail((chi2[g] / dof[g]) / (rest_chi2 / rest_dof), dof[g],
-                                      rest_dof) < 0.01;
+               FUpperTail((chi2[g] / dof[g]) / (rest_chi2 / rest_dof), dof[g], rest_dof) < 0.01;
     }
     // Solve sum r^2 / (s^2 + v I^2) = target over `members` for v >= 0.
     const auto solve = [&](const std::vector<int>& members, double target) {
