@@ -2,6 +2,8 @@
 // parametric bootstrap of the closed form (default) or from t/normal quantiles of the covariance.
 #include "fit/ellipse_steps.h"
 
+#include "fit/distributions.h"
+
 #include <algorithm>
 #include <cmath>
 #include <queue>
@@ -9,54 +11,6 @@
 
 namespace bifilar {
 namespace ellipse {
-
-// Standard normal quantile (Acklam's rational approximation refined by one Halley step; the
-// refinement makes it accurate to ~1e-15).
-double NormalQuantile(double p) {
-  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
-                             1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
-  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
-                             6.680131188771972e+01,  -1.328068155288572e+01};
-  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
-                             -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
-  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
-                             3.754408661907416e+00};
-  double x;
-  if (p < 0.02425) {
-    const double q = std::sqrt(-2 * std::log(p));
-    x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
-  } else if (p > 1 - 0.02425) {
-    const double q = std::sqrt(-2 * std::log(1 - p));
-    x = -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
-  } else {
-    const double q = p - 0.5, r = q * q;
-    x = (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
-        (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1);
-  }
-  const double e = 0.5 * std::erfc(-x / std::sqrt(2.0)) - p;
-  const double u = e * std::sqrt(2 * kPi) * std::exp(x * x / 2);
-  return x - u / (1 + x * u / 2);
-}
-
-// Student-t quantile (Cornish-Fisher expansion in 1/dof; accurate to ~1e-4 for dof >= 3, exact
-// in the normal limit). dof = inf gives the normal quantile.
-double StudentQuantile(double p, double dof) {
-  const double z = NormalQuantile(p);
-  if (!std::isfinite(dof)) return z;
-  if (dof == 1.0) return std::tan(kPi * (p - 0.5));
-  if (dof == 2.0) {
-    const double q = 2 * p - 1;
-    return q * std::sqrt(2.0 / (1 - q * q));
-  }
-  const double z2 = z * z, n = dof;
-  const double g1 = (z2 + 1) * z / 4;
-  const double g2 = ((5 * z2 + 16) * z2 + 3) * z / 96;
-  const double g3 = (((3 * z2 + 19) * z2 + 17) * z2 - 15) * z / 384;
-  const double g4 = ((((79 * z2 + 776) * z2 + 1482) * z2 - 1920) * z2 - 945) * z / 92160;
-  return z + g1 / n + g2 / (n * n) + g3 / (n * n * n) + g4 / (n * n * n * n);
-}
 
 namespace {
 

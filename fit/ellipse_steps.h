@@ -169,11 +169,6 @@ CovarianceEstimate EstimateCovariance(const PreparedData& data, const ClosedForm
 
 // --- Step 7: intervals (ellipse_intervals.cc).
 
-// Standard normal and Student-t quantiles (t: Cornish-Fisher in 1/dof; dof = inf is normal);
-// also used by the tensor fit (fit/tensor_principal.cc).
-double NormalQuantile(double p);
-double StudentQuantile(double p, double dof);
-
 struct Intervals {
   Vec6 lo, hi;                   // at options.confidence, the six quantities
   int bootstrap_replicates = 0;  // 0: t or normal quantiles

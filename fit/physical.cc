@@ -9,7 +9,7 @@
 
 #include "base/enum_names.h"
 #include "base/text_format.h"
-#include "fit/ellipse_steps.h"
+#include "fit/distributions.h"
 
 namespace bifilar {
 namespace physical {
@@ -163,9 +163,9 @@ PhysicalCheck CheckPhysical(const std::array<double, kTensorComponents>& compone
     return check;
   }
   const double p = std::clamp(options.probability, 1e-12, 0.5);
-  check.threshold_z = std::isfinite(options.dof) && options.dof > 0
-                          ? -ellipse::StudentQuantile(1.0 - p, options.dof)
-                          : -ellipse::NormalQuantile(1.0 - p);
+  // Student's t at the fit's dof; the normal quantile when the stds were not estimated (dof
+  // infinite or not positive: fit/distributions.h).
+  check.threshold_z = StudentQuantile(p, options.dof);
   for (size_t k = 0; k < check.inequalities.size(); ++k) {
     if (check.worst < 0 || check.inequalities[k].z < check.inequalities[check.worst].z) {
       check.worst = static_cast<int>(k);

@@ -7,7 +7,7 @@
 #include "base/option_check.h"
 #include "base/text_format.h"
 #include "base/units.h"
-#include "fit/ellipse_steps.h"
+#include "fit/distributions.h"
 #include "fit/solver_logging.h"
 #include "fit/tensor_steps.h"
 
@@ -23,55 +23,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 Eigen::Vector3d ToVector(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
-
-// Continued fraction of the regularized incomplete beta function (modified Lentz).
-double BetaContinuedFraction(double a, double b, double x) {
-  constexpr double kTiny = 1e-300;
-  double c = 1.0, d = 1.0 - (a + b) * x / (a + 1.0);
-  if (std::fabs(d) < kTiny) d = kTiny;
-  d = 1.0 / d;
-  double h = d;
-  for (int m = 1; m <= 300; ++m) {
-    const double m2 = 2.0 * m;
-    double aa = m * (b - m) * x / ((a + m2 - 1) * (a + m2));
-    d = 1.0 + aa * d;
-    c = 1.0 + aa / c;
-    if (std::fabs(d) < kTiny) d = kTiny;
-    if (std::fabs(c) < kTiny) c = kTiny;
-    d = 1.0 / d;
-    h *= d * c;
-    aa = -(a + m) * (a + b + m) * x / ((a + m2) * (a + m2 + 1));
-    d = 1.0 + aa * d;
-    c = 1.0 + aa / c;
-    if (std::fabs(d) < kTiny) d = kTiny;
-    if (std::fabs(c) < kTiny) c = kTiny;
-    d = 1.0 / d;
-    const double delta = d * c;
-    h *= delta;
-    if (std::fabs(delta - 1.0) < 1e-14) break;
-  }
-  return h;
-}
-
-// I_x(a, b), the regularized incomplete beta function.
-double IncompleteBeta(double a, double b, double x) {
-  if (x <= 0.0) return 0.0;
-  if (x >= 1.0) return 1.0;
-  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) +
-                                a * std::log(x) + b * std::log1p(-x));
-  return x < (a + 1.0) / (a + b + 2.0) ? front * BetaContinuedFraction(a, b, x) / a
-                                       : 1.0 - front * BetaContinuedFraction(b, a, 1.0 - x) / b;
-}
-
-}  // namespace
-
-// P(F > f) for F with (d1, d2) degrees of freedom.
-double FDistributionUpperTail(double f, double d1, double d2) {
-  if (!(f > 0.0)) return 1.0;
-  return IncompleteBeta(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
-}
-
-namespace {
 
 }  // namespace
 
@@ -585,8 +536,7 @@ double ReweighPerOrientation(const Design& design, Prepared* data, Solution* fit
     for (int g = 0; g < m; ++g) {
       const double rest_dof = dof_all - dof[g], rest_chi2 = chi2_all - chi2[g];
       own[g] = dof[g] > 0.5 && rest_dof > 0.5 && rest_chi2 > 0 && chi2[g] / dof[g] > 1.0 &&
-               FDistributionUpperTail((chi2[g] / dof[g]) / (rest_chi2 / rest_dof), dof[g],
-                                      rest_dof) < 0.01;
+               FUpperTail((chi2[g] / dof[g]) / (rest_chi2 / rest_dof), dof[g], rest_dof) < 0.01;
     }
     // Solve sum r^2 / (s^2 + v I^2) = target over `members` for v >= 0.
     const auto solve = [&](const std::vector<int>& members, double target) {
@@ -667,7 +617,7 @@ bool OrientationsScatterBeyondTrials(const Prepared& data, const Design& design,
   }
   if (!(pure > 0.0)) return lack > 0.0;
   const double f = (lack / (m - r)) / (pure / (n - m));
-  return FDistributionUpperTail(f, m - r, n - m) < 0.05;
+  return FUpperTail(f, m - r, n - m) < 0.05;
 }
 
 // The covariance mode (kAuto: orientation means when the orientations scatter beyond their
@@ -775,7 +725,7 @@ void FillPrincipal(const Solution& solved, const Covariance& cov,
     for (int c = 0; c < 3; ++c) r.principal_axes[k][c] = p.axes(c, k);
     r.principal_axes_std_deg[k] = p.axes_std_deg(k);
     // Euler intervals: normal, value -+ z std (first order; the angles are not bootstrapped).
-    const double z = ellipse::NormalQuantile(0.5 + 0.5 * options.confidence);
+    const double z = NormalQuantile(0.5 + 0.5 * options.confidence);
     r.euler_deg[k] = {p.euler_deg(k), p.euler_std_deg(k), p.euler_deg(k) - z * p.euler_std_deg(k),
                       p.euler_deg(k) + z * p.euler_std_deg(k), true};
     r.principal_moments_matched_kg_m2[k] = p.matched_moments(k);

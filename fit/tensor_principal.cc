@@ -3,7 +3,7 @@
 // intervals of the components and principal moments (seeded parametric bootstrap, as the
 // ellipse's: fit/ellipse_intervals.cc). Conventions: fit/tensor.h, docs/physics.md §3.5.
 #include "base/units.h"
-#include "fit/ellipse_steps.h"
+#include "fit/distributions.h"
 #include "fit/tensor_steps.h"
 
 #include <algorithm>
@@ -214,14 +214,14 @@ TensorIntervalSet TensorIntervals(const Prepared& data, const Design& design, co
   in.principal_hi.setConstant(NAN);
   if (nb == 0) {
     for (int k = 0; k < 6; ++k) {
-      const double t = ellipse::StudentQuantile(1 - alpha / 2, cov.component_dof(k));
+      const double t = StudentQuantile(1 - alpha / 2, cov.component_dof(k));
       const double sd = std::sqrt(std::max(0.0, cov.cov(k, k)));
       in.lo(k) = s.beta(k) - t * sd;
       in.hi(k) = s.beta(k) + t * sd;
     }
     if (principal) {
       // A principal moment mixes the diagonal: the fewest of their dof (conservative).
-      const double t = ellipse::StudentQuantile(1 - alpha / 2, cov.component_dof.head<3>().minCoeff());
+      const double t = StudentQuantile(1 - alpha / 2, cov.component_dof.head<3>().minCoeff());
       const Principal p = ComputePrincipal(s.beta, cov.cov);
       in.principal_lo = p.moments - t * p.moments_std;
       in.principal_hi = p.moments + t * p.moments_std;

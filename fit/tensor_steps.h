@@ -106,9 +106,6 @@ struct Covariance {
 bool EstimateTensorCovariance(const Prepared& data, const Design& design, const Solution& s,
                               const TensorOptions& options, Covariance* cov, std::string* why);
 
-// P(F > f) of the F distribution with (d1, d2) degrees of freedom (regularized incomplete beta).
-double FDistributionUpperTail(double f, double d1, double d2);
-
 // Principal moments (ascending) and axes, Euler angles of the matched frame, their std.
 struct Principal {
   Eigen::Vector3d moments;

@@ -8,20 +8,12 @@
 #include <vector>
 
 #include "fit/amplitude_trend.h"
+#include "fit/distributions.h"
 #include "fit/trace_fit_steps.h"
 
 namespace bifilar {
 namespace trace {
 namespace {
-
-// 95 % quantile of chi^2 with dof degrees of freedom (table for 1..15; Wilson-Hilferty beyond).
-double ChiSquare95(int dof) {
-  static const double kTable[] = {3.841, 5.991, 7.815, 9.488, 11.070, 12.592, 14.067, 15.507,
-                                  16.919, 18.307, 19.675, 21.026, 22.362, 23.685, 24.996};
-  if (dof >= 1 && dof <= 15) return kTable[dof - 1];
-  const double k = std::max(1, dof), z = 1.6449;
-  return k * std::pow(1.0 - 2.0 / (9.0 * k) + z * std::sqrt(2.0 / (9.0 * k)), 3);
-}
 
 // One band [first, last) of the window: I refitted from the window fit's state at the band's
 // first sample, K_D and C held. ok false when the fit or its std fails.
@@ -82,7 +74,7 @@ void TestConstant(const std::vector<const AmplitudeSweepBand*>& good, AmplitudeS
   // flag says so only when the scatter is significant at 5 %.
   if (sweep->chi2_constant > sweep->chi2_dof)
     sweep->std_scale = std::sqrt(sweep->chi2_constant / sweep->chi2_dof);
-  sweep->bands_disagree = sweep->chi2_constant > ChiSquare95(sweep->chi2_dof);
+  sweep->bands_disagree = sweep->chi2_constant > ChiSquareQuantile(0.95, sweep->chi2_dof);
 }
 
 // The trend over the fitted bands: the weighted curve I_j = I_0 (1 + c A_j^p), p chosen by the
@@ -126,7 +118,7 @@ void FitTrend(const TraceFitOptions& options, double ref, AmplitudeSweep* sweep)
   sweep->trend_detected = std::abs(sweep->trend_z) > options.sweep_trend_z;
   if (sweep->trend_detected) {
     sweep->std_scale = trend.birge;
-    sweep->bands_disagree = trend.dof > 0 && trend.chi2 > ChiSquare95(trend.dof);
+    sweep->bands_disagree = trend.dof > 0 && trend.chi2 > ChiSquareQuantile(0.95, trend.dof);
   }
 }
 

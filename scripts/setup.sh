@@ -16,7 +16,7 @@ packages=(cmake g++ make pkg-config libeigen3-dev libsundials-dev libceres-dev l
           pybind11-dev python3-dev python3-numpy python3-pytest
           liburdfdom-dev libsdformat-dev libmujoco-dev
           python3-pip python3-setuptools python3-wheel python3-venv
-          libcpp-httplib-dev libasio-dev libwebsocketpp-dev libboost-dev
+          libcpp-httplib-dev libasio-dev libwebsocketpp-dev libboost-dev libboost-math-dev
           mypy clang-format)
 missing=()
 for p in "${packages[@]}"; do
