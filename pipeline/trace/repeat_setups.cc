@@ -5,11 +5,12 @@
 #include <numeric>
 
 #include "base/units.h"
+#include "fit/distributions.h"
 
 namespace bifilar {
 namespace {
 
-constexpr double kQz = 3.09;           // Wilson-Hilferty z of Q: p < 0.001
+const double kQz = NormalQuantile(0.999);  // z of Q: p < 0.001
 constexpr double kGapZ = 5.0;          // the clusters' gap over its std
 constexpr double kGapZWithAxes = 3.0;  // ... when the swing axes differ too
 constexpr double kSeparation = 3.0;    // the gap over the largest range within a cluster
@@ -35,11 +36,9 @@ WeightedMean Weighted(const std::vector<double>& v, const std::vector<double>& s
   return m;
 }
 
-// Wilson-Hilferty: Q on dof degrees of freedom as a standard normal z.
-double ChiSquareZ(double q, int dof) {
-  const double k = dof;
-  return (std::cbrt(q / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
-}
+// Q on dof degrees of freedom as the standard normal z of the same upper tail (exact, from the
+// chi^2 tail; -z of the tail keeps its digits where the tail is tiny).
+double ChiSquareZ(double q, int dof) { return -NormalQuantile(ChiSquareUpperTail(q, dof)); }
 
 // A log's own I(A) trend (its amplitude sweep) as an A^2 coefficient: c A^p with p = 1 over the
 // bands' amplitudes [a, b] has the chord slope of c / (a + b) A^2. False without a measured trend.
