@@ -120,9 +120,6 @@ struct RunsConfig {
 // structs (fit/trace_options.h, fit/glitch.h), held by FitConfig as they are: each has one table
 // ({config key, member, bound}, base/option_table.h) from which the loader reads `fit.quality`,
 // `fit.amplitude_sweep` and `fit.glitch`, the checks take their bounds and the cache key its text.
-// The name the Python module (python/src/fit.cc) uses for fit.quality:
-using QualityThresholds = TraceQualityOptions;
-
 struct FitConfig {
   PendulumModel model = PendulumModel::kFull;  // `fit.model`: full | jardin | linear
   // `fit.integrator`: rk853 (default) | cvodes; the fit's ODE solver (pendulum/integrator.h).

@@ -96,7 +96,7 @@ CampaignConfig FitTraceConfig(const FitTraceArgs& a) {
   // Any std given replaces the assumed +-1 mm on L and D, as a rig.uncertainties section does.
   if (a.length_std_m || a.separation_std_m || a.mass_std_kg || a.g_std) u.configured = true;
   if (a.gyro_scale_std) config.imu.gyro_scale_std = *a.gyro_scale_std;
-  QualityThresholds& q = config.fit.quality;
+  TraceQualityOptions& q = config.fit.quality;
   if (a.max_rms_over_noise) q.max_rms_over_noise = *a.max_rms_over_noise;
   if (a.max_residual_autocorr) q.max_residual_autocorr = *a.max_residual_autocorr;
   if (a.whiteness_lags) q.whiteness_lags = *a.whiteness_lags;
