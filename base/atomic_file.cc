@@ -92,8 +92,8 @@ void WriteFileAtomically(const std::string& path, const std::string& text) {
   ::unlink(temp.c_str());
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (fd < 0) {
-    throw UserError(path + ": cannot write (temporary file " + temp + ": " +
-                    std::strerror(errno) + ")");
+    throw UserError(path + ": cannot write (temporary file " + temp + ": " + std::strerror(errno) +
+                    ")");
   }
   size_t done = 0;
   while (done < text.size()) {

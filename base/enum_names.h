@@ -5,8 +5,8 @@
 //
 //   constexpr EnumName<TimeUnit> kTimeUnitNames[] = {{TimeUnit::kSeconds, "s"}, ...};
 //   const char* ToString(TimeUnit u) { return EnumToString(kTimeUnitNames, u); }
-//   bool ParseTimeUnit(const std::string& s, TimeUnit* u) { return ParseEnum(kTimeUnitNames, s, u); }
-//   std::string TimeUnitAllowedValues() { return EnumAllowedValues(kTimeUnitNames); }
+//   bool ParseTimeUnit(const std::string& s, TimeUnit* u) { return ParseEnum(kTimeUnitNames, s, u);
+//   } std::string TimeUnitAllowedValues() { return EnumAllowedValues(kTimeUnitNames); }
 #pragma once
 
 #include <cstddef>

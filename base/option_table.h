@@ -31,8 +31,12 @@ struct OptionRange {
 constexpr OptionRange RangeIn(double lo, double hi, Ends ends) {
   return {OptionRange::Kind::kIn, lo, hi, ends};
 }
-constexpr OptionRange RangeFiniteGt(double lo) { return {OptionRange::Kind::kFiniteGt, lo, 0.0, Ends::kOpen}; }
-constexpr OptionRange RangeFiniteGe(double lo) { return {OptionRange::Kind::kFiniteGe, lo, 0.0, Ends::kClosed}; }
+constexpr OptionRange RangeFiniteGt(double lo) {
+  return {OptionRange::Kind::kFiniteGt, lo, 0.0, Ends::kOpen};
+}
+constexpr OptionRange RangeFiniteGe(double lo) {
+  return {OptionRange::Kind::kFiniteGe, lo, 0.0, Ends::kClosed};
+}
 constexpr OptionRange kAnyValue = {};  // no bound of its own (a flag, or a cross-field bound only)
 
 // One field of an options struct `Options`: a double, int or bool member.
@@ -72,10 +76,17 @@ bool CheckOptionFields(const Options& o, const OptionFields<Options>& fields,
     const OptionRange& r = row.range;
     bool ok = true;
     switch (r.kind) {
-      case OptionRange::Kind::kAny: break;
-      case OptionRange::Kind::kIn: ok = CheckIn(row.field, v, r.lo, r.hi, r.ends, failure); break;
-      case OptionRange::Kind::kFiniteGt: ok = CheckFiniteGt(row.field, v, r.lo, failure); break;
-      case OptionRange::Kind::kFiniteGe: ok = CheckFiniteGe(row.field, v, r.lo, failure); break;
+      case OptionRange::Kind::kAny:
+        break;
+      case OptionRange::Kind::kIn:
+        ok = CheckIn(row.field, v, r.lo, r.hi, r.ends, failure);
+        break;
+      case OptionRange::Kind::kFiniteGt:
+        ok = CheckFiniteGt(row.field, v, r.lo, failure);
+        break;
+      case OptionRange::Kind::kFiniteGe:
+        ok = CheckFiniteGe(row.field, v, r.lo, failure);
+        break;
     }
     if (!ok) return false;
   }

@@ -35,7 +35,8 @@ struct PlotBenchLog {
     fs::create_directories(dir);
     std::string spec;
     {
-      const std::string path = std::string(BIFILAR_SOURCE_DIR) + "/configs/simulate_nonideal_rig.yaml";
+      const std::string path =
+          std::string(BIFILAR_SOURCE_DIR) + "/configs/simulate_nonideal_rig.yaml";
       std::FILE* f = std::fopen(path.c_str(), "rb");
       if (f == nullptr) std::abort();
       char buf[4096];
@@ -48,9 +49,11 @@ struct PlotBenchLog {
     RunSimulateCampaign(ParseSimulateSpec(spec, "nonideal.yaml"), dir + "/logs");
     const std::string yaml = dir + "/c.yaml";
     std::FILE* f = std::fopen(yaml.c_str(), "wb");
-    std::fputs("rig: {filar_length_m: 0.74, filar_separation_m: 0.16, mass_kg: 3.34}\n"
-               "imu:\n  time: {column: t, unit: ms}\n"
-               "  gyro: {columns: [gx, gy, gz], unit: deg/s}\n  accel: null\n", f);
+    std::fputs(
+        "rig: {filar_length_m: 0.74, filar_separation_m: 0.16, mass_kg: 3.34}\n"
+        "imu:\n  time: {column: t, unit: ms}\n"
+        "  gyro: {columns: [gx, gy, gz], unit: deg/s}\n  accel: null\n",
+        f);
     std::fclose(f);
     ConfigLoadOptions load;
     load.require_runs = false;

@@ -7,9 +7,9 @@
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include "bench/bench_support.h"
 #include "fit/swing_axis.h"
 #include "fit/window.h"
-#include "bench/bench_support.h"
 #include "pendulum/simulate.h"
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/logs/imu_log_writer.h"
@@ -36,8 +36,9 @@ void BM_ImuLogParseString(benchmark::State& state) {
 BENCHMARK(BM_ImuLogParseString)->Unit(benchmark::kMicrosecond);
 
 void BM_ImuLogReadFile(benchmark::State& state) {
-  const std::string path =
-      (std::filesystem::temp_directory_path() / ("bifilar_bench_" + std::to_string(::getpid()) + ".csv")).string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("bifilar_bench_" + std::to_string(::getpid()) + ".csv"))
+                               .string();
   std::ofstream(path, std::ios::binary) << CsvText();
   for (auto _ : state) {
     ImuData d = ReadImuLog(path, ImuFormat());
@@ -54,8 +55,10 @@ void BM_SwingAxisAndWindow(benchmark::State& state) {
     SwingAxis axis;
     std::string why;
     if (!EstimateSwingAxis(imu, SwingAxisOptions(), std::nullopt, &axis, &why)) std::abort();
-    FreeOscillationWindow w = FindFreeOscillationWindow(imu.t_s, axis.rate_rad_per_s, WindowOptions());
-    AmplitudeBand band = TrimToAmplitudeBand(imu.t_s, axis.rate_rad_per_s, w, AmplitudeBandOptions());
+    FreeOscillationWindow w =
+        FindFreeOscillationWindow(imu.t_s, axis.rate_rad_per_s, WindowOptions());
+    AmplitudeBand band =
+        TrimToAmplitudeBand(imu.t_s, axis.rate_rad_per_s, w, AmplitudeBandOptions());
     benchmark::DoNotOptimize(band.t0_s);
   }
 }

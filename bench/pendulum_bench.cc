@@ -142,9 +142,17 @@ void BM_PendulumIntegratorTable(benchmark::State& state, IntegratorMethod method
   state.counters["sens_err"] = sens_err;
 }
 BENCHMARK_CAPTURE(BM_PendulumIntegratorTable, rk853, IntegratorMethod::kRungeKutta)
-    ->Arg(80)->Arg(100)->Unit(benchmark::kMillisecond);
+    ->Arg(80)
+    ->Arg(100)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PendulumIntegratorTable, cvodes, IntegratorMethod::kCvodes)
-    ->Arg(80)->Arg(100)->Arg(105)->Arg(110)->Arg(115)->Arg(120)->Unit(benchmark::kMillisecond);
+    ->Arg(80)
+    ->Arg(100)
+    ->Arg(105)
+    ->Arg(110)
+    ->Arg(115)
+    ->Arg(120)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace bifilar

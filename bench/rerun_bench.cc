@@ -21,7 +21,8 @@ namespace fs = std::filesystem;
 
 void BM_CachedRerun39Logs(benchmark::State& state) {
   const fs::path source = fs::path(BIFILAR_SOURCE_DIR) / "sample_runs/prandtl_d/logs";
-  const fs::path work = fs::temp_directory_path() / ("bifilar_rerun_bench_" + std::to_string(getpid()));
+  const fs::path work =
+      fs::temp_directory_path() / ("bifilar_rerun_bench_" + std::to_string(getpid()));
   fs::remove_all(work);
   for (int pitch = -60; pitch <= 60; pitch += 10) {
     const std::string name = "pitch_" + std::to_string(pitch);

@@ -42,8 +42,9 @@ std::string EllipseTable(int rows) {
   text.precision(8);
   for (int i = 0; i < rows; ++i) {
     const double d = pitch(rng), t = d * kRadPerDeg;
-    text << d << ',' << 2.8 * std::cos(t) * std::cos(t) + 2.3 * std::sin(t) * std::sin(t) +
-                            0.02 * std::sin(2 * t) + noise(rng)
+    text << d << ','
+         << 2.8 * std::cos(t) * std::cos(t) + 2.3 * std::sin(t) * std::sin(t) +
+                0.02 * std::sin(2 * t) + noise(rng)
          << '\n';
   }
   return text.str();
@@ -52,7 +53,8 @@ std::string EllipseTable(int rows) {
 void BM_ScaleEllipseTable(benchmark::State& state) {
   const std::string text = EllipseTable(static_cast<int>(state.range(0)));
   for (auto _ : state) {
-    const std::vector<EllipsePoint> points = ParseEllipseTable(text, "table.csv", DisplayUnits::kSi);
+    const std::vector<EllipsePoint> points =
+        ParseEllipseTable(text, "table.csv", DisplayUnits::kSi);
     EllipseResult result;
     std::string why;
     if (!FitEllipse(points, EllipseOptions(), &result, &why)) state.SkipWithError(why.c_str());
@@ -60,8 +62,11 @@ void BM_ScaleEllipseTable(benchmark::State& state) {
   }
   state.SetComplexityN(state.range(0));
 }
-BENCHMARK(BM_ScaleEllipseTable)->RangeMultiplier(10)->Range(10000, 1000000)
-    ->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+BENCHMARK(BM_ScaleEllipseTable)
+    ->RangeMultiplier(10)
+    ->Range(10000, 1000000)
+    ->Unit(benchmark::kMillisecond)
+    ->Complexity(benchmark::oN);
 
 // A campaign folder with `logs` fake logs at 6 angles ("I=<total>"), optional window entries for
 // every log and a tare list of `tare` entries (missing files: error rows).
@@ -129,16 +134,22 @@ void BM_ScaleCampaignWindows(benchmark::State& state) {
   for (auto _ : state) campaign.Run(state);
   state.SetComplexityN(state.range(0));
 }
-BENCHMARK(BM_ScaleCampaignWindows)->RangeMultiplier(4)->Range(250, 4000)
-    ->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+BENCHMARK(BM_ScaleCampaignWindows)
+    ->RangeMultiplier(4)
+    ->Range(250, 4000)
+    ->Unit(benchmark::kMillisecond)
+    ->Complexity(benchmark::oN);
 
 void BM_ScaleTareList(benchmark::State& state) {
   const FakeCampaignDir campaign(60, false, static_cast<int>(state.range(0)));
   for (auto _ : state) campaign.Run(state);
   state.SetComplexityN(state.range(0));
 }
-BENCHMARK(BM_ScaleTareList)->RangeMultiplier(4)->Range(1000, 16000)
-    ->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+BENCHMARK(BM_ScaleTareList)
+    ->RangeMultiplier(4)
+    ->Range(1000, 16000)
+    ->Unit(benchmark::kMillisecond)
+    ->Complexity(benchmark::oN);
 
 // One simulated log of 60 s free swing at `rate_hz` (the `bifilar simulate --trace` defaults:
 // I = 4.1 kg m^2, m = 6.75 kg, L = 2 m, D = 1.8 m, 20 deg, gyro and accelerometer) and its config.
@@ -180,8 +191,13 @@ void BM_ScaleLongLogFit(benchmark::State& state) {
   state.counters["rows"] = static_cast<double>(rows);
   state.counters["I_kg_m2"] = record.inertia_total_kg_m2;
 }
-BENCHMARK(BM_ScaleLongLogFit)->Arg(11667)->Arg(23333)->Arg(46667)
-    ->Unit(benchmark::kMillisecond)->Iterations(2)->Complexity(benchmark::oN);
+BENCHMARK(BM_ScaleLongLogFit)
+    ->Arg(11667)
+    ->Arg(23333)
+    ->Arg(46667)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2)
+    ->Complexity(benchmark::oN);
 
 }  // namespace
 }  // namespace bifilar

@@ -46,12 +46,12 @@ struct TraceStats {
   std::string status;  // "ok", "warned" (ok with a quality flag), "rejected", "error"
   std::string reason;  // message of a rejected/error trace
   double rms_over_noise = NAN;
-  double whiteness = NAN;       // max |rho_k| after AR(1) prewhitening
-  double secondary = NAN;       // secondary-motion ratio
+  double whiteness = NAN;  // max |rho_k| after AR(1) prewhitening
+  double secondary = NAN;  // secondary-motion ratio
   double residual_fraction = NAN;
-  double cycles = NAN;          // periods in the window (min_periods)
-  double trend_z = NAN;         // |z| of the amplitude sweep's trend
-  int glitches = 0;             // glitch samples dropped
+  double cycles = NAN;             // periods in the window (min_periods)
+  double trend_z = NAN;            // |z| of the amplitude sweep's trend
+  int glitches = 0;                // glitch samples dropped
   std::vector<std::string> flags;  // quality flags raised
 };
 
@@ -145,8 +145,7 @@ std::string TempDir() {
   return dir;
 }
 
-CampaignConfig FitConfig(const std::string& dir, const std::string& name,
-                         const std::string& text) {
+CampaignConfig FitConfig(const std::string& dir, const std::string& name, const std::string& text) {
   const std::string path = dir + "/" + name;
   std::ofstream(path) << text;
   ConfigLoadOptions options;
@@ -307,9 +306,12 @@ DataSet SampleCampaign() {
 std::string Num(double v) {
   char text[32];
   const double a = std::abs(v);
-  if (a >= 100) std::snprintf(text, sizeof(text), "%.0f", v);
-  else if (a >= 10) std::snprintf(text, sizeof(text), "%.1f", v);
-  else std::snprintf(text, sizeof(text), "%.2f", v);
+  if (a >= 100)
+    std::snprintf(text, sizeof(text), "%.0f", v);
+  else if (a >= 10)
+    std::snprintf(text, sizeof(text), "%.1f", v);
+  else
+    std::snprintf(text, sizeof(text), "%.2f", v);
   return text;
 }
 
@@ -339,7 +341,8 @@ void PrintTable(const std::vector<DataSet>& sets) {
   std::printf(
       "| data set | n | ok / warned / rejected / error | RMS/noise (warn > %s) | whiteness "
       "(warn > %s) | secondary motion (warn > %s, reject > %s) | residual fraction (reject > %s) "
-      "| cycles (reject < %s) | amplitude trend \\|z\\| (trend > %s) | glitch samples | flags raised |\n",
+      "| cycles (reject < %s) | amplitude trend \\|z\\| (trend > %s) | glitch samples | flags "
+      "raised |\n",
       Num(d.max_rms_over_noise).c_str(), Num(d.max_residual_autocorr).c_str(),
       Num(d.max_secondary_motion_ratio).c_str(), Num(d.reject_secondary_motion_ratio).c_str(),
       Num(d.reject_residual_fraction).c_str(), Num(d.min_periods).c_str(),
@@ -347,7 +350,8 @@ void PrintTable(const std::vector<DataSet>& sets) {
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const DataSet& set : sets) {
     if (!set.absent.empty()) {
-      std::printf("| %s | – | absent: %s | | | | | | | | |\n", set.name.c_str(), set.absent.c_str());
+      std::printf("| %s | – | absent: %s | | | | | | | | |\n", set.name.c_str(),
+                  set.absent.c_str());
       continue;
     }
     std::map<std::string, int> count, flags;
@@ -363,27 +367,39 @@ void PrintTable(const std::vector<DataSet>& sets) {
       glitch_samples += s.glitches;
     }
     const std::string secondary =
-        Cell(set.traces, [](const TraceStats& s) { return s.secondary; },
-             [&](double x) { return x > d.max_secondary_motion_ratio; }) +
+        Cell(
+            set.traces, [](const TraceStats& s) { return s.secondary; },
+            [&](double x) { return x > d.max_secondary_motion_ratio; }) +
         " / **" +
-        std::to_string(std::count_if(set.traces.begin(), set.traces.end(), [&](const TraceStats& s) {
-          return s.secondary > d.reject_secondary_motion_ratio;
-        })) + "**";
+        std::to_string(std::count_if(
+            set.traces.begin(), set.traces.end(),
+            [&](const TraceStats& s) { return s.secondary > d.reject_secondary_motion_ratio; })) +
+        "**";
     std::printf(
         "| %s | %zu | %d / %d / %d / %d | %s | %s | %s | %s | %s | %s | %d in %d logs | %s |\n",
         set.name.c_str(), set.traces.size(), count["ok"], count["warned"], count["rejected"],
         count["error"],
-        Cell(set.traces, [](const TraceStats& s) { return s.rms_over_noise; },
-             [&](double x) { return x > d.max_rms_over_noise; }).c_str(),
-        Cell(set.traces, [](const TraceStats& s) { return s.whiteness; },
-             [&](double x) { return x > d.max_residual_autocorr; }).c_str(),
+        Cell(
+            set.traces, [](const TraceStats& s) { return s.rms_over_noise; },
+            [&](double x) { return x > d.max_rms_over_noise; })
+            .c_str(),
+        Cell(
+            set.traces, [](const TraceStats& s) { return s.whiteness; },
+            [&](double x) { return x > d.max_residual_autocorr; })
+            .c_str(),
         secondary.c_str(),
-        Cell(set.traces, [](const TraceStats& s) { return s.residual_fraction; },
-             [&](double x) { return x > d.reject_residual_fraction; }).c_str(),
-        Cell(set.traces, [](const TraceStats& s) { return s.cycles; },
-             [&](double x) { return x < d.min_periods; }).c_str(),
-        Cell(set.traces, [](const TraceStats& s) { return s.trend_z; },
-             [&](double x) { return x > d.sweep_trend_z; }).c_str(),
+        Cell(
+            set.traces, [](const TraceStats& s) { return s.residual_fraction; },
+            [&](double x) { return x > d.reject_residual_fraction; })
+            .c_str(),
+        Cell(
+            set.traces, [](const TraceStats& s) { return s.cycles; },
+            [&](double x) { return x < d.min_periods; })
+            .c_str(),
+        Cell(
+            set.traces, [](const TraceStats& s) { return s.trend_z; },
+            [&](double x) { return x > d.sweep_trend_z; })
+            .c_str(),
         glitch_samples, glitch_traces, flag_text.empty() ? "–" : flag_text.c_str());
   }
   // Why the rejected and failed traces were refused (first 90 characters, counted).
@@ -448,11 +464,10 @@ int Main(int argc, char** argv) {
     sets.push_back(SyntheticSet(name, phi, 40, 0.0, false));
   }
   std::fprintf(stderr, "bad simulations...\n");
-  sets.push_back(SimulatedPreset(
-      "sim (bad): quadrotor, 3 glitches of 50 rad/s per log",
-      Replaced(Replaced(quad, "spike_count: 1", "spike_count: 3"), "spike_rate_rad_per_s: 5",
-               "spike_rate_rad_per_s: 50"),
-      kQuadrotorFit));
+  sets.push_back(SimulatedPreset("sim (bad): quadrotor, 3 glitches of 50 rad/s per log",
+                                 Replaced(Replaced(quad, "spike_count: 1", "spike_count: 3"),
+                                          "spike_rate_rad_per_s: 5", "spike_rate_rad_per_s: 50"),
+                                 kQuadrotorFit));
   sets.push_back(SimulatedPreset("sim (bad): quadrotor, rocking up to 6° (real: 1.5°)",
                                  Replaced(quad, "rocking_max_deg: 1.5", "rocking_max_deg: 6"),
                                  kQuadrotorFit));
@@ -465,8 +480,8 @@ int Main(int argc, char** argv) {
                   100 * sway);
     sets.push_back(SyntheticSet(name, 0.5, 20, sway, false));
   }
-  sets.push_back(SyntheticSet("sim (bad): window φ = 0.5 of 4 s (1.6 periods)", 0.5, 10, 0.0,
-                              false, 4.0));
+  sets.push_back(
+      SyntheticSet("sim (bad): window φ = 0.5 of 4 s (1.6 periods)", 0.5, 10, 0.0, false, 4.0));
   sets.push_back(SyntheticSet("sim (bad): AR(1) noise only, φ = 0.5", 0.5, 10, 0.0, true));
   std::fprintf(stderr, "sample campaign...\n");
   sets.push_back(SampleCampaign());

@@ -6,10 +6,10 @@
 //       --benchmark_report_aggregates_only=true   (one command line)
 //
 // Arguments: model (0 full, 1 jardin, 2 linear), amplitude (deg). BM_TraceFitCvodes: the same
-// with the CVODE integrator (`fit.integrator: cvodes`) instead of the default DOP853. BM_TraceFitWithBudget: plus the
-// geometry uncertainty budget (8 extra integrations without sensitivities).
-// BM_TraceFitLargeRelease: released at 75 deg. Every case includes the amplitude sweep (the
-// default): the fit's time is the window fit plus the band refits.
+// with the CVODE integrator (`fit.integrator: cvodes`) instead of the default DOP853.
+// BM_TraceFitWithBudget: plus the geometry uncertainty budget (8 extra integrations without
+// sensitivities). BM_TraceFitLargeRelease: released at 75 deg. Every case includes the amplitude
+// sweep (the default): the fit's time is the window fit plus the band refits.
 #include <string>
 
 #include <benchmark/benchmark.h>
@@ -56,7 +56,8 @@ BENCHMARK(BM_TraceFit)
 
 void BM_TraceFitCvodes(benchmark::State& state) {
   TraceFitOptions options;
-  options.integrator = options.integrator.WithMethod(IntegratorMethod::kCvodes);  // as fit.integrator
+  options.integrator =
+      options.integrator.WithMethod(IntegratorMethod::kCvodes);  // as fit.integrator
   RunFit(state, Window(20.0), options);
 }
 BENCHMARK(BM_TraceFitCvodes)->Unit(benchmark::kMillisecond);

@@ -47,7 +47,8 @@ BENCHMARK(BM_UlogPerSample)->Unit(benchmark::kMicrosecond);
 // A real PX4 flight log: every message of every topic is walked, only sensor_combined decoded;
 // items = sensor_combined samples.
 void BM_UlogRealPx4Log(benchmark::State& state) {
-  const std::string path = std::string(BIFILAR_SOURCE_DIR) + "/../shared/data/px4/sample_log_small.ulg";
+  const std::string path =
+      std::string(BIFILAR_SOURCE_DIR) + "/../shared/data/px4/sample_log_small.ulg";
   if (!std::filesystem::exists(path)) {
     state.SkipWithError("real PX4 log absent");
     return;

@@ -18,13 +18,16 @@ std::vector<AngleExtreme> AngleExtremes(const std::vector<double>& t, const std:
                                         const FreeOscillationWindow& w) {
   using namespace window;  // the shared steps (window_steps.h)
   std::vector<AngleExtreme> out;
-  if (t.size() != r.size() || t.empty() || w.last_index >= t.size() || w.last_index <= w.first_index) return out;
+  if (t.size() != r.size() || t.empty() || w.last_index >= t.size() ||
+      w.last_index <= w.first_index)
+    return out;
   const size_t b = w.first_index, e = w.last_index + 1;
   std::vector<double> x(t.size(), 0.0);
   for (size_t k = b; k < e; ++k) x[k] = r[k] - w.rest_bias_rad_per_s;
   // Cumulative trapezoid angle.
   std::vector<double> psi(t.size(), 0.0);
-  for (size_t k = b + 1; k < e; ++k) psi[k] = psi[k - 1] + 0.5 * (x[k] + x[k - 1]) * (t[k] - t[k - 1]);
+  for (size_t k = b + 1; k < e; ++k)
+    psi[k] = psi[k - 1] + 0.5 * (x[k] + x[k - 1]) * (t[k] - t[k - 1]);
   double range = 0.0;
   for (size_t k = b; k < e; ++k) range = std::max(range, std::abs(x[k]));
   const double h = std::max(4.0 * w.noise_sigma_rad_per_s, 1e-6 * range);
@@ -34,8 +37,8 @@ std::vector<AngleExtreme> AngleExtremes(const std::vector<double>& t, const std:
     const double half = 0.5 * w.period_s;
     const double tol = WindowOptions().half_period_tolerance;
     cycles = MergeGlitchSplits(cycles, WindowOptions().blip_fraction * half,
-                               [&](const HalfCycle&, const HalfCycle& before, const HalfCycle& after,
-                                   const HalfCycle*, const HalfCycle*) {
+                               [&](const HalfCycle&, const HalfCycle& before,
+                                   const HalfCycle& after, const HalfCycle*, const HalfCycle*) {
                                  return before.duration() < (1.0 - tol) * half ||
                                         after.duration() < (1.0 - tol) * half;
                                });
@@ -52,9 +55,12 @@ std::vector<AngleExtreme> AngleExtremes(const std::vector<double>& t, const std:
   if (ext.size() < 2) return out;
   for (size_t j = 0; j < ext.size(); ++j) {
     double ref;
-    if (j == 0) ref = ext[1].second;
-    else if (j + 1 == ext.size()) ref = ext[j - 1].second;
-    else ref = 0.5 * (ext[j - 1].second + ext[j + 1].second);
+    if (j == 0)
+      ref = ext[1].second;
+    else if (j + 1 == ext.size())
+      ref = ext[j - 1].second;
+    else
+      ref = 0.5 * (ext[j - 1].second + ext[j + 1].second);
     out.push_back({ext[j].first, 0.5 * std::abs(ext[j].second - ref) * kDegPerRad});
   }
   // The end extremes have one neighbour, so the value above is the mean of two successive
@@ -128,11 +134,12 @@ AmplitudeBand TrimToAmplitudeBand(const std::vector<double>& t, const std::vecto
   band.first_index = FirstAtOrAfter(t, band.t0_s);
   band.last_index = LastAtOrBefore(t, band.t1_s);
   if (band.t1_s - band.t0_s < o.min_periods * w.period_s) {
-    band.message = Prefix(name) +
-                   Fmt("only %.2f periods inside the amplitude band [%g, %g] deg", (band.t1_s - band.t0_s) / w.period_s,
-                       o.min_amplitude_deg, o.max_amplitude_deg) +
-                   Fmt(" (amplitude %.2f to %.2f deg over the window)", ex.front().amplitude_deg,
-                       ex.back().amplitude_deg);
+    band.message =
+        Prefix(name) +
+        Fmt("only %.2f periods inside the amplitude band [%g, %g] deg",
+            (band.t1_s - band.t0_s) / w.period_s, o.min_amplitude_deg, o.max_amplitude_deg) +
+        Fmt(" (amplitude %.2f to %.2f deg over the window)", ex.front().amplitude_deg,
+            ex.back().amplitude_deg);
     return band;
   }
   band.status = WindowStatus::kOk;

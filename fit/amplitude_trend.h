@@ -4,8 +4,9 @@
 // ratio when the points scatter about the fitted curve more than their stds (chi^2 > dof, the
 // PDG rule). Deviations of a real rig from the ideal model are even in the angle; an analytic one
 // starts as A^2 (p = 2), and a rig whose I rises linearly with the amplitude (hooks, wire bending,
-// slack: |psi| terms) as A (p = 1). FitAmplitudeShape lets the data choose p among these. Used by the amplitude sweep within one log (fit/trace_sweep.cc) and
-// across repeats of one set-up (pipeline/trace/repeats.cc). docs/method.md §4 and §8.
+// slack: |psi| terms) as A (p = 1). FitAmplitudeShape lets the data choose p among these. Used by
+// the amplitude sweep within one log (fit/trace_sweep.cc) and across repeats of one set-up
+// (pipeline/trace/repeats.cc). docs/method.md §4 and §8.
 #ifndef BIFILAR_FIT_AMPLITUDE_TREND_H_
 #define BIFILAR_FIT_AMPLITUDE_TREND_H_
 

@@ -68,10 +68,11 @@ FitSeries MakeFitSeries(const std::vector<double>& t_s, const std::vector<double
   series.samples_per_point = static_cast<double>(n) / static_cast<double>(series.t_s.size());
   if (noise_rad_per_s > 0.0) {
     // The rest's own block means: their scatter is the noise of a fitted point.
-    const size_t rest_last = static_cast<size_t>(
-        std::upper_bound(t_s.begin(), t_s.end(), rest_end_s) - t_s.begin());
+    const size_t rest_last =
+        static_cast<size_t>(std::upper_bound(t_s.begin(), t_s.end(), rest_end_s) - t_s.begin());
     std::vector<double> rest_t, rest_mean;
-    if (rest_last >= 2) BlockMeans(t_s, rate_rad_per_s, 0, rest_last - 1, span_s, &rest_t, &rest_mean);
+    if (rest_last >= 2)
+      BlockMeans(t_s, rate_rad_per_s, 0, rest_last - 1, span_s, &rest_t, &rest_mean);
     if (rest_mean.size() >= 20) {
       double mean = 0.0, sq = 0.0;
       for (double v : rest_mean) mean += v;

@@ -215,8 +215,10 @@ bool ResolveCovariance(EllipseCovariance requested, int n_points, int n_groups,
                                           : EllipseCovariance::kPointResiduals;
   }
   if (*mode == EllipseCovariance::kPointResiduals && n_points <= 3) {
-    *why = "need >= 4 points (or a std for every point and covariance 'absolute') to estimate "
-           "the uncertainty, got " + std::to_string(n_points);
+    *why =
+        "need >= 4 points (or a std for every point and covariance 'absolute') to estimate "
+        "the uncertainty, got " +
+        std::to_string(n_points);
     return false;
   }
   if (*mode == EllipseCovariance::kAngleMeans && n_groups <= 3) {
@@ -266,8 +268,8 @@ bool PrepareData(const std::vector<EllipsePoint>& points, const EllipseOptions& 
   d.xw = d.sqrt_w.asDiagonal() * d.x;
   d.groups = GroupByAngle(points, d.w, options.angle_group_tol_deg);
   WarnMergedAngles(points, d.groups, options.angle_group_tol_deg, &d.warnings);
-  return ResolveCovariance(options.covariance, n, static_cast<int>(d.groups.size()),
-                           &d.covariance, why);
+  return ResolveCovariance(options.covariance, n, static_cast<int>(d.groups.size()), &d.covariance,
+                           why);
 }
 
 }  // namespace ellipse

@@ -26,9 +26,9 @@ namespace bifilar {
 
 // One measured moment: one trial (or one per-angle mean) at one pitch angle.
 struct EllipsePoint {
-  double pitch_deg = 0.0;       // nose-up pitch of the aircraft in the rig (deg), in [-180, 180]
-  double inertia_kg_m2 = 0.0;   // moment of inertia about the vertical swing axis (kg m^2), > 0
-  double std_kg_m2 = 0.0;       // standard error of inertia_kg_m2 (kg m^2); 0 or NaN = unknown
+  double pitch_deg = 0.0;      // nose-up pitch of the aircraft in the rig (deg), in [-180, 180]
+  double inertia_kg_m2 = 0.0;  // moment of inertia about the vertical swing axis (kg m^2), > 0
+  double std_kg_m2 = 0.0;      // standard error of inertia_kg_m2 (kg m^2); 0 or NaN = unknown
 };
 
 // How the covariance of (A, B, C) is scaled. Every mode uses the same point estimate.
@@ -123,13 +123,13 @@ double EllipseMoment(double a, double b, double c, double pitch_deg);
 
 // Summary of one solver, independent of the solver library.
 struct EllipseSolverSummary {
-  std::string method;           // "linear_ls", "nelder_mead", "ceres"
-  bool ran = false;             // false when disabled in the options
+  std::string method;  // "linear_ls", "nelder_mead", "ceres"
+  bool ran = false;    // false when disabled in the options
   bool converged = false;
-  std::string message;          // solver's termination message
-  int iterations = 0;           // function evaluations (Nelder-Mead) or iterations (Ceres)
-  int restarts = 0;             // Nelder-Mead restarts from its own result
-  double initial_cost = 0.0;    // 0.5 * sum w r^2 at the start (kg^2 m^4, relative weights)
+  std::string message;        // solver's termination message
+  int iterations = 0;         // function evaluations (Nelder-Mead) or iterations (Ceres)
+  int restarts = 0;           // Nelder-Mead restarts from its own result
+  double initial_cost = 0.0;  // 0.5 * sum w r^2 at the start (kg^2 m^4, relative weights)
   double final_cost = 0.0;
   double time_s = 0.0;
   EllipseParameters parameters;
@@ -141,32 +141,32 @@ struct EllipseSolverSummary {
 
 // Statistics of the trials at one angle group.
 struct EllipseAngleStats {
-  double pitch_deg = 0.0;        // mean pitch of the group
-  int n = 0;                     // number of points
-  double mean_kg_m2 = 0.0;       // mean moment
-  double std_kg_m2 = 0.0;        // sample standard deviation (0 when n == 1)
-  double cov_percent = 0.0;      // 100 * std / mean
-  double fitted_kg_m2 = 0.0;     // fitted curve at pitch_deg
+  double pitch_deg = 0.0;     // mean pitch of the group
+  int n = 0;                  // number of points
+  double mean_kg_m2 = 0.0;    // mean moment
+  double std_kg_m2 = 0.0;     // sample standard deviation (0 when n == 1)
+  double cov_percent = 0.0;   // 100 * std / mean
+  double fitted_kg_m2 = 0.0;  // fitted curve at pitch_deg
 };
 
 // One point's residual.
 struct EllipseResidual {
-  int index = 0;                 // index into the input points
+  int index = 0;  // index into the input points
   double pitch_deg = 0.0;
   double inertia_kg_m2 = 0.0;
   double fitted_kg_m2 = 0.0;
-  double residual_kg_m2 = 0.0;   // measured - fitted
-  double studentized = 0.0;      // internally studentized residual
-  bool outlier = false;          // |studentized| > options.outlier_threshold
+  double residual_kg_m2 = 0.0;  // measured - fitted
+  double studentized = 0.0;     // internally studentized residual
+  bool outlier = false;         // |studentized| > options.outlier_threshold
 };
 
 // NACA Report 467 three-axis estimate at one oblique angle group (paper Eq. 1, phi = 90 + theta).
 struct EllipseNacaEstimate {
   double pitch_deg = 0.0;
   double phi_deg = 0.0;
-  double i_phi_kg_m2 = 0.0;      // per-angle mean moment used
+  double i_phi_kg_m2 = 0.0;  // per-angle mean moment used
   double ixz_kg_m2 = 0.0;
-  double ixz_std_kg_m2 = 0.0;    // propagated from the errors of I_phi, I_x, I_z (independent)
+  double ixz_std_kg_m2 = 0.0;  // propagated from the errors of I_phi, I_x, I_z (independent)
 };
 
 // The paper's Table 1.
@@ -181,20 +181,20 @@ struct EllipseResult {
   // Input and grouping.
   std::vector<EllipsePoint> points;
   int n_points = 0;
-  int n_angles = 0;                   // angle groups (pitch within angle_group_tol_deg)
-  bool weighted = false;              // true when every point had a std (weights 1/std^2)
+  int n_angles = 0;       // angle groups (pitch within angle_group_tol_deg)
+  bool weighted = false;  // true when every point had a std (weights 1/std^2)
 
   // The primary result (linear least squares) with uncertainty.
   double a_kg_m2 = 0.0, b_kg_m2 = 0.0, c_kg_m2 = 0.0;
   EllipseEstimate ix, iz, ixz, tau_deg, ixp, izp;
-  double cov_abc[3][3] = {{0}};       // covariance of (A, B, C) (kg^2 m^4)
+  double cov_abc[3][3] = {{0}};  // covariance of (A, B, C) (kg^2 m^4)
   EllipseCovariance covariance_used = EllipseCovariance::kPointResiduals;
-  double variance_factor = 1.0;       // the scale applied to (X^T W X)^-1
-  double dof = 0.0;                   // degrees of freedom of the intervals (inf for kAbsolute)
-  double reduced_chi2 = 0.0;          // chi^2 / (n - 3) of the points (meaningful when weighted)
-  double circle_chi2 = 0.0;           // (B, C) Cov_BC^-1 (B, C)^T, the test statistic for tau
-  bool tau_defined = true;            // false when I_x ~ I_z
-  int bootstrap_replicates = 0;       // replicates used (0: covariance intervals)
+  double variance_factor = 1.0;  // the scale applied to (X^T W X)^-1
+  double dof = 0.0;              // degrees of freedom of the intervals (inf for kAbsolute)
+  double reduced_chi2 = 0.0;     // chi^2 / (n - 3) of the points (meaningful when weighted)
+  double circle_chi2 = 0.0;      // (B, C) Cov_BC^-1 (B, C)^T, the test statistic for tau
+  bool tau_defined = true;       // false when I_x ~ I_z
+  int bootstrap_replicates = 0;  // replicates used (0: covariance intervals)
 
   // The three fits side by side.
   EllipseSolverSummary linear, nelder_mead, ceres;
@@ -230,17 +230,17 @@ struct EllipsePlanOptions {
   int trials_per_angle = 3;       // trials at each angle, >= 1
   double sigma_kg_m2 = 0.0;       // per-trial standard deviation (kg m^2), in [1e-300, 1e100]
   // Guesses of the aircraft (kg m^2); tau's error depends on I_z - I_x and I_xz.
-  double ix_kg_m2 = 0.0;          // > 0
-  double iz_kg_m2 = 0.0;          // > 0
+  double ix_kg_m2 = 0.0;  // > 0
+  double iz_kg_m2 = 0.0;  // > 0
   double ixz_kg_m2 = 0.0;
   bool Check(std::string* why) const;
 };
 
 struct EllipsePlan {
   int n_points = 0;
-  EllipseParameters truth;        // from the guesses
-  EllipseParameters std;          // predicted standard errors (tau in deg)
-  bool tau_defined = true;        // false when the guessed I_x == I_z and I_xz == 0
+  EllipseParameters truth;  // from the guesses
+  EllipseParameters std;    // predicted standard errors (tau in deg)
+  bool tau_defined = true;  // false when the guessed I_x == I_z and I_xz == 0
 };
 
 bool PlanEllipse(const EllipsePlanOptions& options, EllipsePlan* plan, std::string* why);

@@ -210,7 +210,8 @@ bool PlanEllipse(const EllipsePlanOptions& options, EllipsePlan* plan, std::stri
   plan->std = FromVec(StdFromCovariance(j, cov) * options.sigma_kg_m2);
   for (double s : {plan->std.ix_kg_m2, plan->std.iz_kg_m2, plan->std.ixz_kg_m2}) {
     if (!(std::isfinite(s) && s > 0)) {
-      *why = "internal: a predicted std is " + Num(s) + "; please report this with the command line";
+      *why =
+          "internal: a predicted std is " + Num(s) + "; please report this with the command line";
       return false;
     }
   }

@@ -117,28 +117,30 @@ void NacaEstimates(const PreparedData& data, const ClosedFormFit& closed,
     e.i_phi_kg_m2 = diag->angles[g].mean_kg_m2;
     e.ixz_kg_m2 = (ix * c * c + iz * s * s - e.i_phi_kg_m2) / s2;
     const double sphi = mean_std(g);
-    e.ixz_std_kg_m2 = std::sqrt(sphi * sphi + std::pow(c * c * ix_std, 2) +
-                                std::pow(s * s * iz_std, 2)) / std::fabs(s2);
+    e.ixz_std_kg_m2 =
+        std::sqrt(sphi * sphi + std::pow(c * c * ix_std, 2) + std::pow(s * s * iz_std, 2)) /
+        std::fabs(s2);
     diag->naca.push_back(e);
   }
 }
 
 // Parity: the nonlinear fits must land on the closed form, to 1e-6 of the largest moment in
 // I_x, I_z and I_xz.
-void CheckSolverParity(const ClosedFormFit& closed, const Eq7Fit& nelder_mead,
-                       const Eq7Fit& ceres, Diagnostics* diag) {
+void CheckSolverParity(const ClosedFormFit& closed, const Eq7Fit& nelder_mead, const Eq7Fit& ceres,
+                       Diagnostics* diag) {
   const EllipseParameters& best = closed.best;
   const double scale = MomentScale(closed);
   for (const EllipseSolverSummary* s : {&nelder_mead.summary, &ceres.summary}) {
     if (!s->ran) continue;
     const EllipseParameters& p = s->parameters;
-    const double d = std::max({std::fabs(p.ix_kg_m2 - best.ix_kg_m2),
-                               std::fabs(p.iz_kg_m2 - best.iz_kg_m2),
-                               std::fabs(p.ixz_kg_m2 - best.ixz_kg_m2)}) / scale;
+    const double d =
+        std::max({std::fabs(p.ix_kg_m2 - best.ix_kg_m2), std::fabs(p.iz_kg_m2 - best.iz_kg_m2),
+                  std::fabs(p.ixz_kg_m2 - best.ixz_kg_m2)}) /
+        scale;
     if (!s->converged || d > 1e-6) {
       diag->warnings.push_back(s->method +
-                               " disagrees with the linear fit (max relative difference " +
-                               Num(d) + ", " + s->message + ")");
+                               " disagrees with the linear fit (max relative difference " + Num(d) +
+                               ", " + s->message + ")");
     }
   }
 }
@@ -146,8 +148,8 @@ void CheckSolverParity(const ClosedFormFit& closed, const Eq7Fit& nelder_mead,
 }  // namespace
 
 Diagnostics Diagnose(const PreparedData& data, const ClosedFormFit& closed,
-                     const CovarianceEstimate& cov, const Eq7Fit& nelder_mead,
-                     const Eq7Fit& ceres, const EllipseOptions& options) {
+                     const CovarianceEstimate& cov, const Eq7Fit& nelder_mead, const Eq7Fit& ceres,
+                     const EllipseOptions& options) {
   Diagnostics diag;
   StudentizeResiduals(data, closed, options, &diag);
   AngleStatistics(data, closed, &diag);

@@ -90,27 +90,34 @@ double Eq7Cost(unsigned n, const double* p, double* grad, void* data) {
 
 const char* NloptResultName(nlopt_result r) {
   switch (r) {
-    case NLOPT_SUCCESS: return "success";
-    case NLOPT_STOPVAL_REACHED: return "stopval reached";
-    case NLOPT_FTOL_REACHED: return "ftol reached";
-    case NLOPT_XTOL_REACHED: return "xtol reached";
-    case NLOPT_MAXEVAL_REACHED: return "maxeval reached";
-    case NLOPT_MAXTIME_REACHED: return "maxtime reached";
-    case NLOPT_ROUNDOFF_LIMITED: return "roundoff limited";
-    default: return "failure";
+    case NLOPT_SUCCESS:
+      return "success";
+    case NLOPT_STOPVAL_REACHED:
+      return "stopval reached";
+    case NLOPT_FTOL_REACHED:
+      return "ftol reached";
+    case NLOPT_XTOL_REACHED:
+      return "xtol reached";
+    case NLOPT_MAXEVAL_REACHED:
+      return "maxeval reached";
+    case NLOPT_MAXTIME_REACHED:
+      return "maxtime reached";
+    case NLOPT_ROUNDOFF_LIMITED:
+      return "roundoff limited";
+    default:
+      return "failure";
   }
 }
 
 // One Nelder-Mead run from p (updated in place) with initial steps 5 % of |p| (at least 1e-3
 // kg m^2) and 0.05 rad, times step_scale. Adds its evaluations to *evaluations.
-nlopt_result RunNelderMead(const Eq7Problem& problem, double step_scale, double p[3],
-                           double* cost, int* evaluations) {
+nlopt_result RunNelderMead(const Eq7Problem& problem, double step_scale, double p[3], double* cost,
+                           int* evaluations) {
   nlopt_opt opt = nlopt_create(NLOPT_LN_NELDERMEAD, 3);
   // NLopt passes its data as void*; Eq7Cost only reads it.
   nlopt_set_min_objective(opt, Eq7Cost, const_cast<Eq7Problem*>(&problem));
   const double steps[3] = {std::max(1e-3, 0.05 * std::fabs(p[0])) * step_scale,
-                           std::max(1e-3, 0.05 * std::fabs(p[1])) * step_scale,
-                           0.05 * step_scale};
+                           std::max(1e-3, 0.05 * std::fabs(p[1])) * step_scale, 0.05 * step_scale};
   nlopt_set_initial_step(opt, steps);
   nlopt_set_xtol_rel(opt, 1e-15);
   nlopt_set_ftol_rel(opt, 0.0);
@@ -179,9 +186,9 @@ Eq7Fit FitNelderMead(const Eq7Problem& problem) {
     const double before[3] = {p[0], p[1], p[2]};
     status = RunNelderMead(problem, step_scale, p, &cost, &s.iterations);
     if (status < 0) break;
-    const double moved = std::max({std::fabs(p[0] - before[0]) / problem.scale_kg_m2,
-                                   std::fabs(p[1] - before[1]) / problem.scale_kg_m2,
-                                   std::fabs(p[2] - before[2])});
+    const double moved =
+        std::max({std::fabs(p[0] - before[0]) / problem.scale_kg_m2,
+                  std::fabs(p[1] - before[1]) / problem.scale_kg_m2, std::fabs(p[2] - before[2])});
     if (attempt > 0) ++s.restarts;
     if (attempt > 0 && moved < 1e-14) break;
     step_scale = std::max(1e-6, std::min(1.0, 10 * moved / 0.05));

@@ -21,10 +21,12 @@ namespace {
 class TailQuantiles {
  public:
   TailQuantiles(int count, double p_lo, double p_hi)
-      : count_(count), p_lo_(p_lo), p_hi_(p_hi),
+      : count_(count),
+        p_lo_(p_lo),
+        p_hi_(p_hi),
         keep_lo_(static_cast<size_t>(std::floor(p_lo * (count - 1))) + 2),
-        keep_hi_(static_cast<size_t>(count) -
-                 static_cast<size_t>(std::floor(p_hi * (count - 1)))) {}
+        keep_hi_(static_cast<size_t>(count) - static_cast<size_t>(std::floor(p_hi * (count - 1)))) {
+  }
 
   void Add(double v) {
     if (low_.size() < keep_lo_) {
@@ -70,7 +72,7 @@ class TailQuantiles {
   int count_;
   double p_lo_, p_hi_;
   size_t keep_lo_, keep_hi_;
-  std::priority_queue<double> low_;                                            // max on top
+  std::priority_queue<double> low_;                                              // max on top
   std::priority_queue<double, std::vector<double>, std::greater<double>> high_;  // min on top
 };
 

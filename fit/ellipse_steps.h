@@ -3,10 +3,10 @@
 //
 // The procedure (FitEllipse in fit/ellipse.cc), one function per step:
 //   PrepareData          validated points, weights, angle groups, covariance mode  (ellipse.cc)
-//   FitClosedForm        (a) weighted linear least squares in (A, B, C)     (ellipse_closed_form.cc)
-//   MakeEq7Problem       paper Eq. 7 as an objective, from the paper's start         (ellipse_eq7.cc)
-//   FitNelderMead        (b) NLopt Nelder-Mead on Eq. 7, the fminsearch parity       (ellipse_eq7.cc)
-//   FitCeres             (c) Ceres on Eq. 7 with ceres::Covariance                   (ellipse_eq7.cc)
+//   FitClosedForm        (a) weighted linear least squares in (A, B, C) (ellipse_closed_form.cc)
+//   MakeEq7Problem       paper Eq. 7 as an objective, from the paper's start (ellipse_eq7.cc)
+//   FitNelderMead        (b) NLopt Nelder-Mead on Eq. 7, the fminsearch parity (ellipse_eq7.cc)
+//   FitCeres             (c) Ceres on Eq. 7 with ceres::Covariance (ellipse_eq7.cc)
 //   EstimateCovariance   variance factor, covariance of the six quantities, is tau defined
 //                                                                     (ellipse_closed_form.cc)
 //   ComputeIntervals     parametric bootstrap or t/normal intervals          (ellipse_intervals.cc)
@@ -78,7 +78,7 @@ struct PreparedData {
   Eigen::VectorXd y;                 // measured moments (kg m^2)
   Eigen::VectorXd w;                 // weights
   Eigen::VectorXd sqrt_w;
-  Eigen::MatrixXd xw;                // whitened design diag(sqrt_w) X
+  Eigen::MatrixXd xw;  // whitened design diag(sqrt_w) X
   std::vector<AngleGroup> groups;
   EllipseCovariance covariance = EllipseCovariance::kPointResiduals;  // kAuto resolved
   std::vector<std::string> warnings;
@@ -92,15 +92,15 @@ bool PrepareData(const std::vector<EllipsePoint>& points, const EllipseOptions& 
 // --- Step 2: (a) the closed form (ellipse_closed_form.cc).
 
 struct ClosedFormFit {
-  Eigen::Vector3d abc;          // (A, B, C) (kg m^2)
-  Eigen::Matrix3d normal_inv;   // (X^T W X)^-1
-  Eigen::VectorXd fitted;       // the curve at each point (kg m^2)
-  Eigen::VectorXd resid;        // measured - fitted (kg m^2)
-  double chi2 = 0.0;            // sum w resid^2
-  double point_var = 0.0;       // chi2 / (n - 3), 0 when n == 3
-  double rmse_kg_m2 = 0.0;      // sqrt(mean resid^2)
-  EllipseParameters best;       // the six quantities, canonical branch
-  EllipseSolverSummary summary; // "linear_ls"; its std is set by EstimateCovariance
+  Eigen::Vector3d abc;           // (A, B, C) (kg m^2)
+  Eigen::Matrix3d normal_inv;    // (X^T W X)^-1
+  Eigen::VectorXd fitted;        // the curve at each point (kg m^2)
+  Eigen::VectorXd resid;         // measured - fitted (kg m^2)
+  double chi2 = 0.0;             // sum w resid^2
+  double point_var = 0.0;        // chi2 / (n - 3), 0 when n == 3
+  double rmse_kg_m2 = 0.0;       // sqrt(mean resid^2)
+  EllipseParameters best;        // the six quantities, canonical branch
+  EllipseSolverSummary summary;  // "linear_ls"; its std is set by EstimateCovariance
 };
 
 // QR of the whitened design. False with *why when the design is rank-deficient.
@@ -122,10 +122,10 @@ constexpr int kCompressAbovePoints = 4096;
 // least-squares problem in p = (I_zp, I_xp, tau_rad), with the paper's starting point.
 struct Eq7Problem {
   std::vector<double> pitch_rad, inertia_kg_m2, weight, sqrt_weight;  // one per point
-  bool compressed = false;   // use the sufficient statistics below instead of the points
-  Eigen::Matrix3d u;         // N = X^T W X = U^T U
-  Eigen::Vector3d abc_hat;   // the closed-form (A, B, C)
-  double chi2_min = 0.0;     // the closed form's chi^2
+  bool compressed = false;  // use the sufficient statistics below instead of the points
+  Eigen::Matrix3d u;        // N = X^T W X = U^T U
+  Eigen::Vector3d abc_hat;  // the closed-form (A, B, C)
+  double chi2_min = 0.0;    // the closed form's chi^2
   // The paper's start: tau = 0, I_zp = the (mean) moment nearest 0 deg, I_xp nearest +-90 deg.
   double start[3] = {0.0, 0.0, 0.0};
   double scale_kg_m2 = 1.0;  // MomentScale of the closed form, for the restart test
@@ -151,13 +151,13 @@ Eq7Fit FitCeres(const Eq7Problem& problem);
 // --- Step 6: covariance (ellipse_closed_form.cc).
 
 struct CovarianceEstimate {
-  double variance_factor = 1.0;  // the scale applied to (X^T W X)^-1
-  double dof = 0.0;              // of the intervals (inf for kAbsolute)
-  Eigen::Matrix3d cov_abc;       // of (A, B, C), common offset included (kg^2 m^4)
-  Vec6 std6;                     // delta-method standard errors of the six quantities
-  double circle_chi2 = 0.0;      // (B, C) Cov_BC^-1 (B, C)^T
-  bool tau_defined = true;       // the curve is distinguishable from a circle
-  EllipseParameters ceres_std;   // Ceres' covariance on the same scale (when it has one)
+  double variance_factor = 1.0;    // the scale applied to (X^T W X)^-1
+  double dof = 0.0;                // of the intervals (inf for kAbsolute)
+  Eigen::Matrix3d cov_abc;         // of (A, B, C), common offset included (kg^2 m^4)
+  Vec6 std6;                       // delta-method standard errors of the six quantities
+  double circle_chi2 = 0.0;        // (B, C) Cov_BC^-1 (B, C)^T
+  bool tau_defined = true;         // the curve is distinguishable from a circle
+  EllipseParameters ceres_std;     // Ceres' covariance on the same scale (when it has one)
   bool ceres_std_defined = false;  // ... and its radius R > 0, so that tau's error exists
   std::vector<std::string> warnings;
 };
@@ -193,8 +193,8 @@ struct Diagnostics {
 // Studentized residuals and outliers, per-angle statistics and Table 1, the NACA 467 estimates,
 // and the parity of the nonlinear fits with the closed form.
 Diagnostics Diagnose(const PreparedData& data, const ClosedFormFit& closed,
-                     const CovarianceEstimate& cov, const Eq7Fit& nelder_mead,
-                     const Eq7Fit& ceres, const EllipseOptions& options);
+                     const CovarianceEstimate& cov, const Eq7Fit& nelder_mead, const Eq7Fit& ceres,
+                     const EllipseOptions& options);
 
 }  // namespace ellipse
 }  // namespace bifilar

@@ -15,8 +15,10 @@ namespace {
 // series, else more on the other side; for n >= m + 4. With m = 1, the neighbours of sample k.
 void Neighbours(size_t k, size_t m, size_t n, size_t idx[4]) {
   size_t before = std::min<size_t>(k, 2), after = std::min<size_t>(n - k - m, 2);
-  if (before < 2) after = 4 - before;
-  else if (after < 2) before = 4 - after;
+  if (before < 2)
+    after = 4 - before;
+  else if (after < 2)
+    before = 4 - after;
   int j = 0;
   for (size_t i = k - before; i < k; ++i) idx[j++] = i;
   for (size_t i = k + m; i < k + m + after; ++i) idx[j++] = i;
@@ -163,9 +165,10 @@ std::string DescribeGlitches(const ImuData& data, const std::vector<size_t>& ind
   double largest = 0.0;
   for (size_t k : indices) largest = std::max(largest, data.gyro_in_imu[k].cwiseAbs().maxCoeff());
   char buf[128];
-  std::snprintf(buf, sizeof(buf), "%zu glitch sample%s ignored (gyro readings far outside the "
-                "swing, alone or in runs of 2-3, up to %.3g rad/s) at t =", indices.size(),
-                indices.size() == 1 ? "" : "s", largest);
+  std::snprintf(buf, sizeof(buf),
+                "%zu glitch sample%s ignored (gyro readings far outside the "
+                "swing, alone or in runs of 2-3, up to %.3g rad/s) at t =",
+                indices.size(), indices.size() == 1 ? "" : "s", largest);
   std::string text = buf;
   const size_t shown = std::min<size_t>(indices.size(), 5);
   for (size_t i = 0; i < shown; ++i) {

@@ -52,12 +52,12 @@ PhysicalInequality Inequality(const std::string& name, double margin, const Phys
 std::array<std::string, 3> PrincipalLabels(const Eigen::Matrix3d& axes) {
   std::array<int, 3> nearest = {0, 0, 0};
   for (int k = 0; k < 3; ++k) axes.col(k).cwiseAbs().maxCoeff(&nearest[k]);
-  const bool distinct = nearest[0] != nearest[1] && nearest[0] != nearest[2] &&
-                        nearest[1] != nearest[2];
+  const bool distinct =
+      nearest[0] != nearest[1] && nearest[0] != nearest[2] && nearest[1] != nearest[2];
   std::array<std::string, 3> labels;
   for (int k = 0; k < 3; ++k) {
-    labels[k] = distinct ? std::string("I_") + "xyz"[nearest[k]] + "'"
-                         : "I_" + std::to_string(k + 1);
+    labels[k] =
+        distinct ? std::string("I_") + "xyz"[nearest[k]] + "'" : "I_" + std::to_string(k + 1);
   }
   return labels;
 }
@@ -77,8 +77,8 @@ void CheckFull(const PhysicalVec& c, const PhysicalCov& cov, PhysicalCheck* chec
     const double margin = lambda(a) + lambda(b) - lambda(k);
     const PhysicalVec g = trace_gradient - 2.0 * MomentGradient(eig.eigenvectors().col(k));
     check->inequalities.push_back(
-        Inequality(label[std::min(a, b)] + " + " + label[std::max(a, b)] + " - " + label[k],
-                   margin, g, cov, eig.eigenvectors().col(k)));
+        Inequality(label[std::min(a, b)] + " + " + label[std::max(a, b)] + " - " + label[k], margin,
+                   g, cov, eig.eigenvectors().col(k)));
   }
   check->inequalities.push_back(Inequality("smallest principal moment " + label[0], lambda(0),
                                            MomentGradient(eig.eigenvectors().col(0)), cov,
@@ -94,10 +94,9 @@ void CheckDiagonal(const PhysicalVec& c, const PhysicalCov& cov, PhysicalCheck* 
     g(a) = 1;
     g(b) = 1;
     g(k) = -1;
-    check->inequalities.push_back(Inequality(std::string(kNames[std::min(a, b)]) + " + " +
-                                                 kNames[std::max(a, b)] + " - " + kNames[k],
-                                             c(a) + c(b) - c(k), g, cov,
-                                             Eigen::Vector3d::Unit(k)));
+    check->inequalities.push_back(Inequality(
+        std::string(kNames[std::min(a, b)]) + " + " + kNames[std::max(a, b)] + " - " + kNames[k],
+        c(a) + c(b) - c(k), g, cov, Eigen::Vector3d::Unit(k)));
   }
 }
 
@@ -118,22 +117,21 @@ void CheckPlanar(const PhysicalVec& c, const PhysicalCov& cov, PhysicalCheck* ch
   g(kIxx) = v(0) * v(0);
   g(kIzz) = v(1) * v(1);
   g(kIxz) = -2 * v(0) * v(1);
-  check->inequalities.push_back(
-      Inequality("smaller principal moment of the x-z section", eig.eigenvalues()(0), g, cov,
-                 Eigen::Vector3d(v(0), 0.0, v(1))));
+  check->inequalities.push_back(Inequality("smaller principal moment of the x-z section",
+                                           eig.eigenvalues()(0), g, cov,
+                                           Eigen::Vector3d(v(0), 0.0, v(1))));
 }
 
 }  // namespace physical
-
 
 const char* PhysicalStatusName(PhysicalStatus status) {
   return EnumToString(physical::kPhysicalStatusNames, status, "?");
 }
 
-PhysicalCheck CheckPhysical(const std::array<double, kTensorComponents>& components,
-                            const std::array<std::array<double, kTensorComponents>,
-                                             kTensorComponents>& covariance,
-                            const PhysicalOptions& options) {
+PhysicalCheck CheckPhysical(
+    const std::array<double, kTensorComponents>& components,
+    const std::array<std::array<double, kTensorComponents>, kTensorComponents>& covariance,
+    const PhysicalOptions& options) {
   PhysicalCheck check;
   physical::PhysicalVec c;
   physical::PhysicalCov cov;
@@ -219,17 +217,17 @@ std::string PhysicalCheckMessage(const PhysicalCheck& check) {
              ", but within the noise (not physical at z <= " + Fmt("%.2f", check.threshold_z) +
              "); a flat body comes this close. Check the attitudes' logs if the body is not flat";
     case PhysicalStatus::kNotPhysical: {
-      std::string text = "NOT PHYSICAL: " + numbers + ", below z = " +
-                         Fmt("%.2f", check.threshold_z) + ": no rigid body has these moments (" +
-                         what + ")";
+      std::string text = "NOT PHYSICAL: " + numbers +
+                         ", below z = " + Fmt("%.2f", check.threshold_z) +
+                         ": no rigid body has these moments (" + what + ")";
       if (!check.attitude.empty()) {
         text += ". The logs at " + check.attitude + " drive it";
         if (std::isfinite(check.z_without_attitude)) {
           text += " (without them the worst z is " + Fmt("%+.2f", check.z_without_attitude) + ")";
         }
       }
-      return text + ". Likely causes: " +
-             (check.attitude.empty() ? "some swings" : "those swings") +
+      return text +
+             ". Likely causes: " + (check.attitude.empty() ? "some swings" : "those swings") +
              " made on another rig geometry or wire length (L, D), the body off-centre between "
              "the wires, or the wrong axis (attitude) named for them. Check and refit; do not "
              "use these numbers";

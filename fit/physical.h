@@ -38,10 +38,10 @@ struct PhysicalOptions {
 
 // The checks on the six components (Ixx, Iyy, Izz, Ixy, Ixz, Iyz, products positive; NaN where
 // not determined) and their covariance (kg^2 m^4). Message without an attitude.
-PhysicalCheck CheckPhysical(const std::array<double, kTensorComponents>& components,
-                            const std::array<std::array<double, kTensorComponents>,
-                                             kTensorComponents>& covariance,
-                            const PhysicalOptions& options);
+PhysicalCheck CheckPhysical(
+    const std::array<double, kTensorComponents>& components,
+    const std::array<std::array<double, kTensorComponents>, kTensorComponents>& covariance,
+    const PhysicalOptions& options);
 
 // The planar ellipse's checks (I_x, I_z, I_xz and their covariance from (A, B, C)).
 PhysicalCheck CheckPhysicalEllipse(const EllipseResult& fit, const PhysicalOptions& options);

@@ -37,20 +37,20 @@ struct PhysicalCheck {
   // campaign: I_x, I_z, I_xz only), "" when not checked.
   std::string checked;
   std::vector<PhysicalInequality> inequalities;
-  int worst = -1;                  // index of the smallest z, -1 when none
-  double threshold_z = NAN;        // z at or below which the result is not physical
+  int worst = -1;            // index of the smallest z, -1 when none
+  double threshold_z = NAN;  // z at or below which the result is not physical
   // The attitude whose logs drive a break (filled by the caller, which knows the attitudes:
   // the one whose removal restores the inequality, or, when no refit is possible, the one that
   // measures the largest moment of the broken inequality). Empty when none is named.
   std::string attitude;
-  int orientation = -1;            // the tensor fit's orientation of that attitude, -1: none
-  double z_without_attitude = NAN; // the worst z of the refit without it (NaN: no refit)
-  std::string message;             // one paragraph for the console, the report and results.json
+  int orientation = -1;             // the tensor fit's orientation of that attitude, -1: none
+  double z_without_attitude = NAN;  // the worst z of the refit without it (NaN: no refit)
+  std::string message;              // one paragraph for the console, the report and results.json
 
   bool Flagged() const { return status == PhysicalStatus::kNotPhysical; }
   const PhysicalInequality* Worst() const {
     return worst >= 0 && worst < static_cast<int>(inequalities.size()) ? &inequalities[worst]
-                                                                        : nullptr;
+                                                                       : nullptr;
   }
 };
 

@@ -58,14 +58,13 @@ WhitenessStats ComputeWhiteness(const std::vector<double>& r, int lags) {
 
 int HacBandwidth(double phi, int n, int max_lag) {
   phi = std::clamp(phi, -0.97, 0.97);
-  const double alpha =
-      4.0 * phi * phi / ((1.0 - phi) * (1.0 - phi) * (1.0 + phi) * (1.0 + phi));
+  const double alpha = 4.0 * phi * phi / ((1.0 - phi) * (1.0 - phi) * (1.0 + phi) * (1.0 + phi));
   const double l = 1.1447 * std::cbrt(alpha * std::max(1, n));
   return std::clamp(static_cast<int>(std::ceil(l)), 0, std::max(0, max_lag));
 }
 
-bool HacCovariance(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residuals,
-                   int bandwidth, Eigen::MatrixXd* covariance) {
+bool HacCovariance(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residuals, int bandwidth,
+                   Eigen::MatrixXd* covariance) {
   const Eigen::Index n = jacobian.rows(), p = jacobian.cols();
   if (n <= p || residuals.size() != n || bandwidth < 0) return false;
   const Eigen::MatrixXd jtj = jacobian.transpose() * jacobian;
@@ -83,7 +82,8 @@ bool HacCovariance(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& resid
   Eigen::MatrixXd omega = Eigen::MatrixXd::Zero(p, p);
   Eigen::RowVectorXd block(p);
   for (Eigen::Index t = -lag; t < n; ++t) {
-    const Eigen::Index lo = std::max<Eigen::Index>(t, 0), hi = std::min<Eigen::Index>(t + lag + 1, n);
+    const Eigen::Index lo = std::max<Eigen::Index>(t, 0),
+                       hi = std::min<Eigen::Index>(t + lag + 1, n);
     block = prefix.row(hi) - prefix.row(lo);
     omega.noalias() += block.transpose() * block;
   }

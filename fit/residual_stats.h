@@ -27,11 +27,11 @@ double Ar1Coefficient(const std::vector<double>& r);
 // AR(1) coefficient (e_k = r_k - phi r_{k-1}); structure the model misses (a periodic misfit,
 // sway) survives the prewhitening, a coloured but structureless noise does not.
 struct WhitenessStats {
-  double ar1_phi = 0.0;              // residual AR(1) coefficient
-  double raw_autocorr_lag1 = 0.0;    // rho_1 of r itself
-  double raw_autocorr_max = 0.0;     // max |rho_k| of r, k = 1..lags
+  double ar1_phi = 0.0;                   // residual AR(1) coefficient
+  double raw_autocorr_lag1 = 0.0;         // rho_1 of r itself
+  double raw_autocorr_max = 0.0;          // max |rho_k| of r, k = 1..lags
   double prewhitened_autocorr_max = 0.0;  // max |rho_k| of e, k = 1..lags
-  double ljung_box_q = 0.0;          // Ljung-Box Q of e over the lags (chi^2 with `lags` dof)
+  double ljung_box_q = 0.0;               // Ljung-Box Q of e over the lags (chi^2 with `lags` dof)
 };
 WhitenessStats ComputeWhiteness(const std::vector<double>& r, int lags);
 
@@ -44,7 +44,7 @@ int HacBandwidth(double phi, int n, int max_lag);
 // (J^T J)^-1 Omega (J^T J)^-1 N / (N - p), Omega = sum over |l| <= L of (1 - |l|/(L+1)) Gamma_l
 // of the scores s_k = J_k^T r_k. Computed as the mean outer product of moving sums of L + 1
 // scores (the Bartlett estimator, O(N p^2) for any L). Returns false when J^T J is singular.
-bool HacCovariance(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residuals,
-                   int bandwidth, Eigen::MatrixXd* covariance);
+bool HacCovariance(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residuals, int bandwidth,
+                   Eigen::MatrixXd* covariance);
 
 }  // namespace bifilar

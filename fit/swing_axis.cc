@@ -69,7 +69,8 @@ std::vector<char> RestMask(const ImuData& data, const Eigen::Vector3d& bias, dou
 
 // Principal direction (unit, sign arbitrary) of the gyro signal over [begin, end); nullopt when
 // the signal is constant there (up to the rounding of its mean).
-std::optional<Eigen::Vector3d> GyroPrincipalDirection(const ImuData& data, size_t begin, size_t end) {
+std::optional<Eigen::Vector3d> GyroPrincipalDirection(const ImuData& data, size_t begin,
+                                                      size_t end) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (size_t i = begin; i < end; ++i) mean += data.gyro_in_imu[i];
   const double count = static_cast<double>(std::max<size_t>(1, end - begin));
@@ -303,7 +304,8 @@ bool DownFromAccel(const ImuData& data, const SwingAxisOptions& options, bool in
   } else {
     axis->notes.push_back("accelerometer: only " + std::to_string(count) +
                           " samples at rest; down vector averaged over the swing's turning "
-                          "points in " + (in_window ? "the window" : "the whole log"));
+                          "points in " +
+                          (in_window ? "the window" : "the whole log"));
     count = DownFromTurningPoints(data, range, bias, &f_sum);
   }
   if (count <= 0) return true;
@@ -374,7 +376,8 @@ bool EstimateSwingAxis(const ImuData& data, const SwingAxisOptions& options,
   }
   axis->axis_in_body = options.imu_to_body * axis->axis_in_imu;
   axis->rate_rad_per_s.resize(n);
-  for (size_t i = 0; i < n; ++i) axis->rate_rad_per_s[i] = data.gyro_in_imu[i].dot(axis->axis_in_imu);
+  for (size_t i = 0; i < n; ++i)
+    axis->rate_rad_per_s[i] = data.gyro_in_imu[i].dot(axis->axis_in_imu);
   return true;
 }
 
@@ -394,7 +397,8 @@ double SecondaryMotionRatio(const ImuData& data, const Eigen::Vector3d& axis_in_
     orth_ss += (d - along * n).squaredNorm();
   }
   // Below `tiny` a sum of squares is rounding of the mean, not motion.
-  const double tiny = static_cast<double>(range.second - range.first) * std::pow(1e-12 * (1.0 + mean.norm()), 2);
+  const double tiny =
+      static_cast<double>(range.second - range.first) * std::pow(1e-12 * (1.0 + mean.norm()), 2);
   if (!(along_ss > tiny)) return orth_ss > tiny ? 1e6 : 0.0;  // no swing at all: capped, never inf
   return std::min(1e6, std::sqrt(orth_ss / along_ss));
 }

@@ -33,8 +33,9 @@ enum class SwingAxisMode {
   kFixed,  // SwingAxisOptions::fixed_axis_in_imu
 };
 enum class SwingAxisSource { kAccelAtRest, kAccelOverWindow, kGyroPrincipal, kFixed };
-const char* ToString(SwingAxisMode mode);   // "auto", "fixed"
-const char* ToString(SwingAxisSource source);  // "accel_rest", "accel_window", "gyro_principal", "fixed"
+const char* ToString(SwingAxisMode mode);  // "auto", "fixed"
+const char* ToString(
+    SwingAxisSource source);  // "accel_rest", "accel_window", "gyro_principal", "fixed"
 
 struct SwingAxisOptions {
   SwingAxisMode mode = SwingAxisMode::kAuto;
@@ -81,7 +82,7 @@ inline constexpr char kAccelIgnoredSentence[] =
     "imu.accel: null to say so";
 
 struct SwingAxis {
-  Eigen::Vector3d axis_in_imu = Eigen::Vector3d::UnitZ();  // unit n, IMU axes
+  Eigen::Vector3d axis_in_imu = Eigen::Vector3d::UnitZ();   // unit n, IMU axes
   Eigen::Vector3d axis_in_body = Eigen::Vector3d::UnitZ();  // imu_to_body * n
   SwingAxisSource source = SwingAxisSource::kFixed;
   std::vector<double> rate_rad_per_s;  // gyro . n at every sample of the log (rad/s)
@@ -89,8 +90,8 @@ struct SwingAxis {
   // rest and no window was given), in degrees, conventions above.
   std::optional<double> pitch_measured_deg;
   std::optional<double> roll_measured_deg;
-  int rest_samples = 0;          // samples used for the accelerometer down vector (0: none)
-  double rest_accel_mps2 = 0.0;  // |mean f| over them (should be ~9.8)
+  int rest_samples = 0;            // samples used for the accelerometer down vector (0: none)
+  double rest_accel_mps2 = 0.0;    // |mean f| over them (should be ~9.8)
   std::vector<std::string> notes;  // fallbacks taken (no rest -> window, ...)
   // The accelerometer did not read gravity (removed, a wrong unit, a broken sensor) and was
   // ignored: no pitch, the axis from the gyro. The sentence for the user is in `warnings`.

@@ -154,8 +154,9 @@ bool AnalyseDesign(const Prepared& data, const TensorOptions& options, Design* d
     if (s(k) > options.rank_tolerance * s_max) ++g.rank;
   }
   if (g.rank == 0) {  // an SVD of the 6 x 0 rest below is undefined (it dereferenced null)
-    *why = "the swing axes determine none of the six components (the design has rank 0): swing "
-           "about more axes";
+    *why =
+        "the swing axes determine none of the six components (the design has rank 0): swing "
+        "about more axes";
     return false;
   }
   const Eigen::MatrixXd v = svd.matrixV();
@@ -184,16 +185,17 @@ bool AnalyseDesign(const Prepared& data, const TensorOptions& options, Design* d
     for (int c = 0; c < 6; ++c) {
       if (std::fabs(u(c)) < 1e-6) continue;
       char buffer[48];
-      std::snprintf(buffer, sizeof(buffer), "%s%.3g %s", text.empty() ? (u(c) < 0 ? "-" : "")
-                                                                      : (u(c) < 0 ? " - " : " + "),
+      std::snprintf(buffer, sizeof(buffer), "%s%.3g %s",
+                    text.empty() ? (u(c) < 0 ? "-" : "") : (u(c) < 0 ? " - " : " + "),
                     std::fabs(u(c)), TensorComponentName(c));
       text += buffer;
     }
     g.combinations.push_back(text);
   }
   if (g.rank == 0 || g.unobservable.size() == 6) {
-    *why = "the swing axes determine none of the six components (Ixx, Iyy, Izz, Ixy, Ixz, Iyz are "
-           "all unobservable";
+    *why =
+        "the swing axes determine none of the six components (Ixx, Iyy, Izz, Ixy, Ixz, Iyz are "
+        "all unobservable";
     if (!g.combinations.empty()) *why += "; only " + g.combinations.front() + " is";
     *why += "): swing about more axes";
     return false;
@@ -208,8 +210,9 @@ bool FitTensorClosedForm(const Prepared& data, const Design& design, Solution* s
   const Eigen::MatrixXd zw = data.sqrt_w.asDiagonal() * z;
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(zw);
   if (qr.rank() < design.rank) {
-    *why = "the measured swing axes do not determine the components the design should (singular "
-           "fit)";
+    *why =
+        "the measured swing axes do not determine the components the design should (singular "
+        "fit)";
     return false;
   }
   s->gamma = qr.solve(data.sqrt_w.cwiseProduct(data.y));
@@ -254,10 +257,10 @@ void ComponentDof(const Prepared& data, const Design& design, const Solution& s,
 bool EstimateTensorCovariance(const Prepared& data, const Design& design, const Solution& s,
                               const TensorOptions& options, Covariance* c, std::string* why) {
   const int n = data.n, m = static_cast<int>(data.groups.size()), r = design.rank;
-  const EllipseCovariance mode = data.scale_dof > 0 &&
-                                         data.covariance == EllipseCovariance::kPointResiduals
-                                     ? EllipseCovariance::kAbsolute
-                                     : data.covariance;
+  const EllipseCovariance mode =
+      data.scale_dof > 0 && data.covariance == EllipseCovariance::kPointResiduals
+          ? EllipseCovariance::kAbsolute
+          : data.covariance;
   switch (mode) {
     case EllipseCovariance::kPointResiduals:
       if (n <= r) {
@@ -298,8 +301,8 @@ bool EstimateTensorCovariance(const Prepared& data, const Design& design, const 
   c->cov_gamma = s.normal_inv * c->variance_factor;
   c->cov = design.basis * c->cov_gamma * design.basis.transpose();
   c->component_dof.setConstant(c->dof);
-  const bool per_pool = mode == EllipseCovariance::kAbsolute && data.scale_dof > 0 &&
-                        data.scatter_var.size() == n;
+  const bool per_pool =
+      mode == EllipseCovariance::kAbsolute && data.scale_dof > 0 && data.scatter_var.size() == n;
   // A common offset c adds c to every moment: the components answer with S 1, S the solution
   // operator (for a full design exactly (1, 1, 1, 0, 0, 0)).
   const Eigen::MatrixXd z = data.x * design.basis;
@@ -327,7 +330,8 @@ std::array<double, 3> DownInBodyFromAttitude(double roll_deg, double pitch_deg) 
   return {-std::sin(t), std::sin(f) * std::cos(t), std::cos(f) * std::cos(t)};
 }
 
-double TensorMoment(const std::array<double, kTensorComponents>& c, const std::array<double, 3>& n) {
+double TensorMoment(const std::array<double, kTensorComponents>& c,
+                    const std::array<double, 3>& n) {
   Vec6 beta;
   for (int k = 0; k < 6; ++k) beta(k) = c[k];
   // Scaled by the largest component first: no square of a huge or tiny component overflows.
@@ -457,9 +461,8 @@ double ReweighPerOrientation(const Design& design, Prepared* data, Solution* fit
 // same equation is solved for a relative scatter instead, s_i^2 + (sigma_r I_i)^2: repeats of a
 // real rig scatter by 0.2-0.3 % (release amplitude, hanging) where each log's std says 0.02-0.15 %.
 // *relative receives sigma_r (0 when not used).
-double ReweighForAttitudeScatter(const Design& design, const TensorOptions& options,
-                                 Prepared* data, Solution* fit, double* relative,
-                                 std::vector<double>* by_group) {
+double ReweighForAttitudeScatter(const Design& design, const TensorOptions& options, Prepared* data,
+                                 Solution* fit, double* relative, std::vector<double>* by_group) {
   *relative = 0.0;
   if (!options.attitude_scatter || !data->weighted || data->n <= design.rank) return 0.0;
   const bool full = design.rank == 6;
@@ -470,8 +473,9 @@ double ReweighForAttitudeScatter(const Design& design, const TensorOptions& opti
   const Eigen::VectorXd s2 = data->w.cwiseInverse();  // the stated variances
   double sigma2 = 0.0;
   for (int iteration = 0; iteration < 8; ++iteration) {
-    const Eigen::VectorXd g2 = full ? Eigen::VectorXd(AttitudeSensitivity(*data, fit->beta).array().square())
-                                    : Eigen::VectorXd(fit->fitted.array().square());
+    const Eigen::VectorXd g2 =
+        full ? Eigen::VectorXd(AttitudeSensitivity(*data, fit->beta).array().square())
+             : Eigen::VectorXd(fit->fitted.array().square());
     const Eigen::VectorXd r2 = fit->resid.array().square();
     auto excess = [&](double v) {
       return (r2.array() / (s2.array() + v * g2.array())).sum() - (data->n - design.rank);
@@ -592,7 +596,8 @@ double ReweighPerOrientation(const Design& design, Prepared* data, Solution* fit
       dof += 1.0 - data->w(i) * z.row(i) * fit->normal_inv * z.row(i).transpose();
     }
     data->pool_dof.push_back(std::max(dof, 1.0));
-    for (int i : data->groups[g]) data->scatter_pool[i] = static_cast<int>(data->pool_dof.size()) - 1;
+    for (int i : data->groups[g])
+      data->scatter_pool[i] = static_cast<int>(data->pool_dof.size()) - 1;
   }
   return std::sqrt(shared2);
 }
@@ -622,8 +627,8 @@ bool OrientationsScatterBeyondTrials(const Prepared& data, const Design& design,
 
 // The covariance mode (kAuto: orientation means when the orientations scatter beyond their
 // trials, points otherwise).
-EllipseCovariance CovarianceMode(const Prepared& data, const Design& design,
-                                 const Solution& closed, const TensorOptions& options) {
+EllipseCovariance CovarianceMode(const Prepared& data, const Design& design, const Solution& closed,
+                                 const TensorOptions& options) {
   if (options.covariance != EllipseCovariance::kAuto) return options.covariance;
   return OrientationsScatterBeyondTrials(data, design, closed) ? EllipseCovariance::kAngleMeans
                                                                : EllipseCovariance::kPointResiduals;
@@ -781,8 +786,7 @@ bool FitTensorOnce(const std::vector<TensorPoint>& points, const TensorOptions& 
   r.relative_scatter = relative_scatter;
   r.orientation_relative_scatter = scatter_by_orientation;
   CompareWithClosedForm(closed, solved, &r);
-  const TensorIntervalSet intervals =
-      TensorIntervals(data, design, solved, cov, options, r.full);
+  const TensorIntervalSet intervals = TensorIntervals(data, design, solved, cov, options, r.full);
   r.bootstrap_replicates = intervals.replicates;
   FillComponents(design, solved, cov, intervals, &r);
   WarnUnobservable(&r);

@@ -98,32 +98,32 @@ struct TensorEstimate {
 };
 
 struct TensorPointResidual {
-  int index = 0;                   // into the input points
-  int orientation = 0;             // into TensorResult::orientations
+  int index = 0;        // into the input points
+  int orientation = 0;  // into TensorResult::orientations
   double inertia_kg_m2 = 0.0;
   double fitted_kg_m2 = 0.0;
-  double residual_kg_m2 = 0.0;     // measured - fitted
-  double studentized = 0.0;        // internally studentized
+  double residual_kg_m2 = 0.0;  // measured - fitted
+  double studentized = 0.0;     // internally studentized
   bool outlier = false;
 };
 
 // Residual of one orientation: the (weighted) mean of its points against the fit.
 struct TensorOrientation {
   std::array<double, 3> nominal_in_body = {0, 0, 1};  // the group's first nominal axis (unit)
-  std::vector<int> members;        // point indices
-  double mean_kg_m2 = 0.0;         // weighted mean of the measured moments
-  double fitted_kg_m2 = 0.0;       // weighted mean of the fitted moments
-  double residual_kg_m2 = 0.0;     // mean - fitted
-  double residual_std_kg_m2 = 0.0; // sqrt(variance factor / weight sum): its expected scatter
-  double z = 0.0;                  // residual / residual_std (0 when the std is 0)
-  double scatter_kg_m2 = 0.0;      // sample std of the members (0 for one point)
+  std::vector<int> members;                           // point indices
+  double mean_kg_m2 = 0.0;                            // weighted mean of the measured moments
+  double fitted_kg_m2 = 0.0;                          // weighted mean of the fitted moments
+  double residual_kg_m2 = 0.0;                        // mean - fitted
+  double residual_std_kg_m2 = 0.0;  // sqrt(variance factor / weight sum): its expected scatter
+  double z = 0.0;                   // residual / residual_std (0 when the std is 0)
+  double scatter_kg_m2 = 0.0;       // sample std of the members (0 for one point)
 };
 
 struct TensorResult {
   int n_points = 0;
   int n_orientations = 0;
-  int rank = 0;                    // of the design (6: full 3-D)
-  bool weighted = false;           // every point had a std
+  int rank = 0;           // of the design (6: full 3-D)
+  bool weighted = false;  // every point had a std
   // The attitude scatter found in the residuals (deg, TensorOptions::attitude_scatter), 0 when
   // the stated stds explain the scatter or the design is not full.
   double attitude_scatter_deg = 0.0;
@@ -134,13 +134,13 @@ struct TensorResult {
   // scatter its points were weighed with. An orientation whose logs scatter beyond the others'
   // (F test, p < 0.01) has its own; the others share relative_scatter. Empty when not used.
   std::vector<double> orientation_relative_scatter;
-  bool full = false;               // rank == 6: principal moments and axes below are defined
-  double condition_number = 0.0;   // largest / smallest non-zero singular value of the design
+  bool full = false;              // rank == 6: principal moments and axes below are defined
+  double condition_number = 0.0;  // largest / smallest non-zero singular value of the design
   std::array<double, kTensorComponents> design_singular_values = {};  // descending
   EllipseCovariance covariance_used = EllipseCovariance::kPointResiduals;
   double variance_factor = 1.0;
-  double dof = 0.0;                // of the intervals (inf for absolute)
-  double reduced_chi2 = 0.0;       // chi^2 / (n - rank) of the points
+  double dof = 0.0;           // of the intervals (inf for absolute)
+  double reduced_chi2 = 0.0;  // chi^2 / (n - rank) of the points
   double rmse_kg_m2 = 0.0;
 
   // Ixx, Iyy, Izz, Ixy, Ixz, Iyz (products positive convention), kg m^2.
@@ -162,7 +162,7 @@ struct TensorResult {
   // principal axes, with each principal axis matched to the nearest body axis (x', y', z') and
   // signed along it; body_from_principal = Rz(yaw) Ry(pitch) Rx(roll). In the planar case pitch
   // = -tau. Std by first-order propagation.
-  std::array<TensorEstimate, 3> euler_deg;  // roll, pitch, yaw
+  std::array<TensorEstimate, 3> euler_deg;                     // roll, pitch, yaw
   std::array<double, 3> principal_moments_matched_kg_m2 = {};  // about x', y', z'
 
   std::vector<TensorPointResidual> residuals;
@@ -177,7 +177,7 @@ struct TensorResult {
   // (a campaign names the roll and pitch instead).
   PhysicalCheck physical;
 
-  EllipseSolverSummary ceres;       // the primary fit ("ceres")
+  EllipseSolverSummary ceres;                        // the primary fit ("ceres")
   double closed_form_max_relative_difference = 0.0;  // Ceres vs closed form (QR), parity
   int bootstrap_replicates = 0;
   std::vector<std::string> warnings;

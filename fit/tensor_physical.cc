@@ -23,8 +23,8 @@ PhysicalCheck CheckOf(const TensorResult& r) {
 }
 
 std::string AxisText(const std::array<double, 3>& n) {
-  return "the axis (" + Fmt("%+.3f", n[0]) + ", " + Fmt("%+.3f", n[1]) + ", " +
-         Fmt("%+.3f", n[2]) + ")";
+  return "the axis (" + Fmt("%+.3f", n[0]) + ", " + Fmt("%+.3f", n[1]) + ", " + Fmt("%+.3f", n[2]) +
+         ")";
 }
 
 }  // namespace

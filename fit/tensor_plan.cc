@@ -138,9 +138,9 @@ bool TensorPlanOptions::Check(CheckFailure* failure) const {
                      "given (at least Ixx, Iyy, Izz) with a relative swing std or an attitude "
                      "error",
                      &f));
-  static const char* const kGuessNames[kTensorComponents] = {
-      "guess_kg_m2 Ixx", "guess_kg_m2 Iyy", "guess_kg_m2 Izz",
-      "guess_kg_m2 Ixy", "guess_kg_m2 Ixz", "guess_kg_m2 Iyz"};
+  static const char* const kGuessNames[kTensorComponents] = {"guess_kg_m2 Ixx", "guess_kg_m2 Iyy",
+                                                             "guess_kg_m2 Izz", "guess_kg_m2 Ixy",
+                                                             "guess_kg_m2 Ixz", "guess_kg_m2 Iyz"};
   for (int k = 0; ok && k < kTensorComponents; ++k) {
     ok = CheckIn(kGuessNames[k], guess_kg_m2[k], -kMax, kMax, Ends::kClosed, &f);
   }
@@ -153,9 +153,9 @@ bool TensorPlanOptions::Check(CheckFailure* failure) const {
     const Eigen::Vector3d eig =
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(TensorMatrix(guess_kg_m2)).eigenvalues();
     // Shown to 6 digits: a derived value, its last digits are rounding.
-    ok = eig[0] > 0 || CheckFail("smallest principal moment of guess_kg_m2",
-                                 RoundedToDigits(eig[0], 6),
-                                 "> 0 (check the products' signs and sizes)", &f);
+    ok = eig[0] > 0 ||
+         CheckFail("smallest principal moment of guess_kg_m2", RoundedToDigits(eig[0], 6),
+                   "> 0 (check the products' signs and sizes)", &f);
   }
   return ok;
 }
@@ -349,8 +349,8 @@ int BestAddition(const Eigen::MatrixXd& m, const Eigen::MatrixXd& reduced,
 // Fedorov exchange: swap a chosen orientation for a candidate while det M grows. Removing j
 // leaves M_j; det(M_j + w_c b_c b_c^T) / det(M) = (1 + d_j(c)) / (1 + d_j(j)).
 void FedorovExchange(const Eigen::MatrixXd& reduced, const Eigen::VectorXd& w_all, int rank,
-                     Eigen::MatrixXd* info, std::vector<int>* chosen,
-                     std::vector<char>* in_design, TensorPlan* plan) {
+                     Eigen::MatrixXd* info, std::vector<int>* chosen, std::vector<char>* in_design,
+                     TensorPlan* plan) {
   const int n = static_cast<int>(chosen->size());
   for (int sweep = 0; sweep < 100; ++sweep) {
     bool improved = false;
@@ -381,8 +381,8 @@ void FedorovExchange(const Eigen::MatrixXd& reduced, const Eigen::VectorXd& w_al
 // 3. D-optimal choice of n orientations: greedy, then Fedorov exchange. Weights of the
 // orientation means at the planned trials (in 1/scale^2, so between 1 / (1 + 2 / trials) and
 // 1e290: finite).
-bool ChooseDOptimal(const std::vector<Candidate>& cand, const Subspace& space, double trials,
-                    int n, TensorPlan* plan, std::vector<int>* chosen, std::string* error) {
+bool ChooseDOptimal(const std::vector<Candidate>& cand, const Subspace& space, double trials, int n,
+                    TensorPlan* plan, std::vector<int>* chosen, std::string* error) {
   const int n_cand = static_cast<int>(cand.size());
   const int rank = space.rank;
   const Eigen::MatrixXd& reduced = space.reduced;
@@ -452,7 +452,7 @@ bool DesignCovariance(const std::vector<Candidate>& cand, const std::vector<int>
     // The floor: the attitude error alone, as the trials grow without bound (1e12 stands for
     // infinity; an axis along a principal axis of the guess does not feel a tilt at first order
     // and keeps a finite weight there).
-    plan->floor_std_kg_m2[k] = !plan->observable[k]           ? kNaN
+    plan->floor_std_kg_m2[k] = !plan->observable[k] ? kNaN
                                : options.attitude_std_deg > 0
                                    ? StdAt(cand, chosen, space, *plan, scale, 1e12, k)
                                    : 0.0;
@@ -496,8 +496,8 @@ void TrialsNeeded(const std::vector<Candidate>& cand, const std::vector<int>& ch
 bool CheckPredictedStds(const TensorPlan& plan, std::string* error) {
   for (int k = 0; k < kTensorComponents; ++k) {
     if (plan.observable[k] && !(std::isfinite(plan.std_kg_m2[k]) && plan.std_kg_m2[k] > 0)) {
-      *error = std::string("internal: the predicted std of ") + TensorComponentName(k) +
-               " is " + Fmt("%g", plan.std_kg_m2[k]) + "; please report this with the command line";
+      *error = std::string("internal: the predicted std of ") + TensorComponentName(k) + " is " +
+               Fmt("%g", plan.std_kg_m2[k]) + "; please report this with the command line";
       return false;
     }
   }

@@ -99,8 +99,7 @@ void SetQuantiles(std::vector<std::vector<double>>* values, double alpha, bool p
 }  // namespace
 
 Eigen::Vector3d PrincipalMoments(const Vec6& beta) {
-  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(TensorMatrix(beta),
-                                                         Eigen::EigenvaluesOnly)
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(TensorMatrix(beta), Eigen::EigenvaluesOnly)
       .eigenvalues();
 }
 
@@ -148,8 +147,8 @@ Principal ComputePrincipal(const Vec6& beta, const Mat6& cov) {
     Eigen::Matrix3d axes_plus, axes_minus;
     Decompose(plus, &m, &axes_plus);
     Decompose(minus, &m, &axes_minus);
-    Eigen::Vector3d d = EulerDeg(Matched(axes_plus, r0, nullptr)) -
-                        EulerDeg(Matched(axes_minus, r0, nullptr));
+    Eigen::Vector3d d =
+        EulerDeg(Matched(axes_plus, r0, nullptr)) - EulerDeg(Matched(axes_minus, r0, nullptr));
     for (int k = 0; k < 3; ++k) d(k) = std::remainder(d(k), 360.0);
     jac.col(c) = d / (2 * h);
   }

@@ -57,8 +57,9 @@ Solution FitTensorCeres(const Prepared& data, const Design& design, const Soluti
 
   ceres::Problem problem;
   for (int i = 0; i < data.n; ++i) {
-    problem.AddResidualBlock(MomentResidual::Create(z.row(i).transpose(), data.y(i), data.sqrt_w(i)),
-                             nullptr, gamma.data());
+    problem.AddResidualBlock(
+        MomentResidual::Create(z.row(i).transpose(), data.y(i), data.sqrt_w(i)), nullptr,
+        gamma.data());
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
@@ -85,8 +86,7 @@ Solution FitTensorCeres(const Prepared& data, const Design& design, const Soluti
   summary->iterations = static_cast<int>(ceres_summary.iterations.size());
   summary->initial_cost = ceres_summary.initial_cost;
   summary->final_cost = ceres_summary.final_cost;
-  summary->time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary->time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // A fit Ceres could not finish falls back to the closed form (same problem, exact).
   if (!summary->converged || !s.beta.allFinite()) {
     Solution fallback = closed;

@@ -4,11 +4,11 @@
 // The procedure (FitTensor in fit/tensor.cc), one function per step:
 //   PrepareTensorData   validated points, unit directions, weights, orientation groups  (tensor.cc)
 //   AnalyseDesign       SVD of the nominal design: rank, row space, unobservable components,
-//                       condition number                                                 (tensor.cc)
-//   FitTensorClosedForm weighted least squares in row-space coordinates by QR (parity)   (tensor.cc)
-//   FitTensorCeres      the same problem with Ceres: the primary result            (tensor_solve.cc)
+//                       condition number (tensor.cc)
+//   FitTensorClosedForm weighted least squares in row-space coordinates by QR (parity) (tensor.cc)
+//   FitTensorCeres      the same problem with Ceres: the primary result (tensor_solve.cc)
 //   EstimateTensorCovariance  variance factor of the covariance mode, covariance of the six
-//                       components with the common offset                                (tensor.cc)
+//                       components with the common offset (tensor.cc)
 //   ComputePrincipal    eigen-decomposition, principal moments/axes with std, Euler angles
 //                                                                           (tensor_principal.cc)
 //   TensorIntervals     parametric bootstrap (or t) intervals              (tensor_principal.cc)
@@ -38,10 +38,10 @@ struct Prepared {
   int n = 0;
   bool weighted = false;
   std::vector<Eigen::Vector3d> axes;  // the fitted (used) unit directions
-  Eigen::MatrixXd x;          // n x 6 design of the fitted (used) directions
-  Eigen::MatrixXd x_nominal;  // n x 6 design of the nominal directions
+  Eigen::MatrixXd x;                  // n x 6 design of the fitted (used) directions
+  Eigen::MatrixXd x_nominal;          // n x 6 design of the nominal directions
   Eigen::VectorXd y, w, sqrt_w;
-  std::vector<std::vector<int>> groups;  // orientation groups, point indices
+  std::vector<std::vector<int>> groups;     // orientation groups, point indices
   std::vector<Eigen::Vector3d> group_axis;  // the first member's nominal axis (unit)
   EllipseCovariance covariance = EllipseCovariance::kPointResiduals;  // resolved after the rank
   std::vector<std::string> warnings;
@@ -63,7 +63,7 @@ bool PrepareTensorData(const std::vector<TensorPoint>& points, const TensorOptio
 
 struct Design {
   int rank = 0;
-  Eigen::MatrixXd basis;            // 6 x rank, orthonormal basis of the design's row space
+  Eigen::MatrixXd basis;  // 6 x rank, orthonormal basis of the design's row space
   Eigen::Matrix<double, 6, 1> singular_values;  // descending
   std::array<bool, 6> observable = {};
   double condition_number = 0.0;
@@ -75,16 +75,15 @@ bool AnalyseDesign(const Prepared& data, const TensorOptions& options, Design* d
                    std::string* why);
 
 struct Solution {
-  Eigen::VectorXd gamma;        // row-space coordinates
-  Vec6 beta = Vec6::Zero();     // the six components (min-norm: zero off the row space)
-  Eigen::MatrixXd normal_inv;   // (Z^T W Z)^-1, Z = X basis (rank x rank)
+  Eigen::VectorXd gamma;       // row-space coordinates
+  Vec6 beta = Vec6::Zero();    // the six components (min-norm: zero off the row space)
+  Eigen::MatrixXd normal_inv;  // (Z^T W Z)^-1, Z = X basis (rank x rank)
   Eigen::VectorXd fitted, resid;
   double chi2 = 0.0;
 };
 
 // Weighted least squares by QR of the whitened reduced design. False when singular.
-bool FitTensorClosedForm(const Prepared& data, const Design& design, Solution* s,
-                         std::string* why);
+bool FitTensorClosedForm(const Prepared& data, const Design& design, Solution* s, std::string* why);
 // The same problem solved by Ceres (Levenberg-Marquardt, analytic Jacobian) from the mean
 // moment on the diagonal; normal_inv taken from `closed`.
 Solution FitTensorCeres(const Prepared& data, const Design& design, const Solution& closed,
@@ -96,9 +95,9 @@ struct Covariance {
   // scatter that feed it; inf when none does); equal to `dof` unless the scatter is per
   // orientation.
   Vec6 component_dof = Vec6::Constant(std::numeric_limits<double>::infinity());
-  bool per_pool = false;  // component_dof from the pools of Prepared::scatter_var
-  Mat6 cov = Mat6::Zero();           // of the six components, common offset included
-  Eigen::MatrixXd cov_gamma;         // rank x rank, without the offset (bootstrap)
+  bool per_pool = false;                 // component_dof from the pools of Prepared::scatter_var
+  Mat6 cov = Mat6::Zero();               // of the six components, common offset included
+  Eigen::MatrixXd cov_gamma;             // rank x rank, without the offset (bootstrap)
   Vec6 offset_direction = Vec6::Zero();  // the components' response to a unit common offset
   std::vector<std::string> warnings;
 };
@@ -109,10 +108,10 @@ bool EstimateTensorCovariance(const Prepared& data, const Design& design, const 
 // Principal moments (ascending) and axes, Euler angles of the matched frame, their std.
 struct Principal {
   Eigen::Vector3d moments;
-  Eigen::Matrix3d axes;              // columns: unit axes of the moments, largest component > 0
+  Eigen::Matrix3d axes;  // columns: unit axes of the moments, largest component > 0
   Eigen::Vector3d moments_std, axes_std_deg;
   Eigen::Vector3d euler_deg, euler_std_deg;  // roll, pitch, yaw
-  Eigen::Vector3d matched_moments;   // about x', y', z'
+  Eigen::Vector3d matched_moments;           // about x', y', z'
   std::vector<std::string> warnings;
 };
 Principal ComputePrincipal(const Vec6& beta, const Mat6& cov);

@@ -76,7 +76,8 @@ bool ValidateTraceFit(const TraceFitInput& input, const TraceFitOptions& options
     std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
     const double largest = std::max(std::abs(input.t_s.front()), std::abs(input.t_s.back()));
     if (span > 1e6)
-      return fail("the window spans " + Fmt("%g", span) + " s, more than 1e6 s: check the time unit");
+      return fail("the window spans " + Fmt("%g", span) +
+                  " s, more than 1e6 s: check the time unit");
     if (largest * std::numeric_limits<double>::epsilon() > 1e-3 * steps[steps.size() / 2])
       return fail("timestamps near " + Fmt("%g", largest) + " s are too large for samples " +
                   Fmt("%g", steps[steps.size() / 2]) +
@@ -87,8 +88,8 @@ bool ValidateTraceFit(const TraceFitInput& input, const TraceFitOptions& options
   return true;
 }
 
-Solution MakeSolution(const TraceFitInput& input, const TraceRateCost& cost,
-                      const Minimum& minimum, double period_s, double noise_rad_per_s) {
+Solution MakeSolution(const TraceFitInput& input, const TraceRateCost& cost, const Minimum& minimum,
+                      double period_s, double noise_rad_per_s) {
   const double* p = minimum.p.data();
   Solution s;
   s.params = TraceRateCost::Unscale(p, cost.inertia_scale());
@@ -191,10 +192,14 @@ TraceFitResult AssembleResult(const TraceFitInput& input, const TraceFitOptions&
     Append(*f, &result);
 
   // Never NaN in the output.
-  const double values[] = {result.params.inertia_kg_m2, result.params.drag_coeff_kg_m2,
-                           result.params.viscous_coeff_kg_m2_per_s, result.inertia_std_kg_m2,
-                           result.bias_rad_per_s, result.residual_rms_rad_per_s,
-                           result.angle0_rad, result.rate0_rad_per_s};
+  const double values[] = {result.params.inertia_kg_m2,
+                           result.params.drag_coeff_kg_m2,
+                           result.params.viscous_coeff_kg_m2_per_s,
+                           result.inertia_std_kg_m2,
+                           result.bias_rad_per_s,
+                           result.residual_rms_rad_per_s,
+                           result.angle0_rad,
+                           result.rate0_rad_per_s};
   for (double v : values) {
     if (!std::isfinite(v)) {
       TraceFitResult bad;
@@ -266,9 +271,10 @@ TraceFitResult Finish(TraceFitResult r, const std::string& label,
 }  // namespace
 }  // namespace trace
 
-constexpr EnumName<TraceFitStatus> kTraceFitStatusNames[] = {{TraceFitStatus::kOk, "ok"},
-                                                             {TraceFitStatus::kRejected, "rejected"},
-                                                             {TraceFitStatus::kError, "error"}};
+constexpr EnumName<TraceFitStatus> kTraceFitStatusNames[] = {
+    {TraceFitStatus::kOk, "ok"},
+    {TraceFitStatus::kRejected, "rejected"},
+    {TraceFitStatus::kError, "error"}};
 
 const char* ToString(TraceFitStatus status) {
   return EnumToString(kTraceFitStatusNames, status, "error");
@@ -283,8 +289,7 @@ bool TraceFitOptions::Check(std::string* why) const {
       CheckGe("max_total_iterations", max_total_iterations, 1, &f) &&
       CheckGe("max_integrator_steps", static_cast<double>(max_integrator_steps), 1, &f) &&
       CheckFiniteGt("time_guard_cpu_seconds", time_guard_cpu_seconds, 0, &f) &&
-      TraceQualityOptions::Check(&f) &&
-      CheckGe("min_amplitude_deg", min_amplitude_deg, 0, &f) &&
+      TraceQualityOptions::Check(&f) && CheckGe("min_amplitude_deg", min_amplitude_deg, 0, &f) &&
       CheckGt("max_amplitude_deg", max_amplitude_deg, "min_amplitude_deg", min_amplitude_deg, &f) &&
       CheckLe("max_amplitude_deg", max_amplitude_deg, 90, &f) &&
       CheckGt("refine_rms_over_noise", refine_rms_over_noise, 1, &f) &&
@@ -302,22 +307,20 @@ std::string TraceFitResult::BriefReport() const {
   std::ostringstream s;
   s << ToString(status) << " [" << ToString(model) << "]";
   if (status != TraceFitStatus::kError && params.inertia_kg_m2 > 0.0) {
-    s << " I = " << Fmt("%.5g", params.inertia_kg_m2) << " +- "
-      << Fmt("%.2g", inertia_std_kg_m2) << " kg m^2"
+    s << " I = " << Fmt("%.5g", params.inertia_kg_m2) << " +- " << Fmt("%.2g", inertia_std_kg_m2)
+      << " kg m^2"
       << " (stat " << Fmt("%.2g", inertia_stat_std_kg_m2) << ")"
       << ", K_D = " << Fmt("%.3g", params.drag_coeff_kg_m2)
-      << ", C = " << Fmt("%.3g", params.viscous_coeff_kg_m2_per_s)
-      << ", amplitude " << Fmt("%.1f", amplitude_start_deg) << "->"
-      << Fmt("%.1f", amplitude_end_deg) << " deg"
-      << ", rms/noise " << Fmt("%.2f", rms_over_noise)
-      << ", rho1 " << Fmt("%.2f", residual_autocorr_lag1) << ", " << iterations << " it"
+      << ", C = " << Fmt("%.3g", params.viscous_coeff_kg_m2_per_s) << ", amplitude "
+      << Fmt("%.1f", amplitude_start_deg) << "->" << Fmt("%.1f", amplitude_end_deg) << " deg"
+      << ", rms/noise " << Fmt("%.2f", rms_over_noise) << ", rho1 "
+      << Fmt("%.2f", residual_autocorr_lag1) << ", " << iterations << " it"
       << ", " << Fmt("%.1f", fit_seconds * 1e3) << " ms";
   }
   if (!message.empty()) s << ": " << message;
   for (const std::string& w : warnings) s << "; warning: " << w;
   return s.str();
 }
-
 
 TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& options) {
   using namespace trace;
@@ -364,10 +367,10 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
 
   // 8. Amplitude sweep, and its rule for a rig that departs from the model.
   const AmplitudeSweep sweep =
-      options.amplitude_sweep ? RunAmplitudeSweep(input, options, minimum.p.data(),
-                                                  cost.inertia_scale(), solution.trajectory,
-                                                  guess.period_s, &solve_budget)
-                              : AmplitudeSweep();
+      options.amplitude_sweep
+          ? RunAmplitudeSweep(input, options, minimum.p.data(), cost.inertia_scale(),
+                              solution.trajectory, guess.period_s, &solve_budget)
+          : AmplitudeSweep();
   if (solve_budget.Exhausted()) return finish(Stopped(std::move(result), solve_budget));
   const SweepRule rule = ApplySweepRule(sweep, solution, stat, options);
 
@@ -377,8 +380,8 @@ TraceFitResult FitTrace(const TraceFitInput& input, const TraceFitOptions& optio
 
   // 11. The result: non-finite guard, status, kept series (and the band fit's, when the result
   // is a band's).
-  result = AssembleResult(input, options, std::move(result), minimum, solution, stat, budget,
-                          sweep, rule, whiteness, quality);
+  result = AssembleResult(input, options, std::move(result), minimum, solution, stat, budget, sweep,
+                          rule, whiteness, quality);
   if (options.keep_series && result.HasFit() && rule.inertia_source == "low_amplitude_band") {
     result.band_fitted_rate_rad_per_s =
         BandFittedRate(input, options, minimum.p.data(), cost.inertia_scale(),

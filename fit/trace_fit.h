@@ -6,8 +6,8 @@
 //   r_k = psi'(t_k; I, K_D, C, psi(t0), psi'(t0)) + b - omega_meas(t_k)
 //
 // psi' from the chosen pendulum model (pendulum/model.h) integrated with forward sensitivities
-// (pendulum/integrator.h: DOP853 by default, or CVODES), which give the analytic Jacobian. Solver: Ceres
-// Levenberg-Marquardt from an initial guess computed from the data alone (fit/trace_guess.h);
+// (pendulum/integrator.h: DOP853 by default, or CVODES), which give the analytic Jacobian. Solver:
+// Ceres Levenberg-Marquardt from an initial guess computed from the data alone (fit/trace_guess.h);
 // NLopt refines I in one dimension only when that first fit is poor. The solvers stay inside
 // fit/: nothing here exposes a Ceres or NLopt type.
 #pragma once
@@ -47,13 +47,13 @@ struct TraceFitOptions : TraceQualityOptions, AmplitudeSweepOptions {
   // Fits of real and simulated logs take < 100 iterations and < 1e6 steps, so neither bound
   // changes a normal result; they stop a window that does not hold a free swing, which can
   // otherwise drift for minutes.
-  int max_total_iterations = 500;           // (count) >= 1
-  long max_integrator_steps = 20000000;     // (count) >= 1
+  int max_total_iterations = 500;        // (count) >= 1
+  long max_integrator_steps = 20000000;  // (count) >= 1
   // Last resort only, far above any real fit (< 1 s): CPU time of the calling thread after which
   // the fit is abandoned. Its outcome depends on the machine's speed, so it is not a judgement of
   // the data: status kError, flag `time_guard`, a message of its own ("abandoned by the time
   // guard ..."), and such a record is never cached (pipeline/store/cache.cc).
-  double time_guard_cpu_seconds = 600.0;    // (s) > 0
+  double time_guard_cpu_seconds = 600.0;  // (s) > 0
   // Set (by Ctrl-C, for example) to stop the fit between solver iterations: the result is then
   // kError with `interrupted` true. Not owned; nullptr: never interrupted.
   const std::atomic<bool>* interrupt = nullptr;
@@ -102,34 +102,34 @@ struct TraceFitOptions : TraceQualityOptions, AmplitudeSweepOptions {
 
 // One line of the uncertainty budget: how an input's uncertainty moves I.
 struct UncertaintyContribution {
-  std::string name;           // "filar_length", "filar_separation", "mass", "gravity"
-  double std_input = 0.0;     // configured 1-sigma of the input (m, m, kg, m/s^2)
-  double d_inertia = 0.0;     // dI / d(input) at the solution (kg m^2 per input unit)
+  std::string name;                 // "filar_length", "filar_separation", "mass", "gravity"
+  double std_input = 0.0;           // configured 1-sigma of the input (m, m, kg, m/s^2)
+  double d_inertia = 0.0;           // dI / d(input) at the solution (kg m^2 per input unit)
   double contribution_kg_m2 = 0.0;  // |dI/dq| * std_input
 };
 
 // One band of the amplitude sweep.
 struct AmplitudeSweepBand {
-  double t0_s = 0.0, t1_s = 0.0;           // band limits (s, the log's own time)
+  double t0_s = 0.0, t1_s = 0.0;  // band limits (s, the log's own time)
   int num_samples = 0;
-  double cycles = 0.0;                     // periods in the band
-  double amplitude_start_deg = 0.0;        // fitted |psi| peak over the band's first period
-  double amplitude_end_deg = 0.0;          // ... and its last period
-  double amplitude_mean_deg = 0.0;         // their mean: the band's amplitude
-  double inertia_kg_m2 = 0.0;              // I fitted in the band (K_D, C held)
-  double inertia_std_kg_m2 = 0.0;          // its statistical (HAC) std
-  double residual_fraction = 0.0;          // residual RMS / swing-rate RMS of the band fit
+  double cycles = 0.0;               // periods in the band
+  double amplitude_start_deg = 0.0;  // fitted |psi| peak over the band's first period
+  double amplitude_end_deg = 0.0;    // ... and its last period
+  double amplitude_mean_deg = 0.0;   // their mean: the band's amplitude
+  double inertia_kg_m2 = 0.0;        // I fitted in the band (K_D, C held)
+  double inertia_std_kg_m2 = 0.0;    // its statistical (HAC) std
+  double residual_fraction = 0.0;    // residual RMS / swing-rate RMS of the band fit
   // The band fit's state at t0_s and its gyro bias (K_D and C are the window fit's): what the
   // fit figure needs to draw the band's curve (TraceFitResult::band_fitted_rate_rad_per_s).
-  double angle0_rad = 0.0;                 // psi(t0_s)
-  double rate0_rad_per_s = 0.0;            // psi'(t0_s)
-  double bias_rad_per_s = 0.0;             // b
-  bool ok = false;                         // the band fit converged
+  double angle0_rad = 0.0;       // psi(t0_s)
+  double rate0_rad_per_s = 0.0;  // psi'(t0_s)
+  double bias_rad_per_s = 0.0;   // b
+  bool ok = false;               // the band fit converged
 };
 
 // I against amplitude, and the trend test (docs/method.md, "Amplitude sweep").
 struct AmplitudeSweep {
-  bool evaluated = false;    // false: too few cycles for two bands (note says why)
+  bool evaluated = false;  // false: too few cycles for two bands (note says why)
   std::string note;
   std::vector<AmplitudeSweepBand> bands;  // in time order (amplitude decreasing)
   // The trend over the bands (fit/amplitude_trend.h, FitAmplitudeShape): the weighted curve
@@ -139,9 +139,9 @@ struct AmplitudeSweep {
   double trend_coeff = 0.0;     // c (per deg^p), relative to I_0
   double trend_coeff_std = 0.0;
   double trend_z = 0.0;
-  double trend_chi2 = 0.0;     // chi^2 of the bands about the curve, their own stds
-  int trend_dof = 0;           // bands - 2
-  double trend_scale = 1.0;    // Birge ratio about the curve: sqrt(chi2/dof) when > 1, else 1
+  double trend_chi2 = 0.0;   // chi^2 of the bands about the curve, their own stds
+  int trend_dof = 0;         // bands - 2
+  double trend_scale = 1.0;  // Birge ratio about the curve: sqrt(chi2/dof) when > 1, else 1
   // Mean relative slope of I over the swept amplitudes (% per 10 deg).
   double trend_percent_per_10deg = 0.0;
   double inertia_zero_amplitude_kg_m2 = 0.0;  // I_0, the trend extrapolated to zero amplitude
@@ -154,10 +154,11 @@ struct AmplitudeSweep {
   int low_band = -1;  // index in `bands` of the fitted band with the lowest amplitude (-1: none)
   // Consistency of the bands with one constant I: chi^2 about their weighted mean, its degrees of
   // freedom, and the scale applied to the statistical std (sqrt(chi^2/dof) when chi^2 exceeds
-  // its degrees of freedom, else 1: the Birge ratio as the Particle Data Group applies it): segments of the same swing that disagree beyond their stds show
-  // the real error of the fit (unmodelled motion, coloured disturbances). With a trend the
-  // scale is the trend's (trend_scale): the bands' scatter about the curve, not about a constant,
-  // which would count the trend a second time.
+  // its degrees of freedom, else 1: the Birge ratio as the Particle Data Group applies it):
+  // segments of the same swing that disagree beyond their stds show the real error of the fit
+  // (unmodelled motion, coloured disturbances). With a trend the scale is the trend's
+  // (trend_scale): the bands' scatter about the curve, not about a constant, which would count the
+  // trend a second time.
   double chi2_constant = 0.0;
   // The bands scatter beyond their stds at 5 %: about the constant, or about the trend curve
   // when a trend was detected.
@@ -171,25 +172,25 @@ const char* ToString(TraceFitStatus status);  // "ok", "rejected", "error"
 
 struct TraceFitResult {
   TraceFitStatus status = TraceFitStatus::kError;
-  std::string message;             // why rejected / error; "" when ok (warnings are separate)
-  std::vector<std::string> flags;  // every quality check raised, short machine-readable names
+  std::string message;                // why rejected / error; "" when ok (warnings are separate)
+  std::vector<std::string> flags;     // every quality check raised, short machine-readable names
   std::vector<std::string> warnings;  // one sentence per warning, for every status
   PendulumModel model = PendulumModel::kFull;
 
-  PendulumParams params;            // fitted I, K_D, C
-  double angle0_rad = 0.0;          // fitted psi(t0)
-  double rate0_rad_per_s = 0.0;     // fitted psi'(t0)
-  double bias_rad_per_s = 0.0;      // fitted gyro bias b
-  double drag_coeff_std = 0.0;      // statistical std of K_D (kg m^2)
-  double viscous_coeff_std = 0.0;   // statistical std of C (kg m^2/s)
+  PendulumParams params;           // fitted I, K_D, C
+  double angle0_rad = 0.0;         // fitted psi(t0)
+  double rate0_rad_per_s = 0.0;    // fitted psi'(t0)
+  double bias_rad_per_s = 0.0;     // fitted gyro bias b
+  double drag_coeff_std = 0.0;     // statistical std of K_D (kg m^2)
+  double viscous_coeff_std = 0.0;  // statistical std of C (kg m^2/s)
 
   // Uncertainty of I: statistical (HAC sandwich covariance, robust to coloured residuals), the
   // model-inadequacy term of the amplitude sweep (0 without a trend), the geometry budget, and
   // all combined in quadrature. params.inertia_kg_m2 is the window fit's I, or the
   // lowest-amplitude band's when the sweep found a trend (inertia_source says which).
   double inertia_stat_std_kg_m2 = 0.0;
-  double inertia_iid_std_kg_m2 = 0.0;     // textbook sigma^2 (J^T J)^-1 std (white residuals)
-  int hac_bandwidth = 0;                  // Bartlett bandwidth of the HAC covariance (lags)
+  double inertia_iid_std_kg_m2 = 0.0;  // textbook sigma^2 (J^T J)^-1 std (white residuals)
+  int hac_bandwidth = 0;               // Bartlett bandwidth of the HAC covariance (lags)
   double model_inadequacy_std_kg_m2 = 0.0;
   std::vector<UncertaintyContribution> budget;
   double inertia_budget_std_kg_m2 = 0.0;  // root-sum-square of the budget contributions
@@ -201,18 +202,18 @@ struct TraceFitResult {
   // Goodness of fit.
   int num_samples = 0;
   double residual_rms_rad_per_s = 0.0;
-  double noise_rad_per_s = 0.0;         // noise used for the RMS check (input or data estimate)
-  bool noise_from_input = false;        // true: rest-segment noise; false: from the window
+  double noise_rad_per_s = 0.0;   // noise used for the RMS check (input or data estimate)
+  bool noise_from_input = false;  // true: rest-segment noise; false: from the window
   double rms_over_noise = 0.0;
-  double signal_rms_rad_per_s = 0.0;     // RMS of the fitted swing rate about the bias
-  double residual_autocorr_lag1 = 0.0;  // rho_1 of the residuals
-  double residual_autocorr_max = 0.0;   // max |rho_k|, k = 1..whiteness_lags
-  double residual_ar1_phi = 0.0;        // AR(1) coefficient of the residuals
+  double signal_rms_rad_per_s = 0.0;      // RMS of the fitted swing rate about the bias
+  double residual_autocorr_lag1 = 0.0;    // rho_1 of the residuals
+  double residual_autocorr_max = 0.0;     // max |rho_k|, k = 1..whiteness_lags
+  double residual_ar1_phi = 0.0;          // AR(1) coefficient of the residuals
   double prewhitened_autocorr_max = 0.0;  // max |rho_k| after AR(1) prewhitening (the check)
-  double ljung_box_q = 0.0;             // Ljung-Box Q of the prewhitened residuals (h dof)
-  double amplitude_start_deg = 0.0;     // fitted |psi| peak over the first period
-  double amplitude_end_deg = 0.0;       // fitted |psi| peak over the last period
-  double period_s = 0.0;                // mean period (guess stage)
+  double ljung_box_q = 0.0;               // Ljung-Box Q of the prewhitened residuals (h dof)
+  double amplitude_start_deg = 0.0;       // fitted |psi| peak over the first period
+  double amplitude_end_deg = 0.0;         // fitted |psi| peak over the last period
+  double period_s = 0.0;                  // mean period (guess stage)
 
   // Solver summary.
   int iterations = 0;
@@ -222,8 +223,9 @@ struct TraceFitResult {
   bool interrupted = false;    // stopped by TraceFitOptions::interrupt (status kError)
   bool solver_bound = false;   // stopped by max_total_iterations or max_integrator_steps
   bool time_guard = false;     // abandoned by time_guard_cpu_seconds (status kError)
-  long integrator_steps = 0;   // integrator steps the solvers spent (what max_integrator_steps counts)
-  double fit_seconds = 0.0;    // wall time of FitTrace
+  long integrator_steps =
+      0;  // integrator steps the solvers spent (what max_integrator_steps counts)
+  double fit_seconds = 0.0;  // wall time of FitTrace
   TraceInitialGuess guess;
 
   // Series for plotting (empty unless options.keep_series): the window's times, the measured

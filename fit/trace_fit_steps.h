@@ -3,8 +3,8 @@
 // p = (I / I_guess, K_D / I_guess, C / I_guess, psi(t0), psi'(t0), b).
 //
 // The procedure (FitTrace in fit/trace_fit.cc), one function per step:
-//   ValidateTraceFit        options, geometry, sizes, finite values, increasing times (trace_fit.cc)
-//   EstimateTraceGuess      initial guess from the data alone                  (trace_guess.cc)
+//   ValidateTraceFit        options, geometry, sizes, finite values, increasing times
+//   (trace_fit.cc) EstimateTraceGuess      initial guess from the data alone (trace_guess.cc)
 //   MinimizeLm              Levenberg-Marquardt with an active set for K_D, C >= 0, one retry
 //                           from K_D = C = 0                                    (trace_solve.cc)
 //   RefineInertia           NLopt global search along I, then LM again, when the first fit is
@@ -14,8 +14,9 @@
 //   EstimateStatisticalStd  HAC sandwich covariance over the free parameters (trace_uncertainty.cc)
 //   ComputeInputBudget      geometry and gyro-scale uncertainties to I by the implicit-function
 //                           derivative                                     (trace_uncertainty.cc)
-//   RunAmplitudeSweep       I refitted in equal-cycle bands, trend of I against A^p (trace_sweep.cc)
-//   ApplySweepRule          trend -> low-amplitude band + model inadequacy; Birge scale
+//   RunAmplitudeSweep       I refitted in equal-cycle bands, trend of I against A^p
+//   (trace_sweep.cc) ApplySweepRule          trend -> low-amplitude band + model inadequacy; Birge
+//   scale
 //                                                                               (trace_sweep.cc)
 //   ComputeWhiteness        residual whiteness against their own AR(1) noise (residual_stats.cc)
 //   JudgeQuality            reasons to reject, and warnings                    (trace_quality.cc)
@@ -69,8 +70,7 @@ inline double RmsOfCost(double cost, size_t n) { return std::sqrt(2.0 * cost / n
 // --- Step 1: validation (trace_fit.cc).
 
 // False with *why (the error message) when the options, the geometry or the window are invalid.
-bool ValidateTraceFit(const TraceFitInput& input, const TraceFitOptions& options,
-                      std::string* why);
+bool ValidateTraceFit(const TraceFitInput& input, const TraceFitOptions& options, std::string* why);
 
 // --- The bounds of one fit (trace_solve.cc).
 
@@ -139,8 +139,8 @@ struct Minimum {
   int iterations = 0;              // LM iterations, refinement included
   double initial_cost = 0.0;       // 1/2 sum r^2 at the start (rad^2/s^2)
   double final_cost = 0.0;
-  std::vector<double> residuals;   // fitted - measured at p (rad/s)
-  bool nlopt_refined = false;      // RefineInertia ran
+  std::vector<double> residuals;  // fitted - measured at p (rad/s)
+  bool nlopt_refined = false;     // RefineInertia ran
 };
 
 // Levenberg-Marquardt with the active set from `start`; when it fails, once more from `start`
@@ -161,7 +161,7 @@ void RefineInertia(const TraceRateCost& cost, const Params& start, int max_itera
 // --- Step 5: the solution (trace_fit.cc).
 
 struct Solution {
-  PendulumParams params;              // unscaled I, K_D, C
+  PendulumParams params;  // unscaled I, K_D, C
   double angle0_rad = 0.0;
   double rate0_rad_per_s = 0.0;
   double bias_rad_per_s = 0.0;
@@ -174,8 +174,8 @@ struct Solution {
 };
 
 // Reads the solution off the minimum; the cost's cache must sit at minimum.p.
-Solution MakeSolution(const TraceFitInput& input, const TraceRateCost& cost,
-                      const Minimum& minimum, double period_s, double noise_rad_per_s);
+Solution MakeSolution(const TraceFitInput& input, const TraceRateCost& cost, const Minimum& minimum,
+                      double period_s, double noise_rad_per_s);
 
 // --- Steps 6-7: uncertainty (trace_uncertainty.cc).
 
@@ -194,9 +194,9 @@ struct StatisticalUncertainty {
   double inertia_std_kg_m2 = 0.0;      // HAC
   double inertia_iid_std_kg_m2 = 0.0;  // sigma^2 (J^T J)^-1
   int hac_bandwidth = 0;
-  double drag_coeff_std = 0.0;         // 0 when K_D is held
-  double viscous_coeff_std = 0.0;      // 0 when C is held
-  Findings findings;                   // covariance_failed
+  double drag_coeff_std = 0.0;     // 0 when K_D is held
+  double viscous_coeff_std = 0.0;  // 0 when C is held
+  Findings findings;               // covariance_failed
 };
 
 // Over I, the free damping coefficients, psi(t0), psi'(t0) and b.
@@ -256,9 +256,8 @@ struct Quality {
 };
 
 Quality JudgeQuality(const TraceFitInput& input, const TraceFitOptions& options,
-                     const Minimum& minimum, const Solution& solution,
-                     const AmplitudeSweep& sweep, const WhitenessStats& whiteness,
-                     double noise_rad_per_s);
+                     const Minimum& minimum, const Solution& solution, const AmplitudeSweep& sweep,
+                     const WhitenessStats& whiteness, double noise_rad_per_s);
 
 }  // namespace trace
 }  // namespace bifilar

@@ -24,7 +24,7 @@ struct Crossing {
 std::vector<Crossing> FindCrossings(const std::vector<double>& t, const std::vector<double>& x,
                                     double bias, double band) {
   std::vector<Crossing> out;
-  int state = 0;  // -1 below -band, +1 above +band
+  int state = 0;           // -1 below -band, +1 above +band
   size_t last_change = 0;  // index i such that x[i]-bias and x[i+1]-bias differ in sign
   bool have_change = false;
   for (size_t i = 0; i < x.size(); ++i) {
@@ -229,8 +229,8 @@ double DecayRateOfPeaks(const std::vector<double>& peak_t, const std::vector<dou
 // lambda_v = C / (2 I) and kappa = (4 / (3 pi)) (K_D / I) omega. Pairs of peaks `stride`
 // half-cycles apart give the local rate ln(a_i / a_j) / (t_j - t_i) at A = sqrt(a_i a_j) / w;
 // a straight line through them gives lambda_v (intercept) and kappa (slope), both >= 0.
-void SplitDecay(const std::vector<double>& peak_t, const std::vector<double>& peak_a,
-                double omega0, double lambda, double* lambda_v_out, double* kappa_out) {
+void SplitDecay(const std::vector<double>& peak_t, const std::vector<double>& peak_a, double omega0,
+                double lambda, double* lambda_v_out, double* kappa_out) {
   double lambda_v = 0.8 * lambda, kappa = 0.0;
   const size_t np = peak_a.size();
   const size_t stride = std::max<size_t>(1, np / 6);
@@ -307,8 +307,8 @@ double InertiaFromGuess(const TraceFitInput& input, PendulumModel model,
     const int iterations = model == PendulumModel::kFull ? 2 : 1;
     for (int it = 0; it < iterations; ++it) {
       double model_period = 0.0;
-      if (!ModelPeriod(model, input.geometry, integrator, inertia, std::min(amp_rms, 1.4),
-                       period0, &model_period) ||
+      if (!ModelPeriod(model, input.geometry, integrator, inertia, std::min(amp_rms, 1.4), period0,
+                       &model_period) ||
           !(model_period > 0.0)) {
         break;  // keep the small-angle value; the fit still starts close
       }

@@ -20,15 +20,15 @@ struct TraceFitInput {
 
 // The initial guess, from the data alone (fit/trace_guess.h).
 struct TraceInitialGuess {
-  double period_s = 0.0;             // mean period over the window (zero crossings)
+  double period_s = 0.0;                  // mean period over the window (zero crossings)
   double rate_amplitude_rad_per_s = 0.0;  // rate amplitude of the first cycle
-  double decay_rate_per_s = 0.0;     // envelope decay rate lambda (amplitude ~ exp(-lambda t))
-  double cycles = 0.0;               // periods covered by the window
-  PendulumParams params;             // I (amplitude-corrected), K_D, C
-  double angle0_rad = 0.0;           // psi(t0)
-  double rate0_rad_per_s = 0.0;      // psi'(t0)
-  double bias_rad_per_s = 0.0;       // mean over an integer number of cycles
-  double data_noise_rad_per_s = 0.0; // sample-to-sample scatter estimate of the noise
+  double decay_rate_per_s = 0.0;          // envelope decay rate lambda (amplitude ~ exp(-lambda t))
+  double cycles = 0.0;                    // periods covered by the window
+  PendulumParams params;                  // I (amplitude-corrected), K_D, C
+  double angle0_rad = 0.0;                // psi(t0)
+  double rate0_rad_per_s = 0.0;           // psi'(t0)
+  double bias_rad_per_s = 0.0;            // mean over an integer number of cycles
+  double data_noise_rad_per_s = 0.0;      // sample-to-sample scatter estimate of the noise
 };
 
 }  // namespace bifilar

@@ -22,7 +22,7 @@ namespace {
 // estimate says).
 struct ResidualShape {
   enum class Cause { kNoise, kModel, kGlitch } cause = Cause::kNoise;
-  double early_over_late = 1.0;   // residual RMS, first third over last third
+  double early_over_late = 1.0;         // residual RMS, first third over last third
   double signal_early_over_late = 1.0;  // the same for the fitted swing rate
   double step_over_rms = 0.0;     // largest difference of the means before/after a split, / RMS
   double spike_over_sigma = 0.0;  // largest |r| over the robust sigma (1.4826 MAD)
@@ -94,16 +94,16 @@ void WarnResidualAboveNoise(const TraceFitInput& input, const TraceFitOptions& o
       Fmt("%.2f", solution.rms_over_noise) + "x the noise estimate (warning above " +
       Fmt("%.2f", options.max_rms_over_noise) + "); lag-1 autocorrelation " + Fmt("%.3f", rho1) +
       ", RMS over the window's first third " + Fmt("%.2f", shape.early_over_late) +
-      "x that over its last third (the swing rate's " +
-      Fmt("%.2f", shape.signal_early_over_late) + "x), largest step between segment means " +
-      Fmt("%.2f", shape.step_over_rms) + "x the RMS, largest sample " +
-      Fmt("%.1f", shape.spike_over_sigma) + "x the robust scatter.";
+      "x that over its last third (the swing rate's " + Fmt("%.2f", shape.signal_early_over_late) +
+      "x), largest step between segment means " + Fmt("%.2f", shape.step_over_rms) +
+      "x the RMS, largest sample " + Fmt("%.1f", shape.spike_over_sigma) + "x the robust scatter.";
   switch (shape.cause) {
     case ResidualShape::Cause::kGlitch:
       findings->Warn("rms_above_noise",
                      level + " from a step or spike near t = " + Fmt("%.2f", shape.glitch_t_s) +
                          " s (a glitch): fit the part before or after it (fit.windows or "
-                         "--window), or lower fit.glitch's thresholds." + detail);
+                         "--window), or lower fit.glitch's thresholds." +
+                         detail);
       findings->flags.push_back("residual_glitch");
       return;
     case ResidualShape::Cause::kModel:
@@ -115,8 +115,10 @@ void WarnResidualAboveNoise(const TraceFitInput& input, const TraceFitOptions& o
       return;
     case ResidualShape::Cause::kNoise:
       findings->Warn("rms_above_noise",
-                     level + ", white and even (noise): if the gyro is this noisy in the "
-                             "swing, raise fit.quality.max_rms_over_noise." + detail);
+                     level +
+                         ", white and even (noise): if the gyro is this noisy in the "
+                         "swing, raise fit.quality.max_rms_over_noise." +
+                         detail);
       findings->flags.push_back("residual_noise");
       return;
   }
@@ -129,15 +131,16 @@ void WarnResidualAboveNoise(const TraceFitInput& input, const TraceFitOptions& o
 void WarnAtBounds(const Minimum& minimum, const TraceFitOptions& options, Findings* findings) {
   const bool drag = minimum.fixed[0] || minimum.p[kTraceDrag] <= 0.0;
   const bool viscous = minimum.fixed[1] || minimum.p[kTraceViscous] <= 0.0;
-  const std::string longer =
-      options.longer_window_available
-          ? "fit a longer window (fit.windows or --window)"
-          : "log a longer swing (this window runs to the log's end)";
+  const std::string longer = options.longer_window_available
+                                 ? "fit a longer window (fit.windows or --window)"
+                                 : "log a longer swing (this window runs to the log's end)";
   if (drag && viscous) {
     findings->Warn("damping_at_bound",
                    "K_D = C = 0 (both damping terms at their bound): the swing does not decay in "
-                   "this window; " + longer + ", and check that nothing drives the swing. The "
-                   "fit holds both at 0, where the data asked for negative damping.");
+                   "this window; " +
+                       longer +
+                       ", and check that nothing drives the swing. The "
+                       "fit holds both at 0, where the data asked for negative damping.");
   } else if (drag) {
     findings->Warn("drag_at_bound",
                    "K_D = 0 (air drag at its bound): the damping is all in C here; " + longer +
@@ -146,7 +149,8 @@ void WarnAtBounds(const Minimum& minimum, const TraceFitOptions& options, Findin
   } else if (viscous) {
     findings->Warn("viscous_at_bound",
                    "C = 0 (linear damping at its bound): the damping is all in K_D here; " +
-                       longer + " to separate them. The fit holds C at 0, where the data asked "
+                       longer +
+                       " to separate them. The fit holds C at 0, where the data asked "
                        "for a negative linear damping; I depends little on how the damping is "
                        "split.");
   }
@@ -155,9 +159,8 @@ void WarnAtBounds(const Minimum& minimum, const TraceFitOptions& options, Findin
 }  // namespace
 
 Quality JudgeQuality(const TraceFitInput& input, const TraceFitOptions& options,
-                     const Minimum& minimum, const Solution& solution,
-                     const AmplitudeSweep& sweep, const WhitenessStats& whiteness,
-                     double noise_rad_per_s) {
+                     const Minimum& minimum, const Solution& solution, const AmplitudeSweep& sweep,
+                     const WhitenessStats& whiteness, double noise_rad_per_s) {
   Quality q;
   auto reject = [&q](const char* flag, const std::string& why) {
     q.findings.flags.push_back(flag);
@@ -194,10 +197,9 @@ Quality JudgeQuality(const TraceFitInput& input, const TraceFitOptions& options,
                Fmt("%.3f", options.reject_secondary_motion_ratio) +
                "); the swing axis may be wrong (set imu.swing_axis) or the rig sways");
   } else if (secondary >= 0.0 && secondary > options.max_secondary_motion_ratio) {
-    warn("secondary_motion", "secondary motion " + Fmt("%.3f", secondary) +
-                                 " of the swing energy (warning above " +
-                                 Fmt("%.3f", options.max_secondary_motion_ratio) +
-                                 "); steady the rig before release");
+    warn("secondary_motion",
+         "secondary motion " + Fmt("%.3f", secondary) + " of the swing energy (warning above " +
+             Fmt("%.3f", options.max_secondary_motion_ratio) + "); steady the rig before release");
   }
 
   // Warnings, the most important first: residual level (with its cause) and structure,
@@ -219,10 +221,10 @@ Quality JudgeQuality(const TraceFitInput& input, const TraceFitOptions& options,
   }
   WarnAtBounds(minimum, options, &q.findings);
   if (solution.amplitude_start_deg > options.max_amplitude_deg + 1.0) {
-    warn("amplitude_above_band", "amplitude " + Fmt("%.1f", solution.amplitude_start_deg) +
-                                     " deg above the band max " +
-                                     Fmt("%.1f", options.max_amplitude_deg) +
-                                     ": start the window later, at a smaller amplitude (fit.windows or --window).");
+    warn("amplitude_above_band",
+         "amplitude " + Fmt("%.1f", solution.amplitude_start_deg) + " deg above the band max " +
+             Fmt("%.1f", options.max_amplitude_deg) +
+             ": start the window later, at a smaller amplitude (fit.windows or --window).");
   }
   if (solution.amplitude_end_deg < options.min_amplitude_deg - 0.5) {
     warn("amplitude_below_band", "amplitude " + Fmt("%.2f", solution.amplitude_end_deg) +

@@ -9,8 +9,8 @@
 #include <string>
 
 #include <ceres/ceres.h>
-#include <nlopt.hpp>
 #include <Eigen/Dense>
+#include <nlopt.hpp>
 
 #include "fit/solver_logging.h"
 #include "fit/trace_fit_steps.h"
@@ -72,8 +72,8 @@ class BoundWatch : public ceres::IterationCallback {
   BoundWatch(const double* p, const bool* fixed) : p_(p), fixed_(fixed) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
     if (summary.iteration == 0 || !summary.step_is_successful) return ceres::SOLVER_CONTINUE;
-    const bool at = (!fixed_[0] && p_[kTraceDrag] <= 0.0) ||
-                    (!fixed_[1] && p_[kTraceViscous] <= 0.0);
+    const bool at =
+        (!fixed_[0] && p_[kTraceDrag] <= 0.0) || (!fixed_[1] && p_[kTraceViscous] <= 0.0);
     count_ = at ? count_ + 1 : 0;
     if (count_ >= 1) {
       triggered_ = true;
@@ -228,7 +228,8 @@ SolveOutcome SolveLm(const TraceRateCost& cost, int max_iterations, const bool f
   ceres::Solver::Options options;
   options.minimizer_type = ceres::TRUST_REGION;
   options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // 6x6 normal equations: N x 6 QR costs more
+  options.linear_solver_type =
+      ceres::DENSE_NORMAL_CHOLESKY;  // 6x6 normal equations: N x 6 QR costs more
   options.max_num_iterations = max_iterations;
   // Stop inside the noise: a relative cost change of 1e-7 is N * 1e-7 = 6e-4 units of chi^2 at
   // N = 6000 samples (a parameter 0.025 sigma from the optimum), and 1e-9 relative steps are far
@@ -323,11 +324,9 @@ void RefineInertia(const TraceRateCost& cost, const Params& start, int max_itera
   global.set_upper_bounds(std::vector<double>{1.1});
   global.set_maxeval(120);
   using Objective = decltype(objective);
-  global.set_min_objective(
-      [](unsigned, const double* x, double*, void* data) {
-        return (*static_cast<Objective*>(data))(x[0]);
-      },
-      &objective);
+  global.set_min_objective([](unsigned, const double* x, double*,
+                              void* data) { return (*static_cast<Objective*>(data))(x[0]); },
+                           &objective);
   std::vector<double> x{1.0};
   double best = 0.0;
   try {
@@ -350,7 +349,8 @@ void RefineInertia(const TraceRateCost& cost, const Params& start, int max_itera
     minimum->residuals.swap(r2);
     minimum->iterations += lm2.iterations;
   }
-  Cost(cost, minimum->p.data(), &minimum->residuals);  // leave the cache (trajectory, Jacobian) at the chosen point
+  Cost(cost, minimum->p.data(),
+       &minimum->residuals);  // leave the cache (trajectory, Jacobian) at the chosen point
 }
 
 }  // namespace trace

@@ -131,8 +131,8 @@ AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptio
   const double t0 = input.t_s.front(), t1 = input.t_s.back();
   const double cycles = period_s > 0.0 ? (t1 - t0) / period_s : 0.0;
   const double min_cycles = options.sweep_min_cycles_per_band;
-  const int bands = std::min(options.sweep_max_bands,
-                             static_cast<int>(std::floor(cycles / min_cycles)));
+  const int bands =
+      std::min(options.sweep_max_bands, static_cast<int>(std::floor(cycles / min_cycles)));
   if (bands < 2) {
     sweep.note = "the window holds " + Fmt("%.1f", cycles) + " cycles; a sweep needs 2 bands of " +
                  Fmt("%g", options.sweep_min_cycles_per_band) + " cycles";
@@ -146,8 +146,7 @@ AmplitudeSweep RunAmplitudeSweep(const TraceFitInput& input, const TraceFitOptio
     size_t last = first;
     while (last < n && input.t_s[last] < tb) ++last;  // band = [first, last)
     if (last - first >= 20)
-      sweep.bands.push_back(FitBand(input, options, p, scale, traj, period_s, first, last,
-                                     budget));
+      sweep.bands.push_back(FitBand(input, options, p, scale, traj, period_s, first, last, budget));
     first = last;
   }
   FitTrend(options, scale, &sweep);
@@ -159,8 +158,7 @@ std::vector<double> BandFittedRate(const TraceFitInput& input, const TraceFitOpt
                                    size_t* first) {
   const auto begin = std::lower_bound(input.t_s.begin(), input.t_s.end(), band.t0_s);
   *first = static_cast<size_t>(begin - input.t_s.begin());
-  if (band.num_samples < 2 || *first + band.num_samples > input.t_s.size() ||
-      *begin != band.t0_s) {
+  if (band.num_samples < 2 || *first + band.num_samples > input.t_s.size() || *begin != band.t0_s) {
     return {};
   }
   const std::vector<double> t(begin, begin + band.num_samples);
@@ -218,10 +216,9 @@ SweepRule ApplySweepRule(const AmplitudeSweep& sweep, const Solution& solution,
           Fmt("%g", sweep.trend_exponent) +
           ") fits best); I is taken from the lowest-amplitude band (" +
           Fmt("%.1f", low->amplitude_mean_deg) + " deg)" +
-          (sweep.std_scale > 1.0
-               ? ", its std scaled by " + Fmt("%.2g", sweep.std_scale) +
-                     " for the bands' scatter about the trend,"
-               : std::string()) +
+          (sweep.std_scale > 1.0 ? ", its std scaled by " + Fmt("%.2g", sweep.std_scale) +
+                                       " for the bands' scatter about the trend,"
+                                 : std::string()) +
           " with a model-inadequacy std of " + Fmt("%.2g", rule.model_inadequacy_std_kg_m2) +
           " kg m^2 (the trend's change from that amplitude to zero).");
   return rule;

@@ -104,13 +104,12 @@ bool GapFree(const std::vector<double>& t, size_t first, size_t last, double per
     }
   }
   if (longest <= o.max_gap_periods * period_s) return true;
-  *message = Prefix(name) +
-             Fmt("a gap of %.3g s without samples (from %.3f s", longest, t[at]) +
-             Fmt(" to %.3f s) lies inside the window", t[at + 1]) +
-             Fmt(" [%.3f, ", t[first]) + Fmt("%.3f] s", t[last]) +
-             Fmt(", longer than %g period(s)", o.max_gap_periods) +
+  *message = Prefix(name) + Fmt("a gap of %.3g s without samples (from %.3f s", longest, t[at]) +
+             Fmt(" to %.3f s) lies inside the window", t[at + 1]) + Fmt(" [%.3f, ", t[first]) +
+             Fmt("%.3f] s", t[last]) + Fmt(", longer than %g period(s)", o.max_gap_periods) +
              Fmt(" (%.3f s): the swing cannot be followed across it; give a window on one side "
-                 "of it (fit.windows or --window)", period_s);
+                 "of it (fit.windows or --window)",
+                 period_s);
   return false;
 }
 
@@ -200,7 +199,9 @@ void FindRest(const std::vector<double>& t, const std::vector<double>& r, double
         count > 1 ? std::sqrt(std::max(0.0, (sum2 - sum * sum / count) / (count - 1.0))) : sd0;
     const double sd_ref = std::max(rest_sd, 1e-12);
     const double m = static_cast<double>(e - begin);
-    if (e - begin < 3 || sd > 2.0 * sd_ref || std::abs(mean - rest_mean) > 5.0 * sd_ref / std::sqrt(m)) break;
+    if (e - begin < 3 || sd > 2.0 * sd_ref ||
+        std::abs(mean - rest_mean) > 5.0 * sd_ref / std::sqrt(m))
+      break;
     for (size_t k = begin; k < e; ++k) {
       sum += r[k];
       sum2 += r[k] * r[k];
@@ -244,7 +245,8 @@ bool Analyse(const std::vector<double>& t, const std::vector<double>& r, const W
   for (size_t i = 0; i < n; ++i) {
     if (!std::isfinite(t[i]) || !std::isfinite(r[i]) || (i > 0 && !(t[i] > t[i - 1]))) {
       w->status = WindowStatus::kError;
-      w->message = Prefix(name) + "the swing-rate series must be finite with increasing times (sample " +
+      w->message = Prefix(name) +
+                   "the swing-rate series must be finite with increasing times (sample " +
                    std::to_string(i) + ")";
       return false;
     }
@@ -286,7 +288,8 @@ double HalfPeriod(const std::vector<HalfCycle>& cycles, double min_peak, const W
   double best = 0.0, best_score = 0.0;
   for (double di : d) {
     double score = 0.0;
-    for (double dj : d) if (dj >= di / 1.2 && dj <= di * 1.2) score += dj;
+    for (double dj : d)
+      if (dj >= di / 1.2 && dj <= di * 1.2) score += dj;
     if (score > best_score) {
       best_score = score;
       best = di;
@@ -294,7 +297,8 @@ double HalfPeriod(const std::vector<HalfCycle>& cycles, double min_peak, const W
   }
   if (best == 0.0) return 0.0;
   std::vector<double> near;
-  for (double dj : d) if (dj >= best / 1.2 && dj <= best * 1.2) near.push_back(dj);
+  for (double dj : d)
+    if (dj >= best / 1.2 && dj <= best * 1.2) near.push_back(dj);
   return Median(near);
 }
 
@@ -371,7 +375,8 @@ struct HalfCycleRules {
       // The log ended inside it: fine unless the swing should have crossed zero by now (a quarter
       // period after the peak), which means it was stopped or died out.
       return c.duration() <= (1.0 + o.half_period_tolerance) * half + slack &&
-             c.end_s - t[c.robust_peak_index] <= 0.5 * (1.0 + o.half_period_tolerance) * half + slack;
+             c.end_s - t[c.robust_peak_index] <=
+                 0.5 * (1.0 + o.half_period_tolerance) * half + slack;
     }
     // A free half-cycle peaks near its middle: the rate must cross zero again within about a
     // quarter period of the peak (a hand that grabs near a peak leaves a long, flat tail).
@@ -451,8 +456,10 @@ std::vector<Run> FreeRuns(const std::vector<HalfCycle>& cycles, const HalfCycleR
         reason = WindowEnd::kNoiseFloor;
       } else if (!rules.DurationOk(c)) {
         broken = true;
-        reason = c.robust_peak < floor || prev < 2.0 * floor ? WindowEnd::kNoiseFloor : WindowEnd::kStopped;
-      } else if (!unreliable && c.robust_peak > prev * (1.0 + o.growth_tolerance) + 3.0 * sigma_eff) {
+        reason = c.robust_peak < floor || prev < 2.0 * floor ? WindowEnd::kNoiseFloor
+                                                             : WindowEnd::kStopped;
+      } else if (!unreliable &&
+                 c.robust_peak > prev * (1.0 + o.growth_tolerance) + 3.0 * sigma_eff) {
         broken = true;
         reason = WindowEnd::kStopped;  // pushed: the free decay is broken
         restart = true;
@@ -506,8 +513,8 @@ const Run* LongestRun(const std::vector<Run>& runs, const std::vector<HalfCycle>
 // below the noise floor over more than a tenth of a period, which a free swing never shows (it
 // is below the floor for about floor/peak of a period around each crossing). The window then
 // ends half a period before the tail, clear of the hand.
-void TrimHandStopTail(const std::vector<double>& t, const Analysis& a, double floor,
-                      double period, FreeOscillationWindow* w) {
+void TrimHandStopTail(const std::vector<double>& t, const Analysis& a, double floor, double period,
+                      FreeOscillationWindow* w) {
   w->t1_s = t.back();
   size_t k = a.x.size();
   while (k > 0 && std::abs(a.x[k - 1]) < floor) --k;
@@ -543,8 +550,8 @@ std::string TooShortMessage(const std::vector<double>& t, const std::vector<Half
   const double end_s = best.end == WindowEnd::kLogEnd ? t.back() : cycles[best.last].end_s;
   return Prefix(name) +
          Fmt("free oscillation shorter than %g periods: the swing released at ", o.min_periods) +
-         Fmt("%.3f s ends at ", w.release_s) + Fmt("%.3f s", end_s) + " (" +
-         ToString(best.end) + Fmt("), %.2f periods", (end_s - w.release_s) / period) +
+         Fmt("%.3f s ends at ", w.release_s) + Fmt("%.3f s", end_s) + " (" + ToString(best.end) +
+         Fmt("), %.2f periods", (end_s - w.release_s) / period) +
          Fmt(" of %.3f s later, before a window could start (at ", period) +
          Fmt("%.3f s, after the first extreme)", w.t0_s);
 }
@@ -579,23 +586,30 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t,
   const Run* best = LongestRun(runs, cycles);
   if (!best) {
     w.no_oscillation_found = true;
-    w.message = Prefix(name) + "no oscillation found (no sequence of half-cycles that decays like a "
-                               "free swing)";
+    w.message = Prefix(name) +
+                "no oscillation found (no sequence of half-cycles that decays like a "
+                "free swing)";
     return w;
   }
   // Mean period over the closed half-cycles of the run.
   size_t closed_last = best->last;
   if (cycles[closed_last].open && closed_last > best->first) --closed_last;
-  const double period =
-      2.0 * (cycles[closed_last].end_s - cycles[best->first].start_s) / (closed_last - best->first + 1);
+  const double period = 2.0 * (cycles[closed_last].end_s - cycles[best->first].start_s) /
+                        (closed_last - best->first + 1);
   w.period_s = period;
   w.release_s = cycles[best->first].start_s;
   w.end_reason = best->end;
   w.t0_s = cycles[best->first].end_s + o.start_delay_periods * period;
   switch (best->end) {
-    case WindowEnd::kLogEnd: TrimHandStopTail(t, a, floor, period, &w); break;
-    case WindowEnd::kNoiseFloor: w.t1_s = cycles[best->last].end_s; break;
-    default: w.t1_s = t[cycles[best->last].peak_index] - o.end_margin_periods * period; break;
+    case WindowEnd::kLogEnd:
+      TrimHandStopTail(t, a, floor, period, &w);
+      break;
+    case WindowEnd::kNoiseFloor:
+      w.t1_s = cycles[best->last].end_s;
+      break;
+    default:
+      w.t1_s = t[cycles[best->last].peak_index] - o.end_margin_periods * period;
+      break;
   }
   if (!a.from_rest) BiasFromRun(t, r, cycles, *best, closed_last, &w);
   if (w.t1_s - w.t0_s < o.min_periods * period) {
@@ -626,7 +640,8 @@ FreeOscillationWindow ApplyWindowOverride(const std::vector<double>& t,
   const double half_dt = 0.5 * (t.back() - t.front()) / static_cast<double>(t.size() - 1);
   if (!std::isfinite(t0_s) || !std::isfinite(t1_s) || !(t1_s > t0_s)) {
     w.status = WindowStatus::kError;
-    w.message = Prefix(name) + Fmt("window [%g, %g] s: the end must be after the start", t0_s, t1_s);
+    w.message =
+        Prefix(name) + Fmt("window [%g, %g] s: the end must be after the start", t0_s, t1_s);
     return w;
   }
   if (t0_s < t.front() - half_dt || t1_s > t.back() + half_dt) {
@@ -649,7 +664,8 @@ FreeOscillationWindow ApplyWindowOverride(const std::vector<double>& t,
   if (half <= 0.0) {
     w.status = WindowStatus::kRejected;
     w.no_oscillation_found = true;
-    w.message = Prefix(name) + Fmt("no oscillation found inside the window [%g, %g] s", w.t0_s, w.t1_s);
+    w.message =
+        Prefix(name) + Fmt("no oscillation found inside the window [%g, %g] s", w.t0_s, w.t1_s);
     return w;
   }
   w.period_s = 2.0 * half;
@@ -660,8 +676,9 @@ FreeOscillationWindow ApplyWindowOverride(const std::vector<double>& t,
   }
   if (w.t1_s - w.t0_s < o.min_periods * w.period_s) {
     w.status = WindowStatus::kRejected;
-    w.message = Prefix(name) + Fmt("window [%.3f, %.3f] s is shorter than %g periods (period %.3f s)",
-                                   w.t0_s, w.t1_s, o.min_periods, w.period_s);
+    w.message =
+        Prefix(name) + Fmt("window [%.3f, %.3f] s is shorter than %g periods (period %.3f s)",
+                           w.t0_s, w.t1_s, o.min_periods, w.period_s);
     return w;
   }
   if (!GapFree(t, w.first_index, w.last_index, w.period_s, o, name, &w.message)) {
@@ -687,7 +704,8 @@ bool ParseWindowSpec(const std::string& text, double* t0_s, double* t1_s, std::s
     const size_t b = s.find_first_not_of(" \t\n\v\f\r");
     if (b == std::string::npos) return false;
     const size_t e = s.find_last_not_of(" \t");
-    return e != std::string::npos && e >= b && ParseNumber(std::string_view(s).substr(b, e - b + 1), v);
+    return e != std::string::npos && e >= b &&
+           ParseNumber(std::string_view(s).substr(b, e - b + 1), v);
   };
   double a, b;
   if (!parse(text.substr(0, colon), &a) || !parse(text.substr(colon + 1), &b)) {

@@ -37,24 +37,25 @@
 namespace bifilar {
 
 struct WindowOptions {
-  double min_period_s = 0.3;    // shortest swing period considered (s); > 0. Default 0.3 s.
-  double max_period_s = 10.0;   // longest (s); > min. Default 10 s (rigs swing at 1-3 s).
-  double rest_block_s = 0.25;   // block length of the rest detector (s); > 0.
-  double min_rest_s = 0.5;      // shortest initial rest used for the noise (s); > 0. 0.5 s at
-                                // 100 Hz gives sigma within ~7 % (1/sqrt(2 N)) at 1 sigma.
+  double min_period_s = 0.3;       // shortest swing period considered (s); > 0. Default 0.3 s.
+  double max_period_s = 10.0;      // longest (s); > min. Default 10 s (rigs swing at 1-3 s).
+  double rest_block_s = 0.25;      // block length of the rest detector (s); > 0.
+  double min_rest_s = 0.5;         // shortest initial rest used for the noise (s); > 0. 0.5 s at
+                                   // 100 Hz gives sigma within ~7 % (1/sqrt(2 N)) at 1 sigma.
   double hysteresis_sigmas = 4.0;  // half-cycle threshold in noise sigmas; > 0. Noise alone
                                    // crosses 4 sigma once per ~16000 samples.
-  double half_period_tolerance = 0.3;  // half-cycle duration within +-30 % of T/2; in (0, 1).
-                                       // Covers the period's growth with amplitude (+7 % at 60 deg).
+  double half_period_tolerance =
+      0.3;                         // half-cycle duration within +-30 % of T/2; in (0, 1).
+                                   // Covers the period's growth with amplitude (+7 % at 60 deg).
   double growth_tolerance = 0.15;  // a peak may exceed the previous by 15 % (+3 sigma); >= 0.
   // A peak below stop_drop_factor * (median recent peak ratio) * previous peak means a hand
   // stopped the swing. Default 0.7: free decay of a bifilar rig loses a few % per half-cycle; a
   // hand (rate decaying in ~0.1 s) loses most of it.
-  double stop_drop_factor = 0.7;  // in (0, 1)
-  double noise_floor_sigmas = 10.0;  // the swing ends when peaks fall below this * sigma; > 0.
+  double stop_drop_factor = 0.7;      // in (0, 1)
+  double noise_floor_sigmas = 10.0;   // the swing ends when peaks fall below this * sigma; > 0.
   double start_delay_periods = 0.25;  // t0 after the first extreme after release (periods); >= 0.
   double end_margin_periods = 0.25;   // t1 before the last clean peak after a stop (periods); >= 0.
-  double min_periods = 2.0;  // windows shorter than this many periods are rejected; > 0.
+  double min_periods = 2.0;           // windows shorter than this many periods are rejected; > 0.
   // A one-sample half-cycle shorter than this fraction of T/2 between two pieces of the same sign
   // is a glitch that split a half-cycle: the three are merged when the pieces are not half-cycles
   // but their union is (step 3b). [0, 0.5); 0 disables. Default 0.25: a real half-cycle is never
@@ -79,16 +80,16 @@ struct FreeOscillationWindow {
   // Rejected because no oscillation was found at all (the message says "no oscillation found"):
   // callers act on this (pipeline/trace/trace_process.cc's time-unit hint), never on the text.
   bool no_oscillation_found = false;
-  double t0_s = 0.0, t1_s = 0.0;        // the window (s, the log's own time)
+  double t0_s = 0.0, t1_s = 0.0;           // the window (s, the log's own time)
   size_t first_index = 0, last_index = 0;  // samples with t0 <= t <= t1 (inclusive)
   WindowEnd end_reason = WindowEnd::kLogEnd;
-  bool overridden = false;              // [t0, t1] given by the user
-  double release_s = 0.0;               // detected release (start of the first free half-cycle)
-  double period_s = 0.0;                // mean period over the free oscillation (0: unknown)
-  double noise_sigma_rad_per_s = 0.0;   // rate noise std
-  bool noise_from_rest = false;         // true: from the rest segment; false: high-frequency residual
-  double rest_bias_rad_per_s = 0.0;     // mean rate at rest (without rest: over whole periods)
-  double rest_end_s = 0.0;              // end of the initial rest (valid when noise_from_rest)
+  bool overridden = false;             // [t0, t1] given by the user
+  double release_s = 0.0;              // detected release (start of the first free half-cycle)
+  double period_s = 0.0;               // mean period over the free oscillation (0: unknown)
+  double noise_sigma_rad_per_s = 0.0;  // rate noise std
+  bool noise_from_rest = false;      // true: from the rest segment; false: high-frequency residual
+  double rest_bias_rad_per_s = 0.0;  // mean rate at rest (without rest: over whole periods)
+  double rest_end_s = 0.0;           // end of the initial rest (valid when noise_from_rest)
   int rest_samples = 0;
   double peak_rate_start_rad_per_s = 0.0;  // |rate - bias| of the first/last peak in the window
   double peak_rate_end_rad_per_s = 0.0;
@@ -117,8 +118,8 @@ FreeOscillationWindow FindFreeOscillationWindow(const std::vector<double>& t_s,
 // t1 > t0, inside [t_first, t_last] up to half a sample) -> kError naming the log otherwise; the
 // noise, bias and period are estimated as above; fewer than min_periods periods -> kRejected.
 FreeOscillationWindow ApplyWindowOverride(const std::vector<double>& t_s,
-                                          const std::vector<double>& rate_rad_per_s,
-                                          double t0_s, double t1_s, const WindowOptions& options,
+                                          const std::vector<double>& rate_rad_per_s, double t0_s,
+                                          double t1_s, const WindowOptions& options,
                                           const std::string& name = "");
 
 // Parses "T0:T1" (seconds, the log's own time, e.g. "12.5:48"), as given to --window. False with
@@ -154,7 +155,7 @@ struct AmplitudeBandOptions {
 struct AmplitudeBand {
   WindowStatus status = WindowStatus::kRejected;
   std::string message;
-  double t0_s = 0.0, t1_s = 0.0;   // the trimmed window
+  double t0_s = 0.0, t1_s = 0.0;  // the trimmed window
   size_t first_index = 0, last_index = 0;
   double amplitude_start_deg = 0.0;  // amplitude at the first / last extreme inside it
   double amplitude_end_deg = 0.0;

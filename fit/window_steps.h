@@ -19,9 +19,9 @@ struct HalfCycle {
   double start_s = 0.0;  // interpolated zero crossing where it begins
   double end_s = 0.0;    // where the next begins (or the last sample time when open)
   size_t peak_index = 0;
-  double peak = 0.0;     // max sign * x
-  bool open = false;     // the log ended before it did
-  double max_gap_s = 0.0;  // longest time step between samples inside it (dropped packets)
+  double peak = 0.0;          // max sign * x
+  bool open = false;          // the log ended before it did
+  double max_gap_s = 0.0;     // longest time step between samples inside it (dropped packets)
   size_t samples_beyond = 0;  // samples with sign * x above the hysteresis threshold
   // max sign * x over samples capped at their larger neighbour: one glitch sample cannot raise it
   double robust_peak = 0.0;
@@ -32,7 +32,6 @@ struct HalfCycle {
 // Half-cycles with hysteresis h on x.
 std::vector<HalfCycle> HalfCycles(const std::vector<double>& t, const std::vector<double>& x,
                                   size_t begin, size_t end, double h);
-
 
 // A glitch sample of the other sign (one reading, too small for fit/glitch.h, e.g. 0.4 rad/s on
 // a 1 rad/s swing just after a long timestamp gap) splits a half-cycle in three: two pieces of

@@ -86,7 +86,9 @@ constexpr EnumName<IntegratorMethod> kIntegratorMethodNames[] = {
 
 }  // namespace
 
-const char* ToString(IntegratorMethod method) { return EnumToString(kIntegratorMethodNames, method); }
+const char* ToString(IntegratorMethod method) {
+  return EnumToString(kIntegratorMethodNames, method);
+}
 
 bool ParseIntegratorMethod(const std::string& name, IntegratorMethod* method) {
   return ParseEnum(kIntegratorMethodNames, name, method);
@@ -256,8 +258,8 @@ bool PendulumIntegrator::Integrate(const PendulumParams& params, double angle0_r
     if (k > 0 && t_s[k] < t_s[k - 1]) {
       std::ostringstream os;
       os.precision(17);
-      os << "t_s must be non-decreasing, but t_s[" << k << "] = " << t_s[k] << " < t_s["
-         << k - 1 << "] = " << t_s[k - 1];
+      os << "t_s must be non-decreasing, but t_s[" << k << "] = " << t_s[k] << " < t_s[" << k - 1
+         << "] = " << t_s[k - 1];
       return Fail(why, os.str());
     }
   }
@@ -300,8 +302,9 @@ bool PendulumIntegrator::Integrate(const PendulumParams& params, double angle0_r
 
   im.params = params;
   if (im.options.method == IntegratorMethod::kRungeKutta) {
-    return with_sensitivities ? im.IntegrateRk<true>(angle0_rad, rate0_rad_per_s, t_s, first, out, why)
-                              : im.IntegrateRk<false>(angle0_rad, rate0_rad_per_s, t_s, first, out, why);
+    return with_sensitivities
+               ? im.IntegrateRk<true>(angle0_rad, rate0_rad_per_s, t_s, first, out, why)
+               : im.IntegrateRk<false>(angle0_rad, rate0_rad_per_s, t_s, first, out, why);
   }
   return with_sensitivities
              ? im.IntegrateCvode<true>(angle0_rad, rate0_rad_per_s, t_s, first, out, why)
@@ -352,10 +355,9 @@ bool PendulumIntegrator::Impl::IntegrateRk(double angle0_rad, double rate0_rad_p
   dop853::Stepper<kN> stepper;
   dop853::Stats rk_stats;
   double t_fail = t_s[0];
-  const int status = stepper.Integrate(rhs, t_s[0], y0, t_s.data(), static_cast<int>(first),
-                                       static_cast<int>(t_s.size()), options.rel_tol,
-                                       options.abs_tol, options.max_steps, write, kink,
-                                       &t_fail, &rk_stats);
+  const int status = stepper.Integrate(
+      rhs, t_s[0], y0, t_s.data(), static_cast<int>(first), static_cast<int>(t_s.size()),
+      options.rel_tol, options.abs_tol, options.max_steps, write, kink, &t_fail, &rk_stats);
   stats.steps = rk_stats.steps;
   stats.rejected_steps = rk_stats.rejected;
   stats.rhs_evals = rk_stats.rhs_evals;

@@ -44,9 +44,9 @@ struct IntegratorOptions {
   // 1e-11 relative and energy kept to 1.2e-9: far below any gyro noise, at ~1 ms per
   // 6000-sample trace with sensitivities (README, Performance). kCvodes at the same values is
   // ~18x less accurate globally (rate) and ~14x slower; see WithMethod.
-  double rel_tol = 1e-10;     // Relative tolerance (dimensionless); in (0, 1e-2].
-  double abs_tol = 1e-12;     // Absolute tolerance (rad, rad/s, and for sensitivities); > 0.
-  long max_steps = 1000000;   // Internal steps allowed over the whole trace; > 0.
+  double rel_tol = 1e-10;    // Relative tolerance (dimensionless); in (0, 1e-2].
+  double abs_tol = 1e-12;    // Absolute tolerance (rad, rad/s, and for sensitivities); > 0.
+  long max_steps = 1000000;  // Internal steps allowed over the whole trace; > 0.
   IntegratorMethod method = IntegratorMethod::kRungeKutta;  // ODE solver, see above.
 
   bool Check(std::string* why) const;

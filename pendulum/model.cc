@@ -43,7 +43,8 @@ Rise ComputeRise(const RigGeometry& g, double psi, bool want_d3) {
   r.d2 = k * (cs * inv_s + k * sn * sn * inv_s3);
   if (want_d3) {
     const double inv_s5 = inv_s3 / s2;
-    r.d3 = -k * sn * inv_s + 3.0 * k * k * sn * cs * inv_s3 + 3.0 * k * k * k * sn * sn * sn * inv_s5;
+    r.d3 =
+        -k * sn * inv_s + 3.0 * k * k * sn * cs * inv_s3 + 3.0 * k * k * k * sn * sn * sn * inv_s5;
   }
   return r;
 }

@@ -33,7 +33,7 @@ struct RigGeometry {
   double filar_length_m = 0.0;      // L, wire length (m); > 0 and > D (wires never go slack).
   double filar_separation_m = 0.0;  // D, distance between the wires (m); > 0.
   double mass_kg = 0.0;             // m, whole suspended mass (kg); > 0.
-  double gravity_mps2 = kStandardGravityMps2;    // g, local gravity (m/s^2); > 0.
+  double gravity_mps2 = kStandardGravityMps2;  // g, local gravity (m/s^2); > 0.
 
   // True when every field is finite and in range; otherwise names the field and the range.
   bool Check(std::string* why) const;
@@ -43,8 +43,7 @@ struct RigGeometry {
 // use it): true when filar_length_m > filar_separation_m; otherwise *why (if not null) says
 // "filar_separation_m (D) = .. m is not below filar_length_m (L) = .. m (the wires would go
 // slack); allowed D < L". Callers prefix their file, line and key. NaN fails.
-bool CheckSeparationBelowLength(double filar_length_m, double filar_separation_m,
-                                std::string* why);
+bool CheckSeparationBelowLength(double filar_length_m, double filar_separation_m, std::string* why);
 
 // The unknowns of one swing that enter the equation of motion.
 struct PendulumParams {

@@ -107,7 +107,9 @@ bool CheckUniformRange(const UniformRange& r, const std::string& field, double l
 constexpr EnumName<SampleSteps> kSampleStepsNames[] = {{SampleSteps::kRegular, "regular"},
                                                        {SampleSteps::kLogNormal, "lognormal"}};
 
-const char* ToString(SampleSteps steps) { return EnumToString(kSampleStepsNames, steps, "regular"); }
+const char* ToString(SampleSteps steps) {
+  return EnumToString(kSampleStepsNames, steps, "regular");
+}
 bool ParseSampleSteps(const std::string& name, SampleSteps* steps) {
   return ParseEnum(kSampleStepsNames, name, steps);
 }
@@ -126,7 +128,8 @@ double SofteningCoefficient(double excess_at_30deg, double exponent) {
 }
 
 double ApparentInertiaExcess(double k, double exponent, double amplitude_rad) {
-  const double x = SofteningHarmonicConstant(exponent) * k * std::pow(std::abs(amplitude_rad), exponent);
+  const double x =
+      SofteningHarmonicConstant(exponent) * k * std::pow(std::abs(amplitude_rad), exponent);
   return x < 1.0 ? x / (1.0 - x) : std::numeric_limits<double>::infinity();
 }
 
@@ -290,8 +293,7 @@ struct SwingFrame {
 };
 
 // Everything random is drawn here, in a fixed order.
-RandomInputs DrawRandomInputs(const TraceSetup& setup, const SimulationOptions& options,
-                              Rng& rng) {
+RandomInputs DrawRandomInputs(const TraceSetup& setup, const SimulationOptions& options, Rng& rng) {
   const TimelineOptions& tl = options.timeline;
   const SensorOptions& so = options.sensor;
   RandomInputs in;
@@ -315,11 +317,10 @@ RandomInputs DrawRandomInputs(const TraceSetup& setup, const SimulationOptions& 
   for (int i = 0; i < 3; ++i) in.gyro_scale[i] = rng.Normal(so.gyro_scale_error_sigma);
   for (int i = 0; i < 3; ++i) in.accel_bias[i] = rng.Normal(so.accel_bias_sigma_mps2);
   in.rocking_amp = so.rocking_max_deg * kRadPerDeg * rng.Uniform();
-  in.rocking_hz =
-      so.rocking_frequency_hz > 0
-          ? so.rocking_frequency_hz
-          : std::sqrt(setup.geometry.gravity_mps2 / setup.geometry.filar_length_m) / (2 * kPi) *
-                (0.9 + 0.2 * rng.Uniform());
+  in.rocking_hz = so.rocking_frequency_hz > 0
+                      ? so.rocking_frequency_hz
+                      : std::sqrt(setup.geometry.gravity_mps2 / setup.geometry.filar_length_m) /
+                            (2 * kPi) * (0.9 + 0.2 * rng.Uniform());
   in.rocking_beta = 2.0 * kPi * rng.Uniform();
   return in;
 }
@@ -338,9 +339,9 @@ bool MakeTimeline(const RandomInputs& in, const SimulationOptions& options, Time
   tm.t_end = in.stopped ? tm.t_stop + 5.0 * tm.stop_tau + in.rest_after : tm.t_stop;
   tm.dt = 1.0 / so.sample_rate_hz;
   tm.lognormal = so.sample_steps == SampleSteps::kLogNormal;
-  tm.samples_real =
-      tm.lognormal ? std::floor((tm.t_end - in.start_time) / so.step_range_s.min) + 1.0
-                   : std::floor((tm.t_end - in.start_time) * so.sample_rate_hz) + 1.0;
+  tm.samples_real = tm.lognormal
+                        ? std::floor((tm.t_end - in.start_time) / so.step_range_s.min) + 1.0
+                        : std::floor((tm.t_end - in.start_time) * so.sample_rate_hz) + 1.0;
   if (tm.samples_real > 5e7) {
     return SetWhy(why, "log too long: up to " + Fmt("%g", tm.samples_real) + " samples (" +
                            Fmt("%g", tm.t_end - in.start_time) + " s at " +
@@ -377,13 +378,15 @@ bool SampleTimes(const SensorOptions& so, double start_time, const Timeline& tm,
   samples->n_nominal = n_nominal;
   std::vector<double>& times = samples->times;
   times.reserve(n_nominal);
-  const double mean_drop_run =
-      (1.0 - so.drop_burst_probability) + so.drop_burst_probability * (2.0 + so.drop_burst_max_samples) / 2.0;
-  const double drop_start_p = so.drop_fraction / (mean_drop_run * (1.0 - so.drop_fraction) + so.drop_fraction);
+  const double mean_drop_run = (1.0 - so.drop_burst_probability) +
+                               so.drop_burst_probability * (2.0 + so.drop_burst_max_samples) / 2.0;
+  const double drop_start_p =
+      so.drop_fraction / (mean_drop_run * (1.0 - so.drop_fraction) + so.drop_fraction);
   int drop_left = 0, dropped = 0;
   for (int k = 0; k < n_nominal; ++k) {
     double jitter = rng.Normal(so.time_jitter_sigma_s);
-    jitter = k == 0 ? 0.0 : std::clamp(jitter, -0.4 * dt, 0.4 * dt);  // the clock starts at sample 0
+    jitter =
+        k == 0 ? 0.0 : std::clamp(jitter, -0.4 * dt, 0.4 * dt);  // the clock starts at sample 0
     const double u = rng.Uniform();
     const double u_burst = rng.Uniform();
     const double u_len = rng.Uniform();
@@ -548,7 +551,7 @@ SwingFrame SwingFrameFor(const TraceSetup& setup, double rocking_beta) {
   const double st = std::sin(setup.pitch_rad), ct = std::cos(setup.pitch_rad);
   f.n_body = Eigen::Vector3d(-st, 0.0, ct);
   f.horizontal = Eigen::Vector3d(ct, 0.0, st);  // in the x-z plane, perpendicular to n
-  f.lateral = Eigen::Vector3d::UnitY();  // the other horizontal direction
+  f.lateral = Eigen::Vector3d::UnitY();         // the other horizontal direction
   if (setup.roll_rad != 0.0) {
     // Rolled by phi: n = Rx(-phi) (-sin theta, 0, cos theta) = (-st, sf ct, cf ct), and the two
     // horizontal directions turn with it (docs/physics.md §3.5).
@@ -577,8 +580,8 @@ Eigen::Vector3d DownEstimateInImu(uint64_t seed, const SensorOptions& so, const 
 }
 
 // Rocking of the body about rock_axis after the release: phi and its derivatives at t.
-void RockingAt(double t, double t_release, double rocking_amp, double rock_omega,
-               double decay_s, double* phi, double* dphi, double* ddphi) {
+void RockingAt(double t, double t_release, double rocking_amp, double rock_omega, double decay_s,
+               double* phi, double* dphi, double* ddphi) {
   if (!(t >= t_release && rocking_amp > 0)) return;
   const double x = t - t_release;
   const double e = rocking_amp * std::exp(-x / decay_s);
@@ -664,8 +667,8 @@ Eigen::Vector3d SynthesizeImu(const TraceSetup& setup, const SensorOptions& so, 
 
 // Spikes: distinct samples, the first one inside the free oscillation; on the IMU axis that
 // carries most of the swing, replaced by +-spike_rate_rad_per_s (a stream of their own).
-bool AddSpikes(const SensorOptions& so, uint64_t seed, const SwingFrame& f,
-               const Samples& samples, SimulatedTrace* out, std::string* why) {
+bool AddSpikes(const SensorOptions& so, uint64_t seed, const SwingFrame& f, const Samples& samples,
+               SimulatedTrace* out, std::string* why) {
   if (so.spike_count <= 0) return true;
   const std::vector<double>& times = samples.times;
   const std::vector<size_t>& free_index = samples.free_index;
@@ -692,10 +695,9 @@ bool AddSpikes(const SensorOptions& so, uint64_t seed, const SwingFrame& f,
     out->imu.gyro_in_imu[k][axis] = value;
     truth.spikes.push_back({static_cast<int>(k), times[k], axis, value});
   }
-  std::sort(truth.spikes.begin(), truth.spikes.end(),
-            [](const TraceTruth::Spike& a, const TraceTruth::Spike& b) {
-              return a.sample < b.sample;
-            });
+  std::sort(
+      truth.spikes.begin(), truth.spikes.end(),
+      [](const TraceTruth::Spike& a, const TraceTruth::Spike& b) { return a.sample < b.sample; });
   return true;
 }
 

@@ -50,16 +50,16 @@ struct UniformRange {
 
 // What happens in a log, besides the free oscillation. Durations in seconds.
 struct TimelineOptions {
-  UniformRange rest_before_s = {2.0, 5.0};   // still on the wires before the twist; >= 0
-  UniformRange twist_s = {0.8, 1.2};         // hand twisting to the amplitude; > 0
-  UniformRange hold_s = {1.0, 2.0};          // hand holding at the amplitude; >= 0
-  double tremor_deg = 0.08;                  // hand tremor while holding, RMS angle (deg); >= 0
-  UniformRange tremor_hz = {4.0, 9.0};       // tremor frequencies (Hz); > 0
+  UniformRange rest_before_s = {2.0, 5.0};    // still on the wires before the twist; >= 0
+  UniformRange twist_s = {0.8, 1.2};          // hand twisting to the amplitude; > 0
+  UniformRange hold_s = {1.0, 2.0};           // hand holding at the amplitude; >= 0
+  double tremor_deg = 0.08;                   // hand tremor while holding, RMS angle (deg); >= 0
+  UniformRange tremor_hz = {4.0, 9.0};        // tremor frequencies (Hz); > 0
   double release_rate_sigma_deg_per_s = 0.5;  // psi'(t_release) ~ N(0, sigma) (deg/s); >= 0
-  UniformRange free_s = {40.0, 90.0};        // free oscillation until the log ends or the stop; > 0
-  double stop_probability = 0.5;             // chance a hand stops the swing at the end; [0, 1]
-  double stop_time_constant_s = 0.1;         // rate decays as exp(-t/tau) when stopped; > 0
-  UniformRange rest_after_s = {1.0, 3.0};    // logging continues after the stop; >= 0
+  UniformRange free_s = {40.0, 90.0};      // free oscillation until the log ends or the stop; > 0
+  double stop_probability = 0.5;           // chance a hand stops the swing at the end; [0, 1]
+  double stop_time_constant_s = 0.1;       // rate decays as exp(-t/tau) when stopped; > 0
+  UniformRange rest_after_s = {1.0, 3.0};  // logging continues after the stop; >= 0
 
   bool Check(std::string* why) const;
 };
@@ -81,22 +81,22 @@ bool ParseSampleSteps(const std::string& name, SampleSteps* steps);
 std::string SampleStepsAllowedValues();  // "regular or lognormal"
 
 struct SensorOptions {
-  double sample_rate_hz = 100.0;             // nominal sample rate (Hz); > 0
+  double sample_rate_hz = 100.0;  // nominal sample rate (Hz); > 0
   SampleSteps sample_steps = SampleSteps::kRegular;
-  double step_log_sigma = 0.75;              // kLogNormal: std of ln(step) (-); [0, 3]
+  double step_log_sigma = 0.75;                // kLogNormal: std of ln(step) (-); [0, 3]
   UniformRange step_range_s = {0.008, 0.160};  // kLogNormal: steps clipped to [min, max] (s); > 0
-  double time_jitter_sigma_s = 0.001;        // timestamp jitter, clipped to +-0.4/rate (s); >= 0
-  double drop_fraction = 0.01;               // fraction of samples lost; [0, 0.5]
-  double drop_burst_probability = 0.1;       // chance a loss is a burst rather than one sample; [0,1]
-  int drop_burst_max_samples = 25;           // bursts are 2..max samples long; >= 2
-  UniformRange start_time_s = {0.0, 0.0};    // time stamp of the first sample (s), e.g. uptime
+  double time_jitter_sigma_s = 0.001;          // timestamp jitter, clipped to +-0.4/rate (s); >= 0
+  double drop_fraction = 0.01;                 // fraction of samples lost; [0, 0.5]
+  double drop_burst_probability = 0.1;     // chance a loss is a burst rather than one sample; [0,1]
+  int drop_burst_max_samples = 25;         // bursts are 2..max samples long; >= 2
+  UniformRange start_time_s = {0.0, 0.0};  // time stamp of the first sample (s), e.g. uptime
   double gyro_noise_sigma_deg_per_s = 0.25;  // noise std per sample per axis (deg/s); >= 0
   // Coloured gyro noise: AR(1) over the logged samples, e_k = phi e_(k-1) + sqrt(1 - phi^2) w_k,
   // w_k ~ N(0, gyro_noise_sigma), e_0 = w_0, so the marginal std stays gyro_noise_sigma and the
   // lag-1 autocorrelation is phi. 0 = white (default); [0, 0.99].
   double gyro_noise_ar1_phi = 0.0;
-  // Gyro bias random walk (deg/s per sqrt(s)): per axis, b(t_(k+1)) = b(t_k) + rate sqrt(dt) N(0,1),
-  // starting at the constant bias; 0 = off (default); [0, 10].
+  // Gyro bias random walk (deg/s per sqrt(s)): per axis, b(t_(k+1)) = b(t_k) + rate sqrt(dt)
+  // N(0,1), starting at the constant bias; 0 = off (default); [0, 10].
   double gyro_bias_walk_deg_per_s_per_sqrt_s = 0.0;
   // Single-sample gyro glitches: spike_count samples (distinct; the first one inside the free
   // oscillation, the others anywhere in the log) whose value on the IMU axis most aligned with
@@ -104,20 +104,20 @@ struct SensorOptions {
   // (default 0), rate (rad/s) in (0, 1e4] (default 50).
   int spike_count = 0;
   double spike_rate_rad_per_s = 50.0;
-  double gyro_bias_sigma_deg_per_s = 0.5;    // constant bias per axis ~ N(0, sigma) (deg/s); >= 0
-  double gyro_scale_error_sigma = 0.0;       // scale factor error per axis ~ N(0, sigma) (-); >= 0
-  bool accelerometer = true;                 // false: the log has no accelerometer
+  double gyro_bias_sigma_deg_per_s = 0.5;  // constant bias per axis ~ N(0, sigma) (deg/s); >= 0
+  double gyro_scale_error_sigma = 0.0;     // scale factor error per axis ~ N(0, sigma) (-); >= 0
+  bool accelerometer = true;               // false: the log has no accelerometer
   // The accelerometer logs specific force with gravity removed (f + g down_est, as some IMU
   // firmwares do: the mean is near 0 g), where down_est is the static down (no rocking) tilted
   // by an attitude-estimate error of gravity_removal_error_deg about a random horizontal axis
   // (residual ~ g * error). Only with accelerometer = true; default false.
   bool accel_gravity_removed = false;
   UniformRange gravity_removal_error_deg = {0.0, 0.0};  // per log ~ U(min, max) (deg); [0, 30]
-  double accel_noise_sigma_mps2 = 0.02;      // white noise per sample per axis (m/s^2); >= 0
-  double accel_bias_sigma_mps2 = 0.05;       // constant bias per axis ~ N(0, sigma) (m/s^2); >= 0
-  double rocking_max_deg = 0.3;              // rocking amplitude ~ U(0, max) at release (deg); >= 0
-  double rocking_frequency_hz = 0.0;         // 0: sqrt(g/L)/(2 pi) +-10 %; else this (Hz); >= 0
-  double rocking_decay_s = 15.0;             // rocking amplitude time constant (s); > 0
+  double accel_noise_sigma_mps2 = 0.02;  // white noise per sample per axis (m/s^2); >= 0
+  double accel_bias_sigma_mps2 = 0.05;   // constant bias per axis ~ N(0, sigma) (m/s^2); >= 0
+  double rocking_max_deg = 0.3;          // rocking amplitude ~ U(0, max) at release (deg); >= 0
+  double rocking_frequency_hz = 0.0;     // 0: sqrt(g/L)/(2 pi) +-10 %; else this (Hz); >= 0
+  double rocking_decay_s = 15.0;         // rocking amplitude time constant (s); > 0
 
   bool Check(std::string* why) const;
 };
@@ -169,14 +169,14 @@ double ApparentInertiaExcess(double k, double exponent, double amplitude_rad);
 
 // The physical truth of one trace (everything deterministic; the noise comes from the seed).
 struct TraceSetup {
-  RigGeometry geometry;                  // L, D, whole suspended mass, g
-  PendulumParams params;                 // I, K_D, C of the whole suspended body
-  double pitch_rad = 0.0;                // TRUE pitch of the body axes (nose-up +)
+  RigGeometry geometry;    // L, D, whole suspended mass, g
+  PendulumParams params;   // I, K_D, C of the whole suspended body
+  double pitch_rad = 0.0;  // TRUE pitch of the body axes (nose-up +)
   // TRUE roll (right wing down +, rad), |roll| <= pi: the swing axis in body axes is then
   // (-sin theta, sin phi cos theta, cos phi cos theta) (docs/physics.md §3.5). Default 0.
   double roll_rad = 0.0;
-  double amplitude_rad = 0.3;            // psi at release (sign = twist direction); 0 < |A| < 89 deg
-  Eigen::Matrix3d body_from_imu = Eigen::Matrix3d::Identity();  // IMU mounting (rotation)
+  double amplitude_rad = 0.3;  // psi at release (sign = twist direction); 0 < |A| < 89 deg
+  Eigen::Matrix3d body_from_imu = Eigen::Matrix3d::Identity();     // IMU mounting (rotation)
   Eigen::Vector3d imu_offset_in_body_m = Eigen::Vector3d::Zero();  // IMU position from the CG
 
   bool Check(std::string* why) const;
@@ -184,15 +184,15 @@ struct TraceSetup {
 
 // What the simulator drew for one trace: the truth a fitter should recover.
 struct TraceTruth {
-  double start_time_s = 0.0;           // first nominal sample time
-  double t_twist_s = 0.0;              // hand starts twisting
-  double t_release_s = 0.0;            // free oscillation starts
-  bool stopped = false;                // a hand stopped the swing
-  double t_stop_s = 0.0;               // hand grabs (valid when stopped)
-  double t_end_s = 0.0;                // last nominal sample time
-  double amplitude_rad = 0.0;          // psi(t_release)
-  double release_rate_rad_per_s = 0.0; // psi'(t_release)
-  double amplitude_at_stop_rad = 0.0;  // |psi| envelope estimate at the end of the free part
+  double start_time_s = 0.0;            // first nominal sample time
+  double t_twist_s = 0.0;               // hand starts twisting
+  double t_release_s = 0.0;             // free oscillation starts
+  bool stopped = false;                 // a hand stopped the swing
+  double t_stop_s = 0.0;                // hand grabs (valid when stopped)
+  double t_end_s = 0.0;                 // last nominal sample time
+  double amplitude_rad = 0.0;           // psi(t_release)
+  double release_rate_rad_per_s = 0.0;  // psi'(t_release)
+  double amplitude_at_stop_rad = 0.0;   // |psi| envelope estimate at the end of the free part
   Eigen::Vector3d gyro_bias_rad_per_s = Eigen::Vector3d::Zero();  // IMU axes
   Eigen::Vector3d gyro_scale_error = Eigen::Vector3d::Zero();     // measured = (1+e) true
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();      // IMU axes
@@ -202,21 +202,21 @@ struct TraceTruth {
   Eigen::Vector3d rocking_axis_in_body = Eigen::Vector3d::UnitY();
   Eigen::Vector3d gyro_bias_end_rad_per_s = Eigen::Vector3d::Zero();  // bias at the last sample
   double gravity_removal_error_rad = 0.0;  // attitude error of a gravity-removed accelerometer
-  double softening_k = 0.0;            // k of the softening term (per rad^p); 0 = off
+  double softening_k = 0.0;                // k of the softening term (per rad^p); 0 = off
   struct Spike {
-    int sample = 0;                    // index into the kept samples
+    int sample = 0;  // index into the kept samples
     double t_s = 0.0;
-    int axis = 0;                      // IMU axis 0..2
-    double rate_rad_per_s = 0.0;       // the value written on that axis
+    int axis = 0;                 // IMU axis 0..2
+    double rate_rad_per_s = 0.0;  // the value written on that axis
   };
-  std::vector<Spike> spikes;           // in sample order
-  int samples_nominal = 0;             // samples the IMU would have sent
+  std::vector<Spike> spikes;  // in sample order
+  int samples_nominal = 0;    // samples the IMU would have sent
   int samples_dropped = 0;
-  int free_samples = 0;                // samples in [t_release, t_stop) (or to the end)
+  int free_samples = 0;  // samples in [t_release, t_stop) (or to the end)
 };
 
 struct SimulatedTrace {
-  ImuData imu;       // SI, IMU axes (accel empty when the sensor has none)
+  ImuData imu;  // SI, IMU axes (accel empty when the sensor has none)
   TraceTruth truth;
   // Noise-free swing state at each kept sample (for tests and plots): psi, psi', psi''.
   std::vector<double> angle_rad, rate_rad_per_s, accel_rad_per_s2;
@@ -231,10 +231,10 @@ bool SimulateTrace(const TraceSetup& setup, const SimulationOptions& options, ui
 // ---- Campaign: an aircraft tested at many pitch angles in a rig, plus tare logs of the rig ----
 
 struct AircraftTruth {
-  double mass_kg = 0.0;       // > 0
-  double ix_kg_m2 = 0.0;      // I_x, body axes about the CG; > 0
-  double iz_kg_m2 = 0.0;      // I_z; > 0
-  double ixz_kg_m2 = 0.0;     // I_xz = integral x z dm (docs/physics.md §3)
+  double mass_kg = 0.0;    // > 0
+  double ix_kg_m2 = 0.0;   // I_x, body axes about the CG; > 0
+  double iz_kg_m2 = 0.0;   // I_z; > 0
+  double ixz_kg_m2 = 0.0;  // I_xz = integral x z dm (docs/physics.md §3)
   // The rest of the tensor (docs/physics.md §3.5), for campaigns that roll: I_y > 0 turns it on
   // (0: a pitch-only aircraft, as before); products positive, I_xy = integral x y dm.
   double iy_kg_m2 = 0.0;
@@ -255,9 +255,9 @@ struct AircraftTruth {
 };
 
 struct RigTruth {
-  double mass_kg = 0.0;            // rig structure (kg); > 0
-  double imu_mass_kg = 0.0;        // the IMU (kg), carried in every log; >= 0
-  double inertia_kg_m2 = 0.0;      // rig (+ IMU) inertia about the swing axis when constant; > 0
+  double mass_kg = 0.0;        // rig structure (kg); > 0
+  double imu_mass_kg = 0.0;    // the IMU (kg), carried in every log; >= 0
+  double inertia_kg_m2 = 0.0;  // rig (+ IMU) inertia about the swing axis when constant; > 0
   // Optional per-pitch table (nominal pitch deg -> kg m^2), used instead of the constant when set;
   // must cover every nominal pitch simulated (and the tare pitch).
   std::vector<std::pair<double, double>> inertia_by_pitch_kg_m2;
@@ -283,19 +283,19 @@ struct AttitudeOverride {
 struct CampaignSpec {
   AircraftTruth aircraft;
   RigTruth rig;
-  double filar_length_m = 0.0;       // L; > D
-  double filar_separation_m = 0.0;   // D; > 0
-  double gravity_mps2 = kStandardGravityMps2;     // > 0
-  std::vector<double> pitch_deg;     // nominal pitch angles (deg), distinct, in [-90, 90]
+  double filar_length_m = 0.0;                 // L; > D
+  double filar_separation_m = 0.0;             // D; > 0
+  double gravity_mps2 = kStandardGravityMps2;  // > 0
+  std::vector<double> pitch_deg;               // nominal pitch angles (deg), distinct, in [-90, 90]
   // Attitudes (roll, pitch) in deg instead of pitch_deg (a tensor campaign): folders
   // roll_{R}_pitch_{P}; roll in [-180, 180], pitch in [-90, 90]; needs aircraft.iy_kg_m2.
   std::vector<std::array<double, 2>> attitudes_deg;
-  double roll_error_sigma_deg = 0.5;        // true roll = nominal + N(0, sigma), per log; >= 0
-  int trials_per_pitch = 3;          // >= 1
-  int tare_logs = 0;                 // logs of the rig alone; >= 0
-  double tare_pitch_deg = 0.0;       // rig pitch for the tare logs (nominal)
-  double pitch_error_sigma_deg = 0.5;       // true pitch = nominal + N(0, sigma), per log; >= 0
-  UniformRange amplitude_deg = {5.0, 30.0}; // |psi(t_release)| (deg); 0 < min, max <= 85
+  double roll_error_sigma_deg = 0.5;         // true roll = nominal + N(0, sigma), per log; >= 0
+  int trials_per_pitch = 3;                  // >= 1
+  int tare_logs = 0;                         // logs of the rig alone; >= 0
+  double tare_pitch_deg = 0.0;               // rig pitch for the tare logs (nominal)
+  double pitch_error_sigma_deg = 0.5;        // true pitch = nominal + N(0, sigma), per log; >= 0
+  UniformRange amplitude_deg = {5.0, 30.0};  // |psi(t_release)| (deg); 0 < min, max <= 85
   UniformRange drag_coeff_kg_m2 = {0.02, 0.08};            // K_D per log
   UniformRange viscous_coeff_kg_m2_per_s = {0.005, 0.02};  // C per log
   // Tare logs (rig alone, far less aerodynamic area) draw K_D and C from the ranges above times
@@ -310,14 +310,16 @@ struct CampaignSpec {
   // axis) and mass hung on the rig at tare_pitch_deg, swung calibration_logs times
   // (calibration/reference_{k}.csv), each at an amplitude from calibration_amplitude_deg
   // (default {0, 0}: amplitude_deg).
-  int calibration_logs = 0;                  // [0, 1000]
-  double reference_inertia_kg_m2 = 0.0;      // > 0 when calibration_logs > 0
-  double reference_mass_kg = 0.0;            // > 0 when calibration_logs > 0
+  int calibration_logs = 0;              // [0, 1000]
+  double reference_inertia_kg_m2 = 0.0;  // > 0 when calibration_logs > 0
+  double reference_mass_kg = 0.0;        // > 0 when calibration_logs > 0
   UniformRange calibration_amplitude_deg = {0.0, 0.0};
   // Attitudes whose logs were made otherwise (AttitudeOverride); each names one of attitudes_deg.
   std::vector<AttitudeOverride> attitude_overrides;
 
-  double TrueLengthM() const { return true_filar_length_m > 0 ? true_filar_length_m : filar_length_m; }
+  double TrueLengthM() const {
+    return true_filar_length_m > 0 ? true_filar_length_m : filar_length_m;
+  }
   double TrueSeparationM() const {
     return true_filar_separation_m > 0 ? true_filar_separation_m : filar_separation_m;
   }
@@ -327,19 +329,19 @@ struct CampaignSpec {
 
 // One log of a campaign with its truth.
 struct CampaignTrace {
-  std::string relative_path;    // "pitch_-80/trial_1.csv", "tare/tare_1.csv",
-                                // "calibration/reference_1.csv"
+  std::string relative_path;  // "pitch_-80/trial_1.csv", "tare/tare_1.csv",
+                              // "calibration/reference_1.csv"
   bool is_tare = false;
-  bool is_calibration = false;  // a reference swing (rig + reference object)
+  bool is_calibration = false;           // a reference swing (rig + reference object)
   double inertia_reference_kg_m2 = 0.0;  // the reference object's, for a reference swing
-  int trial = 0;                // 1-based
+  int trial = 0;                         // 1-based
   double nominal_pitch_deg = 0.0;
   double true_pitch_deg = 0.0;
-  double nominal_roll_deg = 0.0;   // attitude campaigns (0 otherwise)
+  double nominal_roll_deg = 0.0;  // attitude campaigns (0 otherwise)
   double true_roll_deg = 0.0;
   double inertia_aircraft_kg_m2 = 0.0;  // 0 for tare logs
   double inertia_rig_kg_m2 = 0.0;
-  TraceSetup setup;             // setup.params.inertia_kg_m2 = I_total, geometry.mass_kg = m
+  TraceSetup setup;  // setup.params.inertia_kg_m2 = I_total, geometry.mass_kg = m
   SimulatedTrace trace;
 };
 

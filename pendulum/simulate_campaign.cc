@@ -34,8 +34,8 @@ double AircraftTruth::InertiaAtAttitude(double roll_rad, double pitch_rad) const
 
 Eigen::Matrix3d AircraftTruth::Tensor() const {
   Eigen::Matrix3d j;
-  j << ix_kg_m2, -ixy_kg_m2, -ixz_kg_m2, -ixy_kg_m2, iy_kg_m2, -iyz_kg_m2, -ixz_kg_m2,
-      -iyz_kg_m2, iz_kg_m2;
+  j << ix_kg_m2, -ixy_kg_m2, -ixz_kg_m2, -ixy_kg_m2, iy_kg_m2, -iyz_kg_m2, -ixz_kg_m2, -iyz_kg_m2,
+      iz_kg_m2;
   return j;
 }
 
@@ -60,7 +60,8 @@ bool AircraftTruth::Check(std::string* why) const {
         !CheckIn("aircraft I_yz", iyz_kg_m2, -1e9, 1e9, Ends::kClosed, &f)) {
       return FailWith(f, why);
     }
-    const Eigen::Vector3d m = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Tensor()).eigenvalues();
+    const Eigen::Vector3d m =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Tensor()).eigenvalues();
     // Positive definite (else the products of inertia are too large), and the triangle
     // inequality of the principal moments (else no rigid body has the tensor).
     if (!CheckGt("aircraft smallest principal moment (products of inertia too large)", m(0), 0,
@@ -142,8 +143,8 @@ bool CheckAttitudeOverrides(const CampaignSpec& spec, std::string* why) {
                   "an attitude of attitudes_deg");
     }
     if (!CheckFiniteGe("attitude_overrides.true_filar_length_m", o.true_filar_length_m, 0.0, &f) ||
-        !CheckFiniteGe("attitude_overrides.true_filar_separation_m", o.true_filar_separation_m,
-                       0.0, &f) ||
+        !CheckFiniteGe("attitude_overrides.true_filar_separation_m", o.true_filar_separation_m, 0.0,
+                       &f) ||
         !CheckGt("attitude_overrides.true_filar_length_m", length,
                  "attitude_overrides.true_filar_separation_m", separation, &f) ||
         !CheckIn("attitude_overrides.inertia_scatter", o.inertia_scatter, 0.0, 0.5, Ends::kClosed,
@@ -264,7 +265,8 @@ bool CampaignSpec::Check(std::string* why) const {
 }
 
 std::string AttitudeFolder(const std::array<double, 2>& roll_pitch_deg) {
-  return "roll_" + FormatPitchDeg(roll_pitch_deg[0]) + "_pitch_" + FormatPitchDeg(roll_pitch_deg[1]);
+  return "roll_" + FormatPitchDeg(roll_pitch_deg[0]) + "_pitch_" +
+         FormatPitchDeg(roll_pitch_deg[1]);
 }
 
 std::string FormatPitchDeg(double pitch_deg) {
@@ -345,14 +347,16 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
     for (const AttitudeOverride& o : spec.attitude_overrides) {
       if (kind != kAircraftLog || !nominal_roll_deg || o.attitude_deg[0] != *nominal_roll_deg ||
           o.attitude_deg[1] != nominal_deg ||
-          (!o.trials.empty() && std::find(o.trials.begin(), o.trials.end(), trial) == o.trials.end())) {
+          (!o.trials.empty() &&
+           std::find(o.trials.begin(), o.trials.end(), trial) == o.trials.end())) {
         continue;
       }
       if (o.true_filar_length_m > 0) s.geometry.filar_length_m = o.true_filar_length_m;
       if (o.true_filar_separation_m > 0) s.geometry.filar_separation_m = o.true_filar_separation_m;
       if (o.inertia_scatter > 0) {
         Rng scatter_rng(DeriveSeed(seed, path + "#scatter"));
-        ct.inertia_aircraft_kg_m2 *= std::max(0.05, 1.0 + o.inertia_scatter * scatter_rng.Normal(1.0));
+        ct.inertia_aircraft_kg_m2 *=
+            std::max(0.05, 1.0 + o.inertia_scatter * scatter_rng.Normal(1.0));
       }
     }
     s.geometry.gravity_mps2 = spec.gravity_mps2;
@@ -392,7 +396,8 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
     }
   }
   for (int k = 1; k <= spec.tare_logs; ++k) {
-    if (!make("tare/tare_" + std::to_string(k) + ".csv", kTareLog, k, spec.tare_pitch_deg)) return false;
+    if (!make("tare/tare_" + std::to_string(k) + ".csv", kTareLog, k, spec.tare_pitch_deg))
+      return false;
   }
   for (int k = 1; k <= spec.calibration_logs; ++k) {
     if (!make("calibration/reference_" + std::to_string(k) + ".csv", kReferenceLog, k,
@@ -402,6 +407,5 @@ bool SimulateCampaign(const CampaignSpec& spec, const SimulationOptions& options
   }
   return true;
 }
-
 
 }  // namespace bifilar

@@ -21,7 +21,7 @@ class Rng {
   explicit Rng(uint64_t seed) : engine_(seed) {}
   double Uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }  // [0, 1)
   double Uniform(const UniformRange& r) { return r.min + (r.max - r.min) * Uniform(); }
-  double Normal() {  // Box-Muller, one value per call (no cached state)
+  double Normal() {                     // Box-Muller, one value per call (no cached state)
     const double u1 = 1.0 - Uniform();  // (0, 1]
     const double u2 = Uniform();
     return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);

@@ -29,10 +29,10 @@ TEST(SplitCsvRecord, QuotedFieldsHoldDelimitersQuotesAndLineBreaks) {
   // RFC 4180 section 2, rules 5-7.
   EXPECT_EQ(SplitCsvRecord("\"aaa\",\"bbb\",\"ccc\""), (Fields{"aaa", "bbb", "ccc"}));
   EXPECT_EQ(SplitCsvRecord("\"a,b\",c"), (Fields{"a,b", "c"}));
-  EXPECT_EQ(SplitCsvRecord("\"a\"\"b\",c"), (Fields{"a\"b", "c"}));   // "" is one quote
-  EXPECT_EQ(SplitCsvRecord("\"\"\"\""), (Fields{"\""}));              // a field that is one quote
+  EXPECT_EQ(SplitCsvRecord("\"a\"\"b\",c"), (Fields{"a\"b", "c"}));  // "" is one quote
+  EXPECT_EQ(SplitCsvRecord("\"\"\"\""), (Fields{"\""}));             // a field that is one quote
   EXPECT_EQ(SplitCsvRecord("\"b\r\nbb\",c"), (Fields{"b\r\nbb", "c"}));  // line break inside
-  EXPECT_EQ(SplitCsvRecord("\"x;y\";z", ';'), (Fields{"x;y", "z"}));  // another delimiter
+  EXPECT_EQ(SplitCsvRecord("\"x;y\";z", ';'), (Fields{"x;y", "z"}));     // another delimiter
 }
 
 TEST(SplitCsvRecord, RecordEndAndSpaces) {
@@ -75,8 +75,8 @@ TEST(ParseNumber, WholeFieldOnly) {
   EXPECT_EQ(v, 0.1);
   EXPECT_TRUE(ParseNumber("2.2250738585072014e-308", &v));
   EXPECT_EQ(v, std::numeric_limits<double>::min());
-  for (const char* text : {"", "+", "-", "1.5x", "1,5", "1e", "1e+", "x1", "++1", "+-1", "--1",
-                           "1 2", ".", "e5"}) {
+  for (const char* text :
+       {"", "+", "-", "1.5x", "1,5", "1e", "1e+", "x1", "++1", "+-1", "--1", "1 2", ".", "e5"}) {
     EXPECT_FALSE(ParseNumber(text, &v)) << text;
   }
 }
@@ -90,8 +90,8 @@ TEST(ParseNumber, WhiteSpaceIsTheCallersToTrim) {
 
 TEST(ParseNumber, InfinityAndNanRefusedUnlessAsked) {
   double v = 0;
-  for (const char* text : {"inf", "-inf", "+inf", "infinity", "INF", "nan", "NaN", "1e400",
-                           "-1e400"}) {
+  for (const char* text :
+       {"inf", "-inf", "+inf", "infinity", "INF", "nan", "NaN", "1e400", "-1e400"}) {
     EXPECT_FALSE(ParseNumber(text, &v)) << text;
     EXPECT_TRUE(ParseNumber(text, &v, NonFinite::kAccept)) << text;
     EXPECT_FALSE(std::isfinite(v)) << text;

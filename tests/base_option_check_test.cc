@@ -45,7 +45,8 @@ TEST(OptionCheck, ValuesReadBackExactly) {
 }
 
 TEST(OptionCheck, OneMessageFormat) {
-  EXPECT_EQ(CheckMessage("window.min_period_s", -1, "> 0"), "window.min_period_s = -1; must be > 0");
+  EXPECT_EQ(CheckMessage("window.min_period_s", -1, "> 0"),
+            "window.min_period_s = -1; must be > 0");
   CheckFailure f{"min_period_s", -1, "> 0"};
   EXPECT_EQ(f.Message(), "min_period_s = -1; must be > 0");
   std::string why;
@@ -55,10 +56,18 @@ TEST(OptionCheck, OneMessageFormat) {
 }
 
 TEST(OptionCheck, ComparisonsAtTheBound) {
-  const auto gt = [](double v) { return MessageOf([v](CheckFailure* f) { return CheckGt("a", v, 0, f); }); };
-  const auto ge = [](double v) { return MessageOf([v](CheckFailure* f) { return CheckGe("a", v, 0, f); }); };
-  const auto lt = [](double v) { return MessageOf([v](CheckFailure* f) { return CheckLt("a", v, 1, f); }); };
-  const auto le = [](double v) { return MessageOf([v](CheckFailure* f) { return CheckLe("a", v, 1, f); }); };
+  const auto gt = [](double v) {
+    return MessageOf([v](CheckFailure* f) { return CheckGt("a", v, 0, f); });
+  };
+  const auto ge = [](double v) {
+    return MessageOf([v](CheckFailure* f) { return CheckGe("a", v, 0, f); });
+  };
+  const auto lt = [](double v) {
+    return MessageOf([v](CheckFailure* f) { return CheckLt("a", v, 1, f); });
+  };
+  const auto le = [](double v) {
+    return MessageOf([v](CheckFailure* f) { return CheckLe("a", v, 1, f); });
+  };
   EXPECT_EQ(gt(1e-300), "");
   EXPECT_EQ(gt(0), "a = 0; must be > 0");
   EXPECT_EQ(ge(0), "");

@@ -53,7 +53,8 @@ std::vector<EllipsePoint> Simulate(const Truth& t, const std::vector<double>& an
     for (int k = 0; k < trials; ++k) {
       EllipsePoint p;
       p.pitch_deg = a;
-      p.inertia_kg_m2 = TrueMoment(t, a) + angle_error + (trial_sigma > 0 ? trial_sigma * normal(*rng) : 0.0);
+      p.inertia_kg_m2 =
+          TrueMoment(t, a) + angle_error + (trial_sigma > 0 ? trial_sigma * normal(*rng) : 0.0);
       points.push_back(p);
     }
   }
@@ -114,8 +115,8 @@ TEST(EllipseFit, ExactDataRecoversTruthAndAllFitsAgree) {
 TEST(EllipseFit, SignConventionsFollowPhysicsMd) {
   // docs/physics.md section 3: tan 2tau = 2 I_xz / (I_z - I_x); tau in (-45, 45]; I_zp about the
   // principal axis nearest body z; the curve is I_zp cos^2(theta - tau) + I_xp sin^2(theta - tau).
-  const std::vector<Truth> truths = {kPaper, {3.0, 2.0, 0.4}, {3.0, 2.0, -0.4}, {2.0, 2.0, 0.3},
-                                     {2.0, 2.0, -0.3}};
+  const std::vector<Truth> truths = {
+      kPaper, {3.0, 2.0, 0.4}, {3.0, 2.0, -0.4}, {2.0, 2.0, 0.3}, {2.0, 2.0, -0.3}};
   for (const Truth& t : truths) {
     std::mt19937_64 rng(2);
     EllipseOptions options;
@@ -199,11 +200,12 @@ void PaperCase(double angle_sigma_slug, double expect_rmse_slug) {
     mean_tau_std += r.tau_deg.std / kRepetitions;
     mean_ixz_std += r.ixz.std / kSlugFt2 / kRepetitions;
   }
-  std::printf("paper case (angle error %.4f slug ft^2): tau within 1/2 std %d/%d, I_xz %d/%d of %d;"
-              " Table 1 sigma %.4f slug ft^2, CoV %.4f %%, RMSE %.4f slug ft^2; mean std tau %.3f"
-              " deg, I_xz %.5f slug ft^2\n",
-              angle_sigma_slug, within1_tau, within2_tau, within1_ixz, within2_ixz, kRepetitions,
-              mean_sigma, mean_cov, mean_rmse, mean_tau_std, mean_ixz_std);
+  std::printf(
+      "paper case (angle error %.4f slug ft^2): tau within 1/2 std %d/%d, I_xz %d/%d of %d;"
+      " Table 1 sigma %.4f slug ft^2, CoV %.4f %%, RMSE %.4f slug ft^2; mean std tau %.3f"
+      " deg, I_xz %.5f slug ft^2\n",
+      angle_sigma_slug, within1_tau, within2_tau, within1_ixz, within2_ixz, kRepetitions,
+      mean_sigma, mean_cov, mean_rmse, mean_tau_std, mean_ixz_std);
   // The error over the reported std is t with 15 dof: within 1 std 67 %, within 2 std 94 % of
   // the time; with 200 draws the binomial sd is 3.3 % and 1.7 %, so >= 60 % / >= 90 % are > 2 sd
   // below and fail only on a real miscalibration.
@@ -234,7 +236,8 @@ Coverage RunCoverage(int campaigns, int replicates, int trials, double angle_sig
   Coverage c;
   for (int k = 0; k < campaigns; ++k) {
     std::mt19937_64 rng(seed0 + k);
-    const auto points = Simulate(kPaper, PaperAngles(), trials, 0.0045 * kSlugFt2, angle_sigma, &rng);
+    const auto points =
+        Simulate(kPaper, PaperAngles(), trials, 0.0045 * kSlugFt2, angle_sigma, &rng);
     EllipseOptions options;
     options.bootstrap_replicates = replicates;
     options.seed = seed0 + k;
@@ -262,11 +265,12 @@ TEST(EllipseFit, IntervalCoverage) {
   // The naive choice (independent points) under a per-angle error: reported, not asserted to pass.
   const Coverage naive =
       RunCoverage(600, 0, 3, 0.0126 * kSlugFt2, EllipseCovariance::kPointResiduals, 60000);
-  std::printf("I_xz 95%% coverage: t-interval trial noise %.3f, with angle error %.3f; bootstrap "
-              "trial noise %.3f, with angle error %.3f, one trial per angle %.3f; naive point "
-              "covariance with angle error %.3f\n",
-              t_points.Fraction(), t_angle.Fraction(), b_points.Fraction(), b_angle.Fraction(),
-              b_single.Fraction(), naive.Fraction());
+  std::printf(
+      "I_xz 95%% coverage: t-interval trial noise %.3f, with angle error %.3f; bootstrap "
+      "trial noise %.3f, with angle error %.3f, one trial per angle %.3f; naive point "
+      "covariance with angle error %.3f\n",
+      t_points.Fraction(), t_angle.Fraction(), b_points.Fraction(), b_angle.Fraction(),
+      b_single.Fraction(), naive.Fraction());
   EXPECT_GE(t_points.Fraction(), 0.93);
   EXPECT_LE(t_points.Fraction(), 0.97);
   EXPECT_GE(t_angle.Fraction(), 0.93);
@@ -411,7 +415,8 @@ TEST(EllipseFit, BadInputIsRejectedWithAMessage) {
     return p;
   };
   // Fewer than three distinct angles mod 180 (0 and 180 are the same axis; 90 and -90 too).
-  EXPECT_FALSE(FitEllipse(make({{0, 3}, {180, 3}, {90, 2}, {-90, 2}, {0, 3.1}}), options, &r, &why));
+  EXPECT_FALSE(
+      FitEllipse(make({{0, 3}, {180, 3}, {90, 2}, {-90, 2}, {0, 3.1}}), options, &r, &why));
   EXPECT_NE(why.find("distinct"), std::string::npos) << why;
   EXPECT_FALSE(FitEllipse(make({{0, 3}, {45, 3}}), options, &r, &why));
   EXPECT_FALSE(FitEllipse({}, options, &r, &why));
@@ -503,7 +508,6 @@ TEST(EllipsePlan, StdsScaleWithAnySigmaAndHugeInputsAreRefused) {
 }  // namespace
 }  // namespace bifilar
 
-
 namespace bifilar {
 namespace {
 
@@ -563,7 +567,9 @@ TEST(EllipseFit, PerfectCircleWithStdColumnHasNoTau) {
     std::vector<EllipsePoint> points;
     for (int d = -80; d <= 90; d += 10) {
       const double t = d * kRadPerDeg;
-      points.push_back({double(d), radius * std::cos(t) * std::cos(t) + radius * std::sin(t) * std::sin(t), stdev});
+      points.push_back({double(d),
+                        radius * std::cos(t) * std::cos(t) + radius * std::sin(t) * std::sin(t),
+                        stdev});
     }
     for (auto mode : {EllipseCovariance::kAuto, EllipseCovariance::kPointResiduals}) {
       EllipseOptions options;
@@ -621,8 +627,7 @@ TEST(EllipseSteps, CompressedEq7IsThePointByPointProblem) {
       EXPECT_LT(std::fabs(a.abc(k) - b.abc(k)) / scale, kRelTol) << "coefficient " << k;
       EXPECT_LT(std::fabs(a.abc(k) - closed.abc(k)) / scale, kRelTol) << "coefficient " << k;
     }
-    EXPECT_NEAR(a.summary.initial_cost, b.summary.initial_cost,
-                kRelTol * b.summary.initial_cost);
+    EXPECT_NEAR(a.summary.initial_cost, b.summary.initial_cost, kRelTol * b.summary.initial_cost);
     EXPECT_NEAR(a.summary.final_cost, b.summary.final_cost, kRelTol * b.summary.final_cost);
     EXPECT_NEAR(a.summary.final_cost, 0.5 * closed.chi2, kRelTol * closed.chi2);
   }
@@ -675,7 +680,7 @@ TEST(EllipseFit, CommonOffsetStdEntersIxIzNotIxzAgainstMonteCarlo) {
   EXPECT_NEAR(sample_std(ix) / std::sqrt(reported_ix_var), 1.0, kRelTol);
   EXPECT_NEAR(sample_std(ixz) / std::sqrt(reported_ixz_var), 1.0, kRelTol);
   EXPECT_DOUBLE_EQ(reported_ixz_var, reported_ixz_var_no_offset);  // not in I_xz at all
-  EXPECT_GT(std::sqrt(reported_ix_var), kRigSigma);                 // dominated by the rig here
+  EXPECT_GT(std::sqrt(reported_ix_var), kRigSigma);                // dominated by the rig here
 }
 
 }  // namespace

@@ -64,7 +64,11 @@ TEST(Glitch, SpikesOfEverySizeAndSignAreFound) {
     // 50 and 5 rad/s, and one 1 rad/s off the swing (which peaks at 1.1 rad/s), at the first
     // and last samples too.
     const std::vector<std::pair<size_t, double>> spikes = {
-        {0, 50.0}, {n / 7, -50.0}, {n / 3, 5.0}, {n / 2, -5.0}, {2 * n / 3, in.rate_rad_per_s[2 * n / 3] + 1.0},
+        {0, 50.0},
+        {n / 7, -50.0},
+        {n / 3, 5.0},
+        {n / 2, -5.0},
+        {2 * n / 3, in.rate_rad_per_s[2 * n / 3] + 1.0},
         {n - 1, -5.0}};
     for (const auto& [k, v] : spikes) in.rate_rad_per_s[k] = v;
     const std::vector<size_t> found = FindGlitches(in.t_s, in.rate_rad_per_s, GlitchOptions());
@@ -85,10 +89,11 @@ TEST(Glitch, GyroGlitchesAreDroppedFromEveryColumn) {
   ImuData data;
   for (size_t k = 0; k < in.t_s.size(); ++k) {
     data.t_s.push_back(in.t_s[k]);
-    data.gyro_in_imu.emplace_back(0.001 * std::sin(0.1 * k), 0.0005 * std::cos(0.07 * k), in.rate_rad_per_s[k]);
+    data.gyro_in_imu.emplace_back(0.001 * std::sin(0.1 * k), 0.0005 * std::cos(0.07 * k),
+                                  in.rate_rad_per_s[k]);
     data.accel_in_imu.emplace_back(0.0, 0.0, -9.8);
   }
-  data.gyro_in_imu[100].x() = 30.0;  // one on x
+  data.gyro_in_imu[100].x() = 30.0;   // one on x
   data.gyro_in_imu[900].z() = -50.0;  // one on z
   const std::vector<size_t> found = FindGyroGlitches(data, GlitchOptions());
   ASSERT_EQ(found, (std::vector<size_t>{100, 900}));
@@ -111,14 +116,23 @@ TEST(Glitch, ShortRunsOfTwoOrThreeAreFound) {
     const TraceFitInput clean = Window(irregular, 0.25, 0.5, 6);
     const size_t n = clean.t_s.size();
     const std::vector<std::vector<std::pair<size_t, double>>> sets = {
-        {{0, 50.0}, {1, 50.0},                         // adjacent, at the start
-         {n / 6, 50.0}, {n / 6 + 1, 50.0},             // adjacent, same sign
-         {n / 4, -50.0}, {n / 4 + 2, -50.0}},          // one apart
-        {{n / 3, 5.0}, {n / 3 + 1, 5.0}, {n / 3 + 2, 5.0},  // three in a row
-         {n / 2, 50.0}, {n / 2 + 1, -50.0}},           // adjacent, both signs
-        {{2 * n / 3, 2.0}, {2 * n / 3 + 1, 2.0},       // 2 rad/s on a 1.1 rad/s swing
-         {5 * n / 6, -2.0}, {5 * n / 6 + 2, -2.0},     // ... one apart
-         {n - 2, -5.0}, {n - 1, -5.0}}};               // adjacent, at the end
+        {{0, 50.0},
+         {1, 50.0},  // adjacent, at the start
+         {n / 6, 50.0},
+         {n / 6 + 1, 50.0},  // adjacent, same sign
+         {n / 4, -50.0},
+         {n / 4 + 2, -50.0}},  // one apart
+        {{n / 3, 5.0},
+         {n / 3 + 1, 5.0},
+         {n / 3 + 2, 5.0},  // three in a row
+         {n / 2, 50.0},
+         {n / 2 + 1, -50.0}},  // adjacent, both signs
+        {{2 * n / 3, 2.0},
+         {2 * n / 3 + 1, 2.0},  // 2 rad/s on a 1.1 rad/s swing
+         {5 * n / 6, -2.0},
+         {5 * n / 6 + 2, -2.0},  // ... one apart
+         {n - 2, -5.0},
+         {n - 1, -5.0}}};  // adjacent, at the end
     for (const auto& spikes : sets) {
       TraceFitInput in = clean;
       std::vector<size_t> expected;

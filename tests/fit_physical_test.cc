@@ -122,9 +122,9 @@ TEST(PhysicalCheck, ThreeAxisFitNamesTheInflatedAxis) {
 // 40 % high break the principal moments' triangle; the refits without each attitude name it.
 TEST(PhysicalCheck, FullTensorFitNamesTheAttitudeWhoseRemovalRestoresIt) {
   const std::array<double, 6> truth = {0.2, 0.3, 0.45, 0.008, 0.010, -0.009};
-  const std::vector<std::array<double, 2>> attitudes = {
-      {0, 0}, {0, 45}, {0, -45}, {0, -90}, {45, 0}, {-45, 0}, {90, 0}, {45, 45}, {-45, 45},
-      {45, -45}, {-45, -45}, {90, 45}};
+  const std::vector<std::array<double, 2>> attitudes = {{0, 0},    {0, 45},   {0, -45},   {0, -90},
+                                                        {45, 0},   {-45, 0},  {90, 0},    {45, 45},
+                                                        {-45, 45}, {45, -45}, {-45, -45}, {90, 45}};
   std::mt19937_64 rng(5);
   std::normal_distribution<double> normal(0.0, 1.0);
   std::vector<TensorPoint> points;

@@ -18,7 +18,9 @@ namespace bifilar {
 namespace {
 
 // The docs/physics.md §2 example rig (period ~2.8 s), as in fit_trace_fit_test.cc.
-SyntheticTraceOptions Truth(double amplitude_deg) { return ExampleRigTraceOptions(amplitude_deg, 7); }
+SyntheticTraceOptions Truth(double amplitude_deg) {
+  return ExampleRigTraceOptions(amplitude_deg, 7);
+}
 
 bool HasFlag(const TraceFitResult& r, const std::string& flag) {
   return std::find(r.flags.begin(), r.flags.end(), flag) != r.flags.end();
@@ -134,7 +136,8 @@ TEST(ParameterAtBound, NoAirDragIsFlaggedWithItsAction) {
 
 // Every warning's summary is one line of at most 160 characters and its first sentence.
 TEST(WarningSummary, FirstSentenceCutAtAWord) {
-  EXPECT_EQ(WarningSummary("a short warning; do this. Details 1.5 here."), "a short warning; do this");
+  EXPECT_EQ(WarningSummary("a short warning; do this. Details 1.5 here."),
+            "a short warning; do this");
   EXPECT_EQ(WarningSummary("no detail at all"), "no detail at all");
   EXPECT_EQ(WarningSummary("is it a footer? Then ignore it"), "is it a footer?");
   EXPECT_EQ(WarningSummary("values 1.06 and e.g. more. Then"), "values 1.06 and e.g. more");

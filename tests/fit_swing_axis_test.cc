@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "base/units.h"
 #include "pendulum/simulate.h"
@@ -33,7 +33,8 @@ TEST(SwingAxis, PitchSignConvention) {
   EXPECT_NEAR(PitchFromDownDeg(Eigen::Vector3d(-0.5, 0.0, std::sqrt(0.75))), 30.0, 1e-12);
   // A small roll does not change the pitch (Euler pitch = asin(-n_x)).
   const double th = 20 * kRadPerDeg, ph = 3 * kRadPerDeg;
-  const Eigen::Vector3d rolled(-std::sin(th), std::sin(ph) * std::cos(th), std::cos(ph) * std::cos(th));
+  const Eigen::Vector3d rolled(-std::sin(th), std::sin(ph) * std::cos(th),
+                               std::cos(ph) * std::cos(th));
   EXPECT_NEAR(PitchFromDownDeg(rolled), 20.0, 1e-12);
   EXPECT_NEAR(RollFromDownDeg(rolled), 3.0, 1e-12);
 }
@@ -45,8 +46,8 @@ struct Synthetic {
   Eigen::Matrix3d imu_to_body;
 };
 
-Synthetic MakeSynthetic(double pitch_deg, const Eigen::Matrix3d& imu_to_body, bool rest, uint64_t seed,
-                        double rocking = 0.02) {
+Synthetic MakeSynthetic(double pitch_deg, const Eigen::Matrix3d& imu_to_body, bool rest,
+                        uint64_t seed, double rocking = 0.02) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   Synthetic s;
@@ -66,7 +67,8 @@ Synthetic MakeSynthetic(double pitch_deg, const Eigen::Matrix3d& imu_to_body, bo
     const Eigen::Vector3d noise_g(normal(rng), normal(rng), normal(rng));
     const Eigen::Vector3d noise_a(normal(rng), normal(rng), normal(rng));
     s.data.t_s.push_back(t);
-    s.data.gyro_in_imu.push_back(rate * s.down_in_imu + rock * horiz_in_imu + bias + gyro_sigma * noise_g);
+    s.data.gyro_in_imu.push_back(rate * s.down_in_imu + rock * horiz_in_imu + bias +
+                                 gyro_sigma * noise_g);
     s.data.accel_in_imu.push_back(-kStandardGravityMps2 * s.down_in_imu + accel_sigma * noise_a);
   }
   return s;
@@ -199,7 +201,9 @@ TEST(SwingAxis, GravityRemovedAccelerometerIsIgnoredWithAWarning) {
     EXPECT_NE(axis.warnings[0].find("gravity removed"), std::string::npos) << axis.warnings[0];
     EXPECT_NE(axis.warnings[0].find("imu.accel: null"), std::string::npos) << axis.warnings[0];
     // The axis is the swing's, within the rocking's pull on the principal direction (~0.5 deg).
-    EXPECT_LT(std::min(AngleDeg(axis.axis_in_imu, s.down_in_imu), AngleDeg(-axis.axis_in_imu, s.down_in_imu)), 1.0);
+    EXPECT_LT(std::min(AngleDeg(axis.axis_in_imu, s.down_in_imu),
+                       AngleDeg(-axis.axis_in_imu, s.down_in_imu)),
+              1.0);
   }
   // With the diagnosis off (0), still ignored, but not called "gravity removed".
   SwingAxisOptions off;
@@ -323,8 +327,9 @@ TEST(SwingAxis, SimulatedLogs) {
       ASSERT_TRUE(EstimateSwingAxis(gyro_only, o, std::nullopt, &principal, &why)) << why;
       EXPECT_LT(AngleDeg(principal.axis_in_imu, trace.truth.swing_axis_in_imu), 0.5);
       // Secondary motion: the simulator's rocking (<= 0.3 deg) is small against the swing.
-      const double ratio = SecondaryMotionRatio(trace.imu, axis.axis_in_imu, trace.truth.t_release_s + 2.0,
-                                                trace.truth.t_release_s + 12.0);
+      const double ratio =
+          SecondaryMotionRatio(trace.imu, axis.axis_in_imu, trace.truth.t_release_s + 2.0,
+                               trace.truth.t_release_s + 12.0);
       EXPECT_LT(ratio, 0.2);
       EXPECT_GT(ratio, 0.0);
     }

@@ -277,13 +277,15 @@ TEST(TensorPlan, BadOptionsSayWhatIsWrong) {
   o = FullRig();
   o.sigma_kg_m2 = 0;
   EXPECT_FALSE(PlanTensor(o, &plan, &why));
-  EXPECT_EQ(why, "sigma_kg_m2 = 0; must be > 0 when sigma_relative = 0 (a per-swing std, "
-                 "absolute or relative)");
+  EXPECT_EQ(why,
+            "sigma_kg_m2 = 0; must be > 0 when sigma_relative = 0 (a per-swing std, "
+            "absolute or relative)");
   o = FullRig();
   o.sigma_relative = 0.01;
   EXPECT_FALSE(PlanTensor(o, &plan, &why));
-  EXPECT_EQ(why, "guess_kg_m2 = \"not given\"; must be given (at least Ixx, Iyy, Izz) with a "
-                 "relative swing std or an attitude error");
+  EXPECT_EQ(why,
+            "guess_kg_m2 = \"not given\"; must be given (at least Ixx, Iyy, Izz) with a "
+            "relative swing std or an attitude error");
   o.guess_given = true;
   o.guess_kg_m2 = {1, 1, 1, 2, 0, 0};  // |Ixy| > the moments: not positive definite
   EXPECT_FALSE(PlanTensor(o, &plan, &why));

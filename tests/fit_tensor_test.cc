@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include "base/option_check.h"
 #include "base/units.h"
@@ -25,9 +25,9 @@ using Tensor = std::array<double, 6>;  // Ixx, Iyy, Izz, Ixy, Ixz, Iyz
 const Tensor kTruth = {0.200, 0.300, 0.450, 0.006, 0.012, -0.009};
 
 // Twelve attitudes (roll, pitch) a rig can reach: level, pitched, rolled, and both.
-const std::vector<std::array<double, 2>> kAttitudes = {
-    {0, 0},   {0, 45},  {0, -45}, {0, -90},  {45, 0},  {-45, 0},
-    {90, 0},  {45, 45}, {-45, 45}, {45, -45}, {-45, -45}, {90, 45}};
+const std::vector<std::array<double, 2>> kAttitudes = {{0, 0},    {0, 45},   {0, -45},   {0, -90},
+                                                       {45, 0},   {-45, 0},  {90, 0},    {45, 45},
+                                                       {-45, 45}, {45, -45}, {-45, -45}, {90, 45}};
 
 Eigen::Matrix3d Matrix(const Tensor& t) {
   Eigen::Matrix3d j;
@@ -44,7 +44,8 @@ std::vector<TensorPoint> Campaign(const Tensor& truth, int trials, double sigma,
     for (int k = 0; k < trials; ++k) {
       TensorPoint p;
       p.direction_in_body = DownInBodyFromAttitude(a[0], a[1]);
-      p.inertia_kg_m2 = TensorMoment(truth, p.direction_in_body) + (sigma > 0 ? sigma * normal(*rng) : 0);
+      p.inertia_kg_m2 =
+          TensorMoment(truth, p.direction_in_body) + (sigma > 0 ? sigma * normal(*rng) : 0);
       p.std_kg_m2 = std_given;
       p.group = group;
       points.push_back(p);
@@ -97,11 +98,10 @@ TEST(Tensor, ExactDataRecoverEveryComponentAndThePrincipalFrame) {
 TEST(Tensor, EulerAnglesOfARotatedTensor) {
   // Principal moments 0.2, 0.3, 0.45 about axes turned by roll 4, pitch -6, yaw 9 deg.
   const double roll = 4, pitch = -6, yaw = 9;
-  const Eigen::Matrix3d rot =
-      (Eigen::AngleAxisd(yaw * kRadPerDeg, Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(pitch * kRadPerDeg, Eigen::Vector3d::UnitY()) *
-       Eigen::AngleAxisd(roll * kRadPerDeg, Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
+  const Eigen::Matrix3d rot = (Eigen::AngleAxisd(yaw * kRadPerDeg, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(pitch * kRadPerDeg, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(roll * kRadPerDeg, Eigen::Vector3d::UnitX()))
+                                  .toRotationMatrix();
   const Eigen::Matrix3d j = rot * Eigen::Vector3d(0.2, 0.3, 0.45).asDiagonal() * rot.transpose();
   const Tensor truth = {j(0, 0), j(1, 1), j(2, 2), -j(0, 1), -j(0, 2), -j(1, 2)};
   std::mt19937_64 rng(2);
@@ -276,8 +276,9 @@ TEST(Tensor, ThreeAxesGiveTheThreeMomentsAndNameTheProducts) {
     EXPECT_TRUE(std::isnan(r.components[3 + k].value));
   }
   bool named = false;
-  for (const std::string& w : r.warnings) named |= w.find("not observable") != std::string::npos &&
-                                                    w.find("Ixy, Ixz, Iyz") != std::string::npos;
+  for (const std::string& w : r.warnings)
+    named |= w.find("not observable") != std::string::npos &&
+             w.find("Ixy, Ixz, Iyz") != std::string::npos;
   EXPECT_TRUE(named);
   EXPECT_TRUE(std::isnan(r.principal_moments[0].value));
 }

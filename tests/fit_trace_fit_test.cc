@@ -2,9 +2,9 @@
 // `full` model at jittered timestamps with 1 % dropped samples, a gyro bias and 0.25 deg/s white
 // noise, fitted with FitTrace. Seeds are fixed; tolerances are explained where they are set.
 #include <algorithm>
-#include <filesystem>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <random>
 #include <string>
 #include <vector>
@@ -35,13 +35,28 @@ TraceFitInput Make(const SyntheticTraceOptions& o) {
 }
 
 bool AllFinite(const TraceFitResult& r) {
-  const double v[] = {r.params.inertia_kg_m2, r.params.drag_coeff_kg_m2,
-                      r.params.viscous_coeff_kg_m2_per_s, r.angle0_rad, r.rate0_rad_per_s,
-                      r.bias_rad_per_s, r.inertia_std_kg_m2, r.inertia_stat_std_kg_m2,
-                      r.inertia_budget_std_kg_m2, r.residual_rms_rad_per_s, r.noise_rad_per_s,
-                      r.rms_over_noise, r.residual_autocorr_lag1, r.residual_autocorr_max,
-                      r.ljung_box_q, r.amplitude_start_deg, r.amplitude_end_deg, r.period_s,
-                      r.initial_cost, r.final_cost, r.fit_seconds, r.drag_coeff_std,
+  const double v[] = {r.params.inertia_kg_m2,
+                      r.params.drag_coeff_kg_m2,
+                      r.params.viscous_coeff_kg_m2_per_s,
+                      r.angle0_rad,
+                      r.rate0_rad_per_s,
+                      r.bias_rad_per_s,
+                      r.inertia_std_kg_m2,
+                      r.inertia_stat_std_kg_m2,
+                      r.inertia_budget_std_kg_m2,
+                      r.residual_rms_rad_per_s,
+                      r.noise_rad_per_s,
+                      r.rms_over_noise,
+                      r.residual_autocorr_lag1,
+                      r.residual_autocorr_max,
+                      r.ljung_box_q,
+                      r.amplitude_start_deg,
+                      r.amplitude_end_deg,
+                      r.period_s,
+                      r.initial_cost,
+                      r.final_cost,
+                      r.fit_seconds,
+                      r.drag_coeff_std,
                       r.viscous_coeff_std};
   for (double x : v)
     if (!std::isfinite(x)) return false;
@@ -146,12 +161,12 @@ TEST(TraceFit, AccuracyOverAmplitudes5To30Deg) {
   const double mx = *std::max_element(err_full.begin(), err_full.end());
   int within2 = 0;
   for (double z : z_full) within2 += std::abs(z) < 2.0;
-  std::printf("  |rel err I|  full: median %.2e max %.2e | jardin: median %.2e max %.2e (%d ok) |"
-              " linear: median %.2e max %.2e (%d ok) | full within 2 sigma: %d/%d\n",
-              med, mx, Median(err_jardin),
-              *std::max_element(err_jardin.begin(), err_jardin.end()), ok_jardin,
-              Median(err_linear), *std::max_element(err_linear.begin(), err_linear.end()),
-              ok_linear, within2, kTraces);
+  std::printf(
+      "  |rel err I|  full: median %.2e max %.2e | jardin: median %.2e max %.2e (%d ok) |"
+      " linear: median %.2e max %.2e (%d ok) | full within 2 sigma: %d/%d\n",
+      med, mx, Median(err_jardin), *std::max_element(err_jardin.begin(), err_jardin.end()),
+      ok_jardin, Median(err_linear), *std::max_element(err_linear.begin(), err_linear.end()),
+      ok_linear, within2, kTraces);
   // Issue 3 targets: median <= 0.01 %, max <= 0.05 %.
   EXPECT_LE(med, 1e-4);
   EXPECT_LE(mx, 5e-4);
@@ -259,7 +274,8 @@ TEST(TraceFit, LinearModelOnA30DegTraceIsFlaggedByTheAmplitudeSweep) {
   EXPECT_NE(r.warnings[0].find("per 10 deg"), std::string::npos) << r.warnings[0];
   // The linear model's bias at the low band is covered by the uncertainty it reports.
   EXPECT_LT(std::abs(r.params.inertia_kg_m2 - truth.params.inertia_kg_m2),
-            3.0 * r.inertia_std_kg_m2) << r.BriefReport();
+            3.0 * r.inertia_std_kg_m2)
+      << r.BriefReport();
   EXPECT_TRUE(AllFinite(r));
   // The same trace with the full model is clean: flat I(A), no warning.
   const TraceFitResult full = FitTrace(in, TraceFitOptions());
@@ -300,16 +316,16 @@ TEST(TraceFit, UncertaintyBudgetMatchesExactScalingOfTheLinearModel) {
   ASSERT_EQ(r.budget.size(), 4u);
   const RigGeometry g = in.geometry;
   const double I = r.params.inertia_kg_m2;
-  const double expected[4] = {-I / g.filar_length_m, 2 * I / g.filar_separation_m,
-                              I / g.mass_kg, I / g.gravity_mps2};
+  const double expected[4] = {-I / g.filar_length_m, 2 * I / g.filar_separation_m, I / g.mass_kg,
+                              I / g.gravity_mps2};
   double sum_sq = 0.0;
   for (int i = 0; i < 4; ++i) {
     // Central difference (step 1e-4 relative, exact for a power law to ~1e-8) through the
     // implicit-function derivative: 1e-4 relative covers the Gauss-Newton approximation.
     EXPECT_NEAR(r.budget[i].d_inertia, expected[i], 1e-4 * std::abs(expected[i]))
         << r.budget[i].name;
-    EXPECT_NEAR(r.budget[i].contribution_kg_m2,
-                std::abs(expected[i]) * r.budget[i].std_input, 1e-4 * I);
+    EXPECT_NEAR(r.budget[i].contribution_kg_m2, std::abs(expected[i]) * r.budget[i].std_input,
+                1e-4 * I);
     sum_sq += r.budget[i].contribution_kg_m2 * r.budget[i].contribution_kg_m2;
   }
   EXPECT_EQ(r.budget[0].name, "filar_length");

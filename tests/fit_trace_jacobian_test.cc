@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
 #include <gtest/gtest.h>
+#include <Eigen/Core>
 
 #include "fit/trace_cost.h"
 #include "fit/trace_synth.h"

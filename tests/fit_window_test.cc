@@ -25,7 +25,7 @@ struct Synth {
   double tremor_deg = 0.15;
   double amplitude_deg = 20.0;
   double period_s = 2.0;
-  double decay_per_s = 0.02;   // envelope exp(-decay t)
+  double decay_per_s = 0.02;  // envelope exp(-decay t)
   double free_s = 40.0;
   bool stop = false;
   double stop_tau_s = 0.1;
@@ -68,12 +68,14 @@ SynthLog MakeLog(const Synth& s) {
   }
   const double ta = s.tremor_deg * kRadPerDeg * std::sqrt(2.0 / 3.0);
   auto free_rate = [&](double tau) {
-    return A * std::exp(-s.decay_per_s * tau) * (-s.decay_per_s * std::cos(w * tau) - w * std::sin(w * tau));
+    return A * std::exp(-s.decay_per_s * tau) *
+           (-s.decay_per_s * std::cos(w * tau) - w * std::sin(w * tau));
   };
   auto rate = [&](double t) {
     if (t >= log.t_release_s) {
       if (t < log.t_stop_s) return free_rate(t - log.t_release_s);
-      return free_rate(log.t_stop_s - log.t_release_s) * std::exp(-(t - log.t_stop_s) / s.stop_tau_s);
+      return free_rate(log.t_stop_s - log.t_release_s) *
+             std::exp(-(t - log.t_stop_s) / s.stop_tau_s);
     }
     if (t < t_twist) return 0.0;
     if (t < t_hold) {
@@ -81,7 +83,8 @@ SynthLog MakeLog(const Synth& s) {
       return A / s.twist_s * (30 * u * u - 60 * u * u * u + 30 * u * u * u * u);
     }
     double r = 0.0;
-    for (int i = 0; i < 3; ++i) r += ta * 2 * kPi * tf[i] * std::cos(2 * kPi * tf[i] * (t - t_hold) + tp[i]);
+    for (int i = 0; i < 3; ++i)
+      r += ta * 2 * kPi * tf[i] * std::cos(2 * kPi * tf[i] * (t - t_hold) + tp[i]);
     return r;
   };
   const double t_start = s.start_in_free ? 0.0 : 0.0;
@@ -122,13 +125,16 @@ void ExpectWindowMatches(const FreeOscillationWindow& w, const SynthLog& log, co
     EXPECT_EQ(w.end_reason, WindowEnd::kLogEnd) << w.BriefReport();
     EXPECT_DOUBLE_EQ(w.t1_s, log.t_s.back());
   }
-  EXPECT_EQ(w.first_index, static_cast<size_t>(std::lower_bound(log.t_s.begin(), log.t_s.end(), w.t0_s) - log.t_s.begin()));
+  EXPECT_EQ(w.first_index,
+            static_cast<size_t>(std::lower_bound(log.t_s.begin(), log.t_s.end(), w.t0_s) -
+                                log.t_s.begin()));
   EXPECT_LE(log.t_s[w.last_index], w.t1_s);
 }
 
 // Noise check: the rest estimate is the std of N samples, whose relative standard error is
 // 1/sqrt(2 N); 4 standard errors, and the rest detector must have used most of the true rest.
-void ExpectNoiseMatches(const FreeOscillationWindow& w, double sigma, double rest_s, double rate_hz) {
+void ExpectNoiseMatches(const FreeOscillationWindow& w, double sigma, double rest_s,
+                        double rate_hz) {
   ASSERT_TRUE(w.noise_from_rest);
   EXPECT_GE(w.rest_samples, 0.7 * rest_s * rate_hz * 0.99 - 10);
   const double rel_tol = 4.0 / std::sqrt(2.0 * w.rest_samples);
@@ -157,7 +163,8 @@ TEST(Window, HandStop) {
   s.stop = true;
   s.seed = 2;
   const SynthLog log = MakeLog(s);
-  ExpectWindowMatches(FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions()), log, s);
+  ExpectWindowMatches(FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions()), log,
+                      s);
 }
 
 // A hand stop less than a half-period before the log ends: the quiet tail sits inside the last,
@@ -175,8 +182,8 @@ TEST(Window, HandStopShortlyBeforeTheLogEnds) {
       const SynthLog log = MakeLog(s);
       const auto w = FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions());
       ASSERT_TRUE(w.IsUsable()) << w.message;
-      EXPECT_LT(w.t1_s, log.t_stop_s) << "rest after " << rest_after_s << ", seed " << seed << ": "
-                                      << w.BriefReport();
+      EXPECT_LT(w.t1_s, log.t_stop_s)
+          << "rest after " << rest_after_s << ", seed " << seed << ": " << w.BriefReport();
       EXPECT_GT(w.t1_s, log.t_stop_s - 2 * s.period_s) << w.BriefReport();
     }
   }
@@ -262,7 +269,8 @@ TEST(Window, RejectsNoOscillation) {
   s.amplitude_deg = 0.0;  // rest, no twist, pure noise
   s.tremor_deg = 0.0;
   const SynthLog log = MakeLog(s);
-  const auto w = FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions(), "noise.csv");
+  const auto w =
+      FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions(), "noise.csv");
   EXPECT_EQ(w.status, WindowStatus::kRejected);
   EXPECT_NE(w.message.find("no oscillation"), std::string::npos) << w.message;
   EXPECT_NE(w.message.find("noise.csv"), std::string::npos);
@@ -274,7 +282,8 @@ TEST(Window, RejectsShorterThanTwoPeriods) {
   s.free_s = 2.2;  // 1.1 periods of free swing, then a hand
   s.stop = true;
   const SynthLog log = MakeLog(s);
-  const auto w = FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions(), "short.csv");
+  const auto w =
+      FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions(), "short.csv");
   EXPECT_EQ(w.status, WindowStatus::kRejected) << w.BriefReport();
   EXPECT_TRUE(w.message.find("shorter than 2 periods") != std::string::npos ||
               w.message.find("no oscillation") != std::string::npos)
@@ -286,7 +295,8 @@ TEST(Window, RejectsBadSeries) {
   EXPECT_EQ(FindFreeOscillationWindow(t, r, WindowOptions()).status, WindowStatus::kError);
   t.assign(20, 0.0);
   r.assign(20, 1.0);
-  EXPECT_EQ(FindFreeOscillationWindow(t, r, WindowOptions()).status, WindowStatus::kError);  // times
+  EXPECT_EQ(FindFreeOscillationWindow(t, r, WindowOptions()).status,
+            WindowStatus::kError);  // times
   WindowOptions bad;
   bad.min_period_s = -1;
   std::string why;
@@ -326,7 +336,8 @@ TEST(Window, OptionsCheckNamesFieldValueAndBound) {
 TEST(Window, Override) {
   Synth s;
   const SynthLog log = MakeLog(s);
-  const auto w = ApplyWindowOverride(log.t_s, log.rate_rad_per_s, 10.0, 30.0, WindowOptions(), "o.csv");
+  const auto w =
+      ApplyWindowOverride(log.t_s, log.rate_rad_per_s, 10.0, 30.0, WindowOptions(), "o.csv");
   ASSERT_TRUE(w.IsUsable()) << w.message;
   EXPECT_TRUE(w.overridden);
   EXPECT_EQ(w.end_reason, WindowEnd::kOverride);
@@ -335,15 +346,19 @@ TEST(Window, Override) {
   EXPECT_NEAR(w.period_s, s.period_s, 0.02 * s.period_s);
   EXPECT_TRUE(w.noise_from_rest);
 
-  const auto outside = ApplyWindowOverride(log.t_s, log.rate_rad_per_s, 10.0, 500.0, WindowOptions(), "o.csv");
+  const auto outside =
+      ApplyWindowOverride(log.t_s, log.rate_rad_per_s, 10.0, 500.0, WindowOptions(), "o.csv");
   EXPECT_EQ(outside.status, WindowStatus::kError);
   EXPECT_NE(outside.message.find("o.csv"), std::string::npos);
   EXPECT_NE(outside.message.find("outside the log"), std::string::npos) << outside.message;
-  const auto reversed = ApplyWindowOverride(log.t_s, log.rate_rad_per_s, 30.0, 10.0, WindowOptions(), "o.csv");
+  const auto reversed =
+      ApplyWindowOverride(log.t_s, log.rate_rad_per_s, 30.0, 10.0, WindowOptions(), "o.csv");
   EXPECT_EQ(reversed.status, WindowStatus::kError);
-  const auto nan = ApplyWindowOverride(log.t_s, log.rate_rad_per_s, std::nan(""), 10.0, WindowOptions(), "o.csv");
+  const auto nan = ApplyWindowOverride(log.t_s, log.rate_rad_per_s, std::nan(""), 10.0,
+                                       WindowOptions(), "o.csv");
   EXPECT_EQ(nan.status, WindowStatus::kError);
-  const auto short_window = ApplyWindowOverride(log.t_s, log.rate_rad_per_s, 10.0, 12.0, WindowOptions(), "o.csv");
+  const auto short_window =
+      ApplyWindowOverride(log.t_s, log.rate_rad_per_s, 10.0, 12.0, WindowOptions(), "o.csv");
   EXPECT_EQ(short_window.status, WindowStatus::kRejected) << short_window.BriefReport();
 }
 
@@ -404,7 +419,8 @@ TEST(Amplitude, TrimToBand) {
   EXPECT_LE(band.t0_s, t20 + 0.5 * s.period_s + 0.05);
   EXPECT_LE(band.t1_s, t5 + 0.05);
   EXPECT_GE(band.t1_s, t5 - 0.5 * s.period_s - 0.05);
-  EXPECT_NEAR(band.amplitude_start_deg, 20.0, 20.0 * (1 - std::exp(-s.decay_per_s * s.period_s / 2)) + 0.3);
+  EXPECT_NEAR(band.amplitude_start_deg, 20.0,
+              20.0 * (1 - std::exp(-s.decay_per_s * s.period_s / 2)) + 0.3);
 
   // No trimming with the default (open) band.
   const auto open = TrimToAmplitudeBand(log.t_s, log.rate_rad_per_s, w, AmplitudeBandOptions());
@@ -446,9 +462,10 @@ TEST(Window, SimulatedLogs) {
     ASSERT_TRUE(SimulateTrace(setup, options, 1000 + i, &trace, &why)) << why;
     const TraceTruth& truth = trace.truth;
     const double T = SmallAnglePeriod(setup.geometry, setup.params.inertia_kg_m2);
-    SCOPED_TRACE("sim " + std::to_string(i) + " T=" + std::to_string(T) +
-                 " release=" + std::to_string(truth.t_release_s) +
-                 (truth.stopped ? " stop=" + std::to_string(truth.t_stop_s) : std::string(" no stop")));
+    SCOPED_TRACE(
+        "sim " + std::to_string(i) + " T=" + std::to_string(T) +
+        " release=" + std::to_string(truth.t_release_s) +
+        (truth.stopped ? " stop=" + std::to_string(truth.t_stop_s) : std::string(" no stop")));
     SwingAxisOptions axis_options;
     axis_options.imu_to_body = setup.body_from_imu;
     SwingAxis axis;
@@ -457,7 +474,8 @@ TEST(Window, SimulatedLogs) {
     ASSERT_TRUE(w.IsUsable()) << w.message;
     ++checked;
     EXPECT_GE(w.t0_s, truth.t_release_s) << w.BriefReport();
-    EXPECT_LE(w.t0_s, truth.t_release_s + 1.1 * T) << w.BriefReport();  // period grows with amplitude
+    EXPECT_LE(w.t0_s, truth.t_release_s + 1.1 * T)
+        << w.BriefReport();  // period grows with amplitude
     if (truth.stopped) {
       ++stopped;
       EXPECT_EQ(w.end_reason, WindowEnd::kStopped) << w.BriefReport();
@@ -469,8 +487,10 @@ TEST(Window, SimulatedLogs) {
     }
     // Rest noise: the simulator's per-axis white noise, projected on a unit axis.
     const double sigma = options.sensor.gyro_noise_sigma_deg_per_s * kRadPerDeg;
-    ExpectNoiseMatches(w, sigma, truth.t_twist_s - truth.start_time_s, options.sensor.sample_rate_hz);
-    EXPECT_NEAR(w.rest_bias_rad_per_s, truth.gyro_bias_rad_per_s.dot(axis.axis_in_imu), 4 * sigma / std::sqrt(150.0));
+    ExpectNoiseMatches(w, sigma, truth.t_twist_s - truth.start_time_s,
+                       options.sensor.sample_rate_hz);
+    EXPECT_NEAR(w.rest_bias_rad_per_s, truth.gyro_bias_rad_per_s.dot(axis.axis_in_imu),
+                4 * sigma / std::sqrt(150.0));
   }
   EXPECT_EQ(checked, 16);
   EXPECT_GT(stopped, 2);  // both endings exercised
@@ -508,7 +528,8 @@ TEST(Window, SimulatedCampaign) {
     axis_options.imu_to_body = spec.rig.body_from_imu;
     SwingAxis axis;
     ASSERT_TRUE(EstimateSwingAxis(ct.trace.imu, axis_options, std::nullopt, &axis, &why)) << why;
-    const auto w = FindFreeOscillationWindow(ct.trace.imu.t_s, axis.rate_rad_per_s, WindowOptions(), ct.relative_path);
+    const auto w = FindFreeOscillationWindow(ct.trace.imu.t_s, axis.rate_rad_per_s, WindowOptions(),
+                                             ct.relative_path);
     ASSERT_TRUE(w.IsUsable()) << w.message;
     EXPECT_GE(w.t0_s, truth.t_release_s);
     EXPECT_LE(w.t0_s, truth.t_release_s + 1.1 * T);  // T grows by < 2 % at 30 deg
@@ -522,12 +543,14 @@ TEST(Window, SimulatedCampaign) {
     // Amplitude at every extreme against the simulator's noise-free angle at the nearest sample
     // (|psi| is flat at an extreme, so the nearest sample is within 1e-3 relative of it).
     // Tolerance 2 % + 0.1 deg: the extremes are estimated from noisy rate through the rest bias.
-    const auto band = TrimToAmplitudeBand(ct.trace.imu.t_s, axis.rate_rad_per_s, w, AmplitudeBandOptions());
+    const auto band =
+        TrimToAmplitudeBand(ct.trace.imu.t_s, axis.rate_rad_per_s, w, AmplitudeBandOptions());
     ASSERT_TRUE(band.IsUsable()) << band.message;
     ASSERT_GT(band.extremes.size(), 10u);
     const auto& ts = ct.trace.imu.t_s;
     for (const auto& e : band.extremes) {
-      const size_t k = std::min<size_t>(std::lower_bound(ts.begin(), ts.end(), e.t_s) - ts.begin(), ts.size() - 1);
+      const size_t k = std::min<size_t>(std::lower_bound(ts.begin(), ts.end(), e.t_s) - ts.begin(),
+                                        ts.size() - 1);
       const size_t nearest = (k > 0 && e.t_s - ts[k - 1] < ts[k] - e.t_s) ? k - 1 : k;
       const double truth_deg = std::abs(ct.trace.angle_rad[nearest]) / kRadPerDeg;
       EXPECT_NEAR(e.amplitude_deg, truth_deg, 0.02 * truth_deg + 0.1) << "t = " << e.t_s;
@@ -553,7 +576,8 @@ TEST(WindowMessages, ShortSwingSaysWhatWasFound) {
       s.stop = true;
       s.seed = seed;
       const SynthLog log = MakeLog(s);
-      const auto w = FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions(), "short.csv");
+      const auto w =
+          FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions(), "short.csv");
       if (w.IsUsable()) continue;
       const size_t open = w.message.find('[');
       if (open != std::string::npos) {
@@ -583,7 +607,8 @@ TEST(WindowMessages, LongGapInsideTheWindowIsRejected) {
   for (double& t : log.t_s) {
     if (t > gap_at) t += 100.0;
   }
-  const auto found = FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions(), "gap.csv");
+  const auto found =
+      FindFreeOscillationWindow(log.t_s, log.rate_rad_per_s, WindowOptions(), "gap.csv");
   if (found.IsUsable()) {
     // The search kept to one side of the gap.
     EXPECT_TRUE(found.t1_s <= gap_at || found.t0_s > gap_at + 100.0) << found.BriefReport();

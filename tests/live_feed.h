@@ -70,8 +70,10 @@ inline void ExpectHighresEqual(const MavlinkImuSample& sent, const MavlinkImuSam
   EXPECT_EQ(got.msgid, kMavlinkMsgidHighresImu);
   EXPECT_DOUBLE_EQ(got.t_s, std::llround(sent.t_s * 1e6) * 1e-6);
   for (int k = 0; k < 3; ++k) {
-    EXPECT_EQ(got.gyro_rad_per_s[k], static_cast<double>(static_cast<float>(sent.gyro_rad_per_s[k])));
-    EXPECT_EQ(got.accel_m_per_s2[k], static_cast<double>(static_cast<float>(sent.accel_m_per_s2[k])));
+    EXPECT_EQ(got.gyro_rad_per_s[k],
+              static_cast<double>(static_cast<float>(sent.gyro_rad_per_s[k])));
+    EXPECT_EQ(got.accel_m_per_s2[k],
+              static_cast<double>(static_cast<float>(sent.accel_m_per_s2[k])));
   }
 }
 

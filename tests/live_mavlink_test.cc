@@ -34,21 +34,48 @@ struct XmlMessage {
 
 const std::vector<XmlMessage>& CommonXmlImuMessages() {
   static const std::vector<XmlMessage> messages = {
-      {"SCALED_IMU", 26,
-       {{"uint32_t", "time_boot_ms"}, {"int16_t", "xacc"}, {"int16_t", "yacc"},
-        {"int16_t", "zacc"}, {"int16_t", "xgyro"}, {"int16_t", "ygyro"}, {"int16_t", "zgyro"},
-        {"int16_t", "xmag"}, {"int16_t", "ymag"}, {"int16_t", "zmag"}},
+      {"SCALED_IMU",
+       26,
+       {{"uint32_t", "time_boot_ms"},
+        {"int16_t", "xacc"},
+        {"int16_t", "yacc"},
+        {"int16_t", "zacc"},
+        {"int16_t", "xgyro"},
+        {"int16_t", "ygyro"},
+        {"int16_t", "zgyro"},
+        {"int16_t", "xmag"},
+        {"int16_t", "ymag"},
+        {"int16_t", "zmag"}},
        {{"int16_t", "temperature"}}},
-      {"RAW_IMU", 27,
-       {{"uint64_t", "time_usec"}, {"int16_t", "xacc"}, {"int16_t", "yacc"}, {"int16_t", "zacc"},
-        {"int16_t", "xgyro"}, {"int16_t", "ygyro"}, {"int16_t", "zgyro"}, {"int16_t", "xmag"},
-        {"int16_t", "ymag"}, {"int16_t", "zmag"}},
+      {"RAW_IMU",
+       27,
+       {{"uint64_t", "time_usec"},
+        {"int16_t", "xacc"},
+        {"int16_t", "yacc"},
+        {"int16_t", "zacc"},
+        {"int16_t", "xgyro"},
+        {"int16_t", "ygyro"},
+        {"int16_t", "zgyro"},
+        {"int16_t", "xmag"},
+        {"int16_t", "ymag"},
+        {"int16_t", "zmag"}},
        {{"uint8_t", "id"}, {"int16_t", "temperature"}}},
-      {"HIGHRES_IMU", 105,
-       {{"uint64_t", "time_usec"}, {"float", "xacc"}, {"float", "yacc"}, {"float", "zacc"},
-        {"float", "xgyro"}, {"float", "ygyro"}, {"float", "zgyro"}, {"float", "xmag"},
-        {"float", "ymag"}, {"float", "zmag"}, {"float", "abs_pressure"},
-        {"float", "diff_pressure"}, {"float", "pressure_alt"}, {"float", "temperature"},
+      {"HIGHRES_IMU",
+       105,
+       {{"uint64_t", "time_usec"},
+        {"float", "xacc"},
+        {"float", "yacc"},
+        {"float", "zacc"},
+        {"float", "xgyro"},
+        {"float", "ygyro"},
+        {"float", "zgyro"},
+        {"float", "xmag"},
+        {"float", "ymag"},
+        {"float", "zmag"},
+        {"float", "abs_pressure"},
+        {"float", "diff_pressure"},
+        {"float", "pressure_alt"},
+        {"float", "temperature"},
         {"uint16_t", "fields_updated"}},
        {{"uint8_t", "id"}}},
   };
@@ -117,7 +144,8 @@ TEST(MavlinkStandard, DecoderReadsTheFieldsWhereTheWireOrderPutsThem) {
       } else {
         bits = 100 * k;  // the times, counts and id: distinct
       }
-      for (int b = 0; b < TypeBytes(type); ++b) payload += static_cast<char>((bits >> 8 * b) & 0xFF);
+      for (int b = 0; b < TypeBytes(type); ++b)
+        payload += static_cast<char>((bits >> 8 * b) & 0xFF);
       if (k == static_cast<int>(m.fields.size())) base_bytes = payload.size();
     }
     MavlinkDecoder decoder;
@@ -198,18 +226,19 @@ TEST(MavlinkStandard, FramesFromTheReferenceAlgorithm) {
       "00000000000000000000000000000000000000000000000000003f6aad");
   // MAVLink 1 SCALED_IMU, seq 7: time_boot_ms 2500, acc (10, -20, -1000) mG,
   // gyro (125, -63, 2500) mrad/s.
-  const std::string scaled = FromHex(
-      "fe160701011ac40900000a00ecff18fc7d00c1ffc40900000000000053f7");
+  const std::string scaled =
+      FromHex("fe160701011ac40900000a00ecff18fc7d00c1ffc40900000000000053f7");
   MavlinkDecoder decoder;
   const auto got = decoder.Feed(highres + scaled);
   ASSERT_EQ(got.size(), 2u);
   EXPECT_EQ(decoder.counters().bad_crc, 0);
-  MavlinkImuSample want{1.0, {0.125, -0.0625, 2.5}, {0.5, -1.25, -9.75}, true,
-                        kMavlinkMsgidHighresImu, 1, 1};
+  MavlinkImuSample want{
+      1.0, {0.125, -0.0625, 2.5}, {0.5, -1.25, -9.75}, true, kMavlinkMsgidHighresImu, 1, 1};
   ExpectSame(want, got[0]);
   const double mg = 1e-3 * kStandardGravityMps2;
-  MavlinkImuSample want_scaled{2.5, {0.125, -0.063, 2.5}, {10 * mg, -20 * mg, -1000 * mg}, true,
-                               kMavlinkMsgidScaledImu, 1, 1};
+  MavlinkImuSample want_scaled{2.5,  {0.125, -0.063, 2.5},   {10 * mg, -20 * mg, -1000 * mg},
+                               true, kMavlinkMsgidScaledImu, 1,
+                               1};
   ExpectSame(want_scaled, got[1]);
   MavlinkFrameOptions o;
   o.seq = 7;
@@ -270,7 +299,7 @@ TEST(MavlinkDecoder, TruncatedPayloadsAreZeroFilled) {
   s.sysid = s.compid = 1;
   for (const int msgid : {kMavlinkMsgidHighresImu, kMavlinkMsgidScaledImu, kMavlinkMsgidRawImu}) {
     const std::string frame = Frame(s, msgid, MavlinkFrameOptions());
-    const std::size_t full = msgid == kMavlinkMsgidHighresImu ? kMavlinkHighresImuBytes
+    const std::size_t full = msgid == kMavlinkMsgidHighresImu  ? kMavlinkHighresImuBytes
                              : msgid == kMavlinkMsgidScaledImu ? kMavlinkScaledImuBytes
                                                                : kMavlinkRawImuBytes;
     EXPECT_LT(static_cast<uint8_t>(frame[1]), full) << msgid;  // really truncated
@@ -365,7 +394,7 @@ std::string MixedStream(const std::vector<MavlinkImuSample>& samples) {
     o.signed_frame = i % 7 == 3;
     o.seq = static_cast<int>(i % 256);
     stream += Frame(samples[i], kMavlinkMsgidHighresImu, o);
-    if (i % 10 == 0) stream += EncodeMavlinkFrame(0, std::string(9, '\x05'), 9, o);  // HEARTBEAT
+    if (i % 10 == 0) stream += EncodeMavlinkFrame(0, std::string(9, '\x05'), 9, o);     // HEARTBEAT
     if (i % 10 == 5) stream += EncodeMavlinkFrame(30, std::string(28, '\x11'), 28, o);  // ATTITUDE
   }
   return stream;
@@ -453,7 +482,7 @@ TEST(MavlinkDecoder, RawImuScalesAreTheUsers) {
   MavlinkDecoderOptions scales;
   std::string why;
   ASSERT_TRUE(scales.Check(&why));
-  scales.raw_imu_gyro_rad_per_s_per_count = 1.0 / 16.4 * kRadPerDeg;  // a ±2000 °/s ADC count
+  scales.raw_imu_gyro_rad_per_s_per_count = 1.0 / 16.4 * kRadPerDeg;      // a ±2000 °/s ADC count
   scales.raw_imu_accel_m_per_s2_per_count = kStandardGravityMps2 / 2048;  // ±16 g
   MavlinkImuSample s{};
   s.t_s = 3.0;

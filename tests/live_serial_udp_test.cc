@@ -13,8 +13,8 @@
 #include <thread>
 #include <vector>
 
-#include <asio.hpp>
 #include <gtest/gtest.h>
+#include <asio.hpp>
 
 #include "pipeline/live/byte_stream.h"
 #include "pipeline/live/mavlink.h"
@@ -57,8 +57,9 @@ void Feed(int fd, const std::vector<std::string>& pieces, const std::vector<doub
   const Clock::time_point start = Clock::now();
   for (std::size_t i = 0; i < pieces.size(); ++i) {
     if (pace_s > 0) {
-      std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
-                                                std::chrono::duration<double>(pace_s * times_s[i])));
+      std::this_thread::sleep_until(start +
+                                    std::chrono::duration_cast<Clock::duration>(
+                                        std::chrono::duration<double>(pace_s * times_s[i])));
     }
     for (std::size_t done = 0; done < pieces[i].size();) {
       const ssize_t n = write(fd, pieces[i].data() + done, pieces[i].size() - done);

@@ -83,8 +83,8 @@ void GaussLegendre(int n, std::vector<double>* x, std::vector<double>* w) {
 
 double QuadraturePeriod(PendulumModel model, const RigGeometry& g, double inertia, double A,
                         int nodes = 128) {
-  const double L = g.filar_length_m, D = g.filar_separation_m, m = g.mass_kg,
-               gm = g.gravity_mps2, k = D * D / 4;
+  const double L = g.filar_length_m, D = g.filar_separation_m, m = g.mass_kg, gm = g.gravity_mps2,
+               k = D * D / 4;
   const auto s = [&](double p) {
     const double half = std::sin(p / 2);
     return std::sqrt(L * L - D * D * half * half);
@@ -118,7 +118,8 @@ double QuadraturePeriod(PendulumModel model, const RigGeometry& g, double inerti
 double IntegratedPeriod(PendulumIntegrator* integrator, const PendulumParams& p, double A,
                         double period_guess_s, int periods) {
   // The grid reaches 30 % beyond the guess: large swings are slower than the small-angle guess.
-  const std::vector<double> t = Grid(0.0, 1.3 * (periods + 1) * period_guess_s, period_guess_s / 64);
+  const std::vector<double> t =
+      Grid(0.0, 1.3 * (periods + 1) * period_guess_s, period_guess_s / 64);
   Trajectory tr;
   std::string why;
   EXPECT_TRUE(integrator->Integrate(p, A, 0.0, t, false, &tr, &why)) << why;
@@ -126,8 +127,8 @@ double IntegratedPeriod(PendulumIntegrator* integrator, const PendulumParams& p,
   for (size_t k = 1; k < t.size(); ++k) {
     if ((tr.angle_rad[k - 1] > 0) != (tr.angle_rad[k] > 0)) {
       // Linear interpolation start, then Newton.
-      double tc = t[k - 1] + (t[k] - t[k - 1]) * tr.angle_rad[k - 1] /
-                                 (tr.angle_rad[k - 1] - tr.angle_rad[k]);
+      double tc = t[k - 1] +
+                  (t[k] - t[k - 1]) * tr.angle_rad[k - 1] / (tr.angle_rad[k - 1] - tr.angle_rad[k]);
       crossings.push_back(tc);
     }
   }
@@ -175,8 +176,8 @@ TEST(PendulumIntegrator, QuadratureIsConverged) {
       EXPECT_NEAR(t64 / t128, 1.0, 1e-14) << ToString(model) << " " << deg;
     }
   }
-  EXPECT_NEAR(QuadraturePeriod(PendulumModel::kLinear, g, 1.5, 1.0) / SmallAnglePeriod(g, 1.5),
-              1.0, 1e-14);
+  EXPECT_NEAR(QuadraturePeriod(PendulumModel::kLinear, g, 1.5, 1.0) / SmallAnglePeriod(g, 1.5), 1.0,
+              1e-14);
 }
 
 // Issue 2 item 3: undamped small-amplitude period equals 2 pi sqrt(4 I L / (m g D^2)) to 1e-7.
@@ -231,25 +232,25 @@ TEST(PendulumIntegrator, EnergyConservedWhenUndamped) {
   cvodes_tight.rel_tol = 1e-12;
   cvodes_tight.abs_tol = 1e-14;
   for (const IntegratorOptions& options : {IntegratorOptions(), cvodes_tight})
-  for (bool sens : {false, true})
-  for (PendulumModel model : kModels) {
-    PendulumIntegrator integrator(model, g, options);
-    for (double deg : {5.0, 20.0, 60.0}) {
-      SCOPED_TRACE(std::string(ToString(options.method)) + " sens=" + std::to_string(sens));
-      Trajectory tr;
-      std::string why;
-      ASSERT_TRUE(integrator.Integrate(Undamped(), deg * kRadPerDeg, 0.1, t, sens, &tr, &why))
-          << why;
-      const double e0 = MechanicalEnergy(model, g, Undamped(), deg * kRadPerDeg, 0.1);
-      double worst = 0.0;
-      for (size_t k = 0; k < t.size(); ++k) {
-        const double e = MechanicalEnergy(model, g, Undamped(), tr.angle_rad[k],
-                                          tr.rate_rad_per_s[k]);
-        worst = std::max(worst, std::abs(e / e0 - 1));
+    for (bool sens : {false, true})
+      for (PendulumModel model : kModels) {
+        PendulumIntegrator integrator(model, g, options);
+        for (double deg : {5.0, 20.0, 60.0}) {
+          SCOPED_TRACE(std::string(ToString(options.method)) + " sens=" + std::to_string(sens));
+          Trajectory tr;
+          std::string why;
+          ASSERT_TRUE(integrator.Integrate(Undamped(), deg * kRadPerDeg, 0.1, t, sens, &tr, &why))
+              << why;
+          const double e0 = MechanicalEnergy(model, g, Undamped(), deg * kRadPerDeg, 0.1);
+          double worst = 0.0;
+          for (size_t k = 0; k < t.size(); ++k) {
+            const double e =
+                MechanicalEnergy(model, g, Undamped(), tr.angle_rad[k], tr.rate_rad_per_s[k]);
+            worst = std::max(worst, std::abs(e / e0 - 1));
+          }
+          EXPECT_LT(worst, 1e-8) << ToString(model) << " " << deg << " deg";
+        }
       }
-      EXPECT_LT(worst, 1e-8) << ToString(model) << " " << deg << " deg";
-    }
-  }
 }
 
 // Damped: the energy falls monotonically, and by exactly the work of the damping torques,
@@ -262,30 +263,30 @@ TEST(PendulumIntegrator, DampedEnergyDecreasesByDampingWork) {
   const double dt = 0.005;
   const std::vector<double> t = Grid(0.0, 60.0, dt);
   for (IntegratorMethod method : kMethods)
-  for (PendulumModel model : kModels) {
-    SCOPED_TRACE(ToString(method));
-    PendulumIntegrator integrator(model, g, WithMethod(method));
-    Trajectory tr;
-    std::string why;
-    ASSERT_TRUE(integrator.Integrate(p, 40 * kRadPerDeg, 0.0, t, false, &tr, &why)) << why;
-    std::vector<double> e(t.size()), power(t.size());
-    for (size_t k = 0; k < t.size(); ++k) {
-      const double w = tr.rate_rad_per_s[k];
-      e[k] = MechanicalEnergy(model, g, p, tr.angle_rad[k], w);
-      power[k] = p.drag_coeff_kg_m2 * std::abs(w) * w * w + p.viscous_coeff_kg_m2_per_s * w * w;
+    for (PendulumModel model : kModels) {
+      SCOPED_TRACE(ToString(method));
+      PendulumIntegrator integrator(model, g, WithMethod(method));
+      Trajectory tr;
+      std::string why;
+      ASSERT_TRUE(integrator.Integrate(p, 40 * kRadPerDeg, 0.0, t, false, &tr, &why)) << why;
+      std::vector<double> e(t.size()), power(t.size());
+      for (size_t k = 0; k < t.size(); ++k) {
+        const double w = tr.rate_rad_per_s[k];
+        e[k] = MechanicalEnergy(model, g, p, tr.angle_rad[k], w);
+        power[k] = p.drag_coeff_kg_m2 * std::abs(w) * w * w + p.viscous_coeff_kg_m2_per_s * w * w;
+      }
+      double work = 0.0;  // Simpson's rule on the uniform grid (even number of intervals)
+      ASSERT_EQ((t.size() - 1) % 2, 0u);
+      for (size_t k = 1; k < t.size(); ++k) {
+        // Integration error: psi'(t_k) has relative error ~1e-8 of E, far below the energy lost
+        // per sample (> 1e-9 E even at a turning point), so the decrease is strict.
+        EXPECT_LT(e[k], e[k - 1]) << ToString(model) << " k=" << k;
+        if (k % 2 == 0) work += dt / 3 * (power[k - 2] + 4 * power[k - 1] + power[k]);
+      }
+      EXPECT_LT(e.back(), 0.5 * e.front());  // the damping is strong enough to matter
+      // Simpson on |w|^3 (a kink at each turning point) converges as dt^2 there: 1e-6 relative.
+      EXPECT_NEAR((e.front() - e.back()) / work, 1.0, 1e-6) << ToString(model);
     }
-    double work = 0.0;  // Simpson's rule on the uniform grid (even number of intervals)
-    ASSERT_EQ((t.size() - 1) % 2, 0u);
-    for (size_t k = 1; k < t.size(); ++k) {
-      // Integration error: psi'(t_k) has relative error ~1e-8 of E, far below the energy lost
-      // per sample (> 1e-9 E even at a turning point), so the decrease is strict.
-      EXPECT_LT(e[k], e[k - 1]) << ToString(model) << " k=" << k;
-      if (k % 2 == 0) work += dt / 3 * (power[k - 2] + 4 * power[k - 1] + power[k]);
-    }
-    EXPECT_LT(e.back(), 0.5 * e.front());  // the damping is strong enough to matter
-    // Simpson on |w|^3 (a kink at each turning point) converges as dt^2 there: 1e-6 relative.
-    EXPECT_NEAR((e.front() - e.back()) / work, 1.0, 1e-6) << ToString(model);
-  }
 }
 
 // Issue 2 item 3: sensitivities against central differences, all 5 columns, all 3 models.
@@ -310,57 +311,58 @@ TEST(PendulumIntegrator, SensitivitiesMatchCentralDifferences) {
   tight.rel_tol = 1e-12;
   tight.abs_tol = 1e-14;
   for (IntegratorMethod method : kMethods)
-  for (PendulumModel model : kModels) {
-    SCOPED_TRACE(std::string(ToString(method)) + " " + ToString(model));
-    PendulumIntegrator integrator(model, g, WithMethod(method));
-    PendulumIntegrator reference(model, g, tight);
-    Trajectory tr;
-    std::string why;
-    ASSERT_TRUE(integrator.Integrate(p, angle0, rate0, t, true, &tr, &why)) << why;
-    ASSERT_EQ(tr.d_rate.rows(), static_cast<Eigen::Index>(t.size()));
-    ASSERT_EQ(tr.d_rate.cols(), kNumSensitivities);
-    ASSERT_EQ(tr.d_angle.rows(), static_cast<Eigen::Index>(t.size()));
-    const double steps[kNumSensitivities] = {1e-4 * p.inertia_kg_m2, 1e-4, 1e-4, 1e-4, 1e-4};
-    for (int j = 0; j < kNumSensitivities; ++j) {
-      const auto run = [&](double delta, Trajectory* out) {
-        PendulumParams q = p;
-        double a0 = angle0, r0 = rate0;
-        if (j == kSensInertia) q.inertia_kg_m2 += delta;
-        if (j == kSensDrag) q.drag_coeff_kg_m2 += delta;
-        if (j == kSensViscous) q.viscous_coeff_kg_m2_per_s += delta;
-        if (j == kSensAngle0) a0 += delta;
-        if (j == kSensRate0) r0 += delta;
-        ASSERT_TRUE(reference.Integrate(q, a0, r0, t, false, out, &why)) << why;
-      };
-      const double h = steps[j];
-      Trajectory p2, p1, m1, m2;
-      run(2 * h, &p2);
-      run(h, &p1);
-      run(-h, &m1);
-      run(-2 * h, &m2);
-      double scale_rate = 0.0, scale_angle = 0.0, err_rate = 0.0, err_angle = 0.0;
-      for (size_t k = 0; k < t.size(); ++k) {
-        const double fd_rate = (-p2.rate_rad_per_s[k] + 8 * p1.rate_rad_per_s[k] -
-                                8 * m1.rate_rad_per_s[k] + m2.rate_rad_per_s[k]) / (12 * h);
-        const double fd_angle =
-            (-p2.angle_rad[k] + 8 * p1.angle_rad[k] - 8 * m1.angle_rad[k] + m2.angle_rad[k]) /
-            (12 * h);
-        scale_rate = std::max(scale_rate, std::abs(fd_rate));
-        scale_angle = std::max(scale_angle, std::abs(fd_angle));
-        err_rate = std::max(err_rate, std::abs(fd_rate - tr.d_rate(k, j)));
-        err_angle = std::max(err_angle, std::abs(fd_angle - tr.d_angle(k, j)));
+    for (PendulumModel model : kModels) {
+      SCOPED_TRACE(std::string(ToString(method)) + " " + ToString(model));
+      PendulumIntegrator integrator(model, g, WithMethod(method));
+      PendulumIntegrator reference(model, g, tight);
+      Trajectory tr;
+      std::string why;
+      ASSERT_TRUE(integrator.Integrate(p, angle0, rate0, t, true, &tr, &why)) << why;
+      ASSERT_EQ(tr.d_rate.rows(), static_cast<Eigen::Index>(t.size()));
+      ASSERT_EQ(tr.d_rate.cols(), kNumSensitivities);
+      ASSERT_EQ(tr.d_angle.rows(), static_cast<Eigen::Index>(t.size()));
+      const double steps[kNumSensitivities] = {1e-4 * p.inertia_kg_m2, 1e-4, 1e-4, 1e-4, 1e-4};
+      for (int j = 0; j < kNumSensitivities; ++j) {
+        const auto run = [&](double delta, Trajectory* out) {
+          PendulumParams q = p;
+          double a0 = angle0, r0 = rate0;
+          if (j == kSensInertia) q.inertia_kg_m2 += delta;
+          if (j == kSensDrag) q.drag_coeff_kg_m2 += delta;
+          if (j == kSensViscous) q.viscous_coeff_kg_m2_per_s += delta;
+          if (j == kSensAngle0) a0 += delta;
+          if (j == kSensRate0) r0 += delta;
+          ASSERT_TRUE(reference.Integrate(q, a0, r0, t, false, out, &why)) << why;
+        };
+        const double h = steps[j];
+        Trajectory p2, p1, m1, m2;
+        run(2 * h, &p2);
+        run(h, &p1);
+        run(-h, &m1);
+        run(-2 * h, &m2);
+        double scale_rate = 0.0, scale_angle = 0.0, err_rate = 0.0, err_angle = 0.0;
+        for (size_t k = 0; k < t.size(); ++k) {
+          const double fd_rate = (-p2.rate_rad_per_s[k] + 8 * p1.rate_rad_per_s[k] -
+                                  8 * m1.rate_rad_per_s[k] + m2.rate_rad_per_s[k]) /
+                                 (12 * h);
+          const double fd_angle =
+              (-p2.angle_rad[k] + 8 * p1.angle_rad[k] - 8 * m1.angle_rad[k] + m2.angle_rad[k]) /
+              (12 * h);
+          scale_rate = std::max(scale_rate, std::abs(fd_rate));
+          scale_angle = std::max(scale_angle, std::abs(fd_angle));
+          err_rate = std::max(err_rate, std::abs(fd_rate - tr.d_rate(k, j)));
+          err_angle = std::max(err_angle, std::abs(fd_angle - tr.d_angle(k, j)));
+        }
+        EXPECT_GT(scale_rate, 0.1) << "column " << j;  // the column is not trivially zero
+        EXPECT_LT(err_rate, 1e-6 * scale_rate) << "column " << j;
+        EXPECT_LT(err_angle, 1e-6 * scale_angle) << "column " << j;
       }
-      EXPECT_GT(scale_rate, 0.1) << "column " << j;  // the column is not trivially zero
-      EXPECT_LT(err_rate, 1e-6 * scale_rate) << "column " << j;
-      EXPECT_LT(err_angle, 1e-6 * scale_angle) << "column " << j;
+      // Row 0: zero for the parameters, identity for the initial state.
+      EXPECT_EQ(tr.d_angle(0, kSensAngle0), 1.0);
+      EXPECT_EQ(tr.d_rate(0, kSensRate0), 1.0);
+      EXPECT_EQ(tr.d_rate(0, kSensInertia), 0.0);
+      EXPECT_EQ(tr.angle_rad[0], angle0);
+      EXPECT_EQ(tr.rate_rad_per_s[0], rate0);
     }
-    // Row 0: zero for the parameters, identity for the initial state.
-    EXPECT_EQ(tr.d_angle(0, kSensAngle0), 1.0);
-    EXPECT_EQ(tr.d_rate(0, kSensRate0), 1.0);
-    EXPECT_EQ(tr.d_rate(0, kSensInertia), 0.0);
-    EXPECT_EQ(tr.angle_rad[0], angle0);
-    EXPECT_EQ(tr.rate_rad_per_s[0], rate0);
-  }
 }
 
 // Issue 2 item 3 and docs/physics.md §2.3: with D/L = 0.44 and m (D/2)^2 / I = 1, a jardin fit of a
@@ -376,13 +378,13 @@ TEST(PendulumIntegrator, FullVersusJardinInertiaBias) {
   g.filar_separation_m = 0.44;
   g.mass_kg = 3.0;
   const double inertia = g.mass_kg * 0.25 * 0.44 * 0.44;  // m (D/2)^2 / I = 1
-  PendulumIntegrator full(PendulumModel::kFull, g);  // kRungeKutta; both methods' periods are
-  PendulumIntegrator jardin(PendulumModel::kJardin, g);  // checked above
+  PendulumIntegrator full(PendulumModel::kFull, g);       // kRungeKutta; both methods' periods are
+  PendulumIntegrator jardin(PendulumModel::kJardin, g);   // checked above
   struct Case {
     double deg, quadrature_percent, physics_md_percent, physics_md_precision;
   };
-  for (const Case& c : {Case{10, 0.0733, 0.08, 0.01}, Case{20, 0.2875, 0.3, 0.05},
-                        Case{45, 1.3106, 1.4, 0.1}}) {
+  for (const Case& c :
+       {Case{10, 0.0733, 0.08, 0.01}, Case{20, 0.2875, 0.3, 0.05}, Case{45, 1.3106, 1.4, 0.1}}) {
     const double A = c.deg * kRadPerDeg;
     const double t0 = SmallAnglePeriod(g, inertia);
     const double t_full = IntegratedPeriod(&full, Undamped(inertia), A, t0, 8);
@@ -410,9 +412,8 @@ TEST(PendulumIntegrator, FullVersusJardinInertiaBias) {
 TEST(PendulumIntegrator, SmallAngleFormulaOverestimate) {
   const auto overestimate = [](PendulumModel model, const RigGeometry& g, double inertia,
                                double A) {
-    return 100 * (InertiaFromSmallAnglePeriod(g, QuadraturePeriod(model, g, inertia, A)) /
-                      inertia -
-                  1);
+    return 100 *
+           (InertiaFromSmallAnglePeriod(g, QuadraturePeriod(model, g, inertia, A)) / inertia - 1);
   };
   RigGeometry narrow;  // D / L = 1e-3: the simple-pendulum limit
   narrow.filar_length_m = 2.0;
@@ -537,9 +538,8 @@ TEST_P(PendulumIntegratorMethod, BadInputFailsWithMessage) {
   std::string why;
   EXPECT_FALSE(integrator.Integrate(Undamped(), 0.1, 0.0, {0.0, 1.0, 0.5}, false, &tr, &why));
   EXPECT_NE(why.find("non-decreasing"), std::string::npos) << why;
-  EXPECT_FALSE(integrator.Integrate(Undamped(), 0.1, 0.0,
-                                    {0.0, std::numeric_limits<double>::quiet_NaN()}, false, &tr,
-                                    &why));
+  EXPECT_FALSE(integrator.Integrate(
+      Undamped(), 0.1, 0.0, {0.0, std::numeric_limits<double>::quiet_NaN()}, false, &tr, &why));
   EXPECT_NE(why.find("t_s[1] is not finite"), std::string::npos) << why;
   EXPECT_FALSE(integrator.Integrate(Undamped(-1.0), 0.1, 0.0, {0.0, 1.0}, false, &tr, &why));
   EXPECT_NE(why.find("inertia_kg_m2 (I)"), std::string::npos) << why;

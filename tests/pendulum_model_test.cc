@@ -161,8 +161,8 @@ TEST(PendulumModel, EnergyBalanceMatchesDampingPower) {
         const auto e_rate = [&](double x) { return MechanicalEnergy(model, g, p, psi, x); };
         const double dE_dt = Derivative(e_angle, psi, 1e-3) * w +
                              Derivative(e_rate, w, 1e-3) * AngularAcceleration(model, g, p, psi, w);
-        const double power = -(p.drag_coeff_kg_m2 * w * std::abs(w) +
-                               p.viscous_coeff_kg_m2_per_s * w) * w;
+        const double power =
+            -(p.drag_coeff_kg_m2 * w * std::abs(w) + p.viscous_coeff_kg_m2_per_s * w) * w;
         // Stencil truncation ~1e-12 of energies ~10 J.
         EXPECT_NEAR(dE_dt, power, 1e-9) << ToString(model) << " " << deg << " " << w;
       }
@@ -174,8 +174,8 @@ TEST(PendulumModel, EnergyBalanceMatchesDampingPower) {
   }
   // Values spelled out for one state (docs/physics.md energies).
   const double psi = 0.5, w = 1.2;
-  const double m = g.mass_kg, I = p.inertia_kg_m2, h = RiseHeight(g, psi),
-               h1 = RiseSlope(g, psi), gm = g.gravity_mps2;
+  const double m = g.mass_kg, I = p.inertia_kg_m2, h = RiseHeight(g, psi), h1 = RiseSlope(g, psi),
+               gm = g.gravity_mps2;
   EXPECT_NEAR(MechanicalEnergy(PendulumModel::kFull, g, p, psi, w),
               0.5 * (I + m * h1 * h1) * w * w + m * gm * h, 1e-13);
   EXPECT_NEAR(MechanicalEnergy(PendulumModel::kJardin, g, p, psi, w), 0.5 * I * w * w + m * gm * h,
@@ -218,7 +218,8 @@ TEST(PendulumModel, RigGeometryCheck) {
     ExpectRigError(g, "filar_length_m (L) = " + FormatCheckValue(bad) + "; must be finite and > 0");
     g = TestGeometry();
     g.filar_separation_m = bad;
-    ExpectRigError(g, "filar_separation_m (D) = " + FormatCheckValue(bad) + "; must be finite and > 0");
+    ExpectRigError(
+        g, "filar_separation_m (D) = " + FormatCheckValue(bad) + "; must be finite and > 0");
     g = TestGeometry();
     g.mass_kg = bad;
     ExpectRigError(g, "mass_kg (m) = " + FormatCheckValue(bad) + "; must be finite and > 0");
@@ -230,12 +231,16 @@ TEST(PendulumModel, RigGeometryCheck) {
   for (double length : {0.8, 0.5}) {
     RigGeometry g = TestGeometry();
     g.filar_length_m = length;
-    ExpectRigError(g, "filar_separation_m (D) = 0.8; must be < filar_length_m (L) = " + FormatCheckValue(length));
+    ExpectRigError(g, "filar_separation_m (D) = 0.8; must be < filar_length_m (L) = " +
+                          FormatCheckValue(length));
   }
   RigGeometry g = TestGeometry();
   g.filar_length_m = 0.5;
   ASSERT_FALSE(g.Check(&why));
-  EXPECT_NE(why.find("filar_separation_m (D) = 0.8; must be < filar_length_m (L) = 0.5 (the wires would go slack)"), std::string::npos) << why;
+  EXPECT_NE(why.find("filar_separation_m (D) = 0.8; must be < filar_length_m (L) = 0.5 (the wires "
+                     "would go slack)"),
+            std::string::npos)
+      << why;
 }
 
 TEST(PendulumModel, PendulumParamsCheck) {
@@ -249,18 +254,23 @@ TEST(PendulumModel, PendulumParamsCheck) {
     PendulumParams p = TestParams();
     p.inertia_kg_m2 = bad;
     EXPECT_FALSE(p.Check(&why));
-    EXPECT_NE(why.find("inertia_kg_m2 (I) = " + FormatCheckValue(bad) + "; must be finite and > 0"), std::string::npos) << why;
+    EXPECT_NE(why.find("inertia_kg_m2 (I) = " + FormatCheckValue(bad) + "; must be finite and > 0"),
+              std::string::npos)
+        << why;
   }
   for (double bad : {-1e-9, nan, std::numeric_limits<double>::infinity()}) {
     PendulumParams p = TestParams();
     p.drag_coeff_kg_m2 = bad;
     EXPECT_FALSE(p.Check(&why));
-    EXPECT_NE(why.find("drag_coeff_kg_m2 (K_D) = " + FormatCheckValue(bad) + "; must be finite and >= 0"), std::string::npos)
+    EXPECT_NE(
+        why.find("drag_coeff_kg_m2 (K_D) = " + FormatCheckValue(bad) + "; must be finite and >= 0"),
+        std::string::npos)
         << why;
     p = TestParams();
     p.viscous_coeff_kg_m2_per_s = bad;
     EXPECT_FALSE(p.Check(&why));
-    EXPECT_NE(why.find("viscous_coeff_kg_m2_per_s (C) = " + FormatCheckValue(bad) + "; must be finite and >= 0"),
+    EXPECT_NE(why.find("viscous_coeff_kg_m2_per_s (C) = " + FormatCheckValue(bad) +
+                       "; must be finite and >= 0"),
               std::string::npos)
         << why;
   }
@@ -293,8 +303,9 @@ TEST(EnumTables, SeparationBelowLengthIsOneCheck) {
   std::string why;
   EXPECT_TRUE(CheckSeparationBelowLength(2.0, 1.0, &why));
   EXPECT_FALSE(CheckSeparationBelowLength(1.0, 1.0, &why));
-  EXPECT_EQ(why, "filar_separation_m (D) = 1; must be < filar_length_m (L) = 1 (the wires would "
-                 "go slack)");
+  EXPECT_EQ(why,
+            "filar_separation_m (D) = 1; must be < filar_length_m (L) = 1 (the wires would "
+            "go slack)");
   EXPECT_FALSE(CheckSeparationBelowLength(NAN, 1.0, nullptr));
 }
 

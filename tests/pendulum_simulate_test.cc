@@ -75,14 +75,16 @@ TEST(Simulate, FreeOscillationIsTheIntegratorOutput) {
   PendulumIntegrator integrator(PendulumModel::kFull, setup.geometry, options.integrator);
   Trajectory trajectory;
   ASSERT_TRUE(integrator.Integrate(setup.params, truth.amplitude_rad, truth.release_rate_rad_per_s,
-                                   t, false, &trajectory, &why)) << why;
+                                   t, false, &trajectory, &why))
+      << why;
   // The truth uses CVODES by default; the fit's default Runge-Kutta agrees to the solvers'
   // global error (~1e-9 rad/s at these tolerances; 1e-7 leaves margin, noise is 4e-3 rad/s).
   EXPECT_EQ(options.integrator.method, IntegratorMethod::kCvodes);
   PendulumIntegrator other(PendulumModel::kFull, setup.geometry, IntegratorOptions());
   Trajectory other_trajectory;
   ASSERT_TRUE(other.Integrate(setup.params, truth.amplitude_rad, truth.release_rate_rad_per_s, t,
-                              false, &other_trajectory, &why)) << why;
+                              false, &other_trajectory, &why))
+      << why;
   for (size_t i = 0; i < t.size(); ++i) {
     ASSERT_NEAR(other_trajectory.rate_rad_per_s[i], trajectory.rate_rad_per_s[i], 1e-7);
   }
@@ -189,7 +191,8 @@ TEST(Simulate, SwayCouplingRaisesTheApparentInertiaAsAToTheFourth) {
     for (size_t k = 1; k < trace.imu.size(); ++k) {
       const double a = trace.angle_rad[k - 1], b = trace.angle_rad[k];
       if (trace.imu.t_s[k - 1] > trace.truth.t_release_s && a > 0 && b <= 0) {
-        crossings.push_back(trace.imu.t_s[k - 1] + a / (a - b) * (trace.imu.t_s[k] - trace.imu.t_s[k - 1]));
+        crossings.push_back(trace.imu.t_s[k - 1] +
+                            a / (a - b) * (trace.imu.t_s[k] - trace.imu.t_s[k - 1]));
       }
     }
     return (crossings.back() - crossings.front()) / (crossings.size() - 1);
@@ -235,7 +238,8 @@ TEST(Simulate, CampaignTruthAndLayout) {
       const double c = std::cos(theta), s = std::sin(theta);
       EXPECT_NEAR(t.inertia_aircraft_kg_m2,
                   spec.aircraft.iz_kg_m2 * c * c + spec.aircraft.ix_kg_m2 * s * s +
-                      spec.aircraft.ixz_kg_m2 * 2 * s * c, 1e-12);
+                      spec.aircraft.ixz_kg_m2 * 2 * s * c,
+                  1e-12);
       EXPECT_NEAR(t.setup.geometry.mass_kg, 6.75, 1e-12);
       EXPECT_LT(std::abs(t.true_pitch_deg - t.nominal_pitch_deg), 5 * 0.5);  // 5 sigma
     }
@@ -261,24 +265,49 @@ TEST(Simulate, BadInputNamesTheParameter) {
     std::function<void(TraceSetup*, SimulationOptions*)> edit;
   };
   const std::vector<Case> cases = {
-      {"filar_length_m (L) = -1; must be in (0, 1000]", [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_length_m = -1; }},
-      {"filar_separation_m (D) = 1.8; must be < filar_length_m (L) = 1.5 (the wires would go slack)",
+      {"filar_length_m (L) = -1; must be in (0, 1000]",
+       [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_length_m = -1; }},
+      {"filar_separation_m (D) = 1.8; must be < filar_length_m (L) = 1.5 (the wires would go "
+       "slack)",
        [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_length_m = 1.5; }},
-      {"filar_separation_m (D) = 0; must be in (0, 1000]", [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_separation_m = 0; }},
-      {"mass_kg (whole suspended mass) = 0; must be in (0, 1000000]", [](TraceSetup* s, SimulationOptions*) { s->geometry.mass_kg = 0; }},
-      {"inertia_kg_m2 (whole suspended inertia) = -2; must be in (0, 1000000000]", [](TraceSetup* s, SimulationOptions*) { s->params.inertia_kg_m2 = -2; }},
-      {"inertia_kg_m2 (whole suspended inertia) = nan; must be in (0, 1000000000]", [](TraceSetup* s, SimulationOptions*) { s->params.inertia_kg_m2 = NAN; }},
-      {"amplitude_deg = 0; must be 0 < |amplitude_deg| < 89", [](TraceSetup* s, SimulationOptions*) { s->amplitude_rad = 0; }},
-      {"pitch_deg = 100; must be in [-90, 90]", [](TraceSetup* s, SimulationOptions*) { s->pitch_rad = 100 * kRadPerDeg; }},
-      {"|imu_offset_in_body_m| = 200; must be <= 100", [](TraceSetup* s, SimulationOptions*) { s->imu_offset_in_body_m = {200, 0, 0}; }},
-      {"det(body_from_imu) = -1; must be > 0", [](TraceSetup* s, SimulationOptions*) { s->body_from_imu = -Eigen::Matrix3d::Identity(); }},
-      {"sensor.sample_rate_hz = 0; must be in (0, 100000]", [](TraceSetup*, SimulationOptions* o) { o->sensor.sample_rate_hz = 0; }},
-      {"timeline.free_s.min = 0; must be > 0", [](TraceSetup*, SimulationOptions* o) { o->timeline.free_s = {0, 0}; }},
-      {"timeline.free_s.min = -5; must be > 0", [](TraceSetup*, SimulationOptions* o) { o->timeline.free_s = {-5, 10}; }},
-      {"timeline.free_s.min = 20; must be <= timeline.free_s.max = 10", [](TraceSetup*, SimulationOptions* o) { o->timeline.free_s = {20, 10}; }},
-      {"integrator: rel_tol = 0.1; must be in (0, 0.01]", [](TraceSetup*, SimulationOptions* o) { o->integrator.rel_tol = 0.1; }},
-      {"sensor.drop_fraction = 0.9; must be in [0, 0.5]", [](TraceSetup*, SimulationOptions* o) { o->sensor.drop_fraction = 0.9; }},
-      {"timeline.stop_probability = 2; must be in [0, 1]", [](TraceSetup*, SimulationOptions* o) { o->timeline.stop_probability = 2; }},
+      {"filar_separation_m (D) = 0; must be in (0, 1000]",
+       [](TraceSetup* s, SimulationOptions*) { s->geometry.filar_separation_m = 0; }},
+      {"mass_kg (whole suspended mass) = 0; must be in (0, 1000000]",
+       [](TraceSetup* s, SimulationOptions*) { s->geometry.mass_kg = 0; }},
+      {"inertia_kg_m2 (whole suspended inertia) = -2; must be in (0, 1000000000]",
+       [](TraceSetup* s, SimulationOptions*) { s->params.inertia_kg_m2 = -2; }},
+      {"inertia_kg_m2 (whole suspended inertia) = nan; must be in (0, 1000000000]",
+       [](TraceSetup* s, SimulationOptions*) { s->params.inertia_kg_m2 = NAN; }},
+      {"amplitude_deg = 0; must be 0 < |amplitude_deg| < 89",
+       [](TraceSetup* s, SimulationOptions*) { s->amplitude_rad = 0; }},
+      {"pitch_deg = 100; must be in [-90, 90]",
+       [](TraceSetup* s, SimulationOptions*) { s->pitch_rad = 100 * kRadPerDeg; }},
+      {"|imu_offset_in_body_m| = 200; must be <= 100",
+       [](TraceSetup* s, SimulationOptions*) {
+         s->imu_offset_in_body_m = {200, 0, 0};
+       }},
+      {"det(body_from_imu) = -1; must be > 0",
+       [](TraceSetup* s, SimulationOptions*) { s->body_from_imu = -Eigen::Matrix3d::Identity(); }},
+      {"sensor.sample_rate_hz = 0; must be in (0, 100000]",
+       [](TraceSetup*, SimulationOptions* o) { o->sensor.sample_rate_hz = 0; }},
+      {"timeline.free_s.min = 0; must be > 0",
+       [](TraceSetup*, SimulationOptions* o) {
+         o->timeline.free_s = {0, 0};
+       }},
+      {"timeline.free_s.min = -5; must be > 0",
+       [](TraceSetup*, SimulationOptions* o) {
+         o->timeline.free_s = {-5, 10};
+       }},
+      {"timeline.free_s.min = 20; must be <= timeline.free_s.max = 10",
+       [](TraceSetup*, SimulationOptions* o) {
+         o->timeline.free_s = {20, 10};
+       }},
+      {"integrator: rel_tol = 0.1; must be in (0, 0.01]",
+       [](TraceSetup*, SimulationOptions* o) { o->integrator.rel_tol = 0.1; }},
+      {"sensor.drop_fraction = 0.9; must be in [0, 0.5]",
+       [](TraceSetup*, SimulationOptions* o) { o->sensor.drop_fraction = 0.9; }},
+      {"timeline.stop_probability = 2; must be in [0, 1]",
+       [](TraceSetup*, SimulationOptions* o) { o->timeline.stop_probability = 2; }},
   };
   for (const Case& c : cases) {
     TraceSetup setup = PrandtlLikeSetup();
@@ -292,14 +321,14 @@ TEST(Simulate, BadInputNamesTheParameter) {
   }
 }
 
-
 // ---- Realism options (issue 8): each one against its setting --------------------------------
 
 // Gyro minus the noise-free rate psi' n (IMU axes = body axes, no rocking): the sensor errors.
 std::vector<Eigen::Vector3d> GyroErrors(const SimulatedTrace& trace, const TraceSetup& setup) {
   const Eigen::Vector3d n(-std::sin(setup.pitch_rad), 0, std::cos(setup.pitch_rad));
   std::vector<Eigen::Vector3d> e(trace.imu.size());
-  for (size_t k = 0; k < e.size(); ++k) e[k] = trace.imu.gyro_in_imu[k] - trace.rate_rad_per_s[k] * n;
+  for (size_t k = 0; k < e.size(); ++k)
+    e[k] = trace.imu.gyro_in_imu[k] - trace.rate_rad_per_s[k] * n;
   return e;
 }
 
@@ -353,11 +382,12 @@ TEST(SimulateRealism, BiasRandomWalkIncrementsScaleWithSqrtDt) {
   std::string why;
   ASSERT_TRUE(SimulateTrace(setup, options, 17, &trace, &why)) << why;
   const std::vector<Eigen::Vector3d> e = GyroErrors(trace, setup);  // = the walk (no other error)
-  EXPECT_NEAR(e[0].norm(), 0.0, 1e-15);                              // starts at the bias (0)
+  EXPECT_NEAR(e[0].norm(), 0.0, 1e-15);                             // starts at the bias (0)
   double sum2 = 0;
   int count = 0;
   for (size_t k = 1; k < e.size(); ++k) {
-    const Eigen::Vector3d z = (e[k] - e[k - 1]) / std::sqrt(trace.imu.t_s[k] - trace.imu.t_s[k - 1]);
+    const Eigen::Vector3d z =
+        (e[k] - e[k - 1]) / std::sqrt(trace.imu.t_s[k] - trace.imu.t_s[k - 1]);
     sum2 += z.squaredNorm();
     count += 3;
   }
@@ -378,7 +408,8 @@ TEST(SimulateRealism, LogNormalStepsLikeACrazyflieLog) {
   std::string why;
   ASSERT_TRUE(SimulateTrace(PrandtlLikeSetup(), options, 5, &trace, &why)) << why;
   std::vector<double> steps;
-  for (size_t k = 1; k < trace.imu.size(); ++k) steps.push_back(trace.imu.t_s[k] - trace.imu.t_s[k - 1]);
+  for (size_t k = 1; k < trace.imu.size(); ++k)
+    steps.push_back(trace.imu.t_s[k] - trace.imu.t_s[k - 1]);
   ASSERT_GT(steps.size(), 7000u);
   double sum = 0;
   for (double s : steps) {
@@ -444,8 +475,9 @@ TEST(SimulateRealism, SpikesHaveTheirCountAndSizeAndChangeNothingElse) {
   for (size_t k = 0; k < clean.imu.size(); ++k) {
     if (clean.imu.gyro_in_imu[k] == spiked.imu.gyro_in_imu[k]) continue;
     ++changed;
-    const auto it = std::find_if(spikes.begin(), spikes.end(),
-                                 [k](const TraceTruth::Spike& s) { return s.sample == static_cast<int>(k); });
+    const auto it = std::find_if(spikes.begin(), spikes.end(), [k](const TraceTruth::Spike& s) {
+      return s.sample == static_cast<int>(k);
+    });
     ASSERT_NE(it, spikes.end()) << "sample " << k << " changed but is not a spike";
     EXPECT_EQ(it->axis, 2);  // the IMU axis most aligned with the swing axis
     EXPECT_EQ(std::abs(spiked.imu.gyro_in_imu[k][2]), 50.0);
@@ -481,7 +513,8 @@ double UndampedPeriod(TraceSetup setup, SimulationOptions options, double amplit
   for (size_t k = 1; k < trace.imu.size(); ++k) {
     const double a = trace.angle_rad[k - 1], b = trace.angle_rad[k];
     if (trace.imu.t_s[k - 1] > trace.truth.t_release_s && a > 0 && b <= 0) {
-      crossings.push_back(trace.imu.t_s[k - 1] + a / (a - b) * (trace.imu.t_s[k] - trace.imu.t_s[k - 1]));
+      crossings.push_back(trace.imu.t_s[k - 1] +
+                          a / (a - b) * (trace.imu.t_s[k] - trace.imu.t_s[k - 1]));
     }
   }
   EXPECT_GE(crossings.size(), 5u);
@@ -512,7 +545,8 @@ TEST(SimulateRealism, SofteningRaisesTheApparentInertiaAsStated) {
     EXPECT_NEAR(ApparentInertiaExcess(k, exponent, 30 * kRadPerDeg), 0.028, 1e-15);
     for (double amplitude_deg : {8.0, 20.0, 30.0}) {
       const double ratio = std::pow(UndampedPeriod(setup, soft, amplitude_deg) /
-                                        UndampedPeriod(setup, options, amplitude_deg), 2);
+                                        UndampedPeriod(setup, options, amplitude_deg),
+                                    2);
       const double predicted = ApparentInertiaExcess(k, exponent, amplitude_deg * kRadPerDeg);
       EXPECT_NEAR(ratio - 1, predicted, 0.01 * predicted)
           << "p " << exponent << " at " << amplitude_deg << " deg";
@@ -523,7 +557,8 @@ TEST(SimulateRealism, SofteningRaisesTheApparentInertiaAsStated) {
   SimulationOptions full = options, full_soft = options;
   full.model = full_soft.model = PendulumModel::kFull;
   full_soft.softening_at_30deg = 0.028;
-  const double ratio = std::pow(UndampedPeriod(setup, full_soft, 30) / UndampedPeriod(setup, full, 30), 2);
+  const double ratio =
+      std::pow(UndampedPeriod(setup, full_soft, 30) / UndampedPeriod(setup, full, 30), 2);
   EXPECT_NEAR(ratio - 1, 0.028, 0.02 * 0.028);
   // The truth records k; the true inertia is untouched.
   SimulatedTrace trace;
@@ -564,18 +599,30 @@ TEST(SimulateRealism, BadSettingsNameTheKey) {
     std::function<void(SimulationOptions*)> edit;
   };
   const std::vector<Case> cases = {
-      {"sensor.gyro_noise_ar1_phi = 1; must be in [0, 0.99]", [](SimulationOptions* o) { o->sensor.gyro_noise_ar1_phi = 1.0; }},
+      {"sensor.gyro_noise_ar1_phi = 1; must be in [0, 0.99]",
+       [](SimulationOptions* o) { o->sensor.gyro_noise_ar1_phi = 1.0; }},
       {"sensor.gyro_bias_walk_deg_per_s_per_sqrt_s",
        [](SimulationOptions* o) { o->sensor.gyro_bias_walk_deg_per_s_per_sqrt_s = -1; }},
       {"sensor.spike_count", [](SimulationOptions* o) { o->sensor.spike_count = -1; }},
-      {"sensor.spike_rate_rad_per_s = 0; must be in (0, 10000]", [](SimulationOptions* o) { o->sensor.spike_rate_rad_per_s = 0; }},
-      {"sensor.step_range_s", [](SimulationOptions* o) { o->sensor.step_range_s = {0, 0.1}; }},
-      {"sensor.step_log_sigma = nan; must be in [0, 3]", [](SimulationOptions* o) { o->sensor.step_log_sigma = NAN; }},
+      {"sensor.spike_rate_rad_per_s = 0; must be in (0, 10000]",
+       [](SimulationOptions* o) { o->sensor.spike_rate_rad_per_s = 0; }},
+      {"sensor.step_range_s",
+       [](SimulationOptions* o) {
+         o->sensor.step_range_s = {0, 0.1};
+       }},
+      {"sensor.step_log_sigma = nan; must be in [0, 3]",
+       [](SimulationOptions* o) { o->sensor.step_log_sigma = NAN; }},
       {"sensor.gravity_removal_error_deg",
-       [](SimulationOptions* o) { o->sensor.gravity_removal_error_deg = {0, 45}; }},
-      {"swing.softening_percent_at_30deg", [](SimulationOptions* o) { o->softening_at_30deg = 0.9; }},
-      {"swing.softening_exponent = 0.5; must be in [1, 4]", [](SimulationOptions* o) { o->softening_exponent = 0.5; }},
-      {"sensor.time_jitter_sigma_s = 0.001; must be <= one sample period 1 / sensor.sample_rate_hz = 5e-04", [](SimulationOptions* o) { o->sensor.sample_rate_hz = 2000; }},
+       [](SimulationOptions* o) {
+         o->sensor.gravity_removal_error_deg = {0, 45};
+       }},
+      {"swing.softening_percent_at_30deg",
+       [](SimulationOptions* o) { o->softening_at_30deg = 0.9; }},
+      {"swing.softening_exponent = 0.5; must be in [1, 4]",
+       [](SimulationOptions* o) { o->softening_exponent = 0.5; }},
+      {"sensor.time_jitter_sigma_s = 0.001; must be <= one sample period 1 / sensor.sample_rate_hz "
+       "= 5e-04",
+       [](SimulationOptions* o) { o->sensor.sample_rate_hz = 2000; }},
   };
   for (const Case& c : cases) {
     SimulationOptions options;
@@ -597,7 +644,8 @@ TEST(SimulateRealism, BadSettingsNameTheKey) {
     std::string why;
     EXPECT_FALSE(SimulateTrace(setup, options, 1, &trace, &why));
     EXPECT_NE(why.find("removes 270 % of the restoring torque at the amplitude 45 deg"),
-              std::string::npos) << why;
+              std::string::npos)
+        << why;
   }
   // More spikes than half the log is refused, not looped on.
   SimulationOptions options;

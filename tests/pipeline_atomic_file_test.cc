@@ -134,8 +134,9 @@ TEST(AtomicFile, WritesA255ByteNameAndRefusesALongerOneWithTheReason) {
   ExpectOnly(dir.path, {longest});
   const std::string too_long = (dir.path / std::string(256, 'b')).string();
   const std::string message = ErrorOf([&] { WriteFileAtomically(too_long, "x"); });
-  EXPECT_NE(message.find("the file name is 256 bytes long, more than this file system allows (255)"),
-            std::string::npos)
+  EXPECT_NE(
+      message.find("the file name is 256 bytes long, more than this file system allows (255)"),
+      std::string::npos)
       << message;
   ExpectOnly(dir.path, {longest});
 }
@@ -145,9 +146,9 @@ TEST(AtomicFile, RefuseToReplaceNamesTheFileAndHonoursForce) {
   const std::string file = (dir.path / "mine.csv").string();
   EXPECT_EQ(ErrorOf([&] { RefuseToReplace(file, "simulate --trace", false); }), "");
   std::ofstream(file) << "mine";
-  EXPECT_EQ(ErrorOf([&] { RefuseToReplace(file, "simulate --trace", false); }),
-            "simulate --trace: " + file +
-                " exists; choose another name, or add --force to overwrite it");
+  EXPECT_EQ(
+      ErrorOf([&] { RefuseToReplace(file, "simulate --trace", false); }),
+      "simulate --trace: " + file + " exists; choose another name, or add --force to overwrite it");
   EXPECT_EQ(ErrorOf([&] { RefuseToReplace(file, "simulate --trace", true); }), "");
 }
 

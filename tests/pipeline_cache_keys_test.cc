@@ -55,16 +55,17 @@ template <class Options>
 void AddTableEdits(const std::string& section, Options FitConfig::*part,
                    std::vector<KeyEdit>* out) {
   for (const OptionField<Options>& row : Options::Fields()) {
-    out->push_back({"fit." + section + "." + row.key, true, [row, part](CampaignConfig* c, Window*) {
-                      Options& o = c->fit.*part;
-                      if (row.flag) {
-                        o.*row.flag = !(o.*row.flag);
-                      } else if (row.whole) {
-                        o.*row.whole += 1;
-                      } else {
-                        o.*row.real *= 1.05;
-                      }
-                    }});
+    out->push_back(
+        {"fit." + section + "." + row.key, true, [row, part](CampaignConfig* c, Window*) {
+           Options& o = c->fit.*part;
+           if (row.flag) {
+             o.*row.flag = !(o.*row.flag);
+           } else if (row.whole) {
+             o.*row.whole += 1;
+           } else {
+             o.*row.real *= 1.05;
+           }
+         }});
   }
 }
 
@@ -154,20 +155,28 @@ std::vector<KeyEdit> OtherEdits() {
       {"aircraft.mass_std_kg", true,
        [](CampaignConfig* c, Window*) { c->aircraft_mass_std_kg = 0.02; }},
       {"aircraft.cg_m", false,
-       [](CampaignConfig* c, Window*) { c->aircraft_cg.cg_m = {0.01, 0.0, 0.02}; }},
+       [](CampaignConfig* c, Window*) {
+         c->aircraft_cg.cg_m = {0.01, 0.0, 0.02};
+       }},
       {"aircraft.cg_std_m", false,
-       [](CampaignConfig* c, Window*) { c->aircraft_cg.cg_std_m = {0.001, 0.001, 0.001}; }},
+       [](CampaignConfig* c, Window*) {
+         c->aircraft_cg.cg_std_m = {0.001, 0.001, 0.001};
+       }},
       // imu: how the log is read and how the IMU hangs
-      {"imu.time.column", true, [](CampaignConfig* c, Window*) { c->imu.format.time_column = "time"; }},
+      {"imu.time.column", true,
+       [](CampaignConfig* c, Window*) { c->imu.format.time_column = "time"; }},
       {"imu.time.unit", true,
        [](CampaignConfig* c, Window*) { c->imu.format.time_unit = TimeUnit::kMilliseconds; }},
       {"imu.gyro.columns", true,
        [](CampaignConfig* c, Window*) { c->imu.format.gyro_columns[2] = "wz"; }},
       {"imu.gyro.unit", true,
        [](CampaignConfig* c, Window*) { c->imu.format.gyro_unit = RateUnit::kDegPerS; }},
-      {"imu.gyro.scale_std", true, [](CampaignConfig* c, Window*) { c->imu.gyro_scale_std = 0.005; }},
+      {"imu.gyro.scale_std", true,
+       [](CampaignConfig* c, Window*) { c->imu.gyro_scale_std = 0.005; }},
       {"imu.accel", true,
-       [](CampaignConfig* c, Window*) { c->imu.format.accel_columns = {"", "", ""}; }},
+       [](CampaignConfig* c, Window*) {
+         c->imu.format.accel_columns = {"", "", ""};
+       }},
       {"imu.accel.columns", true,
        [](CampaignConfig* c, Window*) { c->imu.format.accel_columns[0] = "fx"; }},
       {"imu.accel.unit", true,
@@ -181,18 +190,22 @@ std::vector<KeyEdit> OtherEdits() {
        [](CampaignConfig* c, Window*) { c->imu.format.container = LogContainer::kUlog; }},
       {"imu.ulog.topic", true,
        [](CampaignConfig* c, Window*) { c->imu.format.ulog.topic = "sensor_gyro"; }},
-      {"imu.ulog.multi_id", true, [](CampaignConfig* c, Window*) { c->imu.format.ulog.multi_id = 1; }},
+      {"imu.ulog.multi_id", true,
+       [](CampaignConfig* c, Window*) { c->imu.format.ulog.multi_id = 1; }},
       {"imu.ulog.time_field", true,
        [](CampaignConfig* c, Window*) { c->imu.format.ulog.time_field = "timestamp_sample"; }},
       {"imu.ulog.gyro_fields", true,
        [](CampaignConfig* c, Window*) { c->imu.format.ulog.gyro_fields[0] = "x"; }},
       {"imu.ulog.accel_fields", true,
-       [](CampaignConfig* c, Window*) { c->imu.format.ulog.accel_fields = {"", "", ""}; }},
+       [](CampaignConfig* c, Window*) {
+         c->imu.format.ulog.accel_fields = {"", "", ""};
+       }},
       {"imu.dataflash.instance", true,
        [](CampaignConfig* c, Window*) { c->imu.dataflash_instance = 1; }},
       // runs: which files and which pitch the ellipse uses (set after the fit)
       {"runs.root", false, [](CampaignConfig* c, Window*) { c->runs.root = "/other"; }},
-      {"runs.pattern", false, [](CampaignConfig* c, Window*) { c->runs.pattern = "p{pitch_deg}/*"; }},
+      {"runs.pattern", false,
+       [](CampaignConfig* c, Window*) { c->runs.pattern = "p{pitch_deg}/*"; }},
       {"runs.table", false,
        [](CampaignConfig* c, Window*) {
          c->runs.pattern.clear();
@@ -203,11 +216,15 @@ std::vector<KeyEdit> OtherEdits() {
       {"runs.attitude_tolerance_deg", false,
        [](CampaignConfig* c, Window*) { c->runs.attitude_tolerance_deg = 5.0; }},
       // fit (the tables' keys are added from the tables)
-      {"fit.model", true, [](CampaignConfig* c, Window*) { c->fit.model = PendulumModel::kJardin; }},
+      {"fit.model", true,
+       [](CampaignConfig* c, Window*) { c->fit.model = PendulumModel::kJardin; }},
       {"fit.integrator", true,
        [](CampaignConfig* c, Window*) { c->fit.integrator = IntegratorMethod::kCvodes; }},
       // The file's entry of fit.windows reaches the key as its window.
-      {"fit.windows", true, [](CampaignConfig*, Window* w) { *w = std::array<double, 2>{1.0, 30.0}; }},
+      {"fit.windows", true,
+       [](CampaignConfig*, Window* w) {
+         *w = std::array<double, 2>{1.0, 30.0};
+       }},
       {"fit.max_amplitude_deg", true,
        [](CampaignConfig* c, Window*) { c->fit.max_amplitude_deg = 20.0; }},
       {"fit.min_amplitude_deg", true,
@@ -215,9 +232,12 @@ std::vector<KeyEdit> OtherEdits() {
       // ellipse
       {"ellipse.bootstrap", false, [](CampaignConfig* c, Window*) { c->ellipse.bootstrap = 500; }},
       {"ellipse.seed", false, [](CampaignConfig* c, Window*) { c->ellipse.seed = 7; }},
-      {"ellipse.confidence", false, [](CampaignConfig* c, Window*) { c->ellipse.confidence = 0.9; }},
+      {"ellipse.confidence", false,
+       [](CampaignConfig* c, Window*) { c->ellipse.confidence = 0.9; }},
       {"ellipse.covariance", false,
-       [](CampaignConfig* c, Window*) { c->ellipse.covariance = EllipseCovariance::kPointResiduals; }},
+       [](CampaignConfig* c, Window*) {
+         c->ellipse.covariance = EllipseCovariance::kPointResiduals;
+       }},
       {"ellipse.min_angles", false, [](CampaignConfig* c, Window*) { c->ellipse.min_angles = 4; }},
       // limits: a log beyond max_log_mb is never read (no key); a .csv.gz beyond the
       // decompression cap is an error record, which is cached.
@@ -230,11 +250,13 @@ std::vector<KeyEdit> OtherEdits() {
 // The keys configs/README.md documents: the rows "| `key` |" of its tables under the headings
 // "## Top level", "## `section`" and "### `section.sub` ...", up to the simulation specs.
 std::set<std::string> DocumentedKeys() {
-  const std::string text = test_support::ReadFile(std::string(BIFILAR_SOURCE_DIR) + "/configs/README.md");
+  const std::string text =
+      test_support::ReadFile(std::string(BIFILAR_SOURCE_DIR) + "/configs/README.md");
   std::set<std::string> keys;
   std::string section;
   bool in_keys = false;
-  const std::regex heading(R"(^#{2,3} (.*)$)"), named(R"(^`([a-z_.]+)`)"), row(R"(^\| `([a-z_.]+)` \|)");
+  const std::regex heading(R"(^#{2,3} (.*)$)"), named(R"(^`([a-z_.]+)`)"),
+      row(R"(^\| `([a-z_.]+)` \|)");
   std::istringstream in(text);
   std::smatch m;
   for (std::string line; std::getline(in, line);) {
@@ -256,7 +278,8 @@ TEST(CacheKeys, EveryConfigKeyChangesTheKeyExactlyWhenTheFitCan) {
   const size_t table_keys = edits.size();
   for (KeyEdit& e : OtherEdits()) edits.push_back(std::move(e));
   EXPECT_EQ(table_keys, TraceQualityOptions::Fields().size() +
-                            AmplitudeSweepOptions::Fields().size() + GlitchOptions::Fields().size());
+                            AmplitudeSweepOptions::Fields().size() +
+                            GlitchOptions::Fields().size());
 
   const CampaignConfig base = Base();
   std::string why;
@@ -273,8 +296,9 @@ TEST(CacheKeys, EveryConfigKeyChangesTheKeyExactlyWhenTheFitCan) {
       EXPECT_TRUE(c.fit.Check(&why)) << e.key << ": " << why;
     }
     const bool changed = FitFingerprint(c, TraceRole::kAircraft, window) != key;
-    EXPECT_EQ(changed, e.fit) << e.key << (e.fit ? " can change the fit but not the cache key"
-                                                 : " changes the cache key but not the fit");
+    EXPECT_EQ(changed, e.fit) << e.key
+                              << (e.fit ? " can change the fit but not the cache key"
+                                        : " changes the cache key but not the fit");
   }
   // A tare log swings the rig alone: the aircraft's mass and its std are not in its key.
   const std::string tare_key = FitFingerprint(base, TraceRole::kTare, std::nullopt);

@@ -78,7 +78,8 @@ TEST(Cache, KeyHasEveryFitInputAndNothingElse) {
   EXPECT_TRUE(changed([](CampaignConfig* c) { c->imu.imu_to_body(0, 0) = -1.0; }));
   // Not fit inputs: the rig inertia, pitch source, ellipse, units.
   EXPECT_FALSE(changed([](CampaignConfig* c) { c->rig_inertia.inertia_kg_m2 = 0.3; }));
-  EXPECT_FALSE(changed([](CampaignConfig* c) { c->rig_inertia.kind = RigInertiaSpec::Kind::kTare; }));
+  EXPECT_FALSE(
+      changed([](CampaignConfig* c) { c->rig_inertia.kind = RigInertiaSpec::Kind::kTare; }));
   EXPECT_FALSE(changed([](CampaignConfig* c) { c->runs.pitch_source = PitchSource::kMeasured; }));
   EXPECT_FALSE(changed([](CampaignConfig* c) { c->ellipse.bootstrap = 10; }));
   EXPECT_FALSE(changed([](CampaignConfig* c) { c->units = DisplayUnits::kImperial; }));
@@ -222,8 +223,8 @@ TEST(Cache, AnEntryLackingAKeyIsRefusedNamingIt) {
   const auto write = [&](nlohmann::json record, const std::string& text_of_inertia = "") {
     nlohmann::json entry = good;
     entry["record"] = record;
-    entry["checksum"] = HashToHex(Fnv1a64(key + ";" + hash + ";" + ProgramVersion() + ";" +
-                                          record.dump(-1, ' ', false)));
+    entry["checksum"] = HashToHex(
+        Fnv1a64(key + ";" + hash + ";" + ProgramVersion() + ";" + record.dump(-1, ' ', false)));
     std::string text = entry.dump(1);
     if (!text_of_inertia.empty()) {
       const std::string written = "\"inertia_total_kg_m2\": null";

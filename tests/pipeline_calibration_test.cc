@@ -516,10 +516,10 @@ bool HasFarWarning(const RigCalibrationResult& cal) {
 TEST(Calibration, AFactorFarFromOneWarnsNamingTheReferenceAndTheImpliedD) {
   FakeCampaign c;
   // 45 % low: the fake's k = 0.55 * kTrueFactor = 0.567, the issue's number.
-  c.WriteConfig("{tare: {logs: tare/*.csv}}",
-                "  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: " +
-                    Number(0.55 * kReference) +
-                    ", reference_inertia_std_kg_m2: 0.0012, reference_mass_kg: 4}\n");
+  c.WriteConfig(
+      "{tare: {logs: tare/*.csv}}",
+      "  calibration: {logs: calib/*.csv, reference_inertia_kg_m2: " + Number(0.55 * kReference) +
+          ", reference_inertia_std_kg_m2: 0.0012, reference_mass_kg: 4}\n");
   const CampaignResult result = c.Run();
   ASSERT_TRUE(result.calibration.has_value());
   const RigCalibrationResult& cal = *result.calibration;
@@ -530,11 +530,9 @@ TEST(Calibration, AFactorFarFromOneWarnsNamingTheReferenceAndTheImpliedD) {
     if (w.find("the factor k") != std::string::npos) warning = w;
   }
   EXPECT_NE(warning.find("k = 0.5666"), std::string::npos) << warning;
-  EXPECT_NE(warning.find("rig.calibration.reference_inertia_kg_m2 (0.66 kg m^2"),
-            std::string::npos)
+  EXPECT_NE(warning.find("rig.calibration.reference_inertia_kg_m2 (0.66 kg m^2"), std::string::npos)
       << warning;
-  EXPECT_NE(warning.find("rig.calibration.reference_mass_kg (4 kg)"), std::string::npos)
-      << warning;
+  EXPECT_NE(warning.find("rig.calibration.reference_mass_kg (4 kg)"), std::string::npos) << warning;
   // D sqrt(k): 0.7527 m against the 1 m measured, -24.7 %.
   EXPECT_NE(warning.find("effective D of 0.7527 m against the 1 m measured (-24.7 %"),
             std::string::npos)

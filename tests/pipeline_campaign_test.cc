@@ -36,8 +36,7 @@ const std::vector<double> kPitches = {-60, -30, 0, 30, 60, 90};
 
 double Truth(double pitch_deg) {
   const double t = pitch_deg * kRadPerDeg;
-  return kIz * std::cos(t) * std::cos(t) + kIx * std::sin(t) * std::sin(t) +
-         kIxz * std::sin(2 * t);
+  return kIz * std::cos(t) * std::cos(t) + kIx * std::sin(t) * std::sin(t) + kIxz * std::sin(2 * t);
 }
 
 std::string TempDir() {
@@ -50,8 +49,9 @@ struct FakeCampaign {
   std::string dir;
   std::atomic<int> calls{0};
 
-  explicit FakeCampaign(const std::string& rig_inertia_yaml = "{inertia_kg_m2: 0.5, inertia_std_kg_m2: 0.0}",
-                        const std::string& extra_yaml = "") {
+  explicit FakeCampaign(
+      const std::string& rig_inertia_yaml = "{inertia_kg_m2: 0.5, inertia_std_kg_m2: 0.0}",
+      const std::string& extra_yaml = "") {
     dir = TempDir();
     for (double p : kPitches) {
       for (int k = 1; k <= 2; ++k) {
@@ -143,12 +143,26 @@ TEST(Campaign, RecoversTheEllipseAndWritesEveryOutput) {
   EXPECT_NEAR(json["ellipse"]["Ix_kg_m2"].get<double>(), kIx, 1e-9);
   EXPECT_FALSE(json["version"].get<std::string>().empty());
   EXPECT_NE(json["config"].get<std::string>().find("filar_length_m"), std::string::npos);
-  for (const char* key : {"file", "status", "message", "inertia_total_kg_m2",
-                          "inertia_total_std_kg_m2", "drag_coeff_kg_m2",
-                          "viscous_coeff_kg_m2_per_s", "window_s", "amplitude_deg",
-                          "bias_rad_per_s", "residual_rms_rad_per_s", "pitch_measured_deg",
-                          "model", "iterations", "fit_seconds", "pitch_nominal_deg",
-                          "pitch_used_deg", "inertia_kg_m2", "budget", "flags"}) {
+  for (const char* key : {"file",
+                          "status",
+                          "message",
+                          "inertia_total_kg_m2",
+                          "inertia_total_std_kg_m2",
+                          "drag_coeff_kg_m2",
+                          "viscous_coeff_kg_m2_per_s",
+                          "window_s",
+                          "amplitude_deg",
+                          "bias_rad_per_s",
+                          "residual_rms_rad_per_s",
+                          "pitch_measured_deg",
+                          "model",
+                          "iterations",
+                          "fit_seconds",
+                          "pitch_nominal_deg",
+                          "pitch_used_deg",
+                          "inertia_kg_m2",
+                          "budget",
+                          "flags"}) {
     EXPECT_TRUE(json["traces"][0].contains(key)) << key;
   }
   const std::string traces_csv = ReadFile(out + "/traces.csv");
@@ -320,9 +334,10 @@ TEST(Campaign, RunsTableAndTooFewAngles) {
   WriteFile(c.dir + "/runs.csv",
             "path,pitch_deg\npitch_0/trial_1.csv,0\npitch_90/trial_1.csv,90\n"
             "missing.csv,30\npitch_30/trial_1.csv,abc\n");
-  WriteFile(c.dir + "/campaign.yaml",
-            "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 2, inertia: {inertia_kg_m2: 0.5}}\n"
-            "aircraft: {mass_kg: 10}\nruns: {root: logs, table: runs.csv}\n");
+  WriteFile(
+      c.dir + "/campaign.yaml",
+      "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 2, inertia: {inertia_kg_m2: 0.5}}\n"
+      "aircraft: {mass_kg: 10}\nruns: {root: logs, table: runs.csv}\n");
   const CampaignResult result = c.Run();
   ASSERT_EQ(result.traces.size(), 4u);
   EXPECT_EQ(result.summary.n_ok, 2);
@@ -338,8 +353,10 @@ TEST(Campaign, RunsTableAndTooFewAngles) {
 
 std::string Replace(std::string text, const std::string& from, const std::string& to) {
   const size_t at = text.find(from);
-  if (at == std::string::npos) ADD_FAILURE() << "sample spec changed: '" << from << "' not found";
-  else text.replace(at, from.size(), to);
+  if (at == std::string::npos)
+    ADD_FAILURE() << "sample spec changed: '" << from << "' not found";
+  else
+    text.replace(at, from.size(), to);
   return text;
 }
 
@@ -349,8 +366,11 @@ struct SimulatedCampaign {
   nlohmann::json truth;
   SimulatedCampaign() {
     dir = TempDir();
-    std::string spec = ReadFile(std::string(BIFILAR_SOURCE_DIR) + "/configs/simulate_prandtl_d.yaml");
-    spec = Replace(spec, "pitch_deg: [-80, -70, -60, -50, -40, -30, -20, -10, 0, 10, 20, 30, 40, 50, 60, 70, 80, 90]",
+    std::string spec =
+        ReadFile(std::string(BIFILAR_SOURCE_DIR) + "/configs/simulate_prandtl_d.yaml");
+    spec = Replace(spec,
+                   "pitch_deg: [-80, -70, -60, -50, -40, -30, -20, -10, 0, 10, 20, 30, 40, 50, 60, "
+                   "70, 80, 90]",
                    "pitch_deg: [-60, -20, 0, 45, 90]");
     spec = Replace(spec, "trials_per_pitch: 3", "trials_per_pitch: 2");
     spec = Replace(spec, "tare_logs: 3", "tare_logs: 2");
@@ -367,10 +387,12 @@ struct SimulatedCampaign {
   void WriteConfig(const std::string& rig_inertia, const std::string& pitch_source) {
     WriteFile(dir + "/campaign.yaml",
               "rig:\n  filar_length_m: 2.0\n  filar_separation_m: 1.8\n  mass_kg: 1.25\n"
-              "  inertia: " + rig_inertia + "\n"
-              "aircraft: {mass_kg: 5.5}\n"
-              "runs: {root: logs, pattern: \"pitch_{pitch_deg}/*.csv\", pitch_source: " +
-              pitch_source + "}\n");
+              "  inertia: " +
+                  rig_inertia +
+                  "\n"
+                  "aircraft: {mass_kg: 5.5}\n"
+                  "runs: {root: logs, pattern: \"pitch_{pitch_deg}/*.csv\", pitch_source: " +
+                  pitch_source + "}\n");
   }
   CampaignResult Run() {
     CampaignOptions options;
@@ -429,7 +451,8 @@ TEST(CampaignRealFit, RigLargerThanTotalAndMeasuredPitch) {
   const TraceRecord* r = Find(result, "pitch_0/trial_1.csv");
   ASSERT_NE(r, nullptr);
   EXPECT_NE(r->message.find("rig inertia 50 kg m^2 is not below the measured total"),
-            std::string::npos) << r->message;
+            std::string::npos)
+      << r->message;
   EXPECT_FALSE(result.summary.ellipse_fitted);
   // Same logs, rig fixed: no trace refitted (the rig is not a fit input); measured pitch used.
   c.WriteConfig("{inertia_kg_m2: 0.25}", "measured");

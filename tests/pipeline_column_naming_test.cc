@@ -172,8 +172,9 @@ void ExpectEveryNamingRecognised(const std::string& original_path, const std::st
 
 // A simulated swing (CLI `simulate --trace`: t, gx, gy, gz, ax, ay, az).
 std::string SimulatedLog(const TempDir& dir) {
-  const CliRun sim = Bifilar(dir, "simulate --trace " + dir.path + "/sim.csv --inertia-kg-m2 0.05 "
-                                  "--mass-kg 1.5 -L 1.0 -D 0.4 --duration-s 40 --seed 3");
+  const CliRun sim = Bifilar(dir, "simulate --trace " + dir.path +
+                                      "/sim.csv --inertia-kg-m2 0.05 "
+                                      "--mass-kg 1.5 -L 1.0 -D 0.4 --duration-s 40 --seed 3");
   EXPECT_EQ(sim.exit_code, 0) << sim.err;
   return dir.path + "/sim.csv";
 }
@@ -195,8 +196,8 @@ TEST(ColumnNaming, FixedWingHeaderInitThenFit) {
   TempDir dir;
   const std::string sim = SimulatedLog(dir);
   std::string text = Renamed(ReadFile(sim), "t", {"gx", "gy", "gz"}, Namings()[0]);
-  for (const auto& [from, to] : {std::make_pair(",ax,", ",xAcc,"),
-                                 std::make_pair(",ay,", ",yAcc,"), std::make_pair(",az", ",zAcc")}) {
+  for (const auto& [from, to] : {std::make_pair(",ax,", ",xAcc,"), std::make_pair(",ay,", ",yAcc,"),
+                                 std::make_pair(",az", ",zAcc")}) {
     text.replace(text.find(from), std::string(from).size(), to);
   }
   const std::string log = WriteFile(dir.path + "/YawInertiaPendel01.csv", text);
@@ -218,8 +219,8 @@ TEST(ColumnNaming, UnguessableColumnsAreNamedByInitFlags) {
   TempDir dir;
   const std::string sim = SimulatedLog(dir);
   Naming odd{"zeit", 1.0, {"dreh_a", "dreh_b", "dreh_c"}, 1.0};
-  const std::string log = WriteFile(dir.path + "/odd.csv",
-                                    Renamed(ReadFile(sim), "t", {"gx", "gy", "gz"}, odd));
+  const std::string log =
+      WriteFile(dir.path + "/odd.csv", Renamed(ReadFile(sim), "t", {"gx", "gy", "gz"}, odd));
   const CliRun inspect = Bifilar(dir, "inspect " + log);
   EXPECT_NE(inspect.exit_code, 0);
   const std::string said = inspect.out + inspect.err;
@@ -227,7 +228,8 @@ TEST(ColumnNaming, UnguessableColumnsAreNamedByInitFlags) {
                              "bifilar init --log LOG --time T --gyro X,Y,Z"}) {
     EXPECT_NE(said.find(needle), std::string::npos) << needle << "\n" << said;
   }
-  const CliRun refused = Bifilar(dir, "init " + dir.path + "/c.yaml --rig 1.0,0.4,1.5 --log " + log);
+  const CliRun refused =
+      Bifilar(dir, "init " + dir.path + "/c.yaml --rig 1.0,0.4,1.5 --log " + log);
   EXPECT_NE(refused.exit_code, 0);
   EXPECT_NE((refused.out + refused.err).find("imu.gyro"), std::string::npos) << refused.err;
   const CliRun init = Bifilar(dir, "init " + dir.path + "/c.yaml --rig 1.0,0.4,1.5 --log " + log +
@@ -241,8 +243,8 @@ TEST(ColumnNaming, UnguessableColumnsAreNamedByInitFlags) {
                                           log + " --time zeit --gyro dreh_a,dreh_b,dreh_x");
   EXPECT_NE(missing.exit_code, 0);
   EXPECT_NE(missing.err.find("no column 'dreh_x'"), std::string::npos) << missing.err;
-  const CliRun two = Bifilar(dir, "init " + dir.path + "/e.yaml --rig 1.0,0.4,1.5 --log " + log +
-                                      " --gyro dreh_a,dreh_b");
+  const CliRun two = Bifilar(
+      dir, "init " + dir.path + "/e.yaml --rig 1.0,0.4,1.5 --log " + log + " --gyro dreh_a,dreh_b");
   EXPECT_NE(two.exit_code, 0);
   EXPECT_NE(two.err.find("--gyro takes three column names"), std::string::npos) << two.err;
 }
@@ -275,10 +277,14 @@ TEST(ColumnNaming, NoFalsePositives) {
       {"time,pressure,q,r", false, {}, {}},
       {"time,pressure,p,q,r", true, {"p", "q", "r"}, {"", "", ""}},
       {"t,p,q,r,w1,w2,w3,w4", true, {"p", "q", "r"}, {"", "", ""}},
-      {"t,q0,q1,q2,q3,roll_rate,pitch_rate,yaw_rate", true,
-       {"roll_rate", "pitch_rate", "yaw_rate"}, {"", "", ""}},
+      {"t,q0,q1,q2,q3,roll_rate,pitch_rate,yaw_rate",
+       true,
+       {"roll_rate", "pitch_rate", "yaw_rate"},
+       {"", "", ""}},
       {"t,gx,gy,gz,a1,a2,a3,a4", true, {"gx", "gy", "gz"}, {"", "", ""}},
-      {"Time,xGyro,yGyro,ZGyro,xAcc,yAcc,zAcc,Pressure", true, {"xGyro", "yGyro", "ZGyro"},
+      {"Time,xGyro,yGyro,ZGyro,xAcc,yAcc,zAcc,Pressure",
+       true,
+       {"xGyro", "yGyro", "ZGyro"},
        {"xAcc", "yAcc", "zAcc"}},
   };
   for (const Case& c : cases) {

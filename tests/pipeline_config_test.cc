@@ -96,7 +96,8 @@ TEST(Config, ReadsEveryKey) {
   EXPECT_DOUBLE_EQ(c.rig_mass_kg, 3.5);
   EXPECT_EQ(c.rig_inertia.kind, RigInertiaSpec::Kind::kTare);
   ASSERT_EQ(c.rig_inertia.tare_patterns.size(), 1u);
-  EXPECT_EQ(c.rig_inertia.tare_patterns[0], fs::path(dir + "/logs/tare/*.csv").lexically_normal().string());
+  EXPECT_EQ(c.rig_inertia.tare_patterns[0],
+            fs::path(dir + "/logs/tare/*.csv").lexically_normal().string());
   EXPECT_DOUBLE_EQ(c.uncertainties.filar_length_std_m, 0.002);
   EXPECT_DOUBLE_EQ(c.uncertainties.gravity_std_mps2, 0.001);
   EXPECT_DOUBLE_EQ(c.aircraft_mass_kg, 12.0);
@@ -184,9 +185,10 @@ TEST(Config, TypoInKeyIsNamedWithLine) {
 }
 
 TEST(Config, MissingSectionsAndBadValues) {
-  ExpectError("rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0}}\n"
-              "aircraft: {mass_kg: 1}\n",
-              {"missing required key 'runs'"});
+  ExpectError(
+      "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0}}\n"
+      "aircraft: {mass_kg: 1}\n",
+      {"missing required key 'runs'"});
   std::string yaml = kMinimal;
   ExpectError(yaml + "units: metric\n", {"'units' must be si or imperial"});
   ExpectError(yaml + "fit: {model: quadratic}\n", {"'fit.model' must be full, jardin or linear"});
@@ -198,10 +200,11 @@ TEST(Config, MissingSectionsAndBadValues) {
   ExpectError(yaml + "ellipse: {covariance: magic}\n", {"ellipse.covariance"});
   yaml.replace(yaml.find("mass_kg: 2.0"), 12, "mass_kg: -2.0");
   ExpectError(yaml, {"rig.mass_kg = -2; must be > 0", ":4:"});
-  ExpectError("rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1,\n"
-              "      inertia: {inertia_kg_m2: 0.1, table: {0: 0.1}}}\n"
-              "aircraft: {mass_kg: 1}\nruns: {root: ., pattern: '*.csv'}\n",
-              {"exactly one of"});
+  ExpectError(
+      "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1,\n"
+      "      inertia: {inertia_kg_m2: 0.1, table: {0: 0.1}}}\n"
+      "aircraft: {mass_kg: 1}\nruns: {root: ., pattern: '*.csv'}\n",
+      {"exactly one of"});
   ExpectError("rig: [1, 2]\n", {"'rig' must be a mapping"});
   ExpectError("rig: {filar_length_m: 2\n", {"invalid YAML"});
   ExpectError(std::string(kMinimal) + "runs2: {}\n", {"unknown key 'runs2'"});
@@ -210,11 +213,11 @@ TEST(Config, MissingSectionsAndBadValues) {
 TEST(Config, FitOnlyConfigNeedsNoRuns) {
   ConfigLoadOptions fit_only;
   fit_only.require_runs = false;
-  const CampaignConfig c = LoadCampaignConfig(
-      Write(TempDir(), "fit.yaml",
-            "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1}\n"
-            "imu: {accel: null}\n"),
-      fit_only);
+  const CampaignConfig c =
+      LoadCampaignConfig(Write(TempDir(), "fit.yaml",
+                               "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1}\n"
+                               "imu: {accel: null}\n"),
+                         fit_only);
   EXPECT_TRUE(c.runs.root.empty());
   EXPECT_FALSE(c.imu.format.has_accel());
   EXPECT_DOUBLE_EQ(c.AircraftGeometry().mass_kg, 1.0);
@@ -229,8 +232,9 @@ TEST(Config, RigInertiaTableAndMatrixMounting) {
   EXPECT_EQ(c.rig_inertia.kind, RigInertiaSpec::Kind::kTable);
   EXPECT_EQ(c.rig_inertia.table_kg_m2.size(), 2u);
   EXPECT_DOUBLE_EQ(c.imu.imu_to_body(0, 1), -1.0);
-  ExpectError(std::string(kMinimal) + "imu: {imu_to_body: {matrix: [[1, 1, 0], [0, 1, 0], [0, 0, 1]]}}\n",
-              {"must be a rotation"});
+  ExpectError(
+      std::string(kMinimal) + "imu: {imu_to_body: {matrix: [[1, 1, 0], [0, 1, 0], [0, 0, 1]]}}\n",
+      {"must be a rotation"});
 }
 
 TEST(Config, MissingFileIsNamed) {
@@ -254,13 +258,18 @@ TEST(Config, CountsAndRangesAreBoundedAtLoad) {
   const std::string yaml = kMinimal;
   ExpectError(yaml + "ellipse:\n  bootstrap: 2147483647\n",
               {"ellipse.bootstrap = 2147483647; must be 0 (off) or in [100, 100000]", ":9:"});
-  ExpectError(yaml + "ellipse: {bootstrap: 50}\n", {"ellipse.bootstrap = 50; must be 0 (off) or in [100, 100000]"});
-  ExpectError(yaml + "ellipse: {min_angles: 100000}\n", {"ellipse.min_angles = 100000; must be in [3, 1000]"});
-  ExpectError(yaml + "fit: {max_amplitude_deg: 0}\n", {"fit.max_amplitude_deg = 0; must be in [1, 90]"});
-  ExpectError(yaml + "fit: {max_amplitude_deg: 179.9}\n", {"fit.max_amplitude_deg = 179.9; must be in [1, 90]"});
+  ExpectError(yaml + "ellipse: {bootstrap: 50}\n",
+              {"ellipse.bootstrap = 50; must be 0 (off) or in [100, 100000]"});
+  ExpectError(yaml + "ellipse: {min_angles: 100000}\n",
+              {"ellipse.min_angles = 100000; must be in [3, 1000]"});
+  ExpectError(yaml + "fit: {max_amplitude_deg: 0}\n",
+              {"fit.max_amplitude_deg = 0; must be in [1, 90]"});
+  ExpectError(yaml + "fit: {max_amplitude_deg: 179.9}\n",
+              {"fit.max_amplitude_deg = 179.9; must be in [1, 90]"});
   ExpectError(yaml + "fit: {max_amplitude_deg: 20, min_amplitude_deg: 25}\n",
               {"fit.min_amplitude_deg = 25; must be < max_amplitude_deg = 20"});
-  ExpectError(yaml + "fit: {quality: {whiteness_lags: 100000000}}\n", {"fit.quality.whiteness_lags = 100000000; must be in [1, 1000]"});
+  ExpectError(yaml + "fit: {quality: {whiteness_lags: 100000000}}\n",
+              {"fit.quality.whiteness_lags = 100000000; must be in [1, 1000]"});
   // Nested keys: the line of the key itself, found through the field -> key table.
   ExpectError(yaml + "fit:\n  amplitude_sweep:\n    max_bands: 50\n",
               {"fit.amplitude_sweep.max_bands = 50; must be in [2, 20]", ":10:"});
@@ -295,12 +304,13 @@ TEST(Config, DuplicateKeysDocumentsAndTablePitchesNameBothLines) {
   ExpectError(std::string(kMinimal) + "rig: {filar_length_m: 3}\n",
               {":8: duplicate key 'rig' (first at line 1)"});
   // A second YAML document.
-  ExpectError(std::string(kMinimal) + "---\nunits: imperial\n", {":9:", "second YAML document",
-                                                                  "line 1"});
+  ExpectError(std::string(kMinimal) + "---\nunits: imperial\n",
+              {":9:", "second YAML document", "line 1"});
   // Duplicate table pitches, written alike or differently.
-  const char* table = "rig:\n  filar_length_m: 2\n  filar_separation_m: 1\n  mass_kg: 1\n"
-                      "  inertia:\n    table:\n      0: 0.1\n      %s: 0.2\n"
-                      "aircraft: {mass_kg: 1}\nruns: {root: ., pattern: 'p{pitch_deg}.csv'}\n";
+  const char* table =
+      "rig:\n  filar_length_m: 2\n  filar_separation_m: 1\n  mass_kg: 1\n"
+      "  inertia:\n    table:\n      0: 0.1\n      %s: 0.2\n"
+      "aircraft: {mass_kg: 1}\nruns: {root: ., pattern: 'p{pitch_deg}.csv'}\n";
   char buffer[400];
   std::snprintf(buffer, sizeof(buffer), table, "0");
   ExpectError(buffer, {":8:", "duplicate key 'rig.inertia.table.0' (first at line 7)"});

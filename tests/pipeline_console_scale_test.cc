@@ -48,40 +48,56 @@ ScaledCampaign ScaledSpec(double inertia, const std::string& logs, int trials) {
   const double rig_mass = 0.2 * mass, rig_inertia = 0.05 * inertia;
   auto n = [](double v) { return Fmt("%.6g", v); };
   ScaledCampaign c;
-  c.spec = "seed: 5\nmodel: full\n"
-           "geometry: {filar_length_m: " + n(length) + ", filar_separation_m: " + n(separation) +
-           ", gravity_mps2: " + n(kStandardGravityMps2) + "}\n"
-           "aircraft: {mass_kg: " + n(mass) + ", ix_kg_m2: " + n(0.67 * inertia) +
-           ", iy_kg_m2: " + n(inertia) + ", iz_kg_m2: " + n(1.5 * inertia) +
-           ", ixy_kg_m2: 0, ixz_kg_m2: 0, iyz_kg_m2: 0}\n"
-           "rig: {mass_kg: " + n(rig_mass) + ", imu_mass_kg: " + n(0.01 * mass) +
-           ", inertia_kg_m2: " + n(rig_inertia) +
-           ", tare_logs: 0, imu_offset_m: [0, 0, 0], imu_mounting_rpy_deg: [0, 0, 0]}\n"
-           "campaign: {attitudes_deg: [[0, 0], [0, -90], [90, 0]], trials_per_pitch: " +
-           std::to_string(trials) + ", pitch_error_sigma_deg: 0.3, roll_error_sigma_deg: 0.3}\n"
-           "swing: {amplitude_deg: [8, 15], negative_amplitude_probability: 0.5, "
-           "drag_coeff_kg_m2: [" + n(0.02 * inertia) + ", " + n(0.05 * inertia) +
-           "], viscous_coeff_kg_m2_per_s: [" + n(0.005 * inertia) + ", " + n(0.01 * inertia) +
-           "]}\n"
-           "timeline: {rest_before_s: [1, 2], twist_s: [0.8, 1.0], hold_s: [1, 1.5], tremor_deg: "
-           "0.05, tremor_hz: [4, 9], release_rate_sigma_deg_per_s: 0.3, free_s: [" +
-           n(5.5 * period) + ", " + n(6.5 * period) + "], stop_probability: 0.0, stop_time_constant_s: 0.1, rest_after_s: [1, 1]}\n"
-           "sensor: {sample_rate_hz: 50, sample_steps: regular, gyro_noise_sigma_deg_per_s: 0.2, "
-           "gyro_bias_sigma_deg_per_s: 0.2, gyro_scale_error_sigma: 0.001, accelerometer: true, "
-           "accel_noise_sigma_mps2: 0.02, accel_bias_sigma_mps2: 0.02}\n"
-           "format: {time_column: t, time_unit: s, gyro_columns: [gx, gy, gz], gyro_unit: rad/s, "
-           "accel_columns: [ax, ay, az], accel_unit: m/s^2, significant_digits: 7, gzip: false}\n";
+  c.spec =
+      "seed: 5\nmodel: full\n"
+      "geometry: {filar_length_m: " +
+      n(length) + ", filar_separation_m: " + n(separation) +
+      ", gravity_mps2: " + n(kStandardGravityMps2) +
+      "}\n"
+      "aircraft: {mass_kg: " +
+      n(mass) + ", ix_kg_m2: " + n(0.67 * inertia) + ", iy_kg_m2: " + n(inertia) +
+      ", iz_kg_m2: " + n(1.5 * inertia) +
+      ", ixy_kg_m2: 0, ixz_kg_m2: 0, iyz_kg_m2: 0}\n"
+      "rig: {mass_kg: " +
+      n(rig_mass) + ", imu_mass_kg: " + n(0.01 * mass) + ", inertia_kg_m2: " + n(rig_inertia) +
+      ", tare_logs: 0, imu_offset_m: [0, 0, 0], imu_mounting_rpy_deg: [0, 0, 0]}\n"
+      "campaign: {attitudes_deg: [[0, 0], [0, -90], [90, 0]], trials_per_pitch: " +
+      std::to_string(trials) +
+      ", pitch_error_sigma_deg: 0.3, roll_error_sigma_deg: 0.3}\n"
+      "swing: {amplitude_deg: [8, 15], negative_amplitude_probability: 0.5, "
+      "drag_coeff_kg_m2: [" +
+      n(0.02 * inertia) + ", " + n(0.05 * inertia) + "], viscous_coeff_kg_m2_per_s: [" +
+      n(0.005 * inertia) + ", " + n(0.01 * inertia) +
+      "]}\n"
+      "timeline: {rest_before_s: [1, 2], twist_s: [0.8, 1.0], hold_s: [1, 1.5], tremor_deg: "
+      "0.05, tremor_hz: [4, 9], release_rate_sigma_deg_per_s: 0.3, free_s: [" +
+      n(5.5 * period) + ", " + n(6.5 * period) +
+      "], stop_probability: 0.0, stop_time_constant_s: 0.1, rest_after_s: [1, 1]}\n"
+      "sensor: {sample_rate_hz: 50, sample_steps: regular, gyro_noise_sigma_deg_per_s: 0.2, "
+      "gyro_bias_sigma_deg_per_s: 0.2, gyro_scale_error_sigma: 0.001, accelerometer: true, "
+      "accel_noise_sigma_mps2: 0.02, accel_bias_sigma_mps2: 0.02}\n"
+      "format: {time_column: t, time_unit: s, gyro_columns: [gx, gy, gz], gyro_unit: rad/s, "
+      "accel_columns: [ax, ay, az], accel_unit: m/s^2, significant_digits: 7, gzip: false}\n";
   const std::string config =
-      "gravity_mps2: " + n(kStandardGravityMps2) + "\n"
-      "rig:\n  filar_length_m: " + n(length) + "\n  filar_separation_m: " + n(separation) +
-      "\n  mass_kg: " + n(rig_mass + 0.01 * mass) + "\n  inertia: {inertia_kg_m2: " +
-      n(rig_inertia) + ", inertia_std_kg_m2: " + n(0.001 * rig_inertia) +
+      "gravity_mps2: " + n(kStandardGravityMps2) +
+      "\n"
+      "rig:\n  filar_length_m: " +
+      n(length) + "\n  filar_separation_m: " + n(separation) +
+      "\n  mass_kg: " + n(rig_mass + 0.01 * mass) +
+      "\n  inertia: {inertia_kg_m2: " + n(rig_inertia) +
+      ", inertia_std_kg_m2: " + n(0.001 * rig_inertia) +
       "}\n  uncertainties: {filar_length_std_m: 0.001, filar_separation_std_m: 0.0005, "
-      "mass_std_kg: " + n(0.001 * mass) + "}\n"
-      "aircraft: {mass_kg: " + n(mass) + ", mass_std_kg: " + n(0.002 * mass) + "}\n"
+      "mass_std_kg: " +
+      n(0.001 * mass) +
+      "}\n"
+      "aircraft: {mass_kg: " +
+      n(mass) + ", mass_std_kg: " + n(0.002 * mass) +
+      "}\n"
       "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [gx, gy, gz], unit: rad/s}\n"
       "  accel: {columns: [ax, ay, az], unit: m/s^2}\n"
-      "runs:\n  root: " + logs + "\n  pattern: \"roll_{roll_deg}_pitch_{pitch_deg}/*.csv\"\n"
+      "runs:\n  root: " +
+      logs +
+      "\n  pattern: \"roll_{roll_deg}_pitch_{pitch_deg}/*.csv\"\n"
       "  pitch_source: nominal\n";
   c.config_si = "units: si\n" + config;
   c.config_imperial = "units: imperial\n" + config;
@@ -144,7 +160,9 @@ std::vector<std::string> PlusMinusZero(const std::string& html) {
     for (size_t at = html.find(mark); at != std::string::npos; at = html.find(mark, at + 1)) {
       const size_t v = at + mark.size();
       if (v >= html.size() || html[v] != '0') continue;
-      if (v + 1 < html.size() && (html[v + 1] == '.' || std::isdigit(static_cast<unsigned char>(html[v + 1])))) continue;
+      if (v + 1 < html.size() &&
+          (html[v + 1] == '.' || std::isdigit(static_cast<unsigned char>(html[v + 1]))))
+        continue;
       out.push_back(html.substr(at > 80 ? at - 80 : 0, 100));
     }
   }
@@ -172,17 +190,20 @@ TEST(ScaleFigures, NoPlusMinusZeroNorRepeatedTickAtAnyScaleAndUnit) {
     WriteFile(dir.path + "/spec.yaml", c.spec);
     RunSimulateCampaign(ReadSimulateSpec(dir.path + "/spec.yaml"), logs);
     for (const std::string* config : {&c.config_si, &c.config_imperial}) {
-      SCOPED_TRACE("I = " + Fmt("%g", inertia) + " kg m^2, " + config->substr(0, config->find('\n')));
+      SCOPED_TRACE("I = " + Fmt("%g", inertia) + " kg m^2, " +
+                   config->substr(0, config->find('\n')));
       WriteFile(dir.path + "/config.yaml", *config);
       CampaignOptions options;
       options.out_dir = dir.path + (config == &c.config_si ? "/out_si" : "/out_imperial");
       options.jobs = 2;
-      const CampaignResult result = RunCampaign(LoadCampaignConfig(dir.path + "/config.yaml"), options);
+      const CampaignResult result =
+          RunCampaign(LoadCampaignConfig(dir.path + "/config.yaml"), options);
       ASSERT_EQ(result.summary.n_ok, 3) << result.summary.tensor_message;
       const std::string html = ReadFile(options.out_dir + "/report.html");
       EXPECT_NE(html.find("(stat) &plusmn; "), std::string::npos);
       EXPECT_NE(html.find(" (total)"), std::string::npos);  // the result box gives the total
-      for (const std::string& bad : PlusMinusZero(html)) ADD_FAILURE() << "a std shown as 0: " << bad;
+      for (const std::string& bad : PlusMinusZero(html))
+        ADD_FAILURE() << "a std shown as 0: " << bad;
       for (const std::string& bad : RepeatedTicks(html)) ADD_FAILURE() << "repeated ticks: " << bad;
       EXPECT_NE(html.find("<svg class=\"sweep\""), std::string::npos);
     }
@@ -204,7 +225,8 @@ TEST(ConsoleWidth, NaturalOrderAndWrapping) {
   EXPECT_TRUE(NaturalLess("trial_2.csv", "Trial_10.csv"));
   EXPECT_TRUE(NaturalLess("a_Log-1.csv", "A_log-2.csv"));
   EXPECT_FALSE(NaturalLess("trial_10.csv", "trial_9.csv"));
-  const std::string text = "    warning: " + std::string(30, 'x') + "  aligned  " + std::string(200, 'y');
+  const std::string text =
+      "    warning: " + std::string(30, 'x') + "  aligned  " + std::string(200, 'y');
   const std::string wrapped = WrapText(text, 60, "        ");
   EXPECT_EQ(wrapped.rfind("    warning: ", 0), 0u);
   EXPECT_NE(wrapped.find("  aligned"), std::string::npos);  // blanks between words kept
@@ -222,12 +244,12 @@ TEST(ConsoleWidth, SimulatedCampaignLinesAtMost160) {
   WriteFile(dir.path + "/config.yaml", c.config_imperial);
   std::string logs_list;
   for (const char* a : {"roll_0_pitch_0", "roll_0_pitch_-90", "roll_90_pitch_0"}) {
-    for (const char* t : {"trial_1.csv", "trial_2.csv"}) logs_list += " " + logs + "/" + a + "/" + t;
+    for (const char* t : {"trial_1.csv", "trial_2.csv"})
+      logs_list += " " + logs + "/" + a + "/" + t;
   }
-  for (const std::string& args :
-       {"process " + dir.path + "/config.yaml --out " + dir.path + "/out",
-        "fit " + dir.path + "/config.yaml" + logs_list + " --repeats",
-        "fit " + dir.path + "/config.yaml" + logs_list}) {
+  for (const std::string& args : {"process " + dir.path + "/config.yaml --out " + dir.path + "/out",
+                                  "fit " + dir.path + "/config.yaml" + logs_list + " --repeats",
+                                  "fit " + dir.path + "/config.yaml" + logs_list}) {
     const test_support::CliRun run = Bifilar(dir, args);
     EXPECT_LE(run.exit_code, 1) << args << "\n" << run.err;
     for (const std::string* text : {&run.out, &run.err}) {

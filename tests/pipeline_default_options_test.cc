@@ -45,7 +45,8 @@ template <class T>
 bool DefaultChecks(std::string* why) {
   return T().Check(why);
 }
-#define BIFILAR_OPTIONS(T) {#T, &DefaultChecks<T>}
+#define BIFILAR_OPTIONS(T) \
+  { #T, &DefaultChecks < T> }
 
 using Checker = bool (*)(std::string*);
 
@@ -76,13 +77,13 @@ const std::map<std::string, Checker> kOptions = {
 
 // Values the caller must give: their defaults (zeros, empty) are refused by their Check.
 const std::map<std::string, Checker> kRequiredValues = {
-    BIFILAR_OPTIONS(RigGeometry),     // L, D, mass: the rig's own
-    BIFILAR_OPTIONS(PendulumParams),  // I > 0: a model's, not a setting
-    BIFILAR_OPTIONS(TraceSetup),      // a trace's geometry and truth
-    BIFILAR_OPTIONS(AircraftTruth),   // a simulated aircraft's moments
-    BIFILAR_OPTIONS(RigTruth),        // a simulated rig
-    BIFILAR_OPTIONS(CampaignSpec),    // a simulated campaign's rig and aircraft
-    BIFILAR_OPTIONS(CampaignConfig),  // the config file's rig
+    BIFILAR_OPTIONS(RigGeometry),            // L, D, mass: the rig's own
+    BIFILAR_OPTIONS(PendulumParams),         // I > 0: a model's, not a setting
+    BIFILAR_OPTIONS(TraceSetup),             // a trace's geometry and truth
+    BIFILAR_OPTIONS(AircraftTruth),          // a simulated aircraft's moments
+    BIFILAR_OPTIONS(RigTruth),               // a simulated rig
+    BIFILAR_OPTIONS(CampaignSpec),           // a simulated campaign's rig and aircraft
+    BIFILAR_OPTIONS(CampaignConfig),         // the config file's rig
     BIFILAR_OPTIONS(StartingConfigOptions),  // `init --rig L,D,MASS`
     BIFILAR_OPTIONS(TensorPlanOptions),      // `plan`: the per-swing std of the rig
     BIFILAR_OPTIONS(EllipsePlanOptions),     // `plan`: the per-swing std of the rig

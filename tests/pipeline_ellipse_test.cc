@@ -48,8 +48,7 @@ class EllipseCli : public ::testing::Test {
 
   CliRun Bifilar(const std::string& args) {
     const std::string out = (dir_ / "stdout.txt").string(), err = (dir_ / "stderr.txt").string();
-    const std::string command =
-        std::string(BIFILAR_BINARY) + " " + args + " >" + out + " 2>" + err;
+    const std::string command = std::string(BIFILAR_BINARY) + " " + args + " >" + out + " 2>" + err;
     const int status = std::system(command.c_str());
     CliRun r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -69,7 +68,8 @@ std::string PaperTable(bool with_std, double noise_slug) {
   std::mt19937_64 rng(7);
   std::normal_distribution<double> normal(0, 1);
   std::ostringstream s;
-  s << "# PRANDTL-D, slug ft^2\n" << (with_std ? "pitch_deg, inertia, std\n" : "pitch_deg,inertia\n");
+  s << "# PRANDTL-D, slug ft^2\n"
+    << (with_std ? "pitch_deg, inertia, std\n" : "pitch_deg,inertia\n");
   s.precision(10);
   for (int d = -80; d <= 90; d += 10) {
     const double t = d * kRadPerDeg;
@@ -122,8 +122,8 @@ TEST_F(EllipseCli, HumanOutputPlotsAndSeededReproducibility) {
                            "slug ft^2", "Outliers"}) {
     EXPECT_NE(r.out.find(text), std::string::npos) << text;
   }
-  for (const char* f : {"ellipse_moments.png", "ellipse_moments.svg", "ellipse_polar.png",
-                        "ellipse_polar.svg"}) {
+  for (const char* f :
+       {"ellipse_moments.png", "ellipse_moments.svg", "ellipse_polar.png", "ellipse_polar.svg"}) {
     EXPECT_TRUE(fs::exists(fs::path(plots) / f)) << f;
     EXPECT_GT(fs::file_size(fs::path(plots) / f), 1000u) << f;
   }
@@ -153,7 +153,8 @@ TEST_F(EllipseCli, TauIllDefinedGivesNullNotNan) {
     EXPECT_TRUE(j["Izp_kg_m2"].is_null());
     EXPECT_TRUE(j["Ixz_kg_m2"].is_number());
     bool said = false;
-    for (const auto& w : j["warnings"]) said |= w.get<std::string>().find("ill-defined") != std::string::npos;
+    for (const auto& w : j["warnings"])
+      said |= w.get<std::string>().find("ill-defined") != std::string::npos;
     EXPECT_TRUE(said);
   } else {
     ADD_FAILURE() << "the seeded circle was expected to fail the circle test";
@@ -198,7 +199,8 @@ TEST_F(EllipseCli, BadInputExitsWithCodeTwoAndAClearMessage) {
 }
 
 TEST_F(EllipseCli, PlanPredictsStandardErrors) {
-  const CliRun r = Bifilar("plan --angles=-80:90:10 --trials 3 --sigma 0.005 --units imperial --json");
+  const CliRun r =
+      Bifilar("plan --angles=-80:90:10 --trials 3 --sigma 0.005 --units imperial --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["n_points"], 54);
@@ -218,8 +220,8 @@ TEST_F(EllipseCli, PlanPredictsStandardErrors) {
 
 TEST(EllipseTable, ParsesUnitsCommentsAndWhitespace) {
   const auto points = ParseEllipseTable(
-      "# comment\n\n pitch_deg , inertia , std \n-10, 2.5, 0.01\n+20,2.6e0,1e-2\r\n",
-      "t.csv", DisplayUnits::kImperial);
+      "# comment\n\n pitch_deg , inertia , std \n-10, 2.5, 0.01\n+20,2.6e0,1e-2\r\n", "t.csv",
+      DisplayUnits::kImperial);
   ASSERT_EQ(points.size(), 2u);
   EXPECT_EQ(points[0].pitch_deg, -10.0);
   EXPECT_DOUBLE_EQ(points[1].inertia_kg_m2, 2.6 * kKgM2PerSlugFt2);
@@ -232,11 +234,11 @@ TEST(EllipseTable, ParsesUnitsCommentsAndWhitespace) {
 // gives the same points as one that quotes none (the old splitter kept the quotes: "not a
 // number"), and a quoted comma stays inside its cell.
 TEST(EllipseTable, QuotedCellsAreReadAsRfc4180Says) {
-  const auto plain = ParseEllipseTable("pitch_deg,inertia\n-10,2.5\n20,2.6\n", "t.csv",
-                                       DisplayUnits::kSi);
-  const auto quoted = ParseEllipseTable(
-      "\"pitch_deg\",\"inertia\"\r\n\"-10\",\"2.5\"\r\n\"20\",\"2.6\"\r\n", "t.csv",
-      DisplayUnits::kSi);
+  const auto plain =
+      ParseEllipseTable("pitch_deg,inertia\n-10,2.5\n20,2.6\n", "t.csv", DisplayUnits::kSi);
+  const auto quoted =
+      ParseEllipseTable("\"pitch_deg\",\"inertia\"\r\n\"-10\",\"2.5\"\r\n\"20\",\"2.6\"\r\n",
+                        "t.csv", DisplayUnits::kSi);
   ASSERT_EQ(quoted.size(), plain.size());
   for (size_t i = 0; i < plain.size(); ++i) {
     EXPECT_EQ(quoted[i].pitch_deg, plain[i].pitch_deg);

@@ -68,45 +68,45 @@ TEST(EnumNames, EveryTableReadsBackAndListsWhatItParses) {
   ExpectOneTable<TimeUnit>(
       {TimeUnit::kSeconds, TimeUnit::kMilliseconds, TimeUnit::kMicroseconds},
       [](TimeUnit v) { return ToString(v); }, ParseTimeUnit, TimeUnitAllowedValues());
-  ExpectOneTable<RateUnit>({RateUnit::kRadPerS, RateUnit::kDegPerS, RateUnit::kMilliradPerS},
-                           [](RateUnit v) { return ToString(v); }, ParseRateUnit,
-                           RateUnitAllowedValues());
-  ExpectOneTable<AccelUnit>({AccelUnit::kMetresPerS2, AccelUnit::kStandardGravity},
-                            [](AccelUnit v) { return ToString(v); }, ParseAccelUnit,
-                            AccelUnitAllowedValues());
-  ExpectOneTable<LogContainer>({LogContainer::kAuto, LogContainer::kCsv, LogContainer::kUlog},
-                               [](LogContainer v) { return ToString(v); }, ParseLogContainer,
-                               LogContainerAllowedValues());
-  ExpectOneTable<PitchSource>({PitchSource::kNominal, PitchSource::kMeasured},
-                              [](PitchSource v) { return ToString(v); }, ParsePitchSource,
-                              PitchSourceAllowedValues());
-  ExpectOneTable<ExportFormat>(
-      {ExportFormat::kUrdf, ExportFormat::kSdf, ExportFormat::kJsbsim, ExportFormat::kCsv,
-       ExportFormat::kMjcf, ExportFormat::kArdupilot},
-      ExportFormatName, ParseExportFormat, ExportFormatAllowedValues());
-  ExpectOneTable<IntegratorMethod>({IntegratorMethod::kRungeKutta, IntegratorMethod::kCvodes},
-                                   [](IntegratorMethod v) { return ToString(v); },
-                                   ParseIntegratorMethod, IntegratorMethodAllowedValues());
+  ExpectOneTable<RateUnit>(
+      {RateUnit::kRadPerS, RateUnit::kDegPerS, RateUnit::kMilliradPerS},
+      [](RateUnit v) { return ToString(v); }, ParseRateUnit, RateUnitAllowedValues());
+  ExpectOneTable<AccelUnit>(
+      {AccelUnit::kMetresPerS2, AccelUnit::kStandardGravity},
+      [](AccelUnit v) { return ToString(v); }, ParseAccelUnit, AccelUnitAllowedValues());
+  ExpectOneTable<LogContainer>(
+      {LogContainer::kAuto, LogContainer::kCsv, LogContainer::kUlog},
+      [](LogContainer v) { return ToString(v); }, ParseLogContainer, LogContainerAllowedValues());
+  ExpectOneTable<PitchSource>(
+      {PitchSource::kNominal, PitchSource::kMeasured}, [](PitchSource v) { return ToString(v); },
+      ParsePitchSource, PitchSourceAllowedValues());
+  ExpectOneTable<ExportFormat>({ExportFormat::kUrdf, ExportFormat::kSdf, ExportFormat::kJsbsim,
+                                ExportFormat::kCsv, ExportFormat::kMjcf, ExportFormat::kArdupilot},
+                               ExportFormatName, ParseExportFormat, ExportFormatAllowedValues());
+  ExpectOneTable<IntegratorMethod>(
+      {IntegratorMethod::kRungeKutta, IntegratorMethod::kCvodes},
+      [](IntegratorMethod v) { return ToString(v); }, ParseIntegratorMethod,
+      IntegratorMethodAllowedValues());
   ExpectOneTable<PendulumModel>(
       {PendulumModel::kFull, PendulumModel::kJardin, PendulumModel::kLinear},
       [](PendulumModel v) { return ToString(v); }, ParsePendulumModel,
       PendulumModelAllowedValues());
-  ExpectOneTable<DisplayUnits>({DisplayUnits::kSi, DisplayUnits::kImperial},
-                               [](DisplayUnits v) { return ToString(v); }, ParseDisplayUnits,
-                               DisplayUnitsAllowedValues());
-  ExpectOneTable<EllipseCovariance>(
-      {EllipseCovariance::kAuto, EllipseCovariance::kPointResiduals,
-       EllipseCovariance::kAngleMeans, EllipseCovariance::kAbsolute},
-      EllipseCovarianceName, ParseEllipseCovariance, EllipseCovarianceAllowedValues());
-  ExpectOneTable<TraceStatus>({TraceStatus::kOk, TraceStatus::kRejected, TraceStatus::kError},
-                              [](TraceStatus v) { return ToString(v); }, ParseTraceStatus,
-                              TraceStatusAllowedValues());
-  ExpectOneTable<SampleSteps>({SampleSteps::kRegular, SampleSteps::kLogNormal},
-                              [](SampleSteps v) { return ToString(v); }, ParseSampleSteps,
-                              SampleStepsAllowedValues());
-  ExpectOneTable<TraceRole>({TraceRole::kAircraft, TraceRole::kTare, TraceRole::kCalibration},
-                            [](TraceRole v) { return ToString(v); }, ParseTraceRole,
-                            TraceRoleAllowedValues());
+  ExpectOneTable<DisplayUnits>(
+      {DisplayUnits::kSi, DisplayUnits::kImperial}, [](DisplayUnits v) { return ToString(v); },
+      ParseDisplayUnits, DisplayUnitsAllowedValues());
+  ExpectOneTable<EllipseCovariance>({EllipseCovariance::kAuto, EllipseCovariance::kPointResiduals,
+                                     EllipseCovariance::kAngleMeans, EllipseCovariance::kAbsolute},
+                                    EllipseCovarianceName, ParseEllipseCovariance,
+                                    EllipseCovarianceAllowedValues());
+  ExpectOneTable<TraceStatus>(
+      {TraceStatus::kOk, TraceStatus::kRejected, TraceStatus::kError},
+      [](TraceStatus v) { return ToString(v); }, ParseTraceStatus, TraceStatusAllowedValues());
+  ExpectOneTable<SampleSteps>(
+      {SampleSteps::kRegular, SampleSteps::kLogNormal}, [](SampleSteps v) { return ToString(v); },
+      ParseSampleSteps, SampleStepsAllowedValues());
+  ExpectOneTable<TraceRole>(
+      {TraceRole::kAircraft, TraceRole::kTare, TraceRole::kCalibration},
+      [](TraceRole v) { return ToString(v); }, ParseTraceRole, TraceRoleAllowedValues());
 }
 
 TEST(EnumNames, ExportFrameTable) {

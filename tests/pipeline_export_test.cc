@@ -365,7 +365,8 @@ TEST(ExportRead, StoredConfigWithoutMassStdOrAircraftGivesNoFalseWarning) {
                          o);
   EXPECT_TRUE(std::isnan(in.mass_kg));
   EXPECT_TRUE(no_read_warning(in));
-  in = ReadExportInertia(TensorResults(kExample, kExampleStd, "aircraft: [unclosed\n"), "r.json", o);
+  in =
+      ReadExportInertia(TensorResults(kExample, kExampleStd, "aircraft: [unclosed\n"), "r.json", o);
   EXPECT_FALSE(no_read_warning(in));
 }
 

@@ -43,9 +43,9 @@ std::string WriteConfig(const TempDir& dir, const std::string& extra_fit = "") {
 // `bifilar ARGS` run in `cwd`, output in dir.
 test_support::CliRun RunIn(const TempDir& dir, const std::string& cwd, const std::string& args) {
   const std::string out = dir.path + "/stdout.txt", err = dir.path + "/stderr.txt";
-  const int status = std::system(("cd '" + cwd + "' && " + std::string(BIFILAR_BINARY) + " " +
-                                  args + " >" + out + " 2>" + err)
-                                     .c_str());
+  const int status = std::system(
+      ("cd '" + cwd + "' && " + std::string(BIFILAR_BINARY) + " " + args + " >" + out + " 2>" + err)
+          .c_str());
   test_support::CliRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   r.out = ReadFile(out);
@@ -130,15 +130,17 @@ TEST(FitCli, DropIdenticalLogsComparesSamplesNotBytes) {
   const std::string b = WriteFile(dir.path + "/s-2.csv", crlf);
   const std::string c = WriteFile(dir.path + "/s-3.csv", "t,gx,gy,gz\n" + body + "\n");
   const std::string d = WriteFile(dir.path + "/s-4.csv", "# saved again\nt,gx,gy,gz\n" + body);
-  const std::string e = WriteFile(dir.path + "/s-5.csv",
-                                  "t,gx,gy,gz\n0,0.1,0.2,0.3\n0.01,0.11,0.21,0.31\n0.02,0.12,0.22,0.33\n");
+  const std::string e =
+      WriteFile(dir.path + "/s-5.csv",
+                "t,gx,gy,gz\n0,0.1,0.2,0.3\n0.01,0.11,0.21,0.31\n0.02,0.12,0.22,0.33\n");
   ImuFormat format;
   format.accel_columns = {"", "", ""};
   const DistinctLogs distinct = DropIdenticalLogs({a, b, c, d, e}, format, ImuLogOptions());
   EXPECT_EQ(distinct.kept, (std::vector<std::string>{a, e}));
   ASSERT_EQ(distinct.warnings.size(), 3u);
   for (const std::string& w : distinct.warnings) {
-    EXPECT_NE(w.find(": the same samples as " + a + " (the files differ only in what the reader "
+    EXPECT_NE(w.find(": the same samples as " + a +
+                     " (the files differ only in what the reader "
                      "skips"),
               std::string::npos)
         << w;
@@ -211,8 +213,8 @@ TEST(FitCli, FitWindowsAreReadAsProcessReadsThem) {
     EXPECT_DOUBLE_EQ(j[0]["window_s"][1].get<double>(), 20.0) << r.out;
   }
   // Another log: no entry, the detected window.
-  const test_support::CliRun other = RunIn(
-      dir, kLogs, "fit " + dir.path + "/c.yaml pitch_0/trial_2.csv.gz --json");
+  const test_support::CliRun other =
+      RunIn(dir, kLogs, "fit " + dir.path + "/c.yaml pitch_0/trial_2.csv.gz --json");
   ASSERT_EQ(other.exit_code, 0) << other.err;
   EXPECT_NE(json::parse(other.out)[0]["window_s"][0].get<double>(), 5.0);
 

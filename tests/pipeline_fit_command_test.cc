@@ -53,9 +53,8 @@ TEST(FitCommand, RecordsAndJsonAreWhatTheCliPrints) {
   EXPECT_EQ(result.json[1], TraceRecordToJson(result.records[1], false));
 
   TempDir dir;
-  const test_support::CliRun cli =
-      test_support::Bifilar(dir, "fit " + kConfig + " " + options.logs[0] + " " +
-                                     options.logs[1] + " --json");
+  const test_support::CliRun cli = test_support::Bifilar(
+      dir, "fit " + kConfig + " " + options.logs[0] + " " + options.logs[1] + " --json");
   ASSERT_EQ(cli.exit_code, 0) << cli.err;
   EXPECT_EQ(WithoutTimes(json::parse(cli.out)), WithoutTimes(result.json));
 }

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "fit/trace_synth.h"
 #include "base/units.h"
+#include "fit/trace_synth.h"
 #include "pendulum/model.h"
 #include "pipeline/commands/simulate_spec.h"
 #include "pipeline/config/config.h"
@@ -102,9 +102,10 @@ TEST(FitFigure, DrawnCurveHasThePeriodOfTheReportedInertia) {
   };
   const double reported = period_of(f.fit.params.inertia_kg_m2);
   const double window = period_of(f.fit.inertia_window_kg_m2);
-  std::printf("  drawn period %.5f s over %d crossings; reported I %.6f -> %.5f s; whole-window "
-              "I %.6f -> %.5f s\n", drawn, crossings, f.fit.params.inertia_kg_m2, reported,
-              f.fit.inertia_window_kg_m2, window);
+  std::printf(
+      "  drawn period %.5f s over %d crossings; reported I %.6f -> %.5f s; whole-window "
+      "I %.6f -> %.5f s\n",
+      drawn, crossings, f.fit.params.inertia_kg_m2, reported, f.fit.inertia_window_kg_m2, window);
   EXPECT_NEAR(drawn / reported, 1.0, 1e-3);
   EXPECT_GT(std::abs(window / reported - 1.0), 5e-3);  // the test tells the two fits apart
   // The residual panel is the drawn fit's: measured - fitted, its rms and rms/noise.
@@ -125,9 +126,10 @@ TEST(FitFigure, TitleNamesTheStdAndGivesTheDigitsItSupports) {
   TraceFigureData d;
   std::string why;
   ASSERT_TRUE(MakeTraceFigureData(f.fit, options, &d, &why)) << why;
-  EXPECT_NE(d.title.find(ValueWithStd(f.fit.params.inertia_kg_m2,
-                                      f.record.inertia_total_std_total_kg_m2)),
-            std::string::npos) << d.title;
+  EXPECT_NE(d.title.find(
+                ValueWithStd(f.fit.params.inertia_kg_m2, f.record.inertia_total_std_total_kg_m2)),
+            std::string::npos)
+      << d.title;
   EXPECT_NE(d.title.find("1σ total"), std::string::npos) << d.title;
   // No bare symbols: the subtitles name what K_D, C and the bias are; no rho.
   for (const std::string& text : {d.title, d.subtitle, d.detail, d.residual_label}) {
@@ -164,9 +166,10 @@ std::vector<SvgText> Texts(const std::string& svg) {
     SvgText t;
     std::smatch m;
     if (std::regex_search(attrs, m, std::regex(" x=\"([-0-9.]+)\""))) t.x = std::stod(m[1]);
-    if (std::regex_search(attrs, m, std::regex("font-size=\"([0-9.]+)\""))) t.size = std::stod(m[1]);
-    t.anchor = std::regex_search(attrs, m, std::regex("text-anchor=\"([a-z]+)\"")) ? m[1].str()
-                                                                                 : "start";
+    if (std::regex_search(attrs, m, std::regex("font-size=\"([0-9.]+)\"")))
+      t.size = std::stod(m[1]);
+    t.anchor =
+        std::regex_search(attrs, m, std::regex("text-anchor=\"([a-z]+)\"")) ? m[1].str() : "start";
     t.content = std::regex_replace(svg.substr(attrs_end + 1, close - attrs_end - 1), tag, "");
     if (attrs.find("transform") == std::string::npos) out.push_back(t);  // rotated: skipped
   }
@@ -216,9 +219,9 @@ void ExpectLightSearchableSvg(const std::string& path, const std::string& must_c
 TEST(FitFigure, SvgIsLightAndSearchable) {
   const NonIdealFit& f = Shared();
   ASSERT_EQ(f.record.figures.size(), 2u) << f.record.message;
-  ExpectLightSearchableSvg(f.dir.path + "/fit.svg",
-                           ValueWithStd(f.fit.params.inertia_kg_m2,
-                                        f.record.inertia_total_std_total_kg_m2));
+  ExpectLightSearchableSvg(
+      f.dir.path + "/fit.svg",
+      ValueWithStd(f.fit.params.inertia_kg_m2, f.record.inertia_total_std_total_kg_m2));
 }
 
 }  // namespace
@@ -348,15 +351,17 @@ TEST(FigureExtremes, EllipseFiguresStayOnThePage) {
   std::string many = "pitch_deg,inertia,std\n", four = "pitch_deg,inertia,std\n";
   for (int i = 0; i < 200; ++i) {
     const double theta = -85.0 + 170.0 * i / 199.0, t = (theta - 2.0) * kRadPerDeg;
-    many += std::to_string(theta) + "," +
-            std::to_string(1.6e-5 * std::cos(t) * std::cos(t) + 2.4e-5 * std::sin(t) * std::sin(t)) +
-            ",3e-8\n";
+    many +=
+        std::to_string(theta) + "," +
+        std::to_string(1.6e-5 * std::cos(t) * std::cos(t) + 2.4e-5 * std::sin(t) * std::sin(t)) +
+        ",3e-8\n";
   }
   for (int theta : {-60, -20, 20, 60}) {
     const double t = (theta - 5.0) * kRadPerDeg;
-    four += std::to_string(theta) + "," +
-            std::to_string(4500.0 * std::cos(t) * std::cos(t) + 6100.0 * std::sin(t) * std::sin(t)) +
-            ",5\n";
+    four +=
+        std::to_string(theta) + "," +
+        std::to_string(4500.0 * std::cos(t) * std::cos(t) + 6100.0 * std::sin(t) * std::sin(t)) +
+        ",5\n";
   }
   WriteFile(dir.path + "/many.csv", many);
   WriteFile(dir.path + "/four.csv", four);
@@ -364,8 +369,8 @@ TEST(FigureExtremes, EllipseFiguresStayOnThePage) {
   for (const std::string& table : {std::string("many"), std::string("four")}) {
     const std::string units = table == "four" ? " --units imperial --covariance absolute" : "";
     const test_support::CliRun run =
-        test_support::Bifilar(dir, "ellipse " + dir.path + "/" + table + ".csv --bootstrap 0 --plot " +
-                                       out + "/" + table + units);
+        test_support::Bifilar(dir, "ellipse " + dir.path + "/" + table +
+                                       ".csv --bootstrap 0 --plot " + out + "/" + table + units);
     ASSERT_EQ(run.exit_code, 0) << run.err;
     for (const char* figure : {"/ellipse_moments.svg", "/ellipse_polar.svg"}) {
       SCOPED_TRACE(table + figure);

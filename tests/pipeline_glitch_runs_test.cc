@@ -71,7 +71,9 @@ TEST(GlitchRuns, ShortRunsNeitherRejectNorMoveTheWindow) {
             << reference.window_s[0] << "-" << reference.window_s[1];
         bool named = false;
         for (const std::string& w : r.warnings) {
-          named = named || w.rfind(std::to_string(injection.offsets.size()) + " glitch samples ignored", 0) == 0;
+          named =
+              named ||
+              w.rfind(std::to_string(injection.offsets.size()) + " glitch samples ignored", 0) == 0;
         }
         EXPECT_TRUE(named) << label;
       }
@@ -79,8 +81,8 @@ TEST(GlitchRuns, ShortRunsNeitherRejectNorMoveTheWindow) {
   }
 }
 
-// The 24 public Crazyflie logs (crazyflie/ of the data folder, README there): no sample of theirs is a
-// glitch, alone or in a run (measured: 0 of 13 741 samples; docs/method.md section 1).
+// The 24 public Crazyflie logs (crazyflie/ of the data folder, README there): no sample of theirs
+// is a glitch, alone or in a run (measured: 0 of 13 741 samples; docs/method.md section 1).
 TEST(GlitchRuns, RealCrazyflieLogsLoseNoSample) {
   BIFILAR_REAL_DATA(folder, "crazyflie");
   test_support::TempDir dir("bifilar_glitch_runs");

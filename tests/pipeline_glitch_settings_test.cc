@@ -59,7 +59,8 @@ void ExpectConfigError(const TempDir& dir, const std::string& yaml,
     ADD_FAILURE() << "no error for:\n" << yaml;
   } catch (const UserError& e) {
     const std::string message = e.what();
-    for (const std::string& part : parts) EXPECT_TRUE(Contains(message, part)) << part << " not in: " << message;
+    for (const std::string& part : parts)
+      EXPECT_TRUE(Contains(message, part)) << part << " not in: " << message;
     EXPECT_TRUE(Contains(message, "bad.yaml")) << message;
   }
 }
@@ -101,7 +102,8 @@ TEST(GlitchSettings, ConfigKeysAreReadAndRangesChecked) {
   ExpectConfigError(dir, base + "fit: {glitch: {max_fraction: 0}}\n",
                     {"fit.glitch.max_fraction = 0; must be in (0, 0.1]"});
   ExpectConfigError(dir, base + "fit: {glitch: {enabled: maybe}}\n", {"fit.glitch.enabled"});
-  ExpectConfigError(dir, base + "fit: {glitch: {threshold: 5}}\n", {"unknown key 'fit.glitch.threshold'"});
+  ExpectConfigError(dir, base + "fit: {glitch: {threshold: 5}}\n",
+                    {"unknown key 'fit.glitch.threshold'"});
   // The same ranges for a config built in code.
   CampaignConfig code = d;
   code.fit.glitch.max_fraction = 0.5;
@@ -194,7 +196,8 @@ TEST(GlitchSettings, AGlitchAfterALongGapDoesNotMoveTheWindow) {
       for (size_t i = header + 1; i < lines.size(); ++i) {
         Row r;
         r.line = i;
-        if (std::sscanf(lines[i].c_str(), "%lf,%lf,%lf,%lf", &r.t, &r.w[0], &r.w[1], &r.w[2]) != 4) break;
+        if (std::sscanf(lines[i].c_str(), "%lf,%lf,%lf,%lf", &r.t, &r.w[0], &r.w[1], &r.w[2]) != 4)
+          break;
         rows.push_back(r);
       }
       // The first two long gaps inside the free swing, away from its ends.
@@ -216,12 +219,13 @@ TEST(GlitchSettings, AGlitchAfterALongGapDoesNotMoveTheWindow) {
           for (const std::string& line : edited) body += line + "\n";
           const std::string glitched = WriteFile(dir.path + "/glitched.csv", body);
           const TraceRecord b = ProcessTrace(config, glitched, {});
-          const std::string what = path + " glitch " + std::to_string(glitch) + " rad/s at t = " +
-                                   std::to_string(g.t) + " s";
+          const std::string what = path + " glitch " + std::to_string(glitch) +
+                                   " rad/s at t = " + std::to_string(g.t) + " s";
           ++cases;
           ASSERT_EQ(b.status, TraceStatus::kOk) << what << ": " << b.message;
           EXPECT_LE(b.window_s[0] - a.window_s[0], 2 * 0.160) << what;
-          EXPECT_LE(std::abs(b.inertia_total_kg_m2 - a.inertia_total_kg_m2), a.inertia_total_std_kg_m2)
+          EXPECT_LE(std::abs(b.inertia_total_kg_m2 - a.inertia_total_kg_m2),
+                    a.inertia_total_std_kg_m2)
               << what;
         }
       }

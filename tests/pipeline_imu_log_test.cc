@@ -38,7 +38,8 @@ std::string Rows(int n, double dt = 0.01) {
   std::string s;
   char buf[128];
   for (int k = 0; k < n; ++k) {
-    std::snprintf(buf, sizeof(buf), "%.4f,%.3f,%.3f,%.3f,0.1,-0.2,-9.8\n", k * dt, 0.001 * k, -0.002 * k, 0.5);
+    std::snprintf(buf, sizeof(buf), "%.4f,%.3f,%.3f,%.3f,0.1,-0.2,-9.8\n", k * dt, 0.001 * k,
+                  -0.002 * k, 0.5);
     s += buf;
   }
   return s;
@@ -62,15 +63,16 @@ TEST(ImuLog, ConvertsUnits) {
   f.time_unit = TimeUnit::kMilliseconds;
   f.gyro_unit = RateUnit::kDegPerS;
   f.accel_unit = AccelUnit::kStandardGravity;
-  const ImuData d = ReadImuLogFromString(kHeader + "10,180,0,-90,0,0,-1\n20,0,0,0,0,0,1\n", "ms.csv", f);
+  const ImuData d =
+      ReadImuLogFromString(kHeader + "10,180,0,-90,0,0,-1\n20,0,0,0,0,0,1\n", "ms.csv", f);
   EXPECT_DOUBLE_EQ(d.t_s[0], 0.010);
   EXPECT_DOUBLE_EQ(d.t_s[1], 0.020);
   EXPECT_DOUBLE_EQ(d.gyro_in_imu[0].x(), kPi);
   EXPECT_DOUBLE_EQ(d.gyro_in_imu[0].z(), -kPi / 2);
   EXPECT_DOUBLE_EQ(d.accel_in_imu[0].z(), -kStandardGravityMps2);
   f.time_unit = TimeUnit::kMicroseconds;
-  const ImuData u = ReadImuLogFromString(kHeader + "1700000000000000,0,0,0,0,0,1\n1700000000010000,0,0,0,0,0,1\n",
-                                         "us.csv", f);
+  const ImuData u = ReadImuLogFromString(
+      kHeader + "1700000000000000,0,0,0,0,0,1\n1700000000010000,0,0,0,0,0,1\n", "us.csv", f);
   EXPECT_DOUBLE_EQ(u.t_s[0], 1.7e9);
   EXPECT_NEAR(u.t_s[1] - u.t_s[0], 0.01, 1e-6);  // epoch microseconds keep ~0.2 us resolution
 }
@@ -97,21 +99,24 @@ TEST(ImuLog, CustomNamesExtraColumnsQuotesSpacesCrlfBom) {
 }
 
 TEST(ImuLog, CommentLinesAboveHeaderAndSpaceAlignedColumns) {
-  const ImuData d = ReadImuLogFromString("# logger v2\n// rate 100 Hz\n\n" + kHeader + Rows(3), "c.csv", ImuFormat());
+  const ImuData d = ReadImuLogFromString("# logger v2\n// rate 100 Hz\n\n" + kHeader + Rows(3),
+                                         "c.csv", ImuFormat());
   EXPECT_EQ(d.size(), 3u);
   ASSERT_EQ(d.warnings.size(), 1u);
   EXPECT_TRUE(Contains(d.warnings[0], "skipped 2 comment line(s)")) << d.warnings[0];
   EXPECT_TRUE(Contains(ErrorOf("# only a comment\n"), "no header row, only 1 comment line"));
   ImuFormat f;
   f.delimiter = ' ';
-  const ImuData s = ReadImuLogFromString("  t    gx    gy   gz  ax ay az\n 0.00  1.0  2.0  3.0 0 0 1\n\t0.01  4.0 5.0  6.0 0 0 1\n",
-                                         "aligned.txt", f);
+  const ImuData s = ReadImuLogFromString(
+      "  t    gx    gy   gz  ax ay az\n 0.00  1.0  2.0  3.0 0 0 1\n\t0.01  4.0 5.0  6.0 0 0 1\n",
+      "aligned.txt", f);
   ASSERT_EQ(s.size(), 2u);
   EXPECT_EQ(s.gyro_in_imu[1], Eigen::Vector3d(4, 5, 6));
 }
 
 TEST(ImuLog, GapsKeepRealTimestamps) {
-  const ImuData d = ReadImuLogFromString(kHeader + "0,0,0,0,0,0,1\n0.01,0,0,0,0,0,1\n0.05,0,0,0,0,0,1\n", "gap.csv", ImuFormat());
+  const ImuData d = ReadImuLogFromString(
+      kHeader + "0,0,0,0,0,0,1\n0.01,0,0,0,0,0,1\n0.05,0,0,0,0,0,1\n", "gap.csv", ImuFormat());
   ASSERT_EQ(d.size(), 3u);
   EXPECT_DOUBLE_EQ(d.t_s[2], 0.05);
   EXPECT_TRUE(d.warnings.empty());
@@ -141,7 +146,8 @@ TEST(ImuLog, NonNumericCellInTheMiddleIsAnError) {
 
 TEST(ImuLog, NanAndInfAreErrors) {
   for (const char* bad : {"nan", "NaN", "inf", "-inf", "Infinity"}) {
-    const std::string e = ErrorOf(kHeader + "0,0,0,0,0,0,1\n0.01,0," + bad + ",0,0,0,1\n0.02,0,0,0,0,0,1\n");
+    const std::string e =
+        ErrorOf(kHeader + "0,0,0,0,0,0,1\n0.01,0," + bad + ",0,0,0,1\n0.02,0,0,0,0,0,1\n");
     EXPECT_TRUE(Contains(e, "log.csv:3:3")) << bad << ": " << e;
     EXPECT_TRUE(Contains(e, "NaN and infinite")) << e;
   }
@@ -182,9 +188,11 @@ TEST(ImuLog, AccelerometerColumns) {
   EXPECT_TRUE(Contains(d.warnings[0], "gyro-only"));
   ImuLogOptions o;
   o.require_accel = true;
-  EXPECT_TRUE(Contains(ErrorOf("t,gx,gy,gz\n0,0,0,0\n0.01,0,0,0\n", ImuFormat(), o), "missing column 'ax'"));
+  EXPECT_TRUE(Contains(ErrorOf("t,gx,gy,gz\n0,0,0,0\n0.01,0,0,0\n", ImuFormat(), o),
+                       "missing column 'ax'"));
   // Only some accelerometer columns: always an error.
-  EXPECT_TRUE(Contains(ErrorOf("t,gx,gy,gz,ax,ay\n0,0,0,0,0,0\n0.01,0,0,0,0,0\n"), "missing column 'az'"));
+  EXPECT_TRUE(
+      Contains(ErrorOf("t,gx,gy,gz,ax,ay\n0,0,0,0,0,0\n0.01,0,0,0,0,0\n"), "missing column 'az'"));
 }
 
 TEST(ImuLog, NonIncreasingTimestampsRepairedWithWarning) {
@@ -193,10 +201,10 @@ TEST(ImuLog, NonIncreasingTimestampsRepairedWithWarning) {
   char buf[96];
   for (int k = 0; k < 300; ++k) {
     double t = 0.01 * k;
-    if (k == 50) t = 0.49;            // duplicate of row 49
-    if (k == 100) t = 1.015;          // 1.00 and 1.015 are swapped with the next... (1.01 below)
-    if (k == 101) t = 1.005;          // out of order
-    if (k == 200) t = 50.0;           // forward glitch
+    if (k == 50) t = 0.49;    // duplicate of row 49
+    if (k == 100) t = 1.015;  // 1.00 and 1.015 are swapped with the next... (1.01 below)
+    if (k == 101) t = 1.005;  // out of order
+    if (k == 200) t = 50.0;   // forward glitch
     std::snprintf(buf, sizeof(buf), "%.4f,%d,0,0,0,0,1\n", t, k);
     text += buf;
   }
@@ -240,7 +248,9 @@ TEST(ImuLog, TimeSeriesEndsAtAFooter) {
   const ImuData d = ReadImuLogFromString(kHeader + Rows(100) + footer, "f.csv", ImuFormat());
   EXPECT_EQ(d.size(), 100u);
   ASSERT_EQ(d.warnings.size(), 1u);
-  EXPECT_TRUE(Contains(d.warnings[0], "time series ends at line 102 (a blank line, then a non-numeric row)")) << d.warnings[0];
+  EXPECT_TRUE(Contains(d.warnings[0],
+                       "time series ends at line 102 (a blank line, then a non-numeric row)"))
+      << d.warnings[0];
   EXPECT_TRUE(Contains(d.warnings[0], "3 row(s) after it")) << d.warnings[0];
   // A non-numeric row, then numeric rows jumping back.
   const ImuData n = ReadImuLogFromString(kHeader + Rows(100) + "Flip Data,,,,,,\n0.5,0,0,0,0,0,1\n",
@@ -250,13 +260,17 @@ TEST(ImuLog, TimeSeriesEndsAtAFooter) {
   // Time jumping back with no break: a second log appended (a clock reset).
   const ImuData c = ReadImuLogFromString(kHeader + Rows(100) + Rows(60), "c.csv", ImuFormat());
   EXPECT_EQ(c.size(), 100u);
-  EXPECT_TRUE(Contains(c.warnings.at(0), "time series ends at line 102 (time jumps back from 0.99 to 0"))
+  EXPECT_TRUE(
+      Contains(c.warnings.at(0), "time series ends at line 102 (time jumps back from 0.99 to 0"))
       << c.warnings[0];
   EXPECT_TRUE(Contains(c.warnings.at(0), "60 row(s)")) << c.warnings[0];
   // A NaN in a footer row does not matter: the series ended before it.
-  EXPECT_EQ(ReadImuLogFromString(kHeader + Rows(10) + "\n0,nan,0,0,0,0,1\n", "x.csv", ImuFormat()).size(), 10u);
+  EXPECT_EQ(
+      ReadImuLogFromString(kHeader + Rows(10) + "\n0,nan,0,0,0,0,1\n", "x.csv", ImuFormat()).size(),
+      10u);
   // A blank line inside the data (the series goes on) is still just skipped.
-  const ImuData b = ReadImuLogFromString(kHeader + Rows(3) + "\n0.05,0,0,0,0,0,1\n", "b.csv", ImuFormat());
+  const ImuData b =
+      ReadImuLogFromString(kHeader + Rows(3) + "\n0.05,0,0,0,0,0,1\n", "b.csv", ImuFormat());
   EXPECT_EQ(b.size(), 4u);
   EXPECT_TRUE(b.warnings.empty());
 }
@@ -312,7 +326,8 @@ TEST_F(ImuLogFiles, BinaryFile) {
 
 TEST_F(ImuLogFiles, UnreadableFile) {
   const std::string missing = (dir_ / "missing.csv").string();
-  EXPECT_TRUE(Contains(ErrorOfFile(missing), missing + ": cannot open the log")) << ErrorOfFile(missing);
+  EXPECT_TRUE(Contains(ErrorOfFile(missing), missing + ": cannot open the log"))
+      << ErrorOfFile(missing);
   EXPECT_TRUE(Contains(ErrorOfFile(dir_.string()), "is a folder"));
   if (::geteuid() != 0) {  // root reads anything
     const std::string locked = Write("locked.csv", kHeader + Rows(3));
@@ -386,7 +401,8 @@ TEST_F(ImuLogFiles, SimulatedLogRoundTrip) {
   EXPECT_TRUE(d.warnings.empty());
   for (size_t i = 0; i < d.size(); ++i) {
     ASSERT_NEAR(d.t_s[i], trace.imu.t_s[i], 1e-9 * (1.0 + std::abs(trace.imu.t_s[i])));
-    ASSERT_LT((d.gyro_in_imu[i] - trace.imu.gyro_in_imu[i]).norm(), 1e-8 * (1.0 + trace.imu.gyro_in_imu[i].norm()));
+    ASSERT_LT((d.gyro_in_imu[i] - trace.imu.gyro_in_imu[i]).norm(),
+              1e-8 * (1.0 + trace.imu.gyro_in_imu[i].norm()));
     ASSERT_LT((d.accel_in_imu[i] - trace.imu.accel_in_imu[i]).norm(), 1e-7);
   }
 }

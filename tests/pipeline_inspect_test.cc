@@ -112,8 +112,9 @@ TEST(InspectLog, PeriodAndSmallAngleInertiaOfASimulatedSwing) {
   EXPECT_TRUE(std::isnan(guessed.small_angle_inertia_kg_m2));  // no config, no rig
 
   // With a config: the small-angle inertia, within the period's error (twice, relative).
-  const std::string config = WriteFile(
-      dir.path + "/rig.yaml", "rig: {filar_length_m: 2.0, filar_separation_m: 1.8, mass_kg: 6.75}\n");
+  const std::string config =
+      WriteFile(dir.path + "/rig.yaml",
+                "rig: {filar_length_m: 2.0, filar_separation_m: 1.8, mass_kg: 6.75}\n");
   const CampaignConfig loaded = test_support::LoadFitConfig(config);
   const InspectReport with = InspectLog(dir.path + "/swing.csv", &loaded);
   ASSERT_TRUE(with.error.empty()) << with.error;
@@ -130,8 +131,8 @@ TEST(InspectLog, SaysWhatAFileIsWhenItIsNotALog) {
   EXPECT_EQ(InspectLog(dir.path + "/nothing.csv", nullptr).kind, "missing");
   EXPECT_EQ(InspectLog(dir.path, nullptr).kind, "folder");
   EXPECT_EQ(InspectLog(WriteFile(dir.path + "/e.csv", ""), nullptr).kind, "empty");
-  EXPECT_EQ(InspectLog(WriteFile(dir.path + "/b.csv", std::string("\x01\x02\x00\x7f", 4) +
-                                                        std::string(200, '\x03')),
+  EXPECT_EQ(InspectLog(WriteFile(dir.path + "/b.csv",
+                                 std::string("\x01\x02\x00\x7f", 4) + std::string(200, '\x03')),
                        nullptr)
                 .kind,
             "binary");
@@ -182,8 +183,8 @@ TEST(InspectLog, RealQuadrotorLogGuessedAsTheAuthorsDescribeIt) {
   EXPECT_EQ(r.format.time_unit, TimeUnit::kSeconds);
   EXPECT_EQ(r.format.gyro_columns[0], "wx");
   EXPECT_EQ(r.format.gyro_unit, RateUnit::kRadPerS);
-  EXPECT_FALSE(r.format.has_accel());  // a_d.x is a set-point, not an accelerometer
-  EXPECT_NEAR(r.period_s, 2.2, 0.1);     // the authors' rig swings at ~2.2 s
+  EXPECT_FALSE(r.format.has_accel());                  // a_d.x is a set-point, not an accelerometer
+  EXPECT_NEAR(r.period_s, 2.2, 0.1);                   // the authors' rig swings at ~2.2 s
   EXPECT_GT(std::fabs(r.swing_axis_in_imu[0]), 0.95);  // an Ixx log swings about x
 }
 
@@ -203,8 +204,8 @@ TEST(InitCommand, WritesAConfigThatFitAccepts) {
 
   // Never overwrites without --force; a bad --rig names the problem.
   const std::string before = ReadFile(config);
-  const std::string again = kBinary + " init " + config + " --rig 1,0.5,1 > " + dir.path +
-                            "/again.txt 2>&1";
+  const std::string again =
+      kBinary + " init " + config + " --rig 1,0.5,1 > " + dir.path + "/again.txt 2>&1";
   EXPECT_NE(std::system(again.c_str()), 0);
   EXPECT_NE(ReadFile(dir.path + "/again.txt").find("--force"), std::string::npos);
   EXPECT_EQ(ReadFile(config), before);

@@ -26,8 +26,8 @@ pid_t StartProcess(const std::string& out, const std::string& err) {
     FILE* f = std::freopen(err.c_str(), "w", stderr);
     if (f == nullptr || std::freopen("/dev/null", "w", stdout) == nullptr) _exit(99);
     const std::string config = std::string(BIFILAR_SOURCE_DIR) + "/configs/prandtl_d.yaml";
-    execl(BIFILAR_BINARY, BIFILAR_BINARY, "process", config.c_str(), "--out", out.c_str(),
-          "--jobs", "1", static_cast<char*>(nullptr));
+    execl(BIFILAR_BINARY, BIFILAR_BINARY, "process", config.c_str(), "--out", out.c_str(), "--jobs",
+          "1", static_cast<char*>(nullptr));
     _exit(98);
   }
   return pid;

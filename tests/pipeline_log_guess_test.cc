@@ -148,7 +148,7 @@ TEST(LogGuess, AngleColumnsNamedPqrAreNotTakenForRates) {
 
 TEST(LogGuess, HeaderNamesAreEchoedWithoutTerminalControls) {
   EXPECT_EQ(EchoedName("g\x1b[31mx"), "g?[31mx");
-  EXPECT_EQ(EchoedName("gx\xc2\x85"), "gx?");                 // NEL: valid UTF-8, a line break
+  EXPECT_EQ(EchoedName("gx\xc2\x85"), "gx?");  // NEL: valid UTF-8, a line break
   EXPECT_EQ(EchoedName("\xcf\x89_x (\xc2\xb0/s)"), "\xcf\x89_x (\xc2\xb0/s)");  // kept
   EXPECT_EQ(EchoedName("a\xff"), "a?");
   EXPECT_TRUE(Contains(DescribeUnprintable("gx\xc2\x85"), "U+0085 (NEL"));
@@ -271,10 +271,10 @@ TEST(LogGuess, AccelerometerAdviceNeverNamesTheUnitInUse) {
   const std::string text = InspectReportText(guessed);
   EXPECT_FALSE(Contains(text, "set imu.accel.unit: g")) << text;
   // Declared g: the reading is 1.07 m/s^2, and the advice must not be to declare g.
-  const std::string config = WriteFile(
-      dir.path + "/g.yaml",
-      "rig: {filar_length_m: 2.0, filar_separation_m: 1.8, mass_kg: 6.75}\n"
-      "imu:\n  accel: {columns: [ax, ay, az], unit: g}\n");
+  const std::string config =
+      WriteFile(dir.path + "/g.yaml",
+                "rig: {filar_length_m: 2.0, filar_separation_m: 1.8, mass_kg: 6.75}\n"
+                "imu:\n  accel: {columns: [ax, ay, az], unit: g}\n");
   const CampaignConfig loaded = test_support::LoadFitConfig(config);
   const std::string declared = InspectReportText(InspectLog(dir.path + "/small_f.csv", &loaded));
   EXPECT_TRUE(Contains(declared, "accelerometer")) << declared;

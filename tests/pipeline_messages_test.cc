@@ -43,7 +43,8 @@ struct TempDir {
 // Runs bifilar; returns the exit code, *output gets stdout and stderr.
 int Cli(const TempDir& dir, const std::string& args, std::string* output) {
   const std::string log = dir.path + "/cli.txt";
-  const int status = std::system((std::string(BIFILAR_BINARY) + " " + args + " > " + log + " 2>&1").c_str());
+  const int status =
+      std::system((std::string(BIFILAR_BINARY) + " " + args + " > " + log + " 2>&1").c_str());
   *output = ReadFile(log);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
@@ -89,8 +90,9 @@ TEST(Messages, EllipseTableWithBomGzipOrBinary) {
 
 TEST(Messages, ExtremeValuesNameThePointAndNoSolverChatter) {
   TempDir dir;
-  WriteFile(dir.path + "/x.csv", "pitch_deg,inertia,std\n0,1e300,1e-300\n45,2.6,0.01\n90,2.3,0.01\n"
-                                 "-45,2.5,0.01\n");
+  WriteFile(dir.path + "/x.csv",
+            "pitch_deg,inertia,std\n0,1e300,1e-300\n45,2.6,0.01\n90,2.3,0.01\n"
+            "-45,2.5,0.01\n");
   std::string out;
   EXPECT_EQ(Cli(dir, "ellipse " + dir.path + "/x.csv", &out), 2);
   EXPECT_NE(out.find("x.csv"), std::string::npos) << out;
@@ -98,7 +100,8 @@ TEST(Messages, ExtremeValuesNameThePointAndNoSolverChatter) {
   EXPECT_EQ(out.find("rank-deficient"), std::string::npos) << out;
   EXPECT_EQ(out.find("InitGoogleLogging"), std::string::npos) << out;
   // Large but representable values fit without any solver chatter.
-  WriteFile(dir.path + "/y.csv", "pitch_deg,inertia\n0,1e90\n45,2e90\n90,3e90\n-45,1.5e90\n10,1.1e90\n");
+  WriteFile(dir.path + "/y.csv",
+            "pitch_deg,inertia\n0,1e90\n45,2e90\n90,3e90\n-45,1.5e90\n10,1.1e90\n");
   Cli(dir, "ellipse " + dir.path + "/y.csv", &out);
   EXPECT_EQ(out.find("InitGoogleLogging"), std::string::npos) << out;
   EXPECT_EQ(out.find("Residual and Jacobian"), std::string::npos) << out;
@@ -124,9 +127,10 @@ TEST(Messages, HugeStdNamesTheKeyAndJobsRangeIsShort) {
 
 TEST(Messages, RunsPatternCannotLeaveTheRoot) {
   TempDir dir;
-  WriteFile(dir.path + "/c.yaml",
-            "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.1}}\n"
-            "aircraft: {mass_kg: 1}\nruns:\n  root: .\n  pattern: '../../../bin/{pitch_deg}*'\n");
+  WriteFile(
+      dir.path + "/c.yaml",
+      "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.1}}\n"
+      "aircraft: {mass_kg: 1}\nruns:\n  root: .\n  pattern: '../../../bin/{pitch_deg}*'\n");
   const std::string message = ErrorOf([&] { LoadCampaignConfig(dir.path + "/c.yaml"); });
   EXPECT_NE(message.find("c.yaml:5"), std::string::npos) << message;
   EXPECT_NE(message.find("must stay inside runs.root"), std::string::npos) << message;
@@ -135,9 +139,10 @@ TEST(Messages, RunsPatternCannotLeaveTheRoot) {
 TEST(Messages, RunsPatternHoldsThePitchOnce) {
   // It used to be checked per component only: the second one silently won.
   TempDir dir;
-  WriteFile(dir.path + "/c.yaml",
-            "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.1}}\n"
-            "aircraft: {mass_kg: 1}\nruns:\n  root: .\n  pattern: 'p{pitch_deg}/{pitch_deg}.csv'\n");
+  WriteFile(
+      dir.path + "/c.yaml",
+      "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.1}}\n"
+      "aircraft: {mass_kg: 1}\nruns:\n  root: .\n  pattern: 'p{pitch_deg}/{pitch_deg}.csv'\n");
   const std::string message = ErrorOf([&] { LoadCampaignConfig(dir.path + "/c.yaml"); });
   EXPECT_NE(message.find("c.yaml:5"), std::string::npos) << message;
   EXPECT_NE(message.find("{pitch_deg} only once"), std::string::npos) << message;
@@ -159,8 +164,9 @@ TEST(Messages, TareLogListedTwiceIsOneLog) {
 
 TEST(Messages, ReportOfAMalformedResultsFileNamesIt) {
   TempDir dir;
-  WriteFile(dir.path + "/out/results.json",
-            R"({"version": "x", "traces": [{"file": "a", "window_s": ["a", "b"], "status": "ok"}]})");
+  WriteFile(
+      dir.path + "/out/results.json",
+      R"({"version": "x", "traces": [{"file": "a", "window_s": ["a", "b"], "status": "ok"}]})");
   std::string out;
   EXPECT_EQ(Cli(dir, "report " + dir.path + "/out", &out), 2);
   EXPECT_NE(out.find("results.json"), std::string::npos) << out;
@@ -173,16 +179,18 @@ TEST(Messages, ReportOfAMalformedResultsFileNamesIt) {
   // Not JSON at all: the line and column, and what to do.
   WriteFile(dir.path + "/out/results.json", "{\"traces\": 5");
   EXPECT_EQ(Cli(dir, "report " + dir.path + "/out", &out), 2);
-  EXPECT_NE(out.find("results.json: not valid JSON (parse error at line"), std::string::npos) << out;
+  EXPECT_NE(out.find("results.json: not valid JSON (parse error at line"), std::string::npos)
+      << out;
   EXPECT_EQ(out.find("json.exception"), std::string::npos) << out;
 }
 
 TEST(Messages, DamagedManifestNamesTheFileAndKey) {
   TempDir dir;
   WriteFile(dir.path + "/logs/p0.csv", "x");
-  WriteFile(dir.path + "/c.yaml",
-            "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.1}}\n"
-            "aircraft: {mass_kg: 1}\nruns: {root: logs, pattern: 'p{pitch_deg}.csv'}\n");
+  WriteFile(
+      dir.path + "/c.yaml",
+      "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.1}}\n"
+      "aircraft: {mass_kg: 1}\nruns: {root: logs, pattern: 'p{pitch_deg}.csv'}\n");
   const std::string out_dir = dir.path + "/out";
   const std::pair<const char*, const char*> cases[] = {
       {R"({"files": [1, 2]})", "at key /files/0: type must be string"},
@@ -231,12 +239,14 @@ TEST(Messages, OutOfMemoryNamesTheInput) {
   WriteFile(dir.path + "/big.csv", table.str());
   const std::string log = dir.path + "/oom.txt";
   const int status = std::system(("ulimit -v 120000; " + std::string(BIFILAR_BINARY) + " ellipse " +
-                                  dir.path + "/big.csv > " + log + " 2>&1").c_str());
+                                  dir.path + "/big.csv > " + log + " 2>&1")
+                                     .c_str());
   const std::string out = ReadFile(log);
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 2) << out;
   EXPECT_NE(out.find("out of memory in `bifilar ellipse on " + dir.path + "/big.csv`"),
-            std::string::npos) << out;
+            std::string::npos)
+      << out;
   EXPECT_EQ(out.find("std::bad_alloc"), std::string::npos) << out;
 }
 

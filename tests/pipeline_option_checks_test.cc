@@ -28,7 +28,8 @@ void ExpectOneLineError(const TempDir& dir, const std::string& args, const std::
 // SimulationOptions and TraceSetup through `bifilar simulate --trace`.
 TEST(OptionChecks, SimulateNamesFieldValueAndBound) {
   TempDir dir("bifilar_option_checks");
-  const std::string trace = "simulate --trace " + dir.path + "/t.csv --inertia-kg-m2 1 --mass-kg 6 ";
+  const std::string trace =
+      "simulate --trace " + dir.path + "/t.csv --inertia-kg-m2 1 --mass-kg 6 ";
   ExpectOneLineError(dir, trace + "-L 2 -D 0.9 --amplitude-deg 95",
                      "simulate: amplitude_deg = 95; must be 0 < |amplitude_deg| < 89");
   ExpectOneLineError(dir, trace + "-L 2 -D 0.9 --pitch-deg 120",
@@ -37,11 +38,11 @@ TEST(OptionChecks, SimulateNamesFieldValueAndBound) {
   ExpectOneLineError(dir, trace + "-L 2 -D 2.5",
                      "simulate: filar_separation_m (D) = 2.5; must be < filar_length_m (L) = 2");
   // A spec: SensorOptions' cross-field bound, at the key's line.
-  const std::string spec = test_support::WriteFile(
-      dir.path + "/s.yaml",
-      "geometry: {filar_length_m: 2, filar_separation_m: 0.9}\n"
-      "trace: {inertia_kg_m2: 1, mass_kg: 6}\n"
-      "sensor: {sample_rate_hz: 100, rocking_frequency_hz: 40}\n");
+  const std::string spec =
+      test_support::WriteFile(dir.path + "/s.yaml",
+                              "geometry: {filar_length_m: 2, filar_separation_m: 0.9}\n"
+                              "trace: {inertia_kg_m2: 1, mass_kg: 6}\n"
+                              "sensor: {sample_rate_hz: 100, rocking_frequency_hz: 40}\n");
   ExpectOneLineError(dir, "simulate " + spec + " --out " + dir.path + "/o",
                      "s.yaml:3:53: sensor.rocking_frequency_hz = 40; must be in [0, 25]");
 }

@@ -60,12 +60,13 @@ struct Campaign {
     const double t = pitch * kRadPerDeg;
     std::ostringstream text;
     text.precision(17);
-    text << "I=" << 3 * std::cos(t) * std::cos(t) + 2 * std::sin(t) * std::sin(t) +
-                        0.1 * std::sin(2 * t) + 0.5 + (trial == 1 ? 1e-3 : -1e-3) + offset
+    text << "I="
+         << 3 * std::cos(t) * std::cos(t) + 2 * std::sin(t) * std::sin(t) + 0.1 * std::sin(2 * t) +
+                0.5 + (trial == 1 ? 1e-3 : -1e-3) + offset
          << "\n";
-    WriteFile(dir + "/logs/pitch_" + std::to_string(pitch) + "/trial_" + std::to_string(trial) +
-                  ".csv",
-              text.str());
+    WriteFile(
+        dir + "/logs/pitch_" + std::to_string(pitch) + "/trial_" + std::to_string(trial) + ".csv",
+        text.str());
   }
 
   std::atomic<int> calls{0};
@@ -455,13 +456,15 @@ TEST(OutputSet, OutputFolderHoldingLogsIsRefusedBeforeAnythingIsWritten) {
 // issue 9 item 11: a fit.windows entry for a file that does not exist was ignored silently.
 TEST(OutputSet, WindowForAMissingFileIsAnErrorBeforeAnyFit) {
   Campaign c;
-  c.AppendConfig("fit:\n  windows:\n    pitch_0/trial_1.csv: [1, 20]\n    pitch_0/trial_9.csv: [1, 20]\n");
+  c.AppendConfig(
+      "fit:\n  windows:\n    pitch_0/trial_1.csv: [1, 20]\n    pitch_0/trial_9.csv: [1, 20]\n");
   try {
     c.Run();
     ADD_FAILURE() << "a window for a missing file was accepted";
   } catch (const UserError& e) {
     EXPECT_NE(std::string(e.what()).find("'fit.windows.pitch_0/trial_9.csv' names no log"),
-              std::string::npos) << e.what();
+              std::string::npos)
+        << e.what();
   }
   EXPECT_EQ(c.calls, 0);
 }

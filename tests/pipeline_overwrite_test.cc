@@ -12,11 +12,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/units.h"
+#include "base/user_error.h"
 #include "pipeline/config/config.h"
 #include "pipeline/config/config_template.h"
 #include "pipeline/logs/simulated_log.h"
-#include "base/units.h"
-#include "base/user_error.h"
 #include "test_support.h"
 
 namespace bifilar {
@@ -107,7 +107,8 @@ TEST(Overwrite, ASimulatedLogSaysSoInInspectCsvAndUlog) {
     const CliRun r = Bifilar(dir, "inspect " + log);
     EXPECT_NE(r.out.find("warning: " + SimulatedLogWarning(SimulatedLogOrigin(3))),
               std::string::npos)
-        << name << "\n" << r.out << r.err;
+        << name << "\n"
+        << r.out << r.err;
     // The mark is not counted with other comment lines, and the log reads as before.
     EXPECT_EQ(r.out.find("comment line"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("samples"), std::string::npos) << r.out;
@@ -136,8 +137,9 @@ runs: {root: logs, pattern: "pitch_{pitch_deg}/*.csv"}
   const CliRun r = Bifilar(dir, "process " + config + " --out " + dir.path + "/out");
   const std::string html = ReadFile(dir.path + "/out/report.html");
   ASSERT_FALSE(html.empty()) << r.err;
-  EXPECT_NE(html.find("Simulated data: 4 of the 4 logs were written by <code>bifilar simulate</code>"),
-            std::string::npos);
+  EXPECT_NE(
+      html.find("Simulated data: 4 of the 4 logs were written by <code>bifilar simulate</code>"),
+      std::string::npos);
   EXPECT_NE(html.find("simulated by bifilar"), std::string::npos);
 }
 
@@ -162,8 +164,8 @@ TEST(Overwrite, ExportRefusesItsInputAndTheCampaignFilesHoweverSpelled) {
   };
   for (const std::string& target : refused) {
     for (const std::string format : {"csv", "jsbsim --symmetric --set Iyy=3.5"}) {
-      const CliRun r = Bifilar(dir, "export " + out + " --format " + format + " --out " + target +
-                                        " --force");
+      const CliRun r =
+          Bifilar(dir, "export " + out + " --format " + format + " --out " + target + " --force");
       EXPECT_EQ(r.exit_code, 2) << target << "\n" << r.err;
       EXPECT_NE(r.err.find("export: --out " + target), std::string::npos) << r.err;
     }
@@ -187,12 +189,13 @@ TEST(Overwrite, ExportReplacesItsOwnOutputButNoOtherFileWithoutForce) {
   ASSERT_EQ(Bifilar(dir, "export " + out + " --format csv --out " + csv).exit_code, 0);
   ASSERT_EQ(Bifilar(dir, "export " + out + " --format csv --out " + csv).exit_code, 0);
   const std::string mine = WriteFile(dir.path + "/mine.urdf", "<robot/>\n");
-  CliRun r = Bifilar(dir, "export " + out + " --format urdf --symmetric --set Iyy=3.5 --out " + mine);
+  CliRun r =
+      Bifilar(dir, "export " + out + " --format urdf --symmetric --set Iyy=3.5 --out " + mine);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("export --out: " + mine + " exists"), std::string::npos) << r.err;
   EXPECT_EQ(ReadFile(mine), "<robot/>\n");
-  r = Bifilar(dir, "export " + out + " --format urdf --symmetric --set Iyy=3.5 --out " + mine +
-                       " --force");
+  r = Bifilar(
+      dir, "export " + out + " --format urdf --symmetric --set Iyy=3.5 --out " + mine + " --force");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(ReadFile(mine).rfind("<!-- bifilar export of", 0), 0u);
 }
@@ -228,8 +231,8 @@ std::string TensorResults(const std::vector<double>& v, const std::string& mass 
     t[std::string(names[k]) + "_kg_m2"] = v[k];
     t[std::string(names[k]) + "_kg_m2_std"] = 0.001;
   }
-  nlohmann::json j = {{"program", "bifilar"}, {"tensor", t},
-                      {"config", "aircraft:\n  mass_kg: " + mass + "\n"}};
+  nlohmann::json j = {
+      {"program", "bifilar"}, {"tensor", t}, {"config", "aircraft:\n  mass_kg: " + mass + "\n"}};
   return j.dump();
 }
 
@@ -299,9 +302,12 @@ TEST(Overwrite, InitWritesOnlyConfigsFitAccepts) {
   const struct {
     std::string args, says;
   } refused[] = {
-      {"--rig 594,30,34.3", "rig.filar_length_m = 594; must be in [0.05, 20] (m), a lab rig's range"},
-      {"--rig 0.594,0.030,0.0343 --gravity 9.7", "init: --gravity: gravity_mps2 = 9.7; must be in [9.76, 9.84]"},
-      {"--rig 0.594,0.030,0.0343 --gravity 9.9", "init: --gravity: gravity_mps2 = 9.9; must be in [9.76, 9.84]"},
+      {"--rig 594,30,34.3",
+       "rig.filar_length_m = 594; must be in [0.05, 20] (m), a lab rig's range"},
+      {"--rig 0.594,0.030,0.0343 --gravity 9.7",
+       "init: --gravity: gravity_mps2 = 9.7; must be in [9.76, 9.84]"},
+      {"--rig 0.594,0.030,0.0343 --gravity 9.9",
+       "init: --gravity: gravity_mps2 = 9.9; must be in [9.76, 9.84]"},
       {"--rig 0.594,0.030,0.0343 --gravity nan", "--gravity: 'nan' is not a finite number"},
   };
   for (const auto& c : refused) {
@@ -363,12 +369,12 @@ TEST(Overwrite, StartingConfigKeepsHostileColumnNames) {
   f.accel_columns = {"a\\x", "ay\xe2\x80\xa9", "\xc3\xa9z"};
   o.format = f;
   o.format_source = "x\nfit: {model: linear}\n";
-  const CampaignConfig c = LoadCampaignConfigText(CheckedStartingConfigText(o, "c.yaml"), "c.yaml",
-                                                  [] {
-                                                    ConfigLoadOptions l;
-                                                    l.require_runs = false;
-                                                    return l;
-                                                  }());
+  const CampaignConfig c =
+      LoadCampaignConfigText(CheckedStartingConfigText(o, "c.yaml"), "c.yaml", [] {
+        ConfigLoadOptions l;
+        l.require_runs = false;
+        return l;
+      }());
   EXPECT_EQ(c.imu.format.time_column, f.time_column);
   EXPECT_EQ(c.imu.format.gyro_columns, f.gyro_columns);
   EXPECT_EQ(c.imu.format.accel_columns, f.accel_columns);

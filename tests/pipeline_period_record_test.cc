@@ -28,7 +28,8 @@ constexpr double kLength = 2.0, kSeparation = 1.8, kMass = 6.75, kInertia = 4.1;
 // Simulates a 60 s swing of I = 4.1 kg m^2 released at `amplitude_deg`, and fits it.
 TraceRecord FitSwing(const TempDir& dir, double amplitude_deg, const std::string& config_text,
                      std::string* log_out = nullptr) {
-  const std::string log = dir.path + "/swing_" + std::to_string(static_cast<int>(amplitude_deg)) + ".csv";
+  const std::string log =
+      dir.path + "/swing_" + std::to_string(static_cast<int>(amplitude_deg)) + ".csv";
   char command[512];
   std::snprintf(command, sizeof(command),
                 "%s simulate --trace %s --inertia-kg-m2 %g --mass-kg %g -L %g -D %g "
@@ -115,13 +116,13 @@ TEST(PeriodRecord, FitConsoleLineInTheConfigUnits) {
   const TraceRecord r = FitSwing(dir, 5.0, Config("imperial"), &log);
   ASSERT_TRUE(r.ok()) << r.message;
   const std::string out = dir.path + "/out.txt";
-  const std::string command = std::string(BIFILAR_BINARY) + " fit " + dir.path + "/fit.yaml " +
-                              log + " > " + out + " 2>&1";
+  const std::string command =
+      std::string(BIFILAR_BINARY) + " fit " + dir.path + "/fit.yaml " + log + " > " + out + " 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << ReadFile(out);
   const std::string text = ReadFile(out);
   char expected[160];
-  std::snprintf(expected, sizeof(expected), "period %.4f s (%.4f Hz), small-angle I = ",
-                r.period_s, r.frequency_hz);
+  std::snprintf(expected, sizeof(expected), "period %.4f s (%.4f Hz), small-angle I = ", r.period_s,
+                r.frequency_hz);
   EXPECT_NE(text.find(expected), std::string::npos) << text;
   // units: imperial: every inertia of the line in slug ft^2 (1 slug ft^2 = 1.35581795 kg m^2).
   std::snprintf(expected, sizeof(expected), "= %.5g slug ft^2",

@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <tuple>
 #include <string>
+#include <tuple>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -57,7 +57,8 @@ TEST(PhysicalCampaign, OtherRigForOneAttitudeIsNotPhysical) {
   EXPECT_EQ(console.str().rfind("Error: NOT PHYSICAL", 0), 0u) << console.str();
   std::istringstream lines(console.str());
   for (std::string line; std::getline(lines, line);) {
-    if (line.find("PHYSICAL") != std::string::npos || line.find("Likely causes") != std::string::npos) {
+    if (line.find("PHYSICAL") != std::string::npos ||
+        line.find("Likely causes") != std::string::npos) {
       EXPECT_LE(line.size(), 160u) << line;
     }
   }
@@ -70,7 +71,7 @@ TEST(PhysicalCampaign, OtherRigForOneAttitudeIsNotPhysical) {
     ExportOptions o;
     o.results_path = dir.path + "/out/results.json";
     o.format = format;
-    o.symmetric = true;             // a three-axis campaign holds no products:
+    o.symmetric = true;            // a three-axis campaign holds no products:
     o.set_kg_m2 = {{"Ixz", 0.0}};  // Ixy, Iyz by symmetry, Ixz given
     std::ostringstream out, err;
     EXPECT_NE(RunExport(o, out, err), 0) << ExportFormatName(format);
@@ -106,7 +107,8 @@ namespace {
 
 // configs/simulate_three_axes_two_setups.yaml simulated once; `table` (rows of
 // path,roll_deg,pitch_deg[,group]) replaces runs.pattern when not empty.
-CampaignResult ProcessTwoSetups(const TempDir& dir, const std::string& table, std::string* console) {
+CampaignResult ProcessTwoSetups(const TempDir& dir, const std::string& table,
+                                std::string* console) {
   const std::string source = BIFILAR_SOURCE_DIR;
   if (!std::filesystem::exists(dir.path + "/logs")) {
     RunSimulateCampaign(ReadSimulateSpec(source + "/configs/simulate_three_axes_two_setups.yaml"),
@@ -144,8 +146,8 @@ std::string Rows(bool comment_other_rig, bool groups) {
     for (int trial = 1; trial <= 4; ++trial) {
       const bool other = roll == 90 && trial >= 3;
       t += std::string(comment_other_rig && other ? "#" : "") + folder + "/trial_" +
-           std::to_string(trial) + ".csv.gz," + std::to_string(roll) + "," +
-           std::to_string(pitch) + (groups ? (other ? ",long wires" : ",rig A") : "") + "\n";
+           std::to_string(trial) + ".csv.gz," + std::to_string(roll) + "," + std::to_string(pitch) +
+           (groups ? (other ? ",long wires" : ",rig A") : "") + "\n";
     }
   }
   return t;

@@ -61,7 +61,9 @@ TEST(PlausibleConfig, LengthsAndMassInMillimetresAndGramsNameKeyLineAndUnit) {
   // The case: the quadrotor rig written in mm and g.
   std::string why = FitConfigError(dir, Rig("594", "30", "34.3"));
   EXPECT_TRUE(Contains(why, "fit.yaml:1:")) << why;  // the line of the key
-  EXPECT_TRUE(Contains(why, "rig.filar_length_m = 594; must be in [0.05, 20] (m), a lab rig's range")) << why;
+  EXPECT_TRUE(
+      Contains(why, "rig.filar_length_m = 594; must be in [0.05, 20] (m), a lab rig's range"))
+      << why;
   EXPECT_TRUE(Contains(why, "if this is in mm, write 0.594")) << why;
   // The separation alone in mm.
   why = FitConfigError(dir, Rig("0.594", "30", "0.0343"));
@@ -69,8 +71,10 @@ TEST(PlausibleConfig, LengthsAndMassInMillimetresAndGramsNameKeyLineAndUnit) {
   EXPECT_TRUE(Contains(why, "if this is in mm, write 0.03")) << why;
   // The separation in cm is within D's range but not below L: named, with the cm reading.
   why = FitConfigError(dir, Rig("0.594", "3", "0.0343"));
-  EXPECT_TRUE(Contains(why, "'rig.filar_separation_m': filar_separation_m (D) = 3; must be < "
-                           "filar_length_m (L) = 0.594")) << why;
+  EXPECT_TRUE(Contains(why,
+                       "'rig.filar_separation_m': filar_separation_m (D) = 3; must be < "
+                       "filar_length_m (L) = 0.594"))
+      << why;
   EXPECT_TRUE(Contains(why, "if this is in cm, write 0.03")) << why;
   // The fixed-wing's length in cm.
   why = FitConfigError(dir, Rig("74", "0.16", "3.34"));
@@ -85,9 +89,9 @@ TEST(PlausibleConfig, LengthsAndMassInMillimetresAndGramsNameKeyLineAndUnit) {
   EXPECT_TRUE(Contains(why, "if this is in g, write 5.5")) << why;
   // Too short for any rig, with no unit that fixes it: the range and "SI" are named.
   why = FitConfigError(dir, Rig("0.01", "0.006", "0.0343"));
-  EXPECT_TRUE(
-      Contains(why, "rig.filar_length_m = 0.01; must be in [0.05, 20] (m), a lab rig's range; "
-                    "values are SI (m)"))
+  EXPECT_TRUE(Contains(why,
+                       "rig.filar_length_m = 0.01; must be in [0.05, 20] (m), a lab rig's range; "
+                       "values are SI (m)"))
       << why;
 }
 
@@ -102,7 +106,8 @@ TEST(PlausibleConfig, RigInertiaInKgCm2IsAnError) {
   EXPECT_TRUE(Contains(why, "rig.inertia.inertia_kg_m2 = 2500; must be <= 101.2 (kg m^2)")) << why;
   EXPECT_TRUE(Contains(why, "if this is in kg cm^2, write 0.25")) << why;
   why = FitConfigError(dir, rig + "  inertia:\n    table: {0: 0.25, 90: 2600}\n" + rest);
-  EXPECT_TRUE(Contains(why, "rig.inertia.table (pitch 90 deg) = 2600; must be <= 101.2 (kg m^2)")) << why;
+  EXPECT_TRUE(Contains(why, "rig.inertia.table (pitch 90 deg) = 2600; must be <= 101.2 (kg m^2)"))
+      << why;
   EXPECT_EQ(FitConfigError(dir, rig + "  inertia: {inertia_kg_m2: 0.25}\n" + rest), "");
   // The quadrotor preset's thread "rig" (0.1 g, 1e-10 kg m^2) is fine.
   EXPECT_EQ(FitConfigError(dir, Rig("0.594", "0.030", "0.0001") + "aircraft: {mass_kg: 0.0342}\n"),

@@ -1,7 +1,7 @@
 // Issue 8: defaults that work on real IMU logs, honest uncertainty under coloured noise, and the
 // amplitude sweep. Real logs are read from crazyflie/ of the data folder (BIFILAR_REAL_DATA in
-// tests/test_support.h: skipped when no folder is named); simulated ones come from fit/trace_synth.h and from the
-// simulator's presets (configs/simulate_nonideal_rig.yaml).
+// tests/test_support.h: skipped when no folder is named); simulated ones come from
+// fit/trace_synth.h and from the simulator's presets (configs/simulate_nonideal_rig.yaml).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -56,9 +56,11 @@ TEST(RealRig, CrazyflieLogsAllGiveANumberWithDefaults) {
   const CampaignConfig narrow = LoadFitConfig(CrazyflieConfig(dir, 0.0381));
   // The authors' own script rerun on these logs (small-angle formula, the data folder's README.md);
   // a fit of the nonlinear model at 10-25 deg comes out slightly below it.
-  const std::map<std::string, double> authors = {
-      {"BaseModel_Ixx", 15.78e-6}, {"BaseModel_Izz", 31.96e-6}, {"NarrowMedium_Ixx", 25.68e-6},
-      {"NarrowMedium_Iyy", 27.45e-6}, {"NarrowMedium_Izz", 43.32e-6}};
+  const std::map<std::string, double> authors = {{"BaseModel_Ixx", 15.78e-6},
+                                                 {"BaseModel_Izz", 31.96e-6},
+                                                 {"NarrowMedium_Ixx", 25.68e-6},
+                                                 {"NarrowMedium_Iyy", 27.45e-6},
+                                                 {"NarrowMedium_Izz", 43.32e-6}};
   int n = 0, with_number = 0, rejected = 0;
   for (const auto& entry : fs::directory_iterator(crazyflie)) {
     const std::string name = entry.path().filename().string();
@@ -120,8 +122,10 @@ TEST(RealRig, CoverageUnderColouredNoiseAndIrregularSampling) {
       max_z = std::max(max_z, std::abs(r.sweep.trend_z));
     }
     const double coverage = static_cast<double>(within) / n;
-    std::printf("  AR(1) phi %.2f, irregular 30 Hz: %d/%d = %.3f within 1.96 sigma; trend flagged "
-                "on %d ideal traces (largest |z| %.1f)\n", phi, within, n, coverage, flagged, max_z);
+    std::printf(
+        "  AR(1) phi %.2f, irregular 30 Hz: %d/%d = %.3f within 1.96 sigma; trend flagged "
+        "on %d ideal traces (largest |z| %.1f)\n",
+        phi, within, n, coverage, flagged, max_z);
     // 40 traces: binomial sd of a 95 % coverage is 3.4 %; the bound allows ~2.5 sd below.
     EXPECT_GE(coverage, 0.85) << "phi " << phi;
     EXPECT_EQ(flagged, 0) << "phi " << phi;  // no trend on an ideal rig (trend_z 4)
@@ -134,7 +138,8 @@ TEST(RealRig, CoverageUnderColouredNoiseAndIrregularSampling) {
 TEST(RealRig, NonIdealRigIsFlaggedAndCovered) {
   const std::string dir = TempDir();
   const std::string command = std::string(BIFILAR_BINARY) + " simulate " + kSource +
-                              "/configs/simulate_nonideal_rig.yaml --out " + dir + "/logs > /dev/null";
+                              "/configs/simulate_nonideal_rig.yaml --out " + dir +
+                              "/logs > /dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0);
   const CampaignConfig config = LoadFitConfig(WriteConfig(
       dir, "c.yaml",
@@ -142,7 +147,8 @@ TEST(RealRig, NonIdealRigIsFlaggedAndCovered) {
       "imu:\n  time: {column: t, unit: ms}\n  gyro: {columns: [gx, gy, gz], unit: deg/s}\n"
       "  accel: null\n"));
   std::ifstream truth_file(dir + "/logs/truth.json");
-  const std::string truth((std::istreambuf_iterator<char>(truth_file)), std::istreambuf_iterator<char>());
+  const std::string truth((std::istreambuf_iterator<char>(truth_file)),
+                          std::istreambuf_iterator<char>());
   int n = 0;
   for (const char* pitch : {"pitch_0", "pitch_90"}) {
     const double truth_i = std::string(pitch) == "pitch_0" ? 0.05 : 0.027;

@@ -98,8 +98,9 @@ TEST(RepeatSetups, TheIssuesRollLogsAreTwoSetupsNotAmplitude) {
   EXPECT_TRUE(g[0].setups.axes_differ);
   EXPECT_NEAR(g[0].setups.mean_kg_m2[0], 0.10538, 1e-4);
   EXPECT_NEAR(g[0].setups.mean_kg_m2[1], 0.124295, 1e-4);
-  EXPECT_NE(g[0].setups_text.find("RollInertiaPendel03.csv, RollInertiapendel04.csv at I = 0.10538"),
-            std::string::npos)
+  EXPECT_NE(
+      g[0].setups_text.find("RollInertiaPendel03.csv, RollInertiapendel04.csv at I = 0.10538"),
+      std::string::npos)
       << g[0].setups_text;
   EXPECT_FALSE(c.applied);
   const std::string line = RepeatGroupLine(g[0]) + AmplitudeCorrectionLine(c);
@@ -118,7 +119,8 @@ TEST(RepeatSetups, ACoefficientTheLogsContradictIsNotApplied) {
     for (int k = 0; k < 3; ++k) {
       const double a = 10.0 + 5.0 * k;
       const std::string name = std::string(g ? "b" : "a") + "_" + std::to_string(k + 1);
-      r.push_back(Swing(name, (1.0 + g) * (1.0 + 5e-4 * a * a), 1e-3 * (1.0 + g), a, 0.0, 1e-6, 1.0));
+      r.push_back(
+          Swing(name, (1.0 + g) * (1.0 + 5e-4 * a * a), 1e-3 * (1.0 + g), a, 0.0, 1e-6, 1.0));
       paths.push_back(name);
     }
   }
@@ -239,7 +241,8 @@ TEST(RepeatSetups, TwoHangingsAreReportedAsTwoSetups) {
   EXPECT_NE(line.find("with it every log is within"), std::string::npos) << line;
   bool warned = false;
   for (const std::string& w : r.records[0].warnings) {
-    warned |= w.find("they look like two set-ups, not one: roll_1.csv, roll_2.csv") != std::string::npos;
+    warned |=
+        w.find("they look like two set-ups, not one: roll_1.csv, roll_2.csv") != std::string::npos;
   }
   EXPECT_TRUE(warned);
   // The spread is not amplitude: no coefficient is pooled from it.
@@ -301,24 +304,26 @@ TEST(RepeatSetups, CampaignWarnsPerAttitudeAndHonoursTheGroupColumn) {
       "  accel: {columns: [ax, ay, az], unit: m/s^2}\n"
       "runs: {root: ., table: runs.csv}\n";
   WriteFile(dir.path + "/campaign.yaml", config);
-  WriteFile(dir.path + "/runs.csv",
-            "path,pitch_deg\np_1.csv,0\np_2.csv,0\np_3.csv,0\np_4.csv,0\n");
-  const test_support::CliRun one =
-      test_support::Bifilar(dir, "process " + dir.path + "/campaign.yaml --out " + dir.path + "/out1");
-  EXPECT_NE(one.out.find("Warning: result withheld at roll 0, pitch 0 deg: its 4 logs look like two"),
-            std::string::npos)
+  WriteFile(dir.path + "/runs.csv", "path,pitch_deg\np_1.csv,0\np_2.csv,0\np_3.csv,0\np_4.csv,0\n");
+  const test_support::CliRun one = test_support::Bifilar(
+      dir, "process " + dir.path + "/campaign.yaml --out " + dir.path + "/out1");
+  EXPECT_NE(
+      one.out.find("Warning: result withheld at roll 0, pitch 0 deg: its 4 logs look like two"),
+      std::string::npos)
       << one.out << one.err;
   EXPECT_NE(one.out.find("p_1.csv, p_2.csv at I = "), std::string::npos) << one.out;
   EXPECT_NE(test_support::ReadFile(dir.path + "/out1/results.json").find("look like two set-ups"),
             std::string::npos);
-  WriteFile(dir.path + "/runs.csv", "path,pitch_deg,group\np_1.csv,0,A\np_2.csv,0,A\n"
-                                    "p_3.csv,0,B\np_4.csv,0,B\n");
-  const test_support::CliRun two =
-      test_support::Bifilar(dir, "process " + dir.path + "/campaign.yaml --out " + dir.path + "/out2");
+  WriteFile(dir.path + "/runs.csv",
+            "path,pitch_deg,group\np_1.csv,0,A\np_2.csv,0,A\n"
+            "p_3.csv,0,B\np_4.csv,0,B\n");
+  const test_support::CliRun two = test_support::Bifilar(
+      dir, "process " + dir.path + "/campaign.yaml --out " + dir.path + "/out2");
   EXPECT_NE(two.out.find("are named as 2 set-ups"), std::string::npos) << two.out;
   EXPECT_NE(two.out.find("Traces: 0 ok, 4 rejected"), std::string::npos) << two.out << two.err;
-  WriteFile(dir.path + "/runs.csv", "path,pitch_deg,group\np_1.csv,0,A\np_2.csv,0,A\n"
-                                    "#p_3.csv,0,B\n#p_4.csv,0,B\n");
+  WriteFile(dir.path + "/runs.csv",
+            "path,pitch_deg,group\np_1.csv,0,A\np_2.csv,0,A\n"
+            "#p_3.csv,0,B\n#p_4.csv,0,B\n");
   const test_support::CliRun three = test_support::Bifilar(
       dir, "process " + dir.path + "/campaign.yaml --out " + dir.path + "/out3");
   EXPECT_EQ(three.out.find("set-ups"), std::string::npos) << three.out;
@@ -356,7 +361,8 @@ TEST(RepeatGrouping, HostileGroupByPatternsAreAnsweredOrRefused) {
   for (int i = 0; i < 8000; ++i) deep += "a/";
   RepeatGroupingOptions path;
   path.group_by = "/((.|/)*)x";
-  const std::vector<RepeatGroup> p = GroupRepeats({deep + "swing_1.csv", deep + "swing_2.csv"}, path);
+  const std::vector<RepeatGroup> p =
+      GroupRepeats({deep + "swing_1.csv", deep + "swing_2.csv"}, path);
   ASSERT_EQ(p.size(), 2u);
   EXPECT_NE(p[0].alone.find("does not match --group-by '/((.|/)*)x'"), std::string::npos);
   // (a+)+$ on 28 a's and a b: no match (std::regex took minutes); on a's alone, the a's.
@@ -374,16 +380,17 @@ TEST(RepeatGrouping, HostileGroupByPatternsAreAnsweredOrRefused) {
 // without being read whole.
 TEST(RepeatGrouping, RunsTableKeysAreNumbersAndTheTableIsBounded) {
   const TempDir dir("bifilar_setups_bounds");
-  const std::string attitudes = WriteFile(
-      dir.path + "/attitudes.csv",
-      "path,roll_deg,pitch_deg\nr1.csv,-0,0\nr2.csv,0,-0.0\nr3.csv,0.0,10\n");
+  const std::string attitudes =
+      WriteFile(dir.path + "/attitudes.csv",
+                "path,roll_deg,pitch_deg\nr1.csv,-0,0\nr2.csv,0,-0.0\nr3.csv,0.0,10\n");
   const RunsTableGroups by_attitude = ReadRunsTableGroups(attitudes);
   ASSERT_EQ(by_attitude.groups.size(), 3u);
   EXPECT_EQ(by_attitude.groups[0], "roll 0 pitch 0");
   EXPECT_EQ(by_attitude.groups[1], "roll 0 pitch 0");
   EXPECT_EQ(by_attitude.groups[2], "roll 0 pitch 10");
-  const std::string numbered = WriteFile(
-      dir.path + "/numbered.csv", "path,group\nr1.csv,10\nr2.csv,10.0\nr3.csv,-0\nr4.csv,0\nr5.csv,A\n");
+  const std::string numbered =
+      WriteFile(dir.path + "/numbered.csv",
+                "path,group\nr1.csv,10\nr2.csv,10.0\nr3.csv,-0\nr4.csv,0\nr5.csv,A\n");
   EXPECT_EQ(ReadRunsTableGroups(numbered).groups,
             (std::vector<std::string>{"10", "10", "0", "0", "A"}));
   const auto refused = [](const std::string& table, const std::string& why) {

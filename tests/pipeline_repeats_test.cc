@@ -34,10 +34,9 @@ TraceRecord Record(double inertia, double std) {
 }
 
 TEST(Repeats, GroupsByTheLastNumberOfTheFileName) {
-  const std::vector<RepeatGroup> g =
-      GroupRepeats({"logs/A_Log-1.csv", "logs/B_Log-1.csv", "logs/A_Log-2.csv",
-                    "pitch_10/trial_3.csv", "pitch_10/trial_12.csv", "pitch_20/trial_1.csv",
-                    "single.csv"});
+  const std::vector<RepeatGroup> g = GroupRepeats(
+      {"logs/A_Log-1.csv", "logs/B_Log-1.csv", "logs/A_Log-2.csv", "pitch_10/trial_3.csv",
+       "pitch_10/trial_12.csv", "pitch_20/trial_1.csv", "single.csv"});
   ASSERT_EQ(g.size(), 5u);
   EXPECT_EQ(g[0].name, "logs/A_Log-*.csv");
   EXPECT_EQ(g[0].members, (std::vector<int>{0, 2}));
@@ -75,7 +74,8 @@ TEST(Repeats, RecoversAKnownBetweenRepeatStd) {
   const int sets = 400;
   for (int s = 0; s < sets; ++s) {
     std::vector<TraceRecord> r;
-    for (int k = 0; k < 6; ++k) r.push_back(Record(1.0 + tau * normal(rng) + sigma * normal(rng), sigma));
+    for (int k = 0; k < 6; ++k)
+      r.push_back(Record(1.0 + tau * normal(rng) + sigma * normal(rng), sigma));
     std::vector<RepeatGroup> g = GroupRepeats({"l1", "l2", "l3", "l4", "l5", "l6"});
     CombineRepeats(&g, &r);
     tau_sum += g[0].tau_kg_m2;
@@ -164,7 +164,8 @@ TEST(Repeats, FitCommandCombinesSimulatedQuadrotorRepeats) {
   char dir_template[] = "/tmp/bifilar_repeats_cli_XXXXXX";
   const std::string dir = mkdtemp(dir_template);
   const std::string simulate = std::string(BIFILAR_BINARY) + " simulate " + kSource +
-                               "/configs/simulate_quadrotor.yaml --out " + dir + "/logs > /dev/null";
+                               "/configs/simulate_quadrotor.yaml --out " + dir +
+                               "/logs > /dev/null";
   ASSERT_EQ(std::system(simulate.c_str()), 0);
   std::ofstream(dir + "/fit.yaml") << test_support::QuadrotorFitConfig();
   const std::string fit = std::string(BIFILAR_BINARY) + " fit " + dir + "/fit.yaml " + dir +
@@ -199,7 +200,8 @@ TEST(Repeats, QuadrotorRepeatsAreWithinTheirStd) {
         dir.path + "/" + airframe + ".yaml", test_support::QuadrotorFitConfig(mass)));
     for (const char* axis : {"Ixx", "Iyy", "Izz"}) {
       for (int k = 1; k <= 4; ++k) {
-        paths.push_back(crazyflie + "/" + airframe + "_" + axis + "_Log-" + std::to_string(k) + ".csv");
+        paths.push_back(crazyflie + "/" + airframe + "_" + axis + "_Log-" + std::to_string(k) +
+                        ".csv");
         records.push_back(ProcessTrace(config, paths.back(), {}));
         ASSERT_TRUE(records.back().ok()) << paths.back() << ": " << records.back().message;
       }
@@ -256,11 +258,12 @@ TEST(Repeats, QuadrotorRepeatsAreWithinTheirStd) {
     }
     std::printf("  %s\n", RepeatGroupLine(g).c_str());
   }
-  std::printf("  %d logs: %d beyond 2.5 sigma of their set-up's mean with the per-log std alone, "
-              "%d with the repeats combined; mean scatter of the repeats %.3f %% before the "
-              "amplitude correction, %.3f %% after; Cochran's Q summed over the set-ups %.1f "
-              "before, %.1f after (18 dof)\n",
-              logs, beyond_before, beyond, spread_before, spread_after, q_before, q_after);
+  std::printf(
+      "  %d logs: %d beyond 2.5 sigma of their set-up's mean with the per-log std alone, "
+      "%d with the repeats combined; mean scatter of the repeats %.3f %% before the "
+      "amplitude correction, %.3f %% after; Cochran's Q summed over the set-ups %.1f "
+      "before, %.1f after (18 dof)\n",
+      logs, beyond_before, beyond, spread_before, spread_after, q_before, q_after);
   EXPECT_EQ(logs, 24);
   EXPECT_EQ(beyond, 0);
   // The correction takes out part of the scatter (the release amplitude's share), judged on the

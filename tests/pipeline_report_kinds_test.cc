@@ -54,7 +54,8 @@ CampaignOptions FakeOptions(const std::string& out) {
   o.out_dir = out;
   o.jobs = 2;
   o.figures = true;
-  o.fit_function = [](const CampaignConfig&, const std::string& path, const TraceProcessOptions& options) {
+  o.fit_function = [](const CampaignConfig&, const std::string& path,
+                      const TraceProcessOptions& options) {
     TraceRecord r;
     r.file = options.display_name;
     r.status = TraceStatus::kOk;
@@ -130,8 +131,10 @@ void ExpectCommonDetails(const Page& p) {
     EXPECT_EQ(at, std::string::npos) << e << " in: " << text.substr(at < 120 ? 0 : at - 120, 240);
   }
   EXPECT_NE(Find(page, "<th>roll (deg)</th><th>pitch (deg)</th>"), std::string::npos);
-  EXPECT_NE(Find(page, "<div class=\"scroll\"><table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"),
-            std::string::npos);
+  EXPECT_NE(
+      Find(page,
+           "<div class=\"scroll\"><table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"),
+      std::string::npos);
   // The main result first, in its box before any section.
   EXPECT_LT(Find(page, "<p class=\"result\">Result: "), Find(page, "<h2>"));
   // Table 1 before Table 2 (the paper's order) where both are shown.

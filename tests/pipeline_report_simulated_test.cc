@@ -91,13 +91,14 @@ TEST(ReportSimulated, FullTensorShowsItsEllipsoid) {
                       logs[0]["file"].get<std::string>()),
             std::string::npos);
   std::ostringstream console;
-  PrintCampaignSummary(LoadCampaignConfig(std::string(BIFILAR_SOURCE_DIR) + "/configs/tensor_uav.yaml",
-                                          [&] {
-                                            ConfigLoadOptions o;
-                                            o.runs_root = dir.path + "/logs";
-                                            return o;
-                                          }()),
-                       result, console);
+  PrintCampaignSummary(
+      LoadCampaignConfig(std::string(BIFILAR_SOURCE_DIR) + "/configs/tensor_uav.yaml",
+                         [&] {
+                           ConfigLoadOptions o;
+                           o.runs_root = dir.path + "/logs";
+                           return o;
+                         }()),
+      result, console);
   EXPECT_NE(console.str().find("the logs behind the scatter, residual over their own std: " +
                                logs[0]["file"].get<std::string>()),
             std::string::npos)

@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <plplot/plplot.h>
+#include <nlohmann/json.hpp>
 
 #include "base/user_error.h"
 #include "pipeline/campaign/campaign.h"
@@ -41,7 +41,8 @@ TEST(Report, Base64MatchesRfc4648Vectors) {
 // Every href="#id" of the page names an id="id" of the page (a shared glyph, a section).
 void ExpectEveryHrefResolves(const std::string& html) {
   int refs = 0;
-  for (size_t at = html.find("href=\"#"); at != std::string::npos; at = html.find("href=\"#", at + 1)) {
+  for (size_t at = html.find("href=\"#"); at != std::string::npos;
+       at = html.find("href=\"#", at + 1)) {
     const size_t start = at + 7, end = html.find('"', start);
     ASSERT_NE(end, std::string::npos);
     const std::string id = html.substr(start, end - start);
@@ -67,10 +68,11 @@ std::string MakeCampaign() {
     }
   }
   WriteFile(dir + "/logs/pitch_0/trial_<3>.csv", "broken & <bad>");
-  WriteFile(dir + "/c.yaml",
-            "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.5}}\n"
-            "aircraft: {mass_kg: 5}\nruns: {root: logs, pattern: \"pitch_{pitch_deg}/*.csv\"}\n"
-            "units: imperial\n");
+  WriteFile(
+      dir + "/c.yaml",
+      "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: 0.5}}\n"
+      "aircraft: {mass_kg: 5}\nruns: {root: logs, pattern: \"pitch_{pitch_deg}/*.csv\"}\n"
+      "units: imperial\n");
   CampaignOptions options;
   options.out_dir = dir + "/out";
   options.jobs = 2;
@@ -91,24 +93,31 @@ std::string MakeCampaign() {
     // writes it; and the assumed-inputs warning every trace carries, which the report states
     // once (Table 2), not per trace.
     if (path.find("pitch_45/trial_2") != std::string::npos) {
-      r.warnings.push_back("I depends on the amplitude beyond its statistical error; I is taken "
-                           "from the lowest-amplitude band with a model-inadequacy std of "
-                           "0.0058 kg m^2");
+      r.warnings.push_back(
+          "I depends on the amplitude beyond its statistical error; I is taken "
+          "from the lowest-amplitude band with a model-inadequacy std of "
+          "0.0058 kg m^2");
     }
     std::string why;
-    WriteFigure(o.figure_paths.at(0), FigureOptions{400, 300}, [] {
-      PLFLT x[2] = {0, 1}, y[2] = {0, 1};
-      plenv(0, 1, 0, 1, 0, 0);
-      pllab("t (s)", "rate", "fake fit");
-      plline(2, x, y);
-    }, &why);
+    WriteFigure(
+        o.figure_paths.at(0), FigureOptions{400, 300},
+        [] {
+          PLFLT x[2] = {0, 1}, y[2] = {0, 1};
+          plenv(0, 1, 0, 1, 0, 0);
+          pllab("t (s)", "rate", "fake fit");
+          plline(2, x, y);
+        },
+        &why);
     // Trial 1 of each angle has an amplitude sweep (and its figure), trial 2 is too short.
     if (path.find("trial_1") != std::string::npos) {
       r.sweep.evaluated = true;
-      WriteFigure(o.sweep_figure_paths.at(0), FigureOptions{400, 300}, [] {
-        plenv(0, 1, 0, 1, 0, 0);
-        pllab("amplitude (deg)", "I", "fake sweep");
-      }, &why);
+      WriteFigure(
+          o.sweep_figure_paths.at(0), FigureOptions{400, 300},
+          [] {
+            plenv(0, 1, 0, 1, 0, 0);
+            pllab("amplitude (deg)", "I", "fake sweep");
+          },
+          &why);
     } else {
       r.sweep.note = "the window holds 4.0 cycles";
     }
@@ -121,17 +130,18 @@ std::string MakeCampaign() {
 TEST(Report, HasEverySectionAndEmbedsEveryFigure) {
   const std::string out = MakeCampaign();
   const std::string html = ReadFile(out + "/report.html");
-  for (const char* section : {"Table 2: inertia properties", "Table 1: data quality",
-                              "Figure 3: moment of inertia against pitch",
-                              "Figure 4: ellipse of inertia", "NACA Report 467 comparison",
-                              "Per-angle statistics", "Rejected and failed traces",
-                              "Fit and residual of every trace", "Config used", "slug ft"}) {
+  for (const char* section :
+       {"Table 2: inertia properties", "Table 1: data quality",
+        "Figure 3: moment of inertia against pitch", "Figure 4: ellipse of inertia",
+        "NACA Report 467 comparison", "Per-angle statistics", "Rejected and failed traces",
+        "Fit and residual of every trace", "Config used", "slug ft"}) {
     EXPECT_NE(html.find(section), std::string::npos) << section;
   }
   // 8 trace figures (inline SVG) + Fig. 3 + Fig. 4 (PNG data URIs); no reference to another file.
   auto count = [&](const std::string& needle) {
     int n = 0;
-    for (size_t at = html.find(needle); at != std::string::npos; at = html.find(needle, at + 1)) ++n;
+    for (size_t at = html.find(needle); at != std::string::npos; at = html.find(needle, at + 1))
+      ++n;
     return n;
   };
   EXPECT_EQ(count("<svg class=\"trace\""), 8);
@@ -174,7 +184,8 @@ TEST(Report, HasEverySectionAndEmbedsEveryFigure) {
   const std::string section = html.substr(warnings, after - warnings);
   EXPECT_NE(section.find("1 fitted trace raised warnings"), std::string::npos) << section;
   EXPECT_NE(section.find("pitch_45/trial_2.csv"), std::string::npos) << section;
-  EXPECT_NE(section.find("model-inadequacy std of 0.00428 slug ft^2"), std::string::npos) << section;
+  EXPECT_NE(section.find("model-inadequacy std of 0.00428 slug ft^2"), std::string::npos)
+      << section;
   EXPECT_EQ(html.find("None: every trace passed"), std::string::npos);
   EXPECT_EQ(count("warning: I depends on the amplitude"), 1);  // the trace's caption
   // One unit system: nothing in kg m^2 outside the config text (which names its SI keys).
@@ -203,7 +214,8 @@ uintmax_t ScreenshotInChromium(const std::string& html, const std::string& work_
   const std::string command =
       "timeout 60 /usr/bin/chromium --headless --no-sandbox --disable-gpu --disable-quic "
       "--no-first-run --disable-background-networking --disable-component-update --disable-sync "
-      "--user-data-dir=" + profile + " --enable-logging=stderr --v=0 --screenshot=" + shot +
+      "--user-data-dir=" +
+      profile + " --enable-logging=stderr --v=0 --screenshot=" + shot +
       " --window-size=1200,4000 file://" + html + " > " + log + " 2>&1";
   EXPECT_EQ(std::system(command.c_str()), 0) << ReadFile(log);
   const std::string messages = ReadFile(log);
@@ -225,7 +237,8 @@ TEST(Report, LoadsInHeadlessChromiumWithoutConsoleErrors) {
 }
 
 TEST(Report, CommittedSampleReportLoadsInChromium) {
-  const std::string html = std::string(BIFILAR_SOURCE_DIR) + "/sample_runs/prandtl_d/out/report.html";
+  const std::string html =
+      std::string(BIFILAR_SOURCE_DIR) + "/sample_runs/prandtl_d/out/report.html";
   if (!fs::exists("/usr/bin/chromium")) GTEST_SKIP() << "/usr/bin/chromium not installed";
   if (!fs::exists(html)) GTEST_SKIP() << html << " not generated";
   // Every figure of the sample is embedded: 57 traces (inline SVG) + Fig. 3 + Fig. 4 (PNG).

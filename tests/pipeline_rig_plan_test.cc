@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <nlohmann/json.hpp>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
@@ -408,7 +408,8 @@ TEST(RigPlan, ReferenceBarsAreBuildableOrSaySo) {
       EXPECT_LE(b.length_m, 2.0);
       EXPECT_GE(b.thickness_m, 0.003) << c.inertia;
       EXPECT_LE(b.thickness_m, b.width_m) << c.inertia;
-      EXPECT_NEAR(b.inertia_kg_m2, b.mass_kg * (b.length_m * b.length_m + b.width_m * b.width_m) / 12,
+      EXPECT_NEAR(b.inertia_kg_m2,
+                  b.mass_kg * (b.length_m * b.length_m + b.width_m * b.width_m) / 12,
                   1e-12 * b.inertia_kg_m2);
       // Its period is the aircraft's: the same radius of gyration.
       EXPECT_NEAR(b.inertia_kg_m2 / b.mass_kg, c.inertia / c.mass, 1e-9 * c.inertia / c.mass);

@@ -71,7 +71,8 @@ TEST(Glitches, NeitherRejectNorMoveTheWindowNorBiasI) {
         ASSERT_EQ(a.status, TraceStatus::kOk) << file << ": " << a.message;
         EXPECT_EQ(GlitchWarning(a), "") << file;  // nothing found in a clean log
         EXPECT_EQ(b.status, TraceStatus::kOk) << rate << " rad/s " << file << ": " << b.message;
-        EXPECT_LE(std::abs(b.inertia_total_kg_m2 - a.inertia_total_kg_m2), a.inertia_total_std_kg_m2)
+        EXPECT_LE(std::abs(b.inertia_total_kg_m2 - a.inertia_total_kg_m2),
+                  a.inertia_total_std_kg_m2)
             << rate << " rad/s " << file;
         EXPECT_LE(std::abs(b.window_s[0] - a.window_s[0]), 2 * 0.160) << rate << " rad/s " << file;
         const std::string w = GlitchWarning(b);
@@ -102,7 +103,9 @@ TEST(Glitches, SmallerGlitchesAreFoundOnTheFitResidual) {
     while (std::getline(in, line)) {
       double t = 0, wx = 0, wy = 0, wz = 0;
       char rest[512] = "";
-      if (!done && std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf%511s", &t, &wx, &wy, &wz, rest) >= 4 && t > 15.0) {
+      if (!done &&
+          std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf%511s", &t, &wx, &wy, &wz, rest) >= 4 &&
+          t > 15.0) {
         char row[640];
         std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g%s", t, wx, wy, wz + 0.2, rest);
         line = row;
@@ -117,7 +120,8 @@ TEST(Glitches, SmallerGlitchesAreFoundOnTheFitResidual) {
     ASSERT_EQ(a.status, TraceStatus::kOk) << a.message;
     ASSERT_EQ(b.status, TraceStatus::kOk) << b.message;
     EXPECT_TRUE(Contains(GlitchWarning(b), "off the fit")) << GlitchWarning(b);
-    EXPECT_LE(std::abs(b.inertia_total_kg_m2 - a.inertia_total_kg_m2), a.inertia_total_std_kg_m2) << k;
+    EXPECT_LE(std::abs(b.inertia_total_kg_m2 - a.inertia_total_kg_m2), a.inertia_total_std_kg_m2)
+        << k;
   }
 }
 
@@ -127,7 +131,8 @@ TEST(Glitches, SmallerGlitchesAreFoundOnTheFitResidual) {
 TEST(GravityRemovedAccelerometer, IgnoredWithAWarning) {
   TempDir dir;
   const std::string command = std::string(BIFILAR_BINARY) + " simulate " + kSource +
-                              "/configs/simulate_nonideal_rig.yaml --out " + dir.path + "/logs > /dev/null";
+                              "/configs/simulate_nonideal_rig.yaml --out " + dir.path +
+                              "/logs > /dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0);
   const std::string common =
       "rig: {filar_length_m: 0.74, filar_separation_m: 0.16, mass_kg: 3.34}\n"
@@ -167,7 +172,8 @@ std::string GyroLog(const Rate& rate, const Other& other, int n = 3000) {
   std::string text = "t,gx,gy,gz\n";
   char row[160];
   for (int k = 0; k < n; ++k) {
-    std::snprintf(row, sizeof(row), "%.2f,%.17g,%.17g,%.17g\n", 0.01 * k, other(k), other(k + n), rate(k));
+    std::snprintf(row, sizeof(row), "%.2f,%.17g,%.17g,%.17g\n", 0.01 * k, other(k), other(k + n),
+                  rate(k));
     text += row;
   }
   return text;
@@ -178,7 +184,8 @@ TEST(BadLogs, AllNoiseSaysNoOscillation) {
   WriteFile(dir.path + "/fit.yaml", kGyroFit);
   std::mt19937_64 rng(7);
   std::normal_distribution<double> noise(0.0, 0.004);
-  WriteFile(dir.path + "/noise.csv", GyroLog([&](int) { return noise(rng); }, [&](int) { return noise(rng); }));
+  WriteFile(dir.path + "/noise.csv",
+            GyroLog([&](int) { return noise(rng); }, [&](int) { return noise(rng); }));
   std::string out;
   EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/noise.csv", &out), 1) << out;
   EXPECT_TRUE(Contains(out, "noise.csv")) << out;
@@ -199,7 +206,8 @@ TEST(BadLogs, FooterOnlySaysNoNumericRows) {
 TEST(BadLogs, SingleSpikeOnZerosSaysNoOscillation) {
   TempDir dir;
   WriteFile(dir.path + "/fit.yaml", kGyroFit);
-  WriteFile(dir.path + "/spike.csv", GyroLog([](int k) { return k == 1500 ? 50.0 : 0.0; }, [](int) { return 0.0; }));
+  WriteFile(dir.path + "/spike.csv",
+            GyroLog([](int k) { return k == 1500 ? 50.0 : 0.0; }, [](int) { return 0.0; }));
   std::string out;
   EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/spike.csv", &out), 1) << out;
   EXPECT_TRUE(Contains(out, "spike.csv")) << out;
@@ -212,9 +220,11 @@ TEST(BadLogs, AbsurdGyroValuesNameLineAndColumn) {
   WriteFile(dir.path + "/fit.yaml", kGyroFit);
   // Everywhere (no "amplitude from inf to inf"), and in one sample of a good swing (no glitch
   // repair of a value no gyro gives: the file is corrupt or its unit wrong).
-  WriteFile(dir.path + "/huge.csv", GyroLog([](int k) { return 1e300 * std::sin(0.03 * k); }, [](int) { return 0.0; }));
+  WriteFile(dir.path + "/huge.csv",
+            GyroLog([](int k) { return 1e300 * std::sin(0.03 * k); }, [](int) { return 0.0; }));
   WriteFile(dir.path + "/one.csv",
-            GyroLog([](int k) { return k == 700 ? 1e300 : 0.5 * std::sin(0.03 * k); }, [](int) { return 0.0; }));
+            GyroLog([](int k) { return k == 700 ? 1e300 : 0.5 * std::sin(0.03 * k); },
+                    [](int) { return 0.0; }));
   std::string out;
   EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/huge.csv", &out), 1) << out;
   EXPECT_TRUE(Contains(out, "huge.csv:3:4: column 'gz'")) << out;  // line 3: the first non-zero
@@ -236,27 +246,43 @@ TEST(BadLogs, WindowOutsideTheLogInItsOwnTerms) {
   std::string text = "t,gx,gy,gz\n";
   char row[128];
   for (int k = 0; k <= 13000; ++k) {  // 0-130 s in ms at 100 Hz, a 2 s swing
-    std::snprintf(row, sizeof(row), "%d,0,0,%.9g\n", 10 * k, 0.5 * std::exp(-0.002 * k) * std::sin(0.0314159 * k));
+    std::snprintf(row, sizeof(row), "%d,0,0,%.9g\n", 10 * k,
+                  0.5 * std::exp(-0.002 * k) * std::sin(0.0314159 * k));
     text += row;
   }
   WriteFile(dir.path + "/ms.csv", text);
   std::string out;
-  EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 5000:60000", &out), 1) << out;
-  EXPECT_TRUE(Contains(out, "ms.csv: error: window 5000-60000 s is outside the log (0-130 s); "
-                            "--window takes seconds")) << out;
+  EXPECT_EQ(
+      Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 5000:60000", &out),
+      1)
+      << out;
+  EXPECT_TRUE(Contains(out,
+                       "ms.csv: error: window 5000-60000 s is outside the log (0-130 s); "
+                       "--window takes seconds"))
+      << out;
   EXPECT_TRUE(Contains(out, "if these are ms, give 5:60")) << out;
   EXPECT_FALSE(Contains(out, "constant")) << out;
-  EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 200:300", &out), 1) << out;
-  EXPECT_TRUE(Contains(out, "window 200-300 s is outside the log (0-130 s); --window takes "
-                            "seconds")) << out;
+  EXPECT_EQ(
+      Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 200:300", &out), 1)
+      << out;
+  EXPECT_TRUE(Contains(out,
+                       "window 200-300 s is outside the log (0-130 s); --window takes "
+                       "seconds"))
+      << out;
   EXPECT_TRUE(Contains(out, "; its start 200 s is after the log's end")) << out;
   // Past the log's end only (an end of 1e9 meaning "to the end"): clamped, with a warning naming
   // the end (issue 15 item 8; it was "outside the log").
-  EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 5:1e9", &out), 0) << out;
-  EXPECT_TRUE(Contains(out, "--window 5-1e+09 s: its end 1e+09 s is after the log's "
-                            "end 130 s; clamped to 5-130 s")) << out;
+  EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 5:1e9", &out),
+            0)
+      << out;
+  EXPECT_TRUE(Contains(out,
+                       "--window 5-1e+09 s: its end 1e+09 s is after the log's "
+                       "end 130 s; clamped to 5-130 s"))
+      << out;
   // Inside the log, in seconds: fitted.
-  EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 5:60", &out), 0) << out;
+  EXPECT_EQ(Cli(dir, "fit " + dir.path + "/fit.yaml " + dir.path + "/ms.csv --window 5:60", &out),
+            0)
+      << out;
 }
 
 }  // namespace

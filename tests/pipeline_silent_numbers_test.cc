@@ -53,11 +53,13 @@ int Cli(const TempDir& dir, const std::string& args, std::string* output) {
 std::string Config(const std::string& rig_inertia = "    inertia_kg_m2: 0.5\n",
                    const std::string& extra = "") {
   return "rig:\n  filar_length_m: 2.0\n  filar_separation_m: 1.0\n  mass_kg: 2.0\n"
-         "  inertia:\n" + rig_inertia +
+         "  inertia:\n" +
+         rig_inertia +
          "aircraft:\n  mass_kg: 10\n"
          "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [gx, gy, gz], unit: rad/s}\n"
          "  accel: null\n"
-         "runs:\n  root: logs\n  pattern: \"pitch_{pitch_deg}/*.csv\"\n" + extra;
+         "runs:\n  root: logs\n  pattern: \"pitch_{pitch_deg}/*.csv\"\n" +
+         extra;
 }
 
 std::string LoadError(const TempDir& dir, const std::string& yaml) {
@@ -99,8 +101,13 @@ TEST(SilentNumbers, BlankOrNullNumberIsAnErrorNamingTheKey) {
   // The same in a simulation spec.
   const std::string spec = WriteFile(dir.path + "/s.yaml", "geometry:\n  gravity_mps2:\n");
   std::string out;
-  EXPECT_EQ(Cli(dir, "simulate " + spec + " --trace " + dir.path + "/t.csv --inertia-kg-m2 1 "
-                     "--mass-kg 1", &out), 2) << out;
+  EXPECT_EQ(Cli(dir,
+                "simulate " + spec + " --trace " + dir.path +
+                    "/t.csv --inertia-kg-m2 1 "
+                    "--mass-kg 1",
+                &out),
+            2)
+      << out;
   EXPECT_TRUE(Contains(out, "'geometry.gravity_mps2' is blank")) << out;
   EXPECT_FALSE(std::filesystem::exists(dir.path + "/t.csv"));
 }
@@ -109,8 +116,11 @@ TEST(SilentNumbers, BlankOrNullNumberIsAnErrorNamingTheKey) {
 
 TEST(SilentNumbers, GravityIsBoundedToEarthUnlessOverridden) {
   TempDir dir;
-  const std::string why = LoadError(dir, Config("    inertia_kg_m2: 0.5\n", "gravity_mps2: 98.0665\n"));
-  EXPECT_TRUE(Contains(why, "gravity_mps2 = 98.0665; must be in [9.76, 9.84], a gravity found on Earth")) << why;
+  const std::string why =
+      LoadError(dir, Config("    inertia_kg_m2: 0.5\n", "gravity_mps2: 98.0665\n"));
+  EXPECT_TRUE(
+      Contains(why, "gravity_mps2 = 98.0665; must be in [9.76, 9.84], a gravity found on Earth"))
+      << why;
   EXPECT_TRUE(Contains(why, "[9.76, 9.84]")) << why;
   EXPECT_TRUE(Contains(why, "gravity_off_earth: true")) << why;
   EXPECT_TRUE(Contains(LoadError(dir, Config("    inertia_kg_m2: 0.5\n", "gravity_mps2: 9.7\n")),
@@ -118,7 +128,8 @@ TEST(SilentNumbers, GravityIsBoundedToEarthUnlessOverridden) {
   // Earth's extremes pass; Mars with the override passes; 0 and 1000 never.
   for (const char* ok : {"gravity_mps2: 9.7639\n", "gravity_mps2: 9.8337\n",
                          "gravity_mps2: 3.71\ngravity_off_earth: true\n"}) {
-    const std::string path = WriteFile(dir.path + "/ok.yaml", Config("    inertia_kg_m2: 0.5\n", ok));
+    const std::string path =
+        WriteFile(dir.path + "/ok.yaml", Config("    inertia_kg_m2: 0.5\n", ok));
     EXPECT_NO_THROW(LoadCampaignConfig(path)) << ok;
   }
   EXPECT_DOUBLE_EQ(LoadCampaignConfig(dir.path + "/ok.yaml").gravity_mps2, 3.71);
@@ -139,51 +150,60 @@ TEST(SilentNumbers, SwingAxisAndEllipseSeedAreCheckedInTheConfig) {
   };
   for (const char* bad : {"[1e300, 0, 0]", "[0, 0, 1e-9]", "[0, 0, 0]", "[2000, 0, 0]"}) {
     const std::string why = with_axis(bad);
-    EXPECT_TRUE(Contains(why, "'imu.swing_axis' must be auto or a direction")) << bad << ": " << why;
+    EXPECT_TRUE(Contains(why, "'imu.swing_axis' must be auto or a direction"))
+        << bad << ": " << why;
     EXPECT_TRUE(Contains(why, "[0.001, 1000]")) << why;
   }
   EXPECT_EQ(with_axis("[0, 0, 2]"), "");
   EXPECT_EQ(with_axis("auto"), "");
   // ellipse.seed beyond its range says the range (it said "must be an integer").
   for (const char* seed : {"9223372036854775808", "-1", "4294967296", "1.5"}) {
-    const std::string why =
-        LoadError(dir, Config("    inertia_kg_m2: 0.5\n", std::string("ellipse: {seed: ") + seed + "}\n"));
+    const std::string why = LoadError(
+        dir, Config("    inertia_kg_m2: 0.5\n", std::string("ellipse: {seed: ") + seed + "}\n"));
     EXPECT_TRUE(Contains(why, "'ellipse.seed' must be an integer in [0, 4294967295]")) << why;
   }
-  const std::string path = WriteFile(dir.path + "/ok.yaml",
-                                     Config("    inertia_kg_m2: 0.5\n", "ellipse: {seed: 4294967295}\n"));
+  const std::string path = WriteFile(
+      dir.path + "/ok.yaml", Config("    inertia_kg_m2: 0.5\n", "ellipse: {seed: 4294967295}\n"));
   EXPECT_EQ(LoadCampaignConfig(path).ellipse.seed, 4294967295u);
 }
 
 TEST(SilentNumbers, SeedsAndNumericFlagsAreCheckedOnTheCommandLine) {
   TempDir dir;
-  const std::string table = WriteFile(dir.path + "/t.csv",
-                                      "pitch_deg,inertia\n0,3\n30,2.8\n60,2.3\n90,2\n-30,3.1\n");
+  const std::string table =
+      WriteFile(dir.path + "/t.csv", "pitch_deg,inertia\n0,3\n30,2.8\n60,2.3\n90,2\n-30,3.1\n");
   std::string out;
   for (const char* seed : {"-1", "18446744073709551616", "1e23", "1.5", "x"}) {
     EXPECT_EQ(Cli(dir, std::string("ellipse ") + table + " --seed " + seed, &out), 2) << out;
     EXPECT_TRUE(Contains(out, "--seed")) << out;
     EXPECT_TRUE(Contains(out, "[0, 18446744073709551615]")) << out;
-    EXPECT_EQ(Cli(dir, std::string("simulate --trace ") + dir.path + "/s.csv --inertia-kg-m2 1 "
-                       "--mass-kg 1 -L 2 -D 1 --seed " + seed, &out), 2) << out;
+    EXPECT_EQ(Cli(dir,
+                  std::string("simulate --trace ") + dir.path +
+                      "/s.csv --inertia-kg-m2 1 "
+                      "--mass-kg 1 -L 2 -D 1 --seed " +
+                      seed,
+                  &out),
+              2)
+        << out;
     EXPECT_TRUE(Contains(out, "[0, 18446744073709551615]")) << out;
   }
   EXPECT_EQ(Cli(dir, "ellipse " + table + " --seed 18446744073709551615 --bootstrap 0", &out), 0)
       << out;
   // NaN (and inf) in a numeric flag is refused, naming the flag.
   const std::string config = WriteFile(dir.path + "/fit.yaml", test_support::QuadrotorFitConfig());
-  const std::vector<std::string> commands = {
-      "fit " + config + " " + table + " --max-amplitude nan",
-      "ellipse " + table + " --outlier-threshold nan",
-      "plan --angles 0,45,90 --sigma nan",
-      "plan --angles 0,45,90 --sigma 0.01 --ix inf --iz 1",
-      "simulate --trace " + dir.path + "/s.csv --inertia-kg-m2 1 --mass-kg 1 -L 2 -D 1 "
-      "--amplitude-deg nan",
-      "simulate --trace " + dir.path + "/s.csv --inertia-kg-m2 1 --mass-kg 1 -L 2 -D 1 "
-      "--pitch-deg nan"};
+  const std::vector<std::string> commands = {"fit " + config + " " + table + " --max-amplitude nan",
+                                             "ellipse " + table + " --outlier-threshold nan",
+                                             "plan --angles 0,45,90 --sigma nan",
+                                             "plan --angles 0,45,90 --sigma 0.01 --ix inf --iz 1",
+                                             "simulate --trace " + dir.path +
+                                                 "/s.csv --inertia-kg-m2 1 --mass-kg 1 -L 2 -D 1 "
+                                                 "--amplitude-deg nan",
+                                             "simulate --trace " + dir.path +
+                                                 "/s.csv --inertia-kg-m2 1 --mass-kg 1 -L 2 -D 1 "
+                                                 "--pitch-deg nan"};
   for (const std::string& command : commands) {
     EXPECT_EQ(Cli(dir, command, &out), 2) << command << "\n" << out;
-    EXPECT_TRUE(Contains(out, "finite number") || Contains(out, "not a number")) << command << "\n" << out;
+    EXPECT_TRUE(Contains(out, "finite number") || Contains(out, "not a number")) << command << "\n"
+                                                                                 << out;
   }
   EXPECT_FALSE(std::filesystem::exists(dir.path + "/s.csv"));
 }
@@ -195,8 +215,9 @@ TEST(SilentNumbers, NonPhysicalEllipseIsAWarningAndExitOne) {
   for (int p = -80; p <= 90; p += 10) {
     const double t = p * kRadPerDeg;
     char row[64];
-    std::snprintf(row, sizeof(row), "%d,%.6f\n", p,
-                  p == 30 ? 1000.0 : 3.0 * std::cos(t) * std::cos(t) + 2.0 * std::sin(t) * std::sin(t));
+    std::snprintf(
+        row, sizeof(row), "%d,%.6f\n", p,
+        p == 30 ? 1000.0 : 3.0 * std::cos(t) * std::cos(t) + 2.0 * std::sin(t) * std::sin(t));
     text += row;
   }
   const std::string table = WriteFile(dir.path + "/outlier.csv", text);
@@ -298,9 +319,9 @@ TEST(SilentNumbers, MissingTareLogIsSaidOnceAndFirst) {
   TempDir dir;
   for (int p : {0, 30, 60, 90}) {
     for (int k = 1; k <= 2; ++k) {
-      WriteFile(dir.path + "/logs/pitch_" + std::to_string(p) + "/trial_" + std::to_string(k) +
-                    ".csv",
-                "I=" + std::to_string(3.0 + 0.001 * k + p * 0.001));
+      WriteFile(
+          dir.path + "/logs/pitch_" + std::to_string(p) + "/trial_" + std::to_string(k) + ".csv",
+          "I=" + std::to_string(3.0 + 0.001 * k + p * 0.001));
     }
   }
   const std::string path =
@@ -320,12 +341,16 @@ TEST(SilentNumbers, MissingTareLogIsSaidOnceAndFirst) {
   const CampaignConfig config = LoadCampaignConfig(path);
   const CampaignResult result = RunCampaign(config, options);
   EXPECT_EQ(result.summary.exit_code, 1);
-  EXPECT_TRUE(Contains(result.rig_problem, "tare/rig.csv: tare log not found")) << result.rig_problem;
+  EXPECT_TRUE(Contains(result.rig_problem, "tare/rig.csv: tare log not found"))
+      << result.rig_problem;
   std::ostringstream console;
   PrintCampaignSummary(config, result, console);
   const std::string text = console.str();
   EXPECT_EQ(text.rfind("Error: no usable tare log, so the rig inertia is unknown: tare/rig.csv: "
-                       "tare log not found", 0), 0u) << text;
+                       "tare log not found",
+                       0),
+            0u)
+      << text;
   // The 8 aircraft traces are one line, not 8 (the console showed the same reason 10 times).
   EXPECT_TRUE(Contains(text, "error: 8 aircraft traces: rig inertia unknown")) << text;
   size_t count = 0;

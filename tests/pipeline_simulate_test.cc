@@ -30,8 +30,8 @@ using test_support::ReadFile;
 namespace fs = std::filesystem;
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("bifilar_sim_test_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("bifilar_sim_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   return dir;
 }
@@ -75,16 +75,21 @@ TEST(SimulateSpec, BadInputNamesTheKeyAndLine) {
     std::string yaml, expect;
   };
   const std::vector<Case> cases = {
-      {base + "sensor: {sample_rat_hz: 100}\n", "spec.yaml:2:10: unknown key 'sensor.sample_rat_hz'"},
+      {base + "sensor: {sample_rat_hz: 100}\n",
+       "spec.yaml:2:10: unknown key 'sensor.sample_rat_hz'"},
       {base + "bogus: 1\n", "unknown key 'bogus'"},
       {"geometry: {filar_length_m: 1.5, filar_separation_m: 1.8}\n",
-       "'geometry.filar_separation_m': filar_separation_m (D) = 1.8; must be < filar_length_m (L) = 1.5"},
+       "'geometry.filar_separation_m': filar_separation_m (D) = 1.8; must be < filar_length_m (L) "
+       "= 1.5"},
       {"geometry: {filar_length_m: -1, filar_separation_m: 1.8}\n",
        "spec.yaml:1:28: geometry.filar_length_m = -1; must be in (0, 1000]"},
       {base + "sensor: {sample_rate_hz: 0}\n", "sensor.sample_rate_hz = 0; must be in (0, 100000]"},
-      {base + "timeline: {free_s: 0}\n", "timeline.free_s = [0, 0]; must be min <= max, both in (0, 86400]"},
-      {base + "timeline: {free_s: [50, 40]}\n", "timeline.free_s = [50, 40]; must be min <= max, both in (0, 86400]"},
-      {base + "format: {time_unit: min}\n", "unknown unit 'min' for 'format.time_unit'; allowed s, ms or us"},
+      {base + "timeline: {free_s: 0}\n",
+       "timeline.free_s = [0, 0]; must be min <= max, both in (0, 86400]"},
+      {base + "timeline: {free_s: [50, 40]}\n",
+       "timeline.free_s = [50, 40]; must be min <= max, both in (0, 86400]"},
+      {base + "format: {time_unit: min}\n",
+       "unknown unit 'min' for 'format.time_unit'; allowed s, ms or us"},
       {base + "format: {gyro_unit: rpm}\n", "unknown unit 'rpm' for 'format.gyro_unit'"},
       {base + "format: {accel_unit: ft/s^2}\n", "unknown unit 'ft/s^2' for 'format.accel_unit'"},
       {base + "model: exact\n", "unknown model 'exact'"},
@@ -107,7 +112,8 @@ TEST(SimulateSpec, BadInputNamesTheKeyAndLine) {
   for (const Case& c : cases) {
     const std::string message = ErrorOf(c.yaml);
     EXPECT_NE(message.find(c.expect), std::string::npos)
-        << "yaml:\n" << c.yaml << "message: " << message << "\nexpected: " << c.expect;
+        << "yaml:\n"
+        << c.yaml << "message: " << message << "\nexpected: " << c.expect;
   }
 }
 
@@ -163,15 +169,15 @@ TEST(SimulateCampaign, SameSeedSameBytesAndTruthConsistent) {
   other.seed = 6;
   RunSimulateCampaign(other, c.string());
   const std::vector<std::string> files = {"pitch_-30/trial_1.csv", "pitch_-30/trial_2.csv",
-                                          "pitch_60/trial_1.csv", "pitch_60/trial_2.csv",
-                                          "tare/tare_1.csv", "truth.json"};
+                                          "pitch_60/trial_1.csv",  "pitch_60/trial_2.csv",
+                                          "tare/tare_1.csv",       "truth.json"};
   for (const auto& f : files) {
     ASSERT_TRUE(fs::exists(a / f)) << f;
     EXPECT_EQ(ReadFile(a / f), ReadFile(b / f)) << f;
     EXPECT_NE(ReadFile(a / f), ReadFile(c / f)) << f;
   }
-  // The mark of a simulated log with its seed (pipeline/logs/simulated_log.h), then the header in the
-  // spec's format; no temporary files left behind.
+  // The mark of a simulated log with its seed (pipeline/logs/simulated_log.h), then the header in
+  // the spec's format; no temporary files left behind.
   const std::string head =
       SimulatedCsvMarkerLine(SimulatedLogOrigin(spec.seed)) + "\nt,wx,wy,wz,ax,ay,az\n";
   EXPECT_EQ(ReadFile(a / files[0]).substr(0, head.size()), head);
@@ -204,7 +210,8 @@ TEST(SimulateCampaign, SameSeedSameBytesAndTruthConsistent) {
     const long rows = std::count(csv.begin(), csv.end(), '\n') - 2;  // the mark and the header
     EXPECT_EQ(rows, t["samples"].get<long>());
     EXPECT_GT(t["t_release_s"].get<double>(), t["t_twist_s"].get<double>());
-    EXPECT_TRUE(t["t_stop_s"].is_null() || t["t_stop_s"].get<double>() > t["t_release_s"].get<double>());
+    EXPECT_TRUE(t["t_stop_s"].is_null() ||
+                t["t_stop_s"].get<double>() > t["t_release_s"].get<double>());
     EXPECT_EQ(csv.find("nan"), std::string::npos);
   }
   fs::remove_all(a);
@@ -222,7 +229,10 @@ TEST(SimulateCampaign, ErrorWritesNothing) {
     RunSimulateCampaign(ParseSimulateSpec(yaml, "table.yaml"), dir.string());
     FAIL() << "expected an error";
   } catch (const UserError& e) {
-    EXPECT_NE(std::string(e.what()).find("pitch_deg = 60; must be a pitch of rig.inertia_by_pitch_kg_m2"), std::string::npos) << e.what();
+    EXPECT_NE(
+        std::string(e.what()).find("pitch_deg = 60; must be a pitch of rig.inertia_by_pitch_kg_m2"),
+        std::string::npos)
+        << e.what();
   }
   EXPECT_FALSE(fs::exists(dir));
 }
@@ -238,15 +248,18 @@ TEST(SimulateCli, EndToEnd) {
   fs::create_directories(dir);
   const fs::path spec = dir / "spec.yaml";
   std::ofstream(spec) << kSmallSpec;
-  EXPECT_EQ(RunCli("simulate " + spec.string() + " --out " + (dir / "out").string() + " --seed 3"), 0);
+  EXPECT_EQ(RunCli("simulate " + spec.string() + " --out " + (dir / "out").string() + " --seed 3"),
+            0);
   EXPECT_TRUE(fs::exists(dir / "out/pitch_60/trial_2.csv"));
   EXPECT_TRUE(fs::exists(dir / "out/tare/tare_1.csv"));
   EXPECT_TRUE(fs::exists(dir / "out/truth.json"));
   EXPECT_EQ(nlohmann::json::parse(ReadFile(dir / "out/truth.json"))["seed"].get<int>(), 3);
 
   const std::string trace = (dir / "one.csv").string();
-  EXPECT_EQ(RunCli("simulate --trace " + trace + " --inertia-kg-m2 4.1 --mass-kg 6.75 -L 2 -D 1.8 "
-                   "--amplitude-deg 15 --duration-s 10 --seed 9"), 0);
+  EXPECT_EQ(RunCli("simulate --trace " + trace +
+                   " --inertia-kg-m2 4.1 --mass-kg 6.75 -L 2 -D 1.8 "
+                   "--amplitude-deg 15 --duration-s 10 --seed 9"),
+            0);
   EXPECT_TRUE(fs::exists(trace));
   const nlohmann::json truth = nlohmann::json::parse(ReadFile(dir / "one.truth.json"));
   EXPECT_NEAR(truth["traces"][0]["amplitude_deg"].get<double>(), 15.0, 1e-12);
@@ -255,15 +268,16 @@ TEST(SimulateCli, EndToEnd) {
   // Bad input: exit code 2 and nothing written.
   const std::string bad = (dir / "bad.csv").string();
   const std::string good = " --inertia-kg-m2 4.1 --mass-kg 6.75 ";
-  EXPECT_EQ(RunCli("simulate --trace " + bad + good + "-L 1.5 -D 1.8"), 2);    // L <= D
-  EXPECT_EQ(RunCli("simulate --trace " + bad + good + "-L 0 -D 1.8"), 2);      // L <= 0
+  EXPECT_EQ(RunCli("simulate --trace " + bad + good + "-L 1.5 -D 1.8"), 2);         // L <= D
+  EXPECT_EQ(RunCli("simulate --trace " + bad + good + "-L 0 -D 1.8"), 2);           // L <= 0
   EXPECT_EQ(RunCli("simulate --trace " + bad + " --mass-kg 6.75 -L 2 -D 1.8"), 2);  // no inertia
   EXPECT_EQ(RunCli("simulate --trace " + bad + good + "-L 2 -D 1.8 --duration-s 0"), 2);
   EXPECT_EQ(RunCli("simulate --trace " + bad + good + "-L 2 -D 1.8 --sample-rate-hz 0"), 2);
   EXPECT_EQ(RunCli("simulate --trace " + bad + good + "-L 2 -D 1.8 --model exact"), 2);
   EXPECT_FALSE(fs::exists(bad));
   std::ofstream(dir / "typo.yaml") << std::string(kSmallSpec) + "sensr: {}\n";
-  EXPECT_EQ(RunCli("simulate " + (dir / "typo.yaml").string() + " --out " + (dir / "typo").string()), 2);
+  EXPECT_EQ(
+      RunCli("simulate " + (dir / "typo.yaml").string() + " --out " + (dir / "typo").string()), 2);
   EXPECT_FALSE(fs::exists(dir / "typo"));
   EXPECT_EQ(RunCli("simulate " + spec.string() + " --out " + trace), 2);  // --out is a file
   EXPECT_EQ(RunCli("simulate"), 2);                                       // nothing to do
@@ -286,12 +300,13 @@ int RunCliCapture(const std::string& args, const fs::path& dir, std::string* err
 TEST(SimulateSpec, RealismKeysParseAndBadValuesNameTheKey) {
   const std::string base = "geometry: {filar_length_m: 2.0, filar_separation_m: 1.8}\n";
   const SimulateSpec spec = ParseSimulateSpec(
-      base + "sensor: {sample_steps: lognormal, step_log_sigma: 0.5, step_range_s: [0.01, 0.1],\n"
-             "  gyro_noise_ar1_phi: 0.7, gyro_bias_walk_deg_per_s_per_sqrt_s: 0.02,\n"
-             "  spike_count: 5, spike_rate_rad_per_s: 50, accelerometer: gravity_removed,\n"
-             "  gravity_removal_error_deg: [4, 15]}\n"
-             "swing: {softening_percent_at_30deg: 2.8, softening_exponent: 1}\n"
-             "format: {footer: true}\n",
+      base +
+          "sensor: {sample_steps: lognormal, step_log_sigma: 0.5, step_range_s: [0.01, 0.1],\n"
+          "  gyro_noise_ar1_phi: 0.7, gyro_bias_walk_deg_per_s_per_sqrt_s: 0.02,\n"
+          "  spike_count: 5, spike_rate_rad_per_s: 50, accelerometer: gravity_removed,\n"
+          "  gravity_removal_error_deg: [4, 15]}\n"
+          "swing: {softening_percent_at_30deg: 2.8, softening_exponent: 1}\n"
+          "format: {footer: true}\n",
       "spec.yaml");
   const SensorOptions& s = spec.options.sensor;
   EXPECT_EQ(s.sample_steps, SampleSteps::kLogNormal);
@@ -318,16 +333,24 @@ TEST(SimulateSpec, RealismKeysParseAndBadValuesNameTheKey) {
   EXPECT_FALSE(plain.footer);
 
   const std::vector<std::pair<std::string, std::string>> bad = {
-      {"sensor: {gyro_noise_ar1_phi: 1.0}\n", "spec.yaml:2:30: sensor.gyro_noise_ar1_phi = 1; must be in [0, 0.99]"},
-      {"sensor: {sample_steps: poisson}\n", "unknown value 'poisson' for 'sensor.sample_steps'; allowed regular or lognormal"},
-      {"sensor: {step_range_s: [0.2, 0.1]}\n", "sensor.step_range_s = [0.2, 0.1]; must be min <= max, both in (0, 3600]"},
+      {"sensor: {gyro_noise_ar1_phi: 1.0}\n",
+       "spec.yaml:2:30: sensor.gyro_noise_ar1_phi = 1; must be in [0, 0.99]"},
+      {"sensor: {sample_steps: poisson}\n",
+       "unknown value 'poisson' for 'sensor.sample_steps'; allowed regular or lognormal"},
+      {"sensor: {step_range_s: [0.2, 0.1]}\n",
+       "sensor.step_range_s = [0.2, 0.1]; must be min <= max, both in (0, 3600]"},
       {"sensor: {spike_count: 2.5}\n", "'sensor.spike_count' must be a whole number"},
       {"sensor: {spike_count: 5000}\n", "sensor.spike_count = 5000; must be in [0, 1000]"},
-      {"sensor: {spike_rate_rad_per_s: 0}\n", "sensor.spike_rate_rad_per_s = 0; must be in (0, 10000]"},
-      {"sensor: {accelerometer: gravity}\n", "'sensor.accelerometer' must be true, false or gravity_removed"},
-      {"sensor: {gravity_removal_error_deg: 40}\n", "sensor.gravity_removal_error_deg = [40, 40]; must be min <= max, both in [0, 30]"},
-      {"sensor: {gyro_bias_walk_deg_per_s_per_sqrt_s: -1}\n", "sensor.gyro_bias_walk_deg_per_s_per_sqrt_s = -1; must be in [0, 10]"},
-      {"swing: {softening_percent_at_30deg: 80}\n", "swing.softening_percent_at_30deg = 80; must be in [0, 50]"},
+      {"sensor: {spike_rate_rad_per_s: 0}\n",
+       "sensor.spike_rate_rad_per_s = 0; must be in (0, 10000]"},
+      {"sensor: {accelerometer: gravity}\n",
+       "'sensor.accelerometer' must be true, false or gravity_removed"},
+      {"sensor: {gravity_removal_error_deg: 40}\n",
+       "sensor.gravity_removal_error_deg = [40, 40]; must be min <= max, both in [0, 30]"},
+      {"sensor: {gyro_bias_walk_deg_per_s_per_sqrt_s: -1}\n",
+       "sensor.gyro_bias_walk_deg_per_s_per_sqrt_s = -1; must be in [0, 10]"},
+      {"swing: {softening_percent_at_30deg: 80}\n",
+       "swing.softening_percent_at_30deg = 80; must be in [0, 50]"},
       {"swing: {softening_exponent: 6}\n", "swing.softening_exponent = 6; must be in [1, 4]"},
       {"format: {footer: maybe}\n", "'format.footer' must be true or false"},
       {"sensor: {sample_rate_hz: 2000, time_jitter_sigma_s: 0.001}\n",
@@ -336,7 +359,8 @@ TEST(SimulateSpec, RealismKeysParseAndBadValuesNameTheKey) {
   for (const auto& c : bad) {
     const std::string message = ErrorOf(base + c.first);
     EXPECT_NE(message.find(c.second), std::string::npos)
-        << "yaml:\n" << c.first << "message: " << message << "\nexpected: " << c.second;
+        << "yaml:\n"
+        << c.first << "message: " << message << "\nexpected: " << c.second;
   }
 }
 
@@ -377,12 +401,15 @@ TEST(SimulateTrace, FooterFollowsUnchangedData) {
   EXPECT_EQ(cells[2][6], "Impact Data");
   const nlohmann::json truth = nlohmann::json::parse(ReadFile(dir / "footer.truth.json"));
   const auto& t = truth["traces"][0];
-  EXPECT_NEAR(std::stod(cells[1][0]), 1e3 * (t["t_release_s"].get<double>() - t["start_time_s"].get<double>()), 1e-2);
+  EXPECT_NEAR(std::stod(cells[1][0]),
+              1e3 * (t["t_release_s"].get<double>() - t["start_time_s"].get<double>()), 1e-2);
   EXPECT_LT(std::stod(cells[1][0]), last_time_ms);
   EXPECT_EQ(std::stod(cells[2][0]), 0.0);
   EXPECT_EQ(t["footer_rows"].get<int>(), 4);
   EXPECT_TRUE(truth["options"]["format"]["footer"].get<bool>());
-  EXPECT_FALSE(nlohmann::json::parse(ReadFile(dir / "plain.truth.json"))["options"]["format"].contains("footer"));
+  EXPECT_FALSE(
+      nlohmann::json::parse(ReadFile(dir / "plain.truth.json"))["options"]["format"].contains(
+          "footer"));
   fs::remove_all(dir);
 }
 
@@ -400,7 +427,8 @@ TEST(SimulateCli, RefusesTargetsThatAreNotRegularFilesOrTheSameFile) {
   const std::string d = dir.string() + "/";
   const std::vector<Case> cases = {
       {"--trace " + d + "fifo", "--trace " + d + "fifo: exists and is not a regular file"},
-      {"--trace " + d + "a.csv --truth " + d + "fifo", "--truth " + d + "fifo: exists and is not a regular file"},
+      {"--trace " + d + "a.csv --truth " + d + "fifo",
+       "--truth " + d + "fifo: exists and is not a regular file"},
       {"--trace " + d + "null_link", "null_link: exists and is not a regular file"},
       {"--trace " + d + "sub", "--trace " + d + "sub: is a folder"},
       {"--trace " + d + "b.csv --truth " + d + "b.csv", "are the same file"},
@@ -464,8 +492,11 @@ TEST(SimulateCli, SampleRateFlagNamesWhatTheUserSet) {
   std::string err;
   // Issue 9: --sample-rate-hz 2000 failed on sensor.time_jitter_sigma_s, a key the user never
   // set. The default jitter now follows the rate (at most 10 % of a sample period).
-  EXPECT_EQ(RunCliCapture("simulate --trace " + (dir / "fast.csv").string() + good +
-                              " --sample-rate-hz 2000", dir, &err), 0) << err;
+  EXPECT_EQ(RunCliCapture(
+                "simulate --trace " + (dir / "fast.csv").string() + good + " --sample-rate-hz 2000",
+                dir, &err),
+            0)
+      << err;
   const nlohmann::json truth = nlohmann::json::parse(ReadFile(dir / "fast.truth.json"));
   EXPECT_EQ(truth["options"]["sensor"]["sample_rate_hz"].get<double>(), 2000);
   EXPECT_NEAR(truth["options"]["sensor"]["time_jitter_sigma_s"].get<double>(), 0.1 / 2000, 1e-18);
@@ -475,14 +506,19 @@ TEST(SimulateCli, SampleRateFlagNamesWhatTheUserSet) {
   // A jitter the spec did set, too large for the new rate: the message names both and what to do.
   std::ofstream(dir / "jitter.yaml") << "sensor: {time_jitter_sigma_s: 0.001}\n";
   EXPECT_EQ(RunCliCapture("simulate " + (dir / "jitter.yaml").string() + " --trace " +
-                              (dir / "bad.csv").string() + good + " --sample-rate-hz 2000", dir, &err), 2);
+                              (dir / "bad.csv").string() + good + " --sample-rate-hz 2000",
+                          dir, &err),
+            2);
   EXPECT_NE(err.find("--sample-rate-hz 2000: 'sensor.time_jitter_sigma_s' = 0.001 s in " +
                      (dir / "jitter.yaml").string() + " is more than one sample period"),
-            std::string::npos) << err;
+            std::string::npos)
+      << err;
   EXPECT_NE(err.find("lower it in the spec"), std::string::npos) << err;
   std::ofstream(dir / "rocking.yaml") << "sensor: {rocking_frequency_hz: 2}\n";
   EXPECT_EQ(RunCliCapture("simulate " + (dir / "rocking.yaml").string() + " --trace " +
-                              (dir / "bad.csv").string() + good + " --sample-rate-hz 4", dir, &err), 2);
+                              (dir / "bad.csv").string() + good + " --sample-rate-hz 4",
+                          dir, &err),
+            2);
   EXPECT_NE(err.find("'sensor.rocking_frequency_hz' = 2 Hz"), std::string::npos) << err;
   EXPECT_NE(err.find("raise --sample-rate-hz to at least 8"), std::string::npos) << err;
   EXPECT_FALSE(fs::exists(dir / "bad.csv"));
@@ -558,7 +594,7 @@ TEST(SimulatePresets, QuadrotorLooksLikeTheCrazyflieLogs) {
     std::string csv = ReadFile(dir / t["file"].get<std::string>());
     ASSERT_EQ(csv.rfind("# simulated by bifilar ", 0), 0u);  // the mark, then the real log's form
     csv.erase(0, csv.find('\n') + 1);
-    EXPECT_EQ(csv.substr(0, 11), "t,wx,wy,wz\n");                       // no accelerometer
+    EXPECT_EQ(csv.substr(0, 11), "t,wx,wy,wz\n");                        // no accelerometer
     EXPECT_NE(csv.find("\n\n,,,Rollout Completed"), std::string::npos);  // the footer
     std::ofstream(dir / "one.csv") << csv;
     simulated.push_back(CrazyflieTimes(dir / "one.csv"));
@@ -606,7 +642,8 @@ TEST(SimulatePresets, NonidealRigRecordsItsSoftening) {
     // header says, with 1 / (1 - x30) = 1.12.
     const double x30 = 0.12 / 1.12, x = x30 * std::pow(t["amplitude_deg"].get<double>() / 30, 2);
     EXPECT_NEAR(t["apparent_inertia_excess_at_release"].get<double>(), x / (1 - x), 1e-12);
-    EXPECT_NEAR(t["apparent_inertia_at_release_kg_m2"].get<double>(), inertia * (1 + x / (1 - x)), 1e-15);
+    EXPECT_NEAR(t["apparent_inertia_at_release_kg_m2"].get<double>(), inertia * (1 + x / (1 - x)),
+                1e-15);
     EXPECT_LT(t["amplitude_at_end_deg"].get<double>(), 8.0);  // the sweep reaches small amplitudes
     const double error = t["gravity_removal_error_deg"];
     EXPECT_GE(error, 4.0);
@@ -623,7 +660,8 @@ TEST(SimulatePresets, NonidealRigRecordsItsSoftening) {
     while (std::getline(csv, line)) {
       double v[7];
       ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3],
-                            &v[4], &v[5], &v[6]), 7);
+                            &v[4], &v[5], &v[6]),
+                7);
       mean += Eigen::Vector3d(v[4], v[5], v[6]);
       ++rows;
     }

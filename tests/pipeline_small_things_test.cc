@@ -64,8 +64,7 @@ TEST(SmallThings, RepeatsPrintTheScatterWarningOnce) {
     logs += " " + log;
   }
   const std::string config = dir.path + "/bifilar.yaml";
-  ASSERT_EQ(Cli(dir, "init " + config + " --rig 2,1.5,5 --log " + dir.path + "/run_1.csv", &out),
-            0)
+  ASSERT_EQ(Cli(dir, "init " + config + " --rig 2,1.5,5 --log " + dir.path + "/run_1.csv", &out), 0)
       << out;
   ASSERT_EQ(Cli(dir, "fit " + config + logs + " --repeats", &out), 0) << out;
   EXPECT_EQ(Count(out, "scatter beyond their own stds"), 1) << out;
@@ -135,8 +134,8 @@ TEST(SmallThings, HelpNamesUlog) {
 TEST(SmallThings, CommandLineErrorsHaveThePrefix) {
   TempDir dir("bifilar_small_things");
   std::string out;
-  for (const std::string args : {"fit", "nosuchcommand", "fit a.yaml b.csv --model nonsense",
-                                 "process --jobs", ""}) {
+  for (const std::string args :
+       {"fit", "nosuchcommand", "fit a.yaml b.csv --model nonsense", "process --jobs", ""}) {
     EXPECT_EQ(Cli(dir, args, &out), 2) << args << ": " << out;
     EXPECT_EQ(out.rfind("bifilar: error: ", 0), 0u) << args << ": " << out;
     EXPECT_NE(out.find("Run with --help for more information."), std::string::npos) << out;
@@ -192,11 +191,11 @@ TEST(SmallThings, JunkUlogIsCalledWhatItIs) {
   const ImuData data = ReadImuLog(WriteFile(dir.path + "/csv_named.ulg", csv), format);
   EXPECT_EQ(data.t_s.size(), 50u);
   // Through the command line: the one-line error names the file and says what it is not.
-  const std::string config = WriteFile(
-      dir.path + "/c.yaml",
-      "rig: {filar_length_m: 2, filar_separation_m: 1.5, mass_kg: 5}\n"
-      "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [gx, gy, gz], unit: rad/s}\n"
-      "  accel: null\n");
+  const std::string config =
+      WriteFile(dir.path + "/c.yaml",
+                "rig: {filar_length_m: 2, filar_separation_m: 1.5, mass_kg: 5}\n"
+                "imu:\n  time: {column: t, unit: s}\n  gyro: {columns: [gx, gy, gz], unit: rad/s}\n"
+                "  accel: null\n");
   std::string out;
   EXPECT_EQ(Cli(dir, "fit " + config + " " + text, &out), 1) << out;
   EXPECT_NE(out.find("not a valid ULog file"), std::string::npos) << out;
@@ -227,8 +226,7 @@ TEST(SmallThings, CommittedSampleOutputsHoldTheCodesNumbers) {
     ASSERT_EQ(by_file.count(r.file), 1u) << r.file;
     const nlohmann::json& c = by_file[r.file];
     const double std = c["inertia_total_std_kg_m2"].get<double>();
-    EXPECT_NEAR(r.inertia_total_kg_m2, c["inertia_total_kg_m2"].get<double>(),
-                kFractionOfStd * std)
+    EXPECT_NEAR(r.inertia_total_kg_m2, c["inertia_total_kg_m2"].get<double>(), kFractionOfStd * std)
         << r.file;
     EXPECT_NEAR(r.inertia_total_std_kg_m2, std, kFractionOfStd * std) << r.file;
   }

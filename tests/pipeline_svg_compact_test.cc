@@ -50,11 +50,12 @@ TEST(SvgCompact, EqualGlyphsOfTwoFiguresShareOneSymbol) {
       "<body><svg><symbol overflow=\"visible\" id=\"f0-g1\"><path d=\"A\"/></symbol>"
       "<use href=\"#f0-g1\"/></svg><svg><symbol overflow=\"visible\" id=\"f1-g1\"><path d=\"A\"/>"
       "</symbol><use href=\"#f1-g1\"/></svg></body>";
-  EXPECT_EQ(ShareSvgGlyphs(html),
-            "<body><svg><use href=\"#sg0\"/></svg><svg><use href=\"#sg0\"/></svg>"
-            "<svg width=\"0\" height=\"0\" style=\"position:absolute\" aria-hidden=\"true\"><defs>\n"
-            "<symbol overflow=\"visible\" id=\"sg0\"><path d=\"A\"/></symbol>\n</defs></svg>\n"
-            "</body>");
+  EXPECT_EQ(
+      ShareSvgGlyphs(html),
+      "<body><svg><use href=\"#sg0\"/></svg><svg><use href=\"#sg0\"/></svg>"
+      "<svg width=\"0\" height=\"0\" style=\"position:absolute\" aria-hidden=\"true\"><defs>\n"
+      "<symbol overflow=\"visible\" id=\"sg0\"><path d=\"A\"/></symbol>\n</defs></svg>\n"
+      "</body>");
 }
 
 }  // namespace
@@ -73,14 +74,17 @@ TEST(SvgCompact, PlplotSvgDriverOutput) {
       "    width=\"100\"\n    height=\"50\"\n    stroke=\"none\"\n    fill=\"#FFFFFF\"\n    />\n"
       "  <g\n    transform=\"matrix(1 0 0 -1 0 50)\"\n    >\n"
       "    <polyline\n      stroke-width=\"1.000000e+00\"\n      stroke=\"#000000\"\n"
-      "      stroke-opacity=\"1.000000\"\n      fill=\"none\"\n      points=\"10.00,10.00 20.04,10.00\"\n      />\n"
+      "      stroke-opacity=\"1.000000\"\n      fill=\"none\"\n      points=\"10.00,10.00 "
+      "20.04,10.00\"\n      />\n"
       "    <polyline\n      stroke-width=\"1.000000e+00\"\n      stroke=\"#000000\"\n"
-      "      stroke-opacity=\"1.000000\"\n      fill=\"none\"\n      points=\"30.00,40.00 30.00,40.00\"\n      />\n"
+      "      stroke-opacity=\"1.000000\"\n      fill=\"none\"\n      points=\"30.00,40.00 "
+      "30.00,40.00\"\n      />\n"
       "    <clipPath\n      id=\"text-clipping0\"\n      >\n      <polygon\n"
       "        points=\"0.000000,0.000000 0.000000,49.99 100.000000,49.99 100.000000,0.000000\"\n"
       "        />\n    </clipPath>\n    <g\n      clip-path=\"url(#text-clipping0)\"\n      >\n"
       "      <text\n        dominant-baseline=\"no-change\"\n        fill=\"#000000\"\n"
-      "        fill-opacity=\"1.000000\"\n        xml:space=\"preserve\"\n        font-size=\"17\"\n"
+      "        fill-opacity=\"1.000000\"\n        xml:space=\"preserve\"\n        "
+      "font-size=\"17\"\n"
       "        transform=\"matrix(1.000000 0.000000 0.000000 -1.000000 50.000000 5.000000)\"\n"
       "        text-anchor=\"middle\"\n        x=\"0.000000\"\n        y=\"6.640507\"\n"
       "><tspan font-family=\"sans-serif\" font-style=\"normal\" font-weight=\"normal\">"
@@ -91,10 +95,12 @@ TEST(SvgCompact, PlplotSvgDriverOutput) {
   // (10, 50-10) -> (20, 40): one path with the dot (30, 10) as its second sub-path.
   EXPECT_NE(out.find("<path fill=\"none\" stroke=\"#000000\" stroke-width=\"1\" "
                      "d=\"M10 40l10 0M30 10l0 0\"/>"),
-            std::string::npos) << out;
+            std::string::npos)
+      << out;
   EXPECT_NE(out.find("<text x=\"50\" y=\"51.6\" font-size=\"17\" text-anchor=\"middle\" "
                      "xml:space=\"preserve\"><tspan>I ± σ&lt;</tspan></text>"),
-            std::string::npos) << out;
+            std::string::npos)
+      << out;
   EXPECT_EQ(out.find("clip"), std::string::npos) << out;
   EXPECT_EQ(out.find("<polyline"), std::string::npos) << out;
   EXPECT_EQ(CompactSvg(out), out);

@@ -63,9 +63,9 @@ TEST(SweepFigure, WrittenAndListedForATraceWithASweep) {
   for (const std::string& path : options.sweep_figure_paths) {
     ASSERT_TRUE(fs::exists(path)) << path;
     // a drawn page, not an empty one (the SVG's text is text: a few kB)
-    EXPECT_GT(fs::file_size(path), path.size() > 4 && path.substr(path.size() - 4) == ".svg"
-                                       ? 3000u
-                                       : 10000u) << path;
+    EXPECT_GT(fs::file_size(path),
+              path.size() > 4 && path.substr(path.size() - 4) == ".svg" ? 3000u : 10000u)
+        << path;
   }
   // The SVG is a figure with its title (the trend's z) in it, as text.
   std::ifstream svg(dir + "/long_sweep.svg");
@@ -90,7 +90,7 @@ TEST(SweepFigure, NoneForATraceTooShortForASweep) {
   ASSERT_EQ(r.status, TraceStatus::kOk) << r.message;
   EXPECT_FALSE(r.sweep.evaluated);
   EXPECT_FALSE(r.sweep.note.empty());
-  EXPECT_TRUE(fs::exists(dir + "/short.svg"));        // the fit figure is still drawn
+  EXPECT_TRUE(fs::exists(dir + "/short.svg"));         // the fit figure is still drawn
   EXPECT_FALSE(fs::exists(dir + "/short_sweep.svg"));  // no sweep figure
   const nlohmann::json j = TraceRecordToJson(r, false);
   EXPECT_FALSE(Contains(j["figures"], dir + "/short_sweep.svg"));

@@ -83,17 +83,21 @@ TEST(TensorPlanCli, BadOptionsAreOneLineErrors) {
   } cases[] = {
       {"plan --roll 0 --sigma 0.1", "--roll belongs to the tensor plan: add --tensor"},
       {"plan --tensor --angles 0,30 --sigma 0.1", "--angles belongs to the pitch-plane plan"},
-      {"plan --tensor --roll=200 --sigma 0.1", "plan --tensor: --roll: roll_min_deg = 200; must be in [-180, 180]"},
+      {"plan --tensor --roll=200 --sigma 0.1",
+       "plan --tensor: --roll: roll_min_deg = 200; must be in [-180, 180]"},
       {"plan --tensor --roll=30:-30 --sigma 0.1", "MIN must not exceed MAX"},
       {"plan --tensor --roll=a:3 --sigma 0.1", "--roll 'a:3': 'a' is not a number"},
-      {"plan --tensor --pitch=-95:0 --sigma 0.1", "plan --tensor: --pitch: pitch_min_deg = -95; must be in [-90, 90]"},
+      {"plan --tensor --pitch=-95:0 --sigma 0.1",
+       "plan --tensor: --pitch: pitch_min_deg = -95; must be in [-90, 90]"},
       {"plan --tensor --roll 0",
-       "sigma_kg_m2 = 0; must be > 0 when sigma_relative = 0 (a per-swing std, absolute or relative)"},
+       "sigma_kg_m2 = 0; must be > 0 when sigma_relative = 0 (a per-swing std, absolute or "
+       "relative)"},
       {"plan --tensor --sigma-rel 0.01", "--sigma-rel and --attitude-std need a guess"},
       {"plan --tensor --sigma 0.1 --ixx 1 --iyy 1", "give all of --ixx, --iyy, --izz"},
       {"plan --tensor --sigma 0.1 --ixz 0.1", "needs --ixx, --iyy, --izz"},
       {"plan --tensor --sigma 0.1 --target-rel 0.01", "--target-rel is a fraction"},
-      {"plan --tensor --sigma 0.1 --ixx 1 --iyy 1 --izz 1 --ixy 2", "--ixx ... --iyz: smallest principal moment of guess_kg_m2 = -1; must be > 0"},
+      {"plan --tensor --sigma 0.1 --ixx 1 --iyy 1 --izz 1 --ixy 2",
+       "--ixx ... --iyz: smallest principal moment of guess_kg_m2 = -1; must be > 0"},
       {"plan --angles 0,30,60", "--sigma is required"},
       {"plan --sigma 0.1", "--angles is required"},
   };
@@ -111,7 +115,8 @@ TEST(TensorPlanCli, BadOptionsAreOneLineErrors) {
 // was "not a number". Tiny sigmas now plan as any other (stds scaled); huge ones are refused.
 TEST(TensorPlanCli, TinySigmasPlanAndHugeOnesAreRefused) {
   TempDir dir("bifilar_tensor_plan");
-  for (const std::string sigma : {"--sigma 1e-160", "--sigma 1e-300", "--sigma-rel 1e-170 "
+  for (const std::string sigma : {"--sigma 1e-160", "--sigma 1e-300",
+                                  "--sigma-rel 1e-170 "
                                   "--ixx 1 --iyy 2 --izz 2.5"}) {
     SCOPED_TRACE(sigma);
     const CliRun r =
@@ -131,9 +136,11 @@ TEST(TensorPlanCli, TinySigmasPlanAndHugeOnesAreRefused) {
   const struct {
     std::string args, expect;
   } refused[] = {
-      {"plan --tensor --roll=-45:45 --sigma 1e200", "plan --tensor: --sigma: sigma_kg_m2 = 1e+200; must be in [0, 1e+100]"},
+      {"plan --tensor --roll=-45:45 --sigma 1e200",
+       "plan --tensor: --sigma: sigma_kg_m2 = 1e+200; must be in [0, 1e+100]"},
       {"plan --tensor --roll=-45:45 --sigma 4.9e-324", "too small to compute with"},
-      {"plan --angles 0:90:10 --sigma 1e200", "plan: sigma_kg_m2 = 1e+200; must be in [1e-300, 1e+100]"},
+      {"plan --angles 0:90:10 --sigma 1e200",
+       "plan: sigma_kg_m2 = 1e+200; must be in [1e-300, 1e+100]"},
       {"plan --angles 0:90:10 --sigma 1e400", "'1e400' is out of range"},
       // A subnormal is a number, named as too small, not "not a number".
       {"plan --angles 0:90:10 --sigma 1e-308", "sigma_kg_m2 = 1e-308; must be in [1e-300, 1e+100]"},

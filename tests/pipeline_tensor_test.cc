@@ -1,16 +1,17 @@
-// Tensor campaigns through `process` (pipeline/campaign/campaign_tensor.h): attitudes from the runs table
-// and from {roll_deg}, exact recovery through discovery and grouping with a fake trace fit, the
-// minimal three-axis config, bad rolls, the measured-vs-nominal warning, the planar sample's
-// committed ellipse, a simulated 12 x 2 campaign against its truth (nominal and measured attitudes), and the
-// real Crazyflie logs of the data folder (BIFILAR_REAL_DATA, tests/test_support.h).
+// Tensor campaigns through `process` (pipeline/campaign/campaign_tensor.h): attitudes from the runs
+// table and from {roll_deg}, exact recovery through discovery and grouping with a fake trace fit,
+// the minimal three-axis config, bad rolls, the measured-vs-nominal warning, the planar sample's
+// committed ellipse, a simulated 12 x 2 campaign against its truth (nominal and measured
+// attitudes), and the real Crazyflie logs of the data folder (BIFILAR_REAL_DATA,
+// tests/test_support.h).
 #include "pipeline/campaign/campaign.h"
 
 #include <cmath>
 #include <filesystem>
 #include <sstream>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
 #include "base/user_error.h"
@@ -31,9 +32,9 @@ using test_support::WriteFile;
 // Truth (kg m^2): products 2-4 % of the moments; the rig.
 const std::array<double, 6> kTruth = {0.20, 0.30, 0.45, 0.008, 0.010, -0.009};
 constexpr double kRig = 0.02;
-const std::vector<std::array<double, 2>> kAttitudes = {
-    {0, 0},  {0, 45},  {0, -45},  {0, -90},  {45, 0},    {-45, 0},
-    {90, 0}, {45, 45}, {-45, 45}, {45, -45}, {-45, -45}, {90, 45}};
+const std::vector<std::array<double, 2>> kAttitudes = {{0, 0},    {0, 45},   {0, -45},   {0, -90},
+                                                       {45, 0},   {-45, 0},  {90, 0},    {45, 45},
+                                                       {-45, 45}, {45, -45}, {-45, -45}, {90, 45}};
 
 double Moment(double roll, double pitch) {
   return TensorMoment(kTruth, DownInBodyFromAttitude(roll, pitch));
@@ -93,7 +94,8 @@ std::string WriteTableCampaign(const TempDir& dir, const std::string& extra_rows
 TEST(TensorCampaign, TableWithRollsRecoversTheTensorExactly) {
   TempDir dir("bifilar_tensor");
   const std::string config = WriteTableCampaign(dir);
-  const CampaignResult result = RunCampaign(LoadCampaignConfig(config), FakeOptions(dir.path + "/out"));
+  const CampaignResult result =
+      RunCampaign(LoadCampaignConfig(config), FakeOptions(dir.path + "/out"));
   EXPECT_EQ(result.summary.exit_code, 0);
   EXPECT_FALSE(result.summary.ellipse_fitted);
   EXPECT_NE(result.summary.ellipse_message.find("outside the x-z plane"), std::string::npos);
@@ -104,15 +106,16 @@ TEST(TensorCampaign, TableWithRollsRecoversTheTensorExactly) {
   const nlohmann::json j = nlohmann::json::parse(ReadFile(dir.path + "/out/results.json"));
   const nlohmann::json& t = j["tensor"];
   EXPECT_EQ(t["mode"], "full_3d");
-  for (const char* key : {"Ixx_kg_m2", "Iyy_kg_m2", "Izz_kg_m2", "Ixy_kg_m2", "Ixz_kg_m2",
-                          "Iyz_kg_m2"}) {
+  for (const char* key :
+       {"Ixx_kg_m2", "Iyy_kg_m2", "Izz_kg_m2", "Ixy_kg_m2", "Ixz_kg_m2", "Iyz_kg_m2"}) {
     ASSERT_TRUE(t[key].is_number()) << key;
     ASSERT_TRUE(t[std::string(key) + "_std"].is_number()) << key;
   }
   EXPECT_NEAR(t["Ixy_kg_m2"].get<double>(), 0.008, 1e-9);
   EXPECT_EQ(t["covariance_kg2_m4"].size(), 6u);
   ASSERT_EQ(t["principal_moments_kg_m2"].size(), 3u);
-  EXPECT_LT(t["principal_moments_kg_m2"][0].get<double>(), t["principal_moments_kg_m2"][1].get<double>());
+  EXPECT_LT(t["principal_moments_kg_m2"][0].get<double>(),
+            t["principal_moments_kg_m2"][1].get<double>());
   EXPECT_EQ(t["principal_axes"].size(), 3u);
   EXPECT_EQ(t["orientations"].size(), 12u);
   EXPECT_EQ(t["residuals"].size(), 24u);
@@ -134,11 +137,13 @@ TEST(TensorCampaign, RollOutsideItsRangeNamesTheRow) {
   TempDir dir("bifilar_tensor");
   WriteFile(dir.path + "/logs/extra.csv", "I=0.3\n");
   const std::string config = WriteTableCampaign(dir, "extra.csv,200,0\n");
-  const CampaignResult result = RunCampaign(LoadCampaignConfig(config), FakeOptions(dir.path + "/out"));
+  const CampaignResult result =
+      RunCampaign(LoadCampaignConfig(config), FakeOptions(dir.path + "/out"));
   EXPECT_EQ(result.summary.exit_code, 1);
   bool named = false;
   for (const TraceRecord& r : result.traces) {
-    named |= r.status == TraceStatus::kError && r.message.find("runs.csv:27") != std::string::npos &&
+    named |= r.status == TraceStatus::kError &&
+             r.message.find("runs.csv:27") != std::string::npos &&
              r.message.find("roll") != std::string::npos;
   }
   EXPECT_TRUE(named);
@@ -156,11 +161,12 @@ TEST(TensorCampaign, PatternCapturesRollAndPitchInOneComponent) {
   }
   WriteFile(dir.path + "/logs/roll_x_pitch_0/t1.csv", "I=0.3\n");
   // The minimal config: no aircraft, no rig.inertia (everything that hangs, nothing subtracted).
-  const std::string config = WriteFile(
-      dir.path + "/c.yaml",
-      "rig: {filar_length_m: 0.594, filar_separation_m: 0.03, mass_kg: 0.0343}\n"
-      "runs: {root: logs, pattern: \"roll_{roll_deg}_pitch_{pitch_deg}/*.csv\"}\n");
-  const CampaignResult result = RunCampaign(LoadCampaignConfig(config), FakeOptions(dir.path + "/out"));
+  const std::string config =
+      WriteFile(dir.path + "/c.yaml",
+                "rig: {filar_length_m: 0.594, filar_separation_m: 0.03, mass_kg: 0.0343}\n"
+                "runs: {root: logs, pattern: \"roll_{roll_deg}_pitch_{pitch_deg}/*.csv\"}\n");
+  const CampaignResult result =
+      RunCampaign(LoadCampaignConfig(config), FakeOptions(dir.path + "/out"));
   ASSERT_TRUE(result.tensor_fit.has_value()) << result.summary.tensor_message;
   const TensorResult& t = *result.tensor_fit;
   EXPECT_EQ(t.rank, 3);
@@ -206,8 +212,8 @@ TEST(TensorCampaign, ConfigKeysAreChecked) {
             std::string::npos);
   ConfigLoadOptions load;
   load.runs_root = dir.path + "/logs";
-  const CampaignConfig c =
-      LoadCampaignConfig(WriteFile(dir.path + "/c.yaml", rig + "runs: {pattern: \"*.csv\"}\n"), load);
+  const CampaignConfig c = LoadCampaignConfig(
+      WriteFile(dir.path + "/c.yaml", rig + "runs: {pattern: \"*.csv\"}\n"), load);
   EXPECT_EQ(c.runs.root, fs::path(dir.path + "/logs").lexically_normal().string());
   EXPECT_FALSE(c.rig_inertia_given);
 }
@@ -221,8 +227,9 @@ TEST(TensorCampaign, MeasuredAttitudeFarFromTheNominalWarnsNamingTheLog) {
     for (int t = 0; t < 2; ++t, ++k) {
       const std::string path = dir.path + "/logs/log_" + std::to_string(k) + ".csv";
       const double roll = a[0] + (k == 9 ? 10.0 : 0.2), pitch = a[1] == -90 ? -89.8 : a[1] + 0.2;
-      WriteFile(path, "I=" + Number(TensorMoment(kTruth, DownInBodyFromAttitude(roll, pitch)) + kRig) +
-                          " R=" + Number(roll) + " P=" + Number(pitch) + "\n");
+      WriteFile(path,
+                "I=" + Number(TensorMoment(kTruth, DownInBodyFromAttitude(roll, pitch)) + kRig) +
+                    " R=" + Number(roll) + " P=" + Number(pitch) + "\n");
     }
   }
   const std::string config = WriteFile(
@@ -230,7 +237,8 @@ TEST(TensorCampaign, MeasuredAttitudeFarFromTheNominalWarnsNamingTheLog) {
       "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 1, inertia: {inertia_kg_m2: "
       "0.02}}\naircraft: {mass_kg: 3}\nimu: {accel: {columns: [ax, ay, az]}}\n"
       "runs: {root: logs, table: runs.csv, pitch_source: measured}\nellipse: {bootstrap: 0}\n");
-  const CampaignResult result = RunCampaign(LoadCampaignConfig(config), FakeOptions(dir.path + "/out"));
+  const CampaignResult result =
+      RunCampaign(LoadCampaignConfig(config), FakeOptions(dir.path + "/out"));
   int warned = 0;
   for (const TraceRecord& r : result.traces) {
     for (const std::string& w : r.warnings) {
@@ -332,9 +340,10 @@ TEST(TensorCampaign, CrazyflieAirframeGivesItsThreeMoments) {
   options.jobs = 2;
   options.figures = false;
   options.write_report = false;
-  const CampaignResult result = RunCampaign(
-      LoadCampaignConfig(std::string(BIFILAR_SOURCE_DIR) + "/configs/crazyflie_basemodel.yaml", load),
-      options);
+  const CampaignResult result =
+      RunCampaign(LoadCampaignConfig(
+                      std::string(BIFILAR_SOURCE_DIR) + "/configs/crazyflie_basemodel.yaml", load),
+                  options);
   EXPECT_EQ(result.summary.n_ok, 12);
   ASSERT_TRUE(result.tensor_fit.has_value()) << result.summary.tensor_message;
   const TensorResult& t = *result.tensor_fit;

@@ -1,6 +1,8 @@
-// The total uncertainty (pipeline/records/total_uncertainty.h): named terms in quadrature, the assumed
+// The total uncertainty (pipeline/records/total_uncertainty.h): named terms in quadrature, the
+// assumed
 // +-1 mm on L and D without rig.uncertainties, the total in every output, and on the real
-// quadrotor logs (crazyflie/ of the data folder, tests/test_support.h) the numbers issue 16 asks for.
+// quadrotor logs (crazyflie/ of the data folder, tests/test_support.h) the numbers issue 16 asks
+// for.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -47,11 +49,11 @@ TEST(TotalUncertainty, NamedTermsInQuadrature) {
   r.repeat_scatter_std_kg_m2 = 12.0;
   const TotalUncertainty u = ComposeTotalUncertainty(r);
   ASSERT_EQ(u.terms.size(), 6u);
-  const char* names[] = {kTermStatistical, kTermModelInadequacy, kTermBetweenRepeat,
+  const char* names[] = {kTermStatistical,         kTermModelInadequacy,  kTermBetweenRepeat,
                          kTermAmplitudeCorrection, kTermConfiguredInputs, kTermCalibration};
   for (int k = 0; k < 6; ++k) EXPECT_EQ(u.terms[k].name, names[k]);
   EXPECT_EQ(u.Term(kTermAmplitudeCorrection), 0.0);  // zero unless --repeats corrected the log
-  EXPECT_DOUBLE_EQ(u.stat_std_kg_m2, 13.0);  // sqrt(9 + 16 + 144)
+  EXPECT_DOUBLE_EQ(u.stat_std_kg_m2, 13.0);          // sqrt(9 + 16 + 144)
   EXPECT_DOUBLE_EQ(u.common_mode_std_kg_m2, std::sqrt(142.0));
   EXPECT_DOUBLE_EQ(u.total_std_kg_m2, std::sqrt(169.0 + 142.0));
   EXPECT_EQ(u.Term(kTermCalibration), 0.0);  // the slot is there, zero until calibrated
@@ -302,8 +304,8 @@ TEST(TotalUncertainty, QuadrotorLogsCountTheGeometry) {
       for (const TraceRecord& r : records) {
         // Against the set-up's value, the random-effects mean (a plain mean is pulled by a
         // lowest-band result with its large std, which --repeats keeps uncorrected).
-        const double z = std::abs(r.inertia_total_kg_m2 - groups[0].mean_kg_m2) /
-                         r.inertia_total_std_kg_m2;
+        const double z =
+            std::abs(r.inertia_total_kg_m2 - groups[0].mean_kg_m2) / r.inertia_total_std_kg_m2;
         largest_z = std::max(largest_z, z);
         EXPECT_LE(z, 2.5) << r.file;
         const double total = r.inertia_total_std_total_kg_m2 / r.inertia_total_kg_m2;

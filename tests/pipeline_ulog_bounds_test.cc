@@ -1,5 +1,5 @@
-// Hostile ULog files (issue 23 items 5 and 7), generated here with pipeline/logs/ulog_writer.h: nested
-// array formats that would flatten to gigabytes, deep and circular nesting, thousands of
+// Hostile ULog files (issue 23 items 5 and 7), generated here with pipeline/logs/ulog_writer.h:
+// nested array formats that would flatten to gigabytes, deep and circular nesting, thousands of
 // subscriptions, a damaged size field mid-file, and a huge one-line file given to `inspect`.
 // Each is refused with a message naming the file and the format, or read in one pass; the time
 // and memory these take are measured by bench/ulog_bench.cc, not asserted here.
@@ -9,11 +9,11 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/logs/imu_log.h"
+#include "base/user_error.h"
 #include "pipeline/commands/log_inspect.h"
+#include "pipeline/logs/imu_log.h"
 #include "pipeline/logs/ulog.h"
 #include "pipeline/logs/ulog_writer.h"
-#include "base/user_error.h"
 #include "test_support.h"
 
 namespace bifilar {
@@ -29,7 +29,9 @@ using test_support::ErrorOf;
 // holding scalars; one sample of it.
 std::string NestedLog(int levels) {
   UlogWriter w(0);
-  const auto type = [levels](int k) { return k == 0 ? std::string("top") : "n" + std::to_string(k); };
+  const auto type = [levels](int k) {
+    return k == 0 ? std::string("top") : "n" + std::to_string(k);
+  };
   for (int k = 0; k + 1 < levels; ++k) {
     w.Format(type(k) + ":" + (k == 0 ? "uint64_t timestamp;" : "") + type(k + 1) + " inner;");
   }

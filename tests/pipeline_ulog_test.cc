@@ -1,7 +1,8 @@
-// PX4 ULog reader (pipeline/logs/ulog.h) and writer (pipeline/logs/ulog_writer.h): the real PX4 logs in
-// px4/ of the data folder (tests/test_support.h) against a reference reader's numbers, files written here with dropouts,
-// appended sections, nested types and a cut-short tail, bad input (always an error naming the
-// file, never a crash), the config keys, and a simulated campaign processed from .ulg and .csv.
+// PX4 ULog reader (pipeline/logs/ulog.h) and writer (pipeline/logs/ulog_writer.h): the real PX4
+// logs in px4/ of the data folder (tests/test_support.h) against a reference reader's numbers,
+// files written here with dropouts, appended sections, nested types and a cut-short tail, bad input
+// (always an error naming the file, never a crash), the config keys, and a simulated campaign
+// processed from .ulg and .csv.
 #include "pipeline/logs/ulog.h"
 
 #include <cmath>
@@ -153,7 +154,8 @@ TEST(Ulog, RealLogCutOrDamagedNeverCrashes) {
   EXPECT_GT(half.size(), 100u);
   EXPECT_LT(half.size(), 1298u);
   ASSERT_FALSE(half.warnings.empty());
-  EXPECT_TRUE(Contains(half.warnings[0], "the log ends inside a message at byte")) << half.warnings[0];
+  EXPECT_TRUE(Contains(half.warnings[0], "the log ends inside a message at byte"))
+      << half.warnings[0];
 }
 
 // ---- Files written here ----
@@ -174,17 +176,29 @@ constexpr size_t kFirstMessage = 16 + 3 + 40;
 
 // One sensor_combined sample as FormatImuUlog lays it out (45 bytes: trailing padding dropped).
 std::string SensorCombined(uint64_t t_us, float gx) {
-  return UlogPayload().U64(t_us).F32(gx).F32(-0.5f).F32(0.25f).U32(4000).I32(0)
-      .F32(0.0f).F32(0.125f).F32(-9.8f).U32(4000).U8(0).str();
+  return UlogPayload()
+      .U64(t_us)
+      .F32(gx)
+      .F32(-0.5f)
+      .F32(0.25f)
+      .U32(4000)
+      .I32(0)
+      .F32(0.0f)
+      .F32(0.125f)
+      .F32(-9.8f)
+      .U32(4000)
+      .U8(0)
+      .str();
 }
 
 // A writer with the sensor_combined format and subscription of FormatImuUlog, and other topics.
 UlogWriter SensorCombinedWriter() {
   UlogWriter w(123);
   w.Info("sys_name", "test");
-  w.Format("sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
-           "int32_t accelerometer_timestamp_relative;float[3] accelerometer_m_s2;"
-           "uint32_t accelerometer_integral_dt;uint8_t accelerometer_clipping;uint8_t[3] _padding0;");
+  w.Format(
+      "sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
+      "int32_t accelerometer_timestamp_relative;float[3] accelerometer_m_s2;"
+      "uint32_t accelerometer_integral_dt;uint8_t accelerometer_clipping;uint8_t[3] _padding0;");
   w.Format("cpuload:uint64_t timestamp;float load;");
   w.Parameter("SENS_BOARD_ROT", 0.0f);
   w.AddLogged("cpuload", 0, 0);
@@ -198,14 +212,16 @@ TEST(UlogWriter, RoundTripsAnImuLog) {
   ASSERT_EQ(out.size(), in.size());
   for (size_t k = 0; k < in.size(); ++k) {
     EXPECT_NEAR(out.t_s[k], in.t_s[k], 0.5e-6);  // whole microseconds
-    EXPECT_EQ(out.gyro_in_imu[k].x(), static_cast<double>(static_cast<float>(in.gyro_in_imu[k].x())));
+    EXPECT_EQ(out.gyro_in_imu[k].x(),
+              static_cast<double>(static_cast<float>(in.gyro_in_imu[k].x())));
     EXPECT_EQ(out.accel_in_imu[k].z(), static_cast<double>(-9.8f));
   }
   EXPECT_TRUE(out.warnings.empty());
   // Gyro-only data becomes vehicle_angular_velocity.
   ImuData gyro_only = in;
   gyro_only.accel_in_imu.clear();
-  const ImuData g = ReadUlogImu(FormatImuUlog(gyro_only), "g.ulg", Topic("vehicle_angular_velocity"));
+  const ImuData g =
+      ReadUlogImu(FormatImuUlog(gyro_only), "g.ulg", Topic("vehicle_angular_velocity"));
   EXPECT_EQ(g.size(), 200u);
   EXPECT_FALSE(g.has_accel());
 }
@@ -238,7 +254,8 @@ TEST(UlogReader, DropoutsAreGapsInTime) {
   ASSERT_EQ(d.size(), 20u);  // nothing interpolated
   EXPECT_NEAR(d.t_s[10] - d.t_s[9], 0.124, 1e-9);
   ASSERT_EQ(d.warnings.size(), 1u);
-  EXPECT_TRUE(Contains(d.warnings[0], "1 logging dropout(s) ('O' messages, 120 ms in all")) << d.warnings[0];
+  EXPECT_TRUE(Contains(d.warnings[0], "1 logging dropout(s) ('O' messages, 120 ms in all"))
+      << d.warnings[0];
 }
 
 TEST(UlogReader, NestedTypesArraysAndPadding) {
@@ -258,8 +275,8 @@ TEST(UlogReader, NestedTypesArraysAndPadding) {
   UlogRequest request{"pair", 3, {"timestamp", "v[1].xy[0]", "v[1].d", "k"}};
   const UlogContents c = ParseUlog(w.bytes(), "nested.ulg", request);
   ASSERT_TRUE(c.found);
-  const std::vector<std::string> fields = {"timestamp", "v[0].xy[0]", "v[0].xy[1]", "v[0].d",
-                                           "v[1].xy[0]", "v[1].xy[1]", "v[1].d", "k"};
+  const std::vector<std::string> fields = {"timestamp",  "v[0].xy[0]", "v[0].xy[1]", "v[0].d",
+                                           "v[1].xy[0]", "v[1].xy[1]", "v[1].d",     "k"};
   EXPECT_EQ(c.fields, fields);
   ASSERT_EQ(c.samples(), 3);
   EXPECT_EQ(c.values[4 * 2 + 0], 12.0);
@@ -309,14 +326,17 @@ TEST(UlogReader, TimestampsGoingBackAreRepairedLikeCsv) {
   const ImuData from_ulog = ReadUlogImu(FormatImuUlog(in), "back.ulg", ImuFormat());
   ImuLogWriteOptions csv_options;
   csv_options.significant_digits = 12;
-  const ImuData from_csv = ReadImuLogFromString(FormatImuLog(in, ImuFormat(), csv_options), "back.csv", ImuFormat());
+  const ImuData from_csv =
+      ReadImuLogFromString(FormatImuLog(in, ImuFormat(), csv_options), "back.csv", ImuFormat());
   ASSERT_EQ(from_ulog.size(), from_csv.size());
   ASSERT_EQ(from_ulog.size(), 199u);
   for (size_t k = 0; k < from_csv.size(); ++k) EXPECT_NEAR(from_ulog.t_s[k], from_csv.t_s[k], 1e-9);
   ASSERT_EQ(from_ulog.warnings.size(), 1u);
   ASSERT_EQ(from_csv.warnings.size(), 1u);
-  EXPECT_TRUE(Contains(from_csv.warnings[0], "1 of 200 samples had a timestamp that did not increase"));
-  EXPECT_TRUE(Contains(from_ulog.warnings[0], "1 of 200 samples had a timestamp that did not increase"))
+  EXPECT_TRUE(
+      Contains(from_csv.warnings[0], "1 of 200 samples had a timestamp that did not increase"));
+  EXPECT_TRUE(
+      Contains(from_ulog.warnings[0], "1 of 200 samples had a timestamp that did not increase"))
       << from_ulog.warnings[0];
   EXPECT_TRUE(Contains(from_ulog.warnings[0], "sample 52")) << from_ulog.warnings[0];
   // Too many going back: rejected, as CSV.
@@ -332,7 +352,8 @@ TEST(UlogReader, BadInputNamesTheFileAndByte) {
     return ErrorOf([&] { ReadUlogImu(bytes, "bad.ulg", ImuFormat()); });
   };
   EXPECT_TRUE(Contains(error(good.substr(0, 10)), "bad.ulg: byte 10: the file is 10 bytes long"));
-  EXPECT_TRUE(Contains(error("ULog\x01\x12\x36" + good.substr(7)), "bad.ulg: byte 0: not a ULog file"));
+  EXPECT_TRUE(
+      Contains(error("ULog\x01\x12\x36" + good.substr(7)), "bad.ulg: byte 0: not a ULog file"));
   std::string flags = good;
   flags[16 + 3 + 8] = 2;  // an unknown incompatible flag bit
   EXPECT_TRUE(Contains(error(flags), "bad.ulg: byte 27: unknown incompatible flag bits"));
@@ -341,7 +362,8 @@ TEST(UlogReader, BadInputNamesTheFileAndByte) {
   UlogWriter extra(0);
   extra.Data(42, std::string(8, '\0'));
   orphan += extra.bytes().substr(kFirstMessage);
-  EXPECT_TRUE(Contains(error(orphan), "byte " + std::to_string(good.size()) + ": data for msg_id 42"));
+  EXPECT_TRUE(
+      Contains(error(orphan), "byte " + std::to_string(good.size()) + ": data for msg_id 42"));
   // A data message of the wrong size for its format.
   UlogWriter w2 = SensorCombinedWriter();
   w2.Data(1, SensorCombined(1, 0.0f) + "abcd");
@@ -350,8 +372,9 @@ TEST(UlogReader, BadInputNamesTheFileAndByte) {
   // NaN in a requested field.
   UlogWriter w3 = SensorCombinedWriter();
   w3.Data(1, SensorCombined(1, std::nanf("")));
-  EXPECT_TRUE(Contains(ErrorOf([&] { ReadUlogImu(w3.bytes(), "bad.ulg", ImuFormat()); }),
-                       "sample 1 of the ULog topic 'sensor_combined' (multi_id 0) has gyro_rad[0] = nan"));
+  EXPECT_TRUE(
+      Contains(ErrorOf([&] { ReadUlogImu(w3.bytes(), "bad.ulg", ImuFormat()); }),
+               "sample 1 of the ULog topic 'sensor_combined' (multi_id 0) has gyro_rad[0] = nan"));
   // Circular and undefined nested types.
   UlogWriter w4(0);
   w4.Format("a:uint64_t timestamp;b x;");
@@ -367,11 +390,13 @@ TEST(UlogReader, BadInputNamesTheFileAndByte) {
   // Forced containers.
   ImuFormat ulog;
   ulog.container = LogContainer::kUlog;
-  EXPECT_TRUE(Contains(ErrorOf([&] { ReadImuLogFromString("t,gx,gy,gz\n0,0,0,0\n", "x.csv", ulog); }),
-                       "x.csv: byte 0: not a ULog file"));
+  EXPECT_TRUE(
+      Contains(ErrorOf([&] { ReadImuLogFromString("t,gx,gy,gz\n0,0,0,0\n", "x.csv", ulog); }),
+               "x.csv: byte 0: not a ULog file"));
   ImuFormat csv;
   csv.container = LogContainer::kCsv;
-  EXPECT_TRUE(Contains(ErrorOf([&] { ReadImuLogFromString(good, "x.ulg", csv); }), "not a text CSV file"));
+  EXPECT_TRUE(
+      Contains(ErrorOf([&] { ReadImuLogFromString(good, "x.ulg", csv); }), "not a text CSV file"));
 }
 
 // Every truncation and many random byte flips of a small file: each read either succeeds with
@@ -400,7 +425,8 @@ TEST(UlogReader, FuzzedFilesNeverCrash) {
   int errors = 0;
   for (size_t n = 0; n <= good.size(); ++n) {
     check(good.substr(0, n), "truncated to " + std::to_string(n));
-    errors += ErrorOf([&] { ReadUlogImu(good.substr(0, n), "fuzz.ulg", ImuFormat()); }).empty() ? 0 : 1;
+    errors +=
+        ErrorOf([&] { ReadUlogImu(good.substr(0, n), "fuzz.ulg", ImuFormat()); }).empty() ? 0 : 1;
   }
   EXPECT_GT(errors, 0);
   std::mt19937 rng(11);
@@ -409,7 +435,8 @@ TEST(UlogReader, FuzzedFilesNeverCrash) {
     const int flips = 1 + trial % 4;
     for (int f = 0; f < flips; ++f) {
       const size_t at = std::uniform_int_distribution<size_t>(0, bytes.size() - 1)(rng);
-      bytes[at] = static_cast<char>(bytes[at] ^ (1 << std::uniform_int_distribution<int>(0, 7)(rng)));
+      bytes[at] =
+          static_cast<char>(bytes[at] ^ (1 << std::uniform_int_distribution<int>(0, 7)(rng)));
     }
     check(bytes, "trial " + std::to_string(trial));
   }
@@ -420,7 +447,8 @@ TEST(UlogReader, FuzzedFilesNeverCrash) {
 TEST(UlogConfig, KeysAndTopicDefaults) {
   const std::string dir = TempDir();
   auto load = [&](const std::string& imu) {
-    WriteFile(dir + "/c.yaml", "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 2}\nimu:\n" + imu);
+    WriteFile(dir + "/c.yaml",
+              "rig: {filar_length_m: 2, filar_separation_m: 1, mass_kg: 2}\nimu:\n" + imu);
     ConfigLoadOptions options;
     options.require_runs = false;
     return LoadCampaignConfig(dir + "/c.yaml", options);
@@ -442,10 +470,14 @@ TEST(UlogConfig, KeysAndTopicDefaults) {
   EXPECT_EQ(c.imu.format.ulog.accel_fields[0], "ax");
   c = load("  accel: null\n");
   EXPECT_TRUE(c.imu.format.ulog.accel_fields[0].empty());
-  EXPECT_TRUE(Contains(ErrorOf([&] { load("  format: px4\n"); }), "'imu.format' must be auto, csv or ulog"));
-  EXPECT_TRUE(Contains(ErrorOf([&] { load("  ulog: {topic: my_imu}\n"); }), "'imu.ulog.gyro_fields' is needed"));
-  EXPECT_TRUE(Contains(ErrorOf([&] { load("  ulog: {multi_id: 300}\n"); }), "imu.ulog.multi_id = 300; must be in [0, 255]"));
-  EXPECT_TRUE(Contains(ErrorOf([&] { load("  ulog: {topik: x}\n"); }), "unknown key 'imu.ulog.topik'"));
+  EXPECT_TRUE(Contains(ErrorOf([&] { load("  format: px4\n"); }),
+                       "'imu.format' must be auto, csv or ulog"));
+  EXPECT_TRUE(Contains(ErrorOf([&] { load("  ulog: {topic: my_imu}\n"); }),
+                       "'imu.ulog.gyro_fields' is needed"));
+  EXPECT_TRUE(Contains(ErrorOf([&] { load("  ulog: {multi_id: 300}\n"); }),
+                       "imu.ulog.multi_id = 300; must be in [0, 255]"));
+  EXPECT_TRUE(
+      Contains(ErrorOf([&] { load("  ulog: {topik: x}\n"); }), "unknown key 'imu.ulog.topik'"));
   std::error_code ec;
   fs::remove_all(dir, ec);
 }
@@ -454,16 +486,20 @@ TEST(UlogConfig, KeysAndTopicDefaults) {
 
 std::string Replace(std::string text, const std::string& from, const std::string& to) {
   const size_t at = text.find(from);
-  if (at == std::string::npos) ADD_FAILURE() << "sample spec changed: '" << from << "' not found";
-  else text.replace(at, from.size(), to);
+  if (at == std::string::npos)
+    ADD_FAILURE() << "sample spec changed: '" << from << "' not found";
+  else
+    text.replace(at, from.size(), to);
   return text;
 }
 
 TEST(UlogCampaign, SimulatedUlogGivesTheSameInertiasAsCsv) {
   const std::string dir = TempDir();
   std::string spec = ReadFile(std::string(BIFILAR_SOURCE_DIR) + "/configs/simulate_prandtl_d.yaml");
-  spec = Replace(spec, "pitch_deg: [-80, -70, -60, -50, -40, -30, -20, -10, 0, 10, 20, 30, 40, 50, 60, 70, 80, 90]",
-                 "pitch_deg: [-60, 0, 90]");
+  spec = Replace(
+      spec,
+      "pitch_deg: [-80, -70, -60, -50, -40, -30, -20, -10, 0, 10, 20, 30, 40, 50, 60, 70, 80, 90]",
+      "pitch_deg: [-60, 0, 90]");
   spec = Replace(spec, "trials_per_pitch: 3", "trials_per_pitch: 1");
   spec = Replace(spec, "tare_logs: 3", "tare_logs: 1");
   spec = Replace(spec, "free_s: [35, 45]", "free_s: [20, 25]");
@@ -477,9 +513,12 @@ TEST(UlogCampaign, SimulatedUlogGivesTheSameInertiasAsCsv) {
   auto run = [&](const std::string& sub, const std::string& ext) {
     WriteFile(dir + "/" + sub + ".yaml",
               "rig:\n  filar_length_m: 2.0\n  filar_separation_m: 1.8\n  mass_kg: 1.25\n"
-              "  inertia: {tare: {logs: " + sub + "/tare/*." + ext + "}}\n"
-              "aircraft: {mass_kg: 5.5}\n"
-              "runs: {root: " + sub + ", pattern: \"pitch_{pitch_deg}/*." + ext + "\"}\n");
+              "  inertia: {tare: {logs: " +
+                  sub + "/tare/*." + ext +
+                  "}}\n"
+                  "aircraft: {mass_kg: 5.5}\n"
+                  "runs: {root: " +
+                  sub + ", pattern: \"pitch_{pitch_deg}/*." + ext + "\"}\n");
     CampaignOptions options;
     options.out_dir = dir + "/out_" + sub;
     options.jobs = 2;
@@ -496,10 +535,12 @@ TEST(UlogCampaign, SimulatedUlogGivesTheSameInertiasAsCsv) {
     const TraceRecord& b = ulg.traces[i];
     ASSERT_TRUE(a.ok()) << a.file << ": " << a.message;
     ASSERT_TRUE(b.ok()) << b.file << ": " << b.message;
-    EXPECT_EQ(fs::path(a.file).replace_extension().string(), fs::path(b.file).replace_extension().string());
+    EXPECT_EQ(fs::path(a.file).replace_extension().string(),
+              fs::path(b.file).replace_extension().string());
     // The same samples, stored as float32 (7 digits) and whole microseconds instead of 9-digit
     // text: the inertias differ by ~3e-4 of the fit's std (measured); allow 0.01 of it.
-    EXPECT_NEAR(a.inertia_total_kg_m2, b.inertia_total_kg_m2, 0.01 * a.inertia_total_std_kg_m2) << a.file;
+    EXPECT_NEAR(a.inertia_total_kg_m2, b.inertia_total_kg_m2, 0.01 * a.inertia_total_std_kg_m2)
+        << a.file;
   }
   std::error_code ec;
   fs::remove_all(dir, ec);

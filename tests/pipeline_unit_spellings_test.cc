@@ -51,8 +51,9 @@ TEST(UnitSpellings, HelpTextsPrintStandardGravityAndTheIntegratorTable) {
   const CliRun plan = Bifilar(dir, "plan --help");
   EXPECT_TRUE(Contains(plan.out, "with --rig: local g, m/s^2 (" + g0 + ")")) << plan.out;
   const CliRun process = Bifilar(dir, "process --help");
-  EXPECT_TRUE(Contains(process.out, "ODE solver of the fits: rk853 or cvodes; overrides "
-                                    "fit.integrator"))
+  EXPECT_TRUE(Contains(process.out,
+                       "ODE solver of the fits: rk853 or cvodes; overrides "
+                       "fit.integrator"))
       << process.out;
   EXPECT_EQ(IntegratorMethodAllowedValues(), "rk853 or cvodes");
 }

@@ -228,9 +228,9 @@ TEST(WatchLive, Esp32LoggerOverAWebSocketGivesFitsNumbersAndSurvivesADisconnect)
   int swinging = 0;
   for (const WatchUpdate& u : r.updates) {
     const nlohmann::json j = WatchUpdateToJson(u);
-    for (const char* key : {"t_s", "cycles", "amplitude_deg", "period_s", "inertia_kg_m2",
-                            "inertia_std_stat_kg_m2", "inertia_std_total_kg_m2", "verdict",
-                            "reason"}) {
+    for (const char* key :
+         {"t_s", "cycles", "amplitude_deg", "period_s", "inertia_kg_m2", "inertia_std_stat_kg_m2",
+          "inertia_std_total_kg_m2", "verdict", "reason"}) {
       ASSERT_TRUE(j.contains(key)) << key << " in " << j.dump();
     }
     WatchVerdict verdict;

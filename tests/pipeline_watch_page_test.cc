@@ -82,8 +82,11 @@ TEST(WatchPage, NumbersChangeInHeadlessChromiumAsTheFeederPlays) {
   const std::string command =
       "timeout 120 /usr/bin/chromium --headless --no-sandbox --disable-gpu --no-first-run "
       "--disable-background-networking --disable-component-update --disable-sync "
-      "--user-data-dir=" + profile + " --enable-logging=stderr --v=0 --virtual-time-budget=60000 "
-      "--dump-dom " + page + " > " + dom + " 2> " + log;
+      "--user-data-dir=" +
+      profile +
+      " --enable-logging=stderr --v=0 --virtual-time-budget=60000 "
+      "--dump-dom " +
+      page + " > " + dom + " 2> " + log;
   const int status = std::system(command.c_str());
   feeder.join();
   watch.join();
@@ -94,7 +97,8 @@ TEST(WatchPage, NumbersChangeInHeadlessChromiumAsTheFeederPlays) {
   }
   const std::string html = ReadFile(dom);
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(html, m, std::regex("id=\"updates\" data-first-t=\"([^\"]*)\">([0-9]+)<")))
+  ASSERT_TRUE(
+      std::regex_search(html, m, std::regex("id=\"updates\" data-first-t=\"([^\"]*)\">([0-9]+)<")))
       << html.substr(0, 3000);
   const std::string first_t = m[1];
   const int updates = std::stoi(m[2]);

@@ -92,9 +92,10 @@ TEST(Watch, PipedSimulationGivesFitsNumbersOnTheSavedLog) {
   const TraceRecord fit = FitLog(config, dir.path + "/saved.csv");
   ASSERT_TRUE(fit.ok()) << fit.message;
   const nlohmann::json& record = final["logs"][0]["record"];
-  ExpectRelativelyEqual(record["inertia_total_kg_m2"].get<double>(), fit.inertia_total_kg_m2, 1e-12);
-  ExpectRelativelyEqual(record["inertia_total_std_kg_m2"].get<double>(), fit.inertia_total_std_kg_m2,
+  ExpectRelativelyEqual(record["inertia_total_kg_m2"].get<double>(), fit.inertia_total_kg_m2,
                         1e-12);
+  ExpectRelativelyEqual(record["inertia_total_std_kg_m2"].get<double>(),
+                        fit.inertia_total_std_kg_m2, 1e-12);
   EXPECT_NEAR(fit.inertia_total_kg_m2, kTrueInertia, 5 * fit.inertia_total_std_total_kg_m2);
 }
 
@@ -274,10 +275,12 @@ TEST(Watch, FollowsGrowingUlogAndDataflashLogs) {
     ASSERT_TRUE(on_binary.ok()) << name << ": " << on_binary.message;
     ConfigLoadOptions load;
     load.require_runs = false;
-    const ImuData data = ReadImuLog(dir.path + "/" + name, LoadCampaignConfig(config, load).imu.format);
+    const ImuData data =
+        ReadImuLog(dir.path + "/" + name, LoadCampaignConfig(config, load).imu.format);
     EXPECT_EQ(r.logs[0].samples, static_cast<long>(data.size())) << name;
     ASSERT_TRUE(r.logs[0].record.has_value());
-    ExpectRelativelyEqual(r.logs[0].record->inertia_total_kg_m2, on_saved.inertia_total_kg_m2, 1e-12);
+    ExpectRelativelyEqual(r.logs[0].record->inertia_total_kg_m2, on_saved.inertia_total_kg_m2,
+                          1e-12);
     ExpectRelativelyEqual(on_saved.inertia_total_kg_m2, on_binary.inertia_total_kg_m2, 1e-12);
   }
 }
@@ -398,9 +401,9 @@ TEST(Watch, BlockMeansKeepTheFitBounded) {
   ConfigLoadOptions load;
   load.require_runs = false;
   TempDir dir("watch_bound");
-  const CampaignConfig config = LoadCampaignConfigText(
-      "rig: {filar_length_m: 1.0, filar_separation_m: 0.3, mass_kg: 2}\n", dir.path + "/c.yaml",
-      load);
+  const CampaignConfig config =
+      LoadCampaignConfigText("rig: {filar_length_m: 1.0, filar_separation_m: 0.3, mass_kg: 2}\n",
+                             dir.path + "/c.yaml", load);
   WatchEngineOptions options;
   options.max_fit_samples = 256;
   WatchEngine engine(config, options);

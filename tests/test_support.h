@@ -145,8 +145,9 @@ inline RealData FindRealData(const std::string& relative, std::string* path, std
     return RealData::kUnlabelled;
   }
   if (dir == nullptr || *dir == '\0') {
-    *why = "real data not run: no data folder named (BIFILAR_DATA_DIR; cmake "
-           "-DBIFILAR_DATA_DIR=DIR, or scripts/test.sh with ../shared/data beside the checkout)";
+    *why =
+        "real data not run: no data folder named (BIFILAR_DATA_DIR; cmake "
+        "-DBIFILAR_DATA_DIR=DIR, or scripts/test.sh with ../shared/data beside the checkout)";
     return RealData::kNotNamed;
   }
   std::error_code ec;
@@ -159,16 +160,16 @@ inline RealData FindRealData(const std::string& relative, std::string* path, std
 
 // In a TEST body: declares std::string `var`, the path of `relative` in the data folder, or
 // ends the test as FindRealData says (skip when no folder is named, failure otherwise).
-#define BIFILAR_REAL_DATA(var, relative)                                                  \
-  std::string var;                                                                        \
-  do {                                                                                    \
-    std::string bifilar_real_data_why;                                                    \
-    const ::bifilar::test_support::RealData bifilar_real_data_found =                     \
-        ::bifilar::test_support::FindRealData(relative, &var, &bifilar_real_data_why);    \
-    if (bifilar_real_data_found == ::bifilar::test_support::RealData::kNotNamed)          \
-      GTEST_SKIP() << bifilar_real_data_why;                                              \
-    if (bifilar_real_data_found != ::bifilar::test_support::RealData::kFound)             \
-      FAIL() << bifilar_real_data_why;                                                    \
+#define BIFILAR_REAL_DATA(var, relative)                                               \
+  std::string var;                                                                     \
+  do {                                                                                 \
+    std::string bifilar_real_data_why;                                                 \
+    const ::bifilar::test_support::RealData bifilar_real_data_found =                  \
+        ::bifilar::test_support::FindRealData(relative, &var, &bifilar_real_data_why); \
+    if (bifilar_real_data_found == ::bifilar::test_support::RealData::kNotNamed)       \
+      GTEST_SKIP() << bifilar_real_data_why;                                           \
+    if (bifilar_real_data_found != ::bifilar::test_support::RealData::kFound)          \
+      FAIL() << bifilar_real_data_why;                                                 \
   } while (false)
 
 // The message of the UserError `f` throws ("" when it throws none).

@@ -16,8 +16,7 @@ namespace watch_support {
 
 // The rig: filars 1 m long and 0.3 m apart, 2 kg, I = 0.05 kg m^2 (period ~2.1 s).
 constexpr double kSwingInertia = 0.05;
-constexpr char kSwingConfig[] =
-    "rig: {filar_length_m: 1.0, filar_separation_m: 0.3, mass_kg: 2}\n";
+constexpr char kSwingConfig[] = "rig: {filar_length_m: 1.0, filar_separation_m: 0.3, mass_kg: 2}\n";
 
 struct Swing {
   uint64_t seed = 1;

@@ -31,8 +31,7 @@ double GeometryFactorAllowance(const CampaignConfig& config, const RigCalibratio
   const double d = 2.0 * u.filar_separation_std_m / config.filar_separation_m;
   const double l = u.filar_length_std_m / config.filar_length_m;
   const double g = u.gravity_std_mps2 / config.gravity_mps2;
-  const double expected =
-      std::sqrt(d * d + l * l + g * g + c.factor_rel_std * c.factor_rel_std);
+  const double expected = std::sqrt(d * d + l * l + g * g + c.factor_rel_std * c.factor_rel_std);
   return std::min(kCalibrationFactorSigmas * expected, kCalibrationFactorWarnFraction);
 }
 
@@ -97,8 +96,8 @@ void GivenRigInertia(const CampaignConfig& config, double* rig_given, double* ri
 // One round's records into *out: the reference swings (every one must be ok), their mean
 // inertia with its standard error and scatter, and the rig's inertia (the tare logs' mean, or the
 // given one).
-void ReadReferenceSwings(const std::vector<TraceRecord>& records, bool from_tare,
-                         double rig_given, double rig_given_std, RigCalibrationResult* out) {
+void ReadReferenceSwings(const std::vector<TraceRecord>& records, bool from_tare, double rig_given,
+                         double rig_given_std, RigCalibrationResult* out) {
   std::vector<double> swing, swing_std, tare, tare_std;
   out->logs.clear();
   for (const TraceRecord& r : records) {

@@ -271,9 +271,9 @@ std::string ProgressLine(const TraceRecord& record, DisplayUnits units) {
   std::string line = record.file + ": " + ToString(record.status);
   if (record.ok()) {
     char buffer[160];
-    std::snprintf(buffer, sizeof(buffer), " I_total = %#.5g %s +- %.2g %% (stat) +- %.2g %% (total)",
-                  InertiaToDisplay(record.inertia_total_kg_m2, units),
-                  InertiaUnitName(units),
+    std::snprintf(buffer, sizeof(buffer),
+                  " I_total = %#.5g %s +- %.2g %% (stat) +- %.2g %% (total)",
+                  InertiaToDisplay(record.inertia_total_kg_m2, units), InertiaUnitName(units),
                   100.0 * record.inertia_total_std_kg_m2 / record.inertia_total_kg_m2,
                   100.0 * record.inertia_total_std_total_kg_m2 / record.inertia_total_kg_m2);
     line += buffer;
@@ -401,7 +401,8 @@ void SetRigInertia(const CampaignConfig& config, const TareEstimate& tare, Campa
       std::string first;
       for (const TraceRecord& r : result->traces) {
         if (r.role != TraceRole::kTare) continue;
-        if (failed++ == 0) first = r.message.empty() ? r.file + ": " + ToString(r.status) : r.message;
+        if (failed++ == 0)
+          first = r.message.empty() ? r.file + ": " + ToString(r.status) : r.message;
       }
       result->rig_problem = "no usable tare log, so the rig inertia is unknown: " +
                             (failed == 0 ? std::string("no tare log found") : first) +
@@ -501,19 +502,21 @@ void SubtractRig(const CampaignConfig& config, const TareEstimate& tare,
 // the tensor averages them, until the user keeps one set-up (comments out the other's rows in
 // runs.table with '#'). docs/guide.md, "Two set-ups at one attitude".
 struct SetupGroup {
-  std::string name;            // the group column's value, or "set-up 1" / "set-up 2"
-  std::vector<int> members;    // trace indices
+  std::string name;          // the group column's value, or "set-up 1" / "set-up 2"
+  std::vector<int> members;  // trace indices
 };
 
 // "group 'A' (a.csv, b.csv): I_total = 0.3201 +- 0.0002 kg m^2" for each set-up, the weighted mean
-// of its logs' total moments (rig + aircraft, as the test's text) with the std of a weighted mean (Birge-scaled when they scatter).
+// of its logs' total moments (rig + aircraft, as the test's text) with the std of a weighted mean
+// (Birge-scaled when they scatter).
 std::string SetupGroupsText(const std::vector<SetupGroup>& setups,
                             const std::vector<TraceRecord>& traces) {
   std::string text;
   for (const SetupGroup& s : setups) {
     double sw = 0, swy = 0, chi2 = 0;
     for (int i : s.members) {
-      const double w = 1.0 / (traces[i].inertia_total_std_kg_m2 * traces[i].inertia_total_std_kg_m2);
+      const double w =
+          1.0 / (traces[i].inertia_total_std_kg_m2 * traces[i].inertia_total_std_kg_m2);
       sw += w;
       swy += w * traces[i].inertia_total_kg_m2;
     }
@@ -528,8 +531,9 @@ std::string SetupGroupsText(const std::vector<SetupGroup>& setups,
     for (size_t k = 0; k < s.members.size(); ++k) {
       files += (k ? ", " : "") + traces[s.members[k]].file;
     }
-    text += (text.empty() ? "" : "; ") + s.name + " (" + files + "): I_total = " + Fmt("%.5g", mean) +
-            " +- " + Fmt("%.2g", birge / std::sqrt(sw)) + " kg m^2";
+    text += (text.empty() ? "" : "; ") + s.name + " (" + files +
+            "): I_total = " + Fmt("%.5g", mean) + " +- " + Fmt("%.2g", birge / std::sqrt(sw)) +
+            " kg m^2";
   }
   return text;
 }
@@ -552,14 +556,16 @@ void WithholdTwoSetups(const std::vector<RunFile>& runs, CampaignResult* result)
   for (const auto& [attitude, members] : attitudes) {
     // Named set-ups: the group column's values at this attitude.
     std::map<std::string, std::vector<int>> named;
-    for (int i : members) named[static_cast<size_t>(i) < runs.size() ? runs[i].group : ""].push_back(i);
+    for (int i : members)
+      named[static_cast<size_t>(i) < runs.size() ? runs[i].group : ""].push_back(i);
     std::vector<SetupGroup> setups;
     std::string found;
     if (named.size() > 1) {
       for (const auto& [name, logs] : named) {
         setups.push_back({name.empty() ? "no group" : "group '" + name + "'", logs});
       }
-      found = "are named as " + std::to_string(named.size()) + " set-ups in runs.table's group column";
+      found =
+          "are named as " + std::to_string(named.size()) + " set-ups in runs.table's group column";
     } else {
       std::vector<const TraceRecord*> records;
       std::vector<std::string> names;
@@ -898,9 +904,9 @@ CampaignResult RunCampaign(const CampaignConfig& config, const CampaignOptions& 
   // 5. Ellipse of inertia, Table 1, Fig. 3/4; the inertia tensor
   // (pipeline/campaign/campaign_tensor.h).
   FitCampaignEllipse(config, options, &out, &result);
-  FitCampaignTensor(config, options.figures ? out.figures().string() : "",
-                    [&out](const std::string& name) { out.manifest.Record({"figures/" + name}); },
-                    &result);
+  FitCampaignTensor(
+      config, options.figures ? out.figures().string() : "",
+      [&out](const std::string& name) { out.manifest.Record({"figures/" + name}); }, &result);
   if (result.ellipse_fit && IsPlanarCampaign(result.traces)) {
     result.physical = CheckPlanarPhysical(config, result);
   }

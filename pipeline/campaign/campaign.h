@@ -19,9 +19,9 @@
 
 #include "fit/ellipse.h"
 #include "fit/tensor.h"
+#include "pipeline/campaign/run_discovery.h"  // RunFile, DiscoverRuns
 #include "pipeline/config/config.h"
 #include "pipeline/records/campaign_result.h"
-#include "pipeline/campaign/run_discovery.h"  // RunFile, DiscoverRuns
 #include "pipeline/trace/trace_process.h"
 
 namespace bifilar {
@@ -33,14 +33,14 @@ using TraceFitFunction = std::function<TraceRecord(const CampaignConfig&, const 
 constexpr int kMaxJobs = 256;  // limit of CampaignOptions::jobs (--jobs)
 
 struct CampaignOptions {
-  std::string out_dir;        // output folder (created); an existing non-folder is an error
-  int jobs = 0;               // worker threads; 0 = hardware concurrency; <= kMaxJobs
-  bool force = false;         // ignore the cache (refit everything)
-  bool write_report = true;   // report.html (needs the figures)
-  bool figures = true;        // draw per-trace fit figures and Fig. 3/4
+  std::string out_dir;               // output folder (created); an existing non-folder is an error
+  int jobs = 0;                      // worker threads; 0 = hardware concurrency; <= kMaxJobs
+  bool force = false;                // ignore the cache (refit everything)
+  bool write_report = true;          // report.html (needs the figures)
+  bool figures = true;               // draw per-trace fit figures and Fig. 3/4
   std::ostream* progress = nullptr;  // progress lines / bar; nullptr = quiet
-  bool progress_bar = false;  // redraw one line ('\r') instead of one line per trace
-  TraceFitFunction fit_function;  // empty = ProcessTrace
+  bool progress_bar = false;         // redraw one line ('\r') instead of one line per trace
+  TraceFitFunction fit_function;     // empty = ProcessTrace
   // Ctrl-C (base/interrupt.h): when set, no further fit starts; fits running finish and are
   // cached, and RunCampaign throws CampaignInterrupted before writing any result. nullptr: none.
   const std::atomic<bool>* cancel = nullptr;

@@ -70,8 +70,8 @@ int DropOutputFolder(const std::string& out_dir, std::vector<RunFile>* runs) {
   return static_cast<int>(before - runs->size());
 }
 
-std::vector<std::optional<std::array<double, 2>>> WindowsForRuns(
-    const CampaignConfig& config, const std::vector<RunFile>& runs) {
+std::vector<std::optional<std::array<double, 2>>> WindowsForRuns(const CampaignConfig& config,
+                                                                 const std::vector<RunFile>& runs) {
   // Each entry resolved the two ways ConfigWindowFor does: against runs.root, then the config
   // folder.
   // Canonical paths on both sides (CanonicalLogPath), as ConfigWindowFor matches for `fit`.
@@ -106,13 +106,13 @@ std::vector<std::optional<std::array<double, 2>>> WindowsForRuns(
 void CheckWindowEntriesExist(const CampaignConfig& config) {
   for (const auto& [key, window] : config.fit.windows_s) {
     std::error_code ec;
-    const bool in_root = !config.runs.root.empty() &&
-                         fs::is_regular_file(ResolvePath(config.runs.root, key), ec);
+    const bool in_root =
+        !config.runs.root.empty() && fs::is_regular_file(ResolvePath(config.runs.root, key), ec);
     if (in_root || fs::is_regular_file(ResolvePath(config.folder, key), ec)) continue;
     throw UserError(config.file + ": 'fit.windows." + key + "' names no log that exists (" +
-                    (config.runs.root.empty() ? std::string()
-                                              : "relative to runs.root " + config.runs.root +
-                                                    " or ") +
+                    (config.runs.root.empty()
+                         ? std::string()
+                         : "relative to runs.root " + config.runs.root + " or ") +
                     "relative to the config folder " +
                     (config.folder.empty() ? std::string(".") : config.folder) +
                     "); fix the file name or remove the entry");

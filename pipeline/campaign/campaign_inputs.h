@@ -25,7 +25,7 @@ int DropOutputFolder(const std::string& out_dir, std::vector<RunFile>* runs);
 // when a fit.windows entry matches none of the logs found ("a window for a file that does not
 // exist" used to be ignored silently).
 std::vector<std::optional<std::array<double, 2>>> WindowsForRuns(const CampaignConfig& config,
-                                                                  const std::vector<RunFile>& runs);
+                                                                 const std::vector<RunFile>& runs);
 
 // `bifilar fit`'s check of fit.windows, as WindowsForRuns's for `process`: throws UserError
 // naming the entry when it names no file that exists (relative to runs.root or the config

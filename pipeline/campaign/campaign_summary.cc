@@ -2,8 +2,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <string>
 #include <ostream>
+#include <string>
 
 #include "pipeline/campaign/campaign_tensor.h"
 #include "pipeline/campaign/rig_inertia.h"
@@ -58,8 +58,8 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
       if (!est.defined) {
         std::snprintf(line, sizeof(line), "  %-5s  ill-defined (I_x ~ I_z)\n", name);
       } else {
-        std::snprintf(line, sizeof(line), "  %-5s  %#10.5g +- %#.2g (stat) +- %#.2g (total)\n", name,
-                      inertia(est.value), inertia(est.std),
+        std::snprintf(line, sizeof(line), "  %-5s  %#10.5g +- %#.2g (stat) +- %#.2g (total)\n",
+                      name, inertia(est.value), inertia(est.std),
                       inertia(WithCommonModeScale(est.value, est.std, rel)));
       }
       out << line;
@@ -68,8 +68,9 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
     row("I_z", e.iz);
     row("I_xz", e.ixz);
     if (e.tau_deg.defined) {
-      std::snprintf(line, sizeof(line), "  %-5s  %10.4f +- %.4f deg (stat = total: a scale leaves tau)\n",
-                    "tau", e.tau_deg.value, e.tau_deg.std);
+      std::snprintf(line, sizeof(line),
+                    "  %-5s  %10.4f +- %.4f deg (stat = total: a scale leaves tau)\n", "tau",
+                    e.tau_deg.value, e.tau_deg.std);
     } else {
       std::snprintf(line, sizeof(line), "  %-5s  ill-defined (I_x ~ I_z)\n", "tau");
     }
@@ -79,8 +80,9 @@ void PrintCampaignSummary(const CampaignConfig& config, const CampaignResult& re
                     "  (total: stat and +- %.2f %% common to all moments in quadrature, from the "
                     "uncertainties of %s, the masses and the gyro scale)\n",
                     100.0 * rel,
-                    result.calibration ? "the rig calibration"
-                    : result.common_mode_assumed ? "L, D (assumed +-1 mm), g" : "L, D, g");
+                    result.calibration           ? "the rig calibration"
+                    : result.common_mode_assumed ? "L, D (assumed +-1 mm), g"
+                                                 : "L, D, g");
       out << line;
     }
     for (const std::string& w : e.warnings) {

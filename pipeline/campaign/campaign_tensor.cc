@@ -9,8 +9,8 @@
 
 #include "base/hash.h"
 #include "base/text_format.h"
-#include "fit/physical.h"
 #include "base/version.h"
+#include "fit/physical.h"
 #include "pipeline/figures/tensor_plot.h"
 #include "pipeline/records/tensor_json.h"
 #include "pipeline/records/total_uncertainty.h"
@@ -179,7 +179,8 @@ void PrintPerAxis(const CampaignConfig& config, const CampaignResult& result, st
   auto inertia = [&](double kg_m2) { return InertiaToDisplay(kg_m2, units); };
   char line[320];
   const bool rig = config.rig_inertia_given;
-  out << "Per axis (" << unit << "; mean of its logs, its std: stat, then total; the fit, the "
+  out << "Per axis (" << unit
+      << "; mean of its logs, its std: stat, then total; the fit, the "
          "residual over its expected scatter):\n";
   std::snprintf(line, sizeof(line), "  %7s %7s %4s %11s %11s %9s %9s %11s %8s\n", "roll", "pitch",
                 "logs", rig ? "I_total" : "I", rig ? "I_aircraft" : "", "sd(stat)", "sd(total)",
@@ -211,8 +212,8 @@ void PrintPerAxis(const CampaignConfig& config, const CampaignResult& result, st
     std::snprintf(line, sizeof(line), "  %7.1f %7.1f %4d %s %11s %#9.2g %#9.2g %#11.5g %+8.2f\n",
                   roll, pitch, members, total, aircraft, inertia(o.residual_std_kg_m2),
                   inertia(WithCommonModeScale(o.mean_kg_m2, o.residual_std_kg_m2,
-                                                      result.common_mode_relative_std)), inertia(o.fitted_kg_m2),
-                  o.z);
+                                              result.common_mode_relative_std)),
+                  inertia(o.fitted_kg_m2), o.z);
     out << line;
   }
   if (!rig) {
@@ -244,8 +245,9 @@ void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& resu
   for (int k = 0; k < kTensorComponents; ++k) {
     const TensorEstimate& e = t.components[k];
     if (e.observable) {
-      std::snprintf(line, sizeof(line), "  %-5s %#11.5g +- %#.2g (stat) +- %#.2g (total)  (%.3g %% stat)\n",
-                    kLabels[k], inertia(e.value), inertia(e.std), inertia(total(e.value, e.std)),
+      std::snprintf(line, sizeof(line),
+                    "  %-5s %#11.5g +- %#.2g (stat) +- %#.2g (total)  (%.3g %% stat)\n", kLabels[k],
+                    inertia(e.value), inertia(e.std), inertia(total(e.value, e.std)),
                     e.value != 0 ? 100.0 * e.std / std::fabs(e.value) : 0.0);
     } else {
       std::snprintf(line, sizeof(line), "  %-5s not observable from these swing axes\n",
@@ -265,13 +267,15 @@ void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& resu
   if (t.attitude_scatter_deg > 0) {
     std::snprintf(line, sizeof(line),
                   "  (the moments scatter as if each axis were off by %.2f deg: weighed by that, "
-                  "docs/method.md)\n", t.attitude_scatter_deg);
+                  "docs/method.md)\n",
+                  t.attitude_scatter_deg);
     out << line;
   }
   if (t.relative_scatter > 0) {
     std::snprintf(line, sizeof(line),
                   "  (the moments scatter by %.2f %% beyond their logs' stds: weighed by that, "
-                  "docs/method.md)\n", 100.0 * t.relative_scatter);
+                  "docs/method.md)\n",
+                  100.0 * t.relative_scatter);
     out << line;
   }
   PrintOwnScatter(t, result, out);
@@ -291,8 +295,8 @@ void PrintTensorSummary(const CampaignConfig& config, const CampaignResult& resu
                     "  %d: %#11.5g +- %#.2g (stat) +- %#.2g (total)  axis (%+.4f, %+.4f, %+.4f) +- "
                     "%.2g deg\n",
                     k + 1, inertia(m.value), inertia(m.std), inertia(total(m.value, m.std)),
-                    t.principal_axes[k][0],
-                    t.principal_axes[k][1], t.principal_axes[k][2], t.principal_axes_std_deg[k]);
+                    t.principal_axes[k][0], t.principal_axes[k][1], t.principal_axes[k][2],
+                    t.principal_axes_std_deg[k]);
       out << line;
     }
     std::snprintf(line, sizeof(line),

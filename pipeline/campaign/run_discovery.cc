@@ -210,7 +210,7 @@ std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
   std::string line;
   int line_no = 0;
   int path_col = -1, pitch_col = -1, roll_col = -1;  // roll_deg is optional (0 when absent)
-  int group_col = -1;                                 // group is optional
+  int group_col = -1;                                // group is optional
   while (std::getline(in, line)) {
     ++line_no;
     // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
@@ -274,11 +274,13 @@ std::vector<RunFile> DiscoverTable(const CampaignConfig& config) {
     runs.push_back(run);
   }
   if (path_col < 0) {
-    throw UserError(config.runs.table + ": runs table is empty (runs.table): expected a header "
+    throw UserError(config.runs.table +
+                    ": runs table is empty (runs.table): expected a header "
                     "'path,pitch_deg' and one row per log");
   }
   if (runs.empty()) {
-    throw UserError(config.runs.table + ": runs table has a header but no rows (runs.table): "
+    throw UserError(config.runs.table +
+                    ": runs table has a header but no rows (runs.table): "
                     "add one row 'path,pitch_deg' per log");
   }
   return runs;
@@ -389,9 +391,10 @@ std::vector<RunFile> OncePerPath(std::vector<RunFile> runs) {
     if (inserted) {
       unique.push_back(std::move(run));
     } else if (it->second != run.role && run.error.empty()) {
-      run.error = run.display + ": listed both as " + (it->second == TraceRole::kAircraft ? "an " : "a ") +
-                  ToString(it->second) + " log and as " +
-                  (run.role == TraceRole::kAircraft ? "an " : "a ") + ToString(run.role) + " log";
+      run.error = run.display + ": listed both as " +
+                  (it->second == TraceRole::kAircraft ? "an " : "a ") + ToString(it->second) +
+                  " log and as " + (run.role == TraceRole::kAircraft ? "an " : "a ") +
+                  ToString(run.role) + " log";
       unique.push_back(std::move(run));
     }
   }
@@ -436,7 +439,7 @@ constexpr size_t kMaxRunsTableLineBytes = 65536;
 std::string NumericKey(const std::string& cell) {
   double value = 0.0;
   if (!ParseNumber(cell, &value)) return cell;  // base/csv.h: the whole cell, finite
-  return FormatCheckValue(value + 0.0);  // + 0.0: -0 becomes 0; the shortest exact form
+  return FormatCheckValue(value + 0.0);         // + 0.0: -0 becomes 0; the shortest exact form
 }
 
 }  // namespace
@@ -477,7 +480,8 @@ RunsTableGroups ReadRunsTableGroups(const std::string& table) {
                         ": a runs table needs a header with a 'path' column and a 'group' column "
                         "(or the attitude: 'pitch_deg', optionally 'roll_deg')");
       }
-      out.source = table + (group_col >= 0 ? " (its group column)" : " (its roll_deg and pitch_deg)");
+      out.source =
+          table + (group_col >= 0 ? " (its group column)" : " (its roll_deg and pitch_deg)");
       continue;
     }
     if (out.paths.size() >= kMaxRunsTableRows) {
@@ -503,7 +507,8 @@ RunsTableGroups ReadRunsTableGroups(const std::string& table) {
     out.paths.push_back(cell(path_col));
     out.groups.push_back(group);
   }
-  if (path_col < 0) throw UserError(table + ": runs table is empty: expected a header 'path,group'");
+  if (path_col < 0)
+    throw UserError(table + ": runs table is empty: expected a header 'path,group'");
   return out;
 }
 

@@ -6,10 +6,10 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <iostream>
 #include <memory>
 #include <mutex>
 #include <new>
-#include <iostream>
 #include <streambuf>
 #include <string>
 

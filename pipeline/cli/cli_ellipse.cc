@@ -5,11 +5,10 @@
 #include <limits>
 #include <sstream>
 
-
 #include "base/csv.h"
 #include "pipeline/cli/cli_commands.h"
-#include "pipeline/commands/tensor_plan_command.h"
 #include "pipeline/commands/ellipse_command.h"
+#include "pipeline/commands/tensor_plan_command.h"
 
 namespace bifilar {
 namespace {
@@ -43,7 +42,8 @@ std::vector<double> ParseAngleList(const std::string& list) {
       }
       for (int i = 0; a + i * s <= b + 1e-9 * s; ++i) angles.push_back(a + i * s);
     } else {
-      throw UserError("--angles '" + list + "': '" + item + "' is neither a number nor first:last:step");
+      throw UserError("--angles '" + list + "': '" + item +
+                      "' is neither a number nor first:last:step");
     }
   }
   if (angles.empty()) throw UserError("--angles is empty");
@@ -75,22 +75,25 @@ void RegisterEllipseCommands(CLI::App& app, int* exit_code) {
                       "units of the table's inertia/std and of the console output: si (kg m^2, "
                       "default) or imperial (slug ft^2); JSON is always SI");
   ellipse->add_flag("--json", opts->json, "print the result as JSON (SI)");
-  ellipse->add_option("--plot", opts->plot_dir,
-                      "write ellipse_moments and ellipse_polar figures (.png, .svg) here")
+  ellipse
+      ->add_option("--plot", opts->plot_dir,
+                   "write ellipse_moments and ellipse_polar figures (.png, .svg) here")
       ->check(NonEmptyName());
   ellipse->add_flag("--force", opts->force,
                     "with --plot: replace files of the figures' names that bifilar did not write "
                     "(never a symbolic link)");
   auto seed = std::make_shared<std::string>();
   ellipse->add_option("--seed", *seed, "bootstrap seed, an integer in [0, 2^64 - 1] (default 1)");
-  ellipse->add_option("--bootstrap", opts->fit.bootstrap_replicates,
-                      "parametric bootstrap replicates for the 95% intervals; 0 = t intervals "
-                      "(default 2000)")
+  ellipse
+      ->add_option("--bootstrap", opts->fit.bootstrap_replicates,
+                   "parametric bootstrap replicates for the 95% intervals; 0 = t intervals "
+                   "(default 2000)")
       ->check(CLI::Range(0, kMaxBootstrapReplicates));
   ellipse->add_option("--covariance", *covariance,
                       "auto (default), points, angle_means or absolute (trust the std column)");
-  ellipse->add_option("--outlier-threshold", opts->fit.outlier_threshold,
-                      "flag trials with |studentized residual| above this (default 3)")
+  ellipse
+      ->add_option("--outlier-threshold", opts->fit.outlier_threshold,
+                   "flag trials with |studentized residual| above this (default 3)")
       ->check(FiniteNumber());
   ellipse->callback([opts, units, covariance, seed, exit_code] {
     opts->units = Units(*units);

@@ -53,8 +53,8 @@ void RegisterExportCommand(CLI::App& app, int* exit_code) {
                       *format + "'");
     }
     if (!ParseExportFrame(*frame, &opts->frame)) {
-      throw UserError("export: --frame must be " + ExportFrameAllowedValues() + ", got '" +
-                      *frame + "'");
+      throw UserError("export: --frame must be " + ExportFrameAllowedValues() + ", got '" + *frame +
+                      "'");
     }
     opts->frame_given = frame_option->count() > 0;
     for (const std::string& s : *sets) {

@@ -41,13 +41,13 @@ std::string ResultLine(const TraceRecord& r, DisplayUnits units) {
   }
   const double scale = InertiaToDisplay(1.0, units);
   char buffer[512];
-  std::snprintf(buffer, sizeof(buffer), "%s: %s  I = %s  amplitude %.1f -> %.1f deg  rms/noise %.2f",
-                r.file.c_str(), ToString(r.status),
-                StatAndTotal(scale * r.inertia_total_kg_m2, scale * r.inertia_total_std_kg_m2,
-                             scale * r.inertia_total_std_total_kg_m2, InertiaUnitName(units))
-                    .c_str(),
-                r.amplitude_deg[0], r.amplitude_deg[1],
-                r.residual_rms_rad_per_s / r.noise_rms_rad_per_s);
+  std::snprintf(
+      buffer, sizeof(buffer), "%s: %s  I = %s  amplitude %.1f -> %.1f deg  rms/noise %.2f",
+      r.file.c_str(), ToString(r.status),
+      StatAndTotal(scale * r.inertia_total_kg_m2, scale * r.inertia_total_std_kg_m2,
+                   scale * r.inertia_total_std_total_kg_m2, InertiaUnitName(units))
+          .c_str(),
+      r.amplitude_deg[0], r.amplitude_deg[1], r.residual_rms_rad_per_s / r.noise_rms_rad_per_s);
   return buffer;
 }
 
@@ -61,9 +61,9 @@ std::string DetailLines(const TraceRecord& r, DisplayUnits units) {
   std::string lines;
   if (std::isfinite(r.inertia_total_kg_m2)) {
     std::snprintf(buffer, sizeof(buffer),
-                  "\n    fit: window [%.2f, %.2f] s  K_D %.3g  C %.3g  %d it  %.0f ms", r.window_s[0],
-                  r.window_s[1], scale * r.drag_coeff_kg_m2, scale * r.viscous_coeff_kg_m2_per_s,
-                  r.iterations, 1e3 * r.fit_seconds);
+                  "\n    fit: window [%.2f, %.2f] s  K_D %.3g  C %.3g  %d it  %.0f ms",
+                  r.window_s[0], r.window_s[1], scale * r.drag_coeff_kg_m2,
+                  scale * r.viscous_coeff_kg_m2_per_s, r.iterations, 1e3 * r.fit_seconds);
     lines += buffer;
     if (r.pitch_measured_deg) {
       std::snprintf(buffer, sizeof(buffer), "  pitch %.2f deg", *r.pitch_measured_deg);
@@ -73,10 +73,11 @@ std::string DetailLines(const TraceRecord& r, DisplayUnits units) {
   // The measured period and the hand calculation beside the nonlinear fit: over the whole free
   // oscillation, with no amplitude or damping correction.
   if (std::isfinite(r.period_s)) {
-    std::snprintf(buffer, sizeof(buffer),
-                  "\n    period %.4f s (%.4f Hz), small-angle I = m g D^2 T^2 / (16 pi^2 L) = %.5g %s "
-                  "(whole free swing)",
-                  r.period_s, r.frequency_hz, scale * r.small_angle_inertia_total_kg_m2, unit);
+    std::snprintf(
+        buffer, sizeof(buffer),
+        "\n    period %.4f s (%.4f Hz), small-angle I = m g D^2 T^2 / (16 pi^2 L) = %.5g %s "
+        "(whole free swing)",
+        r.period_s, r.frequency_hz, scale * r.small_angle_inertia_total_kg_m2, unit);
     lines += buffer;
   }
   // I against amplitude (the ideal model is flat).

@@ -3,10 +3,10 @@
 // a commented starting config (pipeline/config/config_template.h).
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <array>
 #include <iostream>
 #include <string>
 #include <vector>

@@ -83,8 +83,8 @@ std::shared_ptr<TensorPlanCli> AddTensorPlanOptions(CLI::App* plan) {
   only(plan->add_option("--iyz", t->iyz,
                         "with --tensor: guessed Iyz = integral y z dm, in --units (default 0)"));
   // NaN or inf is refused like every numeric flag (a NaN guess would read as "not given").
-  for (const char* name : {"--grid-step", "--sigma-rel", "--attitude-std", "--target", "--target-rel",
-                           "--ixx", "--iyy", "--izz", "--ixy", "--iyz"}) {
+  for (const char* name : {"--grid-step", "--sigma-rel", "--attitude-std", "--target",
+                           "--target-rel", "--ixx", "--iyy", "--izz", "--ixy", "--iyz"}) {
     plan->get_option(name)->check(FiniteNumber());
   }
   return t;

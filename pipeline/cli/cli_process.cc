@@ -39,7 +39,8 @@ void PrintTraceWarnings(const CampaignResult& campaign, DisplayUnits units, std:
   }
   if (warned == 0) return;
   out << "Warnings of " << warned << " trace" << (warned == 1 ? "" : "s")
-      << " (first sentence of each; full texts in results.json and report.html, section Warnings):\n"
+      << " (first sentence of each; full texts in results.json and report.html, section "
+         "Warnings):\n"
       << block;
   if (warned > shown) {
     out << "  ... and " << warned - shown << " more traces with warnings (report.html, section "
@@ -62,17 +63,19 @@ void RegisterProcessCommands(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<Args>();
 
   auto* process = app.add_subcommand(
-      "process", "Process a campaign: fit every log, subtract the rig, fit the ellipse, write "
-                 "results.json, traces.csv, angles.csv and report.html");
+      "process",
+      "Process a campaign: fit every log, subtract the rig, fit the ellipse, write "
+      "results.json, traces.csv, angles.csv and report.html");
   process->add_option("config", args->config, "campaign config (YAML, see configs/README.md)")
       ->required();
   process->add_option("--out", args->out, "output folder (default: out/ beside the config)");
   process->add_option("--jobs", args->jobs, "worker threads (default: all cores)")
       ->check(CLI::Range(0, kMaxJobs));
   process->add_flag("--force", args->force, "ignore the cache and refit every log");
-  process->add_option("--integrator", args->integrator,
-                      "ODE solver of the fits: " + IntegratorMethodAllowedValues() +
-                          "; overrides fit.integrator")
+  process
+      ->add_option("--integrator", args->integrator,
+                   "ODE solver of the fits: " + IntegratorMethodAllowedValues() +
+                       "; overrides fit.integrator")
       ->check(CLI::IsMember(IntegratorMethodNames()));
   process->add_option("--runs-root", args->runs_root,
                       "folder of the aircraft logs, instead of the config's runs.root");

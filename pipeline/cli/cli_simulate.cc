@@ -42,27 +42,37 @@ void RegisterSimulateCommand(CLI::App& app, int* exit_code) {
       "Write realistic IMU logs (CSV, or PX4 ULog with `ulog: true` in the spec or a --trace "
       "name ending in .ulg) plus a JSON truth file: a campaign from a spec (SPEC.yaml --out DIR) "
       "or one trace (--trace OUT.csv|OUT.ulg --inertia-kg-m2 --mass-kg -L -D)");
-  sub->add_option("spec", args->spec_file, "simulation spec (YAML); see configs/simulate_prandtl_d.yaml")
+  sub->add_option("spec", args->spec_file,
+                  "simulation spec (YAML); see configs/simulate_prandtl_d.yaml")
       ->check(CLI::ExistingFile);
-  sub->add_option("--out", args->out_dir, "campaign output folder (pitch_*/trial_*.csv, tare/, truth.json)");
-  sub->add_option("--trace", args->trace_csv, "simulate one trace into this file: CSV, PX4 ULog when it ends in .ulg, ArduPilot DataFlash when it ends in .bin");
+  sub->add_option("--out", args->out_dir,
+                  "campaign output folder (pitch_*/trial_*.csv, tare/, truth.json)");
+  sub->add_option("--trace", args->trace_csv,
+                  "simulate one trace into this file: CSV, PX4 ULog when it ends in .ulg, "
+                  "ArduPilot DataFlash when it ends in .bin");
   sub->add_option("--truth", args->truth_json, "truth JSON of --trace (default OUT.truth.json)");
   raw->o_seed = sub->add_option("--seed", raw->seed,
                                 "random seed, an integer in [0, 2^64 - 1] (overrides the spec's "
                                 "`seed`; default 1)");
-  raw->o_inertia = sub->add_option("--inertia-kg-m2", raw->inertia, "--trace: whole suspended inertia I (kg m^2)");
+  raw->o_inertia = sub->add_option("--inertia-kg-m2", raw->inertia,
+                                   "--trace: whole suspended inertia I (kg m^2)");
   raw->o_mass = sub->add_option("--mass-kg", raw->mass, "--trace: whole suspended mass m (kg)");
-  raw->o_length = sub->add_option("-L,--filar-length-m", raw->length, "filar (wire) length L (m), > D");
-  raw->o_separation = sub->add_option("-D,--filar-separation-m", raw->separation, "filar separation D (m), > 0");
+  raw->o_length =
+      sub->add_option("-L,--filar-length-m", raw->length, "filar (wire) length L (m), > D");
+  raw->o_separation =
+      sub->add_option("-D,--filar-separation-m", raw->separation, "filar separation D (m), > 0");
   raw->o_gravity = sub->add_option("--gravity-mps2", raw->gravity,
                                    Fmt("local gravity (m/s^2), default %g", kStandardGravityMps2));
-  raw->o_amplitude = sub->add_option("--amplitude-deg", raw->amplitude, "--trace: psi at release (deg), default 20");
-  raw->o_pitch = sub->add_option("--pitch-deg", raw->pitch, "--trace: true pitch of the body (deg), default 0");
+  raw->o_amplitude = sub->add_option("--amplitude-deg", raw->amplitude,
+                                     "--trace: psi at release (deg), default 20");
+  raw->o_pitch = sub->add_option("--pitch-deg", raw->pitch,
+                                 "--trace: true pitch of the body (deg), default 0");
   raw->o_duration = sub->add_option("--duration-s", raw->duration, "free-oscillation duration (s)");
-  raw->o_sample_rate = sub->add_option("--sample-rate-hz", raw->sample_rate, "IMU sample rate (Hz), default 100");
-  for (CLI::Option* option : {raw->o_inertia, raw->o_mass, raw->o_length, raw->o_separation,
-                              raw->o_gravity, raw->o_amplitude, raw->o_pitch, raw->o_duration,
-                              raw->o_sample_rate}) {
+  raw->o_sample_rate =
+      sub->add_option("--sample-rate-hz", raw->sample_rate, "IMU sample rate (Hz), default 100");
+  for (CLI::Option* option :
+       {raw->o_inertia, raw->o_mass, raw->o_length, raw->o_separation, raw->o_gravity,
+        raw->o_amplitude, raw->o_pitch, raw->o_duration, raw->o_sample_rate}) {
     option->check(FiniteNumber());
   }
   sub->add_option("--model", args->model,

@@ -43,17 +43,20 @@ void PrintFinal(const WatchCommandResult& r, bool json) {
   if (!r.counters.Text().empty()) std::cout << "input: " << r.counters.Text() << "\n";
   for (const WatchLogResult& log : r.logs) {
     std::cout << log.path << ": " << log.samples << " samples saved";
-    if (log.rejected > 0) std::cout << ", " << log.rejected << " lines rejected (" << log.path << ".rejected.txt)";
+    if (log.rejected > 0)
+      std::cout << ", " << log.rejected << " lines rejected (" << log.path << ".rejected.txt)";
     std::cout << "\n";
     if (!log.record) continue;
     const TraceRecord& t = *log.record;
     std::cout << "  fit: " << ToString(t.status);
     if (std::isfinite(t.inertia_total_kg_m2)) {
-      std::cout << Fmt("  I = %.9g", t.inertia_total_kg_m2) << Fmt(" +- %.3g", t.inertia_total_std_kg_m2)
+      std::cout << Fmt("  I = %.9g", t.inertia_total_kg_m2)
+                << Fmt(" +- %.3g", t.inertia_total_std_kg_m2)
                 << Fmt(" (total %.3g) kg m^2", t.inertia_total_std_total_kg_m2);
     }
     if (!t.message.empty()) std::cout << "  " << WarningSummary(t.message, 160);
-    std::cout << "\n  (the same as `bifilar fit " << r.config_path_for_print << " " << log.path << "`)\n";
+    std::cout << "\n  (the same as `bifilar fit " << r.config_path_for_print << " " << log.path
+              << "`)\n";
   }
 }
 
@@ -67,7 +70,8 @@ void RegisterWatchCommand(CLI::App& app, int* exit_code) {
       "being written, standard input (CSV or JSON lines), a serial port, a WebSocket or MAVLink, "
       "saves every sample, and says `enough`, `swing again` or `fix the rig`");
   sub->add_option("config", cli->o.config_path, "config (YAML), as for `bifilar fit`")
-      ->required()->check(CLI::ExistingFile);
+      ->required()
+      ->check(CLI::ExistingFile);
   sub->add_option("source", cli->o.source,
                   "a log file being written (CSV, ULog, DataFlash), - for standard input, "
                   "serial:DEV@BAUD, ws://HOST:PORT/PATH, mavlink:DEV@BAUD, mavlink-udp:HOST:PORT");
@@ -76,17 +80,21 @@ void RegisterWatchCommand(CLI::App& app, int* exit_code) {
                   "config; never over an existing file)");
   sub->add_flag("--json", cli->json, "one JSON object per update, and the final result");
   sub->add_option("--target-percent", cli->o.engine.target_percent,
-                  "target of the per-swing std of I (% of I), default 0.5")->check(FiniteNumber());
+                  "target of the per-swing std of I (% of I), default 0.5")
+      ->check(FiniteNumber());
   sub->add_option("--cycles", cli->o.stop_after_cycles, "end once the fit holds N cycles");
   sub->add_flag("--stop-at-target", cli->o.stop_at_target, "end at the first `enough`");
   sub->add_option("--counter-rate-hz", cli->o.counter_rate_hz,
-                  "the stream has a sample counter, not a time: its rate (Hz)")->check(FiniteNumber());
-  sub->add_option("--counter-column", cli->o.counter_column, "the counter's column or key (default count)");
+                  "the stream has a sample counter, not a time: its rate (Hz)")
+      ->check(FiniteNumber());
+  sub->add_option("--counter-column", cli->o.counter_column,
+                  "the counter's column or key (default count)");
   sub->add_option("--idle-end", cli->o.idle_end_s,
                   "end when no sample came for this many seconds (default: keep waiting)")
       ->check(FiniteNumber());
-  sub->add_flag("--append", cli->o.append_on_reconnect,
-                "after a disconnect or a restarted file, append to the same log (default: a new log)");
+  sub->add_flag(
+      "--append", cli->o.append_on_reconnect,
+      "after a disconnect or a restarted file, append to the same log (default: a new log)");
   sub->add_option("--serve", cli->o.serve_port,
                   "serve the live page on http://127.0.0.1:PORT/ (0: any free port)")
       ->check(CLI::Range(0, 65535));
@@ -101,7 +109,8 @@ void RegisterWatchCommand(CLI::App& app, int* exit_code) {
       *exit_code = 0;
       return;
     }
-    if (cli->o.source.empty()) throw UserError("watch: give a source (a log file, - for stdin, ...)");
+    if (cli->o.source.empty())
+      throw UserError("watch: give a source (a log file, - for stdin, ...)");
     const bool json = cli->json;
     const bool tty = ::isatty(STDERR_FILENO) != 0;
     cli->o.handle_interrupt = true;

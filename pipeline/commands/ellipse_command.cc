@@ -4,10 +4,10 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "base/plot_folder.h"
 #include "base/text_format.h"
 #include "base/user_error.h"
 #include "pipeline/figures/ellipse_plot.h"
-#include "base/plot_folder.h"
 #include "pipeline/records/ellipse_json.h"
 
 namespace bifilar {
@@ -35,9 +35,9 @@ void PrintEllipseReport(const EllipseResult& r, DisplayUnits units, std::ostream
   const double k = 1.0 / InertiaToSi(units);  // SI -> display
   const std::string u = InertiaUnitName(units);
   const char* f = "%.5f";
-  out << "Ellipse of inertia: " << r.n_points << " points at " << r.n_angles
-      << " angle(s), " << (r.weighted ? "weighted by the given std" : "unweighted")
-      << ", covariance '" << EllipseCovarianceName(r.covariance_used) << "'";
+  out << "Ellipse of inertia: " << r.n_points << " points at " << r.n_angles << " angle(s), "
+      << (r.weighted ? "weighted by the given std" : "unweighted") << ", covariance '"
+      << EllipseCovarianceName(r.covariance_used) << "'";
   if (std::isfinite(r.dof)) out << " (" << r.dof << " dof)";
   out << "\n\nThree fits (I = A + B cos 2theta + C sin 2theta; paper Eq. 7):\n";
   Row(out, "", "linear LS (primary)", "Nelder-Mead Eq. 7", "Ceres Eq. 7");
@@ -71,15 +71,16 @@ void PrintEllipseReport(const EllipseResult& r, DisplayUnits units, std::ostream
     status[i] = !fits[i]->ran ? "-"
                               : (fits[i]->converged ? "ok, " : "FAILED, ") +
                                     std::to_string(fits[i]->iterations) +
-                                    (i == 1 ? " evals" : i == 2 ? " iters" : "");
+                                    (i == 1   ? " evals"
+                                     : i == 2 ? " iters"
+                                              : "");
   }
   Row(out, "status", status[0], status[1], status[2]);
 
   out << "\nIntervals ("
-      << (r.bootstrap_replicates > 0
-              ? "seeded parametric bootstrap, " + std::to_string(r.bootstrap_replicates) +
-                    " replicates"
-              : std::string("t quantiles"))
+      << (r.bootstrap_replicates > 0 ? "seeded parametric bootstrap, " +
+                                           std::to_string(r.bootstrap_replicates) + " replicates"
+                                     : std::string("t quantiles"))
       << "):\n";
   const EllipseEstimate* est[6] = {&r.ix, &r.iz, &r.ixz, &r.tau_deg, &r.ixp, &r.izp};
   const char* names[6] = {"I_x", "I_z", "I_xz", "tau", "I_xp", "I_zp"};
@@ -98,8 +99,8 @@ void PrintEllipseReport(const EllipseResult& r, DisplayUnits units, std::ostream
 
   out << "\nTable 1 (paper): error analysis\n";
   if (r.table1.n_angles_with_trials > 0) {
-    out << "  raw data sigma (mean per-angle std)   " << Fmt("%.4f ", r.table1.mean_angle_std_kg_m2 * k)
-        << u << "\n";
+    out << "  raw data sigma (mean per-angle std)   "
+        << Fmt("%.4f ", r.table1.mean_angle_std_kg_m2 * k) << u << "\n";
     out << "  coefficient of variation (mean)       " << Fmt("%.4f %%", r.table1.mean_cov_percent)
         << "\n";
   } else {
@@ -136,9 +137,9 @@ void PrintEllipseReport(const EllipseResult& r, DisplayUnits units, std::ostream
   for (const auto& e : r.residuals) {
     if (!e.outlier) continue;
     char buf[200];
-    std::snprintf(buf, sizeof buf, "  row %d: pitch %.2f deg, inertia %.5f, fitted %.5f %s, r = %.2f\n",
-                  e.index + 1, e.pitch_deg, e.inertia_kg_m2 * k, e.fitted_kg_m2 * k, u.c_str(),
-                  e.studentized);
+    std::snprintf(buf, sizeof buf,
+                  "  row %d: pitch %.2f deg, inertia %.5f, fitted %.5f %s, r = %.2f\n", e.index + 1,
+                  e.pitch_deg, e.inertia_kg_m2 * k, e.fitted_kg_m2 * k, u.c_str(), e.studentized);
     out << buf;
   }
   for (const auto& w : r.warnings) out << "warning: " << w << "\n";
@@ -186,8 +187,7 @@ EllipseCommandResult RunEllipse(const EllipseCommandOptions& options) {
     throw UserError(options.table_path + ": " + why);
   }
   if (!options.plot_dir.empty()) {
-    result.figures =
-        WriteEllipsePlots(result.fit, options.units, options.plot_dir, options.force);
+    result.figures = WriteEllipsePlots(result.fit, options.units, options.plot_dir, options.force);
   }
   return result;
 }
@@ -195,8 +195,8 @@ EllipseCommandResult RunEllipse(const EllipseCommandOptions& options) {
 void PrintEllipseCommand(const EllipseCommandOptions& options, const EllipseCommandResult& result,
                          std::ostream& out) {
   if (options.json) {
-    WriteEllipseResultJson(result.fit,
-                           {{"table", options.table_path}, {"figures", result.figures}}, out);
+    WriteEllipseResultJson(result.fit, {{"table", options.table_path}, {"figures", result.figures}},
+                           out);
     return;
   }
   out << options.table_path << "\n";
@@ -231,7 +231,8 @@ EllipsePlan RunPlan(const PlanCommandOptions& options) {
 
 void PrintPlan(const PlanCommandOptions& options, const EllipsePlan& plan, std::ostream& out) {
   if (options.json) {
-    out << EllipsePlanToJson(plan).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+    out << EllipsePlanToJson(plan).dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+        << "\n";
     return;
   }
   const double k = 1.0 / InertiaToSi(options.units);
@@ -246,8 +247,8 @@ void PrintPlan(const PlanCommandOptions& options, const EllipsePlan& plan, std::
   out << "Predicted standard errors (independent trial noise only):\n";
   out << "  I_xz  " << Fmt("%.5g ", plan.std.ixz_kg_m2 * k) << u << "\n";
   if (plan.tau_defined) {
-    out << "  tau   " << Fmt("%.4g deg", plan.std.tau_deg) << " (tau = "
-        << Fmt("%.4g deg", plan.truth.tau_deg) << ")\n";
+    out << "  tau   " << Fmt("%.4g deg", plan.std.tau_deg)
+        << " (tau = " << Fmt("%.4g deg", plan.truth.tau_deg) << ")\n";
   } else {
     out << "  tau   undefined for I_x = I_z and I_xz = 0\n";
   }

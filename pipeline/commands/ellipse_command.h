@@ -13,12 +13,12 @@
 namespace bifilar {
 
 struct EllipseCommandOptions {
-  std::string table_path;                       // CSV: pitch_deg, inertia[, std]
-  DisplayUnits units = DisplayUnits::kSi;       // units of the table and of the console output
-  bool json = false;                            // print JSON (SI) instead of tables
-  std::string plot_dir;                         // write figures here when non-empty
+  std::string table_path;                  // CSV: pitch_deg, inertia[, std]
+  DisplayUnits units = DisplayUnits::kSi;  // units of the table and of the console output
+  bool json = false;                       // print JSON (SI) instead of tables
+  std::string plot_dir;                    // write figures here when non-empty
   bool force = false;  // --force: replace files of the figures' names bifilar did not write
-  EllipseOptions fit;                           // seed, bootstrap, covariance, ...
+  EllipseOptions fit;  // seed, bootstrap, covariance, ...
 };
 
 struct EllipseCommandResult {
@@ -50,13 +50,13 @@ std::vector<std::string> WriteEllipsePlots(const EllipseResult& result, DisplayU
                                            const std::string& dir, bool force = false);
 
 struct PlanCommandOptions {
-  std::vector<double> pitch_deg;                // proposed angles (deg)
+  std::vector<double> pitch_deg;  // proposed angles (deg)
   int trials_per_angle = 3;
-  double sigma = 0.0;                           // per-trial std, in `units`
+  double sigma = 0.0;  // per-trial std, in `units`
   // Guesses of the aircraft, in `units`. Defaults: the paper's PRANDTL-D (Table 2, slug ft^2
   // 2.3596, 2.8477, 0.0178), converted when units are SI.
   double ix = 0.0, iz = 0.0, ixz = 0.0;
-  bool guesses_given = false;                   // false: use the defaults above
+  bool guesses_given = false;  // false: use the defaults above
   DisplayUnits units = DisplayUnits::kSi;
   bool json = false;
 };

@@ -124,7 +124,8 @@ std::vector<EllipsePoint> ReadEllipseTable(const std::string& path, DisplayUnits
     bytes = std::move(inflated);
   }
   if (bytes.find('\0') != std::string::npos) {
-    throw UserError(path + ": binary data, not a CSV table (expected a header "
+    throw UserError(path +
+                    ": binary data, not a CSV table (expected a header "
                     "'pitch_deg,inertia[,std]' and one row per moment)");
   }
   return ParseEllipseTable(bytes, path, units);

@@ -13,7 +13,6 @@
 
 namespace bifilar {
 
-
 // Parses the table text; `name` (the file name) prefixes error messages. Throws UserError naming
 // the line and column on: no header, missing pitch_deg or inertia column, an unknown or repeated
 // column, a row with the wrong number of fields, a value that is not a number, a pitch outside

@@ -12,13 +12,13 @@
 #include "base/hash.h"
 #include "base/interrupt.h"
 #include "base/json_number.h"
+#include "base/plot_folder.h"
 #include "base/user_error.h"
 #include "fit/window.h"
 #include "pipeline/campaign/calibration.h"
 #include "pipeline/campaign/campaign_inputs.h"
 #include "pipeline/campaign/run_discovery.h"
 #include "pipeline/records/results_json.h"
-#include "base/plot_folder.h"
 #include "pipeline/trace/trace_process.h"
 
 namespace bifilar {
@@ -92,8 +92,11 @@ std::vector<std::string> FigureStems(const std::vector<std::string>& logs) {
 namespace {
 
 nlohmann::json SetupSplitToJson(const SetupSplit& s, const std::string& text) {
-  nlohmann::json j = {{"tested", s.tested}, {"two_setups", s.two_setups}, {"note", s.note},
-                      {"q", JsonNumber(s.q)}, {"q_z", JsonNumber(s.q_z)}};
+  nlohmann::json j = {{"tested", s.tested},
+                      {"two_setups", s.two_setups},
+                      {"note", s.note},
+                      {"q", JsonNumber(s.q)},
+                      {"q_z", JsonNumber(s.q_z)}};
   if (!s.tested) return j;
   j["clusters"] = {s.clusters[0], s.clusters[1]};
   j["mean_kg_m2"] = {JsonNumber(s.mean_kg_m2[0]), JsonNumber(s.mean_kg_m2[1])};
@@ -118,56 +121,57 @@ nlohmann::json SetupSplitToJson(const SetupSplit& s, const std::string& text) {
 nlohmann::json RepeatGroupsToJson(const std::vector<RepeatGroup>& groups) {
   nlohmann::json out = nlohmann::json::array();
   for (const RepeatGroup& g : groups) {
-    out.push_back({{"name", g.name},
-                   {"members", g.members},
-                   {"n_used", g.n_used},
-                   {"mean_kg_m2", JsonNumber(g.mean_kg_m2)},
-                   {"mean_std_kg_m2", JsonNumber(g.mean_std_kg_m2)},
-                   {"plain_mean_kg_m2", JsonNumber(g.plain_mean_kg_m2)},
-                   {"q", JsonNumber(g.q)},
-                   {"tau_kg_m2", JsonNumber(g.tau_kg_m2)},
-                   {"max_abs_z", JsonNumber(g.max_abs_z)},
-                   {"amplitude_trend_percent_per_10deg",
-                    JsonNumber(g.amplitude_trend_percent_per_10deg)},
-                   {"amplitude_trend_z", JsonNumber(g.amplitude_trend_z)},
-                   {"spread_before_percent", JsonNumber(g.spread_before_percent)},
-                   {"spread_after_percent", JsonNumber(g.spread_after_percent)},
-                   {"q_before", JsonNumber(g.q_before)},
-                   {"max_abs_z_before", JsonNumber(g.max_abs_z_before)},
-                   {"correction_std_kg_m2", JsonNumber(g.correction_std_kg_m2)},
-                   {"common_mode_std_kg_m2", JsonNumber(g.common_mode_std_kg_m2)},
-                   {"total_std_kg_m2", JsonNumber(g.total_std_kg_m2)},
-                   {"note", g.note},
-                   {"max_abs_z_own", JsonNumber(g.max_abs_z_own)},
-                   {"alone", g.alone},
-                   {"trend_contradicts_own_trends", g.trend_contradicts_own},
-                   {"setups", SetupSplitToJson(g.setups, g.setups_text)}});
+    out.push_back(
+        {{"name", g.name},
+         {"members", g.members},
+         {"n_used", g.n_used},
+         {"mean_kg_m2", JsonNumber(g.mean_kg_m2)},
+         {"mean_std_kg_m2", JsonNumber(g.mean_std_kg_m2)},
+         {"plain_mean_kg_m2", JsonNumber(g.plain_mean_kg_m2)},
+         {"q", JsonNumber(g.q)},
+         {"tau_kg_m2", JsonNumber(g.tau_kg_m2)},
+         {"max_abs_z", JsonNumber(g.max_abs_z)},
+         {"amplitude_trend_percent_per_10deg", JsonNumber(g.amplitude_trend_percent_per_10deg)},
+         {"amplitude_trend_z", JsonNumber(g.amplitude_trend_z)},
+         {"spread_before_percent", JsonNumber(g.spread_before_percent)},
+         {"spread_after_percent", JsonNumber(g.spread_after_percent)},
+         {"q_before", JsonNumber(g.q_before)},
+         {"max_abs_z_before", JsonNumber(g.max_abs_z_before)},
+         {"correction_std_kg_m2", JsonNumber(g.correction_std_kg_m2)},
+         {"common_mode_std_kg_m2", JsonNumber(g.common_mode_std_kg_m2)},
+         {"total_std_kg_m2", JsonNumber(g.total_std_kg_m2)},
+         {"note", g.note},
+         {"max_abs_z_own", JsonNumber(g.max_abs_z_own)},
+         {"alone", g.alone},
+         {"trend_contradicts_own_trends", g.trend_contradicts_own},
+         {"setups", SetupSplitToJson(g.setups, g.setups_text)}});
   }
   return out;
 }
 
 nlohmann::json AmplitudeCorrectionToJson(const RepeatsAmplitudeCorrection& c) {
-  return {{"applied", c.applied},
-          {"model", "I_0 (1 + c A^2)"},
-          {"to_amplitude_deg", 0.0},
-          {"coeff_per_deg2", JsonNumber(c.coeff_per_deg2)},
-          {"coeff_std_per_deg2", JsonNumber(c.coeff_std_per_deg2)},
-          {"z", JsonNumber(c.z)},
-          {"birge", JsonNumber(c.birge)},
-          {"scatter_percent", JsonNumber(c.scatter_percent)},
-          {"dof", c.dof},
-          {"n_logs", c.n_logs},
-          {"n_groups", c.n_groups},
-          {"n_corrected", c.n_corrected},
-          {"n_low_band_kept", c.n_low_band_kept},
-          {"amplitude_range_deg", {JsonNumber(c.amplitude_min_deg), JsonNumber(c.amplitude_max_deg)}},
-          {"note", c.note},
-          {"own_coeff_per_deg2", JsonNumber(c.own_coeff_per_deg2)},
-          {"own_coeff_std_per_deg2", JsonNumber(c.own_coeff_std_per_deg2)},
-          {"own_trend_logs", c.n_own},
-          {"own_z", JsonNumber(c.own_z)},
-          {"contradicts_own_trends", c.contradicts_own},
-          {"groups_two_setups", c.n_groups_two_setups}};
+  return {
+      {"applied", c.applied},
+      {"model", "I_0 (1 + c A^2)"},
+      {"to_amplitude_deg", 0.0},
+      {"coeff_per_deg2", JsonNumber(c.coeff_per_deg2)},
+      {"coeff_std_per_deg2", JsonNumber(c.coeff_std_per_deg2)},
+      {"z", JsonNumber(c.z)},
+      {"birge", JsonNumber(c.birge)},
+      {"scatter_percent", JsonNumber(c.scatter_percent)},
+      {"dof", c.dof},
+      {"n_logs", c.n_logs},
+      {"n_groups", c.n_groups},
+      {"n_corrected", c.n_corrected},
+      {"n_low_band_kept", c.n_low_band_kept},
+      {"amplitude_range_deg", {JsonNumber(c.amplitude_min_deg), JsonNumber(c.amplitude_max_deg)}},
+      {"note", c.note},
+      {"own_coeff_per_deg2", JsonNumber(c.own_coeff_per_deg2)},
+      {"own_coeff_std_per_deg2", JsonNumber(c.own_coeff_std_per_deg2)},
+      {"own_trend_logs", c.n_own},
+      {"own_z", JsonNumber(c.own_z)},
+      {"contradicts_own_trends", c.contradicts_own},
+      {"groups_two_setups", c.n_groups_two_setups}};
 }
 
 // The config with the command line's overrides; checks them and fit.windows before any fit.
@@ -320,8 +324,8 @@ FitCommandResult RunFit(const FitCommandOptions& options) {
   CalibrateIfConfigured(options, &result);
   // --repeats: identical data is one repeat; the copies are named and dropped before fitting.
   if (options.repeats) {
-    result.distinct = DropIdenticalLogs(options.logs, result.config.imu.format,
-                                        result.config.LogOptions());
+    result.distinct =
+        DropIdenticalLogs(options.logs, result.config.imu.format, result.config.LogOptions());
   } else {
     result.distinct.kept = options.logs;
   }

@@ -20,19 +20,19 @@
 namespace bifilar {
 
 struct FitCommandOptions {
-  std::string config_path;         // YAML: rig geometry, masses, IMU format (configs/README.md)
-  std::vector<std::string> logs;   // CSV (optionally .gz) or PX4 ULog (.ulg)
-  bool repeats = false;            // combine repeats (GroupRepeats, CombineRepeats)
+  std::string config_path;        // YAML: rig geometry, masses, IMU format (configs/README.md)
+  std::vector<std::string> logs;  // CSV (optionally .gz) or PX4 ULog (.ulg)
+  bool repeats = false;           // combine repeats (GroupRepeats, CombineRepeats)
   // --repeats: the part of each file name that names the set-up (a regular expression, case
   // ignored; RepeatGroupingOptions::group_by); "" groups by file name.
   std::string group_by;
   // --repeats: a runs table naming each log's group (its `group` column, else its attitude;
   // pipeline/campaign/run_discovery.h ReadRunsTableGroups); "" none. Not with group_by.
   std::string runs_table;
-  std::string model;               // "" (the config's), "full", "jardin" or "linear"
-  std::string integrator;          // "" (the config's), "rk853" or "cvodes"
-  std::string window;              // "" or "T0:T1" (s, the log's own time)
-  std::string plot_dir;            // write DIR/<log>.svg|.png (+ _sweep) when non-empty
+  std::string model;       // "" (the config's), "full", "jardin" or "linear"
+  std::string integrator;  // "" (the config's), "rk853" or "cvodes"
+  std::string window;      // "" or "T0:T1" (s, the log's own time)
+  std::string plot_dir;    // write DIR/<log>.svg|.png (+ _sweep) when non-empty
   // --force: with plot_dir, replace files of the figures' names bifilar did not write there
   // (never a link; base/plot_folder.h). Without it they are refused before any fit.
   bool force = false;
@@ -42,7 +42,7 @@ struct FitCommandOptions {
   bool handle_interrupt = false;
   // Told as the run goes (the CLI prints them at once); any may be empty.
   std::function<void(const RigCalibrationResult&)> on_calibration;  // before any fit
-  std::function<void(const std::string&)> on_identical_log;  // a dropped copy (--repeats)
+  std::function<void(const std::string&)> on_identical_log;         // a dropped copy (--repeats)
   // --repeats: the groups made (RepeatGroupsText), before any fit.
   std::function<void(const std::string&)> on_groups;
   // Each record once fitted, with the config it was fitted with (its display units).

@@ -44,8 +44,9 @@ std::string RunInit(const InitCommandOptions& o) {
     std::string why;
     if (!options.Check(&why)) throw UserError("init: " + why);
   } else {
-    throw UserError("init: give the rig with --rig L,D,MASS (m, m, kg), e.g. --rig "
-                    "0.594,0.030,0.0343, or run it on a terminal to be asked");
+    throw UserError(
+        "init: give the rig with --rig L,D,MASS (m, m, kg), e.g. --rig "
+        "0.594,0.030,0.0343, or run it on a terminal to be asked");
   }
   const bool columns_named = !o.columns.time.empty() || !o.columns.gyro[0].empty();
   if (columns_named && o.log.empty()) {
@@ -54,18 +55,21 @@ std::string RunInit(const InitCommandOptions& o) {
   if (!o.log.empty()) {
     const InspectReport report = InspectLog(o.log, nullptr, o.columns);
     if (!report.is_log()) {
-      throw UserError("init: --log " + EchoedName(report.error.empty() ? o.log : report.error, 4000));
+      throw UserError("init: --log " +
+                      EchoedName(report.error.empty() ? o.log : report.error, 4000));
     }
     // A log whose series could not be read (a .bin without messages, a header with the same
     // name twice) would give a config `bifilar fit` cannot use with it: refused, with the reason.
     if (report.samples < 2 && !report.error.empty()) {
-      throw UserError("init: --log " + EchoedName(o.log) + ": no config written, the log cannot be "
-                      "read with the format " + (report.format_from_config ? "given" : "guessed") +
-                      ": " + EchoedName(report.error, 4000));
+      throw UserError("init: --log " + EchoedName(o.log) +
+                      ": no config written, the log cannot be "
+                      "read with the format " +
+                      (report.format_from_config ? "given" : "guessed") + ": " +
+                      EchoedName(report.error, 4000));
     }
     if (!report.format_problem.empty()) {
-      throw UserError("init: --log " + EchoedName(o.log) + ": no config written: " +
-                      EchoedName(report.format_problem, 4000));
+      throw UserError("init: --log " + EchoedName(o.log) +
+                      ": no config written: " + EchoedName(report.format_problem, 4000));
     }
     options.format = report.format;
     options.ulog = report.kind == "ulog";

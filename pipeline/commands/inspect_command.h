@@ -37,7 +37,7 @@ struct InitCommandOptions {
   ColumnChoice columns;               // with `log`: its time and gyro columns, named (not guessed)
   std::string rig;                    // "L,D,MASS" (m, m, kg); "": ask_rig
   double gravity_mps2 = kStandardGravityMps2;
-  bool force = false;                 // overwrite `path` if it exists
+  bool force = false;  // overwrite `path` if it exists
   // Without `rig`: fills L, D and the mass (the CLI asks on a terminal); returns false when it
   // cannot ask (then RunInit throws UserError saying to give --rig).
   std::function<bool(StartingConfigOptions*)> ask_rig;

@@ -42,7 +42,8 @@ void ReadUlogTopics(const std::string& bytes, const std::string& name, InspectRe
     info.topic = s.topic;
     info.multi_id = s.multi_id;
     info.samples = s.samples;
-    if (s.samples > 1 && std::isfinite(s.first_timestamp_us) && std::isfinite(s.last_timestamp_us)) {
+    if (s.samples > 1 && std::isfinite(s.first_timestamp_us) &&
+        std::isfinite(s.last_timestamp_us)) {
       const double span_s = (s.last_timestamp_us - s.first_timestamp_us) * 1e-6;
       if (span_s > 0) info.rate_hz = (s.samples - 1) / span_s;
     }
@@ -66,8 +67,9 @@ ImuData ReadDataflashLog(const std::string& bytes, const std::string& path,
   }
   ImuData data = ReadDataflashImu(bytes, path, options);
   if (!report->format_from_config) {
-    report->guesses.push_back("ArduPilot DataFlash log: gyro in rad/s and accelerometer in m/s^2 "
-                              "as ArduPilot logs them (FMTU units checked)");
+    report->guesses.push_back(
+        "ArduPilot DataFlash log: gyro in rad/s and accelerometer in m/s^2 "
+        "as ArduPilot logs them (FMTU units checked)");
   }
   return data;
 }
@@ -110,7 +112,8 @@ void RefineGyroUnitGuess(ImuData* data, InspectReport* report) {
       g = "gyro columns " + report->format.gyro_columns[0] + ", " + report->format.gyro_columns[1] +
           ", " + report->format.gyro_columns[2] +
           Fmt(" in deg/s (from the readings: 99th percentile of |rate| %.3g over the log is no "
-                 "pendulum in rad/s)", p99);
+              "pendulum in rad/s)",
+              p99);
     }
   }
 }
@@ -128,7 +131,8 @@ void CheckGuessedUnits(const std::string& bytes, const std::string& path,
                               PrintableName(report->format.gyro_columns[2]);
   if (!check.angles.empty()) {
     report->format_problem = "the columns " + columns + " look like angles, not angular rates (" +
-                             check.angles + "); bifilar needs the gyro's rates: name those "
+                             check.angles +
+                             "); bifilar needs the gyro's rates: name those "
                              "columns (bifilar init --gyro X,Y,Z, or imu.gyro.columns)";
     return;
   }
@@ -144,10 +148,11 @@ void CheckGuessedUnits(const std::string& bytes, const std::string& path,
     if (g.rfind("time column", 0) == 0) {
       g = "time column '" + PrintableName(report->format.time_column) + "' in " +
           ToString(report->format.time_unit) +
-          (best.time != guess.format.time_unit ? Fmt(" (from the swing: period %.3g s", best.period_s) +
-                               "; the first rows alone suggested " +
-                               std::string(ToString(guess.format.time_unit)) + ")"
-                         : g.substr(std::min(g.size(), g.find(" ("))));
+          (best.time != guess.format.time_unit
+               ? Fmt(" (from the swing: period %.3g s", best.period_s) +
+                     "; the first rows alone suggested " +
+                     std::string(ToString(guess.format.time_unit)) + ")"
+               : g.substr(std::min(g.size(), g.find(" ("))));
     } else if (g.rfind("gyro columns", 0) == 0) {
       g = "gyro columns " + columns + " in " + ToString(report->format.gyro_unit) + " (" +
           check.note + ")";
@@ -242,9 +247,10 @@ void SwingAndWindow(const ImuData& data, const CampaignConfig* config, InspectRe
     }
     report->amplitude_deg = {hi, lo};
     if (hi < 1.0) {
-      report->warnings.push_back(Fmt("largest amplitude %.2g deg: a real swing is several deg; "
-                                        "check the gyro unit (imu.gyro.unit)",
-                                        hi));
+      report->warnings.push_back(
+          Fmt("largest amplitude %.2g deg: a real swing is several deg; "
+              "check the gyro unit (imu.gyro.unit)",
+              hi));
     }
   }
   if (config != nullptr && report->period_s > 0) {
@@ -287,7 +293,8 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config,
   }
   if (LooksGzipped(bytes)) {
     std::string text;
-    if (!GzipDecompress(bytes, &text, &why, DecompressedLogCap(log_options.max_decompressed_bytes))) {
+    if (!GzipDecompress(bytes, &text, &why,
+                        DecompressedLogCap(log_options.max_decompressed_bytes))) {
       report.kind = "binary";
       report.error = path + ": gzip data that cannot be read: " + why;
       return report;
@@ -309,7 +316,8 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config,
       } else if (!GuessUlogFormat(&report)) {
         std::string list;
         for (const UlogTopicInfo& t : report.topics) list += (list.empty() ? "" : ", ") + t.topic;
-        report.error = path + ": a ULog file without an IMU topic bifilar knows "
+        report.error = path +
+                       ": a ULog file without an IMU topic bifilar knows "
                        "(sensor_combined, vehicle_angular_velocity, sensor_gyro); topics: " +
                        Abbreviated(list, 400) +
                        "; name the topic and fields in imu.ulog (configs/README.md)";
@@ -322,9 +330,11 @@ InspectReport InspectLog(const std::string& path, const CampaignConfig* config,
       report.columns = guess.header;
       if (kind != "text" || (!guess.found && config == nullptr)) {
         report.kind = kind == "text" ? "text" : kind;
-        report.error = kind == "binary" ? path + ": a binary file that is neither a ULog log nor gzip"
-                       : kind == "config" ? path + ": a bifilar config (YAML), not a log; give it with --config"
-                                          : path + ": not a log that bifilar recognises: " + guess.why;
+        report.error = kind == "binary"
+                           ? path + ": a binary file that is neither a ULog log nor gzip"
+                       : kind == "config"
+                           ? path + ": a bifilar config (YAML), not a log; give it with --config"
+                           : path + ": not a log that bifilar recognises: " + guess.why;
         report.columns.clear();
         return report;
       }
@@ -371,8 +381,8 @@ std::string InspectReportText(const InspectReport& r) {
   if (!r.topics.empty()) {
     out << "  topics (" << r.topics.size() << "):\n";
     for (const UlogTopicInfo& t : r.topics) {
-      std::snprintf(line, sizeof(line), "    %-32s multi_id %d  %7ld samples", clean(t.topic).c_str(),
-                    t.multi_id, t.samples);
+      std::snprintf(line, sizeof(line), "    %-32s multi_id %d  %7ld samples",
+                    clean(t.topic).c_str(), t.multi_id, t.samples);
       out << line;
       if (t.rate_hz > 0) out << Fmt("  %.1f Hz", t.rate_hz);
       out << "\n";
@@ -514,8 +524,8 @@ nlohmann::json InspectReportToJson(const InspectReport& r) {
                                : nlohmann::json({r.swing_axis_in_imu[0], r.swing_axis_in_imu[1],
                                                  r.swing_axis_in_imu[2]});
   j["swing_axis_source"] = r.swing_axis_source;
-  j["pitch_measured_deg"] = r.pitch_measured_deg ? nlohmann::json(*r.pitch_measured_deg)
-                                                 : nlohmann::json();
+  j["pitch_measured_deg"] =
+      r.pitch_measured_deg ? nlohmann::json(*r.pitch_measured_deg) : nlohmann::json();
   j["window_status"] = r.window_status;
   j["window_s"] = {JsonNumber(r.window_s[0]), JsonNumber(r.window_s[1])};
   j["window_end"] = r.window_end;

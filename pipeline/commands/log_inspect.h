@@ -35,38 +35,38 @@ struct UlogTopicInfo {
 // What `inspect` found in one file. Numbers that do not apply are NaN (null in JSON).
 struct InspectReport {
   std::string file;
-  // "csv", "ulog", "dataflash" (ArduPilot .bin), or what the file is instead: "missing", "folder", "empty", "binary",
-  // "config" (a YAML config), "text" (text that is not a table of numbers).
+  // "csv", "ulog", "dataflash" (ArduPilot .bin), or what the file is instead: "missing", "folder",
+  // "empty", "binary", "config" (a YAML config), "text" (text that is not a table of numbers).
   std::string kind;
   bool is_log() const { return kind == "csv" || kind == "ulog" || kind == "dataflash"; }
-  bool compressed = false;                 // gzip around the log
-  std::vector<std::string> columns;        // CSV header
-  std::vector<UlogTopicInfo> topics;       // ULog subscriptions
+  bool compressed = false;                     // gzip around the log
+  std::vector<std::string> columns;            // CSV header
+  std::vector<UlogTopicInfo> topics;           // ULog subscriptions
   std::vector<DataflashMessageInfo> messages;  // DataFlash messages: counts, rates, instances
-  bool format_from_config = false;         // the format came from --config, not a guess
-  std::vector<std::string> guesses;        // what was guessed without a config, and why
+  bool format_from_config = false;             // the format came from --config, not a guess
+  std::vector<std::string> guesses;            // what was guessed without a config, and why
   // The guessed format cannot be used as it is (the "rate" columns hold angles): why. `init`
   // refuses to write it; `inspect` reports it as the error.
   std::string format_problem;
-  ImuFormat format;                        // the format used to read the series
+  ImuFormat format;  // the format used to read the series
 
   // Series (when read).
   long samples = 0;
   double duration_s = NAN;
-  double rate_mean_hz = NAN;     // (samples - 1) / duration
+  double rate_mean_hz = NAN;  // (samples - 1) / duration
   double step_median_s = NAN;
-  double step_jitter_s = NAN;    // std of the steps that are not dropouts
-  int dropouts = 0;              // steps longer than 2.5 median steps
+  double step_jitter_s = NAN;  // std of the steps that are not dropouts
+  int dropouts = 0;            // steps longer than 2.5 median steps
   double longest_gap_s = NAN;
   bool has_accel = false;
 
   // Swing (when found).
   std::array<double, 3> swing_axis_in_imu = {NAN, NAN, NAN};
-  std::string swing_axis_source;            // "accel_rest", "gyro_principal", ...
+  std::string swing_axis_source;             // "accel_rest", "gyro_principal", ...
   std::optional<double> pitch_measured_deg;  // from the accelerometer
-  std::string window_status;                // "ok", "rejected", "error", "" when not searched
+  std::string window_status;                 // "ok", "rejected", "error", "" when not searched
   std::array<double, 2> window_s = {NAN, NAN};
-  std::string window_end;                   // "log_end", "noise_floor", "stopped"
+  std::string window_end;  // "log_end", "noise_floor", "stopped"
   double release_s = NAN;
   double period_s = NAN;
   double frequency_hz = NAN;

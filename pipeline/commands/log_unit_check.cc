@@ -51,9 +51,10 @@ void HeldAwayFromCenter(const std::vector<double>& t, const std::vector<double>&
     }
     const double mean = sum / block;
     const double sd = std::sqrt(std::max(0.0, sum2 / block - mean * mean));
-    const bool held = sd < 0.05 * shape->half_range &&
-                      std::fabs(mean - shape->center) > 0.5 * shape->half_range;
-    if (held && run_blocks > 0 && std::fabs(mean - run_level / run_blocks) < 0.1 * shape->half_range) {
+    const bool held =
+        sd < 0.05 * shape->half_range && std::fabs(mean - shape->center) > 0.5 * shape->half_range;
+    if (held && run_blocks > 0 &&
+        std::fabs(mean - run_level / run_blocks) < 0.1 * shape->half_range) {
       run_s += t[b + block - 1] - t[b - 1];
       run_level += mean;
       ++run_blocks;
@@ -86,7 +87,8 @@ void Evaluate(const SwingShape& shape, const ImuFormat& guessed, UnitReading* r)
 // How far (in log units) an amplitude lies from the usual releases; 0 inside the band.
 double DistanceFromUsualRelease(double amplitude_deg) {
   if (amplitude_deg < kTypicalReleaseLowDeg) return std::log(kTypicalReleaseLowDeg / amplitude_deg);
-  if (amplitude_deg > kTypicalReleaseHighDeg) return std::log(amplitude_deg / kTypicalReleaseHighDeg);
+  if (amplitude_deg > kTypicalReleaseHighDeg)
+    return std::log(amplitude_deg / kTypicalReleaseHighDeg);
   return 0.0;
 }
 
@@ -105,9 +107,10 @@ std::string LooksLikeAngles(const SwingShape& shape) {
                shape.center, shape.half_range);
   }
   if (std::fabs(shape.center) > shape.half_range) {
-    return Fmt("the readings swing about %.3g (+-%.3g) and never change sign: a pendulum's rate "
-               "swings about zero, an angle about the attitude",
-               shape.center, shape.half_range);
+    return Fmt(
+        "the readings swing about %.3g (+-%.3g) and never change sign: a pendulum's rate "
+        "swings about zero, an angle about the attitude",
+        shape.center, shape.half_range);
   }
   return "";
 }
@@ -169,9 +172,9 @@ UnitCheck CheckUnitsAgainstSwing(const ImuData& data, const ImuFormat& guessed, 
                  : std::vector<TimeUnit>{TimeUnit::kSeconds, TimeUnit::kMilliseconds,
                                          TimeUnit::kMicroseconds};
   const std::vector<RateUnit> rates =
-      gyro_named ? std::vector<RateUnit>{guessed.gyro_unit}
-                 : std::vector<RateUnit>{RateUnit::kRadPerS, RateUnit::kDegPerS,
-                                         RateUnit::kMilliradPerS};
+      gyro_named
+          ? std::vector<RateUnit>{guessed.gyro_unit}
+          : std::vector<RateUnit>{RateUnit::kRadPerS, RateUnit::kDegPerS, RateUnit::kMilliradPerS};
   int guess_index = -1;
   for (TimeUnit t : times) {
     for (RateUnit g : rates) {
@@ -179,7 +182,8 @@ UnitCheck CheckUnitsAgainstSwing(const ImuData& data, const ImuFormat& guessed, 
       r.time = t;
       r.gyro = g;
       Evaluate(shape, guessed, &r);
-      if (t == guessed.time_unit && g == guessed.gyro_unit) guess_index = static_cast<int>(check.readings.size());
+      if (t == guessed.time_unit && g == guessed.gyro_unit)
+        guess_index = static_cast<int>(check.readings.size());
       check.readings.push_back(r);
     }
   }
@@ -188,8 +192,9 @@ UnitCheck CheckUnitsAgainstSwing(const ImuData& data, const ImuFormat& guessed, 
     const UnitReading& r = check.readings[k];
     if (!r.plausible) continue;
     const double d = DistanceFromUsualRelease(r.amplitude_deg);
-    const double best_d =
-        check.best < 0 ? INFINITY : DistanceFromUsualRelease(check.readings[check.best].amplitude_deg);
+    const double best_d = check.best < 0
+                              ? INFINITY
+                              : DistanceFromUsualRelease(check.readings[check.best].amplitude_deg);
     if (d < best_d || (d == best_d && k == guess_index)) check.best = k;
   }
   if (check.best < 0) {
@@ -214,7 +219,8 @@ UnitCheck CheckUnitsAgainstSwing(const ImuData& data, const ImuFormat& guessed, 
             DistanceFromUsualRelease(best.amplitude_deg) + std::log(3.0)) {
       continue;
     }
-    check.note += "; in " + ReadingText(r) + ", also a pendulum: check imu.time.unit and imu.gyro.unit";
+    check.note +=
+        "; in " + ReadingText(r) + ", also a pendulum: check imu.time.unit and imu.gyro.unit";
   }
   return check;
 }

@@ -33,15 +33,15 @@ constexpr double kTypicalReleaseHighDeg = 30.0;
 
 // The swing on the gyro axis that moves most, measured in the units the series was read with.
 struct SwingShape {
-  bool found = false;        // at least four half-cycles of a consistent length
-  int axis = -1;             // 0, 1, 2: IMU x, y, z
-  double period_s = NAN;     // twice the median half-cycle
+  bool found = false;          // at least four half-cycles of a consistent length
+  int axis = -1;               // 0, 1, 2: IMU x, y, z
+  double period_s = NAN;       // twice the median half-cycle
   double amplitude_rad = NAN;  // largest half of |integral of the rate over a half-cycle|
   int half_cycles = 0;
-  double center = NAN;       // middle of the axis' range (0.5 % and 99.5 % percentiles)
-  double half_range = NAN;   // half that range
-  double held_s = 0.0;       // longest still stretch away from the center (s)
-  double held_level = NAN;   // its level, in the reading's units
+  double center = NAN;      // middle of the axis' range (0.5 % and 99.5 % percentiles)
+  double half_range = NAN;  // half that range
+  double held_s = 0.0;      // longest still stretch away from the center (s)
+  double held_level = NAN;  // its level, in the reading's units
 };
 SwingShape MeasureSwing(const ImuData& data);
 
@@ -62,9 +62,9 @@ struct UnitCheck {
   // plausible).
   std::vector<UnitReading> readings;
   int best = -1;
-  bool changed = false;     // the offered units differ from the guess
-  std::string note;         // for the guess line: "period 2.10 s, amplitude 3.0 deg; ..."
-  std::string warning;      // no reading is a pendulum: what it is, and the keys to set
+  bool changed = false;  // the offered units differ from the guess
+  std::string note;      // for the guess line: "period 2.10 s, amplitude 3.0 deg; ..."
+  std::string warning;   // no reading is a pendulum: what it is, and the keys to set
 };
 
 // `data` read with `guessed` (time and gyro units); `time_named`, `gyro_named`: that unit came

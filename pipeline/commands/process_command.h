@@ -12,9 +12,9 @@
 namespace bifilar {
 
 struct ProcessCommandOptions {
-  std::string config_path;  // campaign config (YAML, configs/README.md)
-  std::string runs_root;    // "" : the config's runs.root (--runs-root)
-  std::string integrator;   // "" : the config's fit.integrator; else rk853 or cvodes
+  std::string config_path;             // campaign config (YAML, configs/README.md)
+  std::string runs_root;               // "" : the config's runs.root (--runs-root)
+  std::string integrator;              // "" : the config's fit.integrator; else rk853 or cvodes
   std::optional<std::string> out_dir;  // none: out/ beside the config
   // Jobs, cache, figures, progress, cancel flag and callback; its out_dir is set by RunProcess.
   CampaignOptions campaign;

@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "base/user_error.h"
 #include "base/text_format.h"
+#include "base/user_error.h"
 #include "pipeline/commands/rig_plan.h"
 #include "pipeline/config/config.h"
 #include "pipeline/config/config_template.h"
@@ -86,10 +86,9 @@ std::string WrapLines(const std::string& text) {
   std::istringstream in(text);
   std::string line, out;
   while (std::getline(in, line)) {
-    const std::string indent(line.find_first_not_of(' ') == std::string::npos
-                                 ? 0
-                                 : line.find_first_not_of(' ') + 4,
-                             ' ');
+    const std::string indent(
+        line.find_first_not_of(' ') == std::string::npos ? 0 : line.find_first_not_of(' ') + 4,
+        ' ');
     while (line.size() > kMaxLine) {
       size_t at = std::string::npos;
       for (const char* sep : {"; ", ", ", " "}) {
@@ -349,9 +348,8 @@ bool WriteRigPlanPlot(const RigPlan& p, const std::string& path, std::string* wh
   f.chosen_length_m = p.recommended.length_m;
   f.chosen_total_percent = 100.0 * p.recommended.terms.Total();
   f.title = "bifilar plan --rig: " + Fmt("%.4g", p.options.mass_kg) + " kg, I " +
-            Fmt("%.3g", p.options.inertia_kg_m2) + " " +
-            InertiaUnitPlotLabel(DisplayUnits::kSi) + ", target " +
-            Fmt("%g", p.options.target_percent) + " %";
+            Fmt("%.3g", p.options.inertia_kg_m2) + " " + InertiaUnitPlotLabel(DisplayUnits::kSi) +
+            ", target " + Fmt("%g", p.options.target_percent) + " %";
   return WriteRigPlanFigure(f, path, why);
 }
 

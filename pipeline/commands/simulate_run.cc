@@ -75,8 +75,7 @@ double DefaultTimeJitterSigmaS(double sample_rate_hz) {
   return 0.1 / sample_rate_hz < fallback ? 0.1 / sample_rate_hz : fallback;
 }
 
-void ApplySimulateOverrides(const SimulateOverrides& o, bool single_trace,
-                            SimulateSpec* spec) {
+void ApplySimulateOverrides(const SimulateOverrides& o, bool single_trace, SimulateSpec* spec) {
   if (o.seed) spec->seed = *o.seed;
   if (o.no_accel) spec->options.sensor.accelerometer = false;
   if (o.duration_s) spec->options.timeline.free_s = {*o.duration_s, *o.duration_s};
@@ -112,8 +111,8 @@ SimulateCommandResult RunSimulate(const SimulateCommandOptions& a) {
   if (!a.trace_csv.empty() && !a.out_dir.empty()) {
     throw UserError("give either " + n.out + " or " + n.trace + ", not both");
   }
-  SimulateSpec spec = a.spec_file.empty() ? ParseSimulateSpec("{}", "<defaults>")
-                                          : ReadSimulateSpec(a.spec_file);
+  SimulateSpec spec =
+      a.spec_file.empty() ? ParseSimulateSpec("{}", "<defaults>") : ReadSimulateSpec(a.spec_file);
   if (a.spec_file.empty()) spec.file.clear();
   if (!a.model.empty() && !ParsePendulumModel(a.model, &spec.options.model)) {
     throw UserError(n.model + ": unknown model '" + a.model + "'; allowed " +
@@ -122,15 +121,17 @@ SimulateCommandResult RunSimulate(const SimulateCommandOptions& a) {
   if (a.sample_rate) SetSampleRateFromFlag(&spec, *a.sample_rate, n.sample_rate);
   if (!a.trace_csv.empty()) {
     if (spec.has_campaign) {
-      throw UserError(a.spec_file + ": has campaign sections (aircraft, rig, campaign); simulate "
-                      "it with " + n.out + ", or use a spec without them with " + n.trace);
+      throw UserError(a.spec_file +
+                      ": has campaign sections (aircraft, rig, campaign); simulate "
+                      "it with " +
+                      n.out + ", or use a spec without them with " + n.trace);
     }
     ApplySimulateOverrides(o, true, &spec);
     const TraceRequest& t = spec.trace;
-    for (const auto& [value, name] : {std::make_pair(&t.inertia_kg_m2, &n.inertia),
-                                      std::make_pair(&t.mass_kg, &n.mass),
-                                      std::make_pair(&t.filar_length_m, &n.length),
-                                      std::make_pair(&t.filar_separation_m, &n.separation)}) {
+    for (const auto& [value, name] :
+         {std::make_pair(&t.inertia_kg_m2, &n.inertia), std::make_pair(&t.mass_kg, &n.mass),
+          std::make_pair(&t.filar_length_m, &n.length),
+          std::make_pair(&t.filar_separation_m, &n.separation)}) {
       if (!*value) throw UserError("give " + *name + " (or its spec key) for a single trace");
     }
     std::string why;
@@ -144,7 +145,8 @@ SimulateCommandResult RunSimulate(const SimulateCommandOptions& a) {
   if (a.spec_file.empty()) throw UserError(n.out + " needs a campaign spec file SPEC.yaml");
   if (o.inertia_kg_m2 || o.mass_kg || o.amplitude_deg || o.pitch_deg || !a.truth_json.empty()) {
     throw UserError(n.inertia + ", " + n.mass + ", " + n.amplitude + ", " + n.pitch + " and " +
-                    n.truth + " apply to " + n.trace + " only; a campaign takes them from the spec");
+                    n.truth + " apply to " + n.trace +
+                    " only; a campaign takes them from the spec");
   }
   ApplySimulateOverrides(o, false, &spec);
   std::string why;
@@ -165,7 +167,8 @@ void SetSampleRateFromFlag(SimulateSpec* spec, double rate_hz, const std::string
                     Fmt("%g", s.time_jitter_sigma_s) + " s in " + from +
                     " is more than one sample period at that rate (" + Fmt("%g", 1.0 / rate_hz) +
                     " s); lower it in the spec (or remove it: the default follows the rate), or "
-                    "lower " + flag);
+                    "lower " +
+                    flag);
   }
   if (s.rocking_frequency_hz > rate_hz / 4) {
     throw UserError(flag + " " + Fmt("%g", rate_hz) + ": 'sensor.rocking_frequency_hz' = " +
@@ -202,8 +205,7 @@ void CheckOutputFileTarget(const std::string& path, const std::string& what) {
     const fs::file_status ps = fs::status(parent, ec);
     if (fs::exists(ps)) {
       if (!fs::is_directory(ps)) {
-        throw UserError(what + " " + path + ": " + parent.string() +
-                        " exists and is not a folder");
+        throw UserError(what + " " + path + ": " + parent.string() + " exists and is not a folder");
       }
       break;
     }
@@ -292,7 +294,8 @@ SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string&
   const double inertia = need(r.inertia_kg_m2, "the whole suspended inertia", "--inertia-kg-m2");
   const double mass = need(r.mass_kg, "the whole suspended mass", "--mass-kg");
   const double length = need(r.filar_length_m, "the filar length L", "-L/--filar-length-m");
-  const double separation = need(r.filar_separation_m, "the filar separation D", "-D/--filar-separation-m");
+  const double separation =
+      need(r.filar_separation_m, "the filar separation D", "-D/--filar-separation-m");
   if (csv_path.empty()) throw UserError("--trace: empty output file name");
   std::string truth_path = truth_path_in;
   if (truth_path.empty()) {
@@ -340,8 +343,8 @@ SimulateRunSummary RunSimulateTrace(const SimulateSpec& spec, const std::string&
   s.pitch_rad = r.pitch_deg * kRadPerDeg;
   s.amplitude_rad = r.amplitude_deg * kRadPerDeg;
   s.imu_offset_in_body_m = r.imu_offset_m;
-  s.body_from_imu = MountingFromRollPitchYawDeg(r.imu_mounting_rpy_deg[0], r.imu_mounting_rpy_deg[1],
-                                                r.imu_mounting_rpy_deg[2]);
+  s.body_from_imu = MountingFromRollPitchYawDeg(
+      r.imu_mounting_rpy_deg[0], r.imu_mounting_rpy_deg[1], r.imu_mounting_rpy_deg[2]);
   ct.inertia_aircraft_kg_m2 = 0.0;
   ct.inertia_rig_kg_m2 = 0.0;
   std::string why;

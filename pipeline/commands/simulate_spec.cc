@@ -108,7 +108,8 @@ std::array<std::string, 3> ReadColumns(YamlMap& map, const std::string& key,
 }
 
 template <typename Unit, typename Parse>
-Unit ReadUnit(YamlMap& map, const std::string& key, Unit fallback, Parse parse, const std::string& allowed) {
+Unit ReadUnit(YamlMap& map, const std::string& key, Unit fallback, Parse parse,
+              const std::string& allowed) {
   const YAML::Node node = map.Optional(key);
   if (!node.IsDefined() || node.IsNull()) return fallback;
   const std::string name = map.AsString(node, key);
@@ -123,23 +124,27 @@ Unit ReadUnit(YamlMap& map, const std::string& key, Unit fallback, Parse parse, 
 void ReadFormat(YamlMap map, SimulateSpec* spec) {
   ImuFormat& f = spec->format;
   f.time_column = map.OptionalString("time_column", f.time_column);
-  f.time_unit = ReadUnit(map, "time_unit", f.time_unit,
-                         [](const std::string& n, TimeUnit* u) { return ParseTimeUnit(n, u); },
-                         TimeUnitAllowedValues());
+  f.time_unit = ReadUnit(
+      map, "time_unit", f.time_unit,
+      [](const std::string& n, TimeUnit* u) { return ParseTimeUnit(n, u); },
+      TimeUnitAllowedValues());
   f.gyro_columns = ReadColumns(map, "gyro_columns", f.gyro_columns);
-  f.gyro_unit = ReadUnit(map, "gyro_unit", f.gyro_unit,
-                         [](const std::string& n, RateUnit* u) { return ParseRateUnit(n, u); },
-                         RateUnitAllowedValues());
+  f.gyro_unit = ReadUnit(
+      map, "gyro_unit", f.gyro_unit,
+      [](const std::string& n, RateUnit* u) { return ParseRateUnit(n, u); },
+      RateUnitAllowedValues());
   f.accel_columns = ReadColumns(map, "accel_columns", f.accel_columns);
-  f.accel_unit = ReadUnit(map, "accel_unit", f.accel_unit,
-                          [](const std::string& n, AccelUnit* u) { return ParseAccelUnit(n, u); },
-                          AccelUnitAllowedValues());
+  f.accel_unit = ReadUnit(
+      map, "accel_unit", f.accel_unit,
+      [](const std::string& n, AccelUnit* u) { return ParseAccelUnit(n, u); },
+      AccelUnitAllowedValues());
   const YAML::Node delim = map.Optional("delimiter");
   if (delim.IsDefined() && !delim.IsNull()) {
     const std::string d = map.AsString(delim, "delimiter");
-    if (d.size() != 1 || d == "\"" || d == "\n" || d == "\r" || std::isalnum(static_cast<unsigned char>(d[0])) ||
-        d == "." || d == "-" || d == "+") {
-      throw UserError(map.Where(delim) + ": 'format.delimiter' must be one character such as "
+    if (d.size() != 1 || d == "\"" || d == "\n" || d == "\r" ||
+        std::isalnum(static_cast<unsigned char>(d[0])) || d == "." || d == "-" || d == "+") {
+      throw UserError(map.Where(delim) +
+                      ": 'format.delimiter' must be one character such as "
                       "',', ';' or a tab");
     }
     f.delimiter = d[0];
@@ -191,15 +196,15 @@ void ReadSensor(YamlMap map, SensorOptions* s, bool* time_jitter_given) {
     const YAML::Node jitter = map.Optional("time_jitter_sigma_s");
     const double value = map.AsDouble(jitter, "time_jitter_sigma_s");
     if (value > 1.0 / s->sample_rate_hz) {
-      throw UserError(map.Where(jitter) + ": '" + map.KeyPath("time_jitter_sigma_s") + "' = " +
-                      Fmt("%g", value) + " s is more than one sample period (1/" +
+      throw UserError(map.Where(jitter) + ": '" + map.KeyPath("time_jitter_sigma_s") +
+                      "' = " + Fmt("%g", value) + " s is more than one sample period (1/" +
                       map.KeyPath("sample_rate_hz") + " = " + Fmt("%g", 1.0 / s->sample_rate_hz) +
                       " s); lower it or the sample rate");
     }
   }
-  s->time_jitter_sigma_s = ReadValue(map, "time_jitter_sigma_s",
-                                     DefaultTimeJitterSigmaS(s->sample_rate_hz), 0, false,
-                                     1.0 / s->sample_rate_hz);
+  s->time_jitter_sigma_s =
+      ReadValue(map, "time_jitter_sigma_s", DefaultTimeJitterSigmaS(s->sample_rate_hz), 0, false,
+                1.0 / s->sample_rate_hz);
   s->drop_fraction = ReadValue(map, "drop_fraction", s->drop_fraction, 0, false, 0.5);
   s->drop_burst_probability =
       ReadValue(map, "drop_burst_probability", s->drop_burst_probability, 0, false, 1);
@@ -208,7 +213,8 @@ void ReadSensor(YamlMap map, SensorOptions* s, bool* time_jitter_given) {
   s->start_time_s = ReadRange(map, "start_time_s", s->start_time_s, -1e9, false, 1e9);
   s->gyro_noise_sigma_deg_per_s =
       ReadValue(map, "gyro_noise_sigma_deg_per_s", s->gyro_noise_sigma_deg_per_s, 0, false, 100);
-  s->gyro_noise_ar1_phi = ReadValue(map, "gyro_noise_ar1_phi", s->gyro_noise_ar1_phi, 0, false, 0.99);
+  s->gyro_noise_ar1_phi =
+      ReadValue(map, "gyro_noise_ar1_phi", s->gyro_noise_ar1_phi, 0, false, 0.99);
   s->gyro_bias_walk_deg_per_s_per_sqrt_s =
       ReadValue(map, "gyro_bias_walk_deg_per_s_per_sqrt_s", s->gyro_bias_walk_deg_per_s_per_sqrt_s,
                 0, false, 10);
@@ -251,8 +257,8 @@ void ReadSensor(YamlMap map, SensorOptions* s, bool* time_jitter_given) {
   s->accel_bias_sigma_mps2 =
       ReadValue(map, "accel_bias_sigma_mps2", s->accel_bias_sigma_mps2, 0, false, 10);
   s->rocking_max_deg = ReadValue(map, "rocking_max_deg", s->rocking_max_deg, 0, false, 10);
-  s->rocking_frequency_hz =
-      ReadValue(map, "rocking_frequency_hz", s->rocking_frequency_hz, 0, false, s->sample_rate_hz / 4);
+  s->rocking_frequency_hz = ReadValue(map, "rocking_frequency_hz", s->rocking_frequency_hz, 0,
+                                      false, s->sample_rate_hz / 4);
   s->rocking_decay_s = ReadValue(map, "rocking_decay_s", s->rocking_decay_s, 0, true, 1e6);
   map.Finish();
 }
@@ -293,8 +299,8 @@ void ReadGeometry(YamlMap map, std::optional<double>* length, std::optional<doub
   std::string why;
   if (length->has_value() && separation->has_value() &&
       !CheckSeparationBelowLength(**length, **separation, &why)) {
-    throw UserError(map.Where(length_node) + ": '" + map.KeyPath("filar_separation_m") + "': " +
-                    why);
+    throw UserError(map.Where(length_node) + ": '" + map.KeyPath("filar_separation_m") +
+                    "': " + why);
   }
   map.Finish();
 }
@@ -320,8 +326,8 @@ void ReadModelAndIntegrator(YamlMap& root, SimulateSpec* spec) {
     if (model.IsDefined() && !model.IsNull()) {
       const std::string name = root.AsString(model, "model");
       if (!ParsePendulumModel(name, &spec->options.model)) {
-        throw UserError(root.Where(model) + ": unknown model '" + name +
-                        "' for 'model'; allowed " + PendulumModelAllowedValues());
+        throw UserError(root.Where(model) + ": unknown model '" + name + "' for 'model'; allowed " +
+                        PendulumModelAllowedValues());
       }
     }
   }
@@ -331,9 +337,8 @@ void ReadModelAndIntegrator(YamlMap& root, SimulateSpec* spec) {
       const std::string name = root.AsString(method, "integrator");
       if (!ParseIntegratorMethod(name, &spec->options.integrator.method)) {
         throw UserError(root.Where(method) + ": unknown integrator '" + name +
-                        "' for 'integrator'; allowed " +
-                        IntegratorMethodAllowedValues() + " (default " +
-                        ToString(spec->options.integrator.method) + ")");
+                        "' for 'integrator'; allowed " + IntegratorMethodAllowedValues() +
+                        " (default " + ToString(spec->options.integrator.method) + ")");
       }
     }
   }

@@ -2,7 +2,8 @@
 // and line) and the typed Run functions the CLI calls. The physics lives in pendulum/simulate.h;
 // simulate_spec.cc reads specs, simulate_run.cc runs them and writes the logs
 // (pipeline/logs/imu_log_writer.h), simulate_truth.cc writes truth.json.
-// Key by key documentation: README.md, section "simulate"; example: configs/simulate_prandtl_d.yaml.
+// Key by key documentation: README.md, section "simulate"; example:
+// configs/simulate_prandtl_d.yaml.
 #pragma once
 
 #include <cstdint>
@@ -19,10 +20,10 @@ namespace bifilar {
 // One trace's physical inputs (single-trace mode: the spec's `trace` and `geometry` sections,
 // overridden by command-line flags).
 struct TraceRequest {
-  std::optional<double> inertia_kg_m2;      // whole suspended inertia I (required)
-  std::optional<double> mass_kg;            // whole suspended mass m (required)
-  std::optional<double> filar_length_m;     // L (required)
-  std::optional<double> filar_separation_m; // D (required)
+  std::optional<double> inertia_kg_m2;       // whole suspended inertia I (required)
+  std::optional<double> mass_kg;             // whole suspended mass m (required)
+  std::optional<double> filar_length_m;      // L (required)
+  std::optional<double> filar_separation_m;  // D (required)
   double gravity_mps2 = kStandardGravityMps2;
   double pitch_deg = 0.0;                   // true pitch of the body axes
   double amplitude_deg = 20.0;              // psi at release (sign = twist direction)
@@ -33,18 +34,18 @@ struct TraceRequest {
 };
 
 struct SimulateSpec {
-  std::string file;                 // spec path ("" when built from flags only)
-  uint64_t seed = 1;                // spec `seed`, overridable with --seed
-  SimulationOptions options;        // model, timeline, sensor, sway coupling
-  ImuFormat format;                 // CSV columns and units
-  ImuLogWriteOptions write;         // significant digits
-  bool ulog = false;                // `format.ulog`: campaign logs written as PX4 ULog *.ulg
-  bool gzip = false;                // `format.gzip`: campaign logs written as *.csv.gz
-  bool footer = false;              // `format.footer`: a Crazyflie-like footer after the data
-  bool time_jitter_given = false;   // `sensor.time_jitter_sigma_s` set in the spec
-  bool has_campaign = false;        // `aircraft`, `rig`, `campaign` sections present
+  std::string file;                // spec path ("" when built from flags only)
+  uint64_t seed = 1;               // spec `seed`, overridable with --seed
+  SimulationOptions options;       // model, timeline, sensor, sway coupling
+  ImuFormat format;                // CSV columns and units
+  ImuLogWriteOptions write;        // significant digits
+  bool ulog = false;               // `format.ulog`: campaign logs written as PX4 ULog *.ulg
+  bool gzip = false;               // `format.gzip`: campaign logs written as *.csv.gz
+  bool footer = false;             // `format.footer`: a Crazyflie-like footer after the data
+  bool time_jitter_given = false;  // `sensor.time_jitter_sigma_s` set in the spec
+  bool has_campaign = false;       // `aircraft`, `rig`, `campaign` sections present
   CampaignSpec campaign;
-  bool has_trace = false;           // `trace` section present
+  bool has_trace = false;  // `trace` section present
   TraceRequest trace;
 };
 
@@ -63,8 +64,8 @@ void SetSampleRateFromFlag(SimulateSpec* spec, double sample_rate_hz,
 // words (a flag or a keyword) before calling ApplySimulateOverrides.
 struct SimulateOverrides {
   std::optional<uint64_t> seed;
-  std::optional<double> inertia_kg_m2, mass_kg, length_m, separation_m, gravity_mps2,
-      amplitude_deg, pitch_deg, duration_s;
+  std::optional<double> inertia_kg_m2, mass_kg, length_m, separation_m, gravity_mps2, amplitude_deg,
+      pitch_deg, duration_s;
   bool no_accel = false;  // write no accelerometer columns
 };
 
@@ -86,10 +87,10 @@ SimulateSpec ReadSimulateSpec(const std::string& file);
 SimulateSpec ParseSimulateSpec(const std::string& yaml_text, const std::string& name);
 
 struct SimulateRunSummary {
-  int files_written = 0;        // CSV logs
-  long samples_written = 0;     // rows over all logs
-  long samples_dropped = 0;     // packets lost over all logs
-  std::string truth_path;       // the truth JSON written
+  int files_written = 0;     // CSV logs
+  long samples_written = 0;  // rows over all logs
+  long samples_dropped = 0;  // packets lost over all logs
+  std::string truth_path;    // the truth JSON written
   std::string BriefReport() const;
 };
 

@@ -87,17 +87,17 @@ nlohmann::json OptionsJson(const SimulateSpec& spec) {
     j["softening_harmonic_constant"] = SofteningHarmonicConstant(o.softening_exponent);
   }
   const ImuFormat& f = spec.format;
-  j["format"] = {{"time_column", f.time_column},
-                 {"time_unit", ToString(f.time_unit)},
-                 {"gyro_columns", f.gyro_columns},
-                 {"gyro_unit", ToString(f.gyro_unit)},
-                 {"accel_columns", f.has_accel() && s.accelerometer
-                                       ? nlohmann::json(f.accel_columns)
-                                       : nlohmann::json::array()},
-                 {"accel_unit", ToString(f.accel_unit)},
-                 {"delimiter", std::string(1, f.delimiter)},
-                 {"significant_digits", spec.write.significant_digits},
-                 {"gzip", spec.gzip}};
+  j["format"] = {
+      {"time_column", f.time_column},
+      {"time_unit", ToString(f.time_unit)},
+      {"gyro_columns", f.gyro_columns},
+      {"gyro_unit", ToString(f.gyro_unit)},
+      {"accel_columns", f.has_accel() && s.accelerometer ? nlohmann::json(f.accel_columns)
+                                                         : nlohmann::json::array()},
+      {"accel_unit", ToString(f.accel_unit)},
+      {"delimiter", std::string(1, f.delimiter)},
+      {"significant_digits", spec.write.significant_digits},
+      {"gzip", spec.gzip}};
   if (spec.footer) j["format"]["footer"] = true;
   return j;
 }
@@ -117,8 +117,8 @@ nlohmann::json TraceJson(const CampaignTrace& ct, const SimulateSpec& spec) {
     j["nominal_roll_deg"] = ct.nominal_roll_deg;
     j["true_roll_deg"] = ct.true_roll_deg;
     const double p = ct.true_pitch_deg * kRadPerDeg, r = ct.true_roll_deg * kRadPerDeg;
-    j["swing_axis_in_body"] = Vec(Eigen::Vector3d(-std::sin(p), std::sin(r) * std::cos(p),
-                                                  std::cos(r) * std::cos(p)));
+    j["swing_axis_in_body"] =
+        Vec(Eigen::Vector3d(-std::sin(p), std::sin(r) * std::cos(p), std::cos(r) * std::cos(p)));
   }
   j["mass_kg"] = s.geometry.mass_kg;
   j["inertia_total_kg_m2"] = s.params.inertia_kg_m2;
@@ -177,7 +177,8 @@ nlohmann::json TraceJson(const CampaignTrace& ct, const SimulateSpec& spec) {
     // true inertia stays inertia_total_kg_m2 (the small-amplitude limit).
     const double p = spec.options.softening_exponent;
     j["softening_k_per_rad_p"] = t.softening_k;
-    j["apparent_inertia_excess_at_release"] = ApparentInertiaExcess(t.softening_k, p, t.amplitude_rad);
+    j["apparent_inertia_excess_at_release"] =
+        ApparentInertiaExcess(t.softening_k, p, t.amplitude_rad);
     j["apparent_inertia_at_release_kg_m2"] =
         s.params.inertia_kg_m2 * (1.0 + ApparentInertiaExcess(t.softening_k, p, t.amplitude_rad));
   }
@@ -238,7 +239,8 @@ std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<Campai
   }
   nlohmann::json mounting = nlohmann::json::array();
   for (int r = 0; r < 3; ++r) {
-    mounting.push_back({c.rig.body_from_imu(r, 0), c.rig.body_from_imu(r, 1), c.rig.body_from_imu(r, 2)});
+    mounting.push_back(
+        {c.rig.body_from_imu(r, 0), c.rig.body_from_imu(r, 1), c.rig.body_from_imu(r, 2)});
   }
   rig["body_from_imu"] = mounting;
   j["rig"] = rig;
@@ -257,14 +259,17 @@ std::string CampaignTruthJson(const SimulateSpec& spec, const std::vector<Campai
     j["aircraft"]["iy_kg_m2"] = c.aircraft.iy_kg_m2;
     j["aircraft"]["ixy_kg_m2"] = c.aircraft.ixy_kg_m2;
     j["aircraft"]["iyz_kg_m2"] = c.aircraft.iyz_kg_m2;
-    j["aircraft"]["tensor"] = {
-        {"Ixx_kg_m2", c.aircraft.ix_kg_m2}, {"Iyy_kg_m2", c.aircraft.iy_kg_m2},
-        {"Izz_kg_m2", c.aircraft.iz_kg_m2}, {"Ixy_kg_m2", c.aircraft.ixy_kg_m2},
-        {"Ixz_kg_m2", c.aircraft.ixz_kg_m2}, {"Iyz_kg_m2", c.aircraft.iyz_kg_m2},
-        {"tensor_kg_m2", {Vec(tensor.row(0).transpose()), Vec(tensor.row(1).transpose()),
-                          Vec(tensor.row(2).transpose())}},
-        {"principal_moments_kg_m2", Vec(eig.eigenvalues())},
-        {"principal_axes", axes}};
+    j["aircraft"]["tensor"] = {{"Ixx_kg_m2", c.aircraft.ix_kg_m2},
+                               {"Iyy_kg_m2", c.aircraft.iy_kg_m2},
+                               {"Izz_kg_m2", c.aircraft.iz_kg_m2},
+                               {"Ixy_kg_m2", c.aircraft.ixy_kg_m2},
+                               {"Ixz_kg_m2", c.aircraft.ixz_kg_m2},
+                               {"Iyz_kg_m2", c.aircraft.iyz_kg_m2},
+                               {"tensor_kg_m2",
+                                {Vec(tensor.row(0).transpose()), Vec(tensor.row(1).transpose()),
+                                 Vec(tensor.row(2).transpose())}},
+                               {"principal_moments_kg_m2", Vec(eig.eigenvalues())},
+                               {"principal_axes", axes}};
   }
   j["campaign"] = {{"pitch_deg", c.pitch_deg},
                    {"trials_per_pitch", c.trials_per_pitch},

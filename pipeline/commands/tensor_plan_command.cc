@@ -20,11 +20,16 @@ using nlohmann::json;
 // The flag that sets a TensorPlanOptions field, for its messages ("" when no flag sets it).
 std::string FlagOfPlanField(const std::string& field) {
   static const std::pair<const char*, const char*> kFlags[] = {
-      {"roll_min_deg", "--roll"},           {"roll_max_deg", "--roll"},
-      {"pitch_min_deg", "--pitch"},         {"pitch_max_deg", "--pitch"},
-      {"grid_step_deg", "--grid-step"},     {"n_orientations", "--orientations"},
-      {"sigma_kg_m2", "--sigma"},           {"sigma_relative", "--sigma-rel"},
-      {"attitude_std_deg", "--attitude-std"}, {"target_std_kg_m2", "--target"}};
+      {"roll_min_deg", "--roll"},
+      {"roll_max_deg", "--roll"},
+      {"pitch_min_deg", "--pitch"},
+      {"pitch_max_deg", "--pitch"},
+      {"grid_step_deg", "--grid-step"},
+      {"n_orientations", "--orientations"},
+      {"sigma_kg_m2", "--sigma"},
+      {"sigma_relative", "--sigma-rel"},
+      {"attitude_std_deg", "--attitude-std"},
+      {"target_std_kg_m2", "--target"}};
   for (const auto& [name, flag] : kFlags) {
     if (field.rfind(name, 0) == 0) return flag;  // also "target_std_kg_m2 (0: none)"
   }
@@ -174,8 +179,7 @@ void PrintTensorPlan(const TensorPlanCommandResult& result, DisplayUnits units, 
   if (o.guess_given) {
     out << "Assumed tensor (" << u << "): ";
     for (int c = 0; c < kTensorComponents; ++c) {
-      out << (c ? ", " : "") << TensorComponentName(c) << " "
-          << Fmt("%.5g", o.guess_kg_m2[c] * k);
+      out << (c ? ", " : "") << TensorComponentName(c) << " " << Fmt("%.5g", o.guess_kg_m2[c] * k);
     }
     out << "\n";
   }

@@ -69,7 +69,8 @@ struct Watch {
     for (const WatchSample& s : samples) {
       const WatchSample back = log->Write(s);
       if (!go_on) continue;  // the watch ends, but every sample received is saved
-      if (!engine->Add(back.t_s, back.gyro_rad_per_s, back.has_accel ? &back.accel_mps2 : nullptr)) {
+      if (!engine->Add(back.t_s, back.gyro_rad_per_s,
+                       back.has_accel ? &back.accel_mps2 : nullptr)) {
         continue;
       }
       log->Flush();
@@ -176,7 +177,8 @@ void Loop(Watch* w) {
     }
     if (!w->Take(samples, rejected)) return;
     if (!open) {
-      w->Event(why + (w->log ? "; the log " + w->log->path() + " keeps every sample received" : ""));
+      w->Event(why +
+               (w->log ? "; the log " + w->log->path() + " keeps every sample received" : ""));
       if (!w->source->CanReconnect() || !Reconnect(w, Clock::now())) {
         result->end_reason = w->source->CanReconnect() ? result->end_reason : "end of stream";
         return;
@@ -261,8 +263,9 @@ WatchCommandResult RunWatch(const WatchCommandOptions& options) {
   if (o.engine.log_name == "watch") {
     o.engine.log_name = options.source == "-" ? "stdin" : options.source;
   }
-  Watch w{o, config, OpenWatchSource(options.source, config, input), nullptr, nullptr, &result,
-          options.save_path};
+  Watch w{
+      o,       config,           OpenWatchSource(options.source, config, input), nullptr, nullptr,
+      &result, options.save_path};
   if (options.handle_interrupt) InstallInterruptHandler();
   try {
     Loop(&w);

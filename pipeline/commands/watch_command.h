@@ -27,10 +27,10 @@ struct WatchCommandOptions {
   // The log every sample is written to; "": a new time-stamped file beside the config.
   std::string save_path;
   WatchEngineOptions engine;
-  double counter_rate_hz = 0.0;         // > 0: the stream's time is a sample counter at this rate
+  double counter_rate_hz = 0.0;          // > 0: the stream's time is a sample counter at this rate
   std::string counter_column = "count";  // the counter's column or key
-  int stop_after_cycles = 0;            // > 0: end once the fitted window holds this many cycles
-  bool stop_at_target = false;          // end at the first "enough"
+  int stop_after_cycles = 0;             // > 0: end once the fitted window holds this many cycles
+  bool stop_at_target = false;           // end at the first "enough"
   // End when no sample came for this long (s; the stream stopped); 0: keep waiting (a followed
   // file, a serial port). The watch says once, after idle_warn_s, that nothing is coming.
   double idle_end_s = 0.0;
@@ -69,8 +69,8 @@ struct WatchCommandResult {
   std::string end_reason;            // "end of stream", "interrupted", "target reached", ...
   bool interrupted = false;
   std::string config_path_for_print;  // the CLI's config path, for the final lines
-  nlohmann::json json;               // {logs: [{path, samples, rejected, record}], counters, ...}
-  int ExitCode() const;              // 130 interrupted, 1 no log or its fit not ok, 0 otherwise
+  nlohmann::json json;                // {logs: [{path, samples, rejected, record}], counters, ...}
+  int ExitCode() const;               // 130 interrupted, 1 no log or its fit not ok, 0 otherwise
 };
 
 // Throws UserError on a bad config, source or option before any sample is read.

@@ -20,7 +20,6 @@ namespace bifilar {
 
 namespace fs = std::filesystem;
 
-
 constexpr EnumName<PitchSource> kPitchSourceNames[] = {{PitchSource::kNominal, "nominal"},
                                                        {PitchSource::kMeasured, "measured"}};
 
@@ -82,9 +81,12 @@ bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why) {
               Ends::kClosed, &f)) {
     return true;
   }
-  f.allowed += ", a gravity found on Earth (from the equator's mountains to the poles); check "
-               "for a typo (" + Fmt("%g", kStandardGravityMps2) + " is standard gravity), or set "
-               "'gravity_off_earth: true' for a rig elsewhere";
+  f.allowed +=
+      ", a gravity found on Earth (from the equator's mountains to the poles); check "
+      "for a typo (" +
+      Fmt("%g", kStandardGravityMps2) +
+      " is standard gravity), or set "
+      "'gravity_off_earth: true' for a rig elsewhere";
   return FailWith(f, why);
 }
 
@@ -182,7 +184,6 @@ bool CampaignConfig::CheckPlausible(std::string* why) const {
   }
   return why->empty();
 }
-
 
 namespace {
 

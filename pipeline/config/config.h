@@ -27,7 +27,7 @@
 
 namespace bifilar {
 
-enum class PitchSource { kNominal, kMeasured };    // "nominal", "measured"
+enum class PitchSource { kNominal, kMeasured };  // "nominal", "measured"
 
 // How the rig's own inertia (subtracted from every total) is known: exactly one of three ways.
 struct RigInertiaSpec {
@@ -47,7 +47,7 @@ struct RigInertiaSpec {
 // fix the rig's effective geometry (docs/method.md §15, docs/physics.md §2.6). Absent: the
 // configured L and D are used as they are.
 struct RigCalibrationSpec {
-  bool enabled = false;                    // the section is present
+  bool enabled = false;  // the section is present
   // The reference swings (absolute patterns or files, as rig.inertia.tare.logs); each is fitted
   // with the rig mass + reference_mass_kg and the suspended inertia rig + reference.
   std::vector<std::string> log_patterns;
@@ -64,8 +64,8 @@ struct RigCalibrationSpec {
 // dynamics depend on D^2/L only). Not applied: factor 1, the configured geometry.
 struct GeometryCalibration {
   bool applied = false;
-  double factor = 1.0;           // k = (D^2/L)_effective / (D^2/L)_configured; > 0
-  double factor_rel_std = 0.0;   // std(k) / k: common to every moment of the campaign; >= 0
+  double factor = 1.0;          // k = (D^2/L)_effective / (D^2/L)_configured; > 0
+  double factor_rel_std = 0.0;  // std(k) / k: common to every moment of the campaign; >= 0
 };
 
 // The assumed 1-sigma of L and D (m) when the config has no `rig.uncertainties`: a tape measure.
@@ -92,9 +92,9 @@ struct RigUncertainties {
 
 // The CSV layout of the logs and how the IMU sits on the aircraft.
 struct ImuConfig {
-  ImuFormat format;                      // columns and units
-  double gyro_scale_std = 0.0;           // 1-sigma gyro scale-factor uncertainty (fraction); >= 0
-  bool swing_axis_auto = true;           // `swing_axis: auto`
+  ImuFormat format;             // columns and units
+  double gyro_scale_std = 0.0;  // 1-sigma gyro scale-factor uncertainty (fraction); >= 0
+  bool swing_axis_auto = true;  // `swing_axis: auto`
   Eigen::Vector3d swing_axis_in_imu = Eigen::Vector3d::UnitZ();  // fixed axis (unit) otherwise
   // Rotation taking IMU-frame vectors to body axes (x fwd, y right, z down); default identity.
   Eigen::Matrix3d imu_to_body = Eigen::Matrix3d::Identity();
@@ -105,11 +105,11 @@ struct ImuConfig {
 
 // Where the aircraft logs are and how their pitch is known.
 struct RunsConfig {
-  std::string root;      // absolute folder of the logs (resolved from the config folder)
+  std::string root;  // absolute folder of the logs (resolved from the config folder)
   // Pattern relative to root, '/'-separated; '*' matches any run of characters within one path
   // component, '{pitch_deg}' matches a number (the nominal pitch, deg). Empty when `table` used.
   std::string pattern;
-  std::string table;     // absolute path of a CSV table "path,pitch_deg" (paths relative to root)
+  std::string table;  // absolute path of a CSV table "path,pitch_deg" (paths relative to root)
   PitchSource pitch_source = PitchSource::kNominal;
   // A log whose measured down vector lies farther than this from its nominal one (pitch and
   // roll of the path or table) gets a warning naming it (deg); (0, 180]. Default 3.
@@ -129,8 +129,8 @@ struct FitConfig {
   std::map<std::string, std::array<double, 2>> windows_s;
   std::optional<double> max_amplitude_deg;  // amplitude band, upper (deg); default: fit's own
   std::optional<double> min_amplitude_deg;  // amplitude band, lower (deg); default: fit's own
-  TraceQualityOptions quality;   // `fit.quality` (fit/trace_options.h)
-  AmplitudeSweepOptions sweep;   // `fit.amplitude_sweep` (fit/trace_options.h)
+  TraceQualityOptions quality;              // `fit.quality` (fit/trace_options.h)
+  AmplitudeSweepOptions sweep;              // `fit.amplitude_sweep` (fit/trace_options.h)
   // `fit.glitch`: isolated gyro glitches (fit/glitch.h), dropped before the swing axis, window
   // and fit, and again on the fit's residuals.
   GlitchOptions glitch;
@@ -144,29 +144,30 @@ struct FitConfig {
 };
 
 // Options of the ellipse fit (fit/ellipse.h EllipseOptions, same defaults).
-// Limits of the count-like keys (configs/README.md; fit.quality's in fit/trace_options.h); ellipse.bootstrap's are in fit/ellipse.h
-// (kMinBootstrapReplicates, kMaxBootstrapReplicates). One set of ranges, checked when the config
-// is loaded (naming the line) and by CampaignConfig::Check before any fit runs.
-constexpr int kMaxMinAngles = 1000;        // ellipse.min_angles in [3, 1000]
-constexpr double kMinMaxAmplitudeDeg = 1;  // fit.max_amplitude_deg in [1, 90]: the trace fit's
-constexpr double kMaxMaxAmplitudeDeg = 90; //   model holds to 90 deg; below 1 deg is noise
-constexpr double kMinSwingAxisLength = 1e-3;  // imu.swing_axis: a direction whose length lies
-constexpr double kMaxSwingAxisLength = 1e3;   //   in [1e-3, 1e3] (typos and overflow refused)
+// Limits of the count-like keys (configs/README.md; fit.quality's in fit/trace_options.h);
+// ellipse.bootstrap's are in fit/ellipse.h (kMinBootstrapReplicates, kMaxBootstrapReplicates). One
+// set of ranges, checked when the config is loaded (naming the line) and by CampaignConfig::Check
+// before any fit runs.
+constexpr int kMaxMinAngles = 1000;            // ellipse.min_angles in [3, 1000]
+constexpr double kMinMaxAmplitudeDeg = 1;      // fit.max_amplitude_deg in [1, 90]: the trace fit's
+constexpr double kMaxMaxAmplitudeDeg = 90;     //   model holds to 90 deg; below 1 deg is noise
+constexpr double kMinSwingAxisLength = 1e-3;   // imu.swing_axis: a direction whose length lies
+constexpr double kMaxSwingAxisLength = 1e3;    //   in [1e-3, 1e3] (typos and overflow refused)
 constexpr double kMaxRigInertiaStdKgM2 = 1e3;  // rig.inertia.inertia_std_kg_m2 below this
 // The other std keys (rig.uncertainties.*, aircraft.mass_std_kg, imu.gyro.scale_std) must be
 // below the quantity they qualify (L, D, the masses, g; 1 for the scale factor).
 
 struct EllipseConfig {
-  int bootstrap = 2000;           // parametric bootstrap replicates (0 = covariance intervals)
-  unsigned seed = 1;              // seed of the bootstrap
-  double confidence = 0.95;       // confidence level of the intervals, in (0, 1)
+  int bootstrap = 2000;      // parametric bootstrap replicates (0 = covariance intervals)
+  unsigned seed = 1;         // seed of the bootstrap
+  double confidence = 0.95;  // confidence level of the intervals, in (0, 1)
   // auto | points | angle_means | absolute (fit/ellipse.h, parsed once when the config is read)
   EllipseCovariance covariance = EllipseCovariance::kAuto;
-  int min_angles = 3;             // distinct pitch angles needed to fit the ellipse; [3, 1000]
+  int min_angles = 3;  // distinct pitch angles needed to fit the ellipse; [3, 1000]
 
   // The ranges above: the first field outside them (its name is its key below `ellipse`).
   bool Check(CheckFailure* failure) const;
-  bool Check(std::string* why) const;       // *why = "ellipse.<key> = <value>; must be .."
+  bool Check(std::string* why) const;  // *why = "ellipse.<key> = <value>; must be .."
 };
 
 // `limits`: size caps of the logs (MB = 1e6 bytes), README "Input size limits". The other
@@ -192,15 +193,15 @@ struct AircraftCg {
 AircraftCg ReadAircraftCgText(const std::string& text, const std::string& name);
 
 struct CampaignConfig {
-  std::string file;          // absolute path of the config file
-  std::string folder;        // its folder: relative paths are resolved against it
-  std::string text;          // the YAML text as read (stored in results.json)
+  std::string file;    // absolute path of the config file
+  std::string folder;  // its folder: relative paths are resolved against it
+  std::string text;    // the YAML text as read (stored in results.json)
 
   double filar_length_m = 0.0;      // L (m)
   double filar_separation_m = 0.0;  // D (m)
   double rig_mass_kg = 0.0;         // rig (+ IMU) mass (kg)
   RigInertiaSpec rig_inertia;
-  RigCalibrationSpec calibration;   // rig.calibration (enabled = false when absent)
+  RigCalibrationSpec calibration;  // rig.calibration (enabled = false when absent)
   // The calibration in effect (set by the campaign or `bifilar fit` after the reference swings
   // are fitted, never read from the file). Applied: the geometries below use D_eff, and the
   // L, D and g terms of the budget are replaced by one `calibration` term.
@@ -209,8 +210,8 @@ struct CampaignConfig {
   // the Crazyflie's): rig.mass_kg is everything that hangs and the rig inertia is 0.
   bool rig_inertia_given = true;
   RigUncertainties uncertainties;
-  double aircraft_mass_kg = 0.0;      // aircraft mass (kg); 0 when only tare logs are fitted
-  double aircraft_mass_std_kg = 0.0;  // its standard uncertainty (kg)
+  double aircraft_mass_kg = 0.0;         // aircraft mass (kg); 0 when only tare logs are fitted
+  double aircraft_mass_std_kg = 0.0;     // its standard uncertainty (kg)
   bool aircraft_mass_std_given = false;  // aircraft.mass_std_kg written in the config
   // aircraft.cg_m: the centre of mass in body axes (x forward, y right, z down; m, from the
   // origin of the simulator model's body/link frame), measured apart from the bifilar; export
@@ -218,9 +219,9 @@ struct CampaignConfig {
   AircraftCg aircraft_cg;
   // Local gravity (m/s^2); in [9.76, 9.84] (Earth) unless
   double gravity_mps2 = kStandardGravityMps2;
-  bool gravity_off_earth = false;     // `gravity_off_earth: true`: then in (0, 100]
+  bool gravity_off_earth = false;  // `gravity_off_earth: true`: then in (0, 100]
   ImuConfig imu;
-  RunsConfig runs;       // absent (root empty) for a `fit`-only config
+  RunsConfig runs;  // absent (root empty) for a `fit`-only config
   FitConfig fit;
   EllipseConfig ellipse;
   DisplayUnits units = DisplayUnits::kSi;
@@ -249,7 +250,7 @@ constexpr double kMaxOffEarthGravityMps2 = 100.0;
 bool CheckGravity(double gravity_mps2, bool off_earth, std::string* why);
 
 struct ConfigLoadOptions {
-  bool require_runs = true;      // `process` needs runs/aircraft; `fit` only geometry + IMU
+  bool require_runs = true;  // `process` needs runs/aircraft; `fit` only geometry + IMU
   // `process --runs-root DIR`: the folder of the aircraft logs, replacing runs.root (which may
   // then be absent). Empty: runs.root as written.
   std::string runs_root;
@@ -266,7 +267,7 @@ CampaignConfig LoadCampaignConfigText(const std::string& text, const std::string
 
 const char* ToString(PitchSource source);
 bool ParsePitchSource(const std::string& name, PitchSource* source);  // false: no such name
-std::string PitchSourceAllowedValues();  // "nominal or measured"
+std::string PitchSourceAllowedValues();                               // "nominal or measured"
 
 // `path` resolved against `folder` unless absolute; lexically normalised.
 std::string ResolvePath(const std::string& folder, const std::string& path);

@@ -91,7 +91,8 @@ void ReadLogContainer(YamlMap& imu, ImuFormat* format) {
   UlogSelection& sel = format->ulog;
   const std::string topic = ulog.OptionalString("topic", sel.topic);
   const bool known = UlogTopicDefaults(topic, &sel);
-  if (topic.empty()) throw UserError(ulog.Where(ulog.Optional("topic")) + ": 'imu.ulog.topic' is empty");
+  if (topic.empty())
+    throw UserError(ulog.Where(ulog.Optional("topic")) + ": 'imu.ulog.topic' is empty");
   const YAML::Node multi = ulog.Optional("multi_id");
   sel.multi_id = ulog.OptionalInt("multi_id", 0);
   if (sel.multi_id < 0 || sel.multi_id > 255) {
@@ -102,8 +103,9 @@ void ReadLogContainer(YamlMap& imu, ImuFormat* format) {
   if (ulog.Has("gyro_fields")) {
     sel.gyro_fields = ThreeColumns(ulog, "gyro_fields");
   } else if (!known) {
-    throw UserError(ulog.Where(ulog.Optional("topic")) + ": 'imu.ulog.gyro_fields' is needed for topic '" +
-                    topic + "' (defaults exist for sensor_combined, vehicle_angular_velocity and sensor_gyro)");
+    throw UserError(
+        ulog.Where(ulog.Optional("topic")) + ": 'imu.ulog.gyro_fields' is needed for topic '" +
+        topic + "' (defaults exist for sensor_combined, vehicle_angular_velocity and sensor_gyro)");
   }
   if (ulog.Has("accel_fields") && ulog.Optional("accel_fields").IsNull()) {
     sel.accel_fields = {"", "", ""};
@@ -114,10 +116,12 @@ void ReadLogContainer(YamlMap& imu, ImuFormat* format) {
   }
   std::vector<std::string> names = {sel.time_field, sel.gyro_fields[0], sel.gyro_fields[1],
                                     sel.gyro_fields[2]};
-  if (!sel.accel_fields[0].empty()) names.insert(names.end(), sel.accel_fields.begin(), sel.accel_fields.end());
+  if (!sel.accel_fields[0].empty())
+    names.insert(names.end(), sel.accel_fields.begin(), sel.accel_fields.end());
   const std::set<std::string> distinct(names.begin(), names.end());
   if (distinct.count("") || distinct.size() != names.size()) {
-    throw UserError(ulog.Where(YAML::Node()) + ": 'imu.ulog' field names must be non-empty and distinct");
+    throw UserError(ulog.Where(YAML::Node()) +
+                    ": 'imu.ulog' field names must be non-empty and distinct");
   }
   ulog.Finish();
 }
@@ -176,8 +180,10 @@ void ReadImuMounting(YamlMap& imu, ImuConfig* out) {
     if (!(length >= kMinSwingAxisLength && length <= kMaxSwingAxisLength)) {
       char range[96];
       std::snprintf(range, sizeof(range), "[%g, %g]", kMinSwingAxisLength, kMaxSwingAxisLength);
-      throw UserError(imu.Where(axis) + ": 'imu.swing_axis' must be auto or a direction in IMU "
-                      "axes of length in " + range + ", e.g. [0, 0, 1] (it is normalised)");
+      throw UserError(imu.Where(axis) +
+                      ": 'imu.swing_axis' must be auto or a direction in IMU "
+                      "axes of length in " +
+                      range + ", e.g. [0, 0, 1] (it is normalised)");
     }
     out->swing_axis_auto = false;
     out->swing_axis_in_imu = v.normalized();
@@ -223,7 +229,8 @@ void ReadImu(YamlMap imu, ImuConfig* out) {
     YamlMap dataflash = Sub(imu, "dataflash");  // pipeline/logs/dataflash.h
     const YAML::Node node = dataflash.Optional("instance");
     out->dataflash_instance = dataflash.OptionalInt("instance", -1);
-    if (dataflash.Has("instance") && (out->dataflash_instance < 0 || out->dataflash_instance > 255)) {
+    if (dataflash.Has("instance") &&
+        (out->dataflash_instance < 0 || out->dataflash_instance > 255)) {
       throw UserError(dataflash.Where(node) + ": " +
                       CheckMessage("imu.dataflash.instance", out->dataflash_instance,
                                    "in [0, 255] (the IMU instance of an ArduPilot log; leave it "
@@ -327,8 +334,6 @@ void ReadRigInertia(YamlMap inertia, const std::string& folder, RigInertiaSpec* 
   inertia.Finish();
 }
 
-
-
 // ---- The steps of LoadCampaignConfig, in the order of the file's sections ---------------------
 
 // The file itself: its absolute path, folder (relative paths in it are relative to this) and
@@ -396,7 +401,8 @@ void ReadRig(YamlMap& root, const std::string& path, const ConfigLoadOptions& op
     ReadRigInertia(Sub(rig, "inertia"), config->folder, &config->rig_inertia);
     CheckRigInertiaPlausible(Sub(rig, "inertia"), *config);
   } else if (options.require_runs && root.Has("aircraft")) {
-    throw UserError(path + ": missing required key 'rig.inertia' (or leave out 'aircraft' too: "
+    throw UserError(path +
+                    ": missing required key 'rig.inertia' (or leave out 'aircraft' too: "
                     "then rig.mass_kg is everything that hangs and no rig inertia is subtracted)");
   } else {
     config->rig_inertia_given = false;  // nothing subtracted: the moments of all that hangs
@@ -438,7 +444,8 @@ AircraftCg ReadAircraftCg(YamlMap& aircraft) {
   }
   for (int i = 0; i < 3; ++i) {
     if (cg.Given() && (!std::isfinite(cg.cg_m[i]) || std::abs(cg.cg_m[i]) > 1e3)) {
-      throw UserError(aircraft.Where(at) + ": 'aircraft.cg_m' must be 3 finite numbers within "
+      throw UserError(aircraft.Where(at) +
+                      ": 'aircraft.cg_m' must be 3 finite numbers within "
                       "1000 m of the model origin");
     }
     if (!std::isnan(cg.cg_std_m[i]) && !(std::isfinite(cg.cg_std_m[i]) && cg.cg_std_m[i] >= 0)) {
@@ -454,15 +461,16 @@ void ReadAircraftAndGravity(YamlMap& root, const std::string& path,
   YamlMap aircraft = Sub(root, "aircraft");
   if (root.Has("aircraft")) {
     config->aircraft_mass_kg = Positive(aircraft, "mass_kg");
-    const std::string why = ImplausibleValue("aircraft.mass_kg", "mass", config->aircraft_mass_kg,
-                                             0.0, kMaxMassKg);
+    const std::string why =
+        ImplausibleValue("aircraft.mass_kg", "mass", config->aircraft_mass_kg, 0.0, kMaxMassKg);
     if (!why.empty()) throw UserError(aircraft.Where(aircraft.Optional("mass_kg")) + ": " + why);
     const YAML::Node std_node = aircraft.Optional("mass_std_kg");
     config->aircraft_mass_std_given = std_node.IsDefined() && !std_node.IsNull();
     config->aircraft_mass_std_kg = NonNegative(aircraft, "mass_std_kg", 0.0);
     config->aircraft_cg = ReadAircraftCg(aircraft);
   } else if (options.require_runs && config->rig_inertia_given) {
-    throw UserError(path + ": missing required key 'aircraft' (or leave out 'rig.inertia' too: "
+    throw UserError(path +
+                    ": missing required key 'aircraft' (or leave out 'rig.inertia' too: "
                     "then rig.mass_kg is everything that hangs and no rig inertia is subtracted)");
   }
   aircraft.Finish();
@@ -508,7 +516,8 @@ void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& o
     }
     for (const char* placeholder : {"{pitch_deg}", "{roll_deg}"}) {
       const size_t first = r.pattern.find(placeholder);
-      if (first != std::string::npos && r.pattern.find(placeholder, first + 1) != std::string::npos) {
+      if (first != std::string::npos &&
+          r.pattern.find(placeholder, first + 1) != std::string::npos) {
         throw UserError(runs.Where(runs.Optional("pattern")) + ": 'runs.pattern' may hold " +
                         placeholder + " only once, not in two components");
       }
@@ -538,7 +547,8 @@ void ReadRuns(YamlMap& root, const std::string& path, const ConfigLoadOptions& o
     }
   }
   if (r.pitch_source == PitchSource::kMeasured && !config->imu.format.has_accel()) {
-    throw UserError(path + ": 'runs.pitch_source: measured' needs accelerometer columns (imu.accel)");
+    throw UserError(path +
+                    ": 'runs.pitch_source: measured' needs accelerometer columns (imu.accel)");
   }
   runs.Finish();
 }
@@ -624,8 +634,10 @@ void ReadFit(YamlMap fit, FitConfig* out) {
                     IntegratorMethodAllowedValues() + ", not '" + integrator + "'");
   }
   ReadFitWindows(fit, out);
-  if (fit.Has("max_amplitude_deg")) out->max_amplitude_deg = fit.RequiredDouble("max_amplitude_deg");
-  if (fit.Has("min_amplitude_deg")) out->min_amplitude_deg = fit.RequiredDouble("min_amplitude_deg");
+  if (fit.Has("max_amplitude_deg"))
+    out->max_amplitude_deg = fit.RequiredDouble("max_amplitude_deg");
+  if (fit.Has("min_amplitude_deg"))
+    out->min_amplitude_deg = fit.RequiredDouble("min_amplitude_deg");
   ReadFitOptionSections(fit, out);
   CheckFailure failure;
   if (!out->Check(&failure)) {
@@ -644,8 +656,9 @@ void ReadEllipse(YamlMap ellipse, EllipseConfig* e) {
   const std::string covariance =
       ellipse.OptionalString("covariance", EllipseCovarianceName(e->covariance));
   if (!ParseEllipseCovariance(covariance, &e->covariance)) {
-    throw UserError(ellipse.Where(ellipse.Optional("covariance")) + ": 'ellipse.covariance' must be " +
-                    EllipseCovarianceAllowedValues() + ", not '" + covariance + "'");
+    throw UserError(ellipse.Where(ellipse.Optional("covariance")) +
+                    ": 'ellipse.covariance' must be " + EllipseCovarianceAllowedValues() +
+                    ", not '" + covariance + "'");
   }
   e->min_angles = ellipse.OptionalInt("min_angles", e->min_angles);
   CheckFailure failure;

@@ -5,9 +5,9 @@
 #include <utility>
 #include <vector>
 
+#include "base/user_error.h"
 #include "pendulum/model.h"
 #include "pipeline/config/config.h"
-#include "base/user_error.h"
 
 namespace bifilar {
 namespace {
@@ -145,10 +145,13 @@ std::string StartingConfigText(const StartingConfigOptions& o) {
       << Quoted(format.ulog.topic) << "\n    multi_id: " << format.ulog.multi_id
       << "\n    time_field: " << Quoted(format.ulog.time_field)
       << "\n    gyro_fields: " << List3(format.ulog.gyro_fields) << "\n";
-    if (format.ulog.accel_fields[0].empty()) y << "    accel_fields: null\n";
-    else y << "    accel_fields: " << List3(format.ulog.accel_fields) << "\n";
+    if (format.ulog.accel_fields[0].empty())
+      y << "    accel_fields: null\n";
+    else
+      y << "    accel_fields: " << List3(format.ulog.accel_fields) << "\n";
   } else {
-    y << "  time: {column: " << Quoted(format.time_column) << ", unit: " << ToString(format.time_unit)
+    y << "  time: {column: " << Quoted(format.time_column)
+      << ", unit: " << ToString(format.time_unit)
       << "}\n"
          "  gyro: {columns: "
       << List3(format.gyro_columns) << ", unit: " << ToString(format.gyro_unit) << "}\n";
@@ -214,8 +217,8 @@ std::string FirstChangedName(const std::vector<std::pair<std::string, std::strin
 
 }  // namespace
 
-std::string CheckedStartingConfigText(const StartingConfigOptions& options,
-                                      const std::string& path, CampaignConfig* loaded) {
+std::string CheckedStartingConfigText(const StartingConfigOptions& options, const std::string& path,
+                                      CampaignConfig* loaded) {
   std::string why;
   if (!NamesBounded(options, &why)) throw UserError("init: " + path + ": " + why);
   const std::string text = StartingConfigText(options);
@@ -225,8 +228,8 @@ std::string CheckedStartingConfigText(const StartingConfigOptions& options,
   try {
     config = LoadCampaignConfigText(text, path, load);
   } catch (const UserError& e) {
-    throw UserError("init: " + path + ": the config it would write is one `bifilar fit` rejects: " +
-                    e.what());
+    throw UserError("init: " + path +
+                    ": the config it would write is one `bifilar fit` rejects: " + e.what());
   }
   // The names read back are the names meant (a YAML scalar that changed one would fit the
   // wrong columns, or none).
@@ -251,10 +254,10 @@ std::string CheckedStartingConfigText(const StartingConfigOptions& options,
   }
   const std::string changed = FirstChangedName(pairs);
   if (!changed.empty()) {
-    throw UserError("init: " + path + ": a name of the log" +
-                    (options.format_source.empty() ? std::string()
-                                                   : " " + EchoedName(options.format_source)) +
-                    " does not survive in YAML: " + changed + "; write the config by hand");
+    throw UserError(
+        "init: " + path + ": a name of the log" +
+        (options.format_source.empty() ? std::string() : " " + EchoedName(options.format_source)) +
+        " does not survive in YAML: " + changed + "; write the config by hand");
   }
   if (loaded != nullptr) *loaded = std::move(config);
   return text;

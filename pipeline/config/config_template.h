@@ -20,11 +20,11 @@ struct StartingConfigOptions {
   double filar_length_m = 0.0;      // L (m); > D
   double filar_separation_m = 0.0;  // D (m); > 0
   double mass_kg = 0.0;             // everything that hangs (rig + aircraft) for a first fit (kg)
-  double gravity_mps2 = kStandardGravityMps2;    // local gravity (m/s^2)
+  double gravity_mps2 = kStandardGravityMps2;  // local gravity (m/s^2)
   // The format of the logs; none: the reader's defaults (t, gx/gy/gz rad/s, ax/ay/az m/s^2).
   std::optional<ImuFormat> format;
-  bool ulog = false;                 // the format is a ULog topic, not CSV columns
-  std::string format_source;         // the log the format was guessed from, quoted in a comment
+  bool ulog = false;          // the format is a ULog topic, not CSV columns
+  std::string format_source;  // the log the format was guessed from, quoted in a comment
 
   bool Check(std::string* why) const;
 };
@@ -35,8 +35,8 @@ struct StartingConfigOptions {
 std::string StartingConfigText(const StartingConfigOptions& options);
 
 // The config init writes at `path`, checked before anything is written: the text is loaded with
-// the loader `fit` uses (LoadCampaignConfigText, pipeline/config/config.h: one set of bounds), and the
-// log format read back must be the one meant (a name no YAML scalar carries intact is refused).
+// the loader `fit` uses (LoadCampaignConfigText, pipeline/config/config.h: one set of bounds), and
+// the log format read back must be the one meant (a name no YAML scalar carries intact is refused).
 // Names are bounded (kMaxStartingConfigNameBytes: a 4 MB header cell would make a config over the
 // loader's size cap). Throws UserError "init: <path>: the config it would write is one `bifilar
 // fit` rejects: <the loader's message>". `loaded` (optional) receives the config read back.

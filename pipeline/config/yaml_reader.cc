@@ -133,9 +133,7 @@ std::string YamlMap::KeyPath(const std::string& key) const {
   return path_.empty() ? key : path_ + "." + key;
 }
 
-bool YamlMap::Has(const std::string& key) const {
-  return node_.IsMap() && node_[key].IsDefined();
-}
+bool YamlMap::Has(const std::string& key) const { return node_.IsMap() && node_[key].IsDefined(); }
 
 YAML::Node YamlMap::Optional(const std::string& key) {
   used_.insert(key);
@@ -258,7 +256,9 @@ std::vector<std::string> YamlMap::OptionalStringList(const std::string& key,
   return result;
 }
 
-YamlMap YamlMap::Child(const std::string& key) { return YamlMap(Optional(key), file_, KeyPath(key)); }
+YamlMap YamlMap::Child(const std::string& key) {
+  return YamlMap(Optional(key), file_, KeyPath(key));
+}
 
 void YamlMap::Finish() const {
   if (!node_.IsMap()) return;

@@ -115,7 +115,8 @@ void DrawPrincipalLines(const EllipseResult& r, const MomentPage& p) {
 // Error bars and trials, then the body-axis moments: I_z at 0 deg, I_x at +-90 deg.
 void DrawTrials(const EllipseResult& r, const MomentPage& p) {
   plcol0(kFigureGrey);
-  if (!p.ex.empty()) plerry(static_cast<PLINT>(p.ex.size()), p.ex.data(), p.elo.data(), p.ehi.data());
+  if (!p.ex.empty())
+    plerry(static_cast<PLINT>(p.ex.size()), p.ex.data(), p.elo.data(), p.ehi.data());
   plcol0(kFigureBlack);
   plssym(0, 0.9);
   plpoin(static_cast<PLINT>(p.px.size()), p.px.data(), p.py.data(), 4);  // open circles
@@ -134,10 +135,10 @@ void DrawTrials(const EllipseResult& r, const MomentPage& p) {
 // Legend: trials, error bars, the fit with tau, the body-axis moments.
 void DrawMomentLegend(const EllipseResult& r, const MomentPage& p) {
   const double k = p.k;
-  const std::string curve_text =
-      r.tau_defined ? "fit (Eq. 7), #gt = " + Fmt("%.2f", r.tau_deg.value) + " ± " +
-                          Fmt("%.2f", r.tau_deg.std) + " deg"
-                    : std::string("fit (Eq. 7), #gt undefined");
+  const std::string curve_text = r.tau_defined
+                                     ? "fit (Eq. 7), #gt = " + Fmt("%.2f", r.tau_deg.value) +
+                                           " ± " + Fmt("%.2f", r.tau_deg.std) + " deg"
+                                     : std::string("fit (Eq. 7), #gt undefined");
   const std::string body_text = "body axes: I#dx#u = " + Fmt("%.4g", r.ix.value * k) +
                                 ", I#dz#u = " + Fmt("%.4g", r.iz.value * k) +
                                 ", I#dxz#u = " + Fmt("%.3g", r.ixz.value * k);
@@ -189,7 +190,6 @@ bool WriteEllipseMomentFigure(const EllipseResult& r, const std::string& path,
   };
   return WriteFigure(path, options.figure, draw, why);
 }
-
 
 bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
                              const EllipsePlotOptions& options, std::string* why) {
@@ -247,9 +247,8 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
     plwind(-lim, lim, -lim, lim);
     LabelledBox("bcnst", "bcnstv");
     // (slug ft^2)^-1/2 written slug^-1/2 ft^-1: a superscript inside a superscript is garbled.
-    const std::string unit = ScaledUnit(inverse_sqrt ? InverseSqrtUnit(options.unit_label)
-                                                     : "(" + options.unit_label + ")",
-                                        power);
+    const std::string unit = ScaledUnit(
+        inverse_sqrt ? InverseSqrtUnit(options.unit_label) : "(" + options.unit_label + ")", power);
     pllab(("forward, x#dbody#u  " + unit).c_str(), ("up, -z#dbody#u  " + unit).c_str(),
           inverse_sqrt ? "Ellipse of inertia, radius 1/#(2267)I(#gh)"
                        : "Moments in polar coordinates, radius I(#gh)");
@@ -298,10 +297,9 @@ bool WriteEllipsePolarFigure(const EllipseResult& r, const std::string& path,
     plvpor(0.0, 1.0, 0.0, 1.0);
     plwind(0, 1, 0, 1);
     const std::string caption =
-        r.tau_defined
-            ? "principal axes (red dashed) at #gt = " + Fmt("%.2f", r.tau_deg.value) +
-                  " deg: the principal x axis lies #gt below body x when #gt > 0"
-            : std::string("#gt undefined: the curve cannot be told from a circle");
+        r.tau_defined ? "principal axes (red dashed) at #gt = " + Fmt("%.2f", r.tau_deg.value) +
+                            " deg: the principal x axis lies #gt below body x when #gt > 0"
+                      : std::string("#gt undefined: the curve cannot be told from a circle");
     plptex(0.5, 0.03, 1, 0, 0.5, caption.c_str());
   };
   return WriteFigure(path, figure, draw, why);

@@ -13,9 +13,9 @@
 namespace bifilar {
 
 struct EllipsePlotOptions {
-  double unit_scale = 1.0;             // display value = kg m^2 value * unit_scale; > 0
+  double unit_scale = 1.0;  // display value = kg m^2 value * unit_scale; > 0
   std::string unit_label = InertiaUnitPlotLabel(DisplayUnits::kSi);  // PLplot text
-  FigureOptions figure;                // page size (px)
+  FigureOptions figure;                                              // page size (px)
 };
 
 // Moment against pitch: trials, per-angle mean +- std error bars (given std when weighted), the

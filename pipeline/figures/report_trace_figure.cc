@@ -85,10 +85,10 @@ bool WriteReportTraceFigure(const TraceFitResult& fit, const std::string& title,
                                                        ? inertia_std_kg_m2
                                                        : fit.inertia_std_kg_m2;
   // In the config's units, as every table of the report (I total: rig included).
-  const std::string top_title = "I#dtotal#u = " +
-                                ValueWithStd(k * fit.params.inertia_kg_m2, k * std_kg_m2) + " " +
-                                options.unit_label + " (1σ " + std_label + "), " +
-                                (d.from_band ? "lowest-amplitude band" : "whole window");
+  const std::string top_title =
+      "I#dtotal#u = " + ValueWithStd(k * fit.params.inertia_kg_m2, k * std_kg_m2) + " " +
+      options.unit_label + " (1σ " + std_label + "), " +
+      (d.from_band ? "lowest-amplitude band" : "whole window");
   // The rms of the fit drawn (the band's or the window's), named as such: a warning's "residual
   // 10.3x noise" is the whole window's.
   char label[256];

@@ -112,8 +112,8 @@ void DrawShades(const RigPlanFigure& f, const std::vector<double>& levels, PLcGr
   PLFLT width = 0, height = 0;
   plslabelfunc(PercentOfLog10, nullptr);  // the bar's edges in %
   plcolorbar(&width, &height, PL_COLORBAR_SHADE | PL_COLORBAR_SHADE_LABEL,
-             PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, 0.02, 0.0, 0.035,
-             1.0, 0, 1, 1, 0.0, 0.0, 0, 0.0, 1, label_opts, labels, 1, axis_opts, ticks, sub_ticks,
+             PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, 0.02, 0.0, 0.035, 1.0,
+             0, 1, 1, 0.0, 0.0, 0, 0.0, 1, label_opts, labels, 1, axis_opts, ticks, sub_ticks,
              n_values, values);
   plslabelfunc(nullptr, nullptr);
   plschr(0, 1.0);
@@ -166,8 +166,8 @@ void DrawCaption(const RigPlanFigure& f) {
   if (f.target_drawn) {
     target = "red line: the target " + Fmt("%.3g", f.target_percent) + " %";
   } else if (f.target_percent < f.lowest_percent) {
-    target = "the target " + Fmt("%.3g", f.target_percent) + " % is below every rig shown (lowest " +
-             Fmt("%.3g", f.lowest_percent) + " %)";
+    target = "the target " + Fmt("%.3g", f.target_percent) +
+             " % is below every rig shown (lowest " + Fmt("%.3g", f.lowest_percent) + " %)";
   } else {
     target = "the target " + Fmt("%.3g", f.target_percent) + " % is met everywhere shown";
   }

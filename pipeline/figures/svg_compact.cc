@@ -104,7 +104,6 @@ std::string ShortNumber(double value) {
   return text;
 }
 
-
 // Appends point (qx, qy), in tenths of a pixel, to the path `d`: "Mx yl" for the first point,
 // then the relative step from the last (*px, *py), without the blanks a sign makes redundant.
 void AppendPathPoint(long qx, long qy, bool first, long* px, long* py, std::string* d) {
@@ -229,7 +228,9 @@ std::string PathOfPoints(const std::vector<double>& xy, double height, bool clos
   return d;
 }
 
-std::string Number(const std::string& text) { return ShortNumber(std::strtod(text.c_str(), nullptr)); }
+std::string Number(const std::string& text) {
+  return ShortNumber(std::strtod(text.c_str(), nullptr));
+}
 
 // &#xNN; character references as UTF-8 (markup characters stay references), so the text of
 // the figure can be searched.
@@ -239,11 +240,16 @@ std::string DecodeCharacterReferences(const std::string& text) {
     if (text.compare(i, 3, "&#x") == 0) {
       const size_t end = text.find(';', i);
       if (end != std::string::npos) {
-        const unsigned long code = std::strtoul(text.substr(i + 3, end - i - 3).c_str(), nullptr, 16);
-        if (code == '<') out += "&lt;";
-        else if (code == '&') out += "&amp;";
-        else if (code == '>') out += "&gt;";
-        else if (code < 0x80) out += static_cast<char>(code);
+        const unsigned long code =
+            std::strtoul(text.substr(i + 3, end - i - 3).c_str(), nullptr, 16);
+        if (code == '<')
+          out += "&lt;";
+        else if (code == '&')
+          out += "&amp;";
+        else if (code == '>')
+          out += "&gt;";
+        else if (code < 0x80)
+          out += static_cast<char>(code);
         else if (code < 0x800) {
           out += static_cast<char>(0xC0 | (code >> 6));
           out += static_cast<char>(0x80 | (code & 0x3F));
@@ -271,7 +277,8 @@ std::string DecodeCharacterReferences(const std::string& text) {
 // title "0.05018 ± 0.00066" or a tick "3.5221" shortened to one decimal read "0.1 ± 0" and "3.5"
 // (issue 32).
 std::string CompactTextContent(std::string content) {
-  content = ReplaceAll(content, " font-family=\"sans-serif\" font-style=\"normal\" font-weight=\"normal\"", "");
+  content = ReplaceAll(
+      content, " font-family=\"sans-serif\" font-style=\"normal\" font-weight=\"normal\"", "");
   return DecodeCharacterReferences(SimplifyTagNumbers(content));
 }
 
@@ -303,14 +310,16 @@ std::string CompactText(const std::string& tag, const std::string& content, doub
 std::string StrokeStyle(std::map<std::string, std::string>& a) {
   std::string style = "fill=\"none\" stroke=\"" + a["stroke"] + "\" stroke-width=\"" +
                       Number(a["stroke-width"].empty() ? "1" : a["stroke-width"]) + "\"";
-  const double opacity = a["stroke-opacity"].empty() ? 1.0 : std::strtod(a["stroke-opacity"].c_str(), nullptr);
+  const double opacity =
+      a["stroke-opacity"].empty() ? 1.0 : std::strtod(a["stroke-opacity"].c_str(), nullptr);
   if (opacity < 1.0) style += " stroke-opacity=\"" + ShortNumber(opacity) + "\"";
   return style;
 }
 
 std::string FillStyle(std::map<std::string, std::string>& a) {
   std::string style = "fill=\"" + a["fill"] + "\"";
-  const double opacity = a["fill-opacity"].empty() ? 1.0 : std::strtod(a["fill-opacity"].c_str(), nullptr);
+  const double opacity =
+      a["fill-opacity"].empty() ? 1.0 : std::strtod(a["fill-opacity"].c_str(), nullptr);
   if (opacity < 1.0) style += " fill-opacity=\"" + ShortNumber(opacity) + "\"";
   if (!a["stroke"].empty() && a["stroke"] != "none")  // its outline too (no second fill=)
     style += " " + StrokeStyle(a).substr(std::string("fill=\"none\" ").size());
@@ -338,9 +347,12 @@ std::string CompactPlplotSvg(const std::string& svg) {
   if (box.size() != 4) return svg;
   const double width = box[2], height = box[3];
   // The page in px, as PLplot was given it (the driver says pt: a third larger on screen).
-  std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" +
-                    ShortNumber(width) + "\" height=\"" + ShortNumber(height) + "\" viewBox=\"" + root["viewBox"] +
-                    "\" font-family=\"sans-serif\" stroke-linecap=\"round\" stroke-linejoin=\"round\">\n";
+  std::string out =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" "
+      "width=\"" +
+      ShortNumber(width) + "\" height=\"" + ShortNumber(height) + "\" viewBox=\"" +
+      root["viewBox"] +
+      "\" font-family=\"sans-serif\" stroke-linecap=\"round\" stroke-linejoin=\"round\">\n";
   std::string run_style, run_d;
   auto flush = [&] {
     if (!run_d.empty()) out += "<path " + run_style + " d=\"" + run_d + "\"/>\n";
@@ -372,7 +384,8 @@ std::string CompactPlplotSvg(const std::string& svg) {
       at = close + 7;
     } else if (tag.rfind("<rect", 0) == 0) {
       std::map<std::string, std::string> a = Attributes(tag);
-      out += "<rect width=\"" + a["width"] + "\" height=\"" + a["height"] + "\" fill=\"" + a["fill"] + "\"/>\n";
+      out += "<rect width=\"" + a["width"] + "\" height=\"" + a["height"] + "\" fill=\"" +
+             a["fill"] + "\"/>\n";
     } else if (tag.rfind("<clipPath", 0) == 0) {
       flush();
       const std::string id = Attributes(tag)["id"];
@@ -383,7 +396,8 @@ std::string CompactPlplotSvg(const std::string& svg) {
       if (WholePage(xy, width, height)) {
         dropped_clips.insert(id);
       } else {
-        out += "<clipPath id=\"" + id + "\"><path d=\"" + PathOfPoints(xy, height, true) + "\"/></clipPath>\n";
+        out += "<clipPath id=\"" + id + "\"><path d=\"" + PathOfPoints(xy, height, true) +
+               "\"/></clipPath>\n";
       }
       at = close + 11;
     } else if (tag.rfind("<g", 0) == 0) {
@@ -408,7 +422,8 @@ std::string CompactPlplotSvg(const std::string& svg) {
 }  // namespace
 
 std::string CompactSvg(const std::string& svg) {
-  if (svg.find("<polyline") != std::string::npos || svg.find("dominant-baseline") != std::string::npos)
+  if (svg.find("<polyline") != std::string::npos ||
+      svg.find("dominant-baseline") != std::string::npos)
     return CompactPlplotSvg(svg);
   return SimplifyTagNumbers(CompactSvgPaths(svg));
 }

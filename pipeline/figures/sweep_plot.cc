@@ -35,7 +35,7 @@ struct SweepPage {
   std::vector<double> ax, ai, a_lo, a_hi, i_lo, i_hi;  // the ok bands
   bool trend = false, marked = false;  // a trend; its low band marked as the result's
   double x_lo = 0.0, x_hi = 0.0, y_lo = 0.0, y_hi = 0.0;
-  std::vector<double> tx, ty;  // the trend curve
+  std::vector<double> tx, ty;           // the trend curve
   double y_ref = 0.0, y_ref_std = 0.0;  // the reported I and its std
   std::string title, subtitle, reported_text;
   double left = 0.0, top = 0.0, px_w = 0.0, px_h = 0.0, ring_px = 0.0;
@@ -105,9 +105,9 @@ void SweepTexts(const AmplitudeSweep& sweep, const SweepPlotOptions& options, Sw
   // Compact: the page's caption names the trace and the subtitle's facts go in the title.
   const std::string scatter_text =
       sweep.std_scale > 1.0 ? "bands scatter " + Fmt("%.1f", sweep.std_scale) + "× σ" : "";
-  p->title =
-      options.compact ? "I(A): " + trend_text + (scatter_text.empty() ? "" : ", " + scatter_text)
-                      : name + ": I(A), " + trend_text;
+  p->title = options.compact
+                 ? "I(A): " + trend_text + (scatter_text.empty() ? "" : ", " + scatter_text)
+                 : name + ": I(A), " + trend_text;
   p->subtitle = p->trend ? "the ideal model is flat: this rig departs from it"
                          : "the ideal model is flat: no trend beyond its error";
   if (!scatter_text.empty()) p->subtitle += "; " + scatter_text;
@@ -125,14 +125,15 @@ void SweepPageLayout(const SweepPlotOptions& options, SweepPage* p) {
   const double y_range = std::max(p->y_hi - p->y_lo, 1e-300);
   const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(y_range / 8.0))));
   const double y_abs = std::max(std::fabs(p->y_lo), std::fabs(p->y_hi));
-  const int int_digits = std::max(1, static_cast<int>(std::floor(std::log10(std::max(y_abs, 1.0)))) + 1);
+  const int int_digits =
+      std::max(1, static_cast<int>(std::floor(std::log10(std::max(y_abs, 1.0)))) + 1);
   const int label_chars = int_digits + (decimals > 0 ? 1 + decimals : 0) + (p->y_lo < 0.0 ? 1 : 0);
   // PLplot's characters scale with the page height: font size ~0.04 of it at this kChar, a digit
   // up to 0.64 of that wide (DejaVu Sans); the tick labels sit ~0.8 font sizes off the axis.
   // (A fixed 11 px a character clipped ".127" on the 1100 x 700 page of `fit --plot`.)
   const double font_px = 0.04 * options.figure.height_px;
-  p->left = std::min(0.3, (font_px * (0.64 * label_chars + 1.0)) /
-                              std::max(1, options.figure.width_px));
+  p->left =
+      std::min(0.3, (font_px * (0.64 * label_chars + 1.0)) / std::max(1, options.figure.width_px));
   // Not compact: room between the legend's lower row and the axis label above the plot.
   p->top = options.compact ? 0.83 : 0.63;
   p->px_w = options.figure.width_px * (kRight - p->left);
@@ -233,11 +234,11 @@ void DrawSubtitleAndLegend(const AmplitudeSweep& sweep, const SweepPlotOptions& 
   }
   if (p.trend) {
     sample_line(col[1], row[0], kFigureRed, 2.0);
-    const std::string legend = "trend I#d0#u (1 + c A" +
-                               (sweep.trend_exponent == 1.0
-                                    ? std::string()
-                                    : "#u" + Fmt("%g", sweep.trend_exponent) + "#d") +
-                               ")";
+    const std::string legend =
+        "trend I#d0#u (1 + c A" +
+        (sweep.trend_exponent == 1.0 ? std::string()
+                                     : "#u" + Fmt("%g", sweep.trend_exponent) + "#d") +
+        ")";
     text(col[1], row[0], legend.c_str());
   }
   if (p.marked) {

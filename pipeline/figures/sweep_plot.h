@@ -15,10 +15,10 @@
 namespace bifilar {
 
 struct SweepPlotOptions {
-  std::string title;                     // usually the log's name; empty: "trace"
-  double unit_scale = 1.0;               // display value = kg m^2 value * unit_scale; > 0
+  std::string title;        // usually the log's name; empty: "trace"
+  double unit_scale = 1.0;  // display value = kg m^2 value * unit_scale; > 0
   std::string unit_label = InertiaUnitPlotLabel(DisplayUnits::kSi);  // PLplot text
-  FigureOptions figure = {800, 500};     // page size (px)
+  FigureOptions figure = {800, 500};                                 // page size (px)
   // true: title and axes only, no subtitle or legend, for a page that explains the figure in its
   // caption (the report, which shows one per trace at thumbnail size).
   bool compact = false;

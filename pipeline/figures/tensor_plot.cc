@@ -98,8 +98,8 @@ void DrawMeasuredMoments(const TensorResult& r, const TensorPlotOptions& options
 // One body plane in the viewport (x0, x1, y0, y1): axes, the ellipsoid's section, the principal
 // axes and the measured moments near the plane; `lim` is every panel's half-width.
 void ViewPanel(const TensorResult& r, const std::array<double, kTensorComponents>& c,
-               const TensorPlotOptions& options, double lim, const View& view, double x0,
-               double x1, double y0, double y1) {
+               const TensorPlotOptions& options, double lim, const View& view, double x0, double x1,
+               double y0, double y1) {
   plcol0(kFigureBlack);
   plvpas(x0, x1, y0, y1, 1.0);
   plwind(-lim, lim, -lim, lim);

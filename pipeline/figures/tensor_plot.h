@@ -14,10 +14,10 @@
 namespace bifilar {
 
 struct TensorPlotOptions {
-  double unit_scale = 1.0;               // display value = kg m^2 value * unit_scale; > 0
+  double unit_scale = 1.0;  // display value = kg m^2 value * unit_scale; > 0
   std::string unit_label = InertiaUnitPlotLabel(DisplayUnits::kSi);  // PLplot text
-  FigureOptions figure = {1100, 900};    // page size (px)
-  double near_plane_deg = 10.0;          // measured axes within this of a plane are drawn in it
+  FigureOptions figure = {1100, 900};                                // page size (px)
+  double near_plane_deg = 10.0;  // measured axes within this of a plane are drawn in it
 };
 
 // Needs a full 3-D result (result.full); false with *why otherwise or when drawing fails.

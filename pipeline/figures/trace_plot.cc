@@ -73,8 +73,7 @@ void ResultSeries(const TraceFitResult& r, TraceFigureData* d) {
   d->window_start_s = r.t_s[first];
   for (size_t k = 0; k < n; ++k) {
     const size_t i = first + k;
-    const double fitted =
-        band ? r.band_fitted_rate_rad_per_s[k] : r.fitted_rate_rad_per_s[i];
+    const double fitted = band ? r.band_fitted_rate_rad_per_s[k] : r.fitted_rate_rad_per_s[i];
     d->t_s.push_back(r.t_s[i] - d->window_start_s);
     d->measured_deg_per_s.push_back(r.measured_rate_rad_per_s[i] * kDegPerRad);
     d->fitted_deg_per_s.push_back(fitted * kDegPerRad);
@@ -101,35 +100,35 @@ void Texts(const TraceFitResult& r, const TracePlotOptions& o, TraceFigureData* 
   const std::string name = o.title.empty() ? std::string("trace") : o.title;
   const double k = o.unit_scale;
   const std::string& unit = o.unit_label;
-  const double std_kg_m2 = std::isfinite(o.inertia_std_kg_m2) ? o.inertia_std_kg_m2
-                                                              : r.inertia_std_kg_m2;
+  const double std_kg_m2 =
+      std::isfinite(o.inertia_std_kg_m2) ? o.inertia_std_kg_m2 : r.inertia_std_kg_m2;
   d->title = name + ":  I = " + ValueWithStd(k * r.params.inertia_kg_m2, k * std_kg_m2) + " " +
              unit + "  (± 1σ " + o.std_label + ")";
   if (r.status != TraceFitStatus::kOk) d->title += "  (" + std::string(ToString(r.status)) + ")";
   const std::string model = std::string(ToString(r.model)) + " model";
   if (d->from_band) {
     const AmplitudeSweepBand& b = r.sweep.bands[r.sweep.low_band];
-    d->subtitle = "result: fit of the lowest-amplitude band, " + Fmt("%.1f", b.amplitude_start_deg) +
-                  " → " + Fmt("%.1f", b.amplitude_end_deg) + " deg over " +
-                  Fmt("%.1f", b.t1_s - b.t0_s) + " s (I depends on the amplitude)";
+    d->subtitle = "result: fit of the lowest-amplitude band, " +
+                  Fmt("%.1f", b.amplitude_start_deg) + " → " + Fmt("%.1f", b.amplitude_end_deg) +
+                  " deg over " + Fmt("%.1f", b.t1_s - b.t0_s) + " s (I depends on the amplitude)";
   } else {
     d->subtitle = "result: fit of the whole window, amplitude " +
                   Fmt("%.1f", r.amplitude_start_deg) + " → " + Fmt("%.1f", r.amplitude_end_deg) +
                   " deg";
   }
-  d->detail = model + "; drag K#dD#u = " + Fmt("%.3g", k * r.params.drag_coeff_kg_m2) + " " +
-              unit + ", viscous C = " + Fmt("%.3g", k * r.params.viscous_coeff_kg_m2_per_s) +
-              " " + unit + "/s" + (d->from_band ? " (whole-window fit's)" : "") +
-              "; gyro bias " + Fmt("%.3f", d->bias_deg_per_s) + " deg/s";
-  d->rate_label = std::string(d->from_band ? "band" : "window") +
-                  ": measured samples (grey) and the fit (blue), from t = " +
-                  Fmt("%.2f", d->window_start_s) + " s of the log";
-  d->residual_label =
-      "measured − fit: rms " + Fmt("%.3g", d->residual_rms_deg_per_s) + " deg/s" +
-      (d->rms_over_noise > 0.0
-           ? " = " + Fmt("%.2f", d->rms_over_noise) + " × gyro noise (lines ±1, ±2)"
-           : std::string()) +
-      "; lag-1 autocorrelation " + Fmt("%.2f", d->autocorr_lag1);
+  d->detail = model + "; drag K#dD#u = " + Fmt("%.3g", k * r.params.drag_coeff_kg_m2) + " " + unit +
+              ", viscous C = " + Fmt("%.3g", k * r.params.viscous_coeff_kg_m2_per_s) + " " + unit +
+              "/s" + (d->from_band ? " (whole-window fit's)" : "") + "; gyro bias " +
+              Fmt("%.3f", d->bias_deg_per_s) + " deg/s";
+  d->rate_label =
+      std::string(d->from_band ? "band" : "window") +
+      ": measured samples (grey) and the fit (blue), from t = " + Fmt("%.2f", d->window_start_s) +
+      " s of the log";
+  d->residual_label = "measured − fit: rms " + Fmt("%.3g", d->residual_rms_deg_per_s) + " deg/s" +
+                      (d->rms_over_noise > 0.0
+                           ? " = " + Fmt("%.2f", d->rms_over_noise) + " × gyro noise (lines ±1, ±2)"
+                           : std::string()) +
+                      "; lag-1 autocorrelation " + Fmt("%.2f", d->autocorr_lag1);
   if (d->from_band) {
     d->whole_label = "whole window, band shaded; red: whole-window fit, I = " +
                      Fmt("%.4g", k * r.inertia_window_kg_m2) + " " + unit + " (not the result)";
@@ -143,8 +142,8 @@ std::string ValueWithStd(double value, double std_value) {
     return Fmt("%.6g", value);
   }
   const int std_exp = static_cast<int>(std::floor(std::log10(std_value)));
-  const int value_exp = value != 0.0 ? static_cast<int>(std::floor(std::log10(std::fabs(value))))
-                                     : std_exp;
+  const int value_exp =
+      value != 0.0 ? static_cast<int>(std::floor(std::log10(std::fabs(value)))) : std_exp;
   const int shift = value_exp < -3 || value_exp > 4 ? value_exp : 0;
   const double scale = std::pow(10.0, -shift);
   const int decimals = std::max(0, 1 - (std_exp - shift));

@@ -16,9 +16,9 @@
 namespace bifilar {
 
 struct TracePlotOptions {
-  std::string title;     // usually the log's file name; empty: "trace"
-  int width_px = 1100;   // page width (px); > 0
-  int height_px = 700;   // page height (px); > 0
+  std::string title;    // usually the log's file name; empty: "trace"
+  int width_px = 1100;  // page width (px); > 0
+  int height_px = 700;  // page height (px); > 0
   // Inertias (I, K_D, C) in the title are multiplied by unit_scale and labelled unit_label
   // (PLplot text): the config's display units (slug ft^2 under units: imperial).
   double unit_scale = 1.0;
@@ -31,16 +31,16 @@ struct TracePlotOptions {
 
 // What the fit figure draws (times from the start of the plotted window, rates in deg/s).
 struct TraceFigureData {
-  bool from_band = false;              // the result is the lowest-amplitude band's fit
-  double window_start_s = 0.0;         // log time of the plotted window's first sample (s)
-  std::vector<double> t_s;             // the plotted window's samples
+  bool from_band = false;       // the result is the lowest-amplitude band's fit
+  double window_start_s = 0.0;  // log time of the plotted window's first sample (s)
+  std::vector<double> t_s;      // the plotted window's samples
   std::vector<double> measured_deg_per_s;
   std::vector<double> fitted_deg_per_s;    // the fit that gave the reported I
   std::vector<double> residual_deg_per_s;  // measured - fitted
-  double bias_deg_per_s = 0.0;         // that fit's gyro bias
+  double bias_deg_per_s = 0.0;             // that fit's gyro bias
   double residual_rms_deg_per_s = 0.0;
-  double rms_over_noise = 0.0;         // of that fit; 0 when the noise is unknown
-  double autocorr_lag1 = 0.0;          // of its residuals
+  double rms_over_noise = 0.0;  // of that fit; 0 when the noise is unknown
+  double autocorr_lag1 = 0.0;   // of its residuals
   // from_band: the whole window (from its own first sample) and its fit, not the result.
   std::vector<double> whole_t_s, whole_measured_deg_per_s, whole_fitted_deg_per_s;
   std::string title, subtitle, detail, rate_label, residual_label, whole_label;

@@ -84,9 +84,10 @@ class SerialStream : public ByteStream {
     });
     chunk->append(buffer_.data(), got);
     if (!result || result == asio::error::operation_aborted) return true;
-    closed_why_ = Describe() + ": " +
-                  (result == asio::error::eof ? std::string("end of stream (device closed)")
-                                              : result.message() + " (device closed or unplugged?)");
+    closed_why_ =
+        Describe() + ": " +
+        (result == asio::error::eof ? std::string("end of stream (device closed)")
+                                    : result.message() + " (device closed or unplugged?)");
     *why = closed_why_;
     std::error_code ignored;
     port_.close(ignored);
@@ -112,18 +113,18 @@ class UdpStream : public ByteStream {
     std::error_code ec;
     const asio::ip::address address = asio::ip::make_address(host, ec);
     if (ec) {
-      *error = "udp " + host + ":" + std::to_string(port) + ": not an IP address (" +
-               ec.message() + "); use 0.0.0.0 for every interface or 127.0.0.1";
+      *error = "udp " + host + ":" + std::to_string(port) + ": not an IP address (" + ec.message() +
+               "); use 0.0.0.0 for every interface or 127.0.0.1";
       return false;
     }
     const asio::ip::udp::endpoint endpoint(address, static_cast<unsigned short>(port));
     socket_.open(endpoint.protocol(), ec);
     if (!ec) socket_.bind(endpoint, ec);
     if (ec) {
-      *error = "udp " + host + ":" + std::to_string(port) + ": cannot bind: " + ec.message() +
-               (ec.value() == EADDRINUSE
-                    ? " (another program, e.g. a ground station, holds the port)"
-                    : "");
+      *error =
+          "udp " + host + ":" + std::to_string(port) + ": cannot bind: " + ec.message() +
+          (ec.value() == EADDRINUSE ? " (another program, e.g. a ground station, holds the port)"
+                                    : "");
       return false;
     }
     local_ = socket_.local_endpoint(ec);

@@ -111,7 +111,8 @@ enum class Attempt { kNeedMore, kNotAFrame, kFrame };
 Attempt CheckImuFrame(const uint8_t* p, std::size_t n, const FrameHeader& h, bool* bad_crc) {
   if (n < h.total_bytes) return Attempt::kNeedMore;
   const std::size_t checked = h.header_bytes + h.payload_bytes;
-  *bad_crc = MavlinkCrc(p + 1, checked - 1, MavlinkCrcExtra(h.msgid)) != LittleEndian(p + checked, 2);
+  *bad_crc =
+      MavlinkCrc(p + 1, checked - 1, MavlinkCrcExtra(h.msgid)) != LittleEndian(p + checked, 2);
   return *bad_crc ? Attempt::kNotAFrame : Attempt::kFrame;
 }
 
@@ -174,10 +175,14 @@ uint16_t MavlinkCrc(const uint8_t* bytes, std::size_t size, int crc_extra) {
 
 int MavlinkCrcExtra(int msgid) {
   switch (msgid) {
-    case kMavlinkMsgidHighresImu: return kMavlinkCrcExtraHighresImu;
-    case kMavlinkMsgidScaledImu: return kMavlinkCrcExtraScaledImu;
-    case kMavlinkMsgidRawImu: return kMavlinkCrcExtraRawImu;
-    default: return -1;
+    case kMavlinkMsgidHighresImu:
+      return kMavlinkCrcExtraHighresImu;
+    case kMavlinkMsgidScaledImu:
+      return kMavlinkCrcExtraScaledImu;
+    case kMavlinkMsgidRawImu:
+      return kMavlinkCrcExtraRawImu;
+    default:
+      return -1;
   }
 }
 

@@ -22,13 +22,13 @@
 // byte is garbage. No frame is taken (checked or not) when an IMU frame with a good checksum
 // starts inside it, so a false start in garbage, or a frame cut short whose checksum came
 // right by chance, never swallows a good frame; such a frame waits (in pending_bytes) until
-// the frame inside it is whole, a few frames' time in a live stream. Bytes outside accepted frames are counted as bytes_skipped. Signed MAVLink 2
-// frames (incompat flag 0x01) carry 13 signature bytes after the checksum: skipped, not
-// verified. A frame with an incompat flag this decoder does not know is not read (MAVLink's
-// rule), its bytes count as skipped.
-// Values are passed on as sent (a NaN stays a NaN for the caller to count). A sender may send
-// one IMU as several messages (ArduPilot: RAW_IMU and SCALED_IMU when both streams are on):
-// the caller keeps one msgid, sysid, compid and imu_instance.
+// the frame inside it is whole, a few frames' time in a live stream. Bytes outside accepted frames
+// are counted as bytes_skipped. Signed MAVLink 2 frames (incompat flag 0x01) carry 13 signature
+// bytes after the checksum: skipped, not verified. A frame with an incompat flag this decoder does
+// not know is not read (MAVLink's rule), its bytes count as skipped. Values are passed on as sent
+// (a NaN stays a NaN for the caller to count). A sender may send one IMU as several messages
+// (ArduPilot: RAW_IMU and SCALED_IMU when both streams are on): the caller keeps one msgid, sysid,
+// compid and imu_instance.
 #pragma once
 
 #include <cstddef>

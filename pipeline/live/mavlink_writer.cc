@@ -39,13 +39,18 @@ std::string EncodeMavlinkFrame(int msgid, const std::string& payload, std::size_
   std::string frame;
   if (o.version == 1) {
     frame = {static_cast<char>(kMavlink1Magic), static_cast<char>(body.size()),
-             static_cast<char>(o.seq), static_cast<char>(o.sysid), static_cast<char>(o.compid),
-             static_cast<char>(msgid)};
+             static_cast<char>(o.seq),          static_cast<char>(o.sysid),
+             static_cast<char>(o.compid),       static_cast<char>(msgid)};
   } else {
-    frame = {static_cast<char>(kMavlink2Magic), static_cast<char>(body.size()),
-             static_cast<char>(o.signed_frame ? kMavlinkIncompatSigned : 0), 0,
-             static_cast<char>(o.seq), static_cast<char>(o.sysid), static_cast<char>(o.compid),
-             static_cast<char>(msgid & 0xFF), static_cast<char>((msgid >> 8) & 0xFF),
+    frame = {static_cast<char>(kMavlink2Magic),
+             static_cast<char>(body.size()),
+             static_cast<char>(o.signed_frame ? kMavlinkIncompatSigned : 0),
+             0,
+             static_cast<char>(o.seq),
+             static_cast<char>(o.sysid),
+             static_cast<char>(o.compid),
+             static_cast<char>(msgid & 0xFF),
+             static_cast<char>((msgid >> 8) & 0xFF),
              static_cast<char>((msgid >> 16) & 0xFF)};
   }
   frame += body;

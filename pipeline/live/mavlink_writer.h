@@ -12,11 +12,11 @@
 namespace bifilar::live {
 
 struct MavlinkFrameOptions {
-  int version = 2;            // 1 (magic 0xFE) or 2 (0xFD)
-  int sysid = 1;              // 0..255
-  int compid = 1;             // 0..255
-  int seq = 0;                // 0..255
-  bool truncate_zeros = true; // MAVLink 2: drop the payload's trailing zero bytes (keeps one)
+  int version = 2;             // 1 (magic 0xFE) or 2 (0xFD)
+  int sysid = 1;               // 0..255
+  int compid = 1;              // 0..255
+  int seq = 0;                 // 0..255
+  bool truncate_zeros = true;  // MAVLink 2: drop the payload's trailing zero bytes (keeps one)
   // MAVLink 2: mark the frame signed and append 13 signature bytes. They are placeholders (the
   // decoder skips signatures without verifying them), enough to test the framing.
   bool signed_frame = false;

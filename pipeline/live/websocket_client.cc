@@ -65,9 +65,8 @@ class WebSocketStream : public MessageStream {
     client_.set_fail_handler([this](websocketpp::connection_hdl h) {
       SetState(State::kClosed, "cannot connect: " + Reason(h, false));
     });
-    client_.set_close_handler([this](websocketpp::connection_hdl h) {
-      SetState(State::kClosed, Reason(h, true));
-    });
+    client_.set_close_handler(
+        [this](websocketpp::connection_hdl h) { SetState(State::kClosed, Reason(h, true)); });
     client_.set_message_handler([this](websocketpp::connection_hdl, Client::message_ptr m) {
       std::lock_guard<std::mutex> lock(mutex_);
       messages_.push_back(m->get_payload());

@@ -577,7 +577,7 @@ std::string ListMessages(const DataflashContents& log) {
 // The values of one source: time (s), gyro (rad/s), accel (m/s^2) when `with_accel`.
 struct SourceSeries {
   std::vector<double> t_s;
-  std::vector<double> xyz;  // 3 per sample
+  std::vector<double> xyz;            // 3 per sample
   std::vector<uint64_t> byte_offset;  // of each message in the file
   double time_scale = 1e-6;
 };
@@ -611,12 +611,11 @@ SourceSeries ReadSource(std::string_view bytes, const std::string& name,
     const bool known = rate ? (unit.empty() || unit == "rad/s" || unit == "deg/s")
                             : (unit.empty() || unit == "m/s/s" || unit == "m/s^2");
     if (!known) {
-      throw UserError(name + ": field " + request.fields[k] + " of " + src.message +
-                      " is declared in '" + PrintableAscii(unit, kDataflashTextEcho) +
-                      "' (FMTU), not " + (rate ? "an angular rate (rad/s or deg/s)" :
-                                                 "a specific force (m/s/s)") +
-                      ": the log's units are damaged; it is not read as " +
-                      (rate ? "rad/s" : "m/s^2"));
+      throw UserError(
+          name + ": field " + request.fields[k] + " of " + src.message + " is declared in '" +
+          PrintableAscii(unit, kDataflashTextEcho) + "' (FMTU), not " +
+          (rate ? "an angular rate (rad/s or deg/s)" : "a specific force (m/s/s)") +
+          ": the log's units are damaged; it is not read as " + (rate ? "rad/s" : "m/s^2"));
     }
     scale[a] = unit == "deg/s" ? kRadPerDeg : 1.0;
     if (k < log.field_multipliers.size() && std::isfinite(log.field_multipliers[k]) &&
@@ -700,7 +699,10 @@ void PackRows(const SourceSeries& gyro, const std::vector<double>& accel, bool w
         first = "message " + std::to_string(r + 1) + " of " + what +
                 (r < gyro.byte_offset.size() ? " (byte " + std::to_string(gyro.byte_offset[r]) + ")"
                                              : std::string()) +
-                " has " + (bad == 0 ? "time" : bad <= 3 ? "a gyro rate" : "a specific force") +
+                " has " +
+                (bad == 0   ? "time"
+                 : bad <= 3 ? "a gyro rate"
+                            : "a specific force") +
                 " = " + value +
                 (bad == 0   ? " s"
                  : bad <= 3 ? " rad/s (|rate| <= 1e4 rad/s: a gyro logs no more)"
@@ -736,8 +738,7 @@ bool DataflashMessageInfo::regular() const {
   if (!(span > 0)) return false;
   const double mean_step = span / (count - 1);
   const bool gap = max_step_s > kIrregularStepFactor * mean_step && max_step_s > kIrregularGapS;
-  return !gap &&
-         backward_steps * 100 <= count;  // instances interleaved may step back a little
+  return !gap && backward_steps * 100 <= count;  // instances interleaved may step back a little
 }
 
 const DataflashMessageInfo* DataflashContents::Find(const std::string& name) const {
@@ -892,8 +893,10 @@ ImuData ReadDataflashImu(std::string_view bytes, const std::string& name,
   if (const DataflashMessageInfo* info = log.Find(src.message);
       info != nullptr && info->invalid_instances > 0) {
     data.warnings.push_back(std::to_string(info->invalid_instances) + " " + src.message +
-                            " message(s) skipped: their " + info->instance_field + " field is no "
-                            "instance (" + info->invalid_instance_example + ", a damaged value)");
+                            " message(s) skipped: their " + info->instance_field +
+                            " field is no "
+                            "instance (" +
+                            info->invalid_instance_example + ", a damaged value)");
   }
   if (gyr)
     data.warnings.push_back("no IMU messages: read " + what +

@@ -143,7 +143,9 @@ std::array<int, 3> FindTriplet(const std::vector<ColumnName>& names,
     for (int a = 0; a < 3; ++a) idx[a] = ColumnIndex(names, name_of(a));
     return idx;
   };
-  auto found = [](const std::array<int, 3>& idx) { return idx[0] >= 0 && idx[1] >= 0 && idx[2] >= 0; };
+  auto found = [](const std::array<int, 3>& idx) {
+    return idx[0] >= 0 && idx[1] >= 0 && idx[2] >= 0;
+  };
   for (const std::string& word : words) {
     for (const auto& axes : kAxes) {
       const std::array<int, 3> after = all_three([&](int a) { return word + axes[a]; });
@@ -199,8 +201,8 @@ std::vector<std::vector<double>> NumericColumns(const std::vector<std::string>& 
 // Time column: a known name, else the first whose name holds "time"; -1 when none.
 int GuessTimeColumn(const std::vector<ColumnName>& names) {
   int time = -1;
-  for (const char* n : {"t", "time", "times", "ts", "timestamp", "timeus", "timems",
-                        "timestampus", "timestampms", "sec", "seconds", "elapsed"}) {
+  for (const char* n : {"t", "time", "times", "ts", "timestamp", "timeus", "timems", "timestampus",
+                        "timestampms", "sec", "seconds", "elapsed"}) {
     for (size_t i = 0; i < names.size() && time < 0; ++i) {
       if (names[i].bare == n) time = static_cast<int>(i);
     }
@@ -222,9 +224,9 @@ void GuessTimeUnit(const ColumnName& name, const std::vector<double>& tc, Format
   std::string time_why;
   const std::string& unit = name.bracket;
   if (unit == "s" || unit == "sec" || unit == "ms" || unit == "us" || unit == "\u00b5s") {
-    guess->format.time_unit = unit == "ms"   ? TimeUnit::kMilliseconds
+    guess->format.time_unit = unit == "ms"                        ? TimeUnit::kMilliseconds
                               : unit == "us" || unit == "\u00b5s" ? TimeUnit::kMicroseconds
-                                                                : TimeUnit::kSeconds;
+                                                                  : TimeUnit::kSeconds;
     time_why = "from its name";
   } else if (tname.size() > 2 && tname.compare(tname.size() - 2, 2, "us") == 0) {
     guess->format.time_unit = TimeUnit::kMicroseconds;
@@ -274,16 +276,16 @@ void GuessGyroUnit(const std::vector<ColumnName>& names, const std::array<int, 3
   }
   guess->guesses.push_back("gyro columns " + PrintableName(guess->format.gyro_columns[0]) + ", " +
                            PrintableName(guess->format.gyro_columns[1]) + ", " +
-                           PrintableName(guess->format.gyro_columns[2]) +
-                           " in " + ToString(guess->format.gyro_unit) + " (" + gyro_why + ")");
+                           PrintableName(guess->format.gyro_columns[2]) + " in " +
+                           ToString(guess->format.gyro_unit) + " (" + gyro_why + ")");
 }
 
 // Accelerometer unit: gravity reads ~9.8 in m/s^2, ~1 in g.
 void GuessAccelUnit(const std::array<int, 3>& accel,
                     const std::vector<std::vector<double>>& columns, FormatGuess* guess) {
   std::vector<double> norms;
-  const size_t n = std::min({columns[accel[0]].size(), columns[accel[1]].size(),
-                             columns[accel[2]].size()});
+  const size_t n =
+      std::min({columns[accel[0]].size(), columns[accel[1]].size(), columns[accel[2]].size()});
   for (size_t i = 0; i < n; ++i) {
     norms.push_back(std::hypot(columns[accel[0]][i], columns[accel[1]][i], columns[accel[2]][i]));
   }
@@ -293,21 +295,21 @@ void GuessAccelUnit(const std::array<int, 3>& accel,
   // Gravity reads 1 in g and 9.81 in m/s^2; a reading far from both (gravity removed by the
   // logger, another unit) is no ground for g: m/s^2 is kept, and the guess says so.
   const bool gravity_in_g = std::isfinite(norm) && std::abs(norm - 1.0) <= 0.3;
-  const bool gravity_in_si = std::isfinite(norm) && std::abs(norm / kStandardGravityMps2 - 1.0) <= 0.3;
+  const bool gravity_in_si =
+      std::isfinite(norm) && std::abs(norm / kStandardGravityMps2 - 1.0) <= 0.3;
   if (!gravity_in_g && !gravity_in_si) guess->format.accel_unit = AccelUnit::kMetresPerS2;
-  guess->guesses.push_back("accelerometer columns " + PrintableName(guess->format.accel_columns[0]) + ", " +
-                           PrintableName(guess->format.accel_columns[1]) + ", " +
-                           PrintableName(guess->format.accel_columns[2]) +
-                           " in " + ToString(guess->format.accel_unit) +
-                           (std::isfinite(norm) ? Fmt(" (median |f| %.3g", norm) +
-                                                      (gravity_in_g || gravity_in_si
-                                                           ? std::string(")")
-                                                           : ": neither 1 g nor 9.81 m/s^2, "
-                                                             "gravity removed by the logger or "
-                                                             "another unit; check imu.accel.unit)")
-                                                : ""));
+  guess->guesses.push_back(
+      "accelerometer columns " + PrintableName(guess->format.accel_columns[0]) + ", " +
+      PrintableName(guess->format.accel_columns[1]) + ", " +
+      PrintableName(guess->format.accel_columns[2]) + " in " + ToString(guess->format.accel_unit) +
+      (std::isfinite(norm)
+           ? Fmt(" (median |f| %.3g", norm) + (gravity_in_g || gravity_in_si
+                                                   ? std::string(")")
+                                                   : ": neither 1 g nor 9.81 m/s^2, "
+                                                     "gravity removed by the logger or "
+                                                     "another unit; check imu.accel.unit)")
+           : ""));
 }
-
 
 // The index of the header cell named `name` (surrounding blanks and quotes aside): the cell of
 // exactly that name, else the one cell equal to it ignoring case; -1 when none (or when several
@@ -343,7 +345,8 @@ bool ChosenColumnsPresent(const std::vector<std::string>& header, const ColumnCh
     if (HeaderIndex(header, w, &candidates) >= 0) continue;
     if (!candidates.empty()) {
       std::string list;
-      for (const std::string& c : candidates) list += (list.empty() ? "'" : "', '") + PrintableName(c);
+      for (const std::string& c : candidates)
+        list += (list.empty() ? "'" : "', '") + PrintableName(c);
       *why = "column '" + PrintableName(w) + "' is ambiguous: no column is named exactly so, and " +
              std::to_string(candidates.size()) + " differ from it only in case (" + list +
              "'); name one of them as it is written";
@@ -412,9 +415,9 @@ FormatGuess GuessCsvFormat(const std::string& text, const ColumnChoice& choice) 
           : std::array<int, 3>{HeaderIndex(header, choice.gyro[0]),
                                HeaderIndex(header, choice.gyro[1]),
                                HeaderIndex(header, choice.gyro[2])};
-  const std::array<int, 3> accel = FindTriplet(
-      names, {"a", "acc", "accel", "accelerometer", "accelerometerms2", "acceleration", "f",
-              "specificforce", "linacc"});
+  const std::array<int, 3> accel =
+      FindTriplet(names, {"a", "acc", "accel", "accelerometer", "accelerometerms2", "acceleration",
+                          "f", "specificforce", "linacc"});
   if (time < 0 || gyro[0] < 0) {
     guess.why = UnrecognisedColumnsMessage(header, time < 0 ? "time column" : "gyro columns");
     return guess;
@@ -435,7 +438,8 @@ FormatGuess GuessCsvFormat(const std::string& text, const ColumnChoice& choice) 
     guess.guesses.push_back("no accelerometer columns (gyro-only: the swing axis from the gyro)");
   }
   if (delim != ',') {
-    guess.guesses.push_back(std::string("delimiter '") + (delim == '\t' ? "\\t" : std::string(1, delim)) + "'");
+    guess.guesses.push_back(std::string("delimiter '") +
+                            (delim == '\t' ? "\\t" : std::string(1, delim)) + "'");
   }
   return guess;
 }

@@ -23,9 +23,15 @@ constexpr EnumName<LogContainer> kLogContainerNames[] = {
 
 }  // namespace
 
-bool ParseTimeUnit(const std::string& name, TimeUnit* unit) { return ParseEnum(kTimeUnitNames, name, unit); }
-bool ParseRateUnit(const std::string& name, RateUnit* unit) { return ParseEnum(kRateUnitNames, name, unit); }
-bool ParseAccelUnit(const std::string& name, AccelUnit* unit) { return ParseEnum(kAccelUnitNames, name, unit); }
+bool ParseTimeUnit(const std::string& name, TimeUnit* unit) {
+  return ParseEnum(kTimeUnitNames, name, unit);
+}
+bool ParseRateUnit(const std::string& name, RateUnit* unit) {
+  return ParseEnum(kRateUnitNames, name, unit);
+}
+bool ParseAccelUnit(const std::string& name, AccelUnit* unit) {
+  return ParseEnum(kAccelUnitNames, name, unit);
+}
 bool ParseLogContainer(const std::string& name, LogContainer* container) {
   return ParseEnum(kLogContainerNames, name, container);
 }
@@ -33,7 +39,9 @@ bool ParseLogContainer(const std::string& name, LogContainer* container) {
 const char* ToString(TimeUnit unit) { return EnumToString(kTimeUnitNames, unit, "?"); }
 const char* ToString(RateUnit unit) { return EnumToString(kRateUnitNames, unit, "?"); }
 const char* ToString(AccelUnit unit) { return EnumToString(kAccelUnitNames, unit, "?"); }
-const char* ToString(LogContainer container) { return EnumToString(kLogContainerNames, container, "?"); }
+const char* ToString(LogContainer container) {
+  return EnumToString(kLogContainerNames, container, "?");
+}
 
 std::string TimeUnitAllowedValues() { return EnumAllowedValues(kTimeUnitNames); }
 std::string RateUnitAllowedValues() { return EnumAllowedValues(kRateUnitNames); }
@@ -107,9 +115,12 @@ std::string DescribeUnprintable(std::string_view s) {
       return text;
     }
     if (IsControl(cp)) {
-      const char* name = cp == 0x85 ? " (NEL, a line break)" : cp == 0x1B ? " (ESC)" :
-                         cp == 0x2028 ? " (LS, a line break)" : cp == 0x2029 ? " (PS, a line break)" :
-                         cp == '\n' || cp == '\r' ? " (a line break)" : " (a control character)";
+      const char* name = cp == 0x85                 ? " (NEL, a line break)"
+                         : cp == 0x1B               ? " (ESC)"
+                         : cp == 0x2028             ? " (LS, a line break)"
+                         : cp == 0x2029             ? " (PS, a line break)"
+                         : cp == '\n' || cp == '\r' ? " (a line break)"
+                                                    : " (a control character)";
       std::snprintf(text, sizeof(text), "U+%04X%s at byte %zu", static_cast<unsigned>(cp), name, i);
       return text;
     }
@@ -120,18 +131,24 @@ std::string DescribeUnprintable(std::string_view s) {
 
 double ToSi(TimeUnit unit) {
   switch (unit) {
-    case TimeUnit::kSeconds: return 1.0;
-    case TimeUnit::kMilliseconds: return 1e-3;
-    case TimeUnit::kMicroseconds: return 1e-6;
+    case TimeUnit::kSeconds:
+      return 1.0;
+    case TimeUnit::kMilliseconds:
+      return 1e-3;
+    case TimeUnit::kMicroseconds:
+      return 1e-6;
   }
   return 1.0;
 }
 
 double ToSi(RateUnit unit) {
   switch (unit) {
-    case RateUnit::kRadPerS: return 1.0;
-    case RateUnit::kDegPerS: return kRadPerDeg;
-    case RateUnit::kMilliradPerS: return 1e-3;
+    case RateUnit::kRadPerS:
+      return 1.0;
+    case RateUnit::kDegPerS:
+      return kRadPerDeg;
+    case RateUnit::kMilliradPerS:
+      return 1e-3;
   }
   return 1.0;
 }

@@ -10,8 +10,8 @@
 namespace bifilar {
 
 enum class TimeUnit { kSeconds, kMilliseconds, kMicroseconds };  // "s", "ms", "us"
-enum class RateUnit { kRadPerS, kDegPerS, kMilliradPerS };      // "rad/s", "deg/s", "mrad/s"
-enum class AccelUnit { kMetresPerS2, kStandardGravity };          // "m/s^2", "g"
+enum class RateUnit { kRadPerS, kDegPerS, kMilliradPerS };       // "rad/s", "deg/s", "mrad/s"
+enum class AccelUnit { kMetresPerS2, kStandardGravity };         // "m/s^2", "g"
 
 // Parse the unit names above; false for anything else. One name table per enum
 // (base/enum_names.h) gives these, ToString and the "allowed values" text of messages.
@@ -49,8 +49,8 @@ std::string DescribeUnprintable(std::string_view s);
 // pipeline/logs/ulog.h.
 struct UlogSelection {
   std::string topic = "sensor_combined";  // uORB topic (message name), case sensitive
-  int multi_id = 0;                        // instance of the topic (0 = first); >= 0
-  std::string time_field = "timestamp";    // us since boot
+  int multi_id = 0;                       // instance of the topic (0 = first); >= 0
+  std::string time_field = "timestamp";   // us since boot
   std::array<std::string, 3> gyro_fields = {"gyro_rad[0]", "gyro_rad[1]", "gyro_rad[2]"};
   // All three empty: read the topic gyro-only.
   std::array<std::string, 3> accel_fields = {"accelerometer_m_s2[0]", "accelerometer_m_s2[1]",
@@ -64,16 +64,16 @@ const char* ToString(LogContainer container);
 std::string LogContainerAllowedValues();  // "auto, csv or ulog"
 
 struct ImuFormat {
-  std::string time_column = "t";                              // header name of the time column
-  TimeUnit time_unit = TimeUnit::kSeconds;                    // default seconds
+  std::string time_column = "t";                                 // header name of the time column
+  TimeUnit time_unit = TimeUnit::kSeconds;                       // default seconds
   std::array<std::string, 3> gyro_columns = {"gx", "gy", "gz"};  // IMU x, y, z angular rate
-  RateUnit gyro_unit = RateUnit::kRadPerS;                    // default rad/s
+  RateUnit gyro_unit = RateUnit::kRadPerS;                       // default rad/s
   // IMU x, y, z specific force; all three empty means the log has no accelerometer.
   std::array<std::string, 3> accel_columns = {"ax", "ay", "az"};
-  AccelUnit accel_unit = AccelUnit::kMetresPerS2;             // default m/s^2
-  char delimiter = ',';                                       // field separator
-  LogContainer container = LogContainer::kAuto;               // `imu.format`; default auto
-  UlogSelection ulog;                                         // `imu.ulog`: used for .ulg logs
+  AccelUnit accel_unit = AccelUnit::kMetresPerS2;  // default m/s^2
+  char delimiter = ',';                            // field separator
+  LogContainer container = LogContainer::kAuto;    // `imu.format`; default auto
+  UlogSelection ulog;                              // `imu.ulog`: used for .ulg logs
 
   bool has_accel() const { return !accel_columns[0].empty(); }
   // Column names non-empty and distinct (accelerometer: all three or none).

@@ -33,7 +33,8 @@ std::string_view Trim(std::string_view s) {
 
 std::string_view Unquote(std::string_view s) {
   s = Trim(s);
-  if (s.size() >= 2 && ((s.front() == '"' && s.back() == '"') || (s.front() == '\'' && s.back() == '\''))) {
+  if (s.size() >= 2 &&
+      ((s.front() == '"' && s.back() == '"') || (s.front() == '\'' && s.back() == '\''))) {
     s = Trim(s.substr(1, s.size() - 2));
   }
   return s;
@@ -176,10 +177,13 @@ void RefuseBinary(const std::string& name, const ImuFormat& format, std::string_
   size_t control = 0;
   for (size_t i = 0; i < n; ++i) {
     const unsigned char c = (*text)[i];
-    if (c < 32 && c != '\n' && c != '\r' && c != '\t' && c != static_cast<unsigned char>(format.delimiter)) ++control;
+    if (c < 32 && c != '\n' && c != '\r' && c != '\t' &&
+        c != static_cast<unsigned char>(format.delimiter))
+      ++control;
   }
-  if (control * 100 > n) Fail(name + ": not a text CSV file (" + std::to_string(control) +
-                              " control characters in the first " + std::to_string(n) + " bytes)");
+  if (control * 100 > n)
+    Fail(name + ": not a text CSV file (" + std::to_string(control) +
+         " control characters in the first " + std::to_string(n) + " bytes)");
 }
 
 // The columns a CSV log is read from: the needed ones (time, gyro x y z, then accel x y z when
@@ -213,7 +217,8 @@ std::vector<std::string> ReadHeaderRow(LineReader* reader, const std::string& na
     break;
   }
   *header_line = reader->line_number();
-  if (IsBlank(line) || Trim(line)[0] == '#' || Trim(line)[0] == '%' || Trim(line).substr(0, 2) == "//") {
+  if (IsBlank(line) || Trim(line)[0] == '#' || Trim(line)[0] == '%' ||
+      Trim(line).substr(0, 2) == "//") {
     Fail(name + ": no header row, only " + std::to_string(comment_lines) + " comment line(s)");
   }
   if (!simulated.empty()) data->warnings.push_back(simulated);
@@ -257,14 +262,14 @@ int FindColumn(const std::vector<std::string>& header, const std::string& col,
 
 // Fails on a missing column, guessing the delimiter when the header is one field.
 [[noreturn]] void MissingColumn(const std::vector<std::string>& header, const std::string& col,
-                                const std::string& name, int header_line,
-                                const ImuFormat& format) {
+                                const std::string& name, int header_line, const ImuFormat& format) {
   std::string hint;
   if (header.size() == 1) {
     for (char d : {',', ';', '\t', ' '}) {
       if (d != format.delimiter && header[0].find(d) != std::string::npos) {
-        hint = std::string("; is the delimiter '") + (d == '\t' ? std::string("\\t") : std::string(1, d)) +
-               "' rather than '" + std::string(1, format.delimiter) + "'?";
+        hint = std::string("; is the delimiter '") +
+               (d == '\t' ? std::string("\\t") : std::string(1, d)) + "' rather than '" +
+               std::string(1, format.delimiter) + "'?";
         break;
       }
     }
@@ -278,8 +283,7 @@ int FindColumn(const std::vector<std::string>& header, const std::string& col,
 CsvColumns ParseHeader(LineReader* reader, const std::string& name, const ImuFormat& format,
                        const ImuLogOptions& options, ImuData* data) {
   CsvColumns c;
-  const std::vector<std::string> header =
-      ReadHeaderRow(reader, name, format, &c.header_line, data);
+  const std::vector<std::string> header = ReadHeaderRow(reader, name, format, &c.header_line, data);
   c.names = {format.time_column, format.gyro_columns[0], format.gyro_columns[1],
              format.gyro_columns[2]};
   c.scale = {ToSi(format.time_unit), ToSi(format.gyro_unit), ToSi(format.gyro_unit),
@@ -299,10 +303,12 @@ CsvColumns ParseHeader(LineReader* reader, const std::string& name, const ImuFor
     if (present == 0 && !options.require_accel) {
       data->warnings.push_back("no accelerometer columns (" + Printable(format.accel_columns[0]) +
                                ", " + Printable(format.accel_columns[1]) + ", " +
-                               Printable(format.accel_columns[2]) + ") in the file; read as gyro-only");
+                               Printable(format.accel_columns[2]) +
+                               ") in the file; read as gyro-only");
     } else {
       for (int k = 0; k < 3; ++k) {
-        if (accel_col[k] < 0) MissingColumn(header, format.accel_columns[k], name, c.header_line, format);
+        if (accel_col[k] < 0)
+          MissingColumn(header, format.accel_columns[k], name, c.header_line, format);
         c.names.push_back(format.accel_columns[k]);
         c.scale.push_back(ToSi(format.accel_unit));
         c.column.push_back(accel_col[k]);
@@ -319,14 +325,14 @@ CsvColumns ParseHeader(LineReader* reader, const std::string& name, const ImuFor
 // numeric (too few fields, a cell not a number), "" for a numeric one; *non_finite_message says
 // when a numeric row holds NaN, an infinity or a reading no sensor gives (imu_log.h).
 std::string ReadRowCells(const std::vector<std::string_view>& fields, std::string_view line,
-                         int line_number, const CsvColumns& c, const std::string& name,
-                         double* row, std::string* non_finite_message) {
+                         int line_number, const CsvColumns& c, const std::string& name, double* row,
+                         std::string* non_finite_message) {
   if (static_cast<int>(fields.size()) <= c.max_column) {
     int k = 0;
     while (c.column[k] < static_cast<int>(fields.size())) ++k;
     return name + ":" + std::to_string(line_number) + ": the row has only " +
-           std::to_string(fields.size()) + " field(s); column '" + Printable(c.names[k]) + "' is field " +
-           std::to_string(c.column[k] + 1) + " ('" + Printable(Trim(line)) + "')";
+           std::to_string(fields.size()) + " field(s); column '" + Printable(c.names[k]) +
+           "' is field " + std::to_string(c.column[k] + 1) + " ('" + Printable(Trim(line)) + "')";
   }
   bool non_finite = false;
   for (int k = 0; k < c.needed; ++k) {
@@ -440,15 +446,16 @@ void CheckRowsEnd(const CsvRows& r, int header_line, const std::string& name, Im
   if (r.row_line.empty()) {
     if (r.bad_rows > 0) {
       Fail(name + ": no numeric data rows after the header (line " + std::to_string(header_line) +
-           "): " + std::to_string(r.bad_rows) + " row(s), none of them numbers (a footer only, or "
-           "the wrong columns?); the first: " + r.first_bad);
+           "): " + std::to_string(r.bad_rows) +
+           " row(s), none of them numbers (a footer only, or "
+           "the wrong columns?); the first: " +
+           r.first_bad);
     }
     Fail(name + ":" + std::to_string(header_line) + ": header only, no data rows");
   }
   if (r.end_line > 0) {
     data->warnings.push_back("the time series ends at line " + std::to_string(r.end_line) + " (" +
-                             r.end_reason + "); " +
-                             std::to_string(r.lines_after_end) +
+                             r.end_reason + "); " + std::to_string(r.lines_after_end) +
                              " row(s) after it (a footer?) are ignored; if they are data, "
                              "fix the row");
   } else if (r.bad_rows > 0) {
@@ -502,8 +509,7 @@ ImuData ReadImuLogFromString(const std::string& text, const std::string& name,
   return Parse(text, name, format, options);
 }
 
-ImuData ReadImuLog(const std::string& path, const ImuFormat& format,
-                   const ImuLogOptions& options) {
+ImuData ReadImuLog(const std::string& path, const ImuFormat& format, const ImuLogOptions& options) {
   std::string text = ReadWholeFile(path, options);
   if (UseUlogReader(text, format)) return ReadUlogImu(text, path, format, options);
   if (UseDataflashReader(text, format)) return ReadDataflashImu(text, path, options);

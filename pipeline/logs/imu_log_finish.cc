@@ -22,8 +22,9 @@ constexpr double kMinStepsPerResolution = 1e-3;
 
 ImuData FinishImuLog(const std::string& name, const ImuLogOptions& options,
                      const std::vector<double>& values, int needed,
-                     const std::vector<int>& row_line, [[maybe_unused]] const std::vector<double>& scale,
-                     bool with_accel, ImuData data) {
+                     const std::vector<int>& row_line,
+                     [[maybe_unused]] const std::vector<double>& scale, bool with_accel,
+                     ImuData data) {
   const size_t rows = row_line.size();
   // Timestamps must increase. A sample whose time does not exceed the last kept one is dropped,
   // unless the last kept one was itself a forward glitch (the new time fits between the two

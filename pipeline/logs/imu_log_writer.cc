@@ -4,8 +4,8 @@
 #include <cstdio>
 
 #include "base/atomic_file.h"
-#include "base/option_check.h"
 #include "base/gzip.h"
+#include "base/option_check.h"
 #include "base/user_error.h"
 
 namespace bifilar {

@@ -16,9 +16,9 @@
 namespace bifilar {
 namespace {
 
-constexpr size_t kHeaderSize = 16;      // magic (7), version (1), start timestamp (8)
-constexpr size_t kMessageHeader = 3;    // uint16_t msg_size, uint8_t msg_type
-constexpr size_t kFlagBitsSize = 40;    // compat[8], incompat[8], appended_offsets[3]
+constexpr size_t kHeaderSize = 16;    // magic (7), version (1), start timestamp (8)
+constexpr size_t kMessageHeader = 3;  // uint16_t msg_size, uint8_t msg_type
+constexpr size_t kFlagBitsSize = 40;  // compat[8], incompat[8], appended_offsets[3]
 // Bounds checked before anything is allocated for a format (pipeline/logs/ulog.h):
 constexpr int kMaxNestingDepth = kUlogMaxNestingDepth;  // nested type levels, the topic's included
 // A data message holds at most 65535 - 2 bytes of payload; a type larger than 65535 bytes can
@@ -30,7 +30,21 @@ constexpr uint64_t kMaxFlatNameBytes = kUlogMaxFlatNameBytes;  // all flattened 
 // PX4 logs take ~1e4; 2e6 take ~1 s.
 constexpr uint64_t kMaxFormatWork = 2000000;
 
-enum class Kind : uint8_t { kI8, kU8, kI16, kU16, kI32, kU32, kI64, kU64, kF32, kF64, kBool, kChar, kNested };
+enum class Kind : uint8_t {
+  kI8,
+  kU8,
+  kI16,
+  kU16,
+  kI32,
+  kU32,
+  kI64,
+  kU64,
+  kF32,
+  kF64,
+  kBool,
+  kChar,
+  kNested
+};
 
 struct Scalar {
   const char* name;
@@ -95,14 +109,24 @@ U LoadUnsigned(const unsigned char* p) {
 
 double Decode(const unsigned char* p, Kind kind) {
   switch (kind) {
-    case Kind::kI8: return static_cast<int8_t>(p[0]);
-    case Kind::kU8: case Kind::kBool: case Kind::kChar: return p[0];
-    case Kind::kI16: return static_cast<int16_t>(LoadUnsigned<uint16_t>(p));
-    case Kind::kU16: return LoadUnsigned<uint16_t>(p);
-    case Kind::kI32: return static_cast<int32_t>(LoadUnsigned<uint32_t>(p));
-    case Kind::kU32: return LoadUnsigned<uint32_t>(p);
-    case Kind::kI64: return static_cast<double>(static_cast<int64_t>(LoadUnsigned<uint64_t>(p)));
-    case Kind::kU64: return static_cast<double>(LoadUnsigned<uint64_t>(p));
+    case Kind::kI8:
+      return static_cast<int8_t>(p[0]);
+    case Kind::kU8:
+    case Kind::kBool:
+    case Kind::kChar:
+      return p[0];
+    case Kind::kI16:
+      return static_cast<int16_t>(LoadUnsigned<uint16_t>(p));
+    case Kind::kU16:
+      return LoadUnsigned<uint16_t>(p);
+    case Kind::kI32:
+      return static_cast<int32_t>(LoadUnsigned<uint32_t>(p));
+    case Kind::kU32:
+      return LoadUnsigned<uint32_t>(p);
+    case Kind::kI64:
+      return static_cast<double>(static_cast<int64_t>(LoadUnsigned<uint64_t>(p)));
+    case Kind::kU64:
+      return static_cast<double>(LoadUnsigned<uint64_t>(p));
     case Kind::kF32: {
       const uint32_t bits = LoadUnsigned<uint32_t>(p);
       float f;
@@ -115,7 +139,8 @@ double Decode(const unsigned char* p, Kind kind) {
       std::memcpy(&d, &bits, sizeof(d));
       return d;
     }
-    case Kind::kNested: break;
+    case Kind::kNested:
+      break;
   }
   return 0.0;
 }
@@ -202,8 +227,8 @@ class UlogParser {
     }
   }
   std::vector<uint64_t> appended_offsets_;
-  std::vector<uint8_t> msg_role_;          // by msg_id
-  std::vector<int> subscription_index_;    // by msg_id into out_.subscriptions (-1: none)
+  std::vector<uint8_t> msg_role_;        // by msg_id
+  std::vector<int> subscription_index_;  // by msg_id into out_.subscriptions (-1: none)
   bool first_message_ = true;
 
   // The wanted topic, once subscribed.
@@ -261,8 +286,8 @@ UlogContents UlogParser::Run() {
 
 void UlogParser::ReadSection(uint64_t pos, uint64_t end, bool last) {
   while (pos < end) {
-    if (end - pos < kMessageHeader || pos + kMessageHeader +
-                                              LoadUnsigned<uint16_t>(data_ + pos) > end) {
+    if (end - pos < kMessageHeader ||
+        pos + kMessageHeader + LoadUnsigned<uint16_t>(data_ + pos) > end) {
       // A message cut short: by the end of the file (the logger stopped mid-write) or by the
       // next appended section (the spec's way of appending to a log that may end anywhere).
       if (last) out_.warnings.push_back(DroppedTail(pos));
@@ -282,9 +307,15 @@ void UlogParser::ReadSection(uint64_t pos, uint64_t end, bool last) {
 
 void UlogParser::OnMessage(uint64_t offset, char type, const unsigned char* body, uint32_t size) {
   switch (type) {
-    case 'D': OnData(offset, body, size); return;
-    case 'F': OnFormat(offset, body, size); return;
-    case 'A': OnSubscription(offset, body, size); return;
+    case 'D':
+      OnData(offset, body, size);
+      return;
+    case 'F':
+      OnFormat(offset, body, size);
+      return;
+    case 'A':
+      OnSubscription(offset, body, size);
+      return;
     case 'B':
       if (!first_message_) {
         out_.warnings.push_back("a flag-bits message at byte " + std::to_string(offset) +
@@ -302,11 +333,15 @@ void UlogParser::OnMessage(uint64_t offset, char type, const unsigned char* body
       msg_role_[msg_id] = kUnknown;  // later data with this id is an error
       return;
     }
-    case 'L': case 'C':
+    case 'L':
+    case 'C':
       if (size < (type == 'L' ? 9u : 11u)) Fail(offset, "logging message too short");
       ++out_.log_messages;
       return;
-    case 'I': case 'P': case 'M': case 'Q': {
+    case 'I':
+    case 'P':
+    case 'M':
+    case 'Q': {
       // key_len follows 0 ('I', 'P') or 1 ('M': is_continued, 'Q': default_types) byte(s).
       const uint32_t skip = (type == 'M' || type == 'Q') ? 1 : 0;
       if (size < skip + 1 || body[skip] > size - skip - 1) {
@@ -332,8 +367,8 @@ void UlogParser::NoteSimulatedInfo(const unsigned char* body, uint32_t size) {
     return;
   }
   simulated_noted_ = true;
-  out_.warnings.push_back(SimulatedLogWarning(std::string_view(
-      reinterpret_cast<const char*>(body) + 1 + body[0], size - 1 - body[0])));
+  out_.warnings.push_back(SimulatedLogWarning(
+      std::string_view(reinterpret_cast<const char*>(body) + 1 + body[0], size - 1 - body[0])));
 }
 
 void UlogParser::OnFlagBits(uint64_t offset, const unsigned char* body, uint32_t size) {
@@ -341,7 +376,8 @@ void UlogParser::OnFlagBits(uint64_t offset, const unsigned char* body, uint32_t
     Fail(offset, "flag-bits message too short (" + std::to_string(size) + " bytes, expected 40)");
   }
   const unsigned char* incompat = body + 8;
-  if ((incompat[0] & ~1u) != 0 || std::any_of(incompat + 1, incompat + 8, [](unsigned char c) { return c != 0; })) {
+  if ((incompat[0] & ~1u) != 0 ||
+      std::any_of(incompat + 1, incompat + 8, [](unsigned char c) { return c != 0; })) {
     Fail(offset + kMessageHeader + 8,
          "unknown incompatible flag bits are set: this log uses a newer ULog format that this "
          "reader cannot read");
@@ -391,7 +427,8 @@ void UlogParser::OnFormat(uint64_t offset, const unsigned char* body, uint32_t s
       const std::string_view len = type.substr(bracket + 1);
       uint64_t n = 0;
       size_t i = 0;
-      for (; i < len.size() && len[i] >= '0' && len[i] <= '9' && n <= 65535; ++i) n = n * 10 + (len[i] - '0');
+      for (; i < len.size() && len[i] >= '0' && len[i] <= '9' && n <= 65535; ++i)
+        n = n * 10 + (len[i] - '0');
       if (i == 0 || i + 1 != len.size() || len[i] != ']' || n == 0 || n > 65535) {
         Fail(offset, "format '" + PrintableAscii(type_name, kUlogTextEcho) +
                          "': bad array size in '" + PrintableAscii(field, kUlogTextEcho) + "'");
@@ -455,7 +492,8 @@ UlogParser::TypeInfo UlogParser::Measure(const std::string& type, uint64_t offse
     const uint64_t own = f.name.size() + (f.is_array ? 2 + std::to_string(f.array_len).size() : 0) +
                          (FindScalar(f.type) ? 0 : 1);
     info.fields += static_cast<uint64_t>(f.array_len) * element.fields;
-    info.name_bytes += static_cast<uint64_t>(f.array_len) * (element.fields * own + element.name_bytes);
+    info.name_bytes +=
+        static_cast<uint64_t>(f.array_len) * (element.fields * own + element.name_bytes);
     if (info.name_bytes > kMaxFlatNameBytes) {
       Fail(at, "format '" + PrintableAscii(type, kUlogTextEcho) + "' flattens to " +
                    std::to_string(info.fields) + " or more fields whose names take more than " +
@@ -616,8 +654,9 @@ void UlogParser::OnData(uint64_t offset, const unsigned char* body, uint32_t siz
   const uint16_t msg_id = LoadUnsigned<uint16_t>(body);
   const uint8_t role = msg_role_[msg_id];
   if (role == kUnknown) {
-    Fail(offset, "data for msg_id " + std::to_string(msg_id) +
-                     ", which no subscription ('A' message) before it announced: the file is damaged");
+    Fail(offset,
+         "data for msg_id " + std::to_string(msg_id) +
+             ", which no subscription ('A' message) before it announced: the file is damaged");
   }
   UlogSubscription& subscription = out_.subscriptions[subscription_index_[msg_id]];
   ++subscription.samples;
@@ -640,11 +679,13 @@ void UlogParser::OnData(uint64_t offset, const unsigned char* body, uint32_t siz
                      " bytes; its format defines " + std::to_string(wanted_max_size_) +
                      (wanted_min_size_ != wanted_max_size_
                           ? " (" + std::to_string(wanted_min_size_) + " without trailing padding)"
-                          : std::string()) + ": the file is damaged");
+                          : std::string()) +
+                     ": the file is damaged");
   }
   const unsigned char* p = body + 2;
   if (out_.value_offsets.empty()) first_wanted_offset_ = offset;
-  for (const auto& [field_offset, kind] : wanted_) out_.values.push_back(Decode(p + field_offset, kind));
+  for (const auto& [field_offset, kind] : wanted_)
+    out_.values.push_back(Decode(p + field_offset, kind));
   out_.value_offsets.push_back(offset);
 }
 
@@ -668,9 +709,12 @@ std::string TopicList(const UlogContents& c) {
 // half its range is a wrap. Steps back by less stay (the repair drops those samples).
 void UnwrapTimestamps(const std::string& type, size_t stride, std::vector<double>* values) {
   int bits = 0;
-  if (type == "uint32_t") bits = 32;
-  else if (type == "uint16_t") bits = 16;
-  else if (type == "uint8_t") bits = 8;
+  if (type == "uint32_t")
+    bits = 32;
+  else if (type == "uint16_t")
+    bits = 16;
+  else if (type == "uint8_t")
+    bits = 8;
   if (bits == 0 || values->empty()) return;
   const double range = std::ldexp(1.0, bits);
   double offset = 0.0, previous = (*values)[0];
@@ -698,7 +742,8 @@ bool UlogTopicDefaults(const std::string& topic, UlogSelection* selection) {
   selection->topic = topic;
   if (topic == "sensor_combined") {
     selection->gyro_fields = {"gyro_rad[0]", "gyro_rad[1]", "gyro_rad[2]"};
-    selection->accel_fields = {"accelerometer_m_s2[0]", "accelerometer_m_s2[1]", "accelerometer_m_s2[2]"};
+    selection->accel_fields = {"accelerometer_m_s2[0]", "accelerometer_m_s2[1]",
+                               "accelerometer_m_s2[2]"};
   } else if (topic == "vehicle_angular_velocity") {
     selection->gyro_fields = {"xyz[0]", "xyz[1]", "xyz[2]"};
     selection->accel_fields = {"", "", ""};
@@ -711,7 +756,8 @@ bool UlogTopicDefaults(const std::string& topic, UlogSelection* selection) {
   return true;
 }
 
-UlogContents ParseUlog(std::string_view bytes, const std::string& name, const UlogRequest& request) {
+UlogContents ParseUlog(std::string_view bytes, const std::string& name,
+                       const UlogRequest& request) {
   return UlogParser(bytes, name, request).Run();
 }
 
@@ -728,23 +774,28 @@ ImuData ReadUlogImu(std::string_view bytes, const std::string& name, const ImuFo
   request.topic = sel.topic;
   request.multi_id = sel.multi_id;
   request.fields = {sel.time_field, sel.gyro_fields[0], sel.gyro_fields[1], sel.gyro_fields[2]};
-  if (with_accel) request.fields.insert(request.fields.end(), sel.accel_fields.begin(), sel.accel_fields.end());
+  if (with_accel)
+    request.fields.insert(request.fields.end(), sel.accel_fields.begin(), sel.accel_fields.end());
   const int needed = static_cast<int>(request.fields.size());
 
   UlogContents log = ParseUlog(bytes, name, request);
-  const std::string what = "ULog topic '" + sel.topic + "' (multi_id " + std::to_string(sel.multi_id) + ")";
+  const std::string what =
+      "ULog topic '" + sel.topic + "' (multi_id " + std::to_string(sel.multi_id) + ")";
   if (!log.found) {
     std::string note;
     for (const auto& w : log.warnings) note += "; " + w;
-    throw UserError(name + ": no " + what + " in the log; its topics are: " + TopicList(log) + note);
+    throw UserError(name + ": no " + what + " in the log; its topics are: " + TopicList(log) +
+                    note);
   }
-  if (log.samples() == 0) throw UserError(name + ": the " + what + " is subscribed but has no data");
+  if (log.samples() == 0)
+    throw UserError(name + ": the " + what + " is subscribed but has no data");
 
   ImuData data;
   data.warnings = log.warnings;
   // Field types and scales: the time field in us (ms for uint8_t), the rest SI already.
   const auto type_of = [&](const std::string& field) {
-    return log.field_types[std::find(log.fields.begin(), log.fields.end(), field) - log.fields.begin()];
+    return log
+        .field_types[std::find(log.fields.begin(), log.fields.end(), field) - log.fields.begin()];
   };
   const std::string time_type = type_of(sel.time_field);
   UnwrapTimestamps(time_type, needed, &log.values);
@@ -785,13 +836,15 @@ ImuData ReadUlogImu(std::string_view bytes, const std::string& name, const ImuFo
   const size_t before = data.warnings.size();
   std::vector<double> scale(needed, 1.0);
   scale[0] = time_scale;
-  data = FinishImuLog(name, options, log.values, needed, row_number, scale, with_accel, std::move(data));
+  data = FinishImuLog(name, options, log.values, needed, row_number, scale, with_accel,
+                      std::move(data));
   // The shared repair speaks of CSV lines; here they are sample numbers of the topic.
   for (size_t i = before; i < data.warnings.size(); ++i) {
     std::string& w = data.warnings[i];
     for (const char* from : {"near line ", "at line "}) {
       const size_t at = w.find(from);
-      if (at != std::string::npos) w.replace(at, std::strlen(from), std::string(from, std::strlen(from) - 5) + "sample ");
+      if (at != std::string::npos)
+        w.replace(at, std::strlen(from), std::string(from, std::strlen(from) - 5) + "sample ");
     }
     w += " [" + what + "]";
   }

@@ -86,8 +86,8 @@ struct UlogDropout {
 };
 
 struct UlogContents {
-  int version = 0;                  // file format version (1 today)
-  uint64_t start_timestamp_us = 0;  // header timestamp (us)
+  int version = 0;                              // file format version (1 today)
+  uint64_t start_timestamp_us = 0;              // header timestamp (us)
   std::vector<UlogSubscription> subscriptions;  // in the order of their 'A' messages
   std::vector<UlogDropout> dropouts;
   std::vector<std::string> warnings;  // cut-short tail, unknown version, ...

@@ -27,11 +27,26 @@ void PokeUnsigned(U v, size_t at, std::string* out) {
 
 }  // namespace
 
-UlogPayload& UlogPayload::U8(uint8_t v) { PutUnsigned(v, &bytes_); return *this; }
-UlogPayload& UlogPayload::U16(uint16_t v) { PutUnsigned(v, &bytes_); return *this; }
-UlogPayload& UlogPayload::U32(uint32_t v) { PutUnsigned(v, &bytes_); return *this; }
-UlogPayload& UlogPayload::I32(int32_t v) { PutUnsigned(static_cast<uint32_t>(v), &bytes_); return *this; }
-UlogPayload& UlogPayload::U64(uint64_t v) { PutUnsigned(v, &bytes_); return *this; }
+UlogPayload& UlogPayload::U8(uint8_t v) {
+  PutUnsigned(v, &bytes_);
+  return *this;
+}
+UlogPayload& UlogPayload::U16(uint16_t v) {
+  PutUnsigned(v, &bytes_);
+  return *this;
+}
+UlogPayload& UlogPayload::U32(uint32_t v) {
+  PutUnsigned(v, &bytes_);
+  return *this;
+}
+UlogPayload& UlogPayload::I32(int32_t v) {
+  PutUnsigned(static_cast<uint32_t>(v), &bytes_);
+  return *this;
+}
+UlogPayload& UlogPayload::U64(uint64_t v) {
+  PutUnsigned(v, &bytes_);
+  return *this;
+}
 UlogPayload& UlogPayload::F32(float v) {
   uint32_t bits;
   std::memcpy(&bits, &v, sizeof(bits));
@@ -42,7 +57,10 @@ UlogPayload& UlogPayload::F64(double v) {
   std::memcpy(&bits, &v, sizeof(bits));
   return U64(bits);
 }
-UlogPayload& UlogPayload::Bytes(const std::string& bytes) { bytes_ += bytes; return *this; }
+UlogPayload& UlogPayload::Bytes(const std::string& bytes) {
+  bytes_ += bytes;
+  return *this;
+}
 
 UlogWriter::UlogWriter(uint64_t start_timestamp_us) {
   bytes_.assign(kUlogMagic, sizeof(kUlogMagic));
@@ -52,7 +70,9 @@ UlogWriter::UlogWriter(uint64_t start_timestamp_us) {
 }
 
 void UlogWriter::Message(char type, const std::string& body) {
-  if (body.size() > 65535) throw UserError("ULog writer: a message of " + std::to_string(body.size()) + " bytes is too long");
+  if (body.size() > 65535)
+    throw UserError("ULog writer: a message of " + std::to_string(body.size()) +
+                    " bytes is too long");
   PutUnsigned(static_cast<uint16_t>(body.size()), &bytes_);
   bytes_.push_back(type);
   bytes_ += body;
@@ -78,7 +98,9 @@ void UlogWriter::Data(uint16_t msg_id, const std::string& payload) {
   Message('D', UlogPayload().U16(msg_id).Bytes(payload).str());
 }
 
-void UlogWriter::Dropout(uint16_t duration_ms) { Message('O', UlogPayload().U16(duration_ms).str()); }
+void UlogWriter::Dropout(uint16_t duration_ms) {
+  Message('O', UlogPayload().U16(duration_ms).str());
+}
 
 void UlogWriter::Sync() { Message('S', "\x2F\x73\x13\x20\x25\x0C\xBB\x12"); }
 
@@ -99,31 +121,38 @@ std::string FormatImuUlog(const ImuData& data, const std::string& simulated_orig
   const size_t n = data.t_s.size();
   if (data.gyro_in_imu.size() != n) throw UserError("IMU log: gyro and time lengths differ");
   const bool accel = data.has_accel();
-  if (accel && data.accel_in_imu.size() != n) throw UserError("IMU log: accelerometer and time lengths differ");
+  if (accel && data.accel_in_imu.size() != n)
+    throw UserError("IMU log: accelerometer and time lengths differ");
   UlogWriter w(0);
   w.Info("sys_name", "bifilar simulate");
   if (!simulated_origin.empty()) w.Info(kSimulatedUlogInfoKey, simulated_origin);
   if (accel) {
     // PX4's sensor_combined; the trailing padding field is not logged (spec).
-    w.Format("sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
-             "int32_t accelerometer_timestamp_relative;float[3] accelerometer_m_s2;"
-             "uint32_t accelerometer_integral_dt;uint8_t accelerometer_clipping;"
-             "uint8_t[3] _padding0;");
+    w.Format(
+        "sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
+        "int32_t accelerometer_timestamp_relative;float[3] accelerometer_m_s2;"
+        "uint32_t accelerometer_integral_dt;uint8_t accelerometer_clipping;"
+        "uint8_t[3] _padding0;");
     w.AddLogged("sensor_combined", 0, 0);
   } else {
-    w.Format("vehicle_angular_velocity:uint64_t timestamp;uint64_t timestamp_sample;float[3] xyz;"
-             "uint8_t[4] _padding0;");
+    w.Format(
+        "vehicle_angular_velocity:uint64_t timestamp;uint64_t timestamp_sample;float[3] xyz;"
+        "uint8_t[4] _padding0;");
     w.AddLogged("vehicle_angular_velocity", 0, 0);
   }
   for (size_t k = 0; k < n; ++k) {
-    bool finite = std::isfinite(data.t_s[k]) && data.gyro_in_imu[k].allFinite() && data.t_s[k] >= 0.0;
+    bool finite =
+        std::isfinite(data.t_s[k]) && data.gyro_in_imu[k].allFinite() && data.t_s[k] >= 0.0;
     if (accel) finite = finite && data.accel_in_imu[k].allFinite();
-    if (!finite) throw UserError("IMU log: sample " + std::to_string(k) + " is not finite (or its time is negative)");
+    if (!finite)
+      throw UserError("IMU log: sample " + std::to_string(k) +
+                      " is not finite (or its time is negative)");
     const uint64_t t_us = static_cast<uint64_t>(std::llround(data.t_s[k] * 1e6));
     UlogPayload p;
     p.U64(t_us);
     if (accel) {
-      const uint32_t dt_us = k > 0 ? static_cast<uint32_t>(std::llround((data.t_s[k] - data.t_s[k - 1]) * 1e6)) : 0;
+      const uint32_t dt_us =
+          k > 0 ? static_cast<uint32_t>(std::llround((data.t_s[k] - data.t_s[k - 1]) * 1e6)) : 0;
       for (int i = 0; i < 3; ++i) p.F32(static_cast<float>(data.gyro_in_imu[k][i]));
       p.U32(dt_us).I32(0);
       for (int i = 0; i < 3; ++i) p.F32(static_cast<float>(data.accel_in_imu[k][i]));

@@ -68,8 +68,8 @@ class UlogWriter {
 // gyro_rad[3], accelerometer_m_s2[3] and PX4's other fields, float32 values, a trailing padding
 // field); gyro-only, topic `vehicle_angular_velocity` (timestamp, timestamp_sample, xyz[3]).
 // Timestamps are rounded to whole microseconds. Throws UserError on mismatched lengths or
-// non-finite values. A non-empty `simulated_origin` (SimulatedLogOrigin, pipeline/logs/simulated_log.h)
-// adds the information message that marks the log as simulated.
+// non-finite values. A non-empty `simulated_origin` (SimulatedLogOrigin,
+// pipeline/logs/simulated_log.h) adds the information message that marks the log as simulated.
 std::string FormatImuUlog(const ImuData& data, const std::string& simulated_origin = "");
 
 // FormatImuUlog written atomically to `path` (gzip-compressed when it ends in ".gz").

@@ -13,7 +13,8 @@ void PutEstimate(json* j, const std::string& key, const EllipseEstimate& e) {
   const bool ok = e.defined;
   (*j)[key] = ok ? JsonNumber(e.value) : json(nullptr);
   (*j)[key + "_std"] = ok ? JsonNumber(e.std) : json(nullptr);
-  (*j)[key + "_ci95"] = ok ? json::array({JsonNumber(e.ci_lo), JsonNumber(e.ci_hi)}) : json(nullptr);
+  (*j)[key + "_ci95"] =
+      ok ? json::array({JsonNumber(e.ci_lo), JsonNumber(e.ci_hi)}) : json(nullptr);
 }
 
 json ParametersToJson(const EllipseParameters& p, bool tau_defined) {
@@ -93,9 +94,11 @@ json EllipseResultToJson(const EllipseResult& r, bool with_residuals) {
   j["confidence_interval_method"] =
       r.bootstrap_replicates > 0 ? "parametric_bootstrap_percentile" : "t_quantile";
   j["bootstrap_replicates"] = r.bootstrap_replicates;
-  j["coefficients_kg_m2"] = {{"A", JsonNumber(r.a_kg_m2)}, {"B", JsonNumber(r.b_kg_m2)}, {"C", JsonNumber(r.c_kg_m2)}};
+  j["coefficients_kg_m2"] = {
+      {"A", JsonNumber(r.a_kg_m2)}, {"B", JsonNumber(r.b_kg_m2)}, {"C", JsonNumber(r.c_kg_m2)}};
   json cov = json::array();
-  for (const auto& row : r.cov_abc) cov.push_back({JsonNumber(row[0]), JsonNumber(row[1]), JsonNumber(row[2])});
+  for (const auto& row : r.cov_abc)
+    cov.push_back({JsonNumber(row[0]), JsonNumber(row[1]), JsonNumber(row[2])});
   j["cov_abc_kg2_m4"] = cov;
   j["fits"] = {{"linear_ls", SolverToJson(r.linear, r.tau_defined)},
                {"nelder_mead", SolverToJson(r.nelder_mead, r.tau_defined)},

@@ -141,7 +141,8 @@ json SweepToJson(const AmplitudeSweep& s) {
                      {"inertia_std_kg_m2", b.ok ? JsonNumber(b.inertia_std_kg_m2) : json(nullptr)},
                      {"ok", b.ok}});
   }
-  json j = {{"evaluated", s.evaluated}, {"note", s.note}, {"bands", bands}, {"low_band", s.low_band}};
+  json j = {
+      {"evaluated", s.evaluated}, {"note", s.note}, {"bands", bands}, {"low_band", s.low_band}};
   if (s.evaluated) {
     j["trend_exponent"] = JsonNumber(s.trend_exponent);
     j["trend_coeff_per_deg_p"] = JsonNumber(s.trend_coeff);
@@ -338,7 +339,8 @@ std::string Join(const std::vector<std::string>& parts, const char* separator) {
 double TotalPercent(const TraceRecord& r) {
   if (std::isfinite(r.inertia_std_total_kg_m2) && r.inertia_kg_m2 > 0.0)
     return 100.0 * r.inertia_std_total_kg_m2 / r.inertia_kg_m2;
-  if (r.inertia_total_kg_m2 > 0.0) return 100.0 * r.inertia_total_std_total_kg_m2 / r.inertia_total_kg_m2;
+  if (r.inertia_total_kg_m2 > 0.0)
+    return 100.0 * r.inertia_total_std_total_kg_m2 / r.inertia_total_kg_m2;
   return NAN;
 }
 
@@ -379,10 +381,9 @@ void AddTotalUncertainty(const TraceRecord& r, json* u) {
           ? JsonNumber(100.0 * r.inertia_total_std_total_kg_m2 / r.inertia_total_kg_m2)
           : json(nullptr);
   (*u)["configured_inputs_assumed"] = r.budget_assumed;
-  (*u)["assumed_inputs"] = r.budget_assumed
-                               ? json({{"filar_length_std_m", kAssumedLengthStdM},
-                                       {"filar_separation_std_m", kAssumedLengthStdM}})
-                               : json(nullptr);
+  (*u)["assumed_inputs"] = r.budget_assumed ? json({{"filar_length_std_m", kAssumedLengthStdM},
+                                                    {"filar_separation_std_m", kAssumedLengthStdM}})
+                                            : json(nullptr);
   (*u)["calibrated"] = r.calibrated;
   (*u)["calibration_relative_std"] = r.calibration_relative_std;
 }
@@ -420,7 +421,8 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
   j["bias_rad_per_s"] = JsonNumber(r.bias_rad_per_s);
   j["residual_rms_rad_per_s"] = JsonNumber(r.residual_rms_rad_per_s);
   j["noise_rms_rad_per_s"] = JsonNumber(r.noise_rms_rad_per_s);
-  j["pitch_measured_deg"] = r.pitch_measured_deg ? JsonNumber(*r.pitch_measured_deg) : json(nullptr);
+  j["pitch_measured_deg"] =
+      r.pitch_measured_deg ? JsonNumber(*r.pitch_measured_deg) : json(nullptr);
   j["roll_measured_deg"] = r.roll_measured_deg ? JsonNumber(*r.roll_measured_deg) : json(nullptr);
   j["model"] = r.model;
   j["iterations"] = r.iterations;
@@ -434,10 +436,10 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
   j["figure"] = r.figure;
   j["figures"] = r.figures;
   j["sweep_figure"] = r.sweep_figure;
-  j["swing_axis_in_imu"] = std::isfinite(r.swing_axis_in_imu[0])
-                               ? json::array({r.swing_axis_in_imu[0], r.swing_axis_in_imu[1],
-                                              r.swing_axis_in_imu[2]})
-                               : json(nullptr);
+  j["swing_axis_in_imu"] =
+      std::isfinite(r.swing_axis_in_imu[0])
+          ? json::array({r.swing_axis_in_imu[0], r.swing_axis_in_imu[1], r.swing_axis_in_imu[2]})
+          : json(nullptr);
   j["secondary_motion_ratio"] = JsonNumber(r.secondary_motion_ratio);
   j["rms_over_noise"] = JsonNumber(r.rms_over_noise);
   j["residual_autocorrelation"] = {{"lag1", JsonNumber(r.residual_autocorr_lag1)},
@@ -452,10 +454,11 @@ json TraceRecordToJson(const TraceRecord& r, bool campaign_fields) {
   if (std::isfinite(r.repeat_scatter_std_kg_m2))
     j["uncertainty"]["repeat_scatter_kg_m2"] = r.repeat_scatter_std_kg_m2;
   if (std::isfinite(r.amplitude_correction_kg_m2)) {
-    j["amplitude_correction"] = {{"correction_kg_m2", JsonNumber(r.amplitude_correction_kg_m2)},
-                                 {"std_kg_m2", JsonNumber(r.amplitude_correction_std_kg_m2)},
-                                 {"from_amplitude_deg", JsonNumber(r.amplitude_correction_from_deg)},
-                                 {"to_amplitude_deg", 0.0}};
+    j["amplitude_correction"] = {
+        {"correction_kg_m2", JsonNumber(r.amplitude_correction_kg_m2)},
+        {"std_kg_m2", JsonNumber(r.amplitude_correction_std_kg_m2)},
+        {"from_amplitude_deg", JsonNumber(r.amplitude_correction_from_deg)},
+        {"to_amplitude_deg", 0.0}};
   }
   j["inertia_total_std_total_kg_m2"] = JsonNumber(r.inertia_total_std_total_kg_m2);
   AddTotalUncertainty(r, &j["uncertainty"]);
@@ -515,26 +518,32 @@ json CalibrationToJson(const RigCalibrationResult& c) {
           {"factor", JsonNumber(c.factor)},
           {"factor_std", JsonNumber(c.factor_std)},
           {"factor_relative_std", JsonNumber(c.factor_rel_std)},
-          {"relative_std_parts", {{"reference_inertia", JsonNumber(c.rel_std_reference)},
-                                  {"reference_swings", JsonNumber(c.rel_std_swings)},
-                                  {"rig_inertia", JsonNumber(c.rel_std_rig)}}},
-          {"nominal", {{"filar_length_m", JsonNumber(c.filar_length_m)},
-                       {"filar_separation_m", JsonNumber(c.nominal_separation_m)},
-                       {"d2_over_l_m", JsonNumber(c.nominal_d2_over_l_m)}}},
-          {"effective", {{"filar_length_m", JsonNumber(c.filar_length_m)},
-                         {"filar_separation_m", JsonNumber(c.effective_separation_m)},
-                         {"d2_over_l_m", JsonNumber(c.effective_d2_over_l_m)}}},
-          {"reference", {{"inertia_kg_m2", JsonNumber(c.reference_inertia_kg_m2)},
-                         {"inertia_std_kg_m2", JsonNumber(c.reference_inertia_std_kg_m2)},
-                         {"mass_kg", JsonNumber(c.reference_mass_kg)}}},
-          {"swings", {{"n", c.n_swings},
-                      {"logs", c.logs},
-                      {"total_mean_kg_m2", JsonNumber(c.swings_total_kg_m2)},
-                      {"total_standard_error_kg_m2", JsonNumber(c.swings_total_std_kg_m2)},
-                      {"scatter_kg_m2", JsonNumber(c.swings_scatter_kg_m2)}}},
-          {"rig_inertia", {{"source", c.rig_inertia_source},
-                           {"inertia_kg_m2", JsonNumber(c.rig_inertia_kg_m2)},
-                           {"inertia_std_kg_m2", JsonNumber(c.rig_inertia_std_kg_m2)}}},
+          {"relative_std_parts",
+           {{"reference_inertia", JsonNumber(c.rel_std_reference)},
+            {"reference_swings", JsonNumber(c.rel_std_swings)},
+            {"rig_inertia", JsonNumber(c.rel_std_rig)}}},
+          {"nominal",
+           {{"filar_length_m", JsonNumber(c.filar_length_m)},
+            {"filar_separation_m", JsonNumber(c.nominal_separation_m)},
+            {"d2_over_l_m", JsonNumber(c.nominal_d2_over_l_m)}}},
+          {"effective",
+           {{"filar_length_m", JsonNumber(c.filar_length_m)},
+            {"filar_separation_m", JsonNumber(c.effective_separation_m)},
+            {"d2_over_l_m", JsonNumber(c.effective_d2_over_l_m)}}},
+          {"reference",
+           {{"inertia_kg_m2", JsonNumber(c.reference_inertia_kg_m2)},
+            {"inertia_std_kg_m2", JsonNumber(c.reference_inertia_std_kg_m2)},
+            {"mass_kg", JsonNumber(c.reference_mass_kg)}}},
+          {"swings",
+           {{"n", c.n_swings},
+            {"logs", c.logs},
+            {"total_mean_kg_m2", JsonNumber(c.swings_total_kg_m2)},
+            {"total_standard_error_kg_m2", JsonNumber(c.swings_total_std_kg_m2)},
+            {"scatter_kg_m2", JsonNumber(c.swings_scatter_kg_m2)}}},
+          {"rig_inertia",
+           {{"source", c.rig_inertia_source},
+            {"inertia_kg_m2", JsonNumber(c.rig_inertia_kg_m2)},
+            {"inertia_std_kg_m2", JsonNumber(c.rig_inertia_std_kg_m2)}}},
           {"iterations", c.iterations},
           {"warnings", c.warnings}};
 }
@@ -628,8 +637,9 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   j["schema_version"] = kResultsSchemaVersion;
   // Relative to the working folder when below it (results do not carry the machine's layout).
   std::error_code ec;
-  const std::string relative =
-      std::filesystem::path(config.file).lexically_relative(std::filesystem::current_path(ec)).string();
+  const std::string relative = std::filesystem::path(config.file)
+                                   .lexically_relative(std::filesystem::current_path(ec))
+                                   .string();
   j["config_file"] = !relative.empty() && relative.rfind("..", 0) != 0 ? relative : config.file;
   j["config"] = config.text;
   // The aircraft's mass, for export (not measured by the bifilar; from the config).
@@ -644,15 +654,15 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   // The fit settings in effect: the config's, with the command line's overrides (--integrator),
   // which the config text above does not show.
   const GlitchOptions& glitch = config.fit.glitch;
-  j["fit_settings"] = {
-      {"model", ToString(config.fit.model)},
-      {"integrator", ToString(config.fit.integrator)},
-      {"amplitude_sweep", config.fit.sweep.amplitude_sweep},
-      {"glitch", {{"enabled", glitch.enabled},
-                  {"threshold_sigmas", glitch.threshold_sigmas},
-                  {"range_factor", glitch.range_factor},
-                  {"excursion_fraction", glitch.excursion_fraction},
-                  {"max_fraction", glitch.max_fraction}}}};
+  j["fit_settings"] = {{"model", ToString(config.fit.model)},
+                       {"integrator", ToString(config.fit.integrator)},
+                       {"amplitude_sweep", config.fit.sweep.amplitude_sweep},
+                       {"glitch",
+                        {{"enabled", glitch.enabled},
+                         {"threshold_sigmas", glitch.threshold_sigmas},
+                         {"range_factor", glitch.range_factor},
+                         {"excursion_fraction", glitch.excursion_fraction},
+                         {"max_fraction", glitch.max_fraction}}}};
   j["summary"] = CampaignSummaryToJson(result.summary);
   json rig;
   rig["filar_length_m"] = config.filar_length_m;
@@ -660,8 +670,8 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   rig["mass_kg"] = config.rig_mass_kg;
   rig["aircraft_mass_kg"] = config.aircraft_mass_kg;
   rig["gravity_mps2"] = config.gravity_mps2;
-  rig["inertia_source"] = !config.rig_inertia_given ? "none"
-                          : config.rig_inertia.kind == RigInertiaSpec::Kind::kValue   ? "value"
+  rig["inertia_source"] = !config.rig_inertia_given                                 ? "none"
+                          : config.rig_inertia.kind == RigInertiaSpec::Kind::kValue ? "value"
                           : config.rig_inertia.kind == RigInertiaSpec::Kind::kTable ? "table"
                                                                                     : "tare";
   rig["inertia_kg_m2"] = JsonNumber(result.rig_inertia_kg_m2);
@@ -716,7 +726,8 @@ json ResultsToJson(const CampaignConfig& config, const CampaignResult& result) {
   j["ellipse"] = result.ellipse;
   j["tensor"] = result.tensor;
   if (result.physical) j["physical"] = PhysicalCheckToJson(*result.physical);
-  j["figures"] = {{"moments", result.moments_figure}, {"polar", result.polar_figure},
+  j["figures"] = {{"moments", result.moments_figure},
+                  {"polar", result.polar_figure},
                   {"tensor", result.tensor_figure}};
   return j;
 }
@@ -738,25 +749,23 @@ std::string TracesCsv(const CampaignResult& result) {
   for (const TraceRecord& r : result.traces) {
     out << Cell(r.file) << ',' << ToString(r.role) << ',' << ToString(r.status) << ','
         << Cell(r.pitch_nominal_deg ? *r.pitch_nominal_deg : NAN) << ','
-        << Cell(r.pitch_measured_deg ? *r.pitch_measured_deg : NAN) << ','
-        << Cell(r.pitch_used_deg) << ',' << Cell(r.inertia_total_kg_m2) << ','
-        << Cell(r.inertia_total_std_kg_m2) << ',' << Cell(r.period_s) << ','
-        << Cell(r.frequency_hz) << ',' << Cell(r.small_angle_inertia_total_kg_m2) << ','
-        << Cell(r.rig_inertia_kg_m2) << ','
+        << Cell(r.pitch_measured_deg ? *r.pitch_measured_deg : NAN) << ',' << Cell(r.pitch_used_deg)
+        << ',' << Cell(r.inertia_total_kg_m2) << ',' << Cell(r.inertia_total_std_kg_m2) << ','
+        << Cell(r.period_s) << ',' << Cell(r.frequency_hz) << ','
+        << Cell(r.small_angle_inertia_total_kg_m2) << ',' << Cell(r.rig_inertia_kg_m2) << ','
         << Cell(r.inertia_kg_m2) << ',' << Cell(r.inertia_std_kg_m2) << ','
         << Cell(r.inertia_total_std_total_kg_m2) << ',' << Cell(r.inertia_std_total_kg_m2) << ','
         << Cell(TotalPercent(r)) << ',' << Cell(TermsCell(r)) << ','
-        << (r.budget_assumed ? "true" : "false") << ',' << Cell(r.budget_total_std_kg_m2) << ',' << Cell(r.drag_coeff_kg_m2) << ','
-        << Cell(r.viscous_coeff_kg_m2_per_s) << ',' << Cell(r.window_s[0]) << ','
-        << Cell(r.window_s[1]) << ',' << Cell(r.amplitude_deg[0]) << ','
-        << Cell(r.amplitude_deg[1]) << ',' << Cell(r.bias_rad_per_s) << ','
+        << (r.budget_assumed ? "true" : "false") << ',' << Cell(r.budget_total_std_kg_m2) << ','
+        << Cell(r.drag_coeff_kg_m2) << ',' << Cell(r.viscous_coeff_kg_m2_per_s) << ','
+        << Cell(r.window_s[0]) << ',' << Cell(r.window_s[1]) << ',' << Cell(r.amplitude_deg[0])
+        << ',' << Cell(r.amplitude_deg[1]) << ',' << Cell(r.bias_rad_per_s) << ','
         << Cell(r.residual_rms_rad_per_s) << ',' << Cell(r.model) << ',' << r.iterations << ','
         << Cell(r.fit_seconds) << ',' << (r.from_cache ? "true" : "false") << ','
         << Cell(r.inertia_source) << ',' << Cell(r.inertia_window_kg_m2) << ','
         << Cell(r.model_inadequacy_std_kg_m2) << ',' << Cell(r.secondary_motion_ratio) << ','
-        << Cell(r.rms_over_noise) << ',' << Cell(r.residual_ar1_phi) << ','
-        << r.sweep.bands.size() << ','
-        << (r.sweep.evaluated ? Cell(r.sweep.trend_percent_per_10deg) : "") << ','
+        << Cell(r.rms_over_noise) << ',' << Cell(r.residual_ar1_phi) << ',' << r.sweep.bands.size()
+        << ',' << (r.sweep.evaluated ? Cell(r.sweep.trend_percent_per_10deg) : "") << ','
         << (r.sweep.evaluated ? Cell(r.sweep.trend_z) : "") << ','
         << (r.sweep.evaluated ? (r.sweep.trend_detected ? "true" : "false") : "") << ','
         << Cell(SweepSummary(r.sweep)) << ',' << Cell(Join(r.warnings, " | ")) << ','

@@ -109,7 +109,8 @@ std::vector<double> ResultsReader::Nums(const char* key) const {
   if (v == nullptr) return out;
   if (!v->is_array()) Mistyped(Where(key), "a list", *v);
   for (const json& element : *v) {
-    if (!element.is_number() && !element.is_null()) Mistyped(Where(key) + "[]", "a number", element);
+    if (!element.is_number() && !element.is_null())
+      Mistyped(Where(key) + "[]", "a number", element);
     out.push_back(element.is_number() ? element.get<double>() : NAN);
   }
   return out;

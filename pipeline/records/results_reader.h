@@ -25,15 +25,15 @@ class ResultsReader {
   explicit ResultsReader(const nlohmann::json& node, KeyLog* log = nullptr, std::string path = "");
 
   bool IsObject() const { return node_->is_object(); }
-  bool Has(const char* key) const;                 // present and not null
-  double Num(const char* key) const;               // NaN unless a number
+  bool Has(const char* key) const;    // present and not null
+  double Num(const char* key) const;  // NaN unless a number
   // A number or null/missing (NaN); anything else, or a non-finite number, throws UserError
   // "`file`: PATH.KEY is not a number (TYPE)" (export, which must not write a wrong file).
   double NumOrNull(const char* key, const std::string& file) const;
-  std::string Str(const char* key) const;          // "" unless text
+  std::string Str(const char* key) const;  // "" unless text
   bool Bool(const char* key, bool fallback = false) const;
   int Int(const char* key, int fallback = 0) const;
-  ResultsReader Get(const char* key) const;        // a child (null when missing)
+  ResultsReader Get(const char* key) const;                 // a child (null when missing)
   std::vector<ResultsReader> Items(const char* key) const;  // an array's elements
   std::vector<double> Nums(const char* key) const;          // NaN for non-numbers
   std::vector<std::string> Strs(const char* key) const;     // text elements only

@@ -21,7 +21,8 @@ void PutEstimate(json* j, const std::string& key, const TensorEstimate& e) {
   const bool ok = e.observable && std::isfinite(e.value);
   (*j)[key] = ok ? JsonNumber(e.value) : json(nullptr);
   (*j)[key + "_std"] = ok ? JsonNumber(e.std) : json(nullptr);
-  (*j)[key + "_ci95"] = ok ? json::array({JsonNumber(e.ci_lo), JsonNumber(e.ci_hi)}) : json(nullptr);
+  (*j)[key + "_ci95"] =
+      ok ? json::array({JsonNumber(e.ci_lo), JsonNumber(e.ci_hi)}) : json(nullptr);
 }
 
 json ComponentsOrder() {
@@ -79,8 +80,8 @@ void PutPrincipal(const TensorResult& r, json* j) {
     for (int k = 0; k < 3; ++k) {
       moments.push_back(JsonNumber(r.principal_moments[k].value));
       stds.push_back(JsonNumber(r.principal_moments[k].std));
-      cis.push_back(json::array({JsonNumber(r.principal_moments[k].ci_lo),
-                                 JsonNumber(r.principal_moments[k].ci_hi)}));
+      cis.push_back(json::array(
+          {JsonNumber(r.principal_moments[k].ci_lo), JsonNumber(r.principal_moments[k].ci_hi)}));
       axes.push_back(Vector3(r.principal_axes[k]));
       axes_std.push_back(JsonNumber(r.principal_axes_std_deg[k]));
     }
@@ -208,7 +209,8 @@ json TensorScatterLogs(const TensorResult& r, const TensorJsonContext& c) {
   std::stable_sort(logs.begin(), logs.end(), [](const auto& a, const auto& b) {
     return std::fabs(a.first) > std::fabs(b.first);
   });
-  for (const auto& [ratio, file] : logs) out.push_back({{"file", file}, {"residual_over_std", ratio}});
+  for (const auto& [ratio, file] : logs)
+    out.push_back({{"file", file}, {"residual_over_std", ratio}});
   return out;
 }
 
@@ -236,10 +238,12 @@ json PhysicalCheckToJson(const PhysicalCheck& check) {
   j["status"] = PhysicalStatusName(check.status);
   j["checked"] = check.checked;
   j["worst"] = check.Worst() ? one(*check.Worst()) : json(nullptr);
-  j["threshold_z"] = std::isfinite(check.threshold_z) ? JsonNumber(check.threshold_z) : json(nullptr);
+  j["threshold_z"] =
+      std::isfinite(check.threshold_z) ? JsonNumber(check.threshold_z) : json(nullptr);
   j["attitude"] = check.attitude;
-  j["z_without_attitude"] =
-      std::isfinite(check.z_without_attitude) ? JsonNumber(check.z_without_attitude) : json(nullptr);
+  j["z_without_attitude"] = std::isfinite(check.z_without_attitude)
+                                ? JsonNumber(check.z_without_attitude)
+                                : json(nullptr);
   j["message"] = check.message;
   json all = json::array();
   for (const PhysicalInequality& q : check.inequalities) all.push_back(one(q));
@@ -280,8 +284,8 @@ json PlanarTensorJson(const EllipseResult& e, const TensorJsonContext& c) {
   PutEstimate(&j, "Ixy_kg_m2", TensorEstimate{0, 0, 0, 0, false});
   put("Ixz_kg_m2", e.ixz);
   PutEstimate(&j, "Iyz_kg_m2", TensorEstimate{0, 0, 0, 0, false});
-  j["observable"] = {{"Ixx", true}, {"Iyy", false}, {"Izz", true},
-                     {"Ixy", false}, {"Ixz", true}, {"Iyz", false}};
+  j["observable"] = {{"Ixx", true},  {"Iyy", false}, {"Izz", true},
+                     {"Ixy", false}, {"Ixz", true},  {"Iyz", false}};
   j["unobservable"] = json::array({"Iyy", "Ixy", "Iyz"});
   j["observable_combinations"] = json::array();
   // Ix = A - B, Iz = A + B, Ixz = C: their covariance from that of (A, B, C).
@@ -305,10 +309,11 @@ json PlanarTensorJson(const EllipseResult& e, const TensorJsonContext& c) {
   j["tensor_kg_m2"] = nullptr;
   j["principal_moments_kg_m2"] = nullptr;
   j["principal_axes"] = nullptr;
-  j["principal_in_plane"] = {{"tau_deg", e.tau_defined ? JsonNumber(e.tau_deg.value) : json(nullptr)},
-                             {"Ixp_kg_m2", e.tau_defined ? JsonNumber(e.ixp.value) : json(nullptr)},
-                             {"Izp_kg_m2", e.tau_defined ? JsonNumber(e.izp.value) : json(nullptr)},
-                             {"note", "principal axes of the x-z plane, see the ellipse section"}};
+  j["principal_in_plane"] = {
+      {"tau_deg", e.tau_defined ? JsonNumber(e.tau_deg.value) : json(nullptr)},
+      {"Ixp_kg_m2", e.tau_defined ? JsonNumber(e.ixp.value) : json(nullptr)},
+      {"Izp_kg_m2", e.tau_defined ? JsonNumber(e.izp.value) : json(nullptr)},
+      {"note", "principal axes of the x-z plane, see the ellipse section"}};
   j["rank"] = 3;
   j["n_points"] = e.n_points;
   j["n_orientations"] = e.n_angles;

@@ -17,8 +17,8 @@ namespace bifilar {
 
 // What a campaign knows about each point and orientation (all optional: empty vectors).
 struct TensorJsonContext {
-  std::string mode;                 // "full_3d", "partial", "planar_xz"
-  double confidence = 0.95;         // of the intervals
+  std::string mode;                      // "full_3d", "partial", "planar_xz"
+  double confidence = 0.95;              // of the intervals
   double common_offset_std_kg_m2 = 0.0;  // the rig's, propagated into Ixx, Iyy, Izz
   double systematic_relative_std = NAN;  // L, D, masses, g, gyro scale: scales everything alike
   struct Point {
@@ -26,7 +26,7 @@ struct TensorJsonContext {
     double roll_deg = NAN, pitch_deg = NAN;  // the attitude used for its axis
     double std_kg_m2 = NAN;                  // the log's own std (names the logs of a scatter)
   };
-  std::vector<Point> points;        // one per fitted point, same order
+  std::vector<Point> points;  // one per fitted point, same order
   struct Orientation {
     double roll_deg = NAN, pitch_deg = NAN;  // nominal attitude of the group
   };

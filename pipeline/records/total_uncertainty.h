@@ -26,9 +26,9 @@
 namespace bifilar {
 
 // Term names, in the order of TotalUncertainty::terms.
-constexpr const char* kTermStatistical = "statistical";             // HAC, Birge-scaled (per log)
-constexpr const char* kTermModelInadequacy = "model_inadequacy";    // amplitude trend (per log)
-constexpr const char* kTermBetweenRepeat = "between_repeat";        // tau of --repeats (per log)
+constexpr const char* kTermStatistical = "statistical";           // HAC, Birge-scaled (per log)
+constexpr const char* kTermModelInadequacy = "model_inadequacy";  // amplitude trend (per log)
+constexpr const char* kTermBetweenRepeat = "between_repeat";      // tau of --repeats (per log)
 // The std of the amplitude correction of --repeats (pooled c moved to zero amplitude; per log).
 constexpr const char* kTermAmplitudeCorrection = "amplitude_correction";
 constexpr const char* kTermConfiguredInputs = "configured_inputs";  // L, D, m, g, gyro scale

@@ -124,7 +124,9 @@ WarningLine LineOfWarning(const std::string& warning, size_t max_chars) {
   return line;
 }
 
-const char* ToString(TraceStatus status) { return EnumToString(kTraceStatusNames, status, "error"); }
+const char* ToString(TraceStatus status) {
+  return EnumToString(kTraceStatusNames, status, "error");
+}
 bool ParseTraceStatus(const std::string& name, TraceStatus* status) {
   return ParseEnum(kTraceStatusNames, name, status);
 }
@@ -138,9 +140,12 @@ std::string TraceRoleAllowedValues() { return EnumAllowedValues(kTraceRoleNames)
 
 RigGeometry GeometryForRole(const CampaignConfig& config, TraceRole role) {
   switch (role) {
-    case TraceRole::kTare: return config.TareGeometry();
-    case TraceRole::kCalibration: return config.CalibrationGeometry();
-    case TraceRole::kAircraft: break;
+    case TraceRole::kTare:
+      return config.TareGeometry();
+    case TraceRole::kCalibration:
+      return config.CalibrationGeometry();
+    case TraceRole::kAircraft:
+      break;
   }
   return config.AircraftGeometry();
 }

@@ -18,14 +18,14 @@ namespace bifilar {
 enum class TraceStatus { kOk, kRejected, kError };
 const char* ToString(TraceStatus status);  // "ok", "rejected", "error"
 bool ParseTraceStatus(const std::string& name, TraceStatus* status);
-std::string TraceStatusAllowedValues();      // "ok, rejected or error"
+std::string TraceStatusAllowedValues();  // "ok, rejected or error"
 
 // An aircraft run, a tare log of the rig alone, or a reference swing of rig.calibration (rig +
 // reference object).
 enum class TraceRole { kAircraft, kTare, kCalibration };
-const char* ToString(TraceRole role);        // "aircraft", "tare", "calibration"
+const char* ToString(TraceRole role);  // "aircraft", "tare", "calibration"
 bool ParseTraceRole(const std::string& name, TraceRole* role);
-std::string TraceRoleAllowedValues();        // "aircraft, tare or calibration"
+std::string TraceRoleAllowedValues();  // "aircraft, tare or calibration"
 
 // One term of the systematic uncertainty budget of I (issue 3 item 7).
 struct BudgetTerm {
@@ -37,16 +37,16 @@ struct BudgetTerm {
 // Numbers that do not apply are NaN in memory and null in JSON.
 struct TraceRecord {
   // --- fit of the log (cached per content hash + fit settings) ---
-  std::string file;                      // path as shown to the user (relative to the config)
+  std::string file;  // path as shown to the user (relative to the config)
   TraceStatus status = TraceStatus::kError;
-  std::string message;                   // why rejected/error; warnings for ok
-  double inertia_total_kg_m2 = NAN;      // fitted I of everything suspended (kg m^2)
+  std::string message;               // why rejected/error; warnings for ok
+  double inertia_total_kg_m2 = NAN;  // fitted I of everything suspended (kg m^2)
   // Its per-trace ("stat") std (kg m^2): statistical (HAC) and model-inadequacy terms in
   // quadrature (and the between-repeat std with --repeats); the ellipse's weights. The budget
   // (L, D, m, g, gyro scale) is common-mode: in inertia_total_std_total_kg_m2, not here.
   double inertia_total_std_kg_m2 = NAN;
-  double drag_coeff_kg_m2 = NAN;         // K_D
-  double viscous_coeff_kg_m2_per_s = NAN;  // C
+  double drag_coeff_kg_m2 = NAN;                     // K_D
+  double viscous_coeff_kg_m2_per_s = NAN;            // C
   std::array<double, 2> window_s = {NAN, NAN};       // fitted window [t0, t1] (s)
   std::array<double, 2> amplitude_deg = {NAN, NAN};  // amplitude at start/end of the fitted part
   std::array<double, 2> amplitude_band_deg = {NAN, NAN};  // [min, max] band the fit was held to
@@ -58,33 +58,33 @@ struct TraceRecord {
   double period_s = NAN;
   double frequency_hz = NAN;
   double small_angle_inertia_total_kg_m2 = NAN;
-  double bias_rad_per_s = NAN;           // gyro bias b
+  double bias_rad_per_s = NAN;  // gyro bias b
   double residual_rms_rad_per_s = NAN;
-  double noise_rms_rad_per_s = NAN;      // gyro noise estimated from the rest segment
+  double noise_rms_rad_per_s = NAN;          // gyro noise estimated from the rest segment
   std::optional<double> pitch_measured_deg;  // from the accelerometer; none without one
   std::optional<double> roll_measured_deg;   // ... and its roll (docs/physics.md §3.5)
-  std::string model;                     // "full", "jardin", "linear"
+  std::string model;                         // "full", "jardin", "linear"
   int iterations = 0;
-  double fit_seconds = 0.0;              // wall time of this file's processing (s)
-  std::vector<BudgetTerm> budget;        // systematic contributions (L, D, m, g)
-  double budget_total_std_kg_m2 = NAN;   // root-sum-square of the budget terms
-  std::vector<std::string> flags;        // quality flags raised (rejecting ones and warnings)
-  std::vector<std::string> warnings;     // every warning (reader, window, fit), for every status
-  std::string figure;                    // fit figure file name inside OUT/figures/, "" if none
-  std::vector<std::string> figures;      // every figure written for this trace (paths)
-  std::string sweep_figure;              // amplitude-sweep figure name in OUT/figures/, "" if none
+  double fit_seconds = 0.0;             // wall time of this file's processing (s)
+  std::vector<BudgetTerm> budget;       // systematic contributions (L, D, m, g)
+  double budget_total_std_kg_m2 = NAN;  // root-sum-square of the budget terms
+  std::vector<std::string> flags;       // quality flags raised (rejecting ones and warnings)
+  std::vector<std::string> warnings;    // every warning (reader, window, fit), for every status
+  std::string figure;                   // fit figure file name inside OUT/figures/, "" if none
+  std::vector<std::string> figures;     // every figure written for this trace (paths)
+  std::string sweep_figure;             // amplitude-sweep figure name in OUT/figures/, "" if none
 
   // --- diagnostics (issue 8: what a user needs to judge a real log) ---
   std::array<double, 3> swing_axis_in_imu = {NAN, NAN, NAN};  // unit swing axis used
-  double secondary_motion_ratio = NAN;   // rate energy off the swing axis / on it
-  double rms_over_noise = NAN;           // residual RMS / noise estimate
-  double residual_autocorr_lag1 = NAN;   // rho_1 of the residuals
-  double residual_ar1_phi = NAN;         // AR(1) coefficient of the residuals
-  double prewhitened_autocorr_max = NAN; // whiteness statistic (after AR(1) prewhitening)
-  double inertia_window_kg_m2 = NAN;     // I of the fit over the whole window
-  std::string inertia_source;            // "window" or "low_amplitude_band"
-  double inertia_stat_std_kg_m2 = NAN;   // statistical (HAC) std of I
-  double inertia_iid_std_kg_m2 = NAN;    // textbook std assuming white residuals (comparison)
+  double secondary_motion_ratio = NAN;      // rate energy off the swing axis / on it
+  double rms_over_noise = NAN;              // residual RMS / noise estimate
+  double residual_autocorr_lag1 = NAN;      // rho_1 of the residuals
+  double residual_ar1_phi = NAN;            // AR(1) coefficient of the residuals
+  double prewhitened_autocorr_max = NAN;    // whiteness statistic (after AR(1) prewhitening)
+  double inertia_window_kg_m2 = NAN;        // I of the fit over the whole window
+  std::string inertia_source;               // "window" or "low_amplitude_band"
+  double inertia_stat_std_kg_m2 = NAN;      // statistical (HAC) std of I
+  double inertia_iid_std_kg_m2 = NAN;       // textbook std assuming white residuals (comparison)
   double model_inadequacy_std_kg_m2 = NAN;  // from the amplitude sweep's trend (0: none)
   // Between-repeat std added by `bifilar fit --repeats` (pipeline/trace/repeats.h); NaN: not
   // combined.
@@ -106,20 +106,20 @@ struct TraceRecord {
   bool calibrated = false;
   double calibration_relative_std = 0.0;  // (fraction) >= 0
   int hac_bandwidth = 0;
-  AmplitudeSweep sweep;                  // I against amplitude
+  AmplitudeSweep sweep;  // I against amplitude
 
   // --- campaign bookkeeping (not cached) ---
   TraceRole role = TraceRole::kAircraft;
-  std::string content_hash;              // 16 hex digits, FNV-1a 64 of the file bytes
-  std::string cache_key;                 // 16 hex digits, content hash + fit settings
+  std::string content_hash;  // 16 hex digits, FNV-1a 64 of the file bytes
+  std::string cache_key;     // 16 hex digits, content hash + fit settings
   bool from_cache = false;
   std::optional<double> pitch_nominal_deg;  // from the path or table
-  double pitch_used_deg = NAN;           // nominal or measured, per runs.pitch_source
+  double pitch_used_deg = NAN;              // nominal or measured, per runs.pitch_source
   std::optional<double> roll_nominal_deg;   // from the path or table ({roll_deg}, roll_deg)
-  double roll_used_deg = NAN;            // nominal (0 when none) or measured, like the pitch
-  double rig_inertia_kg_m2 = NAN;        // subtracted tare at this pitch
-  double inertia_kg_m2 = NAN;            // aircraft alone = total - rig (kg m^2)
-  double inertia_std_kg_m2 = NAN;        // sqrt(fit std^2 + rig std^2)
+  double roll_used_deg = NAN;               // nominal (0 when none) or measured, like the pitch
+  double rig_inertia_kg_m2 = NAN;           // subtracted tare at this pitch
+  double inertia_kg_m2 = NAN;               // aircraft alone = total - rig (kg m^2)
+  double inertia_std_kg_m2 = NAN;           // sqrt(fit std^2 + rig std^2)
   // Total uncertainty of inertia_kg_m2 (ComposeAircraftUncertainty): per-log terms, rig inertia,
   // and the scale terms (configured inputs, calibration); the last alone in aircraft_scale_std.
   double inertia_std_total_kg_m2 = NAN;

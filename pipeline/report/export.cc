@@ -190,7 +190,8 @@ std::string NonPhysical(const ExportInertia& in) {
     const Eigen::Vector3d p = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(t).eigenvalues();
     if (!(p[0] > 0)) {
       return "the tensor is not positive definite (principal moments " + Num(p[0]) + ", " +
-             Num(p[1]) + ", " + Num(p[2]) + " kg m^2): no rigid body has it, and simulators "
+             Num(p[1]) + ", " + Num(p[2]) +
+             " kg m^2): no rigid body has it, and simulators "
              "reject it";
     }
     if (p[2] > (p[0] + p[1]) * (1 + 1e-12)) {
@@ -211,8 +212,8 @@ std::string NonPhysical(const ExportInertia& in) {
     if (!(v[pr[0]] * v[pr[1]] > v[pr[2]] * v[pr[2]])) {
       return std::string("the product ") + TensorComponentName(pr[2]) + " = " + Num(v[pr[2]]) +
              " kg m^2 is too large for the moments " + TensorComponentName(pr[0]) + " = " +
-             Num(v[pr[0]]) + " and " + TensorComponentName(pr[1]) + " = " + Num(v[pr[1]]) +
-             " (" + TensorComponentName(pr[2]) + "^2 >= " + TensorComponentName(pr[0]) + " " +
+             Num(v[pr[0]]) + " and " + TensorComponentName(pr[1]) + " = " + Num(v[pr[1]]) + " (" +
+             TensorComponentName(pr[2]) + "^2 >= " + TensorComponentName(pr[0]) + " " +
              TensorComponentName(pr[1]) + "): the tensor is not positive definite";
     }
   }
@@ -371,7 +372,9 @@ void ReadExportMass(const ResultsReader& results, const json& j, const std::stri
       in->mass_std_kg = stored_mass_std_kg;
       in->mass_source = "config aircraft.mass_kg";
     }
-  } else if (!named([&] { return results.Str("config"); }).empty()) {  // written before `aircraft` existed
+  } else if (!named([&] {
+                return results.Str("config");
+              }).empty()) {  // written before `aircraft` existed
     try {
       const YAML::Node config = YAML::Load(results.Str("config"));
       const YAML::Node aircraft = config.IsMap() ? config["aircraft"] : YAML::Node();
@@ -389,11 +392,11 @@ void ReadExportMass(const ResultsReader& results, const json& j, const std::stri
       }
     } catch (const YAML::Exception& e) {
       in->warnings.push_back(name + ": the stored config could not be read for the mass (" +
-                            e.what() + ")");
+                             e.what() + ")");
     }
     if (!in->mass_source.empty() && !(std::isfinite(in->mass_kg) && in->mass_kg > 0)) {
       in->mass_problem = "aircraft.mass_kg = " + Num(in->mass_kg) +
-                        " in the config stored in this result is not a positive mass";
+                         " in the config stored in this result is not a positive mass";
       in->mass_kg = kNaN;
       in->mass_source.clear();
     }

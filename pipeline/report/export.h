@@ -62,7 +62,7 @@ std::string ExportFormatAllowedValues();  // "urdf, sdf, jsbsim, csv, mjcf or ar
 // The frame of a URDF/SDF <inertial>: FLU (REP 103, the default) or the body FRD as measured.
 enum class ExportFrame { kFlu, kFrd };
 bool ParseExportFrame(const std::string& name, ExportFrame* frame);  // false: no such name
-std::string ExportFrameAllowedValues();  // "flu or frd"
+std::string ExportFrameAllowedValues();                              // "flu or frd"
 
 struct ExportOptions {
   std::string results_path;  // results.json written by `bifilar process`
@@ -107,7 +107,7 @@ struct ExportInertia {
   std::string section;  // "tensor" or "ellipse": the results.json section read
   double mass_kg = std::numeric_limits<double>::quiet_NaN();
   double mass_std_kg = std::numeric_limits<double>::quiet_NaN();
-  std::string mass_source;   // "config aircraft.mass_kg", "--mass-kg" or "" (none)
+  std::string mass_source;  // "config aircraft.mass_kg", "--mass-kg" or "" (none)
   // Why the stored config gave no usable mass ("" when it gave one or has none): e.g.
   // "aircraft.mass_kg = -5 in the stored config is not a positive mass".
   std::string mass_problem;

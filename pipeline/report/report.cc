@@ -67,11 +67,20 @@ std::string Escape(const std::string& text) {
   out.reserve(text.size());
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -91,8 +100,8 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
   if (name.empty()) return "<p class=\"note\">(no figure)</p>";
   std::string bytes, why, path;
   if (!ResolveInsideFolder(out_dir, "figures", name, &path, &why)) {
-    return "<p class=\"note\">(figure " + Escape(PrintableAscii(name, 200)) + " refused: " +
-           Escape(why) + ")</p>";
+    return "<p class=\"note\">(figure " + Escape(PrintableAscii(name, 200)) +
+           " refused: " + Escape(why) + ")</p>";
   }
   if (!ReadRegularFile(path, FigureCap(), &bytes, &why)) {
     return "<p class=\"note\">(figure " + Escape(name) + " missing)</p>";
@@ -105,7 +114,8 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
       svg = bytes.substr(std::strlen(kCompactMark));  // compacted by an earlier report
     } else {
       const size_t start = bytes.find("<svg");
-      if (start == std::string::npos) return "<p class=\"note\">(figure " + Escape(name) + " unreadable)</p>";
+      if (start == std::string::npos)
+        return "<p class=\"note\">(figure " + Escape(name) + " unreadable)</p>";
       svg = CompactSvg(bytes.substr(start));
       // The figure's name is keyed by its content, so its compact form serves every later report:
       // stored in its place (atomically; best effort, a read-only folder only costs the time).
@@ -116,11 +126,12 @@ std::string Figure(const std::string& out_dir, const std::string& name, const st
       }
     }
     svg = PrefixSvgIds(svg, prefix);
-    svg.replace(0, 4, "<svg class=\"" + css_class + "\" role=\"img\" aria-label=\"" + Escape(alt) + "\"");
+    svg.replace(0, 4,
+                "<svg class=\"" + css_class + "\" role=\"img\" aria-label=\"" + Escape(alt) + "\"");
     return svg;
   }
-  return "<img class=\"" + css_class + "\" alt=\"" + Escape(alt) + "\" src=\"data:image/png;base64," +
-         Base64(bytes) + "\">";
+  return "<img class=\"" + css_class + "\" alt=\"" + Escape(alt) +
+         "\" src=\"data:image/png;base64," + Base64(bytes) + "\">";
 }
 
 // The amplitude-sweep figure beside trace `t`'s fit figure (I against amplitude,
@@ -213,8 +224,8 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
   // pipeline/records/total_uncertainty.h).
   const auto add = [&](const std::string& label, const Estimate& e, double total) {
     if (!e.defined) return;
-    items += (items.empty() ? "" : ", ") + label + " = " + u.Value(e.value, e.std) +
-             " &plusmn; " + u.Std(e.std) + " (stat)" +
+    items += (items.empty() ? "" : ", ") + label + " = " + u.Value(e.value, e.std) + " &plusmn; " +
+             u.Std(e.std) + " (stat)" +
              (std::isfinite(total) ? " &plusmn; " + u.Std(total) + " (total)" : std::string());
   };
   const double common = p.results.Get("total_uncertainty").Num("common_mode_relative_std");
@@ -224,9 +235,9 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
       return;
     }
     const R total = p.results.Get("total_uncertainty");
-    for (const auto& [key, label] : {std::make_pair("Ix_kg_m2", "I<sub>x</sub>"),
-                                     std::make_pair("Iz_kg_m2", "I<sub>z</sub>"),
-                                     std::make_pair("Ixz_kg_m2", "I<sub>xz</sub>")}) {
+    for (const auto& [key, label] :
+         {std::make_pair("Ix_kg_m2", "I<sub>x</sub>"), std::make_pair("Iz_kg_m2", "I<sub>z</sub>"),
+          std::make_pair("Ixz_kg_m2", "I<sub>xz</sub>")}) {
       add(label, GetEstimate(p.ellipse, key), total.Num(key));
     }
     h << "<p class=\"result\">Result: " << items << " " << u.name
@@ -240,7 +251,8 @@ void WriteHeadline(const ReportPage& p, std::ostream& h) {
   for (int k = 0; k < kTensorComponents; ++k) {
     const char* name = TensorComponentName(k);
     const Estimate e = GetEstimate(p.tensor, std::string(name) + "_kg_m2");
-    add(std::string("I<sub>") + (name + 1) + "</sub>", e, WithCommonModeScale(e.value, e.std, common));
+    add(std::string("I<sub>") + (name + 1) + "</sub>", e,
+        WithCommonModeScale(e.value, e.std, common));
   }
   h << "<p class=\"result\">Result: " << items << " " << u.name
     << " (&plusmn; 1 std: stat, then total; inertia tensor below).</p>\n";
@@ -260,8 +272,8 @@ void WritePhysicalBox(const ReportPage& p, std::ostream& h) {
     << (bad ? "Not physical" : "Borderline") << "</b>";
   if (worst.IsObject()) {
     h << ": " << Escape(worst.Str("inequality")) << " = " << Fmt(worst.Num("margin_kg_m2"), "%.4g")
-      << " &plusmn; " << Fmt(worst.Num("std_kg_m2"), "%.2g") << " kg m&sup2; (z = "
-      << Fmt(worst.Num("z"), "%.2f") << ", not physical at z &le; "
+      << " &plusmn; " << Fmt(worst.Num("std_kg_m2"), "%.2g")
+      << " kg m&sup2; (z = " << Fmt(worst.Num("z"), "%.2f") << ", not physical at z &le; "
       << Fmt(physical.Num("threshold_z"), "%.2f") << ")";
   }
   if (!physical.Str("attitude").empty()) h << "; attitude " << Escape(physical.Str("attitude"));
@@ -287,7 +299,8 @@ void WriteHeader(const ReportPage& p, std::ostream& h) {
   h << ". Traces: " << summary.n_traces << " (<span class=\"ok\">" << summary.n_ok << " ok</span>, "
     << summary.n_rejected << " rejected, " << summary.n_error
     << " error); fits reused from cache: " << summary.n_reused << ".</p>\n";
-  // Simulated logs say so in their warnings (pipeline/logs/simulated_log.h): the page says it first.
+  // Simulated logs say so in their warnings (pipeline/logs/simulated_log.h): the page says it
+  // first.
   int simulated = 0;
   std::string mark;  // the first log's own words, once for the page
   for (const TraceRow& row : p.traces) {
@@ -326,7 +339,8 @@ std::string WarningItem(const Units& u, const std::string& warning) {
 
 // A section's own warnings: one line each, the full text on click.
 void WriteNotes(const std::vector<std::string>& warnings, const Units& u, std::ostream& h) {
-  for (const std::string& w : warnings) h << "<div class=\"note\">" << WarningItem(u, w) << "</div>\n";
+  for (const std::string& w : warnings)
+    h << "<div class=\"note\">" << WarningItem(u, w) << "</div>\n";
 }
 
 // The points flagged as outliers (|studentized residual| > 3), named by their log.
@@ -364,13 +378,20 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
   // The total column (results.json total_uncertainty, pipeline/records/total_uncertainty.h): the
   // std and the common-mode scale terms in quadrature.
   const R total = p.results.Get("total_uncertainty");
-  h << kScrollOpen << "<table><tr><th class=\"l\">quantity</th><th>value</th><th>std (stat)</th>"
+  h << kScrollOpen
+    << "<table><tr><th class=\"l\">quantity</th><th>value</th><th>std (stat)</th>"
        "<th>std (total)</th><th>interval (stat)</th><th class=\"l\">unit</th></tr>\n";
-  struct Row { const char* key; const char* label; bool angle; };
-  for (const Row& row : {Row{"Ix_kg_m2", "I<sub>x</sub>", false}, Row{"Iz_kg_m2", "I<sub>z</sub>", false},
-                         Row{"Ixz_kg_m2", "I<sub>xz</sub>", false}, Row{"tau_deg", "&tau; (principal inclination)", true},
-                         Row{"Ixp_kg_m2", "I<sub>xp</sub> (principal)", false},
-                         Row{"Izp_kg_m2", "I<sub>zp</sub> (principal)", false}}) {
+  struct Row {
+    const char* key;
+    const char* label;
+    bool angle;
+  };
+  for (const Row& row :
+       {Row{"Ix_kg_m2", "I<sub>x</sub>", false}, Row{"Iz_kg_m2", "I<sub>z</sub>", false},
+        Row{"Ixz_kg_m2", "I<sub>xz</sub>", false},
+        Row{"tau_deg", "&tau; (principal inclination)", true},
+        Row{"Ixp_kg_m2", "I<sub>xp</sub> (principal)", false},
+        Row{"Izp_kg_m2", "I<sub>zp</sub> (principal)", false}}) {
     const Estimate e = GetEstimate(ellipse, row.key);
     h << "<tr><td class=\"l\">" << row.label << "</td>";
     const double e_total = total.Num(row.key);
@@ -392,11 +413,12 @@ void WriteTable2(const ReportPage& p, std::ostream& h) {
   h << "<p><b>std (stat)</b>: the scatter between trials and angles, the fits' own errors and the "
        "rig inertia's offset; the interval is its 95 % bootstrap interval. <b>std (total)</b> adds "
        "in quadrature the common-mode terms, one error shared by every moment: the "
-    << (calibrated ? "rig calibration (it replaces the uncertainties of L, D and g)"
-                   : std::string("uncertainties of L, D") +
-                         (assumed ? " (<b>assumed</b> &plusmn;1 mm: no <code>rig.uncertainties</code>)"
-                                  : "") +
-                         ", g")
+    << (calibrated
+            ? "rig calibration (it replaces the uncertainties of L, D and g)"
+            : std::string("uncertainties of L, D") +
+                  (assumed ? " (<b>assumed</b> &plusmn;1 mm: no <code>rig.uncertainties</code>)"
+                           : "") +
+                  ", g")
     << ", the masses and the gyro scale, &plusmn;" << Fmt(100.0 * common, "%.2f")
     << " % of each moment. It scales every moment alike and leaves &tau; unchanged. Read the total "
        "when you use a number; compare trials or set-ups with the stat std. Values are given to "
@@ -443,8 +465,9 @@ void WriteTable1AndRig(const ReportPage& p, std::ostream& h) {
   h << "<tr><td class=\"l\">raw data &sigma; (mean of per-" << (p.Planar() ? "angle" : "attitude")
     << " standard deviations)</td><td>" << u.Inertia(t1.Num("raw_sigma_kg_m2"), "%.3g")
     << "</td><td class=\"l\">" << u.name << "</td></tr>\n";
-  h << "<tr><td class=\"l\">coefficient of variation (mean per " << (p.Planar() ? "angle" : "attitude")
-    << ")</td><td>" << Fmt(t1.Num("cv_percent"), "%.3g") << "</td><td class=\"l\">%</td></tr>\n";
+  h << "<tr><td class=\"l\">coefficient of variation (mean per "
+    << (p.Planar() ? "angle" : "attitude") << ")</td><td>" << Fmt(t1.Num("cv_percent"), "%.3g")
+    << "</td><td class=\"l\">%</td></tr>\n";
   h << "<tr><td class=\"l\">regression RMSE" << (p.Planar() ? "" : " (tensor fit)") << "</td><td>"
     << u.Inertia(rmse, "%.3g") << "</td><td class=\"l\">" << u.name << "</td></tr>\n</table>\n";
   const R rig = p.results.Get("rig");
@@ -452,8 +475,8 @@ void WriteTable1AndRig(const ReportPage& p, std::ostream& h) {
   const double aircraft_mass = rig.Num("aircraft_mass_kg");
   const std::string source = rig.Str("inertia_source");
   const double rig_inertia = rig.Num("inertia_kg_m2");
-  h << "<p>Rig: L = " << Fmt(rig.Num("filar_length_m"), "%.4f") << " m, D = "
-    << Fmt(rig.Num("filar_separation_m"), "%.4f") << " m, rig mass "
+  h << "<p>Rig: L = " << Fmt(rig.Num("filar_length_m"), "%.4f")
+    << " m, D = " << Fmt(rig.Num("filar_separation_m"), "%.4f") << " m, rig mass "
     << Fmt(rig.Num("mass_kg"), "%.4g") << " kg, aircraft mass "
     << (aircraft_mass > 0 ? Fmt(aircraft_mass, "%.4g") + " kg" : std::string("not configured"))
     << ", g = " << Fmt(rig.Num("gravity_mps2"), "%.5f") << " m/s<sup>2</sup>. Rig inertia";
@@ -475,19 +498,24 @@ void WriteEllipseSection(ReportPage& p, std::ostream& h) {
   const std::string moments = p.figures.Str("moments"), polar = p.figures.Str("polar");
   if (!moments.empty()) {
     h << "<h2>Figure 3: moment of inertia against pitch</h2>\n"
-      << Figure(p.out_dir, moments, "moments of inertia against pitch angle", "fig", &p.figures_drawn) << "\n";
+      << Figure(p.out_dir, moments, "moments of inertia against pitch angle", "fig",
+                &p.figures_drawn)
+      << "\n";
   }
   if (!polar.empty()) {
     h << "<h2>Figure 4: ellipse of inertia</h2>\n"
-      << Figure(p.out_dir, polar, "polar plot of the ellipse of inertia", "fig", &p.figures_drawn) << "\n";
+      << Figure(p.out_dir, polar, "polar plot of the ellipse of inertia", "fig", &p.figures_drawn)
+      << "\n";
   }
   const std::vector<R> naca = ellipse.Items("naca");
   if (naca.empty()) return;
   const Estimate ixz = GetEstimate(ellipse, "Ixz_kg_m2");
-  h << "<h2>NACA Report 467 comparison</h2>\n<p>I<sub>xz</sub> from one oblique angle (paper Eq. 1) "
+  h << "<h2>NACA Report 467 comparison</h2>\n<p>I<sub>xz</sub> from one oblique angle (paper Eq. "
+       "1) "
        "against the multi-angle fit "
     << u.Value(ixz.value, ixz.std) << " &plusmn; " << u.Std(ixz.std) << " " << u.name << ".</p>\n"
-    << kScrollOpen << "<table><tr><th>pitch (deg)</th><th>I<sub>xz</sub> NACA 467</th><th>std</th>"
+    << kScrollOpen
+    << "<table><tr><th>pitch (deg)</th><th>I<sub>xz</sub> NACA 467</th><th>std</th>"
        "<th>difference from fit</th></tr>\n";
   for (const R& e : naca) {
     const double v = e.Num("Ixz_kg_m2"), s = e.Num("Ixz_std_kg_m2");
@@ -508,7 +536,8 @@ void WritePrincipal(const ReportPage& p, std::ostream& h) {
   const std::vector<std::vector<double>> axes = tensor.Rows("principal_axes");
   const auto at = [](const std::vector<double>& a, size_t i) { return i < a.size() ? a[i] : NAN; };
   const double common = p.results.Get("total_uncertainty").Num("common_mode_relative_std");
-  h << kScrollOpen << "<table><tr><th>principal</th><th>moment</th><th>std (stat)</th><th>std (total)</th>"
+  h << kScrollOpen
+    << "<table><tr><th>principal</th><th>moment</th><th>std (stat)</th><th>std (total)</th>"
        "<th>axis x</th><th>axis y</th><th>axis z</th><th>axis std (deg)</th></tr>\n";
   for (size_t k = 0; k < 3; ++k) {
     h << "<tr><td>" << k + 1 << "</td><td>" << u.Value(moments[k], at(stds, k)) << "</td><td>"
@@ -532,16 +561,20 @@ void WritePrincipal(const ReportPage& p, std::ostream& h) {
 void WriteOrientations(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
   const double common = p.results.Get("total_uncertainty").Num("common_mode_relative_std");
-  h << "<h2>Per-orientation residuals</h2>\n" << kScrollOpen
+  h << "<h2>Per-orientation residuals</h2>\n"
+    << kScrollOpen
     << "<table><tr><th>#</th><th>roll (deg)</th><th>pitch (deg)</th><th>axis in body</th>"
-       "<th>logs</th><th>mean (" << u.name << ")</th><th>std (stat)</th><th>std (total)</th>"
+       "<th>logs</th><th>mean ("
+    << u.name
+    << ")</th><th>std (stat)</th><th>std (total)</th>"
        "<th>fitted</th><th>residual</th><th>residual / expected</th></tr>\n";
   int index = 0;
   for (const R& o : p.tensor.Items("orientations")) {
     const std::vector<double> axis = o.Nums("axis_in_body");
     std::string axis_text = "&ndash;";
     if (axis.size() == 3) {
-      axis_text = "(" + Fixed(axis[0], 3) + ", " + Fixed(axis[1], 3) + ", " + Fixed(axis[2], 3) + ")";
+      axis_text =
+          "(" + Fixed(axis[0], 3) + ", " + Fixed(axis[1], 3) + ", " + Fixed(axis[2], 3) + ")";
     }
     const double z = o.Num("z"), scatter = o.Num("scatter_kg_m2");
     const double d_std = scatter > 0 ? scatter : std::fabs(o.Num("residual_kg_m2"));
@@ -571,13 +604,15 @@ void WriteTensorSection(ReportPage& p, std::ostream& h) {
   }
   h << "<p>" << tensor.Int("n_points") << " moments about " << tensor.Int("n_orientations")
     << " axes; design rank " << tensor.Int("rank") << " of 6, condition number "
-    << Fmt(tensor.Num("condition_number"), "%.3g") << "; covariance " << Escape(tensor.Str("covariance"));
+    << Fmt(tensor.Num("condition_number"), "%.3g") << "; covariance "
+    << Escape(tensor.Str("covariance"));
   const double scatter = tensor.Num("attitude_scatter_deg");
   if (scatter > 0) h << "; attitude scatter " << Fmt(scatter, "%.2f") << " deg";
   h << ". Products are positive (I<sub>xy</sub> = &int; x y dm); the tensor holds their negatives "
        "(docs/physics.md &sect;3.5). Values are given to the digits their std supports.</p>\n";
   const double common = p.results.Get("total_uncertainty").Num("common_mode_relative_std");
-  h << kScrollOpen << "<table><tr><th class=\"l\">component</th><th>value</th><th>std (stat)</th>"
+  h << kScrollOpen
+    << "<table><tr><th class=\"l\">component</th><th>value</th><th>std (stat)</th>"
        "<th>std (total)</th><th>interval (stat)</th><th class=\"l\">unit</th></tr>\n";
   for (int k = 0; k < kTensorComponents; ++k) {
     const char* name = TensorComponentName(k);
@@ -601,10 +636,12 @@ void WriteTensorSection(ReportPage& p, std::ostream& h) {
        "you use a number.</p>\n";
   const double relative = tensor.Num("relative_scatter");
   std::vector<std::pair<std::string, double>> logs;
-  for (const R& l : tensor.Items("scatter_logs")) logs.emplace_back(l.Str("file"), l.Num("residual_over_std"));
+  for (const R& l : tensor.Items("scatter_logs"))
+    logs.emplace_back(l.Str("file"), l.Num("residual_over_std"));
   if (relative > 0 || scatter > 0) {
     h << "<p class=\"warn\">The moments scatter "
-      << (relative > 0 ? "by " + Fmt(100.0 * relative, "%.2f") + " %" : "as if each axis were off by " + Fmt(scatter, "%.2f") + " deg")
+      << (relative > 0 ? "by " + Fmt(100.0 * relative, "%.2f") + " %"
+                       : "as if each axis were off by " + Fmt(scatter, "%.2f") + " deg")
       << " beyond their logs' stds; the fit is weighed by that (docs/method.md)"
       << (logs.empty() ? "" : "; " + Escape(ScatterLogsText(logs))) << ".</p>\n";
   }
@@ -625,14 +662,17 @@ void WriteTensorSection(ReportPage& p, std::ostream& h) {
 void WriteAngleTable(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
   std::vector<R> angles = p.results.Items("angles");
-  const auto roll = [](const R& a) { const double r = a.Num("roll_deg"); return std::isfinite(r) ? r : 0.0; };
+  const auto roll = [](const R& a) {
+    const double r = a.Num("roll_deg");
+    return std::isfinite(r) ? r : 0.0;
+  };
   std::stable_sort(angles.begin(), angles.end(), [&](const R& a, const R& b) {
     if (roll(a) != roll(b)) return roll(a) < roll(b);
     return a.Num("pitch_deg") < b.Num("pitch_deg");
   });
-  h << "<h2>Per-" << (p.Planar() ? "angle" : "attitude") << " statistics</h2>\n" << kScrollOpen
-    << "<table><tr><th>roll (deg)</th><th>pitch (deg)</th><th>n</th><th>mean (" << u.name
-    << ")</th><th>std</th><th>sem</th><th>total of the mean</th><th>CV (%)</th></tr>\n";
+  h << "<h2>Per-" << (p.Planar() ? "angle" : "attitude") << " statistics</h2>\n"
+    << kScrollOpen << "<table><tr><th>roll (deg)</th><th>pitch (deg)</th><th>n</th><th>mean ("
+    << u.name << ")</th><th>std</th><th>sem</th><th>total of the mean</th><th>CV (%)</th></tr>\n";
   for (const R& a : angles) {
     const double sem = a.Num("inertia_sem_kg_m2");
     h << "<tr><td>" << Fmt(roll(a), "%.2f") << "</td><td>" << Fmt(a.Num("pitch_deg"), "%.2f")
@@ -657,8 +697,10 @@ void WriteRejectedTraces(const ReportPage& p, std::ostream& h) {
          << Escape(InDisplayUnits(p.u, row.t.message)) << "</td></tr>\n";
   }
   if (bad == 0) return;  // nothing to show: the header's counts say every trace was fitted
-  h << "<h2>Rejected and failed traces</h2>\n" << kScrollOpen
-    << "<table><tr><th class=\"l\">file</th><th class=\"l\">status</th><th class=\"l\">reason</th></tr>\n"
+  h << "<h2>Rejected and failed traces</h2>\n"
+    << kScrollOpen
+    << "<table><tr><th class=\"l\">file</th><th class=\"l\">status</th><th "
+       "class=\"l\">reason</th></tr>\n"
     << rows.str() << "</table>" << kScrollClose;
 }
 
@@ -684,7 +726,8 @@ void WriteWarnings(const ReportPage& p, std::ostream& h) {
   h << "<p class=\"warn\">" << warned << " fitted trace" << (warned == 1 ? "" : "s")
     << " raised warnings. Their numbers are in every table above; read why before you trust "
        "them (click a line for the full text).</p>\n"
-    << kScrollOpen << "<table class=\"warnings\"><tr><th class=\"l\">file</th><th class=\"l\">warnings</th></tr>\n"
+    << kScrollOpen
+    << "<table class=\"warnings\"><tr><th class=\"l\">file</th><th class=\"l\">warnings</th></tr>\n"
     << rows.str() << "</table>" << kScrollClose;
 }
 
@@ -704,10 +747,13 @@ std::string StatusCell(const Units& u, const TraceRecord& t) {
 // inertia, window, amplitude.
 void WriteTraceTable(const ReportPage& p, std::ostream& h) {
   const Units& u = p.u;
-  h << "<h2>Traces</h2>\n" << kScrollOpen
+  h << "<h2>Traces</h2>\n"
+    << kScrollOpen
     << "<table><tr><th class=\"l\">file</th><th class=\"l\">role</th>"
-       "<th class=\"l\">status</th><th>roll (deg)</th><th>pitch (deg)</th><th>I total (" << u.name
-    << ")</th><th>std (stat)</th><th>std (total)</th><th>period (s)</th><th>I aircraft</th><th>std (stat)</th>"
+       "<th class=\"l\">status</th><th>roll (deg)</th><th>pitch (deg)</th><th>I total ("
+    << u.name
+    << ")</th><th>std (stat)</th><th>std (total)</th><th>period (s)</th><th>I aircraft</th><th>std "
+       "(stat)</th>"
        "<th>std (total)</th><th>window (s)</th><th>amplitude (deg)</th><th>rms/noise</th></tr>\n";
   for (const TraceRow& row : p.traces) {
     const TraceRecord& t = row.t;
@@ -722,8 +768,8 @@ void WriteTraceTable(const ReportPage& p, std::ostream& h) {
       amplitude = Fmt(a[0], "%.1f") + "&rarr;" + Fmt(a[1], "%.1f");
     const double total_std = t.inertia_total_std_kg_m2, std = t.inertia_std_kg_m2;
     const std::string row_class = DisplayStatus(t) == "ok (warned)" ? "warned"
-                                  : status == "ok"                 ? ""
-                                                                   : status;
+                                  : status == "ok"                  ? ""
+                                                                    : status;
     h << "<tr class=\"" << Escape(row_class) << "\"><td class=\"l\">" << Escape(t.file)
       << "</td><td class=\"l\">" << Escape(ToString(t.role)) << "</td><td class=\"l\">"
       << StatusCell(u, t) << "</td><td>" << Fmt(row.roll, "%.2f") << "</td><td>"
@@ -775,9 +821,11 @@ void WriteTraceFigures(ReportPage& p, std::ostream& h) {
   if (figures.tellp() == 0) return;  // no figures drawn (process --no-figures): no section
   h << "<h2>Fit and residual of every trace</h2>\n<p>Left, each trace: the measured samples of the "
        "swing rate (black dots) on the fit that gave I (light blue line), and beneath them that "
-       "fit's residual (grey) with the &plusmn;1&sigma; gyro noise (red) and its rms, labelled with "
+       "fit's residual (grey) with the &plusmn;1&sigma; gyro noise (red) and its rms, labelled "
+       "with "
        "the part of the log it belongs to (the lowest-amplitude band or the whole window; a "
-       "warning's &ldquo;residual N&times; noise&rdquo; is the whole window's). Its caption gives the record's I<sub>total</sub> with "
+       "warning's &ldquo;residual N&times; noise&rdquo; is the whole window's). Its caption gives "
+       "the record's I<sub>total</sub> with "
        "its stat and total std (the numbers of the tables), the measured period T "
        "and the small-angle inertia m g D<sup>2</sup> T<sup>2</sup> / (16 &pi;<sup>2</sup> L) of "
        "everything suspended, the hand check of the fitted I<sub>total</sub>. Right: I against "
@@ -882,19 +930,21 @@ void RunReport(const std::string& out_dir) {
     throw UserError(path + ": not a bifilar results file (no 'traces')");
   }
   CheckResultsSchema(results, path);  // a newer schema: named before any key is read
-  report_page::CheckFigureNames(results, out_dir);  // before anything reads a file results.json names
+  report_page::CheckFigureNames(results,
+                                out_dir);  // before anything reads a file results.json names
   // A mixed set (a run killed between two renames) is reported, not turned into a page.
   const std::vector<std::string> problems = CheckOutputSet(out_dir, false);
   if (!problems.empty()) {
-    throw UserError(out_dir + ": the outputs are a mixed set from different runs (" +
-                    problems.front() +
-                    (problems.size() > 1 ? ", and " + std::to_string(problems.size() - 1) + " more" : "") +
-                    "); rerun `bifilar process` to rewrite them");
+    throw UserError(
+        out_dir + ": the outputs are a mixed set from different runs (" + problems.front() +
+        (problems.size() > 1 ? ", and " + std::to_string(problems.size() - 1) + " more" : "") +
+        "); rerun `bifilar process` to rewrite them");
   }
   std::string html;
   try {
     html = BuildReportHtml(results, out_dir);
-  } catch (const nlohmann::json::exception& e) {  // a field of the wrong type: name the file, not json
+  } catch (
+      const nlohmann::json::exception& e) {  // a field of the wrong type: name the file, not json
     throw UserError(path + ": not a results file bifilar can read (" + DescribeJsonError(e) +
                     "); rerun `bifilar process` to rewrite it");
   } catch (const UserError& e) {  // ResultsReader: a key of the wrong type, named

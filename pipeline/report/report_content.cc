@@ -114,9 +114,10 @@ ReportPage::ReportPage(const json& results_in, const std::string& out_dir_in, Ke
   const std::string mode = tensor.Str("mode");
   const R observable = tensor.Get("observable");
   const bool products = observable.Bool("Ixy") || observable.Bool("Ixz") || observable.Bool("Iyz");
-  kind = mode == "full_3d"   ? CampaignKind::kFullTensor
-         : mode == "partial" ? (products ? CampaignKind::kPartialTensor : CampaignKind::kSeparateAxes)
-                             : CampaignKind::kPlanar;
+  kind = mode == "full_3d" ? CampaignKind::kFullTensor
+         : mode == "partial"
+             ? (products ? CampaignKind::kPartialTensor : CampaignKind::kSeparateAxes)
+             : CampaignKind::kPlanar;
   for (TraceRecord& t : ReadTraces(results, log_)) {
     TraceRow row{std::move(t)};
     const double roll = row.t.roll_used_deg;
@@ -126,7 +127,8 @@ ReportPage::ReportPage(const json& results_in, const std::string& out_dir_in, Ke
     traces.push_back(row);
   }
   std::stable_sort(traces.begin(), traces.end(), [](const TraceRow& a, const TraceRow& b) {
-    const double pa = std::isfinite(a.pitch) ? a.pitch : 1e9, pb = std::isfinite(b.pitch) ? b.pitch : 1e9;
+    const double pa = std::isfinite(a.pitch) ? a.pitch : 1e9,
+                 pb = std::isfinite(b.pitch) ? b.pitch : 1e9;
     if (a.roll != b.roll) return a.roll < b.roll;
     if (pa != pb) return pa < pb;
     return NaturalLess(a.t.file, b.t.file);  // case ignored, numbers as numbers
@@ -141,10 +143,14 @@ ReportPage::ReportPage(const json& results_in, const std::string& out_dir_in, Ke
 
 const char* KindName(CampaignKind kind) {
   switch (kind) {
-    case CampaignKind::kPlanar: return "planar pitch (the ellipse of inertia in the x-z plane)";
-    case CampaignKind::kFullTensor: return "full inertia tensor (swings about axes in every plane)";
-    case CampaignKind::kPartialTensor: return "partial inertia tensor";
-    case CampaignKind::kSeparateAxes: return "separate axes (one moment per body axis)";
+    case CampaignKind::kPlanar:
+      return "planar pitch (the ellipse of inertia in the x-z plane)";
+    case CampaignKind::kFullTensor:
+      return "full inertia tensor (swings about axes in every plane)";
+    case CampaignKind::kPartialTensor:
+      return "partial inertia tensor";
+    case CampaignKind::kSeparateAxes:
+      return "separate axes (one moment per body axis)";
   }
   return "";
 }

@@ -46,16 +46,18 @@ void PutLogReading(std::ostringstream& out, const CampaignConfig& config) {
   const ImuFormat& f = config.imu.format;
   PutText(out, "imu.format", ToString(f.container));
   PutText(out, "imu.time", f.time_column + "," + ToString(f.time_unit));
-  PutText(out, "imu.gyro", f.gyro_columns[0] + "," + f.gyro_columns[1] + "," + f.gyro_columns[2] +
-                               "," + ToString(f.gyro_unit));
-  PutText(out, "imu.accel", f.accel_columns[0] + "," + f.accel_columns[1] + "," +
-                                f.accel_columns[2] + "," + ToString(f.accel_unit));
+  PutText(out, "imu.gyro",
+          f.gyro_columns[0] + "," + f.gyro_columns[1] + "," + f.gyro_columns[2] + "," +
+              ToString(f.gyro_unit));
+  PutText(out, "imu.accel",
+          f.accel_columns[0] + "," + f.accel_columns[1] + "," + f.accel_columns[2] + "," +
+              ToString(f.accel_unit));
   PutText(out, "imu.delimiter", std::string(1, f.delimiter));
   const UlogSelection& u = f.ulog;
-  PutText(out, "imu.ulog", u.topic + "," + std::to_string(u.multi_id) + "," + u.time_field + "," +
-                               u.gyro_fields[0] + "," + u.gyro_fields[1] + "," + u.gyro_fields[2] +
-                               "," + u.accel_fields[0] + "," + u.accel_fields[1] + "," +
-                               u.accel_fields[2]);
+  PutText(out, "imu.ulog",
+          u.topic + "," + std::to_string(u.multi_id) + "," + u.time_field + "," + u.gyro_fields[0] +
+              "," + u.gyro_fields[1] + "," + u.gyro_fields[2] + "," + u.accel_fields[0] + "," +
+              u.accel_fields[1] + "," + u.accel_fields[2]);
   Put(out, "imu.dataflash.instance", config.imu.dataflash_instance);
   Put(out, "limits.max_decompressed_log_mb", config.limits.max_decompressed_log_mb);
   PutText(out, "imu.swing_axis", config.imu.swing_axis_auto ? "auto" : "fixed");
@@ -131,8 +133,8 @@ std::string EntryChecksum(const std::string& key, const std::string& content_has
 
 }  // namespace
 
-bool TraceCache::Load(const std::string& key, const std::string& content_hash,
-                      TraceRecord* record, std::string* problem) const {
+bool TraceCache::Load(const std::string& key, const std::string& content_hash, TraceRecord* record,
+                      std::string* problem) const {
   problem->clear();
   const std::string path = EntryPath(key);
   std::error_code ec;
@@ -195,10 +197,9 @@ bool TraceCache::Load(const std::string& key, const std::string& content_hash,
         std::make_pair("inertia_total_std_kg_m2", record->inertia_total_std_kg_m2)}) {
     if (std::isinf(value)) return refuse(std::string(field) + " is not a finite number");
   }
-  if (record->ok() && !(record->inertia_total_kg_m2 > 0.0 &&
-                        std::isfinite(record->inertia_total_kg_m2) &&
-                        record->inertia_total_std_kg_m2 >= 0.0 &&
-                        std::isfinite(record->inertia_total_std_kg_m2))) {
+  if (record->ok() &&
+      !(record->inertia_total_kg_m2 > 0.0 && std::isfinite(record->inertia_total_kg_m2) &&
+        record->inertia_total_std_kg_m2 >= 0.0 && std::isfinite(record->inertia_total_std_kg_m2))) {
     return refuse("an ok record needs a finite inertia > 0 and a finite std >= 0");
   }
   return true;

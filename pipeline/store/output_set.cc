@@ -15,8 +15,8 @@
 #include "base/atomic_file.h"
 #include "base/bounded_read.h"
 #include "base/hash.h"
-#include "base/text_format.h"
 #include "base/json_error.h"
+#include "base/text_format.h"
 #include "base/user_error.h"
 
 namespace bifilar {
@@ -415,9 +415,9 @@ void WriteOutputSet(const std::string& out_dir, nlohmann::json results,
   WriteFileAtomically((out / "traces.csv").string(), traces_csv);
   WriteFileAtomically((out / "angles.csv").string(), angles_csv);
   if (report_html_builder) {
-    WriteFileAtomically((out / "report.html").string(),
-                        StampReport(report_html_builder(results, out_dir),
-                                    HashToHex(Fnv1a64(results_text))));
+    WriteFileAtomically(
+        (out / "report.html").string(),
+        StampReport(report_html_builder(results, out_dir), HashToHex(Fnv1a64(results_text))));
   } else {
     std::error_code ec;
     fs::remove(out / "report.html", ec);  // a report of an earlier run would not match
@@ -425,8 +425,8 @@ void WriteOutputSet(const std::string& out_dir, nlohmann::json results,
   WriteFileAtomically((out / "results.json").string(), results_text);
 }
 
-bool ResolveInsideFolder(const std::string& folder, const std::string& sub,
-                         const std::string& name, std::string* path, std::string* why) {
+bool ResolveInsideFolder(const std::string& folder, const std::string& sub, const std::string& name,
+                         std::string* path, std::string* why) {
   const fs::path relative(name);
   why->clear();
   if (name.empty()) {
@@ -445,11 +445,13 @@ bool ResolveInsideFolder(const std::string& folder, const std::string& sub,
   const fs::path root = fs::weakly_canonical(folder, ec_root);
   const fs::path target = fs::weakly_canonical(full, ec_target);
   if (ec_root || ec_target) {
-    *why = "a name whose links cannot be followed (" + (ec_root ? ec_root : ec_target).message() + ")";
+    *why =
+        "a name whose links cannot be followed (" + (ec_root ? ec_root : ec_target).message() + ")";
     return false;
   }
   // Component by component: /out2/x is not inside /out.
-  const auto [root_end, unused] = std::mismatch(root.begin(), root.end(), target.begin(), target.end());
+  const auto [root_end, unused] =
+      std::mismatch(root.begin(), root.end(), target.begin(), target.end());
   if (root_end != root.end()) {
     *why = "a link leading out of " + folder;
     return false;
@@ -475,8 +477,8 @@ std::vector<std::string> CheckOutputSet(const std::string& out_dir, bool check_r
   for (const auto& [name, hash] : results["outputs"].items()) {
     std::string path, why;
     if (!ResolveInsideFolder(out_dir, "", name, &path, &why)) {
-      problems.push_back(results_path + ": outputs names \"" + PrintableAscii(name, 200) +
-                         "\", " + why + ", not a file of " + out_dir + " (not read)");
+      problems.push_back(results_path + ": outputs names \"" + PrintableAscii(name, 200) + "\", " +
+                         why + ", not a file of " + out_dir + " (not read)");
       continue;
     }
     if (!fs::exists(path, ec)) {

@@ -100,8 +100,8 @@ std::vector<std::string> CheckOutputSet(const std::string& out_dir, bool check_r
 // symbolic link is followed, lies inside `folder`; else false with *why ("an absolute path", "a
 // '..' component", "a link leading out of OUT"). A results.json from someone else can then
 // neither read nor change a file outside its folder (issue 33 item 2).
-bool ResolveInsideFolder(const std::string& folder, const std::string& sub,
-                         const std::string& name, std::string* path, std::string* why);
+bool ResolveInsideFolder(const std::string& folder, const std::string& sub, const std::string& name,
+                         std::string* path, std::string* why);
 
 // Throws UserError naming the first of the result files, the manifest and the entries of cache/
 // and figures/ that exists and is not a regular file (a FIFO, device, socket or folder, also

@@ -73,9 +73,9 @@ constexpr int64_t kGroupByMemBytes = 8 << 20;
 
 // A pattern as messages quote it: whole up to 80 bytes, else its start and its size.
 std::string Quoted(const std::string& pattern) {
-  return pattern.size() <= 80 ? "'" + pattern + "'"
-                              : "'" + pattern.substr(0, 60) + "...' (" +
-                                    std::to_string(pattern.size()) + " bytes)";
+  return pattern.size() <= 80
+             ? "'" + pattern + "'"
+             : "'" + pattern.substr(0, 60) + "...' (" + std::to_string(pattern.size()) + " bytes)";
 }
 
 // The compiled --group-by (case ignored), or a UserError naming the pattern and what is wrong.
@@ -107,7 +107,8 @@ Keys KeysOf(const std::vector<std::string>& paths, const RepeatGroupingOptions& 
       key = i < o.named.size() ? o.named[i] : "";
       if (key.empty()) why = "not in " + o.named_source;
     } else if (re != nullptr) {
-      const std::string target = o.group_by.find('/') != std::string::npos ? paths[i] : FileName(paths[i]);
+      const std::string target =
+          o.group_by.find('/') != std::string::npos ? paths[i] : FileName(paths[i]);
       // The whole match and the first capture group (when the pattern has one).
       re2::StringPiece match[2];
       const int n = std::min(2, re->NumberOfCapturingGroups() + 1);
@@ -180,11 +181,12 @@ std::string AloneText(const std::vector<std::string>& paths, const Keys& k, size
       if (d < best) {
         best = d;
         nearest = paths[j] + " (" +
-                  (!o.named.empty() ? "group '" + k.key[j] + "', "
+                  (!o.named.empty()                           ? "group '" + k.key[j] + "', "
                    : !o.group_by.empty() && !k.key[j].empty() ? "'" + k.key[j] + "', "
                                                               : std::string()) +
                   std::to_string(d) + " character(s) apart" +
-                  (o.named.empty() && o.group_by.empty() && by_key ? " besides the number" : "") + ")";
+                  (o.named.empty() && o.group_by.empty() && by_key ? " besides the number" : "") +
+                  ")";
       }
     }
   }
@@ -198,7 +200,8 @@ std::string AloneText(const std::vector<std::string>& paths, const Keys& k, size
 std::string Rule(const RepeatGroupingOptions& o) {
   if (!o.named.empty()) return "as " + o.named_source + " names them";
   if (!o.group_by.empty()) {
-    return "by --group-by " + Quoted(o.group_by) + " (the part of each name it matches; case ignored)";
+    return "by --group-by " + Quoted(o.group_by) +
+           " (the part of each name it matches; case ignored)";
   }
   return "by file name (names that differ only in their last number; case ignored)";
 }

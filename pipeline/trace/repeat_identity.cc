@@ -79,12 +79,14 @@ bool SameSamples(const std::string& a, const std::string& b, const ImuFormat& fo
                  const ImuLogOptions& options) {
   ImuData da, db;
   std::string why;
-  if (!TryReadImuLog(a, format, options, &da, &why) || !TryReadImuLog(b, format, options, &db, &why))
+  if (!TryReadImuLog(a, format, options, &da, &why) ||
+      !TryReadImuLog(b, format, options, &db, &why))
     return false;
   return da.t_s.size() == db.t_s.size() &&
          (da.t_s.empty() ||
           std::memcmp(da.t_s.data(), db.t_s.data(), da.t_s.size() * sizeof(double)) == 0) &&
-         SameVectors(da.gyro_in_imu, db.gyro_in_imu) && SameVectors(da.accel_in_imu, db.accel_in_imu);
+         SameVectors(da.gyro_in_imu, db.gyro_in_imu) &&
+         SameVectors(da.accel_in_imu, db.accel_in_imu);
 }
 
 Content ContentOf(const std::string& path, const ImuFormat& format, const ImuLogOptions& options) {
@@ -115,8 +117,7 @@ Content ContentOf(const std::string& path, const ImuFormat& format, const ImuLog
 }  // namespace
 
 std::vector<IdenticalLog> FindIdenticalLogs(const std::vector<std::string>& paths,
-                                            const ImuFormat& format,
-                                            const ImuLogOptions& options) {
+                                            const ImuFormat& format, const ImuLogOptions& options) {
   std::vector<IdenticalLog> same(paths.size());
   // (read as a log, hash) -> the first paths of each distinct content with that hash.
   std::unordered_map<uint64_t, std::vector<size_t>> firsts[2];
@@ -160,9 +161,8 @@ DistinctLogs DropIdenticalLogs(const std::vector<std::string>& paths, const ImuF
     }
     const std::string& first = paths[same[i].first];
     d.dropped.emplace_back(paths[i], first);
-    const std::string relation = same[i].relation == "given again"
-                                     ? same[i].relation
-                                     : same[i].relation + " " + first;
+    const std::string relation =
+        same[i].relation == "given again" ? same[i].relation : same[i].relation + " " + first;
     const std::string differs =
         same[i].relation == "the same samples as"
             ? " (the files differ only in what the reader skips: line ends, blank or comment "

@@ -11,12 +11,12 @@ namespace bifilar {
 namespace {
 
 const double kQz = NormalQuantile(0.999);  // z of Q: p < 0.001
-constexpr double kGapZ = 5.0;          // the clusters' gap over its std
-constexpr double kGapZWithAxes = 3.0;  // ... when the swing axes differ too
-constexpr double kSeparation = 3.0;    // the gap over the largest range within a cluster
-constexpr double kOwnTrendSigmas = 3.0;  // the own trends' bound: c + 3 std
-constexpr double kAxisMinDeg = 1.0;    // the clusters' axes at least this far apart
-constexpr double kAxisOverSpread = 3.0;  // and this many times their spread within clusters
+constexpr double kGapZ = 5.0;              // the clusters' gap over its std
+constexpr double kGapZWithAxes = 3.0;      // ... when the swing axes differ too
+constexpr double kSeparation = 3.0;        // the gap over the largest range within a cluster
+constexpr double kOwnTrendSigmas = 3.0;    // the own trends' bound: c + 3 std
+constexpr double kAxisMinDeg = 1.0;        // the clusters' axes at least this far apart
+constexpr double kAxisOverSpread = 3.0;    // and this many times their spread within clusters
 
 struct WeightedMean {
   double mean = NAN, std = NAN, q = 0.0;
@@ -52,8 +52,9 @@ bool OwnTrendAsSquare(const TraceRecord& r, double* c, double* s) {
     hi = std::max(hi, b.amplitude_mean_deg);
   }
   if (!(hi > lo)) return false;
-  const double scale = w.trend_exponent == 2.0 ? 1.0 : w.trend_exponent == 1.0 ? 1.0 / (lo + hi)
-                                                                                 : NAN;
+  const double scale = w.trend_exponent == 2.0   ? 1.0
+                       : w.trend_exponent == 1.0 ? 1.0 / (lo + hi)
+                                                 : NAN;
   if (!std::isfinite(scale)) return false;
   *c = w.trend_coeff * scale;
   *s = w.trend_coeff_std * scale;
@@ -72,7 +73,8 @@ void BestCut(const std::vector<double>& v, const std::vector<double>& s, SetupSp
   std::sort(order.begin(), order.end(), [&](int a, int b) { return v[a] < v[b]; });
   double best_q = INFINITY;
   for (int cut = 2; cut <= k - 2; ++cut) {
-    const std::vector<int> lo(order.begin(), order.begin() + cut), hi(order.begin() + cut, order.end());
+    const std::vector<int> lo(order.begin(), order.begin() + cut),
+        hi(order.begin() + cut, order.end());
     const WeightedMean a = Weighted(v, s, lo), b = Weighted(v, s, hi);
     if (a.q + b.q >= best_q) continue;
     best_q = a.q + b.q;
@@ -112,7 +114,8 @@ void AmplitudeExplanation(const std::vector<const TraceRecord*>& records, SetupS
   out->amplitudes_interleave = !(lo[0] > hi[1] || lo[1] > hi[0]);
   PoolOwnTrends(records, out);
   if (out->n_own == 0) return;
-  const double bound = std::abs(out->own_coeff_per_deg2) + kOwnTrendSigmas * out->own_coeff_std_per_deg2;
+  const double bound =
+      std::abs(out->own_coeff_per_deg2) + kOwnTrendSigmas * out->own_coeff_std_per_deg2;
   out->amplitude_allows_percent = 100.0 * bound * std::abs(mean_a2[1] - mean_a2[0]);
   const double allowed = out->amplitude_allows_percent / 100.0 * out->mean_kg_m2[0];
   out->gap_z_beyond_amplitude = (out->mean_kg_m2[1] - out->mean_kg_m2[0] - allowed) /
@@ -132,7 +135,8 @@ void CompareAxes(const std::vector<const TraceRecord*>& records, SetupSplit* out
   const auto aligned = [&](int i) {  // the sign nearest the reference
     std::array<double, 3> a = axis(i);
     const double dot = a[0] * ref[0] + a[1] * ref[1] + a[2] * ref[2];
-    if (dot < 0.0) for (double& x : a) x = -x;
+    if (dot < 0.0)
+      for (double& x : a) x = -x;
     return a;
   };
   const auto angle = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
@@ -156,7 +160,8 @@ void CompareAxes(const std::vector<const TraceRecord*>& records, SetupSplit* out
     }
   }
   out->imu_axis = static_cast<int>(
-      std::max_element(all.begin(), all.end(), [](double a, double b) { return std::abs(a) < std::abs(b); }) -
+      std::max_element(all.begin(), all.end(),
+                       [](double a, double b) { return std::abs(a) < std::abs(b); }) -
       all.begin());
   std::array<double, 3> unit = {0, 0, 0};
   unit[out->imu_axis] = 1.0;
@@ -190,8 +195,9 @@ void Decide(const std::vector<const TraceRecord*>& records, SetupSplit* out) {
   if (out->n_own == 0) {  // no own trend: only amplitudes that interleave rule amplitude out
     out->two_setups = out->amplitudes_interleave;
     if (!out->two_setups) {
-      out->note = "two clusters, but released at different amplitudes and no log measured its "
-                  "own I(A) trend: amplitude and set-up cannot be told apart";
+      out->note =
+          "two clusters, but released at different amplitudes and no log measured its "
+          "own I(A) trend: amplitude and set-up cannot be told apart";
     }
     return;
   }

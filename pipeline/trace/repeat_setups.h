@@ -37,12 +37,12 @@ struct SetupSplit {
   double q_z = NAN;         // its Wilson-Hilferty z (n - 1 dof)
   // The best cut: indices into the records (as given to TestTwoSetups), lower I first.
   std::array<std::vector<int>, 2> clusters;
-  std::array<double, 2> mean_kg_m2 = {NAN, NAN};      // weighted mean of each cluster
-  std::array<double, 2> mean_std_kg_m2 = {NAN, NAN};  // Birge-scaled (scatter within clusters)
+  std::array<double, 2> mean_kg_m2 = {NAN, NAN};         // weighted mean of each cluster
+  std::array<double, 2> mean_std_kg_m2 = {NAN, NAN};     // Birge-scaled (scatter within clusters)
   std::array<double, 2> amplitude_rms_deg = {NAN, NAN};  // RMS of the results' amplitudes
-  double gap_percent = NAN;  // (mean 2 - mean 1) / mean 1
-  double gap_z = NAN;        // gap over its std
-  double separation = NAN;   // gap over the largest range of I within a cluster
+  double gap_percent = NAN;                              // (mean 2 - mean 1) / mean 1
+  double gap_z = NAN;                                    // gap over its std
+  double separation = NAN;  // gap over the largest range of I within a cluster
   bool amplitudes_interleave = false;
   // The logs' own I(A) trends as one A^2 coefficient (weighted mean, Birge-scaled), over the
   // logs whose sweep measured one (n_own); the largest gap they allow between the clusters (%)

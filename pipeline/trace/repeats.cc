@@ -14,8 +14,8 @@ namespace bifilar {
 namespace {
 
 bool Usable(const TraceRecord& r) {
-  return r.ok() && std::isfinite(r.inertia_total_kg_m2) && std::isfinite(r.inertia_total_std_kg_m2) &&
-         r.inertia_total_std_kg_m2 > 0.0;
+  return r.ok() && std::isfinite(r.inertia_total_kg_m2) &&
+         std::isfinite(r.inertia_total_std_kg_m2) && r.inertia_total_std_kg_m2 > 0.0;
 }
 
 // I against each used member's result amplitude across the repeats (fit/amplitude_trend.h, on
@@ -78,7 +78,8 @@ void Scatter(const std::vector<double>& v, const std::vector<double>& s, double*
 // Its total (pipeline/records/total_uncertainty.h) is updated: the correction is a term of its own.
 void AddCorrectionStd(TraceRecord* r) {
   if (std::isfinite(r->amplitude_correction_std_kg_m2))
-    r->inertia_total_std_kg_m2 = std::hypot(r->inertia_total_std_kg_m2, r->amplitude_correction_std_kg_m2);
+    r->inertia_total_std_kg_m2 =
+        std::hypot(r->inertia_total_std_kg_m2, r->amplitude_correction_std_kg_m2);
   UpdateTotalUncertainty(r);
 }
 
@@ -113,9 +114,9 @@ void RepeatValues(const std::vector<TraceRecord*>& used, double a2bar, std::vect
 }
 
 // The scatter before (per-log stds) and after the amplitude correction.
-void ScatterBeforeAndAfter(const std::vector<TraceRecord*>& used,
-                           const std::vector<double>& before, const std::vector<double>& after,
-                           const std::vector<double>& s, RepeatGroup* group) {
+void ScatterBeforeAndAfter(const std::vector<TraceRecord*>& used, const std::vector<double>& before,
+                           const std::vector<double>& after, const std::vector<double>& s,
+                           RepeatGroup* group) {
   std::vector<double> s_before;
   for (const TraceRecord* r : used) s_before.push_back(r->inertia_total_std_kg_m2);
   Scatter(before, s_before, &group->spread_before_percent, &group->q_before);
@@ -200,7 +201,8 @@ void RandomEffectsMean(const std::vector<TraceRecord*>& used, const std::vector<
     // Against the set-up's value, the random-effects mean (a plain mean would be pulled by an
     // imprecise log, a lowest-band result with its large std).
     group->max_abs_z = std::max(group->max_abs_z, std::abs(after[i] - group->mean_kg_m2) / s_re);
-    group->max_abs_z_own = std::max(group->max_abs_z_own, std::abs(after[i] - group->mean_kg_m2) / s[i]);
+    group->max_abs_z_own =
+        std::max(group->max_abs_z_own, std::abs(after[i] - group->mean_kg_m2) / s[i]);
     // The log's own std: its per-log std, tau and the whole std of its correction.
     r.repeat_scatter_std_kg_m2 = group->tau_kg_m2;
     r.inertia_total_std_kg_m2 = std::hypot(r.inertia_total_std_kg_m2, group->tau_kg_m2);
@@ -270,7 +272,8 @@ void TestSetups(const std::vector<TraceRecord>& records, RepeatGroup* group) {
     used.push_back(&records[i]);
     index.push_back(i);
     const std::string& file = records[i].file;
-    names.push_back(file.substr(file.find_last_of('/') == std::string::npos ? 0 : file.find_last_of('/') + 1));
+    names.push_back(
+        file.substr(file.find_last_of('/') == std::string::npos ? 0 : file.find_last_of('/') + 1));
   }
   group->setups = TestTwoSetups(used);
   group->setups_text = TwoSetupsText(group->setups, names);
@@ -371,8 +374,9 @@ RepeatsAmplitudeCorrection CorrectAmplitude(const std::vector<RepeatGroup>& grou
   }
   out.applied = out.n_corrected > 0;
   if (!out.applied) {
-    out.note = "every usable log's result comes from the lowest-amplitude band of its own sweep, "
-               "whose std already covers the change to zero amplitude";
+    out.note =
+        "every usable log's result comes from the lowest-amplitude band of its own sweep, "
+        "whose std already covers the change to zero amplitude";
   }
   return out;
 }
@@ -438,13 +442,14 @@ std::string RepeatGroupLine(const RepeatGroup& g) {
                   g.own_trend_percent_per_10deg, g.own_trend_std_percent_per_10deg);
     line += buffer;
   } else if (std::isfinite(g.amplitude_trend_z)) {
-    std::snprintf(buffer, sizeof(buffer),
-                  "\n    across the repeats I changes by %+.2g %% per 10 deg of amplitude (z = %.1f)%s",
-                  g.amplitude_trend_percent_per_10deg, g.amplitude_trend_z,
-                  std::abs(g.amplitude_trend_z) > 3.0
-                      ? ": the rig departs from the ideal model; release every repeat at the same "
-                        "small amplitude"
-                      : "");
+    std::snprintf(
+        buffer, sizeof(buffer),
+        "\n    across the repeats I changes by %+.2g %% per 10 deg of amplitude (z = %.1f)%s",
+        g.amplitude_trend_percent_per_10deg, g.amplitude_trend_z,
+        std::abs(g.amplitude_trend_z) > 3.0
+            ? ": the rig departs from the ideal model; release every repeat at the same "
+              "small amplitude"
+            : "");
     line += buffer;
   }
   if (std::isfinite(g.correction_std_kg_m2) && g.correction_std_kg_m2 > 0.0) {

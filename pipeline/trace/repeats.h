@@ -45,7 +45,7 @@ struct RepeatGroup {
   // of the amplitude correction's std that differs between the repeats,
   // I_i (A_i^2 - mean A^2) std(c); the part common to the set-up does not scatter them.
   double q = NAN;
-  double tau_kg_m2 = NAN;    // between-repeat std beyond those stds (0: none)
+  double tau_kg_m2 = NAN;  // between-repeat std beyond those stds (0: none)
   // Largest |I_i - mean_kg_m2| / std_i over the used members, std_i those stds with tau added.
   double max_abs_z = NAN;
   // Across the repeats, I against the mean squared amplitude of each log's fit (weighted line):
@@ -68,7 +68,7 @@ struct RepeatGroup {
   // quadrature: what the `--repeats` line and JSON give as the set-up's total.
   double common_mode_std_kg_m2 = NAN;
   double total_std_kg_m2 = NAN;
-  std::string note;          // why nothing was combined (fewer than 2 usable members)
+  std::string note;  // why nothing was combined (fewer than 2 usable members)
   // A group of one: why no other log joined it, and the nearest name that almost matched.
   std::string alone;
   // Largest |I_i - mean_kg_m2| / per-log std, without tau (the between-repeat std).
@@ -92,7 +92,7 @@ struct RepeatGroup {
 struct RepeatGroupingOptions {
   std::string group_by;
   std::vector<std::string> named;
-  std::string named_source;            // the table, for the messages ("runs.csv (group column)")
+  std::string named_source;             // the table, for the messages ("runs.csv (group column)")
   std::vector<std::string> named_rows;  // the table's paths, for the nearest name of a lost log
 };
 
@@ -124,13 +124,12 @@ std::vector<RepeatGroup> GroupRepeats(const std::vector<std::string>& paths);
 // is read once and its samples hashed (FNV-1a 64); only logs whose hashes meet are compared in
 // full, so the scan is linear in the logs, whatever their sizes.
 struct IdenticalLog {
-  int first = -1;         // index of the first earlier path with the same content, or -1
-  std::string relation;   // "given again", "the same file as", "the same bytes as",
-                          // "the same samples as" (empty for -1)
+  int first = -1;        // index of the first earlier path with the same content, or -1
+  std::string relation;  // "given again", "the same file as", "the same bytes as",
+                         // "the same samples as" (empty for -1)
 };
 std::vector<IdenticalLog> FindIdenticalLogs(const std::vector<std::string>& paths,
-                                            const ImuFormat& format,
-                                            const ImuLogOptions& options);
+                                            const ImuFormat& format, const ImuLogOptions& options);
 
 // The logs of `paths` that FindIdenticalLogs keeps (first of each content, in order), and one
 // warning per dropped log naming it and the log it repeats.
@@ -150,17 +149,17 @@ struct RepeatsAmplitudeCorrection {
   double coeff_per_deg2 = NAN;      // c of I_0 (1 + c A^2), relative
   double coeff_std_per_deg2 = NAN;  // with the between-log scatter in the weights
   double z = NAN;
-  double birge = NAN;               // scatter about the pooled fit over the stds, sqrt(chi^2/dof)
-  double scatter_percent = NAN;     // between-log relative std in the pooled fit's weights (%)
+  double birge = NAN;            // scatter about the pooled fit over the stds, sqrt(chi^2/dof)
+  double scatter_percent = NAN;  // between-log relative std in the pooled fit's weights (%)
   int dof = 0;
-  int n_logs = 0, n_groups = 0;     // used by the pooled fit
-  int n_corrected = 0;              // logs moved to zero amplitude
+  int n_logs = 0, n_groups = 0;  // used by the pooled fit
+  int n_corrected = 0;           // logs moved to zero amplitude
   // Logs whose result is the lowest band of their own sweep's trend (inertia_source
   // "low_amplitude_band"): points of the fit, but not corrected (their model-inadequacy std
   // already covers the change to zero amplitude).
   int n_low_band_kept = 0;
   double amplitude_min_deg = NAN, amplitude_max_deg = NAN;
-  std::string note;                 // why it was not applied (the fields above may be set)
+  std::string note;  // why it was not applied (the fields above may be set)
   // The logs' own I(A) trends pooled (PooledOwnTrend, over the logs of the pooled fit), and the
   // pooled coefficient's z against them. Beyond 3 sigma the spread between repeats is not their
   // amplitude: nothing is corrected, and the coefficient fields above stay NaN.
@@ -168,18 +167,17 @@ struct RepeatsAmplitudeCorrection {
   int n_own = 0;
   double own_z = NAN;
   bool contradicts_own = false;
-  int n_groups_two_setups = 0;      // groups left out of the pooled fit: they look like two set-ups
+  int n_groups_two_setups = 0;  // groups left out of the pooled fit: they look like two set-ups
 };
 
 // Combines each group's usable members (status ok, finite I, std > 0). First the set-up test of
 // each group (TestTwoSetups on the values as fitted): a group that looks like two set-ups is
 // left out of the pooled amplitude fit, and its scatter warning says so, naming the clusters.
-// Then the amplitude correction: c pooled over the groups with >= 2 usable members; every usable record whose result
-// is not already a low-amplitude band gets amplitude_correction_* set, the correction subtracted
-// from inertia_total_kg_m2. Then per group:
-// the statistics, and for every used member repeat_scatter_std_kg_m2 = tau, tau and the
-// correction's std added in quadrature to inertia_total_std_kg_m2 (and its total updated) and,
-// when tau > 0, a warning.
+// Then the amplitude correction: c pooled over the groups with >= 2 usable members; every usable
+// record whose result is not already a low-amplitude band gets amplitude_correction_* set, the
+// correction subtracted from inertia_total_kg_m2. Then per group: the statistics, and for every
+// used member repeat_scatter_std_kg_m2 = tau, tau and the correction's std added in quadrature to
+// inertia_total_std_kg_m2 (and its total updated) and, when tau > 0, a warning.
 RepeatsAmplitudeCorrection CombineRepeats(std::vector<RepeatGroup>* groups,
                                           std::vector<TraceRecord>* records);
 

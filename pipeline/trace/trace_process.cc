@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <new>
@@ -18,12 +18,11 @@
 #include "pendulum/model.h"
 #include "pipeline/config/plausibility.h"
 #include "pipeline/figures/figure.h"
-#include "pipeline/figures/sweep_plot.h"
 #include "pipeline/figures/report_trace_figure.h"
+#include "pipeline/figures/sweep_plot.h"
 #include "pipeline/figures/trace_plot.h"
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/records/total_uncertainty.h"
-
 
 namespace bifilar {
 
@@ -121,11 +120,11 @@ std::string WindowOutsideLog(const ImuData& data, std::array<double, 2>* window_
   } else if (t1 <= t.front()) {
     std::snprintf(buf, sizeof(buf), "; its end %g s is before the log's start", t1);
   } else {
-    std::snprintf(buf, sizeof(buf), "; %s", t0 < t.front() - half_dt && t1 > t.back() + half_dt
-                                                ? "both ends are beyond the log"
-                                                : t0 < t.front() - half_dt
-                                                    ? "its start is before the log's start"
-                                                    : "its end is after the log's end");
+    std::snprintf(buf, sizeof(buf), "; %s",
+                  t0 < t.front() - half_dt && t1 > t.back() + half_dt
+                      ? "both ends are beyond the log"
+                  : t0 < t.front() - half_dt ? "its start is before the log's start"
+                                             : "its end is after the log's end");
   }
   return message + buf + unit_hint;
 }
@@ -202,22 +201,21 @@ bool FindWindowAndPitch(const CampaignConfig& config, const std::string& path, c
   const std::string& name = record->file;
   WindowOptions window_options;
   window_options.min_periods = config.fit.quality.min_periods;
-  *window = override_s ? ApplyWindowOverride(data.t_s, axis->rate_rad_per_s, (*override_s)[0],
-                                              (*override_s)[1], window_options, name)
-                       : FindFreeOscillationWindow(data.t_s, axis->rate_rad_per_s, window_options,
-                                                   name);
+  *window = override_s
+                ? ApplyWindowOverride(data.t_s, axis->rate_rad_per_s, (*override_s)[0],
+                                      (*override_s)[1], window_options, name)
+                : FindFreeOscillationWindow(data.t_s, axis->rate_rad_per_s, window_options, name);
   if (!window->IsUsable()) {
     // Time in s declared ms (or the reverse) puts every period 1000 times outside the range.
-    const std::string hint =
-        !override_s && config.imu.format.container != LogContainer::kUlog &&
-                window->no_oscillation_found
-            ? TimeUnitHint(data.t_s, axis->rate_rad_per_s, window_options,
-                           config.imu.format.time_unit)
-            : "";
-    return Fail(record,
-                window->status == WindowStatus::kError ? TraceStatus::kError
-                                                       : TraceStatus::kRejected,
-                window->message + hint, path);
+    const std::string hint = !override_s && config.imu.format.container != LogContainer::kUlog &&
+                                     window->no_oscillation_found
+                                 ? TimeUnitHint(data.t_s, axis->rate_rad_per_s, window_options,
+                                                config.imu.format.time_unit)
+                                 : "";
+    return Fail(
+        record,
+        window->status == WindowStatus::kError ? TraceStatus::kError : TraceStatus::kRejected,
+        window->message + hint, path);
   }
   // No rest seen: the accelerometer averaged over the window still gives the pitch.
   if (!axis->pitch_measured_deg && data.has_accel() && !axis->accel_ignored && !override_s) {
@@ -251,10 +249,9 @@ AmplitudeBandOptions AmplitudeBandOptionsFor(const CampaignConfig& config) {
 }
 
 // 4. Amplitude band: the window trimmed to the config's band of swing amplitude.
-bool ChooseAmplitudeBand(const CampaignConfig& config, const std::string& path,
-                         const ImuData& data, const SwingAxis& axis,
-                         const FreeOscillationWindow& window, AmplitudeBand* band,
-                         TraceRecord* record) {
+bool ChooseAmplitudeBand(const CampaignConfig& config, const std::string& path, const ImuData& data,
+                         const SwingAxis& axis, const FreeOscillationWindow& window,
+                         AmplitudeBand* band, TraceRecord* record) {
   const AmplitudeBandOptions band_options = AmplitudeBandOptionsFor(config);
   record->amplitude_band_deg = {band_options.min_amplitude_deg, band_options.max_amplitude_deg};
   *band = TrimToAmplitudeBand(data.t_s, axis.rate_rad_per_s, window, band_options, record->file);
@@ -269,8 +266,7 @@ bool ChooseAmplitudeBand(const CampaignConfig& config, const std::string& path,
       ImpossibleAmplitude(largest_deg, smallest_deg, config.imu.format.gyro_unit);
   if (!band->IsUsable()) {
     return Fail(record,
-                band->status == WindowStatus::kError ? TraceStatus::kError
-                                                     : TraceStatus::kRejected,
+                band->status == WindowStatus::kError ? TraceStatus::kError : TraceStatus::kRejected,
                 band->message + (impossible.empty() ? "" : "; " + impossible), path);
   }
   if (!impossible.empty()) record->warnings.push_back(impossible);
@@ -285,15 +281,13 @@ TraceFitInput MakeFitInput(const CampaignConfig& config, const TraceProcessOptio
                            const FreeOscillationWindow& window, const AmplitudeBand& band,
                            const std::string& name, FitSeries* series) {
   TraceFitInput input;
-  *series = MakeFitSeries(data.t_s, axis.rate_rad_per_s, band.first_index, band.last_index,
-                          window.period_s,
-                          window.noise_from_rest ? window.noise_sigma_rad_per_s : 0.0,
-                          window.rest_end_s);
+  *series = MakeFitSeries(
+      data.t_s, axis.rate_rad_per_s, band.first_index, band.last_index, window.period_s,
+      window.noise_from_rest ? window.noise_sigma_rad_per_s : 0.0, window.rest_end_s);
   input.t_s = std::move(series->t_s);
   input.rate_rad_per_s = std::move(series->rate_rad_per_s);
   input.noise_rad_per_s = series->noise_rad_per_s;
-  input.secondary_motion_ratio =
-      SecondaryMotionRatio(data, axis.axis_in_imu, band.t0_s, band.t1_s);
+  input.secondary_motion_ratio = SecondaryMotionRatio(data, axis.axis_in_imu, band.t0_s, band.t1_s);
   input.geometry = GeometryForRole(config, options.role);
   input.label = name;
   return input;
@@ -308,15 +302,15 @@ TraceFitResult FitWithResidualGlitchPass(const CampaignConfig& config,
                                          TraceRecord* record) {
   TraceFitResult fit = FitTrace(*input, fit_options);
   if (!fit.HasFit() || fit.residual_rad_per_s.size() != input->t_s.size()) return fit;
-  const std::vector<size_t> more =
-      FindGlitches(fit.t_s, fit.residual_rad_per_s, config.fit.glitch);
+  const std::vector<size_t> more = FindGlitches(fit.t_s, fit.residual_rad_per_s, config.fit.glitch);
   if (more.empty()) return fit;
   double largest = 0.0;
   for (size_t k : more) largest = std::max(largest, std::abs(fit.residual_rad_per_s[k]));
   char text[160];
-  std::snprintf(text, sizeof(text), "%zu glitch sample%s ignored (isolated readings off the "
-                "fit by up to %.3g rad/s) at t =", more.size(), more.size() == 1 ? "" : "s",
-                largest);
+  std::snprintf(text, sizeof(text),
+                "%zu glitch sample%s ignored (isolated readings off the "
+                "fit by up to %.3g rad/s) at t =",
+                more.size(), more.size() == 1 ? "" : "s", largest);
   std::string warning = text;
   for (size_t i = 0; i < more.size() && i < 5; ++i) {
     std::snprintf(text, sizeof(text), "%s %.6g", i ? "," : "", input->t_s[more[i]]);
@@ -472,10 +466,9 @@ void WriteTraceFigures(const CampaignConfig& config, const TraceProcessOptions& 
   sweep_options.figure.height_px = options.figure_height_px;
   sweep_options.compact = options.compact_figure;  // the report explains it in the caption
   for (const std::string& figure_path : options.sweep_figure_paths) {
-    const bool drawn =
-        WriteAmplitudeSweepFigure(fit.sweep, record->inertia_total_kg_m2,
-                                  record->inertia_total_std_kg_m2, figure_path, sweep_options,
-                                  &why);
+    const bool drawn = WriteAmplitudeSweepFigure(fit.sweep, record->inertia_total_kg_m2,
+                                                 record->inertia_total_std_kg_m2, figure_path,
+                                                 sweep_options, &why);
     NoteFigure(drawn, figure_path, why, record);
   }
 }
@@ -502,8 +495,8 @@ TraceRecord ProcessData(const CampaignConfig& config, const std::string& path, c
   // 5. Fit. The residual series is kept for the second glitch pass (and dropped after it when
   // neither a figure nor the caller wants it).
   FitSeries series;
-  TraceFitInput input = MakeFitInput(config, options, data, axis, window, band, record.file,
-                                     &series);
+  TraceFitInput input =
+      MakeFitInput(config, options, data, axis, window, band, record.file, &series);
   TraceFitOptions fit_options = TraceFitOptionsFor(config, options.role);
   fit_options.keep_series = true;
   // A longer window exists when the amplitude band ended the fit before the free swing's end, or
@@ -539,8 +532,9 @@ TraceRecord Guarded(const CampaignConfig& config, const std::string& path,
     record = process(record);
   } catch (const std::bad_alloc&) {  // never a bare "std::bad_alloc"
     record.status = TraceStatus::kError;
-    record.message = record.file + ": out of memory while reading or fitting this log (is it far "
-                                   "larger than a pendulum log?)";
+    record.message = record.file +
+                     ": out of memory while reading or fitting this log (is it far "
+                     "larger than a pendulum log?)";
   } catch (const std::exception& e) {
     record.status = TraceStatus::kError;
     record.message = Renamed(e.what(), path, record.file);
@@ -554,9 +548,8 @@ TraceRecord Guarded(const CampaignConfig& config, const std::string& path,
 
 TraceRecord ProcessTrace(const CampaignConfig& config, const std::string& path,
                          const TraceProcessOptions& options) {
-  return Guarded(config, path, options, [&](const TraceRecord& record) {
-    return Process(config, path, options, record);
-  });
+  return Guarded(config, path, options,
+                 [&](const TraceRecord& record) { return Process(config, path, options, record); });
 }
 
 TraceRecord ProcessTraceData(const CampaignConfig& config, const ImuData& data,
@@ -587,8 +580,7 @@ TraceFitOptions TraceFitOptionsFor(const CampaignConfig& config, TraceRole role)
   fit_options.filar_length_std_m = calibrated ? 0.0 : uncertainties.filar_length_std_m;
   fit_options.filar_separation_std_m = calibrated ? 0.0 : uncertainties.filar_separation_std_m;
   fit_options.mass_std_kg = role == TraceRole::kAircraft
-                                ? std::hypot(uncertainties.mass_std_kg,
-                                             config.aircraft_mass_std_kg)
+                                ? std::hypot(uncertainties.mass_std_kg, config.aircraft_mass_std_kg)
                                 : uncertainties.mass_std_kg;
   fit_options.gravity_std_mps2 = calibrated ? 0.0 : uncertainties.gravity_std_mps2;
   fit_options.gyro_scale_std = config.imu.gyro_scale_std;

@@ -20,7 +20,6 @@
 
 namespace bifilar {
 
-
 // Default upper bound of the amplitude band (deg) when the config sets none: the whole free
 // oscillation is fitted, and the amplitude sweep (docs/method.md) decides whether the rig departs
 // from the model at large amplitude; fit.max_amplitude_deg stays as an override.
@@ -29,7 +28,7 @@ constexpr double kDefaultMaxAmplitudeDeg = 90.0;
 struct TraceProcessOptions {
   // Chooses the suspended mass: aircraft + rig, rig alone, or rig + reference.
   TraceRole role = TraceRole::kAircraft;
-  std::string display_name;               // `file` of the record; default: the path
+  std::string display_name;  // `file` of the record; default: the path
   // Window override [t0, t1] (s); takes precedence over the config's per-file windows.
   std::optional<std::array<double, 2>> window_s;
   // Write the fit-and-residual figure to each of these (.svg or .png); empty = no figure.

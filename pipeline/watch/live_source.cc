@@ -148,9 +148,9 @@ class MavlinkSource : public WatchSource {
                             Fmt(" component %g", m.compid) + Fmt(" imu %g", m.imu_instance);
     if (key_.empty()) key_ = key;
     if (key != key_) return;  // another IMU or the same one sent twice: not counted as input
-    const std::string line = Fmt("mavlink t %.9g", m.t_s) +
-                             Fmt(" gyro %.9g %.9g %.9g", m.gyro_rad_per_s[0], m.gyro_rad_per_s[1],
-                                 m.gyro_rad_per_s[2]);
+    const std::string line =
+        Fmt("mavlink t %.9g", m.t_s) +
+        Fmt(" gyro %.9g %.9g %.9g", m.gyro_rad_per_s[0], m.gyro_rad_per_s[1], m.gyro_rad_per_s[2]);
     ++counters_.lines;
     WatchSample s;
     s.t_s = m.t_s;

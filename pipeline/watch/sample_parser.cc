@@ -95,8 +95,7 @@ void SampleParser::Feed(const std::string& bytes, std::vector<WatchSample>* samp
                         std::vector<RejectedLine>* rejected) {
   partial_ += bytes;
   size_t start = 0;
-  for (size_t nl = partial_.find('\n'); nl != std::string::npos;
-       nl = partial_.find('\n', start)) {
+  for (size_t nl = partial_.find('\n'); nl != std::string::npos; nl = partial_.find('\n', start)) {
     Line(partial_.substr(start, nl - start), samples, rejected);
     start = nl + 1;
   }
@@ -185,7 +184,8 @@ void SampleParser::Line(std::string line, std::vector<WatchSample>* samples,
     if (held_.size() < first) return;
     // A guess of the units waits for motion (see WatchInputOptions::rows_to_guess).
     if (!ColumnsAreTheConfigs() && options_.guess_format &&
-        held_.size() < static_cast<size_t>(std::max(options_.max_rows_held, options_.rows_to_guess))) {
+        held_.size() <
+            static_cast<size_t>(std::max(options_.max_rows_held, options_.rows_to_guess))) {
       if (held_.size() < std::max(first, next_guess_rows_)) return;
       next_guess_rows_ = 2 * held_.size();
       if (!HeldRowsShowMotion()) return;
@@ -300,12 +300,12 @@ void SampleParser::Resolve() {
     throw UserError("watch: the config names accelerometer columns (" + config.accel_columns[0] +
                     ", ...) but the stream has none; set `imu.accel: null` in the config");
   }
-  description_ += ": time " + (counter ? "counter at " + Fmt("%g", options_.counter_rate_hz) + " Hz"
-                                       : input_format_.time_column + " (" +
-                                             ToString(input_format_.time_unit) + ")") +
-                  ", gyro " + input_format_.gyro_columns[0] + "," + input_format_.gyro_columns[1] +
-                  "," + input_format_.gyro_columns[2] + " (" + ToString(input_format_.gyro_unit) +
-                  ")";
+  description_ +=
+      ": time " +
+      (counter ? "counter at " + Fmt("%g", options_.counter_rate_hz) + " Hz"
+               : input_format_.time_column + " (" + ToString(input_format_.time_unit) + ")") +
+      ", gyro " + input_format_.gyro_columns[0] + "," + input_format_.gyro_columns[1] + "," +
+      input_format_.gyro_columns[2] + " (" + ToString(input_format_.gyro_unit) + ")";
   resolved_ = true;
 }
 
@@ -317,8 +317,12 @@ void SampleParser::Row(const std::string& line, const std::vector<std::string>& 
   };
   double values[7] = {0, 0, 0, 0, 0, 0, 0};
   const int indices[7] = {options_.counter_rate_hz > 0 ? counter_index_ : time_index_,
-                          gyro_index_[0], gyro_index_[1], gyro_index_[2],
-                          accel_index_[0], accel_index_[1], accel_index_[2]};
+                          gyro_index_[0],
+                          gyro_index_[1],
+                          gyro_index_[2],
+                          accel_index_[0],
+                          accel_index_[1],
+                          accel_index_[2]};
   const bool has_accel = options_.format.has_accel();
   for (int k = 0; k < 7; ++k) {
     if (indices[k] < 0) continue;
@@ -327,8 +331,8 @@ void SampleParser::Row(const std::string& line, const std::vector<std::string>& 
   const long index = index_++;
   WatchSample s;
   if (options_.counter_rate_hz > 0) {
-    s.t_s = (counter_index_ >= 0 ? values[0] : static_cast<double>(index)) /
-            options_.counter_rate_hz;
+    s.t_s =
+        (counter_index_ >= 0 ? values[0] : static_cast<double>(index)) / options_.counter_rate_hz;
   } else {
     s.t_s = values[0] * ToSi(input_format_.time_unit);
   }

@@ -30,9 +30,9 @@ SavedLog::SavedLog(const std::string& path, const ImuFormat& format, const std::
     : path_(path), format_(format) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) {
-    throw UserError(path + ": cannot create the watch log (" + std::strerror(errno) +
-                    (errno == EEXIST ? "; watch never writes over a file: name another --save)"
-                                     : ")"));
+    throw UserError(
+        path + ": cannot create the watch log (" + std::strerror(errno) +
+        (errno == EEXIST ? "; watch never writes over a file: name another --save)" : ")"));
   }
   file_ = ::fdopen(fd, "w");
   if (file_ == nullptr) {
@@ -105,7 +105,8 @@ std::string DefaultSavedLogPath(const std::string& config_path) {
   std::strftime(stamp, sizeof(stamp), "%Y%m%d_%H%M%S", &utc);
   const std::string base = (folder / ("watch_" + std::string(stamp))).string();
   std::string path = base + ".csv";
-  for (int n = 2; std::filesystem::exists(path); ++n) path = base + "_" + std::to_string(n) + ".csv";
+  for (int n = 2; std::filesystem::exists(path); ++n)
+    path = base + "_" + std::to_string(n) + ".csv";
   return path;
 }
 

@@ -13,12 +13,11 @@
 namespace bifilar {
 namespace {
 
-constexpr EnumName<WatchVerdict> kWatchVerdictNames[] = {
-    {WatchVerdict::kWaiting, "waiting"},
-    {WatchVerdict::kSwinging, "swinging"},
-    {WatchVerdict::kEnough, "enough"},
-    {WatchVerdict::kSwingAgain, "swing_again"},
-    {WatchVerdict::kFixRig, "fix_rig"}};
+constexpr EnumName<WatchVerdict> kWatchVerdictNames[] = {{WatchVerdict::kWaiting, "waiting"},
+                                                         {WatchVerdict::kSwinging, "swinging"},
+                                                         {WatchVerdict::kEnough, "enough"},
+                                                         {WatchVerdict::kSwingAgain, "swing_again"},
+                                                         {WatchVerdict::kFixRig, "fix_rig"}};
 
 constexpr size_t kRecentSamples = 256;  // the ring behind the rate and noise before release
 constexpr int kMinPointsToFit = 20;
@@ -245,9 +244,9 @@ void WatchEngine::Judge(WatchUpdate* u) {
     // measured at rest.
     if (std::isfinite(rest_noise_) && u->rate_noise_rad_per_s > kReleaseNoiseRatio * rest_noise_) {
       u->verdict = WatchVerdict::kSwinging;
-      u->reason = "released; the first fit needs " + Fmt("%g", min_cycles - 1.0) +
-                  " cycles of free swing" +
-                  (record_.message.empty() ? "" : " (" + WarningSummary(record_.message, 100) + ")");
+      u->reason =
+          "released; the first fit needs " + Fmt("%g", min_cycles - 1.0) + " cycles of free swing" +
+          (record_.message.empty() ? "" : " (" + WarningSummary(record_.message, 100) + ")");
       return;
     }
     if (std::isfinite(u->rate_noise_rad_per_s)) {
@@ -256,12 +255,13 @@ void WatchEngine::Judge(WatchUpdate* u) {
     }
     u->verdict = WatchVerdict::kWaiting;
     for (const WatchSwing& s : swings_) u->earlier_swings_kg_m2.push_back(s.inertia_kg_m2);
-    u->reason = "waiting for release: rate noise " + Fmt("%.2g", u->rate_noise_rad_per_s) +
-                " rad/s at " + Fmt("%.0f", u->rate_hz) + " Hz" +
-                (swings_.empty() ? ""
-                                 : "; last swing I = " + Fmt("%.6g", swings_.back().inertia_kg_m2) +
-                                       Fmt(" +- %.2g kg m^2", swings_.back().inertia_std_stat_kg_m2)) +
-                (record_.message.empty() ? "" : " (" + WarningSummary(record_.message, 100) + ")");
+    u->reason =
+        "waiting for release: rate noise " + Fmt("%.2g", u->rate_noise_rad_per_s) + " rad/s at " +
+        Fmt("%.0f", u->rate_hz) + " Hz" +
+        (swings_.empty() ? ""
+                         : "; last swing I = " + Fmt("%.6g", swings_.back().inertia_kg_m2) +
+                               Fmt(" +- %.2g kg m^2", swings_.back().inertia_std_stat_kg_m2)) +
+        (record_.message.empty() ? "" : " (" + WarningSummary(record_.message, 100) + ")");
     return;
   }
   if (record_.status == TraceStatus::kRejected) {
@@ -298,8 +298,8 @@ void WatchEngine::Judge(WatchUpdate* u) {
                               Fmt("%g", options_.target_percent) + " %";
   const std::string warning =
       record_.warnings.empty() ? "" : "; " + WarningSummary(record_.warnings.front(), 120);
-  const bool swing_over = std::isfinite(u->period_s) &&
-                          record_.window_s[1] < u->t_s - 2.0 * u->period_s;
+  const bool swing_over =
+      std::isfinite(u->period_s) && record_.window_s[1] < u->t_s - 2.0 * u->period_s;
   if (relative <= target) {
     u->verdict = WatchVerdict::kEnough;
     u->reason = percent + warning;
@@ -308,12 +308,12 @@ void WatchEngine::Judge(WatchUpdate* u) {
     u->reason = "the release was above the amplitude band: release lower; " + percent;
   } else if (swing_over) {
     u->verdict = WatchVerdict::kSwingAgain;
-    u->reason = "the swing died out at " + Fmt("%.1f", u->amplitude_deg) + " deg before the target (" +
-                percent + "): swing again";
+    u->reason = "the swing died out at " + Fmt("%.1f", u->amplitude_deg) +
+                " deg before the target (" + percent + "): swing again";
   } else {
     u->verdict = WatchVerdict::kSwinging;
-    u->reason = percent + ", about " + Fmt("%.0f", std::ceil(u->cycles_needed)) +
-                " more cycles" + warning;
+    u->reason =
+        percent + ", about " + Fmt("%.0f", std::ceil(u->cycles_needed)) + " more cycles" + warning;
   }
 }
 
@@ -328,8 +328,7 @@ void WatchEngine::CloseSwingIfEnded() {
   const auto first_after =
       std::upper_bound(points_.t_s.begin(), points_.t_s.end(), end) - points_.t_s.begin();
   points_.t_s.erase(points_.t_s.begin(), points_.t_s.begin() + first_after);
-  points_.gyro_in_imu.erase(points_.gyro_in_imu.begin(),
-                            points_.gyro_in_imu.begin() + first_after);
+  points_.gyro_in_imu.erase(points_.gyro_in_imu.begin(), points_.gyro_in_imu.begin() + first_after);
   if (has_accel_) {
     points_.accel_in_imu.erase(points_.accel_in_imu.begin(),
                                points_.accel_in_imu.begin() + first_after);

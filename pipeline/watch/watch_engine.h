@@ -13,8 +13,9 @@
 // and the work per update and the memory stay constant however long the stream (a benchmark,
 // bench/watch_bench.cc, measures it at 1 kHz). Points are merged only while a point spans less
 // than 1/32 of the period (the block mean then keeps the swing's amplitude to 0.2 %); past that,
-// the oldest half of the points is dropped instead, and the fit is of a bounded recent window. The final result is never from block means: it is
-// the fit of the saved log (pipeline/watch/watch_run.h).
+// the oldest half of the points is dropped instead, and the fit is of a bounded recent window. The
+// final result is never from block means: it is the fit of the saved log
+// (pipeline/watch/watch_run.h).
 //
 // Updates are scheduled by the samples' own time (not the wall clock), so the same stream always
 // gives the same updates.
@@ -60,23 +61,23 @@ struct WatchEngineOptions {
 
 // One update: what the terminal line, the JSON lines and the page show.
 struct WatchUpdate {
-  double t_s = NAN;              // data time of the last sample (s)
-  long samples = 0;              // samples received so far
-  double rate_hz = NAN;          // IMU rate of the recent samples (Hz)
-  double rate_noise_rad_per_s = NAN;  // std of the swing-axis rate over the recent samples
-  int swing = 1;                 // number of the current swing (1, 2, ...)
-  double cycles = 0.0;           // cycles of the fitted window
-  double amplitude_deg = NAN;    // amplitude at the end of the fitted window (deg)
-  double period_s = NAN;         // measured period (s)
+  double t_s = NAN;                        // data time of the last sample (s)
+  long samples = 0;                        // samples received so far
+  double rate_hz = NAN;                    // IMU rate of the recent samples (Hz)
+  double rate_noise_rad_per_s = NAN;       // std of the swing-axis rate over the recent samples
+  int swing = 1;                           // number of the current swing (1, 2, ...)
+  double cycles = 0.0;                     // cycles of the fitted window
+  double amplitude_deg = NAN;              // amplitude at the end of the fitted window (deg)
+  double period_s = NAN;                   // measured period (s)
   double small_angle_inertia_kg_m2 = NAN;  // the classic formula (a hand check, labelled)
-  double inertia_kg_m2 = NAN;    // the full-model fit's I of everything suspended
-  double inertia_std_stat_kg_m2 = NAN;   // per-swing std (HAC + model inadequacy)
-  double inertia_std_total_kg_m2 = NAN;  // with the budget (L, D, m, g) in quadrature
-  double cycles_needed = NAN;    // more cycles to reach target_percent (estimate); 0 when there
-  int fit_points = 0;            // points the fit saw (samples, or block means beyond the bound)
-  int block_size = 1;            // samples per point
+  double inertia_kg_m2 = NAN;              // the full-model fit's I of everything suspended
+  double inertia_std_stat_kg_m2 = NAN;     // per-swing std (HAC + model inadequacy)
+  double inertia_std_total_kg_m2 = NAN;    // with the budget (L, D, m, g) in quadrature
+  double cycles_needed = NAN;  // more cycles to reach target_percent (estimate); 0 when there
+  int fit_points = 0;          // points the fit saw (samples, or block means beyond the bound)
+  int block_size = 1;          // samples per point
   WatchVerdict verdict = WatchVerdict::kWaiting;
-  std::string reason;            // why this verdict, in words
+  std::string reason;  // why this verdict, in words
   // Repeats: the I of the earlier swings of this set-up, and whether this one agrees with them.
   std::vector<double> earlier_swings_kg_m2;
   std::string repeat_agreement;  // "" (no earlier swing), "agrees" or "disagrees by ..."
@@ -119,7 +120,7 @@ class WatchEngine {
 
   CampaignConfig config_;
   WatchEngineOptions options_;
-  ImuData points_;            // the swing so far: samples, or block means of block_ samples
+  ImuData points_;  // the swing so far: samples, or block means of block_ samples
   int block_ = 1;
   // The block being filled (block_ > 1): sums and count.
   double pending_t_ = 0.0;

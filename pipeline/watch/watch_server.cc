@@ -22,10 +22,10 @@ struct WatchServer::State {
   std::condition_variable changed;
   long sequence = 0;
   bool stopping = false;
-  std::string message = "{}";  // the last message sent
+  std::string message = "{}";                        // the last message sent
   nlohmann::json history = nlohmann::json::array();  // [cycles, I, std stat] of this swing
   int swing = 0;
-  nlohmann::json events = nlohmann::json::array();   // the last few lines of news
+  nlohmann::json events = nlohmann::json::array();  // the last few lines of news
 
   void Send() {  // with `mutex` held
     message = nlohmann::json{{"history", history}, {"events", events}, {"update", last}}.dump();

@@ -132,7 +132,9 @@ class FollowedFile : public WatchSource {
     parser_.ResetClock();
     last_t_ = -1e300;
   }
-  const InputCounters& counters() const override { return binary_ ? binary_counters_ : parser_.counters(); }
+  const InputCounters& counters() const override {
+    return binary_ ? binary_counters_ : parser_.counters();
+  }
   std::string Describe() const override { return path_; }
   std::string simulated_marker() const override {
     return binary_ ? simulated_marker_ : parser_.simulated_marker();
@@ -220,8 +222,8 @@ long ReplayLog(const std::string& path, const CampaignConfig& config, double spe
   for (const std::string& w : data.warnings) {
     if (IsSimulatedLogWarning(w)) head += "# " + w + "\n";
   }
-  head += f.time_column + "," + f.gyro_columns[0] + "," + f.gyro_columns[1] + "," +
-          f.gyro_columns[2];
+  head +=
+      f.time_column + "," + f.gyro_columns[0] + "," + f.gyro_columns[1] + "," + f.gyro_columns[2];
   if (accel) head += "," + f.accel_columns[0] + "," + f.accel_columns[1] + "," + f.accel_columns[2];
   head += "\n";
   auto write_all = [out_fd](const std::string& text) {

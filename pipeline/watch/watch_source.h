@@ -24,7 +24,6 @@
 
 namespace bifilar {
 
-
 // Opens the source `spec` (above). Throws UserError naming the spec on a bad spec, a missing
 // transport or a source that cannot be opened (a file that does not exist yet is waited for).
 std::unique_ptr<WatchSource> OpenWatchSource(const std::string& spec, const CampaignConfig& config,

@@ -30,12 +30,18 @@ py::list Texts(const std::vector<std::string>& v) {
 py::object ToPython(const nlohmann::json& j) {
   using Type = nlohmann::json::value_t;
   switch (j.type()) {
-    case Type::null: return py::none();
-    case Type::boolean: return py::bool_(j.get<bool>());
-    case Type::number_integer: return py::int_(j.get<std::int64_t>());
-    case Type::number_unsigned: return py::int_(j.get<std::uint64_t>());
-    case Type::number_float: return py::float_(j.get<double>());
-    case Type::string: return Text(j.get_ref<const std::string&>());
+    case Type::null:
+      return py::none();
+    case Type::boolean:
+      return py::bool_(j.get<bool>());
+    case Type::number_integer:
+      return py::int_(j.get<std::int64_t>());
+    case Type::number_unsigned:
+      return py::int_(j.get<std::uint64_t>());
+    case Type::number_float:
+      return py::float_(j.get<double>());
+    case Type::string:
+      return Text(j.get_ref<const std::string&>());
     case Type::array: {
       py::list list;
       for (const nlohmann::json& item : j) list.append(ToPython(item));
@@ -46,7 +52,8 @@ py::object ToPython(const nlohmann::json& j) {
       for (const auto& [key, value] : j.items()) dict[Text(key)] = ToPython(value);
       return std::move(dict);
     }
-    default: return py::none();  // binary / discarded: never produced by the serializers
+    default:
+      return py::none();  // binary / discarded: never produced by the serializers
   }
 }
 
@@ -91,8 +98,7 @@ std::vector<double> Series(const Array& array, const std::string& function,
 }
 
 void SameLength(const std::vector<double>& a, const std::vector<double>& b,
-                const std::string& function, const std::string& name_a,
-                const std::string& name_b) {
+                const std::string& function, const std::string& name_a, const std::string& name_b) {
   if (a.size() != b.size()) {
     throw std::invalid_argument(function + ": " + name_a + " and " + name_b +
                                 " have different lengths (" + std::to_string(a.size()) + " and " +
@@ -104,10 +110,9 @@ void StrictlyIncreasing(const std::vector<double>& t, const std::string& functio
                         const std::string& name) {
   for (size_t i = 1; i < t.size(); ++i) {
     if (!(t[i] > t[i - 1])) {
-      throw std::invalid_argument(function + ": " + name + " must be strictly increasing; " +
-                                  name + "[" + std::to_string(i) + "] = " + Num(t[i]) +
-                                  " follows " + name + "[" + std::to_string(i - 1) +
-                                  "] = " + Num(t[i - 1]));
+      throw std::invalid_argument(function + ": " + name + " must be strictly increasing; " + name +
+                                  "[" + std::to_string(i) + "] = " + Num(t[i]) + " follows " +
+                                  name + "[" + std::to_string(i - 1) + "] = " + Num(t[i - 1]));
     }
   }
 }

@@ -37,8 +37,7 @@ std::string Num(double value);
 std::vector<double> Series(const Array& array, const std::string& function,
                            const std::string& name);
 void SameLength(const std::vector<double>& a, const std::vector<double>& b,
-                const std::string& function, const std::string& name_a,
-                const std::string& name_b);
+                const std::string& function, const std::string& name_a, const std::string& name_b);
 void StrictlyIncreasing(const std::vector<double>& t, const std::string& function,
                         const std::string& name);
 // A config as `bifilar fit` loads it: geometry, masses and IMU format suffice.

@@ -82,8 +82,8 @@ py::dict ResidualColumns(const std::vector<EllipseResidual>& residuals) {
 }
 
 py::object FitEllipseCore(const Array& pitch_array, const Array& inertia_array,
-                          const std::optional<Array>& std_array, int bootstrap,
-                          std::uint64_t seed, double confidence, const std::string& covariance) {
+                          const std::optional<Array>& std_array, int bootstrap, std::uint64_t seed,
+                          double confidence, const std::string& covariance) {
   const char* fn = "fit_ellipse";
   std::vector<EllipsePoint> points;
   {  // the checked copies of the arrays live only until the points are built
@@ -103,8 +103,8 @@ py::object FitEllipseCore(const Array& pitch_array, const Array& inertia_array,
   options.seed = seed;
   options.confidence = confidence;
   if (!ParseEllipseCovariance(covariance, &options.covariance)) {
-    throw std::invalid_argument("fit_ellipse: covariance '" + covariance +
-                                "': expected " + EllipseCovarianceAllowedValues());
+    throw std::invalid_argument("fit_ellipse: covariance '" + covariance + "': expected " +
+                                EllipseCovarianceAllowedValues());
   }
   EllipseResult result;
   std::string why;
@@ -126,9 +126,8 @@ py::object FitEllipseCore(const Array& pitch_array, const Array& inertia_array,
 }  // namespace
 
 void BindEllipse(py::module_& m) {
-  m.def("fit_ellipse", &FitEllipseCore, py::arg("pitch_deg"), py::arg("inertia"),
-        py::arg("std"), py::arg("bootstrap"), py::arg("seed"), py::arg("confidence"),
-        py::arg("covariance"),
+  m.def("fit_ellipse", &FitEllipseCore, py::arg("pitch_deg"), py::arg("inertia"), py::arg("std"),
+        py::arg("bootstrap"), py::arg("seed"), py::arg("confidence"), py::arg("covariance"),
         "fit_ellipse(pitch_deg, inertia, std, bootstrap, seed, confidence, covariance) -> dict: "
         "the `bifilar ellipse --json` document.");
 }

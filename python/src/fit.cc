@@ -82,8 +82,7 @@ CampaignConfig FitTraceConfig(const FitTraceArgs& a) {
   }
   if (a.g) config.gravity_mps2 = *a.g;
   if (a.model && !ParsePendulumModel(*a.model, &config.fit.model)) {
-    throw std::invalid_argument("fit_trace: model '" + *a.model +
-                                "': expected " +
+    throw std::invalid_argument("fit_trace: model '" + *a.model + "': expected " +
                                 PendulumModelAllowedValues());
   }
   if (a.max_amplitude_deg) config.fit.max_amplitude_deg = *a.max_amplitude_deg;
@@ -199,7 +198,6 @@ py::tuple FitTraceCore(const Array& t_array, const Array& rate_array, const FitT
                         ToNumpy(fit.residual_rad_per_s));
 }
 
-
 // C++ wall time of the call fit_trace makes, repeated in C++ without Python in the loop: the
 // reference for examples/bench_fit_trace.py. Returns the seconds of each repeat.
 std::vector<double> TimeFitTraceCore(const Array& t_array, const Array& rate_array,
@@ -254,14 +252,29 @@ FitTraceArgs MakeFitTraceArgs(py::kwargs kwargs) {
   get("whiteness_lags", &a.whiteness_lags);
   get("max_secondary_motion_ratio", &a.max_secondary_motion_ratio);
   get("min_periods", &a.min_periods);
-  if (kwargs.contains("name") && !kwargs["name"].is_none()) a.name = kwargs["name"].cast<std::string>();
+  if (kwargs.contains("name") && !kwargs["name"].is_none())
+    a.name = kwargs["name"].cast<std::string>();
   for (const auto& item : kwargs) {
-    static const char* known[] = {"config", "length_m", "separation_m", "mass_kg", "g", "model",
-                                  "window", "max_amplitude_deg", "min_amplitude_deg",
-                                  "length_std_m", "separation_std_m", "mass_std_kg", "g_std",
-                                  "gyro_scale_std", "max_rms_over_noise",
-                                  "max_residual_autocorr", "whiteness_lags",
-                                  "max_secondary_motion_ratio", "min_periods", "name"};
+    static const char* known[] = {"config",
+                                  "length_m",
+                                  "separation_m",
+                                  "mass_kg",
+                                  "g",
+                                  "model",
+                                  "window",
+                                  "max_amplitude_deg",
+                                  "min_amplitude_deg",
+                                  "length_std_m",
+                                  "separation_std_m",
+                                  "mass_std_kg",
+                                  "g_std",
+                                  "gyro_scale_std",
+                                  "max_rms_over_noise",
+                                  "max_residual_autocorr",
+                                  "whiteness_lags",
+                                  "max_secondary_motion_ratio",
+                                  "min_periods",
+                                  "name"};
     const std::string key = py::str(item.first);
     if (std::find(std::begin(known), std::end(known), key) == std::end(known)) {
       throw py::type_error("fit_trace: unexpected keyword argument '" + key + "'");

@@ -94,10 +94,10 @@ py::dict ReadLogCore(const std::string& path, const std::optional<std::string>& 
   out["rate_rad_per_s"] = ToNumpy(axis.rate_rad_per_s);
   out["gyro_rad_per_s"] = ToNumpy(data.gyro_in_imu);
   out["accel_mps2"] = data.has_accel() ? py::object(ToNumpy(data.accel_in_imu)) : py::none();
-  out["axis_in_imu"] = std::vector<double>{axis.axis_in_imu[0], axis.axis_in_imu[1],
-                                           axis.axis_in_imu[2]};
-  out["axis_in_body"] = std::vector<double>{axis.axis_in_body[0], axis.axis_in_body[1],
-                                            axis.axis_in_body[2]};
+  out["axis_in_imu"] =
+      std::vector<double>{axis.axis_in_imu[0], axis.axis_in_imu[1], axis.axis_in_imu[2]};
+  out["axis_in_body"] =
+      std::vector<double>{axis.axis_in_body[0], axis.axis_in_body[1], axis.axis_in_body[2]};
   out["axis_source"] = ToString(axis.source);
   out["pitch_measured_deg"] =
       axis.pitch_measured_deg ? py::object(py::float_(*axis.pitch_measured_deg)) : py::none();

@@ -141,8 +141,8 @@ py::dict SimulateCore(const SimulateArgs& a) {
     result["accel_mps2"] = data.has_accel() ? py::object(ToNumpy(data.accel_in_imu)) : py::none();
     if (a.trace) result["file"] = Text(*a.trace);
   }
-  result["truth_path"] = summary.truth_path.empty() ? py::object(py::none())
-                                                    : py::object(Text(summary.truth_path));
+  result["truth_path"] =
+      summary.truth_path.empty() ? py::object(py::none()) : py::object(Text(summary.truth_path));
   return result;
 }
 
@@ -155,8 +155,7 @@ void BindSimulate(py::module_& m) {
         SimulateArgs a;
         auto get = [&](const char* key, auto* target) {
           if (kwargs.contains(key) && !kwargs[key].is_none()) {
-            *target =
-                kwargs[key].cast<typename std::decay_t<decltype(*target)>::value_type>();
+            *target = kwargs[key].cast<typename std::decay_t<decltype(*target)>::value_type>();
           }
         };
         get("spec", &a.spec);

@@ -62,7 +62,8 @@ std::vector<std::array<double, 3>> Axes(const Array& array, const std::string& f
     for (int k = 0; k < 3; ++k) {
       axes[i][k] = data[3 * i + k];
       if (!std::isfinite(axes[i][k])) {
-        throw std::invalid_argument(function + ": " + name + "[" + std::to_string(i) + "] is not "
+        throw std::invalid_argument(function + ": " + name + "[" + std::to_string(i) +
+                                    "] is not "
                                     "finite; every value must be finite");
       }
     }
@@ -80,8 +81,10 @@ py::object FitTensorCore(const Array& direction_array, const Array& inertia_arra
   const std::vector<std::array<double, 3>> directions = Axes(direction_array, fn, "directions");
   const std::vector<double> inertia = Series(inertia_array, fn, "inertias");
   if (directions.size() != inertia.size()) {
-    throw std::invalid_argument(std::string(fn) + ": directions and inertias have different "
-                                "lengths (" + std::to_string(directions.size()) + " and " +
+    throw std::invalid_argument(std::string(fn) +
+                                ": directions and inertias have different "
+                                "lengths (" +
+                                std::to_string(directions.size()) + " and " +
                                 std::to_string(inertia.size()) + ")");
   }
   std::vector<double> stds(inertia.size(), 0.0);
@@ -93,7 +96,8 @@ py::object FitTensorCore(const Array& direction_array, const Array& inertia_arra
   if (nominal_array) {
     nominal = Axes(*nominal_array, fn, "nominal");
     if (nominal.size() != inertia.size()) {
-      throw std::invalid_argument(std::string(fn) + ": nominal and inertias have different lengths");
+      throw std::invalid_argument(std::string(fn) +
+                                  ": nominal and inertias have different lengths");
     }
   }
   if (groups && groups->size() != inertia.size()) {
@@ -114,8 +118,8 @@ py::object FitTensorCore(const Array& direction_array, const Array& inertia_arra
   options.common_offset_std_kg_m2 = common_offset_std;
   options.attitude_scatter = attitude_scatter;
   if (!ParseEllipseCovariance(covariance, &options.covariance)) {
-    throw std::invalid_argument("fit_tensor: covariance '" + covariance +
-                                "': expected " + EllipseCovarianceAllowedValues());
+    throw std::invalid_argument("fit_tensor: covariance '" + covariance + "': expected " +
+                                EllipseCovarianceAllowedValues());
   }
   std::string why;
   if (!options.Check(&why)) throw UserError("tensor options: " + why);
@@ -136,10 +140,10 @@ py::object FitTensorCore(const Array& direction_array, const Array& inertia_arra
 }  // namespace
 
 void BindTensor(py::module_& m) {
-  m.def("fit_tensor", &FitTensorCore, py::arg("directions"), py::arg("inertias"),
-        py::arg("stds"), py::arg("nominal"), py::arg("groups"), py::arg("bootstrap"),
-        py::arg("seed"), py::arg("confidence"), py::arg("covariance"),
-        py::arg("common_offset_std"), py::arg("attitude_scatter"),
+  m.def("fit_tensor", &FitTensorCore, py::arg("directions"), py::arg("inertias"), py::arg("stds"),
+        py::arg("nominal"), py::arg("groups"), py::arg("bootstrap"), py::arg("seed"),
+        py::arg("confidence"), py::arg("covariance"), py::arg("common_offset_std"),
+        py::arg("attitude_scatter"),
         "fit_tensor(directions, inertias, stds, nominal, groups, bootstrap, seed, confidence, "
         "covariance, common_offset_std, attitude_scatter) -> dict: the `tensor` section of "
         "results.json for these moments.");

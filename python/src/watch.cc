@@ -106,9 +106,7 @@ class WatchRun {
 }  // namespace
 
 void BindWatch(py::module_& m) {
-  py::class_<WatchRun>(m, "WatchRun")
-      .def("next", &WatchRun::Next)
-      .def("close", &WatchRun::Close);
+  py::class_<WatchRun>(m, "WatchRun").def("next", &WatchRun::Next).def("close", &WatchRun::Close);
   m.def(
       "watch_start",
       [](const std::string& source, const std::string& config, const std::string& save,
@@ -130,8 +128,7 @@ void BindWatch(py::module_& m) {
       },
       py::arg("source"), py::arg("config"), py::arg("save"), py::arg("target_percent"),
       py::arg("counter_rate_hz"), py::arg("counter_column"), py::arg("cycles"),
-      py::arg("stop_at_target"), py::arg("idle_end_s"), py::arg("append"),
-      py::arg("serve_port"));
+      py::arg("stop_at_target"), py::arg("idle_end_s"), py::arg("append"), py::arg("serve_port"));
 }
 
 }  // namespace python

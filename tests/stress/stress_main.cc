@@ -12,10 +12,10 @@
 // by a link, hard link or FIFO; `--out` inside the logs.
 // Then, once each, hostile inputs that must stop quickly with a clear message
 // (issue 15; issue 26: ArduPilot DataFlash logs that are not DataFlash, empty, without IMU, with a
-// bad FMT, and damaged copies): a FIFO and a symlink to /dev/urandom among the logs, /dev/zero as the config, a
-// multi-member gzip log (the baseline's ellipse), a gzip bomb, a FIFO as results.json and as a
-// cache entry (process and report), a YAML alias bomb; (issue 23) simulate, init and export
-// aimed at a user's file, a log, the campaign's results or a link to /proc/self/fd/1.
+// bad FMT, and damaged copies): a FIFO and a symlink to /dev/urandom among the logs, /dev/zero as
+// the config, a multi-member gzip log (the baseline's ellipse), a gzip bomb, a FIFO as results.json
+// and as a cache entry (process and report), a YAML alias bomb; (issue 23) simulate, init and
+// export aimed at a user's file, a log, the campaign's results or a link to /proc/self/fd/1.
 //
 // Asserted for every run: no crash (signal), no hang (each run is bounded by --run-timeout-s,
 // default 60 s, far above the ~0.3 s a run takes), exit code 0, 1 or 2, no NaN or inf written
@@ -57,11 +57,11 @@
 
 #include "base/gzip.h"
 #include "base/units.h"
+#include "pipeline/live/mavlink.h"  // issue 34 block at the end
+#include "pipeline/live/mavlink_writer.h"
 #include "pipeline/logs/dataflash_writer.h"
 #include "pipeline/store/cache.h"
 #include "pipeline/store/output_set.h"
-#include "pipeline/live/mavlink.h"         // issue 34 block at the end
-#include "pipeline/live/mavlink_writer.h"
 
 namespace {
 
@@ -318,7 +318,8 @@ std::string MutateLog(const std::string& text, std::mt19937_64& rng, std::string
       std::string t = text;
       const int k = Uniform(rng, 1, 40);
       for (int i = 0; i < k && !t.empty(); ++i) {
-        t[Uniform(rng, 0, static_cast<int>(t.size()) - 1)] = static_cast<char>(Uniform(rng, 0, 255));
+        t[Uniform(rng, 0, static_cast<int>(t.size()) - 1)] =
+            static_cast<char>(Uniform(rng, 0, 255));
       }
       *what = "byte flips x" + std::to_string(k);
       return t;
@@ -350,8 +351,8 @@ std::string MutateLog(const std::string& text, std::mt19937_64& rng, std::string
     }
     case 5:
     case 6: {
-      static const std::vector<std::string> huge = {"1e308", "-1e308", "1e300", "3e38",
-                                                    "1e-320", "-0", "99999999999999999999"};
+      static const std::vector<std::string> huge = {
+          "1e308", "-1e308", "1e300", "3e38", "1e-320", "-0", "99999999999999999999"};
       static const std::vector<std::string> bad = {"nan", "NaN", "inf", "-inf", "", "x", "1e999"};
       const std::vector<std::string>& values = Uniform(rng, 0, 1) ? huge : bad;
       const int k = Uniform(rng, 1, 30);
@@ -365,7 +366,8 @@ std::string MutateLog(const std::string& text, std::mt19937_64& rng, std::string
         const size_t end = std::min(line.find(',', begin), line.size());
         line.replace(begin, end - begin, Pick(values, rng));
       }
-      *what = std::string(&values == &huge ? "huge" : "NaN/inf/empty") + " values x" + std::to_string(k);
+      *what = std::string(&values == &huge ? "huge" : "NaN/inf/empty") + " values x" +
+              std::to_string(k);
       return Join(lines);
     }
     case 7:
@@ -392,8 +394,10 @@ std::string MutateLog(const std::string& text, std::mt19937_64& rng, std::string
 std::string MutateConfig(const std::string& text, std::mt19937_64& rng, std::string* what) {
   std::vector<std::string> lines = Lines(text);
   static const std::vector<std::string> values = {
-      "0", "-1", "1e308", "-1e308", ".nan", "nan", "2147483647", "-2147483648", "1e-320", "\"\"",
-      "[]", "{}", "~", "abc", "99999999999999999999", "/", "../../..", "[1, 2, 3]", "0.5"};
+      "0",   "-1",         "1e308",       "-1e308", ".nan",
+      "nan", "2147483647", "-2147483648", "1e-320", "\"\"",
+      "[]",  "{}",         "~",           "abc",    "99999999999999999999",
+      "/",   "../../..",   "[1, 2, 3]",   "0.5"};
   switch (Uniform(rng, 0, 4)) {
     case 0:
     case 1: {
@@ -407,7 +411,8 @@ std::string MutateConfig(const std::string& text, std::mt19937_64& rng, std::str
       const size_t colon = line.find(": ");
       const size_t comment = line.find(" #", colon);
       const std::string value = Pick(values, rng);
-      line = line.substr(0, colon + 2) + value + (comment == std::string::npos ? "" : line.substr(comment));
+      line = line.substr(0, colon + 2) + value +
+             (comment == std::string::npos ? "" : line.substr(comment));
       *what = "line " + std::to_string(i + 1) + " value -> " + value;
       return Join(lines);
     }
@@ -421,7 +426,8 @@ std::string MutateConfig(const std::string& text, std::mt19937_64& rng, std::str
       std::string t = text;
       const int k = Uniform(rng, 1, 5);
       for (int j = 0; j < k; ++j) {
-        t[Uniform(rng, 0, static_cast<int>(t.size()) - 1)] = static_cast<char>(Uniform(rng, 32, 126));
+        t[Uniform(rng, 0, static_cast<int>(t.size()) - 1)] =
+            static_cast<char>(Uniform(rng, 32, 126));
       }
       *what = "byte flips x" + std::to_string(k);
       return t;
@@ -440,9 +446,9 @@ struct Workspace {
   std::string dir, logs, out, config_path, config_text;
   std::string harness;  // the runs' stdout and stderr (outside the sentinel tree)
   std::string thesis;   // a user's file beside the campaign: never to be touched
-  std::map<std::string, std::string> pristine;  // path -> content of every log
+  std::map<std::string, std::string> pristine;    // path -> content of every log
   std::map<std::string, std::string> user_files;  // path -> content, must never change
-  double ixz_kg_m2 = NAN, ix_kg_m2 = NAN;        // baseline ellipse
+  double ixz_kg_m2 = NAN, ix_kg_m2 = NAN;         // baseline ellipse
 
   void RestoreLogs() const {
     for (const auto& [path, text] : pristine) {
@@ -450,7 +456,8 @@ struct Workspace {
     }
     // Files a mutation may have added.
     for (const auto& entry : fs::recursive_directory_iterator(logs)) {
-      if (entry.is_regular_file() && !pristine.count(entry.path().string())) fs::remove(entry.path());
+      if (entry.is_regular_file() && !pristine.count(entry.path().string()))
+        fs::remove(entry.path());
     }
   }
   void RestoreConfig() const { WriteFile(config_path, config_text); }
@@ -492,7 +499,8 @@ Workspace MakeWorkspace(const Args& args) {
   std::string config = ReadFile(args.source + "/configs/prandtl_d.yaml");
   if (!Replace(&config, "../sample_runs/prandtl_d/logs/tare/*.csv.gz", "logs/tare/*.csv") ||
       !Replace(&config, "../sample_runs/prandtl_d/logs", "logs") ||
-      !Replace(&config, "*.csv.gz", "*.csv") || !Replace(&config, "bootstrap: 2000", "bootstrap: 200")) {
+      !Replace(&config, "*.csv.gz", "*.csv") ||
+      !Replace(&config, "bootstrap: 2000", "bootstrap: 200")) {
     throw std::runtime_error("configs/prandtl_d.yaml changed: update MakeWorkspace in " __FILE__);
   }
   w.config_text = config;
@@ -508,7 +516,8 @@ Workspace MakeWorkspace(const Args& args) {
 }
 
 std::vector<std::string> ProcessArgv(const Args& args, const Workspace& w, bool force) {
-  std::vector<std::string> argv = {args.binary, "process", w.config_path, "--out", w.out, "--jobs", "2"};
+  std::vector<std::string> argv = {args.binary, "process", w.config_path, "--out", w.out,
+                                   "--jobs",    "2"};
   if (force) argv.push_back("--force");
   return argv;
 }
@@ -530,7 +539,8 @@ void ReadEllipse(const std::string& out, double* ix, double* ixz) {
 void CheckRun(const Outcome& o, const Workspace& w, int case_no, const std::string& kind,
               Failures* failures) {
   if (o.timed_out) failures->Add(case_no, kind, "no answer within the bound: a hang");
-  if (o.signal) failures->Add(case_no, kind, "crashed with signal " + std::to_string(o.signal) + "\n" + o.err);
+  if (o.signal)
+    failures->Add(case_no, kind, "crashed with signal " + std::to_string(o.signal) + "\n" + o.err);
   CheckOutside(o, case_no, kind, failures);
   if (!o.killed && !o.timed_out && !o.signal && (o.exit_code < 0 || o.exit_code > 2)) {
     failures->Add(case_no, kind, "exit code " + std::to_string(o.exit_code) + "\n" + o.err);
@@ -539,17 +549,20 @@ void CheckRun(const Outcome& o, const Workspace& w, int case_no, const std::stri
     failures->Add(case_no, kind, "exit 2 without an error message");
   }
   for (const auto& [path, text] : w.user_files) {
-    if (ReadFile(path) != text) failures->Add(case_no, kind, "user file changed or removed: " + path);
+    if (ReadFile(path) != text)
+      failures->Add(case_no, kind, "user file changed or removed: " + path);
   }
   if (o.killed || !(o.exit_code == 0 || o.exit_code == 1)) return;
   for (const char* name : {"results.json", "traces.csv", "angles.csv"}) {
     const std::string path = w.out + "/" + name;
     if (!fs::exists(path)) {
-      failures->Add(case_no, kind, std::string(name) + " missing after exit " + std::to_string(o.exit_code));
+      failures->Add(case_no, kind,
+                    std::string(name) + " missing after exit " + std::to_string(o.exit_code));
       continue;
     }
     const std::string bad = NonFiniteIn(ReadFile(path), std::string(name) != "results.json");
-    if (!bad.empty()) failures->Add(case_no, kind, std::string(name) + ": non-finite number, " + bad);
+    if (!bad.empty())
+      failures->Add(case_no, kind, std::string(name) + ": non-finite number, " + bad);
   }
   for (const std::string& problem : bifilar::CheckOutputSet(w.out, true)) {
     failures->Add(case_no, kind, "inconsistent output set: " + problem);
@@ -561,8 +574,9 @@ void CheckBaseline(const Workspace& w, int case_no, const std::string& kind, Fai
   ReadEllipse(w.out, &ix, &ixz);
   if (!(std::fabs(ixz - w.ixz_kg_m2) <= 1e-12 && std::fabs(ix - w.ix_kg_m2) <= 1e-12)) {
     char buffer[200];
-    std::snprintf(buffer, sizeof(buffer), "ellipse differs from the baseline: I_x %.9g (%.9g), I_xz %.9g (%.9g)",
-                  ix, w.ix_kg_m2, ixz, w.ixz_kg_m2);
+    std::snprintf(buffer, sizeof(buffer),
+                  "ellipse differs from the baseline: I_x %.9g (%.9g), I_xz %.9g (%.9g)", ix,
+                  w.ix_kg_m2, ixz, w.ixz_kg_m2);
     failures->Add(case_no, kind, buffer);
   }
 }
@@ -571,7 +585,8 @@ void CheckBaseline(const Workspace& w, int case_no, const std::string& kind, Fai
 std::string TamperCache(const Workspace& w, std::mt19937_64& rng) {
   std::vector<std::string> entries;
   if (fs::is_directory(w.out + "/cache")) {
-    for (const auto& e : fs::directory_iterator(w.out + "/cache")) entries.push_back(e.path().string());
+    for (const auto& e : fs::directory_iterator(w.out + "/cache"))
+      entries.push_back(e.path().string());
   }
   std::sort(entries.begin(), entries.end());
   if (entries.empty()) return "no cache entry";
@@ -973,8 +988,8 @@ void CaseNoOverwrite(const Args& args, const Workspace& w, int case_no, Failures
   std::error_code ec;
   fs::remove(link, ec);
   fs::create_symlink("/proc/self/fd/1", link, ec);
-  const std::vector<std::string> trace = {"--inertia-kg-m2", "0.4", "--mass-kg", "6", "-L", "2",
-                                          "-D", "1", "--duration-s", "10"};
+  const std::vector<std::string> trace = {
+      "--inertia-kg-m2", "0.4", "--mass-kg", "6", "-L", "2", "-D", "1", "--duration-s", "10"};
   struct Run {
     std::vector<std::string> argv;
     std::string message;
@@ -990,8 +1005,8 @@ void CaseNoOverwrite(const Args& args, const Workspace& w, int case_no, Failures
       {{args.binary, "export", w.out, "--format", "csv", "--out", w.out + "/results.json",
         "--force"},
        "is the input"},
-      {{args.binary, "export", w.out, "--format", "csv", "--out", w.out + "/../" +
-        fs::path(w.out).filename().string() + "/traces.csv", "--force"},
+      {{args.binary, "export", w.out, "--format", "csv", "--out",
+        w.out + "/../" + fs::path(w.out).filename().string() + "/traces.csv", "--force"},
        "of the output folder"},
       {{args.binary, "export", w.out, "--format", "csv", "--out", w.thesis}, "exists"},
       {{args.binary, "export", w.out, "--format", "csv", "--out", link, "--force"},
@@ -999,8 +1014,8 @@ void CaseNoOverwrite(const Args& args, const Workspace& w, int case_no, Failures
   };
   for (Run& run : runs) {
     if (run.argv[1] == "simulate") run.argv.insert(run.argv.end(), trace.begin(), trace.end());
-    const std::string kind = "no overwrite: bifilar " + run.argv[1] + " " + run.argv[2] + " " +
-                             run.argv[3];
+    const std::string kind =
+        "no overwrite: bifilar " + run.argv[1] + " " + run.argv[2] + " " + run.argv[3];
     const Outcome o = Wait(Start(run.argv, w.harness + "/hostile"), args.run_timeout_s);
     CheckRun(o, w, case_no, kind, failures);
     ExpectStop(o, case_no, kind, {2}, o.err, run.message, failures, /*after_check_run=*/true);
@@ -1047,25 +1062,30 @@ void CaseDataflash(const Args& args, const Workspace& w, int case_no, std::mt199
   };
   const std::vector<Bad> bad = {
       {"noise.bin", noise, "noise.bin: error: not an ArduPilot DataFlash log: no message found"},
-      {"empty.bin", "", "empty.bin: error: the file is empty (expected an ArduPilot DataFlash log)"},
+      {"empty.bin", "",
+       "empty.bin: error: the file is empty (expected an ArduPilot DataFlash log)"},
       {"no_imu.bin", no_imu.bytes(), "no_imu.bin: error: an ArduPilot DataFlash log without IMU"},
-      {"long_fmt.bin", imu_log(120), "long_fmt.bin: error: the FMT of IMU (type 48, byte 89) cannot be read: it defines the message as 120 bytes"},
-      {"short_fmt.bin", imu_log(20), "short_fmt.bin: error: the FMT of IMU (type 48, byte 89) cannot be read: its length 20 is too short for its format"},
+      {"long_fmt.bin", imu_log(120),
+       "long_fmt.bin: error: the FMT of IMU (type 48, byte 89) cannot be read: it defines the "
+       "message as 120 bytes"},
+      {"short_fmt.bin", imu_log(20),
+       "short_fmt.bin: error: the FMT of IMU (type 48, byte 89) cannot be read: its length 20 is "
+       "too short for its format"},
   };
   for (const Bad& b : bad) {
     WriteFile(dir + "/" + b.file, b.bytes);
-    const Outcome o = Wait(Start({args.binary, "fit", w.config_path, dir + "/" + b.file},
-                                 w.harness + "/hostile"),
-                           args.run_timeout_s);
+    const Outcome o =
+        Wait(Start({args.binary, "fit", w.config_path, dir + "/" + b.file}, w.harness + "/hostile"),
+             args.run_timeout_s);
     ExpectStop(o, case_no, "DataFlash " + b.file, {1}, o.out + o.err, b.message, failures);
   }
   const std::string sim = dir + "/sim.bin";
   fs::remove(sim);
-  const Outcome made = Wait(Start({args.binary, "simulate", "--trace", sim, "--inertia-kg-m2",
-                                   "0.4", "--mass-kg", "6", "-L", "2", "-D", "1", "--duration-s",
-                                   "20", "--seed", "26"},
-                                  w.harness + "/hostile"),
-                            args.run_timeout_s);
+  const Outcome made =
+      Wait(Start({args.binary, "simulate", "--trace", sim, "--inertia-kg-m2", "0.4", "--mass-kg",
+                  "6", "-L", "2", "-D", "1", "--duration-s", "20", "--seed", "26"},
+                 w.harness + "/hostile"),
+           args.run_timeout_s);
   ExpectStop(made, case_no, "DataFlash simulate", {0}, made.out, "wrote", failures);
   const std::string clean = ReadFile(sim);
   if (clean.empty()) return;
@@ -1073,17 +1093,26 @@ void CaseDataflash(const Args& args, const Workspace& w, int case_no, std::mt199
   for (int k = 0; k < 40; ++k) {
     std::string bytes = clean;
     switch (k % 4) {
-      case 0: bytes.resize(rng() % bytes.size()); break;
-      case 1: for (int i = 0; i < 30; ++i) bytes[rng() % bytes.size()] = static_cast<char>(rng()); break;
-      case 2: bytes.insert(rng() % bytes.size(), std::string(1 + rng() % 500, static_cast<char>(rng()))); break;
-      default: for (int i = 0; i < 3; ++i) bytes[rng() % 900] = static_cast<char>(rng()); break;
+      case 0:
+        bytes.resize(rng() % bytes.size());
+        break;
+      case 1:
+        for (int i = 0; i < 30; ++i) bytes[rng() % bytes.size()] = static_cast<char>(rng());
+        break;
+      case 2:
+        bytes.insert(rng() % bytes.size(), std::string(1 + rng() % 500, static_cast<char>(rng())));
+        break;
+      default:
+        for (int i = 0; i < 3; ++i) bytes[rng() % 900] = static_cast<char>(rng());
+        break;
     }
     const std::string path = dir + "/damaged_" + std::to_string(k) + ".bin";
     WriteFile(path, bytes);
     argv.push_back(path);
   }
   const Outcome o = Wait(Start(argv, w.harness + "/hostile"), args.run_timeout_s);
-  ExpectStop(o, case_no, "DataFlash damaged copies (inspect)", {0, 1}, o.out, "dataflash", failures);
+  ExpectStop(o, case_no, "DataFlash damaged copies (inspect)", {0, 1}, o.out, "dataflash",
+             failures);
 }
 
 // ---- Issue 33 items 5 and 7 (helper `logs`): what `inspect` and `init` make of a log. ----
@@ -1096,11 +1125,11 @@ void CaseLogGuessAndDamage(const Args& args, const Workspace& w, int case_no, st
   fs::create_directories(dir);
   const std::string sim = dir + "/sim.bin";
   fs::remove(sim);
-  const Outcome made = Wait(Start({args.binary, "simulate", "--trace", sim, "--inertia-kg-m2",
-                                   "0.4", "--mass-kg", "6", "-L", "2", "-D", "1", "--duration-s",
-                                   "20", "--seed", "33"},
-                                  dir),
-                            args.run_timeout_s);
+  const Outcome made =
+      Wait(Start({args.binary, "simulate", "--trace", sim, "--inertia-kg-m2", "0.4", "--mass-kg",
+                  "6", "-L", "2", "-D", "1", "--duration-s", "20", "--seed", "33"},
+                 dir),
+           args.run_timeout_s);
   ExpectStop(made, case_no, "log guess: simulate .bin", {0}, made.out, "wrote", failures);
   const std::string clean = ReadFile(sim);
   // Every IMU message (header a3 95 30): GyrZ at byte 20 of it (TimeUS 8, I 1, GyrX, GyrY 4 each).
@@ -1144,8 +1173,9 @@ void CaseLogGuessAndDamage(const Args& args, const Workspace& w, int case_no, st
     const std::string log = dir + "/" + r.file, config = log + ".yaml";
     WriteFile(log, r.text);
     fs::remove(config);
-    const Outcome o = Wait(Start({args.binary, "init", config, "--log", log, "--rig", "2,1,6"}, dir),
-                           args.run_timeout_s);
+    const Outcome o =
+        Wait(Start({args.binary, "init", config, "--log", log, "--rig", "2,1,6"}, dir),
+             args.run_timeout_s);
     ExpectStop(o, case_no, "log guess: init refuses " + r.file, {1, 2}, o.err, r.message, failures);
     if (fs::exists(config)) failures->Add(case_no, "log guess: init " + r.file, "wrote a config");
   }
@@ -1184,10 +1214,9 @@ void CasePlanNoReplace(const Args& args, const Workspace& w, int case_no, Failur
     table += std::to_string(d) + "," + std::to_string(2.8 - 0.4 * s * s + 0.001 * (d % 3)) + "\n";
   }
   WriteFile(h + "/table.csv", table);
-  const std::vector<std::string> quad = {args.binary,       "plan",        "--rig",
-                                         "--mass",          "0.0343",      "--inertia",
-                                         "1.6e-5",          "--max-length", "0.594",
-                                         "--max-separation", "0.030",      "--target-percent"};
+  const std::vector<std::string> quad = {
+      args.binary, "plan",         "--rig", "--mass",           "0.0343", "--inertia",
+      "1.6e-5",    "--max-length", "0.594", "--max-separation", "0.030",  "--target-percent"};
   const auto plan = [&](const std::string& target, std::vector<std::string> extra) {
     std::vector<std::string> argv = quad;
     argv.push_back(target);
@@ -1221,7 +1250,8 @@ void CasePlanNoReplace(const Args& args, const Workspace& w, int case_no, Failur
     CheckOutside(o, case_no, kind, failures);
     ExpectStop(o, case_no, kind, run.codes, run.codes[0] == 1 ? o.out : o.err, run.message,
                failures);
-    if (o.err.find("PLPLOT") != std::string::npos || o.err.find("Can't open") != std::string::npos) {
+    if (o.err.find("PLPLOT") != std::string::npos ||
+        o.err.find("Can't open") != std::string::npos) {
       failures->Add(case_no, kind, "PLplot reached a path it cannot open:\n" + o.err);
     }
     for (const std::string& path : {h + "/mine.png", h + "/plots/ellipse_polar.png"}) {
@@ -1254,7 +1284,8 @@ int RunHostileInputCases(const Args& args, Workspace& w, int first_case_no, Fail
   return c - first_case_no;
 }
 
-// ---- Issue 33: the fourth hostile-input sweep (report paths, regexes, repeats, runs tables) ------
+// ---- Issue 33: the fourth hostile-input sweep (report paths, regexes, repeats, runs tables)
+// ------
 //
 // Once each, after the hostile inputs above. Asserted as everywhere: no hang, no crash, the
 // expected exit code and message, nothing outside OUT changed (the sentinel).
@@ -1275,8 +1306,8 @@ Outcome RunSweep4(const Args& args, const Workspace& w, int case_no, const std::
 void CaseReportFiguresOutside(const Args& args, const Workspace& w, int case_no,
                               Failures* failures) {
   const std::string kind = "report: figure outside OUT";
-  const Outcome fresh = Wait(Start(ProcessArgv(args, w, true), w.harness + "/sweep4"),
-                             args.run_timeout_s);
+  const Outcome fresh =
+      Wait(Start(ProcessArgv(args, w, true), w.harness + "/sweep4"), args.run_timeout_s);
   CheckRun(fresh, w, case_no, kind + " (process first)", failures);
   const std::string results_path = w.out + "/results.json";
   const std::string text = ResultsText(w);
@@ -1286,7 +1317,8 @@ void CaseReportFiguresOutside(const Args& args, const Workspace& w, int case_no,
     return;
   }
   const std::string drawing = w.dir + "/precious/drawing.svg";
-  WriteFile(drawing, "<?xml version=\"1.0\"?>\n<!-- mine -->\n<svg width=\"1\" height=\"1\"></svg>\n");
+  WriteFile(drawing,
+            "<?xml version=\"1.0\"?>\n<!-- mine -->\n<svg width=\"1\" height=\"1\"></svg>\n");
   const std::string link = w.out + "/figures/leaving.svg";
   std::error_code ec;
   fs::create_symlink(drawing, link, ec);
@@ -1327,15 +1359,27 @@ void CaseGroupByPatterns(const Args& args, const Workspace& w, int case_no, Fail
   };
   const std::vector<Pattern> patterns = {
       {"100 kB", std::string(100000, 'a'), {l1, l2}, {2}, "longer than 4096 bytes"},
-      {"20,000 nested groups", std::string(20000, '(') + "a" + std::string(20000, ')'), {l1, l2},
-       {2}, "longer than 4096 bytes"},
-      {"2,000 nested groups", std::string(2000, '(') + "trial" + std::string(2000, ')'),
-       {l1, l2}, {0, 1}, "repeats: 2 log(s) in 1 group(s)"},
+      {"20,000 nested groups",
+       std::string(20000, '(') + "a" + std::string(20000, ')'),
+       {l1, l2},
+       {2},
+       "longer than 4096 bytes"},
+      {"2,000 nested groups",
+       std::string(2000, '(') + "trial" + std::string(2000, ')'),
+       {l1, l2},
+       {0, 1},
+       "repeats: 2 log(s) in 1 group(s)"},
       // One group or two: the pattern matches (case ignored) up to the last x of the path, and
       // the workspace's random name may hold one. Either way answered, never a crash.
-      {"'/((.|/)*)x' on a 16 kB path", "/((.|/)*)x", {deep + "s-1.csv", deep + "s-2.csv"}, {1},
+      {"'/((.|/)*)x' on a 16 kB path",
+       "/((.|/)*)x",
+       {deep + "s-1.csv", deep + "s-2.csv"},
+       {1},
        "repeats: 2 log(s) in "},
-      {"'(a+)+$' on 28 a's and a b", "(a+)+$", {a28 + "b", a28 + "ab"}, {1},
+      {"'(a+)+$' on 28 a's and a b",
+       "(a+)+$",
+       {a28 + "b", a28 + "ab"},
+       {1},
        "repeats: 2 log(s) in 2 group(s)"},
       {"a backreference", "(a)\\1", {l1, l2}, {2}, "not a regular expression RE2 accepts"}};
   double slowest_s = 0.0;
@@ -1343,8 +1387,8 @@ void CaseGroupByPatterns(const Args& args, const Workspace& w, int case_no, Fail
     std::vector<std::string> argv = {args.binary, "fit", w.config_path};
     argv.insert(argv.end(), p.logs.begin(), p.logs.end());
     argv.insert(argv.end(), {"--repeats", "--group-by", p.pattern});
-    const Outcome o = RunSweep4(args, w, case_no, "--group-by " + p.what, argv, p.codes,
-                                p.message, failures);
+    const Outcome o =
+        RunSweep4(args, w, case_no, "--group-by " + p.what, argv, p.codes, p.message, failures);
     slowest_s = std::max(slowest_s, o.seconds);
   }
   std::cout << "bifilar_stress: --group-by patterns of issue 33: slowest run " << slowest_s
@@ -1362,16 +1406,18 @@ void CaseRepeatsJudgedOnSamples(const Args& args, const Workspace& w, int case_n
   std::string crlf;
   for (char c : text) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
   const std::vector<std::pair<std::string, std::string>> copies = {
-      {dir + "/swing-1.csv", text}, {dir + "/swing-2.csv", crlf},
-      {dir + "/swing-3.csv", text + "\n"}, {dir + "/swing-4.csv", "# saved again\n" + text}};
+      {dir + "/swing-1.csv", text},
+      {dir + "/swing-2.csv", crlf},
+      {dir + "/swing-3.csv", text + "\n"},
+      {dir + "/swing-4.csv", "# saved again\n" + text}};
   std::vector<std::string> argv = {args.binary, "fit", w.config_path};
   for (const auto& [path, bytes] : copies) {
     WriteFile(path, bytes);
     argv.push_back(path);
   }
   argv.insert(argv.end(), {"--repeats", "--json"});
-  const Outcome o = RunSweep4(args, w, case_no, kind, argv, {0, 1}, "identical_logs_dropped",
-                              failures);
+  const Outcome o =
+      RunSweep4(args, w, case_no, kind, argv, {0, 1}, "identical_logs_dropped", failures);
   const nlohmann::json j = nlohmann::json::parse(o.out, nullptr, false);
   if (j.is_discarded() || !j.contains("identical_logs_dropped") ||
       j["identical_logs_dropped"].size() != 3) {
@@ -1386,23 +1432,24 @@ void CaseRunsTablesAndManyLogs(const Args& args, const Workspace& w, int case_no
   const std::string dir = w.harness + "/tables";
   fs::create_directories(dir);
   const std::string l1 = w.logs + "/pitch_0/trial_1.csv", l2 = w.logs + "/pitch_0/trial_2.csv";
-  WriteFile(dir + "/zero.csv", "path,roll_deg,pitch_deg\npitch_0/trial_1.csv,-0,0\n"
-                               "pitch_0/trial_2.csv,0,-0\n");
+  WriteFile(dir + "/zero.csv",
+            "path,roll_deg,pitch_deg\npitch_0/trial_1.csv,-0,0\n"
+            "pitch_0/trial_2.csv,0,-0\n");
   const Outcome zero = RunSweep4(
       args, w, case_no, "runs table: roll -0 and 0",
       {args.binary, "fit", w.config_path, l1, l2, "--repeats", "--runs-table", dir + "/zero.csv"},
       {0, 1}, "repeats: 2 log(s) in 1 group(s)", failures);
   (void)zero;
   WriteFile(dir + "/big.csv", "path,group\n" + std::string(17000000, 'x') + ",A\n");
-  RunSweep4(args, w, case_no, "runs table: 17 MB",
-            {args.binary, "fit", w.config_path, l1, l2, "--repeats", "--runs-table",
-             dir + "/big.csv"},
-            {2}, "too large for a runs table", failures);
+  RunSweep4(
+      args, w, case_no, "runs table: 17 MB",
+      {args.binary, "fit", w.config_path, l1, l2, "--repeats", "--runs-table", dir + "/big.csv"},
+      {2}, "too large for a runs table", failures);
   WriteFile(dir + "/line.csv", "path,group\n" + std::string(100000, 'x') + ",A\n");
-  RunSweep4(args, w, case_no, "runs table: a 100 kB line",
-            {args.binary, "fit", w.config_path, l1, l2, "--repeats", "--runs-table",
-             dir + "/line.csv"},
-            {2}, "line.csv:2: a line of 100002 bytes", failures);
+  RunSweep4(
+      args, w, case_no, "runs table: a 100 kB line",
+      {args.binary, "fit", w.config_path, l1, l2, "--repeats", "--runs-table", dir + "/line.csv"},
+      {2}, "line.csv:2: a line of 100002 bytes", failures);
   fs::remove(dir + "/big.csv");
   std::vector<std::string> argv = {args.binary, "fit", w.config_path};
   for (int k = 0; k < 300; ++k) {
@@ -1450,12 +1497,18 @@ bool ParseArgs(int argc, char** argv, Args* args) {
       }
       return argv[++i];
     };
-    if (a == "--binary") args->binary = next();
-    else if (a == "--source") args->source = next();
-    else if (a == "--seed") args->seed = std::stoull(next());
-    else if (a == "--cases") args->cases = std::stoi(next());
-    else if (a == "--run-timeout-s") args->run_timeout_s = std::stod(next());
-    else if (a == "--keep") args->keep = true;
+    if (a == "--binary")
+      args->binary = next();
+    else if (a == "--source")
+      args->source = next();
+    else if (a == "--seed")
+      args->seed = std::stoull(next());
+    else if (a == "--cases")
+      args->cases = std::stoi(next());
+    else if (a == "--run-timeout-s")
+      args->run_timeout_s = std::stod(next());
+    else if (a == "--keep")
+      args->keep = true;
     else {
       std::cerr << "usage: bifilar_stress --binary BIFILAR --source REPO [--seed N] [--cases N] "
                    "[--run-timeout-s S] [--keep]\n";
@@ -1561,7 +1614,8 @@ std::string CaseKill(CaseContext& x, double forced_s) {
   CheckRun(killed, x.w, x.c, kind + " (" + what + ")", x.failures);
   // `report` on what the kill left: a page from a consistent set, or a refusal naming it.
   const bool mixed = !bifilar::CheckOutputSet(x.w.out, false).empty();
-  const Outcome report = Wait(Start({args.binary, "report", x.w.out}, x.prefix), args.run_timeout_s);
+  const Outcome report =
+      Wait(Start({args.binary, "report", x.w.out}, x.prefix), args.run_timeout_s);
   CheckOutside(report, x.c, kind + " then report (" + what + ")", x.failures);
   if (report.signal || report.timed_out || (report.exit_code != 0 && report.exit_code != 2) ||
       (mixed && report.exit_code != 2) ||
@@ -1593,10 +1647,13 @@ std::string CaseConcurrentRuns(CaseContext& x) {
   CheckRun(ob, x.w, x.c, kind + " (second)", x.failures);
   int ok = 0;
   for (const Outcome* o : {&oa, &ob}) {
-    if (o->exit_code == 0) ++ok;
-    else if (!(o->exit_code == 2 && o->err.find("in use by another bifilar run") != std::string::npos)) {
-      x.failures->Add(x.c, kind, "a run neither succeeded nor was refused for the lock: exit " +
-                                     std::to_string(o->exit_code) + "\n" + o->err);
+    if (o->exit_code == 0)
+      ++ok;
+    else if (!(o->exit_code == 2 &&
+               o->err.find("in use by another bifilar run") != std::string::npos)) {
+      x.failures->Add(x.c, kind,
+                      "a run neither succeeded nor was refused for the lock: exit " +
+                          std::to_string(o->exit_code) + "\n" + o->err);
     }
   }
   if (ok == 0) x.failures->Add(x.c, kind, "neither run succeeded");
@@ -1609,15 +1666,15 @@ std::string CaseConcurrentRuns(CaseContext& x) {
 // A user's file in figures/ or cache/: the run refuses the folder and keeps the file.
 std::string CaseUserFileInOutput(CaseContext& x) {
   const std::string kind = "user file in figures/";
-  const std::string path = x.w.out + "/" + (Uniform(x.rng, 0, 1) ? "figures" : "cache") +
-                           "/user_" + std::to_string(x.c) + ".png";
+  const std::string path = x.w.out + "/" + (Uniform(x.rng, 0, 1) ? "figures" : "cache") + "/user_" +
+                           std::to_string(x.c) + ".png";
   WriteFile(path, "mine");
-  const Outcome o = Wait(Start(ProcessArgv(x.args, x.w, Uniform(x.rng, 0, 1)), x.prefix),
-                         x.args.run_timeout_s);
+  const Outcome o =
+      Wait(Start(ProcessArgv(x.args, x.w, Uniform(x.rng, 0, 1)), x.prefix), x.args.run_timeout_s);
   CheckRun(o, x.w, x.c, kind, x.failures);
   if (o.exit_code != 2 || o.err.find("did not write") == std::string::npos) {
-    x.failures->Add(x.c, kind, "a folder holding a user's file was used: exit " +
-                                   std::to_string(o.exit_code));
+    x.failures->Add(x.c, kind,
+                    "a folder holding a user's file was used: exit " + std::to_string(o.exit_code));
   }
   if (ReadFile(path) != "mine") x.failures->Add(x.c, kind, "the user's file was removed: " + path);
   fs::remove(path);
@@ -1674,8 +1731,8 @@ std::string RunRandomCase(CaseContext& x, double forced_s,
 int Summarize(const Args& args, const Workspace& w, Clock::time_point start, double forced_s,
               const std::map<std::string, int>& kinds_run, const Failures& failures) {
   const double total_s = std::chrono::duration<double>(Clock::now() - start).count();
-  std::cout << "bifilar_stress: seed " << args.seed << ", " << args.cases << " cases in "
-            << total_s << " s (one forced run " << forced_s << " s):";
+  std::cout << "bifilar_stress: seed " << args.seed << ", " << args.cases << " cases in " << total_s
+            << " s (one forced run " << forced_s << " s):";
   for (const auto& [kind, n] : kinds_run) std::cout << " " << kind << " " << n << ";";
   std::cout << " failures " << failures.count << "\n";
   if (!args.keep) {
@@ -1705,8 +1762,9 @@ int RunWatchStressCases(const Args& args, const Workspace& w, int case_no, std::
     std::string fed, line;
     long data_lines = 0;
     bool header = false;
-    static const char* kBad[] = {"garbage here", "\x01\x02\xfe\xff", "nan,0,0,0,0,0,0",
-                                 "0,inf,0,0,0,0,0", "1,2", "-5,0,0,0,0,0,0", "{\"t\": 1}"};
+    static const char* kBad[] = {
+        "garbage here", "\x01\x02\xfe\xff", "nan,0,0,0,0,0,0", "0,inf,0,0,0,0,0",
+        "1,2",          "-5,0,0,0,0,0,0",   "{\"t\": 1}"};
     while (std::getline(in, line)) {
       fed += line + "\n";
       if (line.empty() || line[0] == '#') continue;
@@ -1726,19 +1784,23 @@ int RunWatchStressCases(const Args& args, const Workspace& w, int case_no, std::
     fs::remove(saved, ec);
     fs::remove(saved + ".rejected.txt", ec);
     WriteFile(input, fed);
-    const Outcome o = Wait(Start({"/bin/sh", "-c", args.binary + " watch " + w.config_path +
-                                  " - --json --save " + saved + " < " + input},
-                                 w.harness + "/watch"), args.run_timeout_s);
+    const Outcome o = Wait(Start({"/bin/sh", "-c",
+                                  args.binary + " watch " + w.config_path + " - --json --save " +
+                                      saved + " < " + input},
+                                 w.harness + "/watch"),
+                           args.run_timeout_s);
     if (o.timed_out || o.signal || o.exit_code < 0 || o.exit_code > 2 ||
         (o.exit_code == 2 && o.err.find("error") == std::string::npos)) {
-      failures->Add(case_no, kind, "exit " + std::to_string(o.exit_code) + ", signal " +
-                    std::to_string(o.signal) + (o.timed_out ? ", hung" : "") + "\n" + o.err);
+      failures->Add(case_no, kind,
+                    "exit " + std::to_string(o.exit_code) + ", signal " + std::to_string(o.signal) +
+                        (o.timed_out ? ", hung" : "") + "\n" + o.err);
       continue;
     }
     if (o.exit_code == 2) continue;
     const size_t last = o.out.rfind("{\"counters\"");
     const nlohmann::json final = nlohmann::json::parse(
-        last == std::string::npos ? std::string("{}") : o.out.substr(last, o.out.find('\n', last) - last),
+        last == std::string::npos ? std::string("{}")
+                                  : o.out.substr(last, o.out.find('\n', last) - last),
         nullptr, false);
     if (final.is_discarded() || !final.contains("logs") || final["logs"].empty()) {
       failures->Add(case_no, kind, "no final result line:\n" + o.out.substr(0, 2000));
@@ -1747,11 +1809,13 @@ int RunWatchStressCases(const Args& args, const Workspace& w, int case_no, std::
     const nlohmann::json& log = final["logs"][0];
     const long counted = log["samples"].get<long>() + log["rejected"].get<long>();
     if (counted + (fed.back() == '.' ? -1 : 0) != data_lines && counted != data_lines) {
-      failures->Add(case_no, kind, "lines fed " + std::to_string(data_lines) + ", counted " +
-                    std::to_string(counted));
+      failures->Add(
+          case_no, kind,
+          "lines fed " + std::to_string(data_lines) + ", counted " + std::to_string(counted));
     }
-    const Outcome fit = Wait(Start({args.binary, "fit", w.config_path, saved, "--json"},
-                                   w.harness + "/watch_fit"), args.run_timeout_s);
+    const Outcome fit =
+        Wait(Start({args.binary, "fit", w.config_path, saved, "--json"}, w.harness + "/watch_fit"),
+             args.run_timeout_s);
     const nlohmann::json records = nlohmann::json::parse(fit.out, nullptr, false);
     if (records.is_discarded() || !records.is_array() || records.empty()) {
       failures->Add(case_no, kind, "fit on the saved log: " + fit.err);
@@ -1759,14 +1823,15 @@ int RunWatchStressCases(const Args& args, const Workspace& w, int case_no, std::
     }
     for (const auto& warning : records[0].value("warnings", nlohmann::json::array())) {
       if (warning.get<std::string>().find("line") != std::string::npos) {
-        failures->Add(case_no, kind, "the saved log needed a repair: " + warning.get<std::string>());
+        failures->Add(case_no, kind,
+                      "the saved log needed a repair: " + warning.get<std::string>());
       }
     }
     const nlohmann::json& mine = log["record"]["inertia_total_kg_m2"];
     const nlohmann::json& theirs = records[0]["inertia_total_kg_m2"];
     if (mine.is_number() != theirs.is_number() ||
-        (mine.is_number() &&
-         std::abs(mine.get<double>() - theirs.get<double>()) > 1e-12 * std::abs(theirs.get<double>()))) {
+        (mine.is_number() && std::abs(mine.get<double>() - theirs.get<double>()) >
+                                 1e-12 * std::abs(theirs.get<double>()))) {
       failures->Add(case_no, kind, "watch's final I " + mine.dump() + " != fit's " + theirs.dump());
     }
   }
@@ -1799,7 +1864,8 @@ int main(int argc, char** argv) {
   ReadEllipse(w.out, &w.ix_kg_m2, &w.ixz_kg_m2);
   if (base.exit_code != 0 || !std::isfinite(w.ixz_kg_m2)) {
     std::cerr << "bifilar_stress: the pristine campaign did not process (exit " << base.exit_code
-              << "):\n" << base.err << "\n";
+              << "):\n"
+              << base.err << "\n";
     return 1;
   }
   const double forced_s = base.seconds;
@@ -1826,11 +1892,12 @@ int main(int argc, char** argv) {
 // ---- Issue 34: the MAVLink decoder (pipeline/live/mavlink.h) fed hostile bytes, in-process ----
 // Per case, from the seed: a stream of good IMU frames (HIGHRES_IMU, SCALED_IMU, RAW_IMU;
 // MAVLink 1 and 2, signed, truncated payloads) mixed with random bytes, frames cut short,
-// frames with a flipped bit (both before the signature, which no checksum covers), frames of other messages with random lengths and random start
-// bytes, fed in random chunks (1 byte to 4 kB). Asserted: every good frame's sample comes out,
-// in order (a sample that is not one is allowed only as a checksum collision of a cut frame,
-// counted: about 1 in 2500 cases; more than 3 + cases / 500 fails); the decoder never holds more than two frames'
-// bytes; every value is finite. Also, once per run, 4 MB of pure random bytes.
+// frames with a flipped bit (both before the signature, which no checksum covers), frames of other
+// messages with random lengths and random start bytes, fed in random chunks (1 byte to 4 kB).
+// Asserted: every good frame's sample comes out, in order (a sample that is not one is allowed only
+// as a checksum collision of a cut frame, counted: about 1 in 2500 cases; more than 3 + cases / 500
+// fails); the decoder never holds more than two frames' bytes; every value is finite. Also, once
+// per run, 4 MB of pure random bytes.
 namespace {
 
 // The samples of good frames, and the bytes; `rng` draws the mix.
@@ -1854,21 +1921,22 @@ std::string MavlinkHostileStream(std::mt19937_64& rng,
     o.sysid = Uniform(rng, 0, 255);
     const int msgid = std::vector<int>{kMavlinkMsgidHighresImu, kMavlinkMsgidScaledImu,
                                        kMavlinkMsgidRawImu}[Uniform(rng, 0, 2)];
-    const std::string frame =
-        msgid == kMavlinkMsgidHighresImu ? EncodeHighresImu(s, 0x3F, o)
-        : msgid == kMavlinkMsgidScaledImu ? EncodeScaledImu(s, o)
-                                          : EncodeRawImu(s, MavlinkDecoderOptions(), o);
+    const std::string frame = msgid == kMavlinkMsgidHighresImu ? EncodeHighresImu(s, 0x3F, o)
+                              : msgid == kMavlinkMsgidScaledImu
+                                  ? EncodeScaledImu(s, o)
+                                  : EncodeRawImu(s, MavlinkDecoderOptions(), o);
     // The bytes the checksum covers (a signature is not checked: a cut or a flipped bit
     // there leaves a good sample, and a cut signature takes the next bytes as its own).
-    const int checked = static_cast<int>(frame.size()) -
-                        (o.version == 2 && o.signed_frame ? 13 : 0);
+    const int checked =
+        static_cast<int>(frame.size()) - (o.version == 2 && o.signed_frame ? 13 : 0);
     const int kind = Uniform(rng, 0, 9);
     if (kind <= 4) {  // a good frame
       stream += frame;
       s.msgid = msgid;
       good->push_back(s);
     } else if (kind == 5) {  // random bytes
-      for (int i = Uniform(rng, 1, 300); i > 0; --i) stream += static_cast<char>(Uniform(rng, 0, 255));
+      for (int i = Uniform(rng, 1, 300); i > 0; --i)
+        stream += static_cast<char>(Uniform(rng, 0, 255));
     } else if (kind == 6) {  // a frame cut short
       stream += frame.substr(0, Uniform(rng, 1, checked - 1));
     } else if (kind == 7) {  // a flipped bit
@@ -1900,7 +1968,8 @@ std::vector<bifilar::live::MavlinkImuSample> FeedInChunks(const std::string& str
   bifilar::live::MavlinkDecoder decoder;
   std::vector<bifilar::live::MavlinkImuSample> out;
   for (std::size_t at = 0; at < stream.size();) {
-    const std::size_t n = static_cast<std::size_t>(Uniform(rng, 0, 3) == 0 ? 1 : Uniform(rng, 1, 4096));
+    const std::size_t n =
+        static_cast<std::size_t>(Uniform(rng, 0, 3) == 0 ? 1 : Uniform(rng, 1, 4096));
     for (const auto& s : decoder.Feed(stream.substr(at, n))) {
       for (int i = 0; i < 3; ++i) {
         if (!std::isfinite(s.gyro_rad_per_s[i]) || !std::isfinite(s.accel_m_per_s2[i])) {
@@ -1938,8 +2007,9 @@ int RunMavlinkDecoderCases(uint64_t seed, int cases, Failures* failures) {
       }
     }
     if (next != good.size()) {
-      failures->Add(c, kind, "good frame " + std::to_string(next) + " of " +
-                                 std::to_string(good.size()) + " was lost");
+      failures->Add(c, kind,
+                    "good frame " + std::to_string(next) + " of " + std::to_string(good.size()) +
+                        " was lost");
     }
   }
   std::string noise;
@@ -1948,11 +2018,12 @@ int RunMavlinkDecoderCases(uint64_t seed, int cases, Failures* failures) {
   collisions += static_cast<int>(FeedInChunks(noise, rng, &problem).size());
   if (!problem.empty()) failures->Add(cases + 1, kind, problem + " (random bytes)");
   if (collisions > 3 + cases / 500) {  // seeds 1-11, 500 cases each: 2 in all
-    failures->Add(cases + 1, kind, std::to_string(collisions) +
-                                       " samples from no good frame (checksum collisions?)");
+    failures->Add(
+        cases + 1, kind,
+        std::to_string(collisions) + " samples from no good frame (checksum collisions?)");
   }
-  std::cout << "mavlink decoder: " << cases << " hostile streams and 4 MB of noise, "
-            << collisions << " checksum collisions\n";
+  std::cout << "mavlink decoder: " << cases << " hostile streams and 4 MB of noise, " << collisions
+            << " checksum collisions\n";
   return cases + 1;
 }
 
