@@ -81,6 +81,21 @@ double Quantile(std::vector<double>* v, double p) {
   return (*v)[lo] + (h - lo) * ((*v)[hi] - (*v)[lo]);
 }
 
+// Replicate b: the common offset drawn and added, the components (values 0-5) and principal
+// moments (6-8) recorded.
+void RecordReplicate(Vec6 beta, int b, const Covariance& cov, const TensorOptions& options,
+                     bool principal, std::mt19937_64* rng, std::normal_distribution<double>* normal,
+                     std::vector<std::vector<double>>* values) {
+  if (options.common_offset_std_kg_m2 > 0.0) {
+    beta += cov.offset_direction * (options.common_offset_std_kg_m2 * (*normal)(*rng));
+  }
+  for (int k = 0; k < 6; ++k) (*values)[k][b] = beta(k);
+  if (principal) {
+    const Eigen::Vector3d m = PrincipalMoments(beta);
+    for (int k = 0; k < 3; ++k) (*values)[6 + k][b] = m(k);
+  }
+}
+
 // The replicates' intervals: components (values 0-5) and principal moments (6-8).
 void SetQuantiles(std::vector<std::vector<double>>* values, double alpha, bool principal,
                   TensorIntervalSet* in) {
@@ -187,14 +202,7 @@ TensorIntervalSet PooledReplicates(const Prepared& data, const Design& design, c
       eps(i) = std::sqrt(v) * normal(rng);
     }
     Vec6 beta = s.beta + a * eps;
-    if (options.common_offset_std_kg_m2 > 0.0) {
-      beta += cov.offset_direction * (options.common_offset_std_kg_m2 * normal(rng));
-    }
-    for (int k = 0; k < 6; ++k) values[k][b] = beta(k);
-    if (principal) {
-      const Eigen::Vector3d m = PrincipalMoments(beta);
-      for (int k = 0; k < 3; ++k) values[6 + k][b] = m(k);
-    }
+    RecordReplicate(beta, b, cov, options, principal, &rng, &normal, &values);
   }
   SetQuantiles(&values, alpha, principal, &in);
   return in;
@@ -265,14 +273,7 @@ TensorIntervalSet TensorIntervals(const Prepared& data, const Design& design, co
       for (int k = 0; k < design.rank; ++k) noise(k) = normal(rng);
       beta += design.basis * (std::sqrt(vf) * (chol * noise));
     }
-    if (options.common_offset_std_kg_m2 > 0.0) {
-      beta += cov.offset_direction * (options.common_offset_std_kg_m2 * normal(rng));
-    }
-    for (int k = 0; k < 6; ++k) values[k][b] = beta(k);
-    if (principal) {
-      const Eigen::Vector3d m = PrincipalMoments(beta);
-      for (int k = 0; k < 3; ++k) values[6 + k][b] = m(k);
-    }
+    RecordReplicate(beta, b, cov, options, principal, &rng, &normal, &values);
   }
   SetQuantiles(&values, alpha, principal, &in);
   return in;
