@@ -17,7 +17,7 @@
 #include "fit/swing_axis.h"
 #include "fit/window.h"
 #include "pendulum/model.h"
-#include "pipeline/commands/log_unit_check.h"
+#include "pipeline/logs/log_unit_check.h"
 #include "pipeline/logs/imu_log.h"
 #include "pipeline/logs/ulog.h"
 #include "pipeline/trace/trace_process.h"
@@ -118,7 +118,7 @@ void RefineGyroUnitGuess(ImuData* data, InspectReport* report) {
   }
 }
 
-// The guessed time and gyro units checked against the swing (pipeline/commands/log_unit_check.h):
+// The guessed time and gyro units checked against the swing (pipeline/logs/log_unit_check.h):
 // the series read again in the units that make it a pendulum, the guess lines saying so; angle
 // columns taken for rates are the report's format problem.
 void CheckGuessedUnits(const std::string& bytes, const std::string& path,

@@ -1,4 +1,4 @@
-#include "pipeline/commands/log_unit_check.h"
+#include "pipeline/logs/log_unit_check.h"
 
 #include <algorithm>
 #include <cmath>
