@@ -17,8 +17,8 @@
 #include "fit/swing_axis.h"
 #include "fit/window.h"
 #include "pendulum/model.h"
-#include "pipeline/logs/log_unit_check.h"
 #include "pipeline/logs/imu_log.h"
+#include "pipeline/logs/log_unit_check.h"
 #include "pipeline/logs/ulog.h"
 #include "pipeline/trace/trace_process.h"
 
