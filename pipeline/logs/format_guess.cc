@@ -9,12 +9,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <sstream>
 
 #include "base/csv.h"
 #include "base/statistics.h"
 #include "base/text_format.h"
 #include "base/units.h"
+#include "pipeline/logs/log_line.h"
 
 namespace bifilar {
 namespace {
@@ -36,28 +36,10 @@ std::string TrimAndUnquote(const std::string& s) {
   return t;
 }
 
-// Deliberately not base/csv.h's SplitCsvRecord: the guess splits a header as the log reader does
-// (pipeline/logs/imu_log.cc, Split: runs of white space as one separator, quotes trimmed off a
-// cell, not interpreted), so that the columns it names are the ones the reader finds.
+// A header or row cut as the log reader cuts it (pipeline/logs/log_line.h), so that the columns
+// the guess names are the ones the reader finds.
 std::vector<std::string> SplitLine(const std::string& line, char delim) {
-  std::vector<std::string> out;
-  if (delim == ' ') {
-    std::istringstream in(line);
-    std::string cell;
-    while (in >> cell) out.push_back(cell);
-    return out;
-  }
-  std::string cell;
-  for (char c : line) {
-    if (c == delim) {
-      out.push_back(TrimAndUnquote(cell));
-      cell.clear();
-    } else if (c != '\r') {
-      cell += c;
-    }
-  }
-  out.push_back(TrimAndUnquote(cell));
-  return out;
+  return LogLineCells(line, delim);
 }
 
 // The whole cell as a finite number (base/csv.h), as the reader reads it.

@@ -18,65 +18,19 @@
 #include "base/user_error.h"
 #include "pipeline/logs/dataflash.h"
 #include "pipeline/logs/imu_log_finish.h"
+#include "pipeline/logs/log_line.h"
 #include "pipeline/logs/simulated_log.h"
 #include "pipeline/logs/ulog.h"
 
 namespace bifilar {
 namespace {
 
-std::string_view Trim(std::string_view s) {
-  size_t b = 0, e = s.size();
-  while (b < e && (s[b] == ' ' || s[b] == '\t' || s[b] == '\r')) ++b;
-  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t' || s[e - 1] == '\r')) --e;
-  return s.substr(b, e - b);
-}
-
-std::string_view Unquote(std::string_view s) {
-  s = Trim(s);
-  if (s.size() >= 2 &&
-      ((s.front() == '"' && s.back() == '"') || (s.front() == '\'' && s.back() == '\''))) {
-    s = Trim(s.substr(1, s.size() - 2));
-  }
-  return s;
-}
-
-bool IsBlank(std::string_view line) { return Trim(line).empty(); }
+bool IsBlank(std::string_view line) { return TrimLogCell(line).empty(); }
 
 // Parses one whole cell as a number (base/csv.h's ParseNumber, fast_float inside): surrounding
 // spaces and quotes allowed; infinity and NaN are read, and ReadRowCells names them.
 bool ParseCell(std::string_view cell, double* value) {
-  return ParseNumber(Unquote(cell), value, NonFinite::kAccept);
-}
-
-// Splits `line` on `delim` into `fields` (views into line). Deliberately not base/csv.h's
-// SplitCsvRecord: this is the reader's hot path (views into the text, no copy: ~420 MB/s,
-// docs/developers.md), loggers write space-separated columns too (runs of spaces and tabs are
-// one separator), and quotes are not interpreted beyond trimming them, "" or '', off a cell
-// (Unquote), which is enough for numeric logs with quoted header names. GuessCsvFormat
-// (format_guess.cc) splits a header the same way, quotes uninterpreted too, so that the columns
-// it names are the ones this reader finds.
-void Split(std::string_view line, char delim, std::vector<std::string_view>* fields) {
-  fields->clear();
-  if (delim == ' ') {  // space-separated: runs of spaces (and tabs) are one separator
-    size_t i = 0;
-    while (true) {
-      while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-      if (i >= line.size()) return;
-      const size_t b = i;
-      while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
-      fields->push_back(line.substr(b, i - b));
-    }
-  }
-  size_t start = 0;
-  while (true) {
-    const size_t pos = line.find(delim, start);
-    if (pos == std::string_view::npos) {
-      fields->push_back(line.substr(start));
-      return;
-    }
-    fields->push_back(line.substr(start, pos - start));
-    start = pos + 1;
-  }
+  return ParseNumber(UnquoteLogCell(cell), value, NonFinite::kAccept);
 }
 
 // A cell or a name of the file's echoed in a message (EchoedName, pipeline/logs/imu_format.h).
@@ -207,7 +161,7 @@ std::vector<std::string> ReadHeaderRow(LineReader* reader, const std::string& na
   int comment_lines = 0;
   std::string simulated;  // the mark of `bifilar simulate` (pipeline/logs/simulated_log.h)
   while (reader->Next(&line)) {
-    const std::string_view trimmed = Trim(line);
+    const std::string_view trimmed = TrimLogCell(line);
     if (trimmed.empty()) continue;
     if (simulated.empty() && ParseSimulatedCsvMarker(trimmed, &simulated)) continue;
     if (trimmed[0] == '#' || trimmed[0] == '%' || trimmed.substr(0, 2) == "//") {
@@ -217,8 +171,8 @@ std::vector<std::string> ReadHeaderRow(LineReader* reader, const std::string& na
     break;
   }
   *header_line = reader->line_number();
-  if (IsBlank(line) || Trim(line)[0] == '#' || Trim(line)[0] == '%' ||
-      Trim(line).substr(0, 2) == "//") {
+  if (IsBlank(line) || TrimLogCell(line)[0] == '#' || TrimLogCell(line)[0] == '%' ||
+      TrimLogCell(line).substr(0, 2) == "//") {
     Fail(name + ": no header row, only " + std::to_string(comment_lines) + " comment line(s)");
   }
   if (!simulated.empty()) data->warnings.push_back(simulated);
@@ -227,9 +181,9 @@ std::vector<std::string> ReadHeaderRow(LineReader* reader, const std::string& na
                              " comment line(s) before the header");
   }
   std::vector<std::string_view> fields;
-  Split(line, format.delimiter, &fields);
+  SplitLogLine(line, format.delimiter, &fields);
   std::vector<std::string> header;
-  for (auto f : fields) header.emplace_back(Unquote(f));
+  for (auto f : fields) header.emplace_back(UnquoteLogCell(f));
   bool all_numeric = true;
   double v;
   for (auto f : fields) all_numeric = all_numeric && ParseCell(f, &v);
@@ -332,21 +286,22 @@ std::string ReadRowCells(const std::vector<std::string_view>& fields, std::strin
     while (c.column[k] < static_cast<int>(fields.size())) ++k;
     return name + ":" + std::to_string(line_number) + ": the row has only " +
            std::to_string(fields.size()) + " field(s); column '" + Printable(c.names[k]) +
-           "' is field " + std::to_string(c.column[k] + 1) + " ('" + Printable(Trim(line)) + "')";
+           "' is field " + std::to_string(c.column[k] + 1) + " ('" + Printable(TrimLogCell(line)) +
+           "')";
   }
   bool non_finite = false;
   for (int k = 0; k < c.needed; ++k) {
     const std::string_view cell = fields[c.column[k]];
     if (!ParseCell(cell, &row[k])) {
       return name + ":" + std::to_string(line_number) + ":" + std::to_string(c.column[k] + 1) +
-             ": column '" + Printable(c.names[k]) + "' holds '" + Printable(Trim(cell)) +
+             ": column '" + Printable(c.names[k]) + "' holds '" + Printable(TrimLogCell(cell)) +
              "', which is not a number";
     }
     if (!std::isfinite(row[k]) && !non_finite) {
       non_finite = true;
       *non_finite_message = name + ":" + std::to_string(line_number) + ":" +
                             std::to_string(c.column[k] + 1) + ": column '" + c.names[k] +
-                            "' holds '" + Printable(Trim(cell)) +
+                            "' holds '" + Printable(TrimLogCell(cell)) +
                             "'; NaN and infinite values are not allowed";
     } else if (k != kImuRowTime && !non_finite) {
       // A reading no sensor gives (imu_log.h): an error like NaN, if the row is data.
@@ -356,7 +311,7 @@ std::string ReadRowCells(const std::vector<std::string_view>& fields, std::strin
         non_finite = true;
         *non_finite_message = name + ":" + std::to_string(line_number) + ":" +
                               std::to_string(c.column[k] + 1) + ": column '" + c.names[k] +
-                              "' holds '" + Printable(Trim(cell)) +
+                              "' holds '" + Printable(TrimLogCell(cell)) +
                               "' = " + Fmt("%g", row[k] * c.scale[k]) +
                               (gyro ? " rad/s, beyond any gyro (|rate| <= 1e4 rad/s)"
                                     : " m/s^2, beyond any accelerometer (|f| <= 1e5 m/s^2)") +
@@ -398,7 +353,7 @@ CsvRows ParseRows(LineReader* reader, size_t text_size, const CsvColumns& c,
       if (first_blank_line == 0 && !r.row_line.empty()) first_blank_line = reader->line_number();
       continue;
     }
-    Split(line, format.delimiter, &fields);
+    SplitLogLine(line, format.delimiter, &fields);
     std::string non_finite_message;
     const std::string bad =
         ReadRowCells(fields, line, reader->line_number(), c, name, row, &non_finite_message);

@@ -11,20 +11,11 @@
 #include "base/text_format.h"
 #include "base/user_error.h"
 #include "pipeline/logs/imu_log_options.h"
+#include "pipeline/logs/log_line.h"
 #include "pipeline/logs/simulated_log.h"
 
 namespace bifilar {
 namespace {
-
-std::string Trim(const std::string& s) {
-  size_t a = 0, b = s.size();
-  while (a < b && (s[a] == ' ' || s[a] == '\t' || s[a] == '"' || s[a] == '\'')) ++a;
-  while (b > a && (s[b - 1] == ' ' || s[b - 1] == '\t' || s[b - 1] == '"' || s[b - 1] == '\'' ||
-                   s[b - 1] == '\r')) {
-    --b;
-  }
-  return s.substr(a, b - a);
-}
 
 bool IsComment(const std::string& line) {
   return line.rfind("#", 0) == 0 || line.rfind("%", 0) == 0 || line.rfind("//", 0) == 0;
@@ -37,22 +28,9 @@ char GuessDelimiter(const std::string& header) {
   return ' ';
 }
 
-// Deliberately not base/csv.h's SplitCsvRecord: a stream's line is split as a log's is
-// (pipeline/logs/imu_log.cc), runs of spaces as one separator, quotes (" or ') trimmed off a
-// cell rather than interpreted (a logger quotes names, never a delimiter inside one).
+// A stream's line is cut as a log's is (pipeline/logs/log_line.h).
 std::vector<std::string> Split(const std::string& line, char delimiter) {
-  std::vector<std::string> cells;
-  std::string cell;
-  for (char c : line) {
-    if (c == delimiter) {
-      if (delimiter != ' ' || !cell.empty()) cells.push_back(Trim(cell));
-      cell.clear();
-    } else {
-      cell += c;
-    }
-  }
-  if (delimiter != ' ' || !cell.empty()) cells.push_back(Trim(cell));
-  return cells;
+  return LogLineCells(line, delimiter);
 }
 
 int IndexOf(const std::vector<std::string>& header, const std::string& name) {
