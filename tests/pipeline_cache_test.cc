@@ -12,16 +12,10 @@
 #include <nlohmann/json.hpp>
 
 #include "base/version.h"
+#include "test_support.h"
 
 namespace bifilar {
 namespace {
-
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // An ok record with the few fields the cache tests look at.
 TraceRecord OkRecord() {
@@ -172,7 +166,7 @@ TEST(Cache, EntryProvesItsKeyAndIntegrity) {
   const std::string key = "00000000000000k1", other = "00000000000000k2", hash = "00000000000000aa";
   cache.Store(key, hash, r);
   cache.Store(other, "00000000000000bb", r);
-  const std::string good = ReadText(cache.EntryPath(key));
+  const std::string good = test_support::ReadFile(cache.EntryPath(key));
   TraceRecord loaded;
   std::string problem;
   auto refused = [&](const std::string& text, std::string content_hash = "") {
@@ -188,7 +182,8 @@ TEST(Cache, EntryProvesItsKeyAndIntegrity) {
   scaled.replace(scaled.find("4.1"), 3, "3.69");
   EXPECT_NE(refused(scaled).find("checksum mismatch"), std::string::npos);
   // Another trace's entry copied into this key's file.
-  EXPECT_NE(refused(ReadText(cache.EntryPath(other))).find("belongs to key"), std::string::npos);
+  EXPECT_NE(refused(test_support::ReadFile(cache.EntryPath(other))).find("belongs to key"),
+            std::string::npos);
   // The right key, a different log content (the log was replaced).
   EXPECT_NE(refused(good, "00000000000000cc").find("another log"), std::string::npos);
   // NaN and a negative inertia written over the value (checksum fixed up or not): refused.
@@ -218,7 +213,7 @@ TEST(Cache, AnEntryLackingAKeyIsRefusedNamingIt) {
   r.period_s = 2.49;
   const std::string key = "00000000000000k1", hash = "00000000000000aa";
   cache.Store(key, hash, r);
-  const nlohmann::json good = nlohmann::json::parse(ReadText(cache.EntryPath(key)));
+  const nlohmann::json good = nlohmann::json::parse(test_support::ReadFile(cache.EntryPath(key)));
   // The entry as TraceCache::Store writes it, with its checksum made to match `record`.
   const auto write = [&](nlohmann::json record, const std::string& text_of_inertia = "") {
     nlohmann::json entry = good;
