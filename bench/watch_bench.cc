@@ -108,24 +108,6 @@ double FirstEnough(const CampaignConfig& config, const ImuData& data, double tar
   return NAN;
 }
 
-// The first cut where `fit` on the log so far reaches the target (NaN: none before `until`).
-double FirstFitReaching(const CampaignConfig& config, const ImuData& data, double target_percent,
-                        double step, double until) {
-  for (double cut = data.t_s.front() + 2.0; cut <= std::min(until, data.t_s.back()); cut += step) {
-    ImuData part;
-    for (size_t i = 0; i < data.size() && data.t_s[i] <= cut; ++i) {
-      part.t_s.push_back(data.t_s[i]);
-      part.gyro_in_imu.push_back(data.gyro_in_imu[i]);
-      part.accel_in_imu.push_back(data.accel_in_imu[i]);
-    }
-    const TraceRecord r = ProcessTraceData(config, part, "sw.csv", TraceProcessOptions());
-    if (r.ok() && 100.0 * r.inertia_total_std_kg_m2 / r.inertia_total_kg_m2 <= target_percent) {
-      return cut;
-    }
-  }
-  return NAN;
-}
-
 void BM_WatchEnoughSurvey(benchmark::State& state) {
   const CampaignConfig config = Config();
   constexpr double kTargetPercent = 0.05;
@@ -137,7 +119,8 @@ void BM_WatchEnoughSurvey(benchmark::State& state) {
       double period = 2.0;
       const double t_enough = FirstEnough(config, data, kTargetPercent, &period);
       const double until = std::isfinite(t_enough) ? t_enough + 2.0 * period : data.t_s.back();
-      const double t_fit = FirstFitReaching(config, data, kTargetPercent, period / 8, until);
+      const double t_fit =
+          watch_support::FirstFitReaching(config, data, kTargetPercent, period / 8, until);
       ++swings;
       if (std::isnan(t_enough) && std::isnan(t_fit)) {
         ++neither;

@@ -381,18 +381,8 @@ TEST(Watch, EnoughWithinOneCycleOfFitOnTheLogSoFar) {
     if (u.verdict == WatchVerdict::kEnough) t_enough = u.t_s;
   }
   ASSERT_TRUE(std::isfinite(t_enough)) << "never enough";
-  double t_fit = NAN;
-  for (double cut = data.t_s.front() + 2.0; cut <= data.t_s.back() && std::isnan(t_fit);
-       cut += period / 8) {
-    ImuData part;
-    for (size_t i = 0; i < data.size() && data.t_s[i] <= cut; ++i) {
-      part.t_s.push_back(data.t_s[i]);
-      part.gyro_in_imu.push_back(data.gyro_in_imu[i]);
-      part.accel_in_imu.push_back(data.accel_in_imu[i]);
-    }
-    const TraceRecord r = ProcessTraceData(config, part, "sw.csv", TraceProcessOptions());
-    if (r.ok() && r.inertia_total_std_kg_m2 / r.inertia_total_kg_m2 <= 0.0005) t_fit = cut;
-  }
+  const double t_fit = watch_support::FirstFitReaching(config, data, options.target_percent,
+                                                       period / 8, data.t_s.back());
   ASSERT_TRUE(std::isfinite(t_fit));
   EXPECT_LE(std::abs(t_enough - t_fit), period) << t_enough << " vs " << t_fit;
 }

@@ -1,8 +1,11 @@
 // What the `bifilar watch` tests (tests/pipeline_watch*_test.cc) and the watch benchmark
 // (bench/watch_bench.cc) share: a swing simulated on one small rig, that rig's `bifilar fit`
-// config, and `fit` on a log. Header-only and without GoogleTest, so the benchmark includes it.
+// config, `fit` on a log, and the first cut of a log where `fit` reaches a target. Header-only and
+// without GoogleTest, so the benchmark includes it.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <optional>
@@ -10,6 +13,8 @@
 
 #include "pipeline/commands/fit_command.h"
 #include "pipeline/commands/simulate_spec.h"
+#include "pipeline/config/config.h"
+#include "pipeline/trace/trace_process.h"
 
 namespace bifilar {
 namespace watch_support {
@@ -53,6 +58,24 @@ inline TraceRecord FitLog(const std::string& config, const std::string& log) {
   fit.config_path = config;
   fit.logs = {log};
   return RunFit(fit).records.at(0);
+}
+
+// The first cut where `fit` on the log so far reaches the target (NaN: none before `until`).
+inline double FirstFitReaching(const CampaignConfig& config, const ImuData& data,
+                               double target_percent, double step, double until) {
+  for (double cut = data.t_s.front() + 2.0; cut <= std::min(until, data.t_s.back()); cut += step) {
+    ImuData part;
+    for (size_t i = 0; i < data.size() && data.t_s[i] <= cut; ++i) {
+      part.t_s.push_back(data.t_s[i]);
+      part.gyro_in_imu.push_back(data.gyro_in_imu[i]);
+      part.accel_in_imu.push_back(data.accel_in_imu[i]);
+    }
+    const TraceRecord r = ProcessTraceData(config, part, "sw.csv", TraceProcessOptions());
+    if (r.ok() && 100.0 * r.inertia_total_std_kg_m2 / r.inertia_total_kg_m2 <= target_percent) {
+      return cut;
+    }
+  }
+  return NAN;
 }
 
 }  // namespace watch_support
