@@ -230,11 +230,8 @@ bool FitTensorClosedForm(const Prepared& data, const Design& design, Solution* s
 // component that only orientations without scatter feed keeps many dof (its interval ~normal),
 // one fed by an orientation whose few logs scatter gets that orientation's few.
 namespace {
-void ComponentDof(const Prepared& data, const Design& design, const Solution& s,
-                  const TensorOptions& options, Covariance* c) {
-  const Eigen::MatrixXd z = data.x * design.basis;
-  // a = basis (Z^T W Z)^-1 Z^T W: 6 x n.
-  const Eigen::MatrixXd a = design.basis * s.normal_inv * z.transpose() * data.w.asDiagonal();
+void ComponentDof(const Prepared& data, const TensorOptions& options, Covariance* c) {
+  const Eigen::MatrixXd& a = c->solution_operator;
   const int pools = static_cast<int>(data.pool_dof.size());
   const double off2 = options.common_offset_std_kg_m2 * options.common_offset_std_kg_m2;
   for (int k = 0; k < 6; ++k) {
@@ -312,7 +309,10 @@ bool EstimateTensorCovariance(const Prepared& data, const Design& design, const 
   const double off = options.common_offset_std_kg_m2;
   c->cov += off * off * c->offset_direction * c->offset_direction.transpose();
   c->per_pool = per_pool;
-  if (per_pool) ComponentDof(data, design, s, options, c);
+  if (per_pool) {
+    c->solution_operator = design.basis * s.normal_inv * z.transpose() * data.w.asDiagonal();
+    ComponentDof(data, options, c);
+  }
   return true;
 }
 
@@ -520,11 +520,13 @@ double ReweighPerOrientation(const Design& design, Prepared* data, Solution* fit
   std::vector<bool> own(m, false);
   std::vector<double> sigma2(m, 0.0);
   double shared2 = 0.0, shared_dof = 0.0;
+  std::vector<double> dof(m);  // each orientation's, as its scatter was solved with
   for (int iteration = 0; iteration < 8; ++iteration) {
     const Eigen::MatrixXd z = data->x * design.basis;
     const Eigen::VectorXd r2 = fit->resid.array().square();
     const Eigen::VectorXd i2 = fit->fitted.array().square();
-    std::vector<double> dof(m, 0.0), chi2(m, 0.0);
+    std::vector<double> chi2(m, 0.0);
+    dof.assign(m, 0.0);
     for (int g = 0; g < m; ++g) {
       for (int i : data->groups[g]) {
         dof[g] += 1.0 - data->w(i) * z.row(i) * fit->normal_inv * z.row(i).transpose();
@@ -590,12 +592,7 @@ double ReweighPerOrientation(const Design& design, Prepared* data, Solution* fit
   data->pool_dof.assign(1, data->scale_dof);
   for (int g = 0; g < m; ++g) {
     if (!own[g]) continue;
-    double dof = 0.0;
-    const Eigen::MatrixXd z = data->x * design.basis;
-    for (int i : data->groups[g]) {
-      dof += 1.0 - data->w(i) * z.row(i) * fit->normal_inv * z.row(i).transpose();
-    }
-    data->pool_dof.push_back(std::max(dof, 1.0));
+    data->pool_dof.push_back(std::max(dof[g], 1.0));
     for (int i : data->groups[g])
       data->scatter_pool[i] = static_cast<int>(data->pool_dof.size()) - 1;
   }

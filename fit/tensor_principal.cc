@@ -179,13 +179,12 @@ namespace {
 // pool's dof (scaled inverse chi^2), so a component fed by a scattering orientation with few logs
 // gets its wide interval and the others keep theirs; beta* = beta + A eps, A the solution
 // operator.
-TensorIntervalSet PooledReplicates(const Prepared& data, const Design& design, const Solution& s,
-                                   const Covariance& cov, const TensorOptions& options,
-                                   bool principal, TensorIntervalSet in) {
+TensorIntervalSet PooledReplicates(const Prepared& data, const Solution& s, const Covariance& cov,
+                                   const TensorOptions& options, bool principal,
+                                   TensorIntervalSet in) {
   const double alpha = 1.0 - options.confidence;
   const int nb = options.bootstrap_replicates;
-  const Eigen::MatrixXd z = data.x * design.basis;
-  const Eigen::MatrixXd a = design.basis * s.normal_inv * z.transpose() * data.w.asDiagonal();
+  const Eigen::MatrixXd& a = cov.solution_operator;
   const Eigen::VectorXd known = data.w.cwiseInverse() - data.scatter_var;
   std::mt19937_64 rng(options.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -235,7 +234,7 @@ TensorIntervalSet TensorIntervals(const Prepared& data, const Design& design, co
     }
     return in;
   }
-  if (cov.per_pool) return PooledReplicates(data, design, s, cov, options, principal, in);
+  if (cov.per_pool) return PooledReplicates(data, s, cov, options, principal, in);
   // Replicates beta* = beta + (noise solved through the fit): with a scale estimated from the
   // data each replicate first draws its variance factor from the scaled inverse chi^2 of the
   // estimate; orientation-means mode draws one error per orientation, shared by its points.

@@ -95,7 +95,9 @@ struct Covariance {
   // scatter that feed it; inf when none does); equal to `dof` unless the scatter is per
   // orientation.
   Vec6 component_dof = Vec6::Constant(std::numeric_limits<double>::infinity());
-  bool per_pool = false;                 // component_dof from the pools of Prepared::scatter_var
+  bool per_pool = false;  // component_dof from the pools of Prepared::scatter_var
+  // With per_pool: the solution operator A = basis (Z^T W Z)^-1 Z^T W (6 x n), beta = A y.
+  Eigen::MatrixXd solution_operator;
   Mat6 cov = Mat6::Zero();               // of the six components, common offset included
   Eigen::MatrixXd cov_gamma;             // rank x rank, without the offset (bootstrap)
   Vec6 offset_direction = Vec6::Zero();  // the components' response to a unit common offset
