@@ -10,13 +10,13 @@
 namespace bifilar {
 namespace {
 
-const double kQz = NormalQuantile(0.999);  // z of Q: p < 0.001
-constexpr double kGapZ = 5.0;              // the clusters' gap over its std
-constexpr double kGapZWithAxes = 3.0;      // ... when the swing axes differ too
-constexpr double kSeparation = 3.0;        // the gap over the largest range within a cluster
-constexpr double kOwnTrendSigmas = 3.0;    // the own trends' bound: c + 3 std
-constexpr double kAxisMinDeg = 1.0;        // the clusters' axes at least this far apart
-constexpr double kAxisOverSpread = 3.0;    // and this many times their spread within clusters
+constexpr double kQp = 0.001;            // Q's p below which the repeats disagree
+constexpr double kGapZ = 5.0;            // the clusters' gap over its std
+constexpr double kGapZWithAxes = 3.0;    // ... when the swing axes differ too
+constexpr double kSeparation = 3.0;      // the gap over the largest range within a cluster
+constexpr double kOwnTrendSigmas = 3.0;  // the own trends' bound: c + 3 std
+constexpr double kAxisMinDeg = 1.0;      // the clusters' axes at least this far apart
+constexpr double kAxisOverSpread = 3.0;  // and this many times their spread within clusters
 
 struct WeightedMean {
   double mean = NAN, std = NAN, q = 0.0;
@@ -35,10 +35,6 @@ WeightedMean Weighted(const std::vector<double>& v, const std::vector<double>& s
   for (int i : which) m.q += std::pow((v[i] - m.mean) / s[i], 2);
   return m;
 }
-
-// Q on dof degrees of freedom as the standard normal z of the same upper tail (exact, from the
-// chi^2 tail; -z of the tail keeps its digits where the tail is tiny).
-double ChiSquareZ(double q, int dof) { return -NormalQuantile(ChiSquareUpperTail(q, dof)); }
 
 // A log's own I(A) trend (its amplitude sweep) as an A^2 coefficient: c A^p with p = 1 over the
 // bands' amplitudes [a, b] has the chord slope of c / (a + b) A^2. False without a measured trend.
@@ -269,8 +265,11 @@ SetupSplit TestTwoSetups(const std::vector<const TraceRecord*>& records) {
   std::vector<int> all(k);
   std::iota(all.begin(), all.end(), 0);
   out.q = Weighted(v, s, all).q;
-  out.q_z = ChiSquareZ(out.q, k - 1);
-  if (!(out.q_z > kQz)) {
+  // Q's p from its chi^2 tail, reported as the normal z of the same tail (-z of the tail keeps
+  // its digits where the tail is tiny).
+  const double p = ChiSquareUpperTail(out.q, k - 1);
+  out.q_z = -NormalQuantile(p);
+  if (!(p < kQp)) {
     out.note = "the repeats agree within their stds (Q's p >= 0.001)";
     return out;
   }
